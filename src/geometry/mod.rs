@@ -1,0 +1,9 @@
+//! Rays, axis-aligned boxes and the two ray–triangle tests.
+
+mod aabb;
+mod ray;
+pub(crate) mod triangle;
+
+pub use aabb::Aabb;
+pub use ray::Ray;
+pub use triangle::{MollerTrumbore, TriangleHit, TriangleIntersector, TriangleTest, Watertight};

@@ -1,0 +1,313 @@
+//! Ray–triangle intersection: the handout's `rayIntersectShape` step. It returns the distance and
+//! barycentrics only; turning them into a surface point is `Mesh::fill_intersection`.
+//!
+//! Barycentric convention (both tests): the hit point is `(1-u-v)·v0 + u·v1 + v·v2`.
+//! The accepted interval is `t_min <= t < t_max`: the strict upper bound makes a closest-hit query
+//! keep the first of two hits at the same distance and keeps an occlusion ray from hitting the
+//! surface at its far end.
+
+use super::Ray;
+use glam::{DVec3, Vec3};
+
+/// Distance and barycentrics of a ray–triangle hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    pub t: f32,
+    pub u: f32,
+    pub v: f32,
+}
+
+/// Which triangle test the traversal uses; chosen at run time, compiled as a type parameter.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum TriangleTest {
+    /// Woop, Benthin & Wald 2013: no gaps along shared edges, no double hits at vertices.
+    #[default]
+    Watertight,
+    /// Möller & Trumbore 1997: the test students usually write first; can miss rays through edges.
+    MollerTrumbore,
+}
+
+impl TriangleTest {
+    pub const ALL: [TriangleTest; 2] = [TriangleTest::Watertight, TriangleTest::MollerTrumbore];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            TriangleTest::Watertight => "watertight",
+            TriangleTest::MollerTrumbore => "Möller–Trumbore",
+        }
+    }
+}
+
+/// A ray–triangle test with per-ray precomputation, used as a type parameter of the traversal so
+/// the choice costs nothing per triangle.
+pub trait TriangleIntersector: Copy + Send + Sync + 'static {
+    /// Data computed once per ray.
+    type Prepared: Copy;
+    fn prepare(ray: &Ray) -> Self::Prepared;
+    fn intersect(p: &Self::Prepared, ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit>;
+}
+
+/// Watertight ray–triangle intersection. Woop, Benthin & Wald, "Watertight Ray/Triangle
+/// Intersection", JCGT 2(1), 2013. The ray is sheared so it points along +z; the 2D edge functions
+/// are then evaluated exactly consistently for a shared edge, and recomputed in double precision
+/// when one of them is exactly zero (the paper's fallback), so rays through edges and vertices hit.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Watertight;
+
+#[derive(Clone, Copy, Debug)]
+pub struct WatertightRay {
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
+
+impl TriangleIntersector for Watertight {
+    type Prepared = WatertightRay;
+
+    #[inline]
+    fn prepare(ray: &Ray) -> WatertightRay {
+        let d = ray.dir();
+        let a = d.abs();
+        let kz = if a.x >= a.y && a.x >= a.z { 0 } else if a.y >= a.z { 1 } else { 2 };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        // Keep the winding of the sheared triangle independent of the direction's sign.
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        WatertightRay { kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
+    }
+
+    #[inline(always)]
+    fn intersect(p: &WatertightRay, ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
+        let o = ray.origin();
+        let a = tri[0] - o;
+        let b = tri[1] - o;
+        let c = tri[2] - o;
+        let (ax, ay) = (a[p.kx] - p.sx * a[p.kz], a[p.ky] - p.sy * a[p.kz]);
+        let (bx, by) = (b[p.kx] - p.sx * b[p.kz], b[p.ky] - p.sy * b[p.kz]);
+        let (cx, cy) = (c[p.kx] - p.sx * c[p.kz], c[p.ky] - p.sy * c[p.kz]);
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            let (ax, ay, bx, by, cx, cy) =
+                (ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64);
+            u = (cx * by - cy * bx) as f32;
+            v = (ax * cy - ay * cx) as f32;
+            w = (bx * ay - by * ax) as f32;
+        }
+        // Inside when all three edge functions share a sign (both faces are hit).
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let az = p.sz * a[p.kz];
+        let bz = p.sz * b[p.kz];
+        let cz = p.sz * c[p.kz];
+        let t_scaled = u * az + v * bz + w * cz;
+        let inv_det = 1.0 / det;
+        let t = t_scaled * inv_det;
+        if !(t >= ray.t_min && t < ray.t_max) {
+            return None;
+        }
+        // u, v, w weight v0, v1, v2: in our convention u ↔ v1 and v ↔ v2.
+        Some(TriangleHit { t, u: v * inv_det, v: w * inv_det })
+    }
+}
+
+/// Möller–Trumbore ray–triangle intersection. Möller & Trumbore, "Fast, Minimum Storage
+/// Ray/Triangle Intersection", JGT 2(1), 1997. A ray (nearly) parallel to the plane is rejected
+/// with a tolerance relative to the edge and direction lengths, so the test is scale-independent.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MollerTrumbore;
+
+impl TriangleIntersector for MollerTrumbore {
+    type Prepared = ();
+
+    #[inline]
+    fn prepare(_ray: &Ray) {}
+
+    #[inline(always)]
+    fn intersect(_: &(), ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
+        let d = ray.dir();
+        let e1 = tri[1] - tri[0];
+        let e2 = tri[2] - tri[0];
+        let pv = d.cross(e2);
+        let det = e1.dot(pv);
+        // |det| = |d|·|e1 × e2|·|cos|; reject below 1e-7 of its largest possible value.
+        let scale = d.length() * e1.length() * e2.length();
+        if !(det.abs() > 1e-7 * scale) {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let s = ray.origin() - tri[0];
+        let u = s.dot(pv) * inv_det;
+        if !(0.0..=1.0).contains(&u) {
+            return None;
+        }
+        let q = s.cross(e1);
+        let v = d.dot(q) * inv_det;
+        if v < 0.0 || u + v > 1.0 || v.is_nan() {
+            return None;
+        }
+        let t = e2.dot(q) * inv_det;
+        if !(t >= ray.t_min && t < ray.t_max) {
+            return None;
+        }
+        Some(TriangleHit { t, u, v })
+    }
+}
+
+/// Intersect with a run-time choice of test (for callers outside the hot loop).
+pub fn intersect_triangle(test: TriangleTest, ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
+    match test {
+        TriangleTest::Watertight => Watertight::intersect(&Watertight::prepare(ray), ray, tri),
+        TriangleTest::MollerTrumbore => MollerTrumbore::intersect(&(), ray, tri),
+    }
+}
+
+/// Twice the triangle's area, in double precision (used to detect degenerate triangles).
+pub fn double_area(tri: &[Vec3; 3]) -> f64 {
+    let a = tri[0].as_dvec3();
+    let b: DVec3 = tri[1].as_dvec3() - a;
+    let c: DVec3 = tri[2].as_dvec3() - a;
+    b.cross(c).length()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TRI: [Vec3; 3] = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+
+    fn both(ray: &Ray, tri: &[Vec3; 3]) -> [Option<TriangleHit>; 2] {
+        [
+            intersect_triangle(TriangleTest::Watertight, ray, tri),
+            intersect_triangle(TriangleTest::MollerTrumbore, ray, tri),
+        ]
+    }
+
+    fn close(a: f32, b: f32) -> bool {
+        (a - b).abs() <= 1e-6 * (1.0 + a.abs().max(b.abs()))
+    }
+
+    #[test]
+    fn hit_gives_distance_and_barycentrics() {
+        let r = Ray::new(Vec3::new(0.25, 0.5, 2.0), -Vec3::Z);
+        for h in both(&r, &TRI) {
+            let h = h.expect("hit");
+            assert!(close(h.t, 2.0) && close(h.u, 0.25) && close(h.v, 0.5), "{h:?}");
+        }
+    }
+
+    #[test]
+    fn barycentrics_reconstruct_the_hit_point_for_an_oblique_ray() {
+        let tri = [Vec3::new(1.0, 2.0, 3.0), Vec3::new(4.0, 0.0, 2.0), Vec3::new(2.0, 5.0, -1.0)];
+        let target = tri[0] * 0.2 + tri[1] * 0.3 + tri[2] * 0.5;
+        let o = Vec3::new(-3.0, 7.0, 9.0);
+        let r = Ray::new(o, (target - o) * 0.37);
+        for h in both(&r, &tri) {
+            let h = h.expect("hit");
+            assert!(close(h.u, 0.3) && close(h.v, 0.5), "{h:?}");
+            assert!((r.at(h.t) - target).length() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn miss_outside_the_triangle() {
+        for o in [Vec3::new(0.6, 0.6, 1.0), Vec3::new(-0.1, 0.5, 1.0), Vec3::new(0.5, -0.1, 1.0)] {
+            let r = Ray::new(o, -Vec3::Z);
+            assert_eq!(both(&r, &TRI), [None, None], "origin {o}");
+        }
+    }
+
+    #[test]
+    fn back_faces_are_hit() {
+        let r = Ray::new(Vec3::new(0.25, 0.25, -1.0), Vec3::Z);
+        for h in both(&r, &TRI) {
+            assert!(close(h.expect("back face hit").t, 1.0));
+        }
+    }
+
+    #[test]
+    fn parallel_ray_misses() {
+        // In the plane, through the triangle's interior, and above it.
+        for o in [Vec3::new(-1.0, 0.25, 0.0), Vec3::new(-1.0, 0.25, 0.5)] {
+            let r = Ray::new(o, Vec3::X);
+            assert_eq!(both(&r, &TRI), [None, None], "origin {o}");
+        }
+    }
+
+    #[test]
+    fn t_interval_is_respected() {
+        let r = Ray::segment(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z, 0.0, 1.5);
+        assert_eq!(both(&r, &TRI), [None, None], "hit beyond t_max");
+        let r = Ray::segment(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z, 2.5, 10.0);
+        assert_eq!(both(&r, &TRI), [None, None], "hit before t_min");
+        let r = Ray::segment(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z, 2.0, 10.0);
+        assert!(both(&r, &TRI).iter().all(Option::is_some), "t_min is inclusive");
+        let r = Ray::segment(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z, 0.0, 2.0);
+        assert_eq!(both(&r, &TRI), [None, None], "t_max is exclusive");
+        let r = Ray::new(Vec3::new(0.25, 0.25, -2.0), -Vec3::Z);
+        assert_eq!(both(&r, &TRI), [None, None], "triangle behind the origin");
+    }
+
+    #[test]
+    fn watertight_hits_edges_and_vertices() {
+        let points = [
+            Vec3::new(0.5, 0.0, 0.0), // on edge v0-v1
+            Vec3::new(0.0, 0.5, 0.0), // on edge v0-v2
+            Vec3::new(0.5, 0.5, 0.0), // on the hypotenuse
+            Vec3::new(0.0, 0.0, 0.0), // vertices
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        for p in points {
+            for dir in [-Vec3::Z, Vec3::new(0.3, -0.2, -1.0)] {
+                let o = p - dir * 3.0;
+                let r = Ray::new(o, dir);
+                let h = intersect_triangle(TriangleTest::Watertight, &r, &TRI);
+                assert!(h.is_some(), "point {p} dir {dir}");
+                assert!(close(h.unwrap().t, 3.0));
+            }
+        }
+    }
+
+    #[test]
+    fn watertight_shared_edge_is_never_missed() {
+        // Two triangles sharing the diagonal of the unit square; rays along the diagonal in
+        // awkward floating-point positions must hit at least one of them.
+        let t1 = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0)];
+        let t2 = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+        for i in 1..1000 {
+            let s = i as f32 / 1000.0 * 0.999_37;
+            let p = Vec3::new(s, s, 0.0);
+            let dir = Vec3::new(0.113, 0.071, -1.0);
+            let r = Ray::new(p - dir * 1.7, dir);
+            let hit1 = intersect_triangle(TriangleTest::Watertight, &r, &t1).is_some();
+            let hit2 = intersect_triangle(TriangleTest::Watertight, &r, &t2).is_some();
+            assert!(hit1 || hit2, "gap at s = {s}");
+        }
+    }
+
+    #[test]
+    fn degenerate_triangle_is_never_hit() {
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::X * 2.0];
+        let r = Ray::new(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z);
+        assert_eq!(both(&r, &tri), [None, None]);
+        assert_eq!(double_area(&tri), 0.0);
+    }
+
+    #[test]
+    fn empty_ray_is_never_hit() {
+        let r = Ray::new(Vec3::new(0.25, f32::NAN, 1.0), -Vec3::Z);
+        assert_eq!(both(&r, &TRI), [None, None]);
+    }
+}

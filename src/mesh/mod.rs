@@ -1,0 +1,8 @@
+//! The triangle mesh we render, and loading it from OBJ files.
+
+#[allow(clippy::module_inception)]
+mod mesh;
+mod obj;
+
+pub use mesh::{Mesh, MeshGroup, SurfaceInteraction};
+pub use obj::{load_obj, parse_obj, LoadReport, MeshError};

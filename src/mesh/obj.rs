@@ -1,0 +1,374 @@
+//! OBJ loading through `tobj`, with errors that name the file and, where known, the line.
+//!
+//! We read the file ourselves (to tell a missing file from a directory from binary data) and hand
+//! the text to tobj. tobj reports *what* failed but not *where*; on failure we scan the text once
+//! for the first line showing that fault, so the user can open the file at the right place.
+
+use super::{Mesh, MeshGroup};
+use crate::geometry::triangle::double_area;
+use glam::{Vec2, Vec3};
+use std::fmt;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Why a mesh could not be loaded. Every message starts with the file name.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("{}: no such file", .path.display())]
+    NotFound { path: PathBuf },
+    #[error("{}: is a directory, not an OBJ file", .path.display())]
+    IsDirectory { path: PathBuf },
+    #[error("{}: cannot read: {source}", .path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{}: line {line}: not a text file (binary data or invalid UTF-8)", .path.display())]
+    NotText { path: PathBuf, line: usize },
+    #[error("{}{}: {message}", .path.display(), LineSuffix(*.line))]
+    Parse { path: PathBuf, line: Option<usize>, message: String },
+    #[error("{}{}: {message}", .path.display(), LineSuffix(*.line))]
+    IndexOutOfRange { path: PathBuf, line: Option<usize>, message: String },
+    #[error("{}{}: {what} has a NaN or infinite coordinate", .path.display(), LineSuffix(*.line))]
+    NonFinite { path: PathBuf, line: Option<usize>, what: &'static str },
+    #[error("{}: no triangles{}", .path.display(), if *.degenerate > 0 { format!(" (all {} faces are degenerate)", .degenerate) } else { String::new() })]
+    NoTriangles { path: PathBuf, degenerate: usize },
+}
+
+impl MeshError {
+    /// The line the error points at, when known.
+    pub fn line(&self) -> Option<usize> {
+        match self {
+            MeshError::NotText { line, .. } => Some(*line),
+            MeshError::Parse { line, .. }
+            | MeshError::IndexOutOfRange { line, .. }
+            | MeshError::NonFinite { line, .. } => *line,
+            _ => None,
+        }
+    }
+}
+
+struct LineSuffix(Option<usize>);
+
+impl fmt::Display for LineSuffix {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            Some(n) => write!(f, ": line {n}"),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What loading found, for the UI's status line and the CLI's report.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LoadReport {
+    pub path: PathBuf,
+    pub vertices: usize,
+    pub triangles: usize,
+    /// Zero-area triangles left out of the mesh (and so out of the BVH).
+    pub degenerate_skipped: usize,
+    pub groups: usize,
+    pub has_normals: bool,
+    pub has_uvs: bool,
+    #[serde(skip)]
+    pub load_time: Duration,
+}
+
+/// Load an OBJ file: polygons are triangulated, groups kept, zero-area triangles skipped.
+pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError> {
+    let path = path.as_ref();
+    let start = Instant::now();
+    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => MeshError::NotFound { path: path.into() },
+        _ => MeshError::Io { path: path.into(), source: e },
+    })?;
+    if meta.is_dir() {
+        return Err(MeshError::IsDirectory { path: path.into() });
+    }
+    let bytes = std::fs::read(path).map_err(|e| MeshError::Io { path: path.into(), source: e })?;
+    let text = match std::str::from_utf8(&bytes) {
+        Ok(t) => t,
+        Err(e) => return Err(MeshError::NotText { path: path.into(), line: line_at(&bytes, e.valid_up_to()) }),
+    };
+    let (mesh, mut report) = parse_obj(path, text)?;
+    report.load_time = start.elapsed();
+    Ok((mesh, report))
+}
+
+/// Parse OBJ text; `path` is used for the mesh name and in error messages.
+pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
+    let path = path.as_ref();
+    if let Some(pos) = text.bytes().position(|b| b == 0) {
+        return Err(MeshError::NotText { path: path.into(), line: line_at(text.as_bytes(), pos) });
+    }
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    // Materials are not needed to show a BVH; a missing .mtl must not fail the load.
+    let loaded = tobj::load_obj_buf(&mut Cursor::new(text.as_bytes()), &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    });
+    let models = match loaded {
+        Ok((models, _materials)) => models,
+        Err(e) => return Err(diagnose(path, text, e)),
+    };
+
+    let mut mesh = Mesh { name: mesh_name(path), ..Default::default() };
+    let has_normals = models.iter().any(|m| !m.mesh.normals.is_empty());
+    let has_uvs = models.iter().any(|m| !m.mesh.texcoords.is_empty());
+    let mut degenerate = 0usize;
+    for model in &models {
+        let m = &model.mesh;
+        let base = mesh.positions.len() as u32;
+        let nverts = m.positions.len() / 3;
+        mesh.positions.extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        if has_normals {
+            if m.normals.len() == m.positions.len() {
+                mesh.normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])));
+            } else {
+                // A part without normals: zero normals make `fill_intersection` use the plane's.
+                mesh.normals.extend(std::iter::repeat_n(Vec3::ZERO, nverts));
+            }
+        }
+        if has_uvs {
+            if m.texcoords.len() / 2 == nverts {
+                mesh.uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+            } else {
+                mesh.uvs.extend(std::iter::repeat_n(Vec2::ZERO, nverts));
+            }
+        }
+        let first = mesh.triangles.len() as u32;
+        for f in m.indices.chunks_exact(3) {
+            let tri = [f[0] + base, f[1] + base, f[2] + base];
+            let verts = tri.map(|i| mesh.positions[i as usize]);
+            if verts.iter().all(|v| v.is_finite()) && double_area(&verts) == 0.0 {
+                degenerate += 1;
+            } else {
+                mesh.triangles.push(tri);
+            }
+        }
+        let last = mesh.triangles.len() as u32;
+        if last > first {
+            mesh.groups.push(MeshGroup { name: model.name.clone(), triangles: first..last });
+        }
+    }
+
+    if mesh.positions.iter().any(|p| !p.is_finite()) {
+        return Err(MeshError::NonFinite { path: path.into(), line: first_bad_line(text, "v", 3), what: "a vertex position" });
+    }
+    if mesh.normals.iter().any(|n| !n.is_finite()) {
+        return Err(MeshError::NonFinite { path: path.into(), line: first_bad_line(text, "vn", 3), what: "a vertex normal" });
+    }
+    if mesh.uvs.iter().any(|t| !t.is_finite()) {
+        return Err(MeshError::NonFinite { path: path.into(), line: first_bad_line(text, "vt", 1), what: "a texture coordinate" });
+    }
+    if mesh.triangles.is_empty() {
+        return Err(MeshError::NoTriangles { path: path.into(), degenerate });
+    }
+    let report = LoadReport {
+        path: path.into(),
+        vertices: mesh.positions.len(),
+        triangles: mesh.triangles.len(),
+        degenerate_skipped: degenerate,
+        groups: mesh.groups.len(),
+        has_normals,
+        has_uvs,
+        load_time: Duration::ZERO,
+    };
+    Ok((mesh, report))
+}
+
+fn mesh_name(path: &Path) -> String {
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
+}
+
+/// 1-based line number of byte offset `pos`.
+fn line_at(bytes: &[u8], pos: usize) -> usize {
+    bytes[..pos.min(bytes.len())].iter().filter(|&&b| b == b'\n').count() + 1
+}
+
+/// Lines of the file as (1-based number, keyword, rest of the tokens); comments dropped.
+fn statements(text: &str) -> impl Iterator<Item = (usize, &str, Vec<&str>)> {
+    text.lines().enumerate().filter_map(|(i, line)| {
+        let line = line.split('#').next().unwrap_or("");
+        let mut tokens = line.split_whitespace();
+        let keyword = tokens.next()?;
+        Some((i + 1, keyword, tokens.collect()))
+    })
+}
+
+/// First `keyword` line whose first `min` values are missing, unparsable or not finite.
+fn first_bad_line(text: &str, keyword: &str, min: usize) -> Option<usize> {
+    statements(text).find_map(|(n, k, args)| {
+        let bad = args.len() < min
+            || args.iter().take(3).any(|a| a.parse::<f32>().map_or(true, |x| !x.is_finite()));
+        (k == keyword && bad).then_some(n)
+    })
+}
+
+/// First `keyword` line with a value that does not parse (or too few values).
+fn first_unparsable_line(text: &str, keyword: &str, min: usize) -> Option<usize> {
+    statements(text).find_map(|(n, k, args)| {
+        let bad = args.len() < min || args.iter().take(3).any(|a| a.parse::<f32>().is_err());
+        (k == keyword && bad).then_some(n)
+    })
+}
+
+/// Which attribute of a face corner (`v/vt/vn`) a check is about.
+#[derive(Clone, Copy)]
+enum Corner {
+    Position = 0,
+    TexCoord = 1,
+    Normal = 2,
+}
+
+/// First face line with a malformed corner, or an index of `which` outside what was declared
+/// before it (OBJ indices are 1-based; negative ones count back from the last declared).
+fn first_bad_face(text: &str, which: Option<Corner>) -> Option<(usize, String)> {
+    let mut counts = [0i64; 3];
+    for (n, k, args) in statements(text) {
+        match k {
+            "v" => counts[0] += 1,
+            "vt" => counts[1] += 1,
+            "vn" => counts[2] += 1,
+            "f" => {
+                if which.is_none() && args.len() < 3 {
+                    return Some((n, format!("a face needs at least 3 corners, this one has {}", args.len())));
+                }
+                for corner in &args {
+                    for (slot, part) in corner.split('/').enumerate().take(3) {
+                        if part.is_empty() && slot > 0 {
+                            continue;
+                        }
+                        let Ok(idx) = part.parse::<i64>() else {
+                            if which.is_none() {
+                                return Some((n, format!("face corner '{corner}' is not a number")));
+                            }
+                            continue;
+                        };
+                        let Some(which) = which else { continue };
+                        if slot != which as usize {
+                            continue;
+                        }
+                        let count = counts[slot];
+                        let resolved = if idx < 0 { count + idx + 1 } else { idx };
+                        if idx == 0 || resolved < 1 || resolved > count {
+                            let what = ["vertex", "texture coordinate", "normal"][slot];
+                            return Some((n, format!("face refers to {what} {idx}, but only {count} are declared before this line")));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// Turn tobj's error into ours, with the line found by scanning the text.
+fn diagnose(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
+    use tobj::LoadError as L;
+    let path: PathBuf = path.into();
+    let parse = |line: Option<usize>, message: &str| MeshError::Parse { path: path.clone(), line, message: message.to_string() };
+    match e {
+        L::PositionParseError => parse(first_unparsable_line(text, "v", 3), "cannot read a vertex position (expected 3 numbers)"),
+        L::NormalParseError => parse(first_unparsable_line(text, "vn", 3), "cannot read a vertex normal (expected 3 numbers)"),
+        L::TexcoordParseError => parse(first_unparsable_line(text, "vt", 1), "cannot read a texture coordinate"),
+        L::FaceParseError | L::InvalidPolygon => match first_bad_face(text, None) {
+            Some((line, msg)) => parse(Some(line), &msg),
+            None => parse(None, &format!("invalid face ({e})")),
+        },
+        L::FaceVertexOutOfBounds | L::FaceTexCoordOutOfBounds | L::FaceNormalOutOfBounds => {
+            let which = match e {
+                L::FaceVertexOutOfBounds => Corner::Position,
+                L::FaceTexCoordOutOfBounds => Corner::TexCoord,
+                _ => Corner::Normal,
+            };
+            let (line, message) = match first_bad_face(text, Some(which)) {
+                Some((line, msg)) => (Some(line), msg),
+                None => (None, e.to_string()),
+            };
+            MeshError::IndexOutOfRange { path, line, message }
+        }
+        other => parse(None, &format!("not a valid OBJ file ({other})")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quads_are_triangulated_and_groups_kept() {
+        let text = "o first\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\ng second\nv 0 0 1\nf 1 2 5\n";
+        let (mesh, report) = parse_obj("quad.obj", text).unwrap();
+        assert_eq!(mesh.triangles.len(), 3);
+        assert_eq!(report.triangles, 3);
+        let names: Vec<_> = mesh.groups.iter().map(|g| g.name.as_str()).collect();
+        assert_eq!(names, ["first", "second"]);
+        assert_eq!(mesh.groups[0].triangles, 0..2);
+        assert!(!report.has_normals && !report.has_uvs);
+    }
+
+    #[test]
+    fn normals_and_uvs_are_kept() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\n";
+        let (mesh, report) = parse_obj("t.obj", text).unwrap();
+        assert!(report.has_normals && report.has_uvs);
+        assert_eq!(mesh.normals.len(), mesh.positions.len());
+        assert_eq!(mesh.uvs.len(), mesh.positions.len());
+        assert!(mesh.normals.iter().all(|&n| n == Vec3::Z));
+    }
+
+    #[test]
+    fn degenerate_triangles_are_skipped_and_counted() {
+        let text = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\nf 1 1 4\n";
+        let (mesh, report) = parse_obj("d.obj", text).unwrap();
+        assert_eq!(mesh.triangles, vec![[0, 1, 3]]);
+        assert_eq!(report.degenerate_skipped, 2);
+    }
+
+    fn err(text: &str) -> MeshError {
+        parse_obj("bad.obj", text).expect_err("must fail")
+    }
+
+    #[test]
+    fn nan_position_names_the_line() {
+        let e = err("v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
+        assert!(matches!(e, MeshError::NonFinite { line: Some(3), .. }), "{e}");
+        assert_eq!(e.to_string(), "bad.obj: line 3: a vertex position has a NaN or infinite coordinate");
+        let e = err("v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n");
+        assert_eq!(e.line(), Some(2));
+    }
+
+    #[test]
+    fn index_out_of_range_names_the_line() {
+        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n");
+        assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(5), .. }), "{e}");
+        assert!(e.to_string().contains("vertex 9"), "{e}");
+        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
+        assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(4), .. }), "{e}");
+    }
+
+    #[test]
+    fn unparsable_position_names_the_line() {
+        let e = err("v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n");
+        assert!(matches!(e, MeshError::Parse { line: Some(2), .. }), "{e}");
+    }
+
+    #[test]
+    fn no_triangles_is_an_error() {
+        assert!(matches!(err("v 0 0 0\nv 1 0 0\n"), MeshError::NoTriangles { degenerate: 0, .. }));
+        assert!(matches!(err(""), MeshError::NoTriangles { .. }));
+        let e = err("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+        assert!(matches!(e, MeshError::NoTriangles { degenerate: 1, .. }), "{e}");
+    }
+
+    #[test]
+    fn nul_byte_is_not_text() {
+        let e = err("v 0 0 0\n\0\0\0");
+        assert!(matches!(e, MeshError::NotText { line: 2, .. }), "{e}");
+    }
+}
