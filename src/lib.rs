@@ -1,5 +1,6 @@
 //! bvhscope's core: geometry, mesh loading, BVH construction and traversal, statistics and the
 //! ray-cast renderer. Nothing here knows about the GUI; the app and the CLI are thin layers on top.
 
+pub mod bvh;
 pub mod geometry;
 pub mod mesh;

@@ -6,4 +6,7 @@ pub(crate) mod triangle;
 
 pub use aabb::Aabb;
 pub use ray::Ray;
-pub use triangle::{MollerTrumbore, TriangleHit, TriangleIntersector, TriangleTest, Watertight};
+pub use triangle::{
+    double_area as triangle_double_area, intersect_triangle, MollerTrumbore, TriangleHit,
+    TriangleIntersector, TriangleTest, Watertight,
+};

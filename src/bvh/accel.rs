@@ -1,0 +1,69 @@
+//! The interface shared by every acceleration structure (BVH, linear scan), so the renderer, the
+//! tests and the CLI can swap one for another.
+
+use super::TraversalStats;
+use crate::geometry::{Ray, TriangleTest};
+
+/// A closest hit: distance, barycentrics and the mesh's triangle index.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub u: f32,
+    pub v: f32,
+    pub prim: u32,
+}
+
+impl Hit {
+    pub fn triangle_hit(&self) -> crate::geometry::TriangleHit {
+        crate::geometry::TriangleHit {
+            t: self.t,
+            u: self.u,
+            v: self.v,
+        }
+    }
+}
+
+/// Which child a traversal visits first at an interior node.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+pub enum TraversalOrder {
+    /// The handout's rule: the ray's direction sign on the node's split axis picks the near child.
+    SplitAxisSign,
+    /// The child whose box the ray enters first (needs both entry distances, which we have).
+    #[default]
+    EntryDistance,
+}
+
+impl TraversalOrder {
+    pub const ALL: [TraversalOrder; 2] =
+        [TraversalOrder::SplitAxisSign, TraversalOrder::EntryDistance];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            TraversalOrder::SplitAxisSign => "split-axis sign",
+            TraversalOrder::EntryDistance => "entry distance",
+        }
+    }
+}
+
+/// Run-time choices of a query; each combination is its own compiled loop.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+pub struct TraceOptions {
+    pub order: TraversalOrder,
+    pub test: TriangleTest,
+}
+
+pub trait Accelerator: Sync {
+    /// Closest hit within the ray's interval; on a hit, `ray.t_max` is the hit distance.
+    fn closest_hit<S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        opts: TraceOptions,
+        stats: &mut S,
+    ) -> Option<Hit>;
+    /// Whether anything is hit within the ray's interval (stops at the first hit found).
+    fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool;
+}

@@ -1,0 +1,249 @@
+//! The top-down build driver shared by every split strategy (pbrt-v4 §7.3, "BVH construction").
+//!
+//! It keeps an explicit work stack instead of recursing, so a 10M-triangle mesh or a million
+//! identical triangles cannot overflow the call stack. Nodes are allocated in pairs when a node is
+//! split, so the two children of a node are adjacent and an interior node needs only one index.
+
+use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
+use super::split::{self, BuildPrim, NodeInfo, SplitDecision, SplitScratch, SplitStrategy};
+use crate::geometry::Aabb;
+use crate::mesh::Mesh;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Largest leaf the node format can hold (its count field is 16 bits); we cap far lower.
+pub const MAX_LEAF_SIZE_LIMIT: u32 = 255;
+
+/// Below this depth a node is always split by equal count, whatever the strategy says. Equal
+/// count halves the range, so the tree depth stays under `HEURISTIC_DEPTH_LIMIT + 32`, inside the
+/// traversal's fixed stack, even for adversarial inputs where midpoint splits peel off one
+/// triangle at a time.
+pub const HEURISTIC_DEPTH_LIMIT: u32 = (TRAVERSAL_STACK_SIZE as u32) - 33;
+
+/// Cost constants of the surface area heuristic (Goldsmith & Salmon 1987; MacDonald & Booth 1990).
+/// The defaults, 1 and 1, make the normalised SAH cost of a tree read as "expected traversal steps
+/// plus triangle tests per ray that hits the root box". They are parameters because the right
+/// ratio depends on the traversal code; the builder and the statistics use the same values.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SahCost {
+    /// Cost of visiting an interior node (one step: two child box tests).
+    pub traversal: f32,
+    /// Cost of one ray–triangle test.
+    pub intersection: f32,
+}
+
+impl Default for SahCost {
+    fn default() -> Self {
+        Self {
+            traversal: 1.0,
+            intersection: 1.0,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BuildParams {
+    pub strategy: SplitStrategy,
+    /// Most triangles in a leaf (default 4). The SAH strategies may stop earlier when a leaf is
+    /// cheaper than a split; no strategy makes a larger leaf.
+    pub max_leaf_size: u32,
+    /// Bins per axis for `SahBinned` (default 16).
+    pub sah_bins: u32,
+    pub cost: SahCost,
+}
+
+impl Default for BuildParams {
+    fn default() -> Self {
+        Self {
+            strategy: SplitStrategy::SahBinned,
+            max_leaf_size: 4,
+            sah_bins: 16,
+            cost: SahCost::default(),
+        }
+    }
+}
+
+impl BuildParams {
+    pub fn with_strategy(strategy: SplitStrategy) -> Self {
+        Self {
+            strategy,
+            ..Self::default()
+        }
+    }
+}
+
+/// What the build did and how long each phase took.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct BuildReport {
+    /// Triangle bounds and centroids.
+    pub setup_time: Duration,
+    /// The top-down splitting.
+    pub split_time: Duration,
+    /// Copying triangles into leaf order.
+    pub reorder_time: Duration,
+    /// Nodes where the strategy found no useful split (midpoint with an empty side, SAH with
+    /// coincident centroids) and an equal-count split was used instead.
+    pub fallback_splits: u32,
+    /// Nodes split by equal count because they were deeper than `HEURISTIC_DEPTH_LIMIT`.
+    pub depth_limited_splits: u32,
+}
+
+impl BuildReport {
+    pub fn total_time(&self) -> Duration {
+        self.setup_time + self.split_time + self.reorder_time
+    }
+}
+
+struct Task {
+    node: u32,
+    start: u32,
+    end: u32,
+    depth: u32,
+}
+
+impl Bvh {
+    /// Build a BVH over the mesh's triangles.
+    pub fn build(mesh: &Mesh, params: &BuildParams) -> Bvh {
+        let t0 = Instant::now();
+        let params = BuildParams {
+            max_leaf_size: params.max_leaf_size.clamp(1, MAX_LEAF_SIZE_LIMIT),
+            sah_bins: params
+                .sah_bins
+                .clamp(2, split::sah_binned_max_bins() as u32),
+            ..*params
+        };
+        let make = |i: usize| {
+            let tri = mesh.triangle(i as u32);
+            let bounds = Aabb::from_points(&tri);
+            BuildPrim {
+                bounds,
+                centroid: bounds.center(),
+                index: i as u32,
+            }
+        };
+        let n = mesh.triangle_count();
+        let mut prims: Vec<BuildPrim> = if n >= 1 << 16 {
+            (0..n).into_par_iter().map(make).collect()
+        } else {
+            (0..n).map(make).collect()
+        };
+        let setup_time = t0.elapsed();
+
+        let t1 = Instant::now();
+        let mut report = BuildReport {
+            setup_time,
+            ..Default::default()
+        };
+        let nodes = build_nodes(&mut prims, &params, &mut report);
+        report.split_time = t1.elapsed();
+
+        let t2 = Instant::now();
+        let prim_ids: Vec<u32> = prims.iter().map(|p| p.index).collect();
+        let tris = prim_ids.iter().map(|&i| mesh.triangle(i)).collect();
+        report.reorder_time = t2.elapsed();
+        Bvh {
+            nodes,
+            prim_ids,
+            tris,
+            params,
+            report,
+        }
+    }
+}
+
+fn node_info(prims: &[BuildPrim]) -> NodeInfo {
+    let mut bounds = Aabb::EMPTY;
+    let mut centroid_bounds = Aabb::EMPTY;
+    for p in prims {
+        bounds = bounds.union(p.bounds);
+        centroid_bounds = centroid_bounds.grow(p.centroid);
+    }
+    NodeInfo {
+        bounds,
+        centroid_bounds,
+    }
+}
+
+fn build_nodes(
+    prims: &mut [BuildPrim],
+    params: &BuildParams,
+    report: &mut BuildReport,
+) -> Vec<BvhNode> {
+    let mut nodes =
+        Vec::with_capacity((2 * prims.len() / params.max_leaf_size.max(1) as usize).max(1));
+    nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
+    if prims.is_empty() {
+        return nodes; // one empty leaf: every ray misses its empty box
+    }
+    let mut scratch = SplitScratch::default();
+    let mut stack = vec![Task {
+        node: 0,
+        start: 0,
+        end: prims.len() as u32,
+        depth: 0,
+    }];
+    while let Some(task) = stack.pop() {
+        let range = &mut prims[task.start as usize..task.end as usize];
+        let info = node_info(range);
+        let n = range.len();
+        let decision = if n == 1 {
+            SplitDecision::Leaf
+        } else if task.depth >= HEURISTIC_DEPTH_LIMIT {
+            report.depth_limited_splits += 1;
+            split::split_equal_count(range, &info)
+        } else {
+            let d = match params.strategy {
+                SplitStrategy::Midpoint | SplitStrategy::EqualCount
+                    if n <= params.max_leaf_size as usize =>
+                {
+                    SplitDecision::Leaf
+                }
+                SplitStrategy::Midpoint => split::split_midpoint(range, &info),
+                SplitStrategy::EqualCount => split::split_equal_count(range, &info),
+                SplitStrategy::SahBinned => split::split_sah_binned(range, &info, params),
+                SplitStrategy::SahSweep => {
+                    split::split_sah_sweep(range, &info, params, &mut scratch)
+                }
+            };
+            match d {
+                // A strategy may only ask for a leaf that fits; otherwise split it anyway.
+                SplitDecision::Leaf if n > params.max_leaf_size as usize => {
+                    report.fallback_splits += 1;
+                    split::split_equal_count(range, &info)
+                }
+                // A split must leave both sides non-empty; treat anything else like a fallback.
+                SplitDecision::Fallback | SplitDecision::Split { .. } if !matches!(d, SplitDecision::Split { mid, .. } if mid > 0 && mid < n) =>
+                {
+                    report.fallback_splits += 1;
+                    split::split_equal_count(range, &info)
+                }
+                d => d,
+            }
+        };
+        match decision {
+            SplitDecision::Split { axis, mid } => {
+                let left = nodes.len() as u32;
+                nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
+                nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
+                nodes[task.node as usize] = BvhNode::interior(info.bounds, left, axis);
+                let mid = task.start + mid as u32;
+                let depth = task.depth + 1;
+                // Right pushed first so the left subtree is laid out right after its parent pair.
+                stack.push(Task {
+                    node: left + 1,
+                    start: mid,
+                    end: task.end,
+                    depth,
+                });
+                stack.push(Task {
+                    node: left,
+                    start: task.start,
+                    end: mid,
+                    depth,
+                });
+            }
+            _ => nodes[task.node as usize] = BvhNode::leaf(info.bounds, task.start, n as u16),
+        }
+    }
+    nodes
+}

@@ -1,0 +1,20 @@
+//! Bounding volume hierarchies: the flat node array, the top-down builder with one file per split
+//! strategy, ordered traversal generic over a statistics sink, tree statistics, and the linear scan
+//! every BVH is checked against.
+
+mod accel;
+mod build;
+mod counters;
+mod linear;
+mod node;
+pub mod split;
+mod stats;
+mod traverse;
+
+pub use accel::{Accelerator, Hit, TraceOptions, TraversalOrder};
+pub use build::{BuildParams, BuildReport, SahCost, MAX_LEAF_SIZE_LIMIT};
+pub use counters::{NoStats, RayCounters, TraversalStats};
+pub use linear::LinearScan;
+pub use node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
+pub use split::SplitStrategy;
+pub use stats::TreeStats;

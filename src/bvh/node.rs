@@ -1,0 +1,108 @@
+//! The flat BVH: 32-byte nodes in one array, children of a node stored next to each other, and
+//! the triangles reordered so each leaf is a contiguous range (the handout's `orderedShapes`).
+
+use super::{BuildParams, BuildReport};
+use crate::geometry::Aabb;
+use glam::Vec3;
+
+/// Depth of the traversal stack. The builder guarantees the tree is shallower than this
+/// (see `build::HEURISTIC_DEPTH_LIMIT`), so the fixed-size stack cannot overflow.
+pub const TRAVERSAL_STACK_SIZE: usize = 128;
+
+/// One node: 24 bytes of bounds, then either the first of two adjacent children (interior,
+/// `count == 0`) or the first of `count` triangles (leaf).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhNode {
+    pub bounds: Aabb,
+    /// Interior: index of the left child (the right one follows it). Leaf: first triangle.
+    pub index: u32,
+    /// Number of triangles; 0 marks an interior node.
+    pub count: u16,
+    /// Split axis of an interior node (0 = x, 1 = y, 2 = z); the handout's ordering rule reads it.
+    pub axis: u8,
+    pub _pad: u8,
+}
+
+const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
+
+impl BvhNode {
+    #[inline(always)]
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+
+    pub fn leaf(bounds: Aabb, first: u32, count: u16) -> Self {
+        Self {
+            bounds,
+            index: first,
+            count,
+            axis: 0,
+            _pad: 0,
+        }
+    }
+
+    pub fn interior(bounds: Aabb, left: u32, axis: u8) -> Self {
+        Self {
+            bounds,
+            index: left,
+            count: 0,
+            axis,
+            _pad: 0,
+        }
+    }
+
+    /// The triangle range of a leaf.
+    pub fn prims(&self) -> std::ops::Range<usize> {
+        self.index as usize..self.index as usize + self.count as usize
+    }
+}
+
+/// A built BVH over one mesh.
+#[derive(Clone, Debug)]
+pub struct Bvh {
+    /// Node 0 is the root.
+    pub nodes: Vec<BvhNode>,
+    /// Leaf order → the mesh's triangle index.
+    pub prim_ids: Vec<u32>,
+    /// Triangle vertices in leaf order, so a leaf reads contiguous memory.
+    pub tris: Vec<[Vec3; 3]>,
+    pub params: BuildParams,
+    pub report: BuildReport,
+}
+
+impl Bvh {
+    pub fn root_bounds(&self) -> Aabb {
+        self.nodes[0].bounds
+    }
+
+    /// Bytes used by the nodes and the primitive index array.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<BvhNode>() + self.prim_ids.len() * 4
+    }
+
+    /// Visit every node with its depth (root = 0), depth-first, without recursion.
+    pub fn for_each_node(&self, mut f: impl FnMut(usize, &BvhNode, u32)) {
+        let mut stack = vec![(0usize, 0u32)];
+        while let Some((i, depth)) = stack.pop() {
+            let n = &self.nodes[i];
+            f(i, n, depth);
+            if !n.is_leaf() {
+                stack.push((n.index as usize + 1, depth + 1));
+                stack.push((n.index as usize, depth + 1));
+            }
+        }
+    }
+
+    /// Bounds of every node at exactly `depth`, and optionally of leaves above it: what the app's
+    /// box overlay draws.
+    pub fn boxes_at_depth(&self, depth: u32, include_shallower_leaves: bool) -> Vec<(usize, Aabb)> {
+        let mut out = Vec::new();
+        self.for_each_node(|i, n, d| {
+            if d == depth || (include_shallower_leaves && n.is_leaf() && d < depth) {
+                out.push((i, n.bounds));
+            }
+        });
+        out
+    }
+}

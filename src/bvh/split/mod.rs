@@ -1,0 +1,159 @@
+//! Split strategies: given the primitives of one node, decide whether to make a leaf or where to
+//! split, and partition the primitives accordingly. One file per strategy; the driver that calls
+//! them is `bvh::build`.
+
+mod equal_count;
+mod midpoint;
+mod sah_binned;
+mod sah_sweep;
+
+use crate::geometry::Aabb;
+use glam::Vec3;
+
+pub use equal_count::split_equal_count;
+pub use midpoint::split_midpoint;
+pub use sah_binned::split_sah_binned;
+
+/// The largest bin count the binned SAH accepts.
+pub const fn sah_binned_max_bins() -> usize {
+    sah_binned::MAX_BINS
+}
+pub use sah_sweep::split_sah_sweep;
+
+/// How the builder chooses splits.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+pub enum SplitStrategy {
+    /// Middle of the centroid bounds on the widest axis.
+    Midpoint,
+    /// Median centroid on the widest axis: equally many triangles on each side.
+    EqualCount,
+    /// Surface area heuristic, evaluated at bin boundaries on all three axes.
+    #[default]
+    SahBinned,
+    /// Surface area heuristic, evaluated between every pair of neighbouring centroids.
+    SahSweep,
+}
+
+impl SplitStrategy {
+    pub const ALL: [SplitStrategy; 4] = [
+        SplitStrategy::Midpoint,
+        SplitStrategy::EqualCount,
+        SplitStrategy::SahBinned,
+        SplitStrategy::SahSweep,
+    ];
+
+    /// Kebab-case name used on the command line.
+    pub fn short_name(self) -> &'static str {
+        match self {
+            SplitStrategy::Midpoint => "midpoint",
+            SplitStrategy::EqualCount => "equal-count",
+            SplitStrategy::SahBinned => "sah",
+            SplitStrategy::SahSweep => "sah-sweep",
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            SplitStrategy::Midpoint => "Midpoint",
+            SplitStrategy::EqualCount => "Equal count",
+            SplitStrategy::SahBinned => "SAH binned",
+            SplitStrategy::SahSweep => "SAH sweep",
+        }
+    }
+
+    /// One line for a tooltip or `--help`.
+    pub fn description(self) -> &'static str {
+        match self {
+            SplitStrategy::Midpoint => "split the widest axis of the centroid bounds in the middle; fast, poor on uneven meshes",
+            SplitStrategy::EqualCount => "split at the median centroid of the widest axis; balanced tree, ignores box sizes",
+            SplitStrategy::SahBinned => "surface area heuristic over bins on all axes; near-best trees, fast to build",
+            SplitStrategy::SahSweep => "surface area heuristic tried between every pair of centroids; exact, slowest to build",
+        }
+    }
+
+    pub fn from_short_name(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.short_name() == s)
+    }
+}
+
+/// A triangle as the builder sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct BuildPrim {
+    pub bounds: Aabb,
+    pub centroid: Vec3,
+    /// The mesh's triangle index.
+    pub index: u32,
+}
+
+/// What the builder knows about the node being split.
+#[derive(Clone, Copy, Debug)]
+pub struct NodeInfo {
+    pub bounds: Aabb,
+    pub centroid_bounds: Aabb,
+}
+
+/// A strategy's answer. `Split::mid` is the partition point: `prims[..mid]` go left.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SplitDecision {
+    Leaf,
+    Split {
+        axis: u8,
+        mid: usize,
+    },
+    /// The strategy found no useful split (e.g. midpoint with one side empty) and asks the driver
+    /// for its fallback, the equal-count split; the driver counts these for the statistics.
+    Fallback,
+}
+
+/// Scratch memory a strategy may reuse from node to node (no allocation per node).
+#[derive(Default)]
+pub struct SplitScratch {
+    pub areas: Vec<f32>,
+}
+
+/// Move the elements satisfying `left` to the front; returns how many there are. Unstable.
+pub(crate) fn partition<T>(items: &mut [T], mut left: impl FnMut(&T) -> bool) -> usize {
+    let mut i = 0;
+    let mut j = items.len();
+    loop {
+        while i < j && left(&items[i]) {
+            i += 1;
+        }
+        while i < j && !left(&items[j - 1]) {
+            j -= 1;
+        }
+        if i >= j {
+            return i;
+        }
+        items.swap(i, j - 1);
+        i += 1;
+        j -= 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn partition_moves_matching_items_first() {
+        let mut v = vec![5, 1, 8, 2, 9, 3, 7];
+        let k = partition(&mut v, |&x| x < 5);
+        assert_eq!(k, 3);
+        assert!(v[..k].iter().all(|&x| x < 5) && v[k..].iter().all(|&x| x >= 5));
+        let mut e: Vec<i32> = vec![];
+        assert_eq!(partition(&mut e, |_| true), 0);
+        let mut all = vec![1, 2];
+        assert_eq!(partition(&mut all, |_| true), 2);
+        assert_eq!(partition(&mut all, |_| false), 0);
+    }
+
+    #[test]
+    fn short_names_round_trip() {
+        for s in SplitStrategy::ALL {
+            assert_eq!(SplitStrategy::from_short_name(s.short_name()), Some(s));
+        }
+    }
+}

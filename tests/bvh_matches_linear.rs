@@ -1,0 +1,356 @@
+//! Every strategy and both traversal orders give the linear scan's closest hit; any-hit agrees.
+
+mod common;
+
+use bvhscope::bvh::{
+    Accelerator, BuildParams, Bvh, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions,
+    TraversalOrder,
+};
+use bvhscope::geometry::{Ray, TriangleTest};
+use bvhscope::mesh::Mesh;
+use glam::Vec3;
+use proptest::prelude::*;
+
+fn all_options() -> Vec<TraceOptions> {
+    let mut v = Vec::new();
+    for test in TriangleTest::ALL {
+        for order in TraversalOrder::ALL {
+            v.push(TraceOptions { order, test });
+        }
+    }
+    v
+}
+
+/// Compare one ray on every strategy's BVH against the linear scan.
+fn check_ray(mesh: &Mesh, bvhs: &[Bvh], linear: &LinearScan, ray: Ray) {
+    for opts in all_options() {
+        let mut r = ray;
+        let expected = linear.closest_hit(&mut r, opts, &mut NoStats);
+        for bvh in bvhs {
+            let mut r = ray;
+            let mut counters = RayCounters::default();
+            let got = bvh.closest_hit(&mut r, opts, &mut counters);
+            let what = format!("{:?} {:?} ray {:?}", bvh.params.strategy, opts, ray);
+            match (expected, got) {
+                (None, None) => {}
+                (Some(e), Some(g)) => {
+                    assert!(
+                        (e.t - g.t).abs() <= 1e-5 * e.t.abs().max(1e-30),
+                        "t {} vs {}: {what}",
+                        e.t,
+                        g.t
+                    );
+                    if e.prim != g.prim {
+                        // Allowed only when the two triangles are hit at the same distance.
+                        let tri = mesh.triangle(g.prim);
+                        let h = bvhscope::geometry::intersect_triangle(opts.test, &ray, &tri)
+                            .expect("BVH prim is hit");
+                        assert_eq!(h.t, e.t, "different primitive at a different t: {what}");
+                    }
+                    assert_eq!(r.t_max, g.t, "ray t_max updated to the hit: {what}");
+                }
+                _ => panic!("linear {expected:?} but BVH {got:?}: {what}"),
+            }
+            let any = bvh.any_hit(&ray, opts, &mut NoStats);
+            assert_eq!(
+                any,
+                expected.is_some(),
+                "any-hit disagrees with closest hit: {what}"
+            );
+            assert!(
+                counters.nodes_visited >= 1 || expected.is_none(),
+                "counters ran: {what}"
+            );
+        }
+    }
+}
+
+fn build_all(mesh: &Mesh) -> Vec<Bvh> {
+    SplitStrategy::ALL
+        .into_iter()
+        .flat_map(|s| {
+            // Default parameters, plus odd ones: leaf size 1 and 7, few bins.
+            [
+                BuildParams::with_strategy(s),
+                BuildParams {
+                    max_leaf_size: 1,
+                    sah_bins: 4,
+                    ..BuildParams::with_strategy(s)
+                },
+                BuildParams {
+                    max_leaf_size: 7,
+                    sah_bins: 3,
+                    ..BuildParams::with_strategy(s)
+                },
+            ]
+        })
+        .map(|p| Bvh::build(mesh, &p))
+        .collect()
+}
+
+fn vec3(range: f32) -> impl Strategy<Value = Vec3> {
+    (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+/// Triangle soups: random small triangles around random centres, some clustered, some huge,
+/// some axis-aligned (flat boxes), some sharing exact vertices.
+fn soup() -> impl Strategy<Value = Mesh> {
+    prop::collection::vec((vec3(10.0), vec3(2.0), vec3(2.0), 0u8..4), 1..120).prop_map(|tris| {
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for (c, a, b, kind) in tris {
+            let (a, b) = match kind {
+                0 => (a, b),
+                1 => (a * 8.0, b * 8.0), // large, overlapping
+                2 => (Vec3::new(a.x, a.y, 0.0), Vec3::new(b.x, b.y, 0.0)), // flat in z
+                _ => (a * 0.01, b * 0.01), // tiny
+            };
+            let base = positions.len() as u32;
+            positions.extend([c, c + a, c + b]);
+            triangles.push([base, base + 1, base + 2]);
+            if kind == 3 && base >= 3 {
+                // A second triangle sharing an edge with the previous one.
+                triangles.push([base - 3, base - 2, base]);
+            }
+        }
+        let mut m = Mesh::from_triangles("soup", positions, triangles);
+        // Drop triangles that came out degenerate, as the loader does.
+        let pos = m.positions.clone();
+        m.triangles.retain(|t| {
+            bvhscope::geometry::triangle_double_area(&t.map(|i| pos[i as usize])) > 0.0
+        });
+        m.groups[0].triangles = 0..m.triangles.len() as u32;
+        m
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+
+    #[test]
+    fn random_soups_closest_hit_equals_linear(
+        mesh in soup(),
+        rays in prop::collection::vec((vec3(20.0), vec3(1.0), 0usize..1000, 0.0f32..1.0, 0.0f32..1.0), 1..40),
+    ) {
+        prop_assume!(mesh.triangle_count() > 0);
+        let bvhs = build_all(&mesh);
+        for bvh in &bvhs {
+            common::check_invariants(bvh, &mesh);
+        }
+        let linear = LinearScan::new(&mesh);
+        for (origin, dir, target, u, v) in rays {
+            // Half the rays aim at a point on a triangle so hits are common; the rest are random.
+            let d = if target % 2 == 0 {
+                let tri = mesh.triangle((target / 2 % mesh.triangle_count()) as u32);
+                let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+                tri[0] * (1.0 - u - v) + tri[1] * u + tri[2] * v - origin
+            } else {
+                dir
+            };
+            check_ray(&mesh, &bvhs, &linear, Ray::new(origin, d));
+        }
+    }
+}
+
+#[test]
+fn axis_parallel_and_negative_zero_rays_match_linear() {
+    // A grid of axis-aligned unit quads hit by rays with exact zero (and -0) direction parts,
+    // through shared edges and vertices.
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for i in 0..6 {
+        for j in 0..6 {
+            let b = positions.len() as u32;
+            let (x, y) = (i as f32, j as f32);
+            positions.extend([
+                Vec3::new(x, y, 0.0),
+                Vec3::new(x + 1.0, y, 0.0),
+                Vec3::new(x + 1.0, y + 1.0, 0.0),
+                Vec3::new(x, y + 1.0, 0.0),
+            ]);
+            triangles.extend([[b, b + 1, b + 2], [b, b + 2, b + 3]]);
+        }
+    }
+    let mesh = Mesh::from_triangles("grid", positions, triangles);
+    let bvhs = build_all(&mesh);
+    let linear = LinearScan::new(&mesh);
+    for i in 0..=24 {
+        for j in 0..=24 {
+            let (x, y) = (i as f32 * 0.25, j as f32 * 0.25);
+            for dir in [
+                Vec3::new(0.0, 0.0, -1.0),
+                Vec3::new(-0.0, -0.0, -1.0),
+                Vec3::new(0.0, -0.0, 1.0),
+            ] {
+                let o = Vec3::new(x, y, -dir.z * 3.0);
+                check_ray(&mesh, &bvhs, &linear, Ray::new(o, dir));
+            }
+        }
+    }
+    // Rays lying in the plane of the grid, along its lines.
+    for k in 0..=6 {
+        check_ray(
+            &mesh,
+            &bvhs,
+            &linear,
+            Ray::new(Vec3::new(-1.0, k as f32, 0.0), Vec3::X),
+        );
+        check_ray(
+            &mesh,
+            &bvhs,
+            &linear,
+            Ray::new(Vec3::new(k as f32, 7.0, 0.0), Vec3::new(-0.0, -1.0, 0.0)),
+        );
+    }
+}
+
+#[test]
+fn identical_triangles_build_a_bounded_tree() {
+    // 200k copies of one triangle: no split can separate them; the tree must still have small
+    // leaves and bounded depth, and rays must find one of them.
+    let n = 200_000u32;
+    let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+    let mesh = Mesh::from_triangles("same", positions, vec![[0, 1, 2]; n as usize]);
+    for s in SplitStrategy::ALL {
+        let bvh = Bvh::build(&mesh, &BuildParams::with_strategy(s));
+        let stats = bvhscope::bvh::TreeStats::of(&bvh);
+        assert!(
+            stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32,
+            "{s:?} depth {}",
+            stats.max_depth
+        );
+        assert!(stats.leaf_size_histogram.len() <= 5, "{s:?} leaf sizes");
+        if s != SplitStrategy::EqualCount {
+            assert!(
+                stats.fallback_splits > 0,
+                "{s:?} must report its fallback splits"
+            );
+        }
+        let mut r = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
+        let hit = bvh
+            .closest_hit(&mut r, TraceOptions::default(), &mut NoStats)
+            .expect("hit");
+        assert_eq!(hit.t, 1.0);
+    }
+}
+
+#[test]
+fn exponentially_spaced_triangles_stay_within_the_stack_depth() {
+    // Midpoint splits peel one triangle off at a time here; the depth limit must kick in.
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    // Centroids at 4^i: every midpoint split separates only the largest one.
+    for i in -60..60 {
+        let x = 4f32.powi(i);
+        let b = positions.len() as u32;
+        positions.extend([
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::new(x, 1.0, 0.0),
+            Vec3::new(x, 0.0, 1.0),
+        ]);
+        triangles.push([b, b + 1, b + 2]);
+    }
+    let mesh = Mesh::from_triangles("exp", positions, triangles);
+    let linear = LinearScan::new(&mesh);
+    let bvh = Bvh::build(
+        &mesh,
+        &BuildParams {
+            max_leaf_size: 1,
+            ..BuildParams::with_strategy(SplitStrategy::Midpoint)
+        },
+    );
+    let stats = bvhscope::bvh::TreeStats::of(&bvh);
+    assert!(stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32);
+    assert!(
+        stats.depth_limited_splits > 0,
+        "this input must reach the depth limit: {stats:?}"
+    );
+    common::check_invariants(&bvh, &mesh);
+    for i in 0..50 {
+        let ray = Ray::new(
+            Vec3::new(-1.0, 0.1 + i as f32 * 0.01, 0.2),
+            Vec3::new(1.0, 1e-20, 0.0),
+        );
+        check_ray(&mesh, std::slice::from_ref(&bvh), &linear, ray);
+    }
+}
+
+#[test]
+fn empty_mesh_builds_and_misses() {
+    let mesh = Mesh::from_triangles("empty", vec![], vec![]);
+    for bvh in build_all(&mesh) {
+        let mut r = Ray::new(Vec3::ZERO, Vec3::X);
+        assert!(bvh
+            .closest_hit(&mut r, TraceOptions::default(), &mut NoStats)
+            .is_none());
+        assert!(!bvh.any_hit(&r, TraceOptions::default(), &mut NoStats));
+    }
+}
+
+/// Rays from a sphere around the mesh towards random points in its box, plus rays from inside.
+fn mesh_rays(mesh: &Mesh, count: usize, seed: u64) -> Vec<Ray> {
+    let b = mesh.bounds();
+    let (c, r) = (b.center(), b.extent().length());
+    let mut state = seed;
+    let mut rnd = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 40) as f32) / (1u64 << 24) as f32
+    };
+    (0..count)
+        .map(|i| {
+            let target = b.min + b.extent() * Vec3::new(rnd(), rnd(), rnd());
+            let origin = if i % 4 == 0 {
+                b.min + b.extent() * Vec3::new(rnd(), rnd(), rnd())
+            } else {
+                let d = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(Vec3::X);
+                c + d * r
+            };
+            Ray::new(origin, target - origin + Vec3::splat(1e-7))
+        })
+        .collect()
+}
+
+#[test]
+fn shared_meshes_closest_hit_equals_linear() {
+    let Some(_) = common::shared_models() else {
+        return;
+    };
+    for name in [
+        "suzanne.obj",
+        "teapot.obj",
+        "spot.obj",
+        "cow.obj",
+        "stanford-bunny.obj",
+        "beast.obj",
+        "moer-lite-lab1-bvh/models/Monkey.obj",
+    ] {
+        let mesh = common::shared_mesh(name).unwrap();
+        let bvhs: Vec<Bvh> = SplitStrategy::ALL
+            .into_iter()
+            .map(|s| Bvh::build(&mesh, &BuildParams::with_strategy(s)))
+            .collect();
+        for bvh in &bvhs {
+            common::check_invariants(bvh, &mesh);
+        }
+        let linear = LinearScan::new(&mesh);
+        let rays = if mesh.triangle_count() > 20_000 {
+            150
+        } else {
+            600
+        };
+        let mut hits = 0;
+        for ray in mesh_rays(&mesh, rays, 7) {
+            let mut r = ray;
+            hits += linear
+                .closest_hit(&mut r, TraceOptions::default(), &mut NoStats)
+                .is_some() as usize;
+            check_ray(&mesh, &bvhs, &linear, ray);
+        }
+        assert!(
+            hits > rays / 10,
+            "{name}: too few hits ({hits}) for the test to mean anything"
+        );
+    }
+}
