@@ -4,3 +4,4 @@
 pub mod bvh;
 pub mod geometry;
 pub mod mesh;
+pub mod render;

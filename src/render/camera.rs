@@ -1,0 +1,234 @@
+//! A pinhole camera (position, look-at, up, vertical field of view, image size) and its rays.
+//! Pixel (0, 0) is the top-left corner; a pixel's ray passes through its centre.
+
+use crate::geometry::{Aabb, Ray};
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Camera {
+    pub position: Vec3,
+    pub look_at: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view in degrees.
+    pub vfov_deg: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum CameraError {
+    #[error("camera position, look-at and up must be finite numbers")]
+    NotFinite,
+    #[error("camera position and look-at point are the same")]
+    NoDirection,
+    #[error("camera up vector is zero or parallel to the viewing direction")]
+    BadUp,
+    #[error("vertical field of view must be between 0 and 180 degrees (got {0})")]
+    BadFov(f32),
+    #[error("image size must be at least 1x1 and at most 16384x16384 (got {0}x{1})")]
+    BadSize(u32, u32),
+}
+
+/// The camera's ray generator: a basis computed once per frame.
+#[derive(Clone, Copy, Debug)]
+pub struct RayGen {
+    origin: Vec3,
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    inv_w: f32,
+    inv_h: f32,
+}
+
+impl RayGen {
+    /// The ray through continuous pixel coordinates (x right, y down; pixel centres at +0.5).
+    #[inline]
+    pub fn ray(&self, x: f32, y: f32) -> Ray {
+        let sx = 2.0 * x * self.inv_w - 1.0;
+        let sy = 1.0 - 2.0 * y * self.inv_h;
+        let dir = (self.forward + self.right * sx + self.up * sy).normalize();
+        Ray::new(self.origin, dir)
+    }
+
+    /// The ray through the centre of pixel (px, py).
+    #[inline]
+    pub fn pixel_ray(&self, px: u32, py: u32) -> Ray {
+        self.ray(px as f32 + 0.5, py as f32 + 0.5)
+    }
+}
+
+impl Camera {
+    pub fn validate(&self) -> Result<(), CameraError> {
+        if !(self.position.is_finite() && self.look_at.is_finite() && self.up.is_finite()) {
+            return Err(CameraError::NotFinite);
+        }
+        let f = self.look_at - self.position;
+        if f.length_squared() == 0.0 {
+            return Err(CameraError::NoDirection);
+        }
+        if f.normalize().cross(self.up).length_squared() < 1e-12 {
+            return Err(CameraError::BadUp);
+        }
+        if !(self.vfov_deg > 0.0 && self.vfov_deg < 180.0) {
+            return Err(CameraError::BadFov(self.vfov_deg));
+        }
+        if self.width == 0 || self.height == 0 || self.width > 16384 || self.height > 16384 {
+            return Err(CameraError::BadSize(self.width, self.height));
+        }
+        Ok(())
+    }
+
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// The ray generator; the camera must be valid (`validate`).
+    pub fn ray_gen(&self) -> RayGen {
+        let forward = (self.look_at - self.position).normalize();
+        let right = forward.cross(self.up).normalize();
+        let up = right.cross(forward);
+        let tan_half = (self.vfov_deg.to_radians() * 0.5).tan();
+        RayGen {
+            origin: self.position,
+            forward,
+            right: right * tan_half * self.aspect(),
+            up: up * tan_half,
+            inv_w: 1.0 / self.width as f32,
+            inv_h: 1.0 / self.height as f32,
+        }
+    }
+
+    /// A camera that shows all of `bounds` from a fixed oblique direction (front, right, above),
+    /// with +y up: the default view of the CLI and the app.
+    pub fn framing(bounds: &Aabb, width: u32, height: u32) -> Camera {
+        Self::framing_from(bounds, width, height, Vec3::new(0.45, 0.35, 1.0))
+    }
+
+    /// Like `framing`, looking along `-from`.
+    pub fn framing_from(bounds: &Aabb, width: u32, height: u32, from: Vec3) -> Camera {
+        let vfov_deg = 45.0f32;
+        let (center, radius) = if bounds.is_empty() {
+            (Vec3::ZERO, 1.0)
+        } else {
+            (bounds.center(), (bounds.extent().length() * 0.5).max(1e-6))
+        };
+        let aspect = width.max(1) as f32 / height.max(1) as f32;
+        let half_v = (vfov_deg.to_radians() * 0.5).tan();
+        // The bounding sphere must fit in the narrower of the two fields of view.
+        let half = half_v.min(half_v * aspect).atan();
+        let distance = radius / half.sin() * 1.02;
+        let dir = from.try_normalize().unwrap_or(Vec3::Z);
+        Camera {
+            position: center + dir * distance,
+            look_at: center,
+            up: Vec3::Y,
+            vfov_deg,
+            width,
+            height,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn centre_pixel_looks_at_the_target_and_corners_span_the_fov() {
+        let cam = Camera {
+            position: Vec3::new(0.0, 1.0, 5.0),
+            look_at: Vec3::ZERO,
+            up: Vec3::Y,
+            vfov_deg: 45.0,
+            width: 1200,
+            height: 800,
+        };
+        cam.validate().unwrap();
+        let g = cam.ray_gen();
+        let centre = g.ray(600.0, 400.0);
+        assert!((centre.dir() - (-cam.position).normalize()).length() < 1e-6);
+        // Top and bottom edge rays are 45° apart.
+        let top = g.ray(600.0, 0.0).dir();
+        let bottom = g.ray(600.0, 800.0).dir();
+        assert!((top.angle_between(bottom).to_degrees() - 45.0).abs() < 1e-3);
+        assert!(top.y > bottom.y, "row 0 is the top of the image");
+        assert!(
+            g.ray(1200.0, 400.0).dir().x > 0.0,
+            "the last column is on the right"
+        );
+    }
+
+    #[test]
+    fn framing_contains_the_box() {
+        let b = Aabb::new(Vec3::new(-1.0, 0.0, -2.0), Vec3::new(3.0, 1.0, 0.5));
+        for (w, h) in [(640, 480), (300, 900)] {
+            let cam = Camera::framing(&b, w, h);
+            cam.validate().unwrap();
+            let g = cam.ray_gen();
+            // Every box corner projects inside the image.
+            let fwd = (cam.look_at - cam.position).normalize();
+            let right = fwd.cross(Vec3::Y).normalize();
+            let up = right.cross(fwd);
+            let t = (cam.vfov_deg.to_radians() / 2.0).tan();
+            for i in 0..8 {
+                let c = Vec3::new(
+                    if i & 1 == 0 { b.min.x } else { b.max.x },
+                    if i & 2 == 0 { b.min.y } else { b.max.y },
+                    if i & 4 == 0 { b.min.z } else { b.max.z },
+                );
+                let d = c - cam.position;
+                let z = d.dot(fwd);
+                assert!(z > 0.0);
+                assert!(
+                    (d.dot(right) / z).abs() <= t * cam.aspect() && (d.dot(up) / z).abs() <= t,
+                    "corner {c} outside for {w}x{h}"
+                );
+            }
+            let _ = g;
+        }
+    }
+
+    #[test]
+    fn invalid_cameras_are_rejected() {
+        let ok = Camera {
+            position: Vec3::Z,
+            look_at: Vec3::ZERO,
+            up: Vec3::Y,
+            vfov_deg: 45.0,
+            width: 8,
+            height: 8,
+        };
+        assert_eq!(
+            Camera {
+                look_at: Vec3::Z,
+                ..ok
+            }
+            .validate(),
+            Err(CameraError::NoDirection)
+        );
+        assert_eq!(
+            Camera { up: Vec3::Z, ..ok }.validate(),
+            Err(CameraError::BadUp)
+        );
+        assert_eq!(
+            Camera {
+                vfov_deg: 180.0,
+                ..ok
+            }
+            .validate(),
+            Err(CameraError::BadFov(180.0))
+        );
+        assert_eq!(
+            Camera { width: 0, ..ok }.validate(),
+            Err(CameraError::BadSize(0, 8))
+        );
+        assert_eq!(
+            Camera {
+                position: Vec3::NAN,
+                ..ok
+            }
+            .validate(),
+            Err(CameraError::NotFinite)
+        );
+    }
+}

@@ -1,0 +1,17 @@
+//! The ray-cast renderer shared by the CLI and the app: a pinhole camera, one ray per pixel in
+//! progressive passes over tiles (rayon), per-pixel counters, and conversion of the result into
+//! images: normals, depth, and heatmaps of traversal work with a legend.
+
+mod camera;
+mod colormap;
+mod frame;
+mod legend;
+mod raycast;
+mod views;
+
+pub use camera::{Camera, CameraError};
+pub use colormap::ColorMap;
+pub use frame::{Frame, PixelSample};
+pub use legend::draw_legend;
+pub use raycast::{render, render_progressive, Cancelled, PassInfo, RenderSettings, PASS_STRIDES};
+pub use views::{view_image, HeatRange, Legend, View};

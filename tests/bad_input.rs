@@ -1,0 +1,119 @@
+//! Every kind of bad mesh file gives its own error naming the file, never a panic.
+
+use bvhscope::mesh::{load_obj, MeshError};
+use std::path::PathBuf;
+
+fn temp_file(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bvhscope-bad-input-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn load_err(path: &PathBuf) -> MeshError {
+    let e = load_obj(path).expect_err("bad input must fail");
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with(&path.display().to_string()),
+        "message names the file: {msg}"
+    );
+    assert!(!msg.contains('\n'), "one line: {msg}");
+    e
+}
+
+#[test]
+fn missing_file() {
+    let p = std::env::temp_dir().join("bvhscope-definitely-missing.obj");
+    assert!(matches!(load_err(&p), MeshError::NotFound { .. }));
+}
+
+#[test]
+fn directory() {
+    let p = std::env::temp_dir();
+    assert!(matches!(load_err(&p), MeshError::IsDirectory { .. }));
+}
+
+#[test]
+fn binary_file() {
+    let p = temp_file(
+        "binary.obj",
+        &[
+            0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13, 0xff, 0xfe,
+        ],
+    );
+    assert!(matches!(load_err(&p), MeshError::NotText { line: 1, .. }));
+    let p = temp_file("latin1.obj", b"v 0 0 0\nv 1 0 0\n# caf\xe9\nf 1 2 3\n");
+    assert!(matches!(load_err(&p), MeshError::NotText { line: 3, .. }));
+}
+
+#[test]
+fn no_triangles() {
+    let p = temp_file("empty.obj", b"");
+    assert!(matches!(load_err(&p), MeshError::NoTriangles { .. }));
+    let p = temp_file("points.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\np 1 2 3\nl 1 2\n");
+    assert!(matches!(load_err(&p), MeshError::NoTriangles { .. }));
+}
+
+#[test]
+fn index_out_of_range() {
+    let p = temp_file("oob.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    let e = load_err(&p);
+    assert!(
+        matches!(e, MeshError::IndexOutOfRange { line: Some(4), .. }),
+        "{e}"
+    );
+    let p = temp_file(
+        "oob-normal.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n",
+    );
+    let e = load_err(&p);
+    assert!(
+        matches!(e, MeshError::IndexOutOfRange { line: Some(5), .. }),
+        "{e}"
+    );
+    assert!(e.to_string().contains("normal 2"), "{e}");
+}
+
+#[test]
+fn nan_and_infinite_coordinates() {
+    let p = temp_file("nan.obj", b"v 0 0 0\nv 1 NaN 0\nv 0 1 0\nf 1 2 3\n");
+    assert!(matches!(
+        load_err(&p),
+        MeshError::NonFinite { line: Some(2), .. }
+    ));
+    let p = temp_file("inf.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 -inf\nf 1 2 3\n");
+    assert!(matches!(
+        load_err(&p),
+        MeshError::NonFinite { line: Some(3), .. }
+    ));
+    let p = temp_file(
+        "nan-normal.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 nan 1\nf 1//1 2//1 3//1\n",
+    );
+    assert!(matches!(
+        load_err(&p),
+        MeshError::NonFinite {
+            line: Some(4),
+            what: "a vertex normal",
+            ..
+        }
+    ));
+}
+
+#[test]
+fn garbage_text() {
+    let p = temp_file("garbage.obj", b"v 0 0 0\nv one two three\nf 1 2 3\n");
+    let e = load_err(&p);
+    assert!(matches!(e, MeshError::Parse { line: Some(2), .. }), "{e}");
+    let p = temp_file("face.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n");
+    let e = load_err(&p);
+    assert!(
+        matches!(
+            e,
+            MeshError::Parse { line: Some(4), .. }
+                | MeshError::IndexOutOfRange { line: Some(4), .. }
+        ),
+        "{e}"
+    );
+}
