@@ -2,6 +2,7 @@
 //! ray-cast renderer. Nothing here knows about the GUI; the app and the CLI are thin layers on top.
 
 pub mod bvh;
+pub mod cli;
 pub mod geometry;
 pub mod mesh;
 pub mod render;

@@ -104,22 +104,49 @@ impl Camera {
         Self::framing_from(bounds, width, height, Vec3::new(0.45, 0.35, 1.0))
     }
 
-    /// Like `framing`, looking along `-from`.
+    /// Like `framing`, looking along `-from`: the closest camera distance at which all eight
+    /// corners of the box lie inside 95% of the image (found by bisection).
     pub fn framing_from(bounds: &Aabb, width: u32, height: u32, from: Vec3) -> Camera {
         let vfov_deg = 45.0f32;
-        let (center, radius) = if bounds.is_empty() {
-            (Vec3::ZERO, 1.0)
+        let (width, height) = (width.max(1), height.max(1));
+        let b = if bounds.is_empty() {
+            Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))
         } else {
-            (bounds.center(), (bounds.extent().length() * 0.5).max(1e-6))
+            *bounds
         };
-        let aspect = width.max(1) as f32 / height.max(1) as f32;
-        let half_v = (vfov_deg.to_radians() * 0.5).tan();
-        // The bounding sphere must fit in the narrower of the two fields of view.
-        let half = half_v.min(half_v * aspect).atan();
-        let distance = radius / half.sin() * 1.02;
+        let center = b.center();
+        let radius = (b.extent().length() * 0.5).max(1e-6);
         let dir = from.try_normalize().unwrap_or(Vec3::Z);
+        let forward = -dir;
+        let right = forward.cross(Vec3::Y).try_normalize().unwrap_or(Vec3::X);
+        let up = right.cross(forward);
+        let tan_v = (vfov_deg.to_radians() * 0.5).tan() * 0.95;
+        let tan_h = tan_v * width as f32 / height as f32;
+        let fits = |d: f32| {
+            let eye = center + dir * d;
+            (0..8).all(|i| {
+                let c = Vec3::new(
+                    if i & 1 == 0 { b.min.x } else { b.max.x },
+                    if i & 2 == 0 { b.min.y } else { b.max.y },
+                    if i & 4 == 0 { b.min.z } else { b.max.z },
+                );
+                let v = c - eye;
+                let z = v.dot(forward);
+                z > 0.0 && v.dot(right).abs() <= tan_h * z && v.dot(up).abs() <= tan_v * z
+            })
+        };
+        // The bounding sphere's distance always fits; bisect towards the box.
+        let (mut lo, mut hi) = (0.0f32, radius / tan_v.min(tan_h).atan().sin() * 1.02);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if fits(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
         Camera {
-            position: center + dir * distance,
+            position: center + dir * hi,
             look_at: center,
             up: Vec3::Y,
             vfov_deg,

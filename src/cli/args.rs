@@ -1,0 +1,199 @@
+//! Arguments shared by the subcommands, and clap's value lists for the core's enums (so `--help`
+//! lists every strategy, view, order, test and colour map under its kebab-case name).
+
+use crate::bvh::{BuildParams, SahCost, SplitStrategy, TraceOptions, TraversalOrder};
+use crate::geometry::{Aabb, TriangleTest};
+use crate::render::{Camera, ColorMap, View};
+use clap::builder::PossibleValue;
+use clap::{Args, ValueEnum};
+use glam::Vec3;
+
+impl ValueEnum for SplitStrategy {
+    fn value_variants<'a>() -> &'a [Self] {
+        &SplitStrategy::ALL
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(self.short_name()).help(self.description()))
+    }
+}
+
+impl ValueEnum for View {
+    fn value_variants<'a>() -> &'a [Self] {
+        &View::ALL
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(self.short_name()).help(self.label()))
+    }
+}
+
+impl ValueEnum for TraversalOrder {
+    fn value_variants<'a>() -> &'a [Self] {
+        &TraversalOrder::ALL
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        let name = match self {
+            TraversalOrder::SplitAxisSign => "split-axis",
+            TraversalOrder::EntryDistance => "entry-distance",
+        };
+        Some(PossibleValue::new(name).help(self.label()))
+    }
+}
+
+impl ValueEnum for TriangleTest {
+    fn value_variants<'a>() -> &'a [Self] {
+        &TriangleTest::ALL
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        let name = match self {
+            TriangleTest::Watertight => "watertight",
+            TriangleTest::MollerTrumbore => "moller-trumbore",
+        };
+        Some(PossibleValue::new(name).help(self.label()))
+    }
+}
+
+impl ValueEnum for ColorMap {
+    fn value_variants<'a>() -> &'a [Self] {
+        &ColorMap::ALL
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(self.label()))
+    }
+}
+
+/// How to build and traverse the BVH.
+#[derive(Args, Debug, Clone)]
+pub struct BuildArgs {
+    /// Split strategy.
+    #[arg(long, short, value_enum, default_value = "sah")]
+    pub strategy: SplitStrategy,
+    /// Most triangles in a leaf (1..=255).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=255))]
+    pub max_leaf_size: u32,
+    /// Bins per axis for the binned SAH (2..=256).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(2..=256))]
+    pub bins: u32,
+    /// SAH cost of one traversal step (relative to one triangle test).
+    #[arg(long, default_value_t = 1.0)]
+    pub traversal_cost: f32,
+    /// Child visited first at interior nodes.
+    #[arg(long, value_enum, default_value = "entry-distance")]
+    pub order: TraversalOrder,
+    /// Ray–triangle test.
+    #[arg(long = "triangle-test", value_enum, default_value = "watertight")]
+    pub test: TriangleTest,
+}
+
+impl BuildArgs {
+    pub fn params(&self, strategy: SplitStrategy) -> BuildParams {
+        BuildParams {
+            strategy,
+            max_leaf_size: self.max_leaf_size,
+            sah_bins: self.bins,
+            cost: SahCost {
+                traversal: self.traversal_cost,
+                ..SahCost::default()
+            },
+        }
+    }
+
+    pub fn trace(&self) -> TraceOptions {
+        TraceOptions {
+            order: self.order,
+            test: self.test,
+        }
+    }
+}
+
+/// The camera and image size of a render.
+#[derive(Args, Debug, Clone)]
+pub struct ViewArgs {
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Camera as EYE:TARGET[:UP], each X,Y,Z (e.g. 0,1,5:0,0,0). Default: frames the mesh.
+    #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
+    pub camera: Option<(Vec3, Vec3, Vec3)>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 45.0)]
+    pub fov: f32,
+}
+
+impl ViewArgs {
+    pub fn camera(&self, bounds: &Aabb) -> Result<Camera, super::CliError> {
+        let (w, h) = self.size;
+        let cam = match self.camera {
+            Some((position, look_at, up)) => Camera {
+                position,
+                look_at,
+                up,
+                vfov_deg: self.fov,
+                width: w,
+                height: h,
+            },
+            None => Camera {
+                vfov_deg: self.fov,
+                ..Camera::framing(bounds, w, h)
+            },
+        };
+        cam.validate()
+            .map_err(|e| super::CliError::Usage(format!("--camera: {e}")))?;
+        Ok(cam)
+    }
+}
+
+/// `1280x720` → (1280, 720).
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{s}' is not WIDTHxHEIGHT"))
+    };
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("'{s}': width and height must be 1..=16384"));
+    }
+    Ok((w, h))
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|c| c.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not X,Y,Z"))?;
+    match v[..] {
+        [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!("'{s}' is not X,Y,Z (three finite numbers)")),
+    }
+}
+
+/// `0,1,5:0,0,0[:0,1,0]` → (eye, target, up).
+pub fn parse_camera(s: &str) -> Result<(Vec3, Vec3, Vec3), String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    match parts[..] {
+        [eye, target] => Ok((parse_vec3(eye)?, parse_vec3(target)?, Vec3::Y)),
+        [eye, target, up] => Ok((parse_vec3(eye)?, parse_vec3(target)?, parse_vec3(up)?)),
+        _ => Err(format!("'{s}' is not EYE:TARGET[:UP]")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_and_cameras_parse() {
+        assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
+        assert!(
+            parse_size("0x10").is_err() && parse_size("12").is_err() && parse_size("axb").is_err()
+        );
+        let (e, t, u) = parse_camera("0,1,5:0,0,0").unwrap();
+        assert_eq!((e, t, u), (Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y));
+        assert_eq!(parse_camera("1,2,3:4,5,6:0,0,1").unwrap().2, Vec3::Z);
+        assert!(parse_camera("1,2:0,0,0").is_err() && parse_camera("nan,0,0:0,0,0").is_err());
+    }
+}

@@ -1,0 +1,75 @@
+//! The command line: `render`, `stats` and `compare`, over the same core as the app.
+//! Errors print one line naming the file and the problem and exit with code 2.
+
+mod args;
+mod compare;
+mod progress;
+mod render;
+mod stats;
+
+pub use args::{parse_camera, parse_size, BuildArgs};
+pub use compare::{compare_rows, CompareRow};
+
+use crate::mesh::{load_obj, LoadReport, Mesh, MeshError};
+use clap::{Parser, Subcommand};
+use std::path::{Path, PathBuf};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "bvhscope",
+    version,
+    about = "Makes bounding volume hierarchies visible: build a BVH with a chosen split strategy, ray-cast it, and see what each ray costs."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// A mesh (.obj) to open in the desktop app.
+    pub file: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Ray-cast a mesh to a PNG: normals, depth, or a heatmap of traversal work.
+    Render(render::RenderArgs),
+    /// Print the statistics of the BVH built over a mesh.
+    Stats(stats::StatsArgs),
+    /// Build every strategy and compare them (and a linear scan) on the same rays.
+    Compare(compare::CompareArgs),
+}
+
+/// An error the CLI reports in one line before exiting with code 2.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    #[error("{0}")]
+    Usage(String),
+    #[error("{}: cannot write: {source}", .path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// Load a mesh with a spinner when it takes over a second, and print what the loader skipped.
+pub(crate) fn load_mesh(path: &Path) -> Result<(Mesh, LoadReport), CliError> {
+    let label = format!("loading {}", path.display());
+    let (mesh, report) = progress::with_spinner(&label, || load_obj(path))?;
+    if report.degenerate_skipped > 0 {
+        eprintln!(
+            "note: {}: {} degenerate (zero-area) triangles skipped",
+            path.display(),
+            report.degenerate_skipped
+        );
+    }
+    Ok((mesh, report))
+}
+
+/// Run a parsed subcommand.
+pub fn run(command: Command) -> Result<(), CliError> {
+    match command {
+        Command::Render(a) => render::run(&a),
+        Command::Stats(a) => stats::run(&a),
+        Command::Compare(a) => compare::run(&a),
+    }
+}

@@ -1,0 +1,102 @@
+//! `bvhscope render`: ray-cast a mesh to a PNG.
+
+use super::args::{BuildArgs, ViewArgs};
+use super::{load_mesh, progress, CliError};
+use crate::bvh::Bvh;
+use crate::render::{
+    draw_legend, render_progressive, view_image, ColorMap, HeatRange, RenderSettings, View,
+};
+use clap::Args;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU64};
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// The mesh (.obj).
+    pub mesh: PathBuf,
+    #[command(flatten)]
+    pub build: BuildArgs,
+    /// What to show.
+    #[arg(long, value_enum, default_value = "normals")]
+    pub view: View,
+    /// Output PNG.
+    #[arg(long, short, default_value = "out.png")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub view_args: ViewArgs,
+    /// Colour map of heatmaps.
+    #[arg(long, value_enum, default_value = "viridis")]
+    pub colormap: ColorMap,
+    /// Fixed heatmap range MIN:MAX (default: the frame's own min and max).
+    #[arg(long, value_parser = parse_range)]
+    pub range: Option<(f32, f32)>,
+}
+
+fn parse_range(s: &str) -> Result<(f32, f32), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("'{s}' is not MIN:MAX"))?;
+    let (a, b) = (a.trim().parse::<f32>(), b.trim().parse::<f32>());
+    match (a, b) {
+        (Ok(a), Ok(b)) if a.is_finite() && b.is_finite() && a < b => Ok((a, b)),
+        _ => Err(format!("'{s}' is not MIN:MAX with MIN < MAX")),
+    }
+}
+
+pub fn run(a: &RenderArgs) -> Result<(), CliError> {
+    let (mesh, _) = load_mesh(&a.mesh)?;
+    let camera = a.view_args.camera(&mesh.bounds())?;
+    let params = a.build.params(a.build.strategy);
+    let bvh = progress::with_spinner("building the BVH", || Bvh::build(&mesh, &params));
+    let settings = RenderSettings {
+        trace: a.build.trace(),
+        count: a.view.is_heatmap(),
+        progressive: false,
+    };
+    let total = camera.width as u64 * camera.height as u64;
+    let done = AtomicU64::new(0);
+    let frame = progress::with_bar("rendering", total, &done, || {
+        render_progressive(
+            &bvh,
+            &mesh,
+            &camera,
+            &settings,
+            &AtomicBool::new(false),
+            &done,
+            |_, _| {},
+        )
+    })
+    .expect("never cancelled");
+    let range = a
+        .range
+        .map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
+    let (img, legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
+    let img = match &legend {
+        Some(l) => draw_legend(&img, l),
+        None => img,
+    };
+    img.save(&a.output).map_err(|e| CliError::Write {
+        path: a.output.clone(),
+        source: match e {
+            image::ImageError::IoError(io) => io,
+            other => std::io::Error::other(other.to_string()),
+        },
+    })?;
+    let hits = frame.samples.iter().filter(|s| s.is_hit()).count();
+    eprint!(
+        "wrote {} ({}x{}, {} of {} pixels hit",
+        a.output.display(),
+        camera.width,
+        camera.height,
+        hits,
+        total
+    );
+    if let Some(l) = legend {
+        eprint!(
+            "; {}: min {} mean {:.2} max {}",
+            l.title, l.min, l.mean, l.max
+        );
+    }
+    eprintln!(")");
+    Ok(())
+}

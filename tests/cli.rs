@@ -1,0 +1,170 @@
+//! The command line as a user runs it: outputs, formats, and one-line errors with exit code 2.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bvhscope(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_bvhscope"))
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bvhscope-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// A small mesh of our own: two triangles forming a tent.
+fn tent() -> PathBuf {
+    let p = tmp("tent.obj");
+    std::fs::write(&p, "o tent\nv -1 0 -1\nv 1 0 -1\nv 0 1 0\nv -1 0 1\nv 1 0 1\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n").unwrap();
+    p
+}
+
+#[test]
+fn bad_input_gives_one_line_and_exit_code_2() {
+    let missing = tmp("missing.obj");
+    let nan = tmp("nan.obj");
+    std::fs::write(&nan, "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let dir = std::env::temp_dir();
+    for (args, needle) in [
+        (vec!["render", missing.to_str().unwrap()], "no such file"),
+        (vec!["stats", nan.to_str().unwrap()], "line 2"),
+        (vec!["compare", dir.to_str().unwrap()], "is a directory"),
+    ] {
+        let out = bvhscope(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert!(
+            err.contains(needle) && err.contains(args[1]),
+            "names the file and problem: {err}"
+        );
+        assert!(
+            !err.contains("panicked") && !err.contains("backtrace"),
+            "{err}"
+        );
+    }
+    let out = bvhscope(&[
+        "render",
+        tent().to_str().unwrap(),
+        "--camera",
+        "0,0,0:0,0,0",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--camera"));
+}
+
+#[test]
+fn strategy_help_lists_every_strategy() {
+    let out = bvhscope(&["render", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    for name in ["midpoint", "equal-count", "sah", "sah-sweep"] {
+        assert!(help.contains(name), "--help lists {name}");
+    }
+}
+
+#[test]
+fn render_writes_a_png_of_the_requested_size_with_legend_for_heatmaps() {
+    let out_png = tmp("normals.png");
+    let out = bvhscope(&[
+        "render",
+        tent().to_str().unwrap(),
+        "--size",
+        "64x48",
+        "-o",
+        out_png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = image::open(&out_png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (64, 48));
+    assert!(
+        img.pixels().any(|p| p.0 != [0, 0, 0]),
+        "the mesh is visible"
+    );
+
+    let heat = tmp("visits.png");
+    let out = bvhscope(&[
+        "render",
+        tent().to_str().unwrap(),
+        "--size",
+        "64x48",
+        "--view",
+        "visits",
+        "--strategy",
+        "midpoint",
+        "-o",
+        heat.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let img = image::open(&heat).unwrap().to_rgb8();
+    assert!(img.height() > 48, "legend strip appended below the image");
+    // The corner ray misses the root box: 0 nodes visited, the bottom of viridis.
+    let low = bvhscope::render::ColorMap::Viridis.map(0.0);
+    assert_eq!(img.get_pixel(0, 0).0, low);
+    assert!(
+        img.get_pixel(32, 30).0 != low,
+        "the tent's middle costs more than nothing"
+    );
+}
+
+#[test]
+fn stats_and_compare_print_their_tables() {
+    let out = bvhscope(&[
+        "stats",
+        tent().to_str().unwrap(),
+        "--strategy",
+        "equal-count",
+        "--max-leaf-size",
+        "1",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("nodes           7 (3 interior, 4 leaves)"),
+        "{text}"
+    );
+
+    let out = bvhscope(&[
+        "compare",
+        tent().to_str().unwrap(),
+        "--size",
+        "40x30",
+        "--runs",
+        "1",
+        "--format",
+        "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 5, "four strategies and the linear scan");
+    assert_eq!(rows[4]["name"], "Linear scan");
+    assert_eq!(rows[4]["tri_tests_per_ray"], 4.0);
+    for r in rows {
+        assert!(r["frame_ms"].as_f64().unwrap() > 0.0);
+    }
+
+    let out = bvhscope(&[
+        "compare",
+        tent().to_str().unwrap(),
+        "--size",
+        "40x30",
+        "--runs",
+        "1",
+        "--format",
+        "csv",
+    ]);
+    let csv = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(csv.lines().count(), 6, "{csv}");
+    assert!(csv.starts_with("strategy,build_ms"));
+}
