@@ -206,9 +206,9 @@ fn axis_parallel_and_negative_zero_rays_match_linear() {
 
 #[test]
 fn identical_triangles_build_a_bounded_tree() {
-    // 200k copies of one triangle: no split can separate them; the tree must still have small
-    // leaves and bounded depth, and rays must find one of them.
-    let n = 200_000u32;
+    // A million copies of one triangle: no split can separate them; the tree must still have
+    // small leaves and bounded depth, and rays must find one of them.
+    let n = 1_000_000u32;
     let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
     let mesh = Mesh::from_triangles("same", positions, vec![[0, 1, 2]; n as usize]);
     for s in SplitStrategy::ALL {
@@ -287,70 +287,106 @@ fn empty_mesh_builds_and_misses() {
     }
 }
 
-/// Rays from a sphere around the mesh towards random points in its box, plus rays from inside.
-fn mesh_rays(mesh: &Mesh, count: usize, seed: u64) -> Vec<Ray> {
-    let b = mesh.bounds();
-    let (c, r) = (b.center(), b.extent().length());
-    let mut state = seed;
-    let mut rnd = move || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 40) as f32) / (1u64 << 24) as f32
-    };
-    (0..count)
-        .map(|i| {
-            let target = b.min + b.extent() * Vec3::new(rnd(), rnd(), rnd());
-            let origin = if i % 4 == 0 {
-                b.min + b.extent() * Vec3::new(rnd(), rnd(), rnd())
-            } else {
-                let d = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(Vec3::X);
-                c + d * r
-            };
-            Ray::new(origin, target - origin + Vec3::splat(1e-7))
+struct SharedCase {
+    name: &'static str,
+    mesh: Mesh,
+    bvhs: Vec<Bvh>,
+    linear: LinearScan,
+}
+
+/// The shared meshes with a BVH per strategy, built once for all proptest cases.
+fn shared_cases() -> &'static [SharedCase] {
+    static CASES: std::sync::OnceLock<Vec<SharedCase>> = std::sync::OnceLock::new();
+    CASES.get_or_init(|| {
+        if common::shared_models().is_none() {
+            return Vec::new();
+        }
+        [
+            "suzanne.obj",
+            "teapot.obj",
+            "spot.obj",
+            "cow.obj",
+            "stanford-bunny.obj",
+            "beast.obj",
+            "moer-lite-lab1-bvh/models/Monkey.obj",
+        ]
+        .into_iter()
+        .map(|name| {
+            let mesh = common::shared_mesh(name).unwrap();
+            let bvhs: Vec<Bvh> = SplitStrategy::ALL
+                .into_iter()
+                .map(|s| Bvh::build(&mesh, &BuildParams::with_strategy(s)))
+                .collect();
+            for bvh in &bvhs {
+                common::check_invariants(bvh, &mesh);
+            }
+            let linear = LinearScan::new(&mesh);
+            SharedCase {
+                name,
+                mesh,
+                bvhs,
+                linear,
+            }
         })
         .collect()
+    })
+}
+
+/// A ray from a point on (or, for `inside`, within) the mesh's bounding sphere towards a point
+/// in its box; all parameters in [0, 1].
+fn mesh_ray(mesh: &Mesh, from: Vec3, to: Vec3, inside: bool) -> Ray {
+    let b = mesh.bounds();
+    let target = b.min + b.extent() * to;
+    let origin = if inside {
+        b.min + b.extent() * from
+    } else {
+        let d = (from - 0.5).normalize_or(Vec3::X);
+        b.center() + d * b.extent().length()
+    };
+    Ray::new(origin, target - origin)
+}
+
+fn unit3() -> impl Strategy<Value = Vec3> {
+    (0.0f32..1.0, 0.0f32..1.0, 0.0f32..1.0).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, .. ProptestConfig::default() })]
+
+    #[test]
+    fn shared_meshes_closest_hit_equals_linear(
+        which in 0usize..7,
+        rays in prop::collection::vec((unit3(), unit3(), prop::bool::weighted(0.25)), 1..12),
+    ) {
+        let cases = shared_cases();
+        if cases.is_empty() {
+            return Ok(()); // notice printed by shared_models()
+        }
+        let case = &cases[which % cases.len()];
+        for (from, to, inside) in rays {
+            check_ray(&case.mesh, &case.bvhs, &case.linear, mesh_ray(&case.mesh, from, to, inside));
+        }
+    }
 }
 
 #[test]
-fn shared_meshes_closest_hit_equals_linear() {
-    let Some(_) = common::shared_models() else {
-        return;
-    };
-    for name in [
-        "suzanne.obj",
-        "teapot.obj",
-        "spot.obj",
-        "cow.obj",
-        "stanford-bunny.obj",
-        "beast.obj",
-        "moer-lite-lab1-bvh/models/Monkey.obj",
-    ] {
-        let mesh = common::shared_mesh(name).unwrap();
-        let bvhs: Vec<Bvh> = SplitStrategy::ALL
-            .into_iter()
-            .map(|s| Bvh::build(&mesh, &BuildParams::with_strategy(s)))
-            .collect();
-        for bvh in &bvhs {
-            common::check_invariants(bvh, &mesh);
-        }
-        let linear = LinearScan::new(&mesh);
-        let rays = if mesh.triangle_count() > 20_000 {
-            150
-        } else {
-            600
-        };
+fn shared_meshes_are_hit_by_the_test_rays() {
+    // Guards the property test above: its rays must actually hit the meshes often.
+    for case in shared_cases() {
         let mut hits = 0;
-        for ray in mesh_rays(&mesh, rays, 7) {
-            let mut r = ray;
-            hits += linear
+        for i in 0..200 {
+            let f = |k: u32| ((i * 7919 + k * 104729) % 1000) as f32 / 1000.0;
+            let mut r = mesh_ray(
+                &case.mesh,
+                Vec3::new(f(1), f(2), f(3)),
+                Vec3::new(f(4), f(5), f(6)),
+                false,
+            );
+            hits += case
+                .linear
                 .closest_hit(&mut r, TraceOptions::default(), &mut NoStats)
                 .is_some() as usize;
-            check_ray(&mesh, &bvhs, &linear, ray);
         }
-        assert!(
-            hits > rays / 10,
-            "{name}: too few hits ({hits}) for the test to mean anything"
-        );
+        assert!(hits > 20, "{}: only {hits} of 200 rays hit", case.name);
     }
 }
