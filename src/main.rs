@@ -4,11 +4,9 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match (cli.command, cli.file) {
-        (Some(command), _) => run(command),
-        (None, _) => Err(CliError::Usage(
-            "the desktop app is not part of this build yet; use a subcommand (see --help)".into(),
-        )),
+    let result = match cli.command {
+        Some(command) => run(command),
+        None => open_app(cli.file),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -17,4 +15,16 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+#[cfg(feature = "gui")]
+fn open_app(file: Option<std::path::PathBuf>) -> Result<(), CliError> {
+    bvhscope::app::run(bvhscope::app::AppOptions { file }).map_err(CliError::Usage)
+}
+
+#[cfg(not(feature = "gui"))]
+fn open_app(_file: Option<std::path::PathBuf>) -> Result<(), CliError> {
+    Err(CliError::Usage(
+        "this build has no desktop app (built without the `gui` feature); use a subcommand, see --help".into(),
+    ))
 }

@@ -14,10 +14,7 @@ fn temp_file(name: &str, bytes: &[u8]) -> PathBuf {
 fn load_err(path: &PathBuf) -> MeshError {
     let e = load_obj(path).expect_err("bad input must fail");
     let msg = e.to_string();
-    assert!(
-        msg.starts_with(&path.display().to_string()),
-        "message names the file: {msg}"
-    );
+    assert!(msg.starts_with(&path.display().to_string()), "message names the file: {msg}");
     assert!(!msg.contains('\n'), "one line: {msg}");
     e
 }
@@ -36,12 +33,7 @@ fn directory() {
 
 #[test]
 fn binary_file() {
-    let p = temp_file(
-        "binary.obj",
-        &[
-            0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13, 0xff, 0xfe,
-        ],
-    );
+    let p = temp_file("binary.obj", &[0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13, 0xff, 0xfe]);
     assert!(matches!(load_err(&p), MeshError::NotText { line: 1, .. }));
     let p = temp_file("latin1.obj", b"v 0 0 0\nv 1 0 0\n# caf\xe9\nf 1 2 3\n");
     assert!(matches!(load_err(&p), MeshError::NotText { line: 3, .. }));
@@ -59,46 +51,21 @@ fn no_triangles() {
 fn index_out_of_range() {
     let p = temp_file("oob.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
     let e = load_err(&p);
-    assert!(
-        matches!(e, MeshError::IndexOutOfRange { line: Some(4), .. }),
-        "{e}"
-    );
-    let p = temp_file(
-        "oob-normal.obj",
-        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n",
-    );
+    assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(4), .. }), "{e}");
+    let p = temp_file("oob-normal.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n");
     let e = load_err(&p);
-    assert!(
-        matches!(e, MeshError::IndexOutOfRange { line: Some(5), .. }),
-        "{e}"
-    );
+    assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(5), .. }), "{e}");
     assert!(e.to_string().contains("normal 2"), "{e}");
 }
 
 #[test]
 fn nan_and_infinite_coordinates() {
     let p = temp_file("nan.obj", b"v 0 0 0\nv 1 NaN 0\nv 0 1 0\nf 1 2 3\n");
-    assert!(matches!(
-        load_err(&p),
-        MeshError::NonFinite { line: Some(2), .. }
-    ));
+    assert!(matches!(load_err(&p), MeshError::NonFinite { line: Some(2), .. }));
     let p = temp_file("inf.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 -inf\nf 1 2 3\n");
-    assert!(matches!(
-        load_err(&p),
-        MeshError::NonFinite { line: Some(3), .. }
-    ));
-    let p = temp_file(
-        "nan-normal.obj",
-        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 nan 1\nf 1//1 2//1 3//1\n",
-    );
-    assert!(matches!(
-        load_err(&p),
-        MeshError::NonFinite {
-            line: Some(4),
-            what: "a vertex normal",
-            ..
-        }
-    ));
+    assert!(matches!(load_err(&p), MeshError::NonFinite { line: Some(3), .. }));
+    let p = temp_file("nan-normal.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 nan 1\nf 1//1 2//1 3//1\n");
+    assert!(matches!(load_err(&p), MeshError::NonFinite { line: Some(4), what: "a vertex normal", .. }));
 }
 
 #[test]
@@ -109,11 +76,7 @@ fn garbage_text() {
     let p = temp_file("face.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n");
     let e = load_err(&p);
     assert!(
-        matches!(
-            e,
-            MeshError::Parse { line: Some(4), .. }
-                | MeshError::IndexOutOfRange { line: Some(4), .. }
-        ),
+        matches!(e, MeshError::Parse { line: Some(4), .. } | MeshError::IndexOutOfRange { line: Some(4), .. }),
         "{e}"
     );
 }

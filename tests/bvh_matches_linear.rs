@@ -3,8 +3,7 @@
 mod common;
 
 use bvhscope::bvh::{
-    Accelerator, BuildParams, Bvh, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions,
-    TraversalOrder,
+    Accelerator, BuildParams, Bvh, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions, TraversalOrder,
 };
 use bvhscope::geometry::{Ray, TriangleTest};
 use bvhscope::mesh::Mesh;
@@ -34,17 +33,11 @@ fn check_ray(mesh: &Mesh, bvhs: &[Bvh], linear: &LinearScan, ray: Ray) {
             match (expected, got) {
                 (None, None) => {}
                 (Some(e), Some(g)) => {
-                    assert!(
-                        (e.t - g.t).abs() <= 1e-5 * e.t.abs().max(1e-30),
-                        "t {} vs {}: {what}",
-                        e.t,
-                        g.t
-                    );
+                    assert!((e.t - g.t).abs() <= 1e-5 * e.t.abs().max(1e-30), "t {} vs {}: {what}", e.t, g.t);
                     if e.prim != g.prim {
                         // Allowed only when the two triangles are hit at the same distance.
                         let tri = mesh.triangle(g.prim);
-                        let h = bvhscope::geometry::intersect_triangle(opts.test, &ray, &tri)
-                            .expect("BVH prim is hit");
+                        let h = bvhscope::geometry::intersect_triangle(opts.test, &ray, &tri).expect("BVH prim is hit");
                         assert_eq!(h.t, e.t, "different primitive at a different t: {what}");
                     }
                     assert_eq!(r.t_max, g.t, "ray t_max updated to the hit: {what}");
@@ -52,15 +45,8 @@ fn check_ray(mesh: &Mesh, bvhs: &[Bvh], linear: &LinearScan, ray: Ray) {
                 _ => panic!("linear {expected:?} but BVH {got:?}: {what}"),
             }
             let any = bvh.any_hit(&ray, opts, &mut NoStats);
-            assert_eq!(
-                any,
-                expected.is_some(),
-                "any-hit disagrees with closest hit: {what}"
-            );
-            assert!(
-                counters.nodes_visited >= 1 || expected.is_none(),
-                "counters ran: {what}"
-            );
+            assert_eq!(any, expected.is_some(), "any-hit disagrees with closest hit: {what}");
+            assert!(counters.nodes_visited >= 1 || expected.is_none(), "counters ran: {what}");
         }
     }
 }
@@ -72,16 +58,8 @@ fn build_all(mesh: &Mesh) -> Vec<Bvh> {
             // Default parameters, plus odd ones: leaf size 1 and 7, few bins.
             [
                 BuildParams::with_strategy(s),
-                BuildParams {
-                    max_leaf_size: 1,
-                    sah_bins: 4,
-                    ..BuildParams::with_strategy(s)
-                },
-                BuildParams {
-                    max_leaf_size: 7,
-                    sah_bins: 3,
-                    ..BuildParams::with_strategy(s)
-                },
+                BuildParams { max_leaf_size: 1, sah_bins: 4, ..BuildParams::with_strategy(s) },
+                BuildParams { max_leaf_size: 7, sah_bins: 3, ..BuildParams::with_strategy(s) },
             ]
         })
         .map(|p| Bvh::build(mesh, &p))
@@ -101,9 +79,9 @@ fn soup() -> impl Strategy<Value = Mesh> {
         for (c, a, b, kind) in tris {
             let (a, b) = match kind {
                 0 => (a, b),
-                1 => (a * 8.0, b * 8.0), // large, overlapping
+                1 => (a * 8.0, b * 8.0),                                   // large, overlapping
                 2 => (Vec3::new(a.x, a.y, 0.0), Vec3::new(b.x, b.y, 0.0)), // flat in z
-                _ => (a * 0.01, b * 0.01), // tiny
+                _ => (a * 0.01, b * 0.01),                                 // tiny
             };
             let base = positions.len() as u32;
             positions.extend([c, c + a, c + b]);
@@ -116,9 +94,7 @@ fn soup() -> impl Strategy<Value = Mesh> {
         let mut m = Mesh::from_triangles("soup", positions, triangles);
         // Drop triangles that came out degenerate, as the loader does.
         let pos = m.positions.clone();
-        m.triangles.retain(|t| {
-            bvhscope::geometry::triangle_double_area(&t.map(|i| pos[i as usize])) > 0.0
-        });
+        m.triangles.retain(|t| bvhscope::geometry::triangle_double_area(&t.map(|i| pos[i as usize])) > 0.0);
         m.groups[0].triangles = 0..m.triangles.len() as u32;
         m
     })
@@ -177,11 +153,7 @@ fn axis_parallel_and_negative_zero_rays_match_linear() {
     for i in 0..=24 {
         for j in 0..=24 {
             let (x, y) = (i as f32 * 0.25, j as f32 * 0.25);
-            for dir in [
-                Vec3::new(0.0, 0.0, -1.0),
-                Vec3::new(-0.0, -0.0, -1.0),
-                Vec3::new(0.0, -0.0, 1.0),
-            ] {
+            for dir in [Vec3::new(0.0, 0.0, -1.0), Vec3::new(-0.0, -0.0, -1.0), Vec3::new(0.0, -0.0, 1.0)] {
                 let o = Vec3::new(x, y, -dir.z * 3.0);
                 check_ray(&mesh, &bvhs, &linear, Ray::new(o, dir));
             }
@@ -189,18 +161,8 @@ fn axis_parallel_and_negative_zero_rays_match_linear() {
     }
     // Rays lying in the plane of the grid, along its lines.
     for k in 0..=6 {
-        check_ray(
-            &mesh,
-            &bvhs,
-            &linear,
-            Ray::new(Vec3::new(-1.0, k as f32, 0.0), Vec3::X),
-        );
-        check_ray(
-            &mesh,
-            &bvhs,
-            &linear,
-            Ray::new(Vec3::new(k as f32, 7.0, 0.0), Vec3::new(-0.0, -1.0, 0.0)),
-        );
+        check_ray(&mesh, &bvhs, &linear, Ray::new(Vec3::new(-1.0, k as f32, 0.0), Vec3::X));
+        check_ray(&mesh, &bvhs, &linear, Ray::new(Vec3::new(k as f32, 7.0, 0.0), Vec3::new(-0.0, -1.0, 0.0)));
     }
 }
 
@@ -214,22 +176,13 @@ fn identical_triangles_build_a_bounded_tree() {
     for s in SplitStrategy::ALL {
         let bvh = Bvh::build(&mesh, &BuildParams::with_strategy(s));
         let stats = bvhscope::bvh::TreeStats::of(&bvh);
-        assert!(
-            stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32,
-            "{s:?} depth {}",
-            stats.max_depth
-        );
+        assert!(stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32, "{s:?} depth {}", stats.max_depth);
         assert!(stats.leaf_size_histogram.len() <= 5, "{s:?} leaf sizes");
         if s != SplitStrategy::EqualCount {
-            assert!(
-                stats.fallback_splits > 0,
-                "{s:?} must report its fallback splits"
-            );
+            assert!(stats.fallback_splits > 0, "{s:?} must report its fallback splits");
         }
         let mut r = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
-        let hit = bvh
-            .closest_hit(&mut r, TraceOptions::default(), &mut NoStats)
-            .expect("hit");
+        let hit = bvh.closest_hit(&mut r, TraceOptions::default(), &mut NoStats).expect("hit");
         assert_eq!(hit.t, 1.0);
     }
 }
@@ -243,34 +196,19 @@ fn exponentially_spaced_triangles_stay_within_the_stack_depth() {
     for i in -60..60 {
         let x = 4f32.powi(i);
         let b = positions.len() as u32;
-        positions.extend([
-            Vec3::new(x, 0.0, 0.0),
-            Vec3::new(x, 1.0, 0.0),
-            Vec3::new(x, 0.0, 1.0),
-        ]);
+        positions.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)]);
         triangles.push([b, b + 1, b + 2]);
     }
     let mesh = Mesh::from_triangles("exp", positions, triangles);
     let linear = LinearScan::new(&mesh);
-    let bvh = Bvh::build(
-        &mesh,
-        &BuildParams {
-            max_leaf_size: 1,
-            ..BuildParams::with_strategy(SplitStrategy::Midpoint)
-        },
-    );
+    let bvh =
+        Bvh::build(&mesh, &BuildParams { max_leaf_size: 1, ..BuildParams::with_strategy(SplitStrategy::Midpoint) });
     let stats = bvhscope::bvh::TreeStats::of(&bvh);
     assert!(stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32);
-    assert!(
-        stats.depth_limited_splits > 0,
-        "this input must reach the depth limit: {stats:?}"
-    );
+    assert!(stats.depth_limited_splits > 0, "this input must reach the depth limit: {stats:?}");
     common::check_invariants(&bvh, &mesh);
     for i in 0..50 {
-        let ray = Ray::new(
-            Vec3::new(-1.0, 0.1 + i as f32 * 0.01, 0.2),
-            Vec3::new(1.0, 1e-20, 0.0),
-        );
+        let ray = Ray::new(Vec3::new(-1.0, 0.1 + i as f32 * 0.01, 0.2), Vec3::new(1.0, 1e-20, 0.0));
         check_ray(&mesh, std::slice::from_ref(&bvh), &linear, ray);
     }
 }
@@ -280,9 +218,7 @@ fn empty_mesh_builds_and_misses() {
     let mesh = Mesh::from_triangles("empty", vec![], vec![]);
     for bvh in build_all(&mesh) {
         let mut r = Ray::new(Vec3::ZERO, Vec3::X);
-        assert!(bvh
-            .closest_hit(&mut r, TraceOptions::default(), &mut NoStats)
-            .is_none());
+        assert!(bvh.closest_hit(&mut r, TraceOptions::default(), &mut NoStats).is_none());
         assert!(!bvh.any_hit(&r, TraceOptions::default(), &mut NoStats));
     }
 }
@@ -313,20 +249,13 @@ fn shared_cases() -> &'static [SharedCase] {
         .into_iter()
         .map(|name| {
             let mesh = common::shared_mesh(name).unwrap();
-            let bvhs: Vec<Bvh> = SplitStrategy::ALL
-                .into_iter()
-                .map(|s| Bvh::build(&mesh, &BuildParams::with_strategy(s)))
-                .collect();
+            let bvhs: Vec<Bvh> =
+                SplitStrategy::ALL.into_iter().map(|s| Bvh::build(&mesh, &BuildParams::with_strategy(s))).collect();
             for bvh in &bvhs {
                 common::check_invariants(bvh, &mesh);
             }
             let linear = LinearScan::new(&mesh);
-            SharedCase {
-                name,
-                mesh,
-                bvhs,
-                linear,
-            }
+            SharedCase { name, mesh, bvhs, linear }
         })
         .collect()
     })
@@ -376,16 +305,8 @@ fn shared_meshes_are_hit_by_the_test_rays() {
         let mut hits = 0;
         for i in 0..200 {
             let f = |k: u32| ((i * 7919 + k * 104729) % 1000) as f32 / 1000.0;
-            let mut r = mesh_ray(
-                &case.mesh,
-                Vec3::new(f(1), f(2), f(3)),
-                Vec3::new(f(4), f(5), f(6)),
-                false,
-            );
-            hits += case
-                .linear
-                .closest_hit(&mut r, TraceOptions::default(), &mut NoStats)
-                .is_some() as usize;
+            let mut r = mesh_ray(&case.mesh, Vec3::new(f(1), f(2), f(3)), Vec3::new(f(4), f(5), f(6)), false);
+            hits += case.linear.closest_hit(&mut r, TraceOptions::default(), &mut NoStats).is_some() as usize;
         }
         assert!(hits > 20, "{}: only {hits} of 200 rays hit", case.name);
     }

@@ -4,10 +4,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 fn bvhscope(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_bvhscope"))
-        .args(args)
-        .output()
-        .expect("runs")
+    Command::new(env!("CARGO_BIN_EXE_bvhscope")).args(args).output().expect("runs")
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -19,7 +16,8 @@ fn tmp(name: &str) -> PathBuf {
 /// A small mesh of our own: two triangles forming a tent.
 fn tent() -> PathBuf {
     let p = tmp("tent.obj");
-    std::fs::write(&p, "o tent\nv -1 0 -1\nv 1 0 -1\nv 0 1 0\nv -1 0 1\nv 1 0 1\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n").unwrap();
+    std::fs::write(&p, "o tent\nv -1 0 -1\nv 1 0 -1\nv 0 1 0\nv -1 0 1\nv 1 0 1\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n")
+        .unwrap();
     p
 }
 
@@ -38,21 +36,10 @@ fn bad_input_gives_one_line_and_exit_code_2() {
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
-        assert!(
-            err.contains(needle) && err.contains(args[1]),
-            "names the file and problem: {err}"
-        );
-        assert!(
-            !err.contains("panicked") && !err.contains("backtrace"),
-            "{err}"
-        );
+        assert!(err.contains(needle) && err.contains(args[1]), "names the file and problem: {err}");
+        assert!(!err.contains("panicked") && !err.contains("backtrace"), "{err}");
     }
-    let out = bvhscope(&[
-        "render",
-        tent().to_str().unwrap(),
-        "--camera",
-        "0,0,0:0,0,0",
-    ]);
+    let out = bvhscope(&["render", tent().to_str().unwrap(), "--camera", "0,0,0:0,0,0"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--camera"));
 }
@@ -69,25 +56,11 @@ fn strategy_help_lists_every_strategy() {
 #[test]
 fn render_writes_a_png_of_the_requested_size_with_legend_for_heatmaps() {
     let out_png = tmp("normals.png");
-    let out = bvhscope(&[
-        "render",
-        tent().to_str().unwrap(),
-        "--size",
-        "64x48",
-        "-o",
-        out_png.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = bvhscope(&["render", tent().to_str().unwrap(), "--size", "64x48", "-o", out_png.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let img = image::open(&out_png).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (64, 48));
-    assert!(
-        img.pixels().any(|p| p.0 != [0, 0, 0]),
-        "the mesh is visible"
-    );
+    assert!(img.pixels().any(|p| p.0 != [0, 0, 0]), "the mesh is visible");
 
     let heat = tmp("visits.png");
     let out = bvhscope(&[
@@ -108,43 +81,17 @@ fn render_writes_a_png_of_the_requested_size_with_legend_for_heatmaps() {
     // The corner ray misses the root box: 0 nodes visited, the bottom of viridis.
     let low = bvhscope::render::ColorMap::Viridis.map(0.0);
     assert_eq!(img.get_pixel(0, 0).0, low);
-    assert!(
-        img.get_pixel(32, 30).0 != low,
-        "the tent's middle costs more than nothing"
-    );
+    assert!(img.get_pixel(32, 30).0 != low, "the tent's middle costs more than nothing");
 }
 
 #[test]
 fn stats_and_compare_print_their_tables() {
-    let out = bvhscope(&[
-        "stats",
-        tent().to_str().unwrap(),
-        "--strategy",
-        "equal-count",
-        "--max-leaf-size",
-        "1",
-    ]);
+    let out = bvhscope(&["stats", tent().to_str().unwrap(), "--strategy", "equal-count", "--max-leaf-size", "1"]);
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success() && text.contains("nodes           7 (3 interior, 4 leaves)"),
-        "{text}"
-    );
+    assert!(out.status.success() && text.contains("nodes           7 (3 interior, 4 leaves)"), "{text}");
 
-    let out = bvhscope(&[
-        "compare",
-        tent().to_str().unwrap(),
-        "--size",
-        "40x30",
-        "--runs",
-        "1",
-        "--format",
-        "json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = bvhscope(&["compare", tent().to_str().unwrap(), "--size", "40x30", "--runs", "1", "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 5, "four strategies and the linear scan");
@@ -154,16 +101,7 @@ fn stats_and_compare_print_their_tables() {
         assert!(r["frame_ms"].as_f64().unwrap() > 0.0);
     }
 
-    let out = bvhscope(&[
-        "compare",
-        tent().to_str().unwrap(),
-        "--size",
-        "40x30",
-        "--runs",
-        "1",
-        "--format",
-        "csv",
-    ]);
+    let out = bvhscope(&["compare", tent().to_str().unwrap(), "--size", "40x30", "--runs", "1", "--format", "csv"]);
     let csv = String::from_utf8_lossy(&out.stdout);
     assert_eq!(csv.lines().count(), 6, "{csv}");
     assert!(csv.starts_with("strategy,build_ms"));

@@ -25,41 +25,16 @@ fn moer_lite_scene_matches_linear_for_every_strategy() {
     let reference = render(&LinearScan::new(&mesh), &mesh, &camera, &settings);
     let ref_mask = reference.hit_mask();
     let hits = ref_mask.iter().filter(|&&h| h).count();
-    assert!(
-        hits > 50_000,
-        "the monkey covers a good part of the frame ({hits} pixels)"
-    );
-    let (ref_img, _) = view_image(
-        &reference,
-        View::Normals,
-        ColorMap::Viridis,
-        HeatRange::Auto,
-        Default::default(),
-    );
+    assert!(hits > 50_000, "the monkey covers a good part of the frame ({hits} pixels)");
+    let (ref_img, _) = view_image(&reference, View::Normals, ColorMap::Viridis, HeatRange::Auto, Default::default());
 
     for strategy in SplitStrategy::ALL {
         let bvh = Bvh::build(&mesh, &BuildParams::with_strategy(strategy));
         for order in TraversalOrder::ALL {
-            let s = RenderSettings {
-                trace: TraceOptions {
-                    order,
-                    ..settings.trace
-                },
-                ..settings
-            };
+            let s = RenderSettings { trace: TraceOptions { order, ..settings.trace }, ..settings };
             let frame = render(&bvh, &mesh, &camera, &s);
-            assert_eq!(
-                frame.hit_mask(),
-                ref_mask,
-                "{strategy:?} {order:?}: hit mask differs"
-            );
-            let (img, _) = view_image(
-                &frame,
-                View::Normals,
-                ColorMap::Viridis,
-                HeatRange::Auto,
-                Default::default(),
-            );
+            assert_eq!(frame.hit_mask(), ref_mask, "{strategy:?} {order:?}: hit mask differs");
+            let (img, _) = view_image(&frame, View::Normals, ColorMap::Viridis, HeatRange::Auto, Default::default());
             // Identical except where two triangles tie at a shared edge, where the interpolated
             // normals agree up to rounding.
             let off = img

@@ -15,18 +15,12 @@ pub struct Hit {
 
 impl Hit {
     pub fn triangle_hit(&self) -> crate::geometry::TriangleHit {
-        crate::geometry::TriangleHit {
-            t: self.t,
-            u: self.u,
-            v: self.v,
-        }
+        crate::geometry::TriangleHit { t: self.t, u: self.u, v: self.v }
     }
 }
 
 /// Which child a traversal visits first at an interior node.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum TraversalOrder {
     /// The handout's rule: the ray's direction sign on the node's split axis picks the near child.
     SplitAxisSign,
@@ -36,8 +30,7 @@ pub enum TraversalOrder {
 }
 
 impl TraversalOrder {
-    pub const ALL: [TraversalOrder; 2] =
-        [TraversalOrder::SplitAxisSign, TraversalOrder::EntryDistance];
+    pub const ALL: [TraversalOrder; 2] = [TraversalOrder::SplitAxisSign, TraversalOrder::EntryDistance];
 
     pub fn label(self) -> &'static str {
         match self {
@@ -48,9 +41,7 @@ impl TraversalOrder {
 }
 
 /// Run-time choices of a query; each combination is its own compiled loop.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct TraceOptions {
     pub order: TraversalOrder,
     pub test: TriangleTest,
@@ -58,12 +49,7 @@ pub struct TraceOptions {
 
 pub trait Accelerator: Sync {
     /// Closest hit within the ray's interval; on a hit, `ray.t_max` is the hit distance.
-    fn closest_hit<S: TraversalStats>(
-        &self,
-        ray: &mut Ray,
-        opts: TraceOptions,
-        stats: &mut S,
-    ) -> Option<Hit>;
+    fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit>;
     /// Whether anything is hit within the ray's interval (stops at the first hit found).
     fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool;
 }

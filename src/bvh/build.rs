@@ -8,6 +8,7 @@ use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 use super::split::{self, BuildPrim, NodeInfo, SplitDecision, SplitScratch, SplitStrategy};
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
+use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -34,10 +35,7 @@ pub struct SahCost {
 
 impl Default for SahCost {
     fn default() -> Self {
-        Self {
-            traversal: 1.0,
-            intersection: 1.0,
-        }
+        Self { traversal: 1.0, intersection: 1.0 }
     }
 }
 
@@ -54,21 +52,13 @@ pub struct BuildParams {
 
 impl Default for BuildParams {
     fn default() -> Self {
-        Self {
-            strategy: SplitStrategy::SahBinned,
-            max_leaf_size: 4,
-            sah_bins: 16,
-            cost: SahCost::default(),
-        }
+        Self { strategy: SplitStrategy::SahBinned, max_leaf_size: 4, sah_bins: 16, cost: SahCost::default() }
     }
 }
 
 impl BuildParams {
     pub fn with_strategy(strategy: SplitStrategy) -> Self {
-        Self {
-            strategy,
-            ..Self::default()
-        }
+        Self { strategy, ..Self::default() }
     }
 }
 
@@ -104,50 +94,43 @@ struct Task {
 impl Bvh {
     /// Build a BVH over the mesh's triangles.
     pub fn build(mesh: &Mesh, params: &BuildParams) -> Bvh {
+        match Self::build_controlled(mesh, params, &WorkControl::new()) {
+            Ok(bvh) => bvh,
+            Err(Cancelled) => unreachable!("nobody else holds this control"),
+        }
+    }
+
+    /// Build with a control: progress counts triangles placed in leaves (out of all triangles),
+    /// and a cancel request stops the build within a few hundred nodes.
+    pub fn build_controlled(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<Bvh, Cancelled> {
         let t0 = Instant::now();
         let params = BuildParams {
             max_leaf_size: params.max_leaf_size.clamp(1, MAX_LEAF_SIZE_LIMIT),
-            sah_bins: params
-                .sah_bins
-                .clamp(2, split::sah_binned_max_bins() as u32),
+            sah_bins: params.sah_bins.clamp(2, split::sah_binned_max_bins() as u32),
             ..*params
         };
+        let n = mesh.triangle_count();
+        control.set_total(n as u64);
         let make = |i: usize| {
             let tri = mesh.triangle(i as u32);
             let bounds = Aabb::from_points(&tri);
-            BuildPrim {
-                bounds,
-                centroid: bounds.center(),
-                index: i as u32,
-            }
+            BuildPrim { bounds, centroid: bounds.center(), index: i as u32 }
         };
-        let n = mesh.triangle_count();
-        let mut prims: Vec<BuildPrim> = if n >= 1 << 16 {
-            (0..n).into_par_iter().map(make).collect()
-        } else {
-            (0..n).map(make).collect()
-        };
+        let mut prims: Vec<BuildPrim> =
+            if n >= 1 << 16 { (0..n).into_par_iter().map(make).collect() } else { (0..n).map(make).collect() };
         let setup_time = t0.elapsed();
+        control.check()?;
 
         let t1 = Instant::now();
-        let mut report = BuildReport {
-            setup_time,
-            ..Default::default()
-        };
-        let nodes = build_nodes(&mut prims, &params, &mut report);
+        let mut report = BuildReport { setup_time, ..Default::default() };
+        let nodes = build_nodes(&mut prims, &params, &mut report, control)?;
         report.split_time = t1.elapsed();
 
         let t2 = Instant::now();
         let prim_ids: Vec<u32> = prims.iter().map(|p| p.index).collect();
         let tris = prim_ids.iter().map(|&i| mesh.triangle(i)).collect();
         report.reorder_time = t2.elapsed();
-        Bvh {
-            nodes,
-            prim_ids,
-            tris,
-            params,
-            report,
-        }
+        Ok(Bvh { nodes, prim_ids, tris, params, report })
     }
 }
 
@@ -158,31 +141,28 @@ fn node_info(prims: &[BuildPrim]) -> NodeInfo {
         bounds = bounds.union(p.bounds);
         centroid_bounds = centroid_bounds.grow(p.centroid);
     }
-    NodeInfo {
-        bounds,
-        centroid_bounds,
-    }
+    NodeInfo { bounds, centroid_bounds }
 }
 
 fn build_nodes(
     prims: &mut [BuildPrim],
     params: &BuildParams,
     report: &mut BuildReport,
-) -> Vec<BvhNode> {
-    let mut nodes =
-        Vec::with_capacity((2 * prims.len() / params.max_leaf_size.max(1) as usize).max(1));
+    control: &WorkControl,
+) -> Result<Vec<BvhNode>, Cancelled> {
+    let mut nodes = Vec::with_capacity((2 * prims.len() / params.max_leaf_size.max(1) as usize).max(1));
     nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
     if prims.is_empty() {
-        return nodes; // one empty leaf: every ray misses its empty box
+        return Ok(nodes); // one empty leaf: every ray misses its empty box
     }
     let mut scratch = SplitScratch::default();
-    let mut stack = vec![Task {
-        node: 0,
-        start: 0,
-        end: prims.len() as u32,
-        depth: 0,
-    }];
+    let mut stack = vec![Task { node: 0, start: 0, end: prims.len() as u32, depth: 0 }];
+    let mut steps = 0u32;
     while let Some(task) = stack.pop() {
+        steps += 1;
+        if steps % 256 == 0 {
+            control.check()?;
+        }
         let range = &mut prims[task.start as usize..task.end as usize];
         let info = node_info(range);
         let n = range.len();
@@ -193,19 +173,18 @@ fn build_nodes(
             split::split_equal_count(range, &info)
         } else {
             let d = match params.strategy {
-                SplitStrategy::Midpoint | SplitStrategy::EqualCount
-                    if n <= params.max_leaf_size as usize =>
-                {
+                SplitStrategy::Midpoint | SplitStrategy::EqualCount if n <= params.max_leaf_size as usize => {
                     SplitDecision::Leaf
                 }
                 SplitStrategy::Midpoint => split::split_midpoint(range, &info),
                 SplitStrategy::EqualCount => split::split_equal_count(range, &info),
                 SplitStrategy::SahBinned => split::split_sah_binned(range, &info, params),
-                SplitStrategy::SahSweep => {
-                    split::split_sah_sweep(range, &info, params, &mut scratch)
-                }
+                SplitStrategy::SahSweep => split::split_sah_sweep(range, &info, params, &mut scratch),
             };
             match d {
+                // No useful split, but the triangles fit in a leaf: that is the best we can do
+                // (e.g. the two halves of a quad whose diagonal spans its box share a centroid).
+                SplitDecision::Fallback if n <= params.max_leaf_size as usize => SplitDecision::Leaf,
                 // A strategy may only ask for a leaf that fits; otherwise split it anyway.
                 SplitDecision::Leaf if n > params.max_leaf_size as usize => {
                     report.fallback_splits += 1;
@@ -229,21 +208,34 @@ fn build_nodes(
                 let mid = task.start + mid as u32;
                 let depth = task.depth + 1;
                 // Right pushed first so the left subtree is laid out right after its parent pair.
-                stack.push(Task {
-                    node: left + 1,
-                    start: mid,
-                    end: task.end,
-                    depth,
-                });
-                stack.push(Task {
-                    node: left,
-                    start: task.start,
-                    end: mid,
-                    depth,
-                });
+                stack.push(Task { node: left + 1, start: mid, end: task.end, depth });
+                stack.push(Task { node: left, start: task.start, end: mid, depth });
             }
-            _ => nodes[task.node as usize] = BvhNode::leaf(info.bounds, task.start, n as u16),
+            _ => {
+                nodes[task.node as usize] = BvhNode::leaf(info.bounds, task.start, n as u16);
+                control.add_done(n as u64);
+            }
         }
     }
-    nodes
+    Ok(nodes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::torus;
+
+    #[test]
+    fn build_reports_progress_and_can_be_cancelled() {
+        let mesh = torus(2.0, 0.5, 64, 32);
+        let control = WorkControl::new();
+        let bvh = Bvh::build_controlled(&mesh, &BuildParams::default(), &control).unwrap();
+        assert_eq!(control.total(), mesh.triangle_count() as u64);
+        assert_eq!(control.done(), control.total(), "every triangle ends in a leaf");
+        assert_eq!(bvh.prim_ids.len(), mesh.triangle_count());
+
+        let cancelled = WorkControl::new();
+        cancelled.cancel();
+        assert_eq!(Bvh::build_controlled(&mesh, &BuildParams::default(), &cancelled).unwrap_err(), Cancelled);
+    }
 }

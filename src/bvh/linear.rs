@@ -12,30 +12,17 @@ pub struct LinearScan {
 
 impl LinearScan {
     pub fn new(mesh: &Mesh) -> Self {
-        Self {
-            tris: (0..mesh.triangle_count() as u32)
-                .map(|i| mesh.triangle(i))
-                .collect(),
-        }
+        Self { tris: (0..mesh.triangle_count() as u32).map(|i| mesh.triangle(i)).collect() }
     }
 
-    fn closest<T: TriangleIntersector, S: TraversalStats>(
-        &self,
-        ray: &mut Ray,
-        stats: &mut S,
-    ) -> Option<Hit> {
+    fn closest<T: TriangleIntersector, S: TraversalStats>(&self, ray: &mut Ray, stats: &mut S) -> Option<Hit> {
         let p = T::prepare(ray);
         let mut best = None;
         stats.triangle_tests(self.tris.len() as u32);
         for (i, tri) in self.tris.iter().enumerate() {
             if let Some(h) = T::intersect(&p, ray, tri) {
                 ray.t_max = h.t;
-                best = Some(Hit {
-                    t: h.t,
-                    u: h.u,
-                    v: h.v,
-                    prim: i as u32,
-                });
+                best = Some(Hit { t: h.t, u: h.u, v: h.v, prim: i as u32 });
             }
         }
         best
@@ -55,12 +42,7 @@ impl LinearScan {
 }
 
 impl Accelerator for LinearScan {
-    fn closest_hit<S: TraversalStats>(
-        &self,
-        ray: &mut Ray,
-        opts: TraceOptions,
-        stats: &mut S,
-    ) -> Option<Hit> {
+    fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
         match opts.test {
             TriangleTest::Watertight => self.closest::<Watertight, S>(ray, stats),
             TriangleTest::MollerTrumbore => self.closest::<MollerTrumbore, S>(ray, stats),

@@ -33,23 +33,11 @@ impl BvhNode {
     }
 
     pub fn leaf(bounds: Aabb, first: u32, count: u16) -> Self {
-        Self {
-            bounds,
-            index: first,
-            count,
-            axis: 0,
-            _pad: 0,
-        }
+        Self { bounds, index: first, count, axis: 0, _pad: 0 }
     }
 
     pub fn interior(bounds: Aabb, left: u32, axis: u8) -> Self {
-        Self {
-            bounds,
-            index: left,
-            count: 0,
-            axis,
-            _pad: 0,
-        }
+        Self { bounds, index: left, count: 0, axis, _pad: 0 }
     }
 
     /// The triangle range of a leaf.

@@ -55,11 +55,7 @@ impl TreeStats {
         let mut depth_sum = 0u64;
         let mut cost = 0f64;
         bvh.for_each_node(|_, n, depth| {
-            let rel = if root_area > 0.0 {
-                n.bounds.area() as f64 / root_area
-            } else {
-                0.0
-            };
+            let rel = if root_area > 0.0 { n.bounds.area() as f64 / root_area } else { 0.0 };
             if n.is_leaf() {
                 s.leaves += 1;
                 depth_sum += depth as u64;
@@ -75,11 +71,7 @@ impl TreeStats {
                 cost += c.traversal as f64 * rel;
             }
         });
-        s.mean_leaf_depth = if s.leaves > 0 {
-            depth_sum as f64 / s.leaves as f64
-        } else {
-            0.0
-        };
+        s.mean_leaf_depth = if s.leaves > 0 { depth_sum as f64 / s.leaves as f64 } else { 0.0 };
         s.sah_cost = cost;
         s
     }

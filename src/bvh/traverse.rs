@@ -13,12 +13,7 @@ use super::{Accelerator, Hit, TraceOptions, TraversalOrder, TraversalStats};
 use crate::geometry::{MollerTrumbore, Ray, TriangleIntersector, TriangleTest, Watertight};
 
 impl Bvh {
-    fn closest<
-        T: TriangleIntersector,
-        const BY_DISTANCE: bool,
-        const ANY: bool,
-        S: TraversalStats,
-    >(
+    fn closest<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
         &self,
         ray: &mut Ray,
         stats: &mut S,
@@ -27,11 +22,7 @@ impl Bvh {
         let (origin, inv_dir) = (ray.origin(), ray.inv_dir());
         // Which child is near under the handout's rule, per axis: a negative direction component
         // (including -0) means the right child (larger coordinates) is met first.
-        let dir_neg = [
-            inv_dir.x.is_sign_negative(),
-            inv_dir.y.is_sign_negative(),
-            inv_dir.z.is_sign_negative(),
-        ];
+        let dir_neg = [inv_dir.x.is_sign_negative(), inv_dir.y.is_sign_negative(), inv_dir.z.is_sign_negative()];
         stats.box_tests(1);
         let (t0, t1) = nodes[0].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
         if !(t0 <= t1) {
@@ -63,25 +54,13 @@ impl Bvh {
             } else {
                 let left = node.index as usize;
                 stats.box_tests(2);
-                let (l0, l1) = nodes[left]
-                    .bounds
-                    .slab(origin, inv_dir, ray.t_min, ray.t_max);
-                let (r0, r1) = nodes[left + 1]
-                    .bounds
-                    .slab(origin, inv_dir, ray.t_min, ray.t_max);
+                let (l0, l1) = nodes[left].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
+                let (r0, r1) = nodes[left + 1].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
                 let hit_l = l0 <= l1;
                 let hit_r = r0 <= r1;
                 if hit_l && hit_r {
-                    let right_first = if BY_DISTANCE {
-                        r0 < l0
-                    } else {
-                        dir_neg[node.axis as usize]
-                    };
-                    let (near, far, far_t) = if right_first {
-                        (left + 1, left, l0)
-                    } else {
-                        (left, left + 1, r0)
-                    };
+                    let right_first = if BY_DISTANCE { r0 < l0 } else { dir_neg[node.axis as usize] };
+                    let (near, far, far_t) = if right_first { (left + 1, left, l0) } else { (left, left + 1, r0) };
                     stack[sp] = (far as u32, far_t);
                     sp += 1;
                     current = near;
@@ -97,12 +76,7 @@ impl Bvh {
             // Pop the next node that can still hold a hit nearer than the best so far.
             loop {
                 if sp == 0 {
-                    return best.map(|(i, h)| Hit {
-                        t: h.t,
-                        u: h.u,
-                        v: h.v,
-                        prim: self.prim_ids[i],
-                    });
+                    return best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] });
                 }
                 sp -= 1;
                 let (n, t_enter) = stack[sp];
@@ -112,12 +86,7 @@ impl Bvh {
                 }
             }
         }
-        best.map(|(i, h)| Hit {
-            t: h.t,
-            u: h.u,
-            v: h.v,
-            prim: self.prim_ids[i],
-        })
+        best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
     }
 
     fn dispatch<const ANY: bool, S: TraversalStats>(
@@ -128,29 +97,16 @@ impl Bvh {
     ) -> Option<Hit> {
         use TraversalOrder::*;
         match (opts.test, opts.order) {
-            (TriangleTest::Watertight, EntryDistance) => {
-                self.closest::<Watertight, true, ANY, S>(ray, stats)
-            }
-            (TriangleTest::Watertight, SplitAxisSign) => {
-                self.closest::<Watertight, false, ANY, S>(ray, stats)
-            }
-            (TriangleTest::MollerTrumbore, EntryDistance) => {
-                self.closest::<MollerTrumbore, true, ANY, S>(ray, stats)
-            }
-            (TriangleTest::MollerTrumbore, SplitAxisSign) => {
-                self.closest::<MollerTrumbore, false, ANY, S>(ray, stats)
-            }
+            (TriangleTest::Watertight, EntryDistance) => self.closest::<Watertight, true, ANY, S>(ray, stats),
+            (TriangleTest::Watertight, SplitAxisSign) => self.closest::<Watertight, false, ANY, S>(ray, stats),
+            (TriangleTest::MollerTrumbore, EntryDistance) => self.closest::<MollerTrumbore, true, ANY, S>(ray, stats),
+            (TriangleTest::MollerTrumbore, SplitAxisSign) => self.closest::<MollerTrumbore, false, ANY, S>(ray, stats),
         }
     }
 }
 
 impl Accelerator for Bvh {
-    fn closest_hit<S: TraversalStats>(
-        &self,
-        ray: &mut Ray,
-        opts: TraceOptions,
-        stats: &mut S,
-    ) -> Option<Hit> {
+    fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
         self.dispatch::<false, S>(ray, opts, stats)
     }
 

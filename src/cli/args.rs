@@ -90,18 +90,12 @@ impl BuildArgs {
             strategy,
             max_leaf_size: self.max_leaf_size,
             sah_bins: self.bins,
-            cost: SahCost {
-                traversal: self.traversal_cost,
-                ..SahCost::default()
-            },
+            cost: SahCost { traversal: self.traversal_cost, ..SahCost::default() },
         }
     }
 
     pub fn trace(&self) -> TraceOptions {
-        TraceOptions {
-            order: self.order,
-            test: self.test,
-        }
+        TraceOptions { order: self.order, test: self.test }
     }
 }
 
@@ -123,35 +117,18 @@ impl ViewArgs {
     pub fn camera(&self, bounds: &Aabb) -> Result<Camera, super::CliError> {
         let (w, h) = self.size;
         let cam = match self.camera {
-            Some((position, look_at, up)) => Camera {
-                position,
-                look_at,
-                up,
-                vfov_deg: self.fov,
-                width: w,
-                height: h,
-            },
-            None => Camera {
-                vfov_deg: self.fov,
-                ..Camera::framing(bounds, w, h)
-            },
+            Some((position, look_at, up)) => Camera { position, look_at, up, vfov_deg: self.fov, width: w, height: h },
+            None => Camera { vfov_deg: self.fov, ..Camera::framing(bounds, w, h) },
         };
-        cam.validate()
-            .map_err(|e| super::CliError::Usage(format!("--camera: {e}")))?;
+        cam.validate().map_err(|e| super::CliError::Usage(format!("--camera: {e}")))?;
         Ok(cam)
     }
 }
 
 /// `1280x720` → (1280, 720).
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("'{s}' is not WIDTHxHEIGHT"))
-    };
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("'{s}' is not WIDTHxHEIGHT"));
     let (w, h) = (parse(w)?, parse(h)?);
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(format!("'{s}': width and height must be 1..=16384"));
@@ -188,9 +165,7 @@ mod tests {
     #[test]
     fn sizes_and_cameras_parse() {
         assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
-        assert!(
-            parse_size("0x10").is_err() && parse_size("12").is_err() && parse_size("axb").is_err()
-        );
+        assert!(parse_size("0x10").is_err() && parse_size("12").is_err() && parse_size("axb").is_err());
         let (e, t, u) = parse_camera("0,1,5:0,0,0").unwrap();
         assert_eq!((e, t, u), (Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y));
         assert_eq!(parse_camera("1,2,3:4,5,6:0,0,1").unwrap().2, Vec3::Z);

@@ -8,9 +8,7 @@
 
 use super::args::{BuildArgs, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{
-    Accelerator, Bvh, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions, TreeStats,
-};
+use crate::bvh::{Accelerator, Bvh, LinearScan, NoStats, SplitStrategy, TraceOptions, TreeStats};
 use crate::mesh::Mesh;
 use crate::render::{render, Camera, RenderSettings};
 use clap::{Args, ValueEnum};
@@ -70,24 +68,8 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-fn mean_counters(c: impl Iterator<Item = RayCounters>) -> (f64, f64) {
-    let (mut nodes, mut tris, mut n) = (0u64, 0u64, 0u64);
-    for c in c {
-        nodes += c.nodes_visited as u64;
-        tris += c.triangle_tests as u64;
-        n += 1;
-    }
-    let n = n.max(1) as f64;
-    (nodes as f64 / n, tris as f64 / n)
-}
-
 /// Time the linear scan: on the whole frame if that is cheap enough, else on a spread sample.
-fn time_linear(
-    mesh: &Mesh,
-    camera: &Camera,
-    trace: TraceOptions,
-    budget: Duration,
-) -> (f64, Option<usize>) {
+fn time_linear(mesh: &Mesh, camera: &Camera, trace: TraceOptions, budget: Duration) -> (f64, Option<usize>) {
     let linear = LinearScan::new(mesh);
     let gen = camera.ray_gen();
     let total = camera.width as usize * camera.height as usize;
@@ -122,25 +104,15 @@ pub fn compare_rows(
     linear_budget: Duration,
 ) -> Vec<CompareRow> {
     let rays = camera.width as f64 * camera.height as f64;
-    let plain = RenderSettings {
-        trace: build.trace(),
-        count: false,
-        progressive: false,
-    };
-    let counting = RenderSettings {
-        count: true,
-        ..plain
-    };
+    let plain = RenderSettings { trace: build.trace(), count: false, progressive: false };
+    let counting = RenderSettings { count: true, ..plain };
     let mut rows = Vec::new();
     for strategy in SplitStrategy::ALL {
         let params = build.params(strategy);
-        let bvh = progress::with_spinner(&format!("building {}", strategy.label()), || {
-            Bvh::build(mesh, &params)
-        });
+        let bvh = progress::with_spinner(&format!("building {}", strategy.label()), || Bvh::build(mesh, &params));
         let stats = TreeStats::of(&bvh);
         let frame = render(&bvh, mesh, camera, &counting);
-        let (nodes_per_ray, tri_tests_per_ray) =
-            mean_counters(frame.samples.iter().map(|s| s.counters));
+        let summary = frame.ray_summary();
         let times: Vec<f64> = (0..runs)
             .map(|_| {
                 let t = Instant::now();
@@ -156,8 +128,8 @@ pub fn compare_rows(
             max_depth: stats.max_depth,
             mean_leaf_depth: stats.mean_leaf_depth,
             sah_cost: Some(stats.sah_cost),
-            nodes_per_ray,
-            tri_tests_per_ray,
+            nodes_per_ray: summary.mean_nodes_visited,
+            tri_tests_per_ray: summary.mean_triangle_tests,
             frame_ms,
             mrays_per_s: rays / frame_ms / 1e3,
             speedup_over_linear: 0.0,
@@ -165,9 +137,8 @@ pub fn compare_rows(
             fallback_splits: stats.fallback_splits,
         });
     }
-    let (linear_ms, sampled) = progress::with_spinner("timing the linear scan", || {
-        time_linear(mesh, camera, build.trace(), linear_budget)
-    });
+    let (linear_ms, sampled) =
+        progress::with_spinner("timing the linear scan", || time_linear(mesh, camera, build.trace(), linear_budget));
     rows.push(CompareRow {
         name: "Linear scan".to_string(),
         build_ms: None,
@@ -206,11 +177,7 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
                 "mesh": a.mesh, "triangles": mesh.triangle_count(), "width": camera.width, "height": camera.height,
                 "threads": threads, "trace": a.build.trace(), "rows": rows,
             });
-            let _ = writeln!(
-                o,
-                "{}",
-                serde_json::to_string_pretty(&v).expect("plain data serialises")
-            );
+            let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
         CompareFormat::Csv => {
             let _ = writeln!(o, "strategy,build_ms,nodes,max_depth,mean_leaf_depth,sah_cost,nodes_per_ray,tri_tests_per_ray,frame_ms,mrays_per_s,speedup_over_linear,sampled_rays");
@@ -237,11 +204,8 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
             let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | nodes / ray | tri tests / ray | frame ms | MRays/s | speedup vs linear |");
             let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
             for r in &rows {
-                let depth = if r.nodes > 0 {
-                    format!("{} / {:.1}", r.max_depth, r.mean_leaf_depth)
-                } else {
-                    "—".into()
-                };
+                let depth =
+                    if r.nodes > 0 { format!("{} / {:.1}", r.max_depth, r.mean_leaf_depth) } else { "—".into() };
                 let frame = if r.sampled_rays.is_some() {
                     format!("{:.0} *", r.frame_ms)
                 } else {
@@ -278,11 +242,7 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
                 .map(|r| format!("{} {}", r.name, r.fallback_splits))
                 .collect();
             if !fallbacks.is_empty() {
-                let _ = writeln!(
-                    o,
-                    "Equal-count fallback splits (no useful split found): {}.",
-                    fallbacks.join(", ")
-                );
+                let _ = writeln!(o, "Equal-count fallback splits (no useful split found): {}.", fallbacks.join(", "));
             }
         }
     }

@@ -45,10 +45,7 @@ pub enum CliError {
     #[error("{0}")]
     Usage(String),
     #[error("{}: cannot write: {source}", .path.display())]
-    Write {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Write { path: PathBuf, source: std::io::Error },
 }
 
 /// Load a mesh with a spinner when it takes over a second, and print what the loader skipped.
@@ -56,11 +53,7 @@ pub(crate) fn load_mesh(path: &Path) -> Result<(Mesh, LoadReport), CliError> {
     let label = format!("loading {}", path.display());
     let (mesh, report) = progress::with_spinner(&label, || load_obj(path))?;
     if report.degenerate_skipped > 0 {
-        eprintln!(
-            "note: {}: {} degenerate (zero-area) triangles skipped",
-            path.display(),
-            report.degenerate_skipped
-        );
+        eprintln!("note: {}: {} degenerate (zero-area) triangles skipped", path.display(), report.degenerate_skipped);
     }
     Ok((mesh, report))
 }

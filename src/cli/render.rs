@@ -3,12 +3,10 @@
 use super::args::{BuildArgs, ViewArgs};
 use super::{load_mesh, progress, CliError};
 use crate::bvh::Bvh;
-use crate::render::{
-    draw_legend, render_progressive, view_image, ColorMap, HeatRange, RenderSettings, View,
-};
+use crate::render::{draw_legend, render_progressive, view_image, ColorMap, HeatRange, RenderSettings, View};
+use crate::work::WorkControl;
 use clap::Args;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, AtomicU64};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -33,9 +31,7 @@ pub struct RenderArgs {
 }
 
 fn parse_range(s: &str) -> Result<(f32, f32), String> {
-    let (a, b) = s
-        .split_once(':')
-        .ok_or_else(|| format!("'{s}' is not MIN:MAX"))?;
+    let (a, b) = s.split_once(':').ok_or_else(|| format!("'{s}' is not MIN:MAX"))?;
     let (a, b) = (a.trim().parse::<f32>(), b.trim().parse::<f32>());
     match (a, b) {
         (Ok(a), Ok(b)) if a.is_finite() && b.is_finite() && a < b => Ok((a, b)),
@@ -48,28 +44,14 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let camera = a.view_args.camera(&mesh.bounds())?;
     let params = a.build.params(a.build.strategy);
     let bvh = progress::with_spinner("building the BVH", || Bvh::build(&mesh, &params));
-    let settings = RenderSettings {
-        trace: a.build.trace(),
-        count: a.view.is_heatmap(),
-        progressive: false,
-    };
+    let settings = RenderSettings { trace: a.build.trace(), count: a.view.is_heatmap(), progressive: false };
     let total = camera.width as u64 * camera.height as u64;
-    let done = AtomicU64::new(0);
-    let frame = progress::with_bar("rendering", total, &done, || {
-        render_progressive(
-            &bvh,
-            &mesh,
-            &camera,
-            &settings,
-            &AtomicBool::new(false),
-            &done,
-            |_, _| {},
-        )
+    let control = WorkControl::new();
+    let frame = progress::with_bar("rendering", &control, || {
+        render_progressive(&bvh, &mesh, &camera, &settings, &control, |_, _| {})
     })
-    .expect("never cancelled");
-    let range = a
-        .range
-        .map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
+    .map_err(|_| CliError::Usage("render cancelled".into()))?;
+    let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
     let (img, legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
     let img = match &legend {
         Some(l) => draw_legend(&img, l),
@@ -83,19 +65,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         },
     })?;
     let hits = frame.samples.iter().filter(|s| s.is_hit()).count();
-    eprint!(
-        "wrote {} ({}x{}, {} of {} pixels hit",
-        a.output.display(),
-        camera.width,
-        camera.height,
-        hits,
-        total
-    );
+    eprint!("wrote {} ({}x{}, {} of {} pixels hit", a.output.display(), camera.width, camera.height, hits, total);
     if let Some(l) = legend {
-        eprint!(
-            "; {}: min {} mean {:.2} max {}",
-            l.title, l.min, l.mean, l.max
-        );
+        eprint!("; {}: min {} mean {:.2} max {}", l.title, l.min, l.mean, l.max);
     }
     eprintln!(")");
     Ok(())

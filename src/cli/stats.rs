@@ -31,10 +31,7 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     match a.format {
         StatsFormat::Json => {
             let v = serde_json::json!({ "mesh": report, "params": params, "stats": s });
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&v).expect("plain data serialises")
-            );
+            println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
         StatsFormat::Text => print!("{}", format_text(&report, &params, &s)),
     }
@@ -42,11 +39,7 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
 }
 
 /// The statistics as a human-readable block.
-pub fn format_text(
-    report: &crate::mesh::LoadReport,
-    params: &crate::bvh::BuildParams,
-    s: &TreeStats,
-) -> String {
+pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildParams, s: &TreeStats) -> String {
     let mut o = String::new();
     let _ = writeln!(o, "mesh            {}", report.path.display());
     let _ = writeln!(
@@ -66,16 +59,8 @@ pub fn format_text(
         "build           {:.2} ms (setup {:.2}, split {:.2}, reorder {:.2})",
         s.build_total_ms, s.build_setup_ms, s.build_split_ms, s.build_reorder_ms
     );
-    let _ = writeln!(
-        o,
-        "nodes           {} ({} interior, {} leaves)",
-        s.nodes, s.interior_nodes, s.leaves
-    );
-    let _ = writeln!(
-        o,
-        "depth           max {}, mean leaf depth {:.2}",
-        s.max_depth, s.mean_leaf_depth
-    );
+    let _ = writeln!(o, "nodes           {} ({} interior, {} leaves)", s.nodes, s.interior_nodes, s.leaves);
+    let _ = writeln!(o, "depth           max {}, mean leaf depth {:.2}", s.max_depth, s.mean_leaf_depth);
     let _ = writeln!(
         o,
         "SAH cost        {:.3} (C_trav = {}, C_isect = {}, normalised by root area)",
@@ -88,22 +73,15 @@ pub fn format_text(
         s.memory_bytes as f64 / s.triangles.max(1) as f64
     );
     if s.fallback_splits > 0 || s.depth_limited_splits > 0 {
-        let _ = writeln!(o, "fallbacks       {} equal-count splits where the strategy found none, {} below the depth limit", s.fallback_splits, s.depth_limited_splits);
+        let _ = writeln!(
+            o,
+            "fallbacks       {} equal-count splits where the strategy found none, {} below the depth limit",
+            s.fallback_splits, s.depth_limited_splits
+        );
     }
     let _ = writeln!(o, "leaf sizes      (triangles: leaves)");
-    let most = s
-        .leaf_size_histogram
-        .iter()
-        .copied()
-        .max()
-        .unwrap_or(1)
-        .max(1);
-    for (k, &n) in s
-        .leaf_size_histogram
-        .iter()
-        .enumerate()
-        .filter(|(_, &n)| n > 0)
-    {
+    let most = s.leaf_size_histogram.iter().copied().max().unwrap_or(1).max(1);
+    for (k, &n) in s.leaf_size_histogram.iter().enumerate().filter(|(_, &n)| n > 0) {
         let bar = "#".repeat((n * 40).div_ceil(most));
         let _ = writeln!(o, "  {k:>3}: {n:>8}  {bar}");
     }

@@ -28,10 +28,7 @@ impl Default for Aabb {
 
 impl Aabb {
     /// The empty box: the identity of `union`.
-    pub const EMPTY: Aabb = Aabb {
-        min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
-    };
+    pub const EMPTY: Aabb = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
 
     pub fn new(min: Vec3, max: Vec3) -> Self {
         Self { min, max }
@@ -43,18 +40,12 @@ impl Aabb {
 
     #[inline]
     pub fn grow(self, p: Vec3) -> Self {
-        Self {
-            min: self.min.min(p),
-            max: self.max.max(p),
-        }
+        Self { min: self.min.min(p), max: self.max.max(p) }
     }
 
     #[inline]
     pub fn union(self, o: Aabb) -> Self {
-        Self {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-        }
+        Self { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     #[inline]
@@ -113,29 +104,13 @@ impl Aabb {
     #[inline(always)]
     pub fn slab(&self, origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> (f32, f32) {
         // Sign-selected planes; `is_sign_negative` distinguishes -inf (from -0) from +inf.
-        let (nx, fx) = if inv_dir.x.is_sign_negative() {
-            (self.max.x, self.min.x)
-        } else {
-            (self.min.x, self.max.x)
-        };
-        let (ny, fy) = if inv_dir.y.is_sign_negative() {
-            (self.max.y, self.min.y)
-        } else {
-            (self.min.y, self.max.y)
-        };
-        let (nz, fz) = if inv_dir.z.is_sign_negative() {
-            (self.max.z, self.min.z)
-        } else {
-            (self.min.z, self.max.z)
-        };
-        let t_enter = t_min
-            .max((nx - origin.x) * inv_dir.x)
-            .max((ny - origin.y) * inv_dir.y)
-            .max((nz - origin.z) * inv_dir.z);
-        let t_exit = t_max
-            .min((fx - origin.x) * inv_dir.x)
-            .min((fy - origin.y) * inv_dir.y)
-            .min((fz - origin.z) * inv_dir.z);
+        let (nx, fx) = if inv_dir.x.is_sign_negative() { (self.max.x, self.min.x) } else { (self.min.x, self.max.x) };
+        let (ny, fy) = if inv_dir.y.is_sign_negative() { (self.max.y, self.min.y) } else { (self.min.y, self.max.y) };
+        let (nz, fz) = if inv_dir.z.is_sign_negative() { (self.max.z, self.min.z) } else { (self.min.z, self.max.z) };
+        let t_enter =
+            t_min.max((nx - origin.x) * inv_dir.x).max((ny - origin.y) * inv_dir.y).max((nz - origin.z) * inv_dir.z);
+        let t_exit =
+            t_max.min((fx - origin.x) * inv_dir.x).min((fy - origin.y) * inv_dir.y).min((fz - origin.z) * inv_dir.z);
         (t_enter, t_exit)
     }
 }
@@ -179,11 +154,7 @@ mod tests {
         // The ray runs inside the plane y = 0 (a face of the box): 0 * inf = NaN must not reject it.
         for (y, dy) in [(0.0f32, 0.0f32), (0.0, -0.0), (1.0, 0.0), (1.0, -0.0)] {
             let r = Ray::new(Vec3::new(-1.0, y, 0.5), Vec3::new(1.0, dy, 0.0));
-            assert_eq!(
-                unit().intersect(&r),
-                Some((1.0, 2.0)),
-                "y = {y}, dy = {dy:?}"
-            );
+            assert_eq!(unit().intersect(&r), Some((1.0, 2.0)), "y = {y}, dy = {dy:?}");
         }
     }
 

@@ -7,6 +7,6 @@ pub(crate) mod triangle;
 pub use aabb::Aabb;
 pub use ray::Ray;
 pub use triangle::{
-    double_area as triangle_double_area, intersect_triangle, MollerTrumbore, TriangleHit,
-    TriangleIntersector, TriangleTest, Watertight,
+    double_area as triangle_double_area, intersect_triangle, MollerTrumbore, TriangleHit, TriangleIntersector,
+    TriangleTest, Watertight,
 };

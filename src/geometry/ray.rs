@@ -27,11 +27,7 @@ impl Ray {
     pub fn segment(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
         // 1/±0 = ±inf keeps the sign of a -0 component, which the slab test relies on.
         let inv_dir = Vec3::ONE / dir;
-        let valid = origin.is_finite()
-            && dir.is_finite()
-            && dir != Vec3::ZERO
-            && !t_min.is_nan()
-            && !t_max.is_nan();
+        let valid = origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO && !t_min.is_nan() && !t_max.is_nan();
         Self {
             origin,
             dir,

@@ -18,9 +18,7 @@ pub struct TriangleHit {
 }
 
 /// Which triangle test the traversal uses; chosen at run time, compiled as a type parameter.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum TriangleTest {
     /// Woop, Benthin & Wald 2013: no gaps along shared edges, no double hits at vertices.
     #[default]
@@ -86,14 +84,7 @@ impl TriangleIntersector for Watertight {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        WatertightRay {
-            kx,
-            ky,
-            kz,
-            sx: d[kx] / d[kz],
-            sy: d[ky] / d[kz],
-            sz: 1.0 / d[kz],
-        }
+        WatertightRay { kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
     }
 
     #[inline(always)]
@@ -109,9 +100,7 @@ impl TriangleIntersector for Watertight {
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
         if u == 0.0 || v == 0.0 || w == 0.0 {
-            let (ax, ay, bx, by, cx, cy) = (
-                ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
-            );
+            let (ax, ay, bx, by, cx, cy) = (ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64);
             u = (cx * by - cy * bx) as f32;
             v = (ax * cy - ay * cx) as f32;
             w = (bx * ay - by * ax) as f32;
@@ -134,11 +123,7 @@ impl TriangleIntersector for Watertight {
             return None;
         }
         // u, v, w weight v0, v1, v2: in our convention u ↔ v1 and v ↔ v2.
-        Some(TriangleHit {
-            t,
-            u: v * inv_det,
-            v: w * inv_det,
-        })
+        Some(TriangleHit { t, u: v * inv_det, v: w * inv_det })
     }
 }
 
@@ -205,11 +190,7 @@ pub fn double_area(tri: &[Vec3; 3]) -> f64 {
 mod tests {
     use super::*;
 
-    const TRI: [Vec3; 3] = [
-        Vec3::new(0.0, 0.0, 0.0),
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, 1.0, 0.0),
-    ];
+    const TRI: [Vec3; 3] = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
 
     fn both(ray: &Ray, tri: &[Vec3; 3]) -> [Option<TriangleHit>; 2] {
         [
@@ -227,20 +208,13 @@ mod tests {
         let r = Ray::new(Vec3::new(0.25, 0.5, 2.0), -Vec3::Z);
         for h in both(&r, &TRI) {
             let h = h.expect("hit");
-            assert!(
-                close(h.t, 2.0) && close(h.u, 0.25) && close(h.v, 0.5),
-                "{h:?}"
-            );
+            assert!(close(h.t, 2.0) && close(h.u, 0.25) && close(h.v, 0.5), "{h:?}");
         }
     }
 
     #[test]
     fn barycentrics_reconstruct_the_hit_point_for_an_oblique_ray() {
-        let tri = [
-            Vec3::new(1.0, 2.0, 3.0),
-            Vec3::new(4.0, 0.0, 2.0),
-            Vec3::new(2.0, 5.0, -1.0),
-        ];
+        let tri = [Vec3::new(1.0, 2.0, 3.0), Vec3::new(4.0, 0.0, 2.0), Vec3::new(2.0, 5.0, -1.0)];
         let target = tri[0] * 0.2 + tri[1] * 0.3 + tri[2] * 0.5;
         let o = Vec3::new(-3.0, 7.0, 9.0);
         let r = Ray::new(o, (target - o) * 0.37);
@@ -253,11 +227,7 @@ mod tests {
 
     #[test]
     fn miss_outside_the_triangle() {
-        for o in [
-            Vec3::new(0.6, 0.6, 1.0),
-            Vec3::new(-0.1, 0.5, 1.0),
-            Vec3::new(0.5, -0.1, 1.0),
-        ] {
+        for o in [Vec3::new(0.6, 0.6, 1.0), Vec3::new(-0.1, 0.5, 1.0), Vec3::new(0.5, -0.1, 1.0)] {
             let r = Ray::new(o, -Vec3::Z);
             assert_eq!(both(&r, &TRI), [None, None], "origin {o}");
         }
@@ -287,10 +257,7 @@ mod tests {
         let r = Ray::segment(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z, 2.5, 10.0);
         assert_eq!(both(&r, &TRI), [None, None], "hit before t_min");
         let r = Ray::segment(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z, 2.0, 10.0);
-        assert!(
-            both(&r, &TRI).iter().all(Option::is_some),
-            "t_min is inclusive"
-        );
+        assert!(both(&r, &TRI).iter().all(Option::is_some), "t_min is inclusive");
         let r = Ray::segment(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z, 0.0, 2.0);
         assert_eq!(both(&r, &TRI), [None, None], "t_max is exclusive");
         let r = Ray::new(Vec3::new(0.25, 0.25, -2.0), -Vec3::Z);
@@ -322,16 +289,8 @@ mod tests {
     fn watertight_shared_edge_is_never_missed() {
         // Two triangles sharing the diagonal of the unit square; rays along the diagonal in
         // awkward floating-point positions must hit at least one of them.
-        let t1 = [
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(1.0, 1.0, 0.0),
-        ];
-        let t2 = [
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(1.0, 1.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-        ];
+        let t1 = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0)];
+        let t2 = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
         for i in 1..1000 {
             let s = i as f32 / 1000.0 * 0.999_37;
             let p = Vec3::new(s, s, 0.0);

@@ -46,10 +46,7 @@ impl Mesh {
             normals: Vec::new(),
             uvs: Vec::new(),
             triangles,
-            groups: vec![MeshGroup {
-                name: name.to_string(),
-                triangles: 0..n,
-            }],
+            groups: vec![MeshGroup { name: name.to_string(), triangles: 0..n }],
         }
     }
 
@@ -60,18 +57,11 @@ impl Mesh {
     #[inline]
     pub fn triangle(&self, prim: u32) -> [Vec3; 3] {
         let [a, b, c] = self.triangles[prim as usize];
-        [
-            self.positions[a as usize],
-            self.positions[b as usize],
-            self.positions[c as usize],
-        ]
+        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
     }
 
     pub fn bounds(&self) -> Aabb {
-        self.triangles
-            .iter()
-            .flatten()
-            .fold(Aabb::EMPTY, |b, &i| b.grow(self.positions[i as usize]))
+        self.triangles.iter().flatten().fold(Aabb::EMPTY, |b, &i| b.grow(self.positions[i as usize]))
     }
 
     /// The group a triangle belongs to.
@@ -90,9 +80,7 @@ impl Mesh {
         } else {
             let [n0, n1, n2] = idx.map(|i| self.normals[i as usize]);
             // A zero or cancelling vertex normal falls back to the plane's normal.
-            (n0 * w + n1 * hit.u + n2 * hit.v)
-                .try_normalize()
-                .unwrap_or(geometric_normal)
+            (n0 * w + n1 * hit.u + n2 * hit.v).try_normalize().unwrap_or(geometric_normal)
         };
         let uv = if self.uvs.is_empty() {
             Vec2::new(hit.u, hit.v)
@@ -110,8 +98,7 @@ impl Mesh {
             prim,
         };
         debug_assert!(
-            (ray.at(si.t) - si.position).length()
-                <= 1e-3 * (1.0 + si.position.length() + si.t * ray.dir().length()),
+            (ray.at(si.t) - si.position).length() <= 1e-3 * (1.0 + si.position.length() + si.t * ray.dir().length()),
             "hit point disagrees with the ray"
         );
         si
@@ -138,15 +125,7 @@ mod tests {
         let m = quad();
         let r = Ray::new(Vec3::new(0.75, 0.25, 1.0), -Vec3::Z);
         // (0.75, 0.25) = 0.25·v0 + 0.5·v1 + 0.25·v2 in triangle 0.
-        let si = m.fill_intersection(
-            &r,
-            0,
-            TriangleHit {
-                t: 1.0,
-                u: 0.5,
-                v: 0.25,
-            },
-        );
+        let si = m.fill_intersection(&r, 0, TriangleHit { t: 1.0, u: 0.5, v: 0.25 });
         assert!((si.position - Vec3::new(0.75, 0.25, 0.0)).length() < 1e-6);
         assert_eq!(si.geometric_normal, Vec3::Z);
         let expect_n = (Vec3::Z * 0.75 + Vec3::new(0.0, 1.0, 1.0) * 0.25).normalize();
@@ -159,15 +138,7 @@ mod tests {
         let mut m = quad();
         m.normals.clear();
         let r = Ray::new(Vec3::new(0.25, 0.75, 1.0), -Vec3::Z);
-        let si = m.fill_intersection(
-            &r,
-            1,
-            TriangleHit {
-                t: 1.0,
-                u: 0.25,
-                v: 0.5,
-            },
-        );
+        let si = m.fill_intersection(&r, 1, TriangleHit { t: 1.0, u: 0.25, v: 0.5 });
         assert_eq!(si.shading_normal, Vec3::Z);
         assert_eq!(si.prim, 1);
     }

@@ -1,5 +1,6 @@
 //! The triangle mesh we render, and loading it from OBJ files.
 
+pub mod generate;
 #[allow(clippy::module_inception)]
 mod mesh;
 mod obj;

@@ -20,30 +20,15 @@ pub enum MeshError {
     #[error("{}: is a directory, not an OBJ file", .path.display())]
     IsDirectory { path: PathBuf },
     #[error("{}: cannot read: {source}", .path.display())]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     #[error("{}: line {line}: not a text file (binary data or invalid UTF-8)", .path.display())]
     NotText { path: PathBuf, line: usize },
     #[error("{}{}: {message}", .path.display(), LineSuffix(*.line))]
-    Parse {
-        path: PathBuf,
-        line: Option<usize>,
-        message: String,
-    },
+    Parse { path: PathBuf, line: Option<usize>, message: String },
     #[error("{}{}: {message}", .path.display(), LineSuffix(*.line))]
-    IndexOutOfRange {
-        path: PathBuf,
-        line: Option<usize>,
-        message: String,
-    },
+    IndexOutOfRange { path: PathBuf, line: Option<usize>, message: String },
     #[error("{}{}: {what} has a NaN or infinite coordinate", .path.display(), LineSuffix(*.line))]
-    NonFinite {
-        path: PathBuf,
-        line: Option<usize>,
-        what: &'static str,
-    },
+    NonFinite { path: PathBuf, line: Option<usize>, what: &'static str },
     #[error("{}: no triangles{}", .path.display(), if *.degenerate > 0 { format!(" (all {} faces are degenerate)", .degenerate) } else { String::new() })]
     NoTriangles { path: PathBuf, degenerate: usize },
 }
@@ -93,26 +78,15 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
     let start = Instant::now();
     let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => MeshError::NotFound { path: path.into() },
-        _ => MeshError::Io {
-            path: path.into(),
-            source: e,
-        },
+        _ => MeshError::Io { path: path.into(), source: e },
     })?;
     if meta.is_dir() {
         return Err(MeshError::IsDirectory { path: path.into() });
     }
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
-        path: path.into(),
-        source: e,
-    })?;
+    let bytes = std::fs::read(path).map_err(|e| MeshError::Io { path: path.into(), source: e })?;
     let text = match std::str::from_utf8(&bytes) {
         Ok(t) => t,
-        Err(e) => {
-            return Err(MeshError::NotText {
-                path: path.into(),
-                line: line_at(&bytes, e.valid_up_to()),
-            })
-        }
+        Err(e) => return Err(MeshError::NotText { path: path.into(), line: line_at(&bytes, e.valid_up_to()) }),
     };
     let (mesh, mut report) = parse_obj(path, text)?;
     report.load_time = start.elapsed();
@@ -123,10 +97,7 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
 pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
     if let Some(pos) = text.bytes().position(|b| b == 0) {
-        return Err(MeshError::NotText {
-            path: path.into(),
-            line: line_at(text.as_bytes(), pos),
-        });
+        return Err(MeshError::NotText { path: path.into(), line: line_at(text.as_bytes(), pos) });
     }
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -136,18 +107,14 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
         ..Default::default()
     };
     // Materials are not needed to show a BVH; a missing .mtl must not fail the load.
-    let loaded = tobj::load_obj_buf(&mut Cursor::new(text.as_bytes()), &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    });
+    let loaded =
+        tobj::load_obj_buf(&mut Cursor::new(text.as_bytes()), &options, |_| Err(tobj::LoadError::OpenFileFailed));
     let models = match loaded {
         Ok((models, _materials)) => models,
         Err(e) => return Err(diagnose(path, text, e)),
     };
 
-    let mut mesh = Mesh {
-        name: mesh_name(path),
-        ..Default::default()
-    };
+    let mut mesh = Mesh { name: mesh_name(path), ..Default::default() };
     let has_normals = models.iter().any(|m| !m.mesh.normals.is_empty());
     let has_uvs = models.iter().any(|m| !m.mesh.texcoords.is_empty());
     let mut degenerate = 0usize;
@@ -155,18 +122,10 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
         let nverts = m.positions.len() / 3;
-        mesh.positions.extend(
-            m.positions
-                .chunks_exact(3)
-                .map(|p| Vec3::new(p[0], p[1], p[2])),
-        );
+        mesh.positions.extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
         if has_normals {
             if m.normals.len() == m.positions.len() {
-                mesh.normals.extend(
-                    m.normals
-                        .chunks_exact(3)
-                        .map(|n| Vec3::new(n[0], n[1], n[2])),
-                );
+                mesh.normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])));
             } else {
                 // A part without normals: zero normals make `fill_intersection` use the plane's.
                 mesh.normals.extend(std::iter::repeat_n(Vec3::ZERO, nverts));
@@ -174,8 +133,7 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
         }
         if has_uvs {
             if m.texcoords.len() / 2 == nverts {
-                mesh.uvs
-                    .extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+                mesh.uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
             } else {
                 mesh.uvs.extend(std::iter::repeat_n(Vec2::ZERO, nverts));
             }
@@ -192,10 +150,7 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
         }
         let last = mesh.triangles.len() as u32;
         if last > first {
-            mesh.groups.push(MeshGroup {
-                name: model.name.clone(),
-                triangles: first..last,
-            });
+            mesh.groups.push(MeshGroup { name: model.name.clone(), triangles: first..last });
         }
     }
 
@@ -221,10 +176,7 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
         });
     }
     if mesh.triangles.is_empty() {
-        return Err(MeshError::NoTriangles {
-            path: path.into(),
-            degenerate,
-        });
+        return Err(MeshError::NoTriangles { path: path.into(), degenerate });
     }
     let report = LoadReport {
         path: path.into(),
@@ -240,18 +192,12 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
 }
 
 fn mesh_name(path: &Path) -> String {
-    path.file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| path.display().to_string())
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
 }
 
 /// 1-based line number of byte offset `pos`.
 fn line_at(bytes: &[u8], pos: usize) -> usize {
-    bytes[..pos.min(bytes.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
+    bytes[..pos.min(bytes.len())].iter().filter(|&&b| b == b'\n').count() + 1
 }
 
 /// Lines of the file as (1-based number, keyword, rest of the tokens); comments dropped.
@@ -267,11 +213,7 @@ fn statements(text: &str) -> impl Iterator<Item = (usize, &str, Vec<&str>)> {
 /// First `keyword` line whose first `min` values are missing, unparsable or not finite.
 fn first_bad_line(text: &str, keyword: &str, min: usize) -> Option<usize> {
     statements(text).find_map(|(n, k, args)| {
-        let bad = args.len() < min
-            || args
-                .iter()
-                .take(3)
-                .any(|a| a.parse::<f32>().map_or(true, |x| !x.is_finite()));
+        let bad = args.len() < min || args.iter().take(3).any(|a| a.parse::<f32>().map_or(true, |x| !x.is_finite()));
         (k == keyword && bad).then_some(n)
     })
 }
@@ -303,13 +245,7 @@ fn first_bad_face(text: &str, which: Option<Corner>) -> Option<(usize, String)> 
             "vn" => counts[2] += 1,
             "f" => {
                 if which.is_none() && args.len() < 3 {
-                    return Some((
-                        n,
-                        format!(
-                            "a face needs at least 3 corners, this one has {}",
-                            args.len()
-                        ),
-                    ));
+                    return Some((n, format!("a face needs at least 3 corners, this one has {}", args.len())));
                 }
                 for corner in &args {
                     for (slot, part) in corner.split('/').enumerate().take(3) {
@@ -318,10 +254,7 @@ fn first_bad_face(text: &str, which: Option<Corner>) -> Option<(usize, String)> 
                         }
                         let Ok(idx) = part.parse::<i64>() else {
                             if which.is_none() {
-                                return Some((
-                                    n,
-                                    format!("face corner '{corner}' is not a number"),
-                                ));
+                                return Some((n, format!("face corner '{corner}' is not a number")));
                             }
                             continue;
                         };
@@ -333,7 +266,10 @@ fn first_bad_face(text: &str, which: Option<Corner>) -> Option<(usize, String)> 
                         let resolved = if idx < 0 { count + idx + 1 } else { idx };
                         if idx == 0 || resolved < 1 || resolved > count {
                             let what = ["vertex", "texture coordinate", "normal"][slot];
-                            return Some((n, format!("face refers to {what} {idx}, but only {count} are declared before this line")));
+                            return Some((
+                                n,
+                                format!("face refers to {what} {idx}, but only {count} are declared before this line"),
+                            ));
                         }
                     }
                 }
@@ -354,18 +290,13 @@ fn diagnose(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
         message: message.to_string(),
     };
     match e {
-        L::PositionParseError => parse(
-            first_unparsable_line(text, "v", 3),
-            "cannot read a vertex position (expected 3 numbers)",
-        ),
-        L::NormalParseError => parse(
-            first_unparsable_line(text, "vn", 3),
-            "cannot read a vertex normal (expected 3 numbers)",
-        ),
-        L::TexcoordParseError => parse(
-            first_unparsable_line(text, "vt", 1),
-            "cannot read a texture coordinate",
-        ),
+        L::PositionParseError => {
+            parse(first_unparsable_line(text, "v", 3), "cannot read a vertex position (expected 3 numbers)")
+        }
+        L::NormalParseError => {
+            parse(first_unparsable_line(text, "vn", 3), "cannot read a vertex normal (expected 3 numbers)")
+        }
+        L::TexcoordParseError => parse(first_unparsable_line(text, "vt", 1), "cannot read a texture coordinate"),
         L::FaceParseError | L::InvalidPolygon => match first_bad_face(text, None) {
             Some((line, msg)) => parse(Some(line), &msg),
             None => parse(None, &format!("invalid face ({e})")),
@@ -380,11 +311,7 @@ fn diagnose(path: &Path, text: &str, e: tobj::LoadError) -> MeshError {
                 Some((line, msg)) => (Some(line), msg),
                 None => (None, e.to_string()),
             };
-            MeshError::IndexOutOfRange {
-                path,
-                line,
-                message,
-            }
+            MeshError::IndexOutOfRange { path, line, message }
         }
         other => parse(None, &format!("not a valid OBJ file ({other})")),
     }
@@ -396,8 +323,7 @@ mod tests {
 
     #[test]
     fn quads_are_triangulated_and_groups_kept() {
-        let text =
-            "o first\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\ng second\nv 0 0 1\nf 1 2 5\n";
+        let text = "o first\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\ng second\nv 0 0 1\nf 1 2 5\n";
         let (mesh, report) = parse_obj("quad.obj", text).unwrap();
         assert_eq!(mesh.triangles.len(), 3);
         assert_eq!(report.triangles, 3);
@@ -409,8 +335,7 @@ mod tests {
 
     #[test]
     fn normals_and_uvs_are_kept() {
-        let text =
-            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\n";
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\n";
         let (mesh, report) = parse_obj("t.obj", text).unwrap();
         assert!(report.has_normals && report.has_uvs);
         assert_eq!(mesh.normals.len(), mesh.positions.len());
@@ -433,14 +358,8 @@ mod tests {
     #[test]
     fn nan_position_names_the_line() {
         let e = err("v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
-        assert!(
-            matches!(e, MeshError::NonFinite { line: Some(3), .. }),
-            "{e}"
-        );
-        assert_eq!(
-            e.to_string(),
-            "bad.obj: line 3: a vertex position has a NaN or infinite coordinate"
-        );
+        assert!(matches!(e, MeshError::NonFinite { line: Some(3), .. }), "{e}");
+        assert_eq!(e.to_string(), "bad.obj: line 3: a vertex position has a NaN or infinite coordinate");
         let e = err("v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n");
         assert_eq!(e.line(), Some(2));
     }
@@ -448,16 +367,10 @@ mod tests {
     #[test]
     fn index_out_of_range_names_the_line() {
         let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n");
-        assert!(
-            matches!(e, MeshError::IndexOutOfRange { line: Some(5), .. }),
-            "{e}"
-        );
+        assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(5), .. }), "{e}");
         assert!(e.to_string().contains("vertex 9"), "{e}");
         let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
-        assert!(
-            matches!(e, MeshError::IndexOutOfRange { line: Some(4), .. }),
-            "{e}"
-        );
+        assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(4), .. }), "{e}");
     }
 
     #[test]
@@ -468,16 +381,10 @@ mod tests {
 
     #[test]
     fn no_triangles_is_an_error() {
-        assert!(matches!(
-            err("v 0 0 0\nv 1 0 0\n"),
-            MeshError::NoTriangles { degenerate: 0, .. }
-        ));
+        assert!(matches!(err("v 0 0 0\nv 1 0 0\n"), MeshError::NoTriangles { degenerate: 0, .. }));
         assert!(matches!(err(""), MeshError::NoTriangles { .. }));
         let e = err("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
-        assert!(
-            matches!(e, MeshError::NoTriangles { degenerate: 1, .. }),
-            "{e}"
-        );
+        assert!(matches!(e, MeshError::NoTriangles { degenerate: 1, .. }), "{e}");
     }
 
     #[test]

@@ -109,11 +109,7 @@ impl Camera {
     pub fn framing_from(bounds: &Aabb, width: u32, height: u32, from: Vec3) -> Camera {
         let vfov_deg = 45.0f32;
         let (width, height) = (width.max(1), height.max(1));
-        let b = if bounds.is_empty() {
-            Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))
-        } else {
-            *bounds
-        };
+        let b = if bounds.is_empty() { Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)) } else { *bounds };
         let center = b.center();
         let radius = (b.extent().length() * 0.5).max(1e-6);
         let dir = from.try_normalize().unwrap_or(Vec3::Z);
@@ -145,14 +141,7 @@ impl Camera {
                 lo = mid;
             }
         }
-        Camera {
-            position: center + dir * hi,
-            look_at: center,
-            up: Vec3::Y,
-            vfov_deg,
-            width,
-            height,
-        }
+        Camera { position: center + dir * hi, look_at: center, up: Vec3::Y, vfov_deg, width, height }
     }
 }
 
@@ -179,10 +168,7 @@ mod tests {
         let bottom = g.ray(600.0, 800.0).dir();
         assert!((top.angle_between(bottom).to_degrees() - 45.0).abs() < 1e-3);
         assert!(top.y > bottom.y, "row 0 is the top of the image");
-        assert!(
-            g.ray(1200.0, 400.0).dir().x > 0.0,
-            "the last column is on the right"
-        );
+        assert!(g.ray(1200.0, 400.0).dir().x > 0.0, "the last column is on the right");
     }
 
     #[test]
@@ -217,45 +203,11 @@ mod tests {
 
     #[test]
     fn invalid_cameras_are_rejected() {
-        let ok = Camera {
-            position: Vec3::Z,
-            look_at: Vec3::ZERO,
-            up: Vec3::Y,
-            vfov_deg: 45.0,
-            width: 8,
-            height: 8,
-        };
-        assert_eq!(
-            Camera {
-                look_at: Vec3::Z,
-                ..ok
-            }
-            .validate(),
-            Err(CameraError::NoDirection)
-        );
-        assert_eq!(
-            Camera { up: Vec3::Z, ..ok }.validate(),
-            Err(CameraError::BadUp)
-        );
-        assert_eq!(
-            Camera {
-                vfov_deg: 180.0,
-                ..ok
-            }
-            .validate(),
-            Err(CameraError::BadFov(180.0))
-        );
-        assert_eq!(
-            Camera { width: 0, ..ok }.validate(),
-            Err(CameraError::BadSize(0, 8))
-        );
-        assert_eq!(
-            Camera {
-                position: Vec3::NAN,
-                ..ok
-            }
-            .validate(),
-            Err(CameraError::NotFinite)
-        );
+        let ok = Camera { position: Vec3::Z, look_at: Vec3::ZERO, up: Vec3::Y, vfov_deg: 45.0, width: 8, height: 8 };
+        assert_eq!(Camera { look_at: Vec3::Z, ..ok }.validate(), Err(CameraError::NoDirection));
+        assert_eq!(Camera { up: Vec3::Z, ..ok }.validate(), Err(CameraError::BadUp));
+        assert_eq!(Camera { vfov_deg: 180.0, ..ok }.validate(), Err(CameraError::BadFov(180.0)));
+        assert_eq!(Camera { width: 0, ..ok }.validate(), Err(CameraError::BadSize(0, 8)));
+        assert_eq!(Camera { position: Vec3::NAN, ..ok }.validate(), Err(CameraError::NotFinite));
     }
 }

@@ -1,9 +1,7 @@
 //! Perceptual colour maps for heatmaps, from the `colorous` crate (viridis and inferno: van der
 //! Walt & Smith's matplotlib maps; turbo: Mikhailov 2019).
 
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum ColorMap {
     #[default]
     Viridis,
@@ -13,12 +11,7 @@ pub enum ColorMap {
 }
 
 impl ColorMap {
-    pub const ALL: [ColorMap; 4] = [
-        ColorMap::Viridis,
-        ColorMap::Inferno,
-        ColorMap::Magma,
-        ColorMap::Turbo,
-    ];
+    pub const ALL: [ColorMap; 4] = [ColorMap::Viridis, ColorMap::Inferno, ColorMap::Magma, ColorMap::Turbo];
 
     pub fn label(self) -> &'static str {
         match self {

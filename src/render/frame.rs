@@ -22,12 +22,7 @@ impl PixelSample {
         t: f32::INFINITY,
         normal: Vec3::ZERO,
         prim: u32::MAX,
-        counters: RayCounters {
-            nodes_visited: 0,
-            box_tests: 0,
-            leaves_visited: 0,
-            triangle_tests: 0,
-        },
+        counters: RayCounters { nodes_visited: 0, box_tests: 0, leaves_visited: 0, triangle_tests: 0 },
     };
 
     pub fn is_hit(&self) -> bool {
@@ -75,14 +70,8 @@ impl Frame {
     pub fn traced(&self) -> impl Iterator<Item = &PixelSample> + '_ {
         let s = self.stride.max(1) as usize;
         let w = self.width as usize;
-        let rows = if self.stride == 0 {
-            0
-        } else {
-            self.height as usize
-        };
-        (0..rows)
-            .step_by(s)
-            .flat_map(move |y| (0..w).step_by(s).map(move |x| &self.samples[y * w + x]))
+        let rows = if self.stride == 0 { 0 } else { self.height as usize };
+        (0..rows).step_by(s).flat_map(move |y| (0..w).step_by(s).map(move |x| &self.samples[y * w + x]))
     }
 
     /// Hit mask, row by row (true = hit), at full resolution.
@@ -91,5 +80,38 @@ impl Frame {
             .flat_map(|y| (0..self.width).map(move |x| (x, y)))
             .map(|(x, y)| self.sample(x, y).is_hit())
             .collect()
+    }
+}
+
+/// Per-ray work over the traced rays of a frame (hit and missed).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct RaySummary {
+    pub rays: u64,
+    pub hits: u64,
+    pub mean_nodes_visited: f64,
+    pub max_nodes_visited: u32,
+    pub mean_box_tests: f64,
+    pub mean_triangle_tests: f64,
+    pub max_triangle_tests: u32,
+}
+
+impl Frame {
+    pub fn ray_summary(&self) -> RaySummary {
+        let mut s = RaySummary::default();
+        let (mut nodes, mut boxes, mut tris) = (0u64, 0u64, 0u64);
+        for p in self.traced() {
+            s.rays += 1;
+            s.hits += p.is_hit() as u64;
+            nodes += p.counters.nodes_visited as u64;
+            boxes += p.counters.box_tests as u64;
+            tris += p.counters.triangle_tests as u64;
+            s.max_nodes_visited = s.max_nodes_visited.max(p.counters.nodes_visited);
+            s.max_triangle_tests = s.max_triangle_tests.max(p.counters.triangle_tests);
+        }
+        let n = s.rays.max(1) as f64;
+        s.mean_nodes_visited = nodes as f64 / n;
+        s.mean_box_tests = boxes as f64 / n;
+        s.mean_triangle_tests = tris as f64 / n;
+        s
     }
 }

@@ -15,10 +15,7 @@ fn text_width(s: &str) -> u32 {
 
 fn draw_text(img: &mut RgbImage, x: u32, y: u32, s: &str, color: Rgb<u8>) {
     for (i, ch) in s.chars().enumerate() {
-        let glyph = font8x8::BASIC_FONTS
-            .get(ch)
-            .or_else(|| font8x8::LATIN_FONTS.get(ch))
-            .unwrap_or([0; 8]);
+        let glyph = font8x8::BASIC_FONTS.get(ch).or_else(|| font8x8::LATIN_FONTS.get(ch)).unwrap_or([0; 8]);
         for (row, bits) in glyph.iter().enumerate() {
             for col in 0..8u32 {
                 if bits & (1 << col) == 0 {
@@ -61,15 +58,11 @@ pub fn draw_legend(img: &RgbImage, legend: &Legend) -> RgbImage {
     let hi = fmt_value(legend.range_max as f64);
     let bar_y = y0 + LINE + PAD;
     let bar_x0 = PAD + text_width(&lo) + PAD;
-    let bar_x1 = w
-        .saturating_sub(PAD + text_width(&hi) + PAD)
-        .max(bar_x0 + 1);
+    let bar_x1 = w.saturating_sub(PAD + text_width(&hi) + PAD).max(bar_x0 + 1);
     draw_text(&mut out, PAD, bar_y, &lo, white);
     draw_text(&mut out, bar_x1 + PAD, bar_y, &hi, white);
     for x in bar_x0..bar_x1 {
-        let c = legend
-            .colormap
-            .map((x - bar_x0) as f32 / (bar_x1 - bar_x0 - 1).max(1) as f32);
+        let c = legend.colormap.map((x - bar_x0) as f32 / (bar_x1 - bar_x0 - 1).max(1) as f32);
         for y in bar_y..bar_y + LINE {
             out.put_pixel(x, y, Rgb(c));
         }

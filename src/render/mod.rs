@@ -5,13 +5,13 @@
 mod camera;
 mod colormap;
 mod frame;
-mod legend;
+pub mod legend;
 mod raycast;
 mod views;
 
 pub use camera::{Camera, CameraError};
 pub use colormap::ColorMap;
-pub use frame::{Frame, PixelSample};
+pub use frame::{Frame, PixelSample, RaySummary};
 pub use legend::draw_legend;
-pub use raycast::{render, render_progressive, Cancelled, PassInfo, RenderSettings, PASS_STRIDES};
+pub use raycast::{render, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
 pub use views::{view_image, HeatRange, Legend, View};

@@ -6,8 +6,8 @@
 use super::{Camera, Frame, PixelSample};
 use crate::bvh::{Accelerator, NoStats, RayCounters, TraceOptions, TraversalStats};
 use crate::mesh::Mesh;
+use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// Pixel strides of the passes, coarse to fine.
@@ -34,95 +34,43 @@ pub struct PassInfo {
     pub elapsed: Duration,
 }
 
-/// The render was cancelled before finishing.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("render cancelled")]
-pub struct Cancelled;
-
 /// Render a full frame in one pass (no cancellation, no progress).
-pub fn render<A: Accelerator>(
-    accel: &A,
-    mesh: &Mesh,
-    camera: &Camera,
-    settings: &RenderSettings,
-) -> Frame {
-    let settings = RenderSettings {
-        progressive: false,
-        ..*settings
-    };
-    render_progressive(
-        accel,
-        mesh,
-        camera,
-        &settings,
-        &AtomicBool::new(false),
-        &AtomicU64::new(0),
-        |_, _| {},
-    )
-    .expect("not cancelled")
+pub fn render<A: Accelerator>(accel: &A, mesh: &Mesh, camera: &Camera, settings: &RenderSettings) -> Frame {
+    let settings = RenderSettings { progressive: false, ..*settings };
+    match render_progressive(accel, mesh, camera, &settings, &WorkControl::new(), |_, _| {}) {
+        Ok(frame) => frame,
+        Err(Cancelled) => unreachable!("nobody else holds this control"),
+    }
 }
 
-/// Render pass by pass. `rays_done` is increased as bands finish (for progress bars); `on_pass`
-/// sees the frame after each pass. Returns the finished frame, or `Cancelled` once `cancel` is set.
+/// Render pass by pass. The control's total is set to the pixel count and its done counter
+/// advanced as bands finish; `on_pass` sees the frame after each pass. Returns the finished frame,
+/// or `Cancelled` once the control is cancelled (checked before each band).
 pub fn render_progressive<A: Accelerator>(
     accel: &A,
     mesh: &Mesh,
     camera: &Camera,
     settings: &RenderSettings,
-    cancel: &AtomicBool,
-    rays_done: &AtomicU64,
+    control: &WorkControl,
     mut on_pass: impl FnMut(&Frame, &PassInfo),
 ) -> Result<Frame, Cancelled> {
     let start = Instant::now();
+    control.set_total(camera.width as u64 * camera.height as u64);
     let mut frame = Frame::new(camera.width, camera.height);
     frame.counted = settings.count;
-    let strides: &[u32] = if settings.progressive {
-        &PASS_STRIDES
-    } else {
-        &[1]
-    };
+    let strides: &[u32] = if settings.progressive { &PASS_STRIDES } else { &[1] };
     let mut previous = 0u32;
     for &stride in strides {
         let t = Instant::now();
         let rays = if settings.count {
-            trace_pass::<A, RayCounters>(
-                accel,
-                mesh,
-                camera,
-                settings.trace,
-                &mut frame,
-                stride,
-                previous,
-                cancel,
-                rays_done,
-            )
+            trace_pass::<A, RayCounters>(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
         } else {
-            trace_pass::<A, NoStats>(
-                accel,
-                mesh,
-                camera,
-                settings.trace,
-                &mut frame,
-                stride,
-                previous,
-                cancel,
-                rays_done,
-            )
+            trace_pass::<A, NoStats>(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
         };
-        if cancel.load(Ordering::Relaxed) {
-            return Err(Cancelled);
-        }
+        control.check()?;
         frame.stride = stride;
         previous = stride;
-        on_pass(
-            &frame,
-            &PassInfo {
-                stride,
-                rays,
-                pass_time: t.elapsed(),
-                elapsed: start.elapsed(),
-            },
-        );
+        on_pass(&frame, &PassInfo { stride, rays, pass_time: t.elapsed(), elapsed: start.elapsed() });
     }
     Ok(frame)
 }
@@ -137,8 +85,7 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
     frame: &mut Frame,
     stride: u32,
     previous: u32,
-    cancel: &AtomicBool,
-    rays_done: &AtomicU64,
+    control: &WorkControl,
 ) -> u64 {
     let gen = camera.ray_gen();
     let w = frame.width;
@@ -148,7 +95,7 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
         .par_chunks_mut(band_len)
         .enumerate()
         .map(|(band, samples)| {
-            if cancel.load(Ordering::Relaxed) {
+            if control.is_cancelled() {
                 return 0;
             }
             let y0 = band as u32 * TILE;
@@ -173,17 +120,14 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
                                     counters: stats.into(),
                                 }
                             }
-                            None => PixelSample {
-                                counters: stats.into(),
-                                ..PixelSample::MISS
-                            },
+                            None => PixelSample { counters: stats.into(), ..PixelSample::MISS },
                         };
                         samples[(dy * w + x) as usize] = sample;
                         traced += 1;
                     }
                 }
             }
-            rays_done.fetch_add(traced, Ordering::Relaxed);
+            control.add_done(traced);
             traced
         })
         .sum()
@@ -227,67 +171,35 @@ mod tests {
     fn progressive_passes_trace_each_pixel_once_and_match_a_single_pass() {
         let (mesh, cam) = quad_scene();
         let bvh = Bvh::build(&mesh, &BuildParams::default());
-        let settings = RenderSettings {
-            count: true,
-            progressive: true,
-            ..Default::default()
-        };
+        let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
         let mut strides = Vec::new();
         let mut total = 0;
-        let done = AtomicU64::new(0);
-        let frame = render_progressive(
-            &bvh,
-            &mesh,
-            &cam,
-            &settings,
-            &AtomicBool::new(false),
-            &done,
-            |f, p| {
-                strides.push(f.stride);
-                total += p.rays;
-            },
-        )
+        let control = WorkControl::new();
+        let frame = render_progressive(&bvh, &mesh, &cam, &settings, &control, |f, p| {
+            strides.push(f.stride);
+            total += p.rays;
+        })
         .unwrap();
         assert_eq!(strides, PASS_STRIDES);
-        assert_eq!(
-            total,
-            37 * 23,
-            "every pixel traced exactly once over all passes"
-        );
-        assert_eq!(done.load(Ordering::Relaxed), 37 * 23);
+        assert_eq!(total, 37 * 23, "every pixel traced exactly once over all passes");
+        assert_eq!(control.done(), 37 * 23);
         let single = render(&bvh, &mesh, &cam, &settings);
         assert_eq!(frame.samples, single.samples);
-        assert!(
-            frame.samples.iter().any(|s| s.is_hit()) && frame.samples.iter().any(|s| !s.is_hit())
-        );
-        assert!(
-            frame.samples.iter().all(|s| s.counters.box_tests >= 1),
-            "counters recorded"
-        );
+        assert!(frame.samples.iter().any(|s| s.is_hit()) && frame.samples.iter().any(|s| !s.is_hit()));
+        assert!(frame.samples.iter().all(|s| s.counters.box_tests >= 1), "counters recorded");
     }
 
     #[test]
     fn cancel_stops_the_render() {
         let (mesh, cam) = quad_scene();
         let bvh = Bvh::build(&mesh, &BuildParams::default());
-        let cancel = AtomicBool::new(false);
-        let settings = RenderSettings {
-            progressive: true,
-            ..Default::default()
-        };
+        let control = WorkControl::new();
+        let settings = RenderSettings { progressive: true, ..Default::default() };
         let mut passes = 0;
-        let r = render_progressive(
-            &bvh,
-            &mesh,
-            &cam,
-            &settings,
-            &cancel,
-            &AtomicU64::new(0),
-            |_, _| {
-                passes += 1;
-                cancel.store(true, Ordering::Relaxed);
-            },
-        );
+        let r = render_progressive(&bvh, &mesh, &cam, &settings, &control, |_, _| {
+            passes += 1;
+            control.cancel();
+        });
         assert_eq!(r.unwrap_err(), Cancelled);
         assert_eq!(passes, 1);
     }

@@ -5,9 +5,7 @@ use super::{ColorMap, Frame, PixelSample};
 use crate::bvh::SahCost;
 use image::RgbImage;
 
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum View {
     #[default]
     Normals,
@@ -21,13 +19,7 @@ pub enum View {
 }
 
 impl View {
-    pub const ALL: [View; 5] = [
-        View::Normals,
-        View::Depth,
-        View::Visits,
-        View::TriTests,
-        View::Cost,
-    ];
+    pub const ALL: [View; 5] = [View::Normals, View::Depth, View::Visits, View::TriTests, View::Cost];
 
     pub fn short_name(self) -> &'static str {
         match self {
@@ -157,18 +149,7 @@ pub fn view_image(
                 image::Rgb(colormap.map((view.metric(frame.sample(x, y), cost) - lo) * scale))
             });
             let title = format!("{} per ray", view.label().to_lowercase());
-            (
-                img,
-                Some(Legend {
-                    title,
-                    colormap,
-                    range_min: lo,
-                    range_max: hi,
-                    min,
-                    max,
-                    mean,
-                }),
-            )
+            (img, Some(Legend { title, colormap, range_min: lo, range_max: hi, min, max, mean }))
         }
     }
 }

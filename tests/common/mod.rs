@@ -14,15 +14,9 @@ pub fn shared_models() -> Option<PathBuf> {
         return Some(dir);
     }
     if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!(
-            "CI=true but the shared test meshes are missing: {}",
-            dir.display()
-        );
+        panic!("CI=true but the shared test meshes are missing: {}", dir.display());
     }
-    eprintln!(
-        "notice: {} not found; skipping tests on shared meshes",
-        dir.display()
-    );
+    eprintln!("notice: {} not found; skipping tests on shared meshes", dir.display());
     None
 }
 
@@ -39,10 +33,7 @@ pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
     for &p in &bvh.prim_ids {
         seen[p as usize] += 1;
     }
-    assert!(
-        seen.iter().all(|&c| c == 1),
-        "prim_ids is not a permutation"
-    );
+    assert!(seen.iter().all(|&c| c == 1), "prim_ids is not a permutation");
     for (i, &p) in bvh.prim_ids.iter().enumerate() {
         assert_eq!(bvh.tris[i], mesh.triangle(p), "reordered triangle {i}");
     }
@@ -54,23 +45,13 @@ pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
         reached += 1;
         let node: &BvhNode = &bvh.nodes[i];
         if let Some(pb) = parent {
-            assert!(
-                pb.contains_box(&node.bounds),
-                "node {i} box sticks out of its parent"
-            );
+            assert!(pb.contains_box(&node.bounds), "node {i} box sticks out of its parent");
         }
         if node.is_leaf() {
-            assert!(
-                node.count as u32 <= bvh.params.max_leaf_size,
-                "leaf {i} has {} > max",
-                node.count
-            );
+            assert!(node.count as u32 <= bvh.params.max_leaf_size, "leaf {i} has {} > max", node.count);
             for k in node.prims() {
                 for v in bvh.tris[k] {
-                    assert!(
-                        node.bounds.contains_box(&Aabb::new(v, v)),
-                        "leaf {i} does not contain its triangle"
-                    );
+                    assert!(node.bounds.contains_box(&Aabb::new(v, v)), "leaf {i} does not contain its triangle");
                 }
             }
             leaf_ranges.push(node.prims());
@@ -81,18 +62,11 @@ pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
             stack.push((l + 1, Some(node.bounds)));
         }
     }
-    assert_eq!(
-        reached,
-        bvh.nodes.len(),
-        "every node is reachable exactly once"
-    );
+    assert_eq!(reached, bvh.nodes.len(), "every node is reachable exactly once");
     leaf_ranges.sort_by_key(|r| r.start);
     let mut next = 0;
     for r in &leaf_ranges {
-        assert_eq!(
-            r.start, next,
-            "leaf ranges must tile the primitive array without gaps or overlap"
-        );
+        assert_eq!(r.start, next, "leaf ranges must tile the primitive array without gaps or overlap");
         next = r.end;
     }
     assert_eq!(next, n, "leaf ranges must cover every triangle");

@@ -11,9 +11,6 @@ pub fn split_midpoint(prims: &mut [BuildPrim], node: &NodeInfo) -> SplitDecision
     if mid == 0 || mid == prims.len() {
         SplitDecision::Fallback
     } else {
-        SplitDecision::Split {
-            axis: axis as u8,
-            mid,
-        }
+        SplitDecision::Split { axis: axis as u8, mid }
     }
 }

@@ -21,9 +21,7 @@ pub const fn sah_binned_max_bins() -> usize {
 pub use sah_sweep::split_sah_sweep;
 
 /// How the builder chooses splits.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum SplitStrategy {
     /// Middle of the centroid bounds on the widest axis.
     Midpoint,
@@ -37,12 +35,8 @@ pub enum SplitStrategy {
 }
 
 impl SplitStrategy {
-    pub const ALL: [SplitStrategy; 4] = [
-        SplitStrategy::Midpoint,
-        SplitStrategy::EqualCount,
-        SplitStrategy::SahBinned,
-        SplitStrategy::SahSweep,
-    ];
+    pub const ALL: [SplitStrategy; 4] =
+        [SplitStrategy::Midpoint, SplitStrategy::EqualCount, SplitStrategy::SahBinned, SplitStrategy::SahSweep];
 
     /// Kebab-case name used on the command line.
     pub fn short_name(self) -> &'static str {
@@ -66,10 +60,16 @@ impl SplitStrategy {
     /// One line for a tooltip or `--help`.
     pub fn description(self) -> &'static str {
         match self {
-            SplitStrategy::Midpoint => "split the widest axis of the centroid bounds in the middle; fast, poor on uneven meshes",
-            SplitStrategy::EqualCount => "split at the median centroid of the widest axis; balanced tree, ignores box sizes",
+            SplitStrategy::Midpoint => {
+                "split the widest axis of the centroid bounds in the middle; fast, poor on uneven meshes"
+            }
+            SplitStrategy::EqualCount => {
+                "split at the median centroid of the widest axis; balanced tree, ignores box sizes"
+            }
             SplitStrategy::SahBinned => "surface area heuristic over bins on all axes; near-best trees, fast to build",
-            SplitStrategy::SahSweep => "surface area heuristic tried between every pair of centroids; exact, slowest to build",
+            SplitStrategy::SahSweep => {
+                "surface area heuristic tried between every pair of centroids; exact, slowest to build"
+            }
         }
     }
 
@@ -102,8 +102,8 @@ pub enum SplitDecision {
         axis: u8,
         mid: usize,
     },
-    /// The strategy found no useful split (e.g. midpoint with one side empty) and asks the driver
-    /// for its fallback, the equal-count split; the driver counts these for the statistics.
+    /// The strategy found no useful split (e.g. midpoint with one side empty). The driver makes a
+    /// leaf if the triangles fit in one, else splits by equal count and counts it in the statistics.
     Fallback,
 }
 

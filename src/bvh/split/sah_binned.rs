@@ -16,11 +16,7 @@ fn bin_of(c: f32, lo: f32, scale: f32, bins: usize) -> usize {
     ((c - lo) * scale).max(0.0).min((bins - 1) as f32) as usize
 }
 
-pub fn split_sah_binned(
-    prims: &mut [BuildPrim],
-    node: &NodeInfo,
-    params: &BuildParams,
-) -> SplitDecision {
+pub fn split_sah_binned(prims: &mut [BuildPrim], node: &NodeInfo, params: &BuildParams) -> SplitDecision {
     let bins = (params.sah_bins as usize).clamp(2, MAX_BINS);
     let cb = node.centroid_bounds;
     let n = prims.len();
@@ -73,11 +69,6 @@ pub fn split_sah_binned(
         return SplitDecision::Leaf;
     }
     let scale = bins as f32 / (cb.max[axis] - cb.min[axis]);
-    let mid = partition(prims, |p| {
-        bin_of(p.centroid[axis], cb.min[axis], scale, bins) < plane
-    });
-    SplitDecision::Split {
-        axis: axis as u8,
-        mid,
-    }
+    let mid = partition(prims, |p| bin_of(p.centroid[axis], cb.min[axis], scale, bins) < plane);
+    SplitDecision::Split { axis: axis as u8, mid }
 }

@@ -8,11 +8,7 @@ use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 
 fn sort_on(prims: &mut [BuildPrim], axis: usize) {
-    prims.sort_unstable_by(|a, b| {
-        a.centroid[axis]
-            .total_cmp(&b.centroid[axis])
-            .then(a.index.cmp(&b.index))
-    });
+    prims.sort_unstable_by(|a, b| a.centroid[axis].total_cmp(&b.centroid[axis]).then(a.index.cmp(&b.index)));
 }
 
 pub fn split_sah_sweep(
@@ -55,8 +51,7 @@ pub fn split_sah_sweep(
     let Some((weighted, axis, mid)) = best else {
         return SplitDecision::Fallback;
     };
-    let split_cost =
-        params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
+    let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
     let leaf_cost = params.cost.intersection * n as f32;
     if n <= params.max_leaf_size as usize && leaf_cost <= split_cost {
         return SplitDecision::Leaf;
@@ -64,8 +59,5 @@ pub fn split_sah_sweep(
     if sorted_on != Some(axis) {
         sort_on(prims, axis);
     }
-    SplitDecision::Split {
-        axis: axis as u8,
-        mid,
-    }
+    SplitDecision::Split { axis: axis as u8, mid }
 }

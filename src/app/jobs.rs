@@ -1,0 +1,260 @@
+//! Background work for the app: loading, building and rendering each run on their own thread
+//! and report over one channel; the UI thread only polls. Starting a job of a kind cancels the
+//! running one of that kind, and results of superseded jobs are dropped by id.
+
+use super::scene::{Scene, SceneSource};
+use crate::bvh::{BuildParams, Bvh};
+use crate::bvh::{SahCost, TraceOptions};
+use crate::mesh::{load_obj, Mesh};
+use crate::render::{
+    render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, Legend, PassInfo, RenderSettings, View,
+};
+use crate::work::{Cancelled, WorkControl};
+use std::path::PathBuf;
+use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// How a frame is turned into colours (the parts of the view that need no re-trace are here too,
+/// since any change of view restarts the refinement anyway).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewStyle {
+    pub view: View,
+    pub colormap: ColorMap,
+    pub range: HeatRange,
+    pub cost: SahCost,
+}
+
+#[derive(Clone)]
+pub struct RenderRequest {
+    pub bvh: Arc<Bvh>,
+    pub mesh: Arc<Mesh>,
+    pub camera: Camera,
+    pub trace: TraceOptions,
+    pub style: ViewStyle,
+    pub progressive: bool,
+}
+
+impl RenderRequest {
+    /// Whether two requests would produce the same image.
+    pub fn same_as(&self, o: &RenderRequest) -> bool {
+        Arc::ptr_eq(&self.bvh, &o.bvh)
+            && Arc::ptr_eq(&self.mesh, &o.mesh)
+            && self.camera == o.camera
+            && self.trace == o.trace
+            && self.style == o.style
+            && self.progressive == o.progressive
+    }
+}
+
+/// One finished render pass, ready to show.
+pub struct PassOutput {
+    pub frame: Arc<Frame>,
+    pub image: egui::ColorImage,
+    pub legend: Option<Legend>,
+    pub info: PassInfo,
+    pub camera: Camera,
+    pub style: ViewStyle,
+}
+
+/// What a file dialog was opened for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pick {
+    Open,
+    SavePng,
+    SaveStatsCsv,
+    SaveStatsJson,
+}
+
+pub enum JobEvent {
+    Loaded(Result<Scene, String>),
+    Built { scene_id: u64, params: BuildParams, result: Result<Arc<Bvh>, Cancelled> },
+    Pass(PassOutput),
+    Picked { pick: Pick, path: Option<PathBuf>, took: Duration },
+}
+
+/// A job in flight.
+pub struct Running {
+    pub id: u64,
+    pub control: Arc<WorkControl>,
+    pub started: Instant,
+    pub label: String,
+}
+
+pub struct Jobs {
+    tx: Sender<(u64, JobEvent)>,
+    rx: Receiver<(u64, JobEvent)>,
+    ctx: egui::Context,
+    next_id: u64,
+    pub load: Option<Running>,
+    pub build: Option<Running>,
+    pub render: Option<Running>,
+    pub picking: Option<Pick>,
+    /// The last render started (to tell whether a new one is needed).
+    pub last_render: Option<RenderRequest>,
+    /// The last build started: its parameters and scene.
+    pub last_build: Option<(BuildParams, u64)>,
+}
+
+impl Jobs {
+    pub fn new(ctx: egui::Context) -> Self {
+        let (tx, rx) = channel();
+        Self {
+            tx,
+            rx,
+            ctx,
+            next_id: 1,
+            load: None,
+            build: None,
+            render: None,
+            picking: None,
+            last_render: None,
+            last_build: None,
+        }
+    }
+
+    fn start(&mut self, label: String) -> Running {
+        let id = self.next_id;
+        self.next_id += 1;
+        Running { id, control: Arc::new(WorkControl::new()), started: Instant::now(), label }
+    }
+
+    fn sender(&self, id: u64) -> impl Fn(JobEvent) + Send + 'static {
+        let (tx, ctx) = (self.tx.clone(), self.ctx.clone());
+        move |e| {
+            // The receiver lives as long as the app; if it is gone, nobody needs the result.
+            let _ = tx.send((id, e));
+            ctx.request_repaint();
+        }
+    }
+
+    pub fn is_busy(&self) -> bool {
+        self.load.is_some() || self.build.is_some() || self.render.is_some()
+    }
+
+    /// Load an OBJ in the background.
+    pub fn load(&mut self, path: PathBuf) {
+        if let Some(old) = self.load.take() {
+            old.control.cancel();
+        }
+        let job = self.start(format!("Loading {}", path.display()));
+        let send = self.sender(job.id);
+        std::thread::spawn(move || {
+            let result = load_obj(&path)
+                .map(|(mesh, report)| Scene::new(Arc::new(mesh), report, SceneSource::File(path)))
+                .map_err(|e| e.to_string());
+            send(JobEvent::Loaded(result));
+        });
+        self.load = Some(job);
+    }
+
+    /// Build a BVH in the background; a running build is cancelled.
+    pub fn build(&mut self, mesh: Arc<Mesh>, params: BuildParams, scene_id: u64) {
+        if let Some(old) = self.build.take() {
+            old.control.cancel();
+        }
+        let job = self.start(format!("Building ({})", params.strategy.label()));
+        let (send, control) = (self.sender(job.id), job.control.clone());
+        std::thread::spawn(move || {
+            let result = Bvh::build_controlled(&mesh, &params, &control).map(Arc::new);
+            send(JobEvent::Built { scene_id, params, result });
+        });
+        self.build = Some(job);
+        self.last_build = Some((params, scene_id));
+    }
+
+    /// Render progressively in the background; a running render is cancelled.
+    pub fn render(&mut self, req: RenderRequest) {
+        if let Some(old) = self.render.take() {
+            old.control.cancel();
+        }
+        let job = self.start("Rendering".to_string());
+        let (send, control) = (self.sender(job.id), job.control.clone());
+        let r = req.clone();
+        std::thread::spawn(move || {
+            // Always count: the heatmaps and the hover read-out need the counters, and counting
+            // costs little next to shading.
+            let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive };
+            let _ = render_progressive(&*r.bvh, &r.mesh, &r.camera, &settings, &control, |frame, info| {
+                let (img, legend) = view_image(frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
+                let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
+                send(JobEvent::Pass(PassOutput {
+                    frame: Arc::new(frame.clone()),
+                    image,
+                    legend,
+                    info: *info,
+                    camera: r.camera,
+                    style: r.style,
+                }));
+            });
+        });
+        self.render = Some(job);
+        self.last_render = Some(req);
+    }
+
+    /// Ask for a file with the system dialog, off the UI thread (rfd's async dialog blocks its
+    /// thread until answered where a portal or zenity exists, and returns None at once where not).
+    pub fn pick_file(&mut self, pick: Pick, suggested_name: &str) {
+        if self.picking.is_some() {
+            return;
+        }
+        self.picking = Some(pick);
+        let send = self.sender(0);
+        let name = suggested_name.to_string();
+        std::thread::spawn(move || {
+            let start = Instant::now();
+            let dialog = rfd::AsyncFileDialog::new();
+            let fut = async move {
+                match pick {
+                    Pick::Open => dialog.add_filter("Wavefront OBJ", &["obj", "OBJ"]).pick_file().await,
+                    Pick::SavePng => dialog.add_filter("PNG image", &["png"]).set_file_name(&name).save_file().await,
+                    Pick::SaveStatsCsv => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
+                    Pick::SaveStatsJson => dialog.add_filter("JSON", &["json"]).set_file_name(&name).save_file().await,
+                }
+            };
+            let path = pollster_block_on(fut).map(|h| h.path().to_path_buf());
+            send(JobEvent::Picked { pick, path, took: start.elapsed() });
+        });
+    }
+
+    /// Events of current jobs (superseded ones are dropped); finished jobs are cleared.
+    pub fn poll(&mut self) -> Vec<JobEvent> {
+        let mut out = Vec::new();
+        while let Ok((id, event)) = self.rx.try_recv() {
+            let current = |slot: &Option<Running>| slot.as_ref().is_some_and(|r| r.id == id);
+            match &event {
+                JobEvent::Loaded(_) if current(&self.load) => self.load = None,
+                JobEvent::Built { .. } if current(&self.build) => self.build = None,
+                JobEvent::Pass(p) if current(&self.render) => {
+                    if p.info.stride == 1 {
+                        self.render = None;
+                    }
+                }
+                JobEvent::Picked { .. } => self.picking = None,
+                _ => continue,
+            }
+            out.push(event);
+        }
+        out
+    }
+}
+
+/// Run a future to completion on this thread (rfd's dialogs are futures).
+fn pollster_block_on<F: std::future::Future>(fut: F) -> F::Output {
+    use std::task::{Context, Poll, Wake, Waker};
+    struct ThreadWaker(std::thread::Thread);
+    impl Wake for ThreadWaker {
+        fn wake(self: Arc<Self>) {
+            self.0.unpark();
+        }
+    }
+    let waker = Waker::from(Arc::new(ThreadWaker(std::thread::current())));
+    let mut cx = Context::from_waker(&waker);
+    let mut fut = std::pin::pin!(fut);
+    loop {
+        match fut.as_mut().poll(&mut cx) {
+            Poll::Ready(v) => return v,
+            Poll::Pending => std::thread::park(),
+        }
+    }
+}

@@ -1,0 +1,124 @@
+//! The viewport's orbit camera: yaw and pitch around a target at a distance, +y up.
+
+use crate::geometry::Aabb;
+use crate::render::Camera;
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitCamera {
+    pub target: Vec3,
+    /// Rotation about +y, radians; 0 looks along -z.
+    pub yaw: f32,
+    /// Elevation, radians, within ±89°.
+    pub pitch: f32,
+    pub distance: f32,
+    pub vfov_deg: f32,
+}
+
+const MAX_PITCH: f32 = 89.0 * std::f32::consts::PI / 180.0;
+
+impl OrbitCamera {
+    /// The default view of `bounds` (the CLI's default camera) for an image of the given aspect.
+    pub fn home(bounds: &Aabb, aspect: f32) -> Self {
+        let (w, h) = aspect_size(aspect);
+        Self::from_camera(&Camera::framing(bounds, w, h))
+    }
+
+    fn from_camera(c: &Camera) -> Self {
+        let offset = c.position - c.look_at;
+        let distance = offset.length();
+        let d = offset / distance;
+        Self {
+            target: c.look_at,
+            yaw: d.x.atan2(d.z),
+            pitch: d.y.clamp(-1.0, 1.0).asin().clamp(-MAX_PITCH, MAX_PITCH),
+            distance,
+            vfov_deg: c.vfov_deg,
+        }
+    }
+
+    /// Unit vector from the target to the eye.
+    pub fn direction(&self) -> Vec3 {
+        Vec3::new(self.pitch.cos() * self.yaw.sin(), self.pitch.sin(), self.pitch.cos() * self.yaw.cos())
+    }
+
+    pub fn camera(&self, width: u32, height: u32) -> Camera {
+        Camera {
+            position: self.target + self.direction() * self.distance,
+            look_at: self.target,
+            up: Vec3::Y,
+            vfov_deg: self.vfov_deg,
+            width,
+            height,
+        }
+    }
+
+    /// Rotate by a mouse drag of (dx, dy) pixels.
+    pub fn orbit(&mut self, dx: f32, dy: f32) {
+        self.yaw -= dx * 0.008;
+        self.pitch = (self.pitch + dy * 0.008).clamp(-MAX_PITCH, MAX_PITCH);
+    }
+
+    /// Move the target so the scene follows a drag of (dx, dy) pixels in a view `height` high.
+    pub fn pan(&mut self, dx: f32, dy: f32, height: f32) {
+        let forward = -self.direction();
+        let right = forward.cross(Vec3::Y).normalize_or(Vec3::X);
+        let up = right.cross(forward);
+        let per_pixel = 2.0 * self.distance * (self.vfov_deg.to_radians() * 0.5).tan() / height.max(1.0);
+        self.target += (-right * dx + up * dy) * per_pixel;
+    }
+
+    /// Zoom by mouse-wheel steps (positive: closer).
+    pub fn zoom(&mut self, steps: f32) {
+        self.distance = (self.distance * (-steps * 0.0015).exp()).clamp(1e-6, 1e9);
+    }
+
+    /// Keep the direction, fit `bounds` into the view.
+    pub fn frame(&mut self, bounds: &Aabb, aspect: f32) {
+        let (w, h) = aspect_size(aspect);
+        *self = Self {
+            yaw: self.yaw,
+            pitch: self.pitch,
+            ..Self::from_camera(&Camera::framing_from(bounds, w, h, self.direction()))
+        };
+    }
+}
+
+/// An image size with the given aspect (for framing, only the ratio matters).
+fn aspect_size(aspect: f32) -> (u32, u32) {
+    let aspect = if aspect.is_finite() && aspect > 0.0 { aspect.clamp(0.05, 20.0) } else { 1.0 };
+    ((1000.0 * aspect).round().max(1.0) as u32, 1000)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn home_matches_the_cli_default_camera() {
+        let b = Aabb::new(Vec3::new(-1.0, 0.0, -2.0), Vec3::new(3.0, 1.0, 0.5));
+        let o = OrbitCamera::home(&b, 1.6);
+        let c = Camera::framing(&b, 1600, 1000);
+        let oc = o.camera(1600, 1000);
+        assert!((oc.position - c.position).length() < 1e-4 * c.position.length().max(1.0));
+        assert_eq!(oc.look_at, c.look_at);
+    }
+
+    #[test]
+    fn orbit_keeps_distance_and_pan_moves_target_and_eye_together() {
+        let mut o = OrbitCamera::home(&Aabb::new(Vec3::splat(-1.0), Vec3::ONE), 1.0);
+        let d = o.distance;
+        o.orbit(120.0, -40.0);
+        let c = o.camera(100, 100);
+        assert!(((c.position - c.look_at).length() - d).abs() < 1e-4);
+        let before = o.camera(100, 100);
+        o.pan(10.0, 5.0, 100.0);
+        let after = o.camera(100, 100);
+        let moved = after.look_at - before.look_at;
+        assert!(moved.length() > 0.0);
+        assert!(((after.position - before.position) - moved).length() < 1e-5);
+        o.orbit(0.0, 1e6);
+        assert!(o.pitch <= MAX_PITCH, "pitch is clamped short of the pole");
+        o.camera(10, 10).validate().unwrap();
+    }
+}

@@ -1,0 +1,187 @@
+//! The node-box overlay: BVH boxes as wireframes over the ray-cast image, in the same pinhole
+//! projection as the renderer. Edges are clipped against the near plane in camera space before
+//! projection, so a box around or behind the camera draws correctly instead of wrapping around.
+
+use crate::geometry::Aabb;
+use crate::render::Camera;
+use egui::{Color32, Mesh, Pos2, Rect};
+use glam::Vec3;
+
+/// Corner pairs of the 12 box edges; corner k has x from bit 0, y from bit 1, z from bit 2.
+const EDGES: [(usize, usize); 12] =
+    [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
+
+/// Projects world points into a screen rectangle as the camera sees them.
+pub struct Projector {
+    eye: Vec3,
+    right: Vec3,
+    up: Vec3,
+    forward: Vec3,
+    /// Screen pixels per unit of x/z and y/z.
+    sx: f32,
+    sy: f32,
+    center: Pos2,
+    near: f32,
+}
+
+impl Projector {
+    pub fn new(camera: &Camera, rect: Rect, near: f32) -> Self {
+        let forward = (camera.look_at - camera.position).normalize();
+        let right = forward.cross(camera.up).normalize();
+        let up = right.cross(forward);
+        let tan_v = (camera.vfov_deg.to_radians() * 0.5).tan();
+        let tan_h = tan_v * camera.aspect();
+        Self {
+            eye: camera.position,
+            right,
+            up,
+            forward,
+            sx: rect.width() * 0.5 / tan_h,
+            sy: rect.height() * 0.5 / tan_v,
+            center: rect.center(),
+            near,
+        }
+    }
+
+    fn to_camera(&self, p: Vec3) -> Vec3 {
+        let d = p - self.eye;
+        Vec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.forward))
+    }
+
+    fn to_screen(&self, c: Vec3) -> Pos2 {
+        Pos2::new(self.center.x + c.x / c.z * self.sx, self.center.y - c.y / c.z * self.sy)
+    }
+
+    /// The screen segment of a world segment, clipped to the near plane; None if wholly behind it.
+    #[cfg(test)]
+    pub fn segment(&self, a: Vec3, b: Vec3) -> Option<(Pos2, Pos2)> {
+        self.clip_segment(self.to_camera(a), self.to_camera(b))
+    }
+
+    fn clip_segment(&self, mut a: Vec3, mut b: Vec3) -> Option<(Pos2, Pos2)> {
+        if a.z < self.near && b.z < self.near {
+            return None;
+        }
+        if a.z < self.near {
+            a = a + (b - a) * ((self.near - a.z) / (b.z - a.z));
+        } else if b.z < self.near {
+            b = b + (a - b) * ((self.near - b.z) / (a.z - b.z));
+        }
+        Some((self.to_screen(a), self.to_screen(b)))
+    }
+
+    /// The 12 edges of a box, clipped and projected.
+    pub fn box_edges(&self, b: &Aabb) -> impl Iterator<Item = (Pos2, Pos2)> + '_ {
+        let corners: [Vec3; 8] = std::array::from_fn(|k| {
+            self.to_camera(Vec3::new(
+                if k & 1 == 0 { b.min.x } else { b.max.x },
+                if k & 2 == 0 { b.min.y } else { b.max.y },
+                if k & 4 == 0 { b.min.z } else { b.max.z },
+            ))
+        });
+        EDGES.iter().filter_map(move |&(i, j)| self.clip_segment(corners[i], corners[j]))
+    }
+}
+
+/// A distinct, stable colour per node (golden-ratio hue steps).
+pub fn node_color(node: usize) -> Color32 {
+    let hue = (node as f32 * 0.618_034).fract();
+    egui::ecolor::Hsva::new(hue, 0.85, 1.0, 1.0).into()
+}
+
+/// All boxes as one mesh of thin quads: far cheaper for egui than 12 line shapes per box, which
+/// keeps 10,000 boxes smooth.
+pub fn boxes_mesh(boxes: &[(usize, Aabb)], camera: &Camera, rect: Rect, width: f32) -> Mesh {
+    let extent = boxes.iter().fold(Aabb::EMPTY, |acc, (_, b)| acc.union(*b)).extent().length().max(1e-6);
+    let near = (extent * 1e-4).max((camera.position - camera.look_at).length() * 1e-4);
+    let projector = Projector::new(camera, rect, near);
+    let clip = rect.expand(rect.width().max(rect.height()));
+    let mut mesh = Mesh::default();
+    for (node, b) in boxes {
+        let color = node_color(*node);
+        for (p, q) in projector.box_edges(b) {
+            // Segments far outside the view are dropped; egui clips the rest to the viewport.
+            if !clip.contains(p) && !clip.contains(q) && !Rect::from_two_pos(p, q).intersects(rect) {
+                continue;
+            }
+            let d = q - p;
+            let len = d.length();
+            if !(len.is_finite()) || len < 1e-3 {
+                continue;
+            }
+            let n = egui::vec2(-d.y, d.x) / len * (width * 0.5);
+            let base = mesh.vertices.len() as u32;
+            for v in [p + n, p - n, q - n, q + n] {
+                mesh.colored_vertex(v, color);
+            }
+            mesh.add_triangle(base, base + 1, base + 2);
+            mesh.add_triangle(base, base + 2, base + 3);
+        }
+    }
+    mesh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera {
+            position: Vec3::new(0.0, 0.0, 5.0),
+            look_at: Vec3::ZERO,
+            up: Vec3::Y,
+            vfov_deg: 90.0,
+            width: 200,
+            height: 100,
+        }
+    }
+
+    fn rect() -> Rect {
+        Rect::from_min_size(Pos2::ZERO, egui::vec2(200.0, 100.0))
+    }
+
+    #[test]
+    fn points_project_like_the_renderer() {
+        let p = Projector::new(&camera(), rect(), 0.01);
+        // The look-at point is the centre; with a 90° vertical fov, y = z·tan(45°) is the top edge.
+        let (a, _) = p.segment(Vec3::ZERO, Vec3::ZERO).unwrap();
+        assert_eq!(a, Pos2::new(100.0, 50.0));
+        let (top, _) = p.segment(Vec3::new(0.0, 5.0, 0.0), Vec3::ZERO).unwrap();
+        assert!((top.y - 0.0).abs() < 1e-3, "{top:?}");
+        // And the renderer's ray through that screen point heads towards the world point.
+        let g = camera().ray_gen();
+        let dir = g.ray(150.0, 25.0).dir();
+        let world = Vec3::new(0.0, 0.0, 5.0) + dir * (5.0 / -dir.z);
+        let (s, _) = p.segment(world, world).unwrap();
+        assert!((s - Pos2::new(150.0, 25.0)).length() < 1e-2, "{s:?}");
+    }
+
+    #[test]
+    fn edges_behind_the_camera_are_dropped_and_crossing_ones_clipped() {
+        let p = Projector::new(&camera(), rect(), 0.01);
+        assert!(p.segment(Vec3::new(0.0, 0.0, 6.0), Vec3::new(1.0, 0.0, 9.0)).is_none());
+        let (a, b) = p.segment(Vec3::new(1.0, 0.0, 10.0), Vec3::new(1.0, 0.0, 0.0)).expect("part is visible");
+        assert!(a.x.is_finite() && b.x.is_finite());
+        // x/z = 1/5 with tan(h/2) = 2 (aspect 2, 90° vertical): 100 + 0.2 / 2 * 100 = 110.
+        assert!((b.x - 110.0).abs() < 1e-3, "the visible end projects normally: {b:?}");
+        // A box around the camera still yields finite, clipped edges.
+        let around = Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0));
+        let edges: Vec<_> = p.box_edges(&around).collect();
+        assert!(!edges.is_empty() && edges.len() < 12);
+        assert!(edges.iter().all(|(a, b)| a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite()));
+    }
+
+    #[test]
+    fn mesh_has_one_quad_per_visible_edge() {
+        let boxes = vec![
+            (1, Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))),
+            (2, Aabb::new(Vec3::splat(-0.5), Vec3::splat(0.5))),
+        ];
+        let m = boxes_mesh(&boxes, &camera(), rect(), 1.0);
+        // Seen head-on, 4 edges of each box are parallel to the view axis... but still have length
+        // except the ones pointing exactly at the centre; all 24 edges project to some length here.
+        assert_eq!(m.vertices.len() % 4, 0);
+        assert!(m.vertices.len() / 4 >= 16 && m.vertices.len() / 4 <= 24);
+        assert_ne!(node_color(1), node_color(2));
+    }
+}

@@ -1,0 +1,57 @@
+//! The build panel: strategy and its parameters, traversal order and triangle test. Any change
+//! rebuilds (or re-renders) in the background.
+
+use crate::app::BvhscopeApp;
+use crate::bvh::{SplitStrategy, TraversalOrder};
+use crate::geometry::TriangleTest;
+
+pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
+    ui.heading("Build");
+    let s = &mut app.settings;
+    let label = ui.label("Split strategy");
+    egui::ComboBox::from_id_salt("strategy")
+        .selected_text(s.build.strategy.label())
+        .width(200.0)
+        .show_ui(ui, |ui| {
+            for k in SplitStrategy::ALL {
+                ui.selectable_value(&mut s.build.strategy, k, k.label()).on_hover_text(k.description());
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text(s.build.strategy.description());
+
+    ui.add(egui::Slider::new(&mut s.build.max_leaf_size, 1..=32).text("Max leaf size"))
+        .on_hover_text("Most triangles in a leaf. The SAH strategies may stop earlier when a leaf is cheaper.");
+    let sah = s.build.strategy == SplitStrategy::SahBinned;
+    ui.add_enabled(sah, egui::Slider::new(&mut s.build.sah_bins, 2..=64).text("SAH bins"))
+        .on_hover_text("Bins per axis of the binned SAH: more bins, closer to the exact sweep, slower build.");
+    ui.add(egui::Slider::new(&mut s.build.cost.traversal, 0.1..=4.0).text("SAH traversal cost"))
+        .on_hover_text("Cost of one traversal step relative to one triangle test (1 = equal).");
+
+    ui.add_space(4.0);
+    ui.label("Traversal order");
+    for o in TraversalOrder::ALL {
+        let tip = match o {
+            TraversalOrder::SplitAxisSign => {
+                "The handout's rule: the ray's sign on the node's split axis picks the near child"
+            }
+            TraversalOrder::EntryDistance => "Visit the child whose box the ray enters first",
+        };
+        ui.radio_value(&mut s.trace.order, o, o.label()).on_hover_text(tip);
+    }
+    ui.label("Triangle test");
+    for t in TriangleTest::ALL {
+        let tip = match t {
+            TriangleTest::Watertight => "Woop, Benthin & Wald 2013: no cracks along shared edges",
+            TriangleTest::MollerTrumbore => "Möller & Trumbore 1997: the classic; may miss rays exactly through edges",
+        };
+        ui.radio_value(&mut s.trace.test, t, t.label()).on_hover_text(tip);
+    }
+    if let Some(job) = &app.jobs.build {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label(format!("{} {:.0}%", job.label, job.control.fraction() * 100.0));
+        });
+    }
+}

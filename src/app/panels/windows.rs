@@ -1,0 +1,61 @@
+//! Floating windows: Help (shortcuts), and the path field used when no file dialog is available.
+
+use crate::app::shortcuts::{MOUSE, SHORTCUTS};
+use crate::app::{BvhscopeApp, Pick};
+use std::path::PathBuf;
+
+pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
+    let mut open = app.show_help;
+    egui::Window::new("Help").open(&mut open).resizable(false).show(ctx, |ui| {
+        ui.heading("Keyboard");
+        egui::Grid::new("keys").num_columns(2).striped(true).show(ui, |ui| {
+            for (shortcut, _, what) in SHORTCUTS {
+                ui.monospace(ctx.format_shortcut(shortcut));
+                ui.label(*what);
+                ui.end_row();
+            }
+        });
+        ui.heading("Mouse");
+        egui::Grid::new("mouse").num_columns(2).striped(true).show(ui, |ui| {
+            for (input, what) in MOUSE {
+                ui.monospace(*input);
+                ui.label(*what);
+                ui.end_row();
+            }
+        });
+    });
+    app.show_help = open;
+
+    let Some(window) = &mut app.path_window else { return };
+    let title = match window.pick {
+        Pick::Open => "Open a mesh",
+        Pick::SavePng => "Save the view as PNG",
+        Pick::SaveStatsCsv => "Export statistics (CSV)",
+        Pick::SaveStatsJson => "Export statistics (JSON)",
+    };
+    let mut keep = true;
+    let mut chosen = None;
+    egui::Window::new(title).collapsible(false).resizable(false).show(ctx, |ui| {
+        if let Some(note) = &window.note {
+            ui.label(note);
+        }
+        let label = ui.label("Path");
+        let edit = ui.add(egui::TextEdit::singleline(&mut window.text).desired_width(420.0)).labelled_by(label.id);
+        let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        ui.horizontal(|ui| {
+            let verb = if window.pick == Pick::Open { "Open" } else { "Save" };
+            if (ui.button(verb).clicked() || enter) && !window.text.trim().is_empty() {
+                chosen = Some((window.pick, PathBuf::from(window.text.trim())));
+            }
+            if ui.button("Cancel").clicked() {
+                keep = false;
+            }
+        });
+    });
+    if let Some((pick, path)) = chosen {
+        app.path_window = None;
+        app.picked(pick, path);
+    } else if !keep {
+        app.path_window = None;
+    }
+}

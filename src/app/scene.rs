@@ -1,0 +1,48 @@
+//! The mesh on screen and where it came from.
+
+use crate::mesh::{generate, LoadReport, Mesh};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneSource {
+    Builtin,
+    File(PathBuf),
+}
+
+#[derive(Clone)]
+pub struct Scene {
+    pub mesh: Arc<Mesh>,
+    pub report: LoadReport,
+    pub source: SceneSource,
+}
+
+impl Scene {
+    pub fn new(mesh: Arc<Mesh>, report: LoadReport, source: SceneSource) -> Self {
+        Self { mesh, report, source }
+    }
+
+    /// The scene shown when no file is given.
+    pub fn builtin() -> Self {
+        let mesh = generate::builtin_scene();
+        let report = LoadReport {
+            path: PathBuf::from(&mesh.name),
+            vertices: mesh.positions.len(),
+            triangles: mesh.triangle_count(),
+            groups: mesh.groups.len(),
+            has_normals: true,
+            has_uvs: true,
+            ..Default::default()
+        };
+        Self::new(Arc::new(mesh), report, SceneSource::Builtin)
+    }
+
+    pub fn title(&self) -> String {
+        match &self.source {
+            SceneSource::Builtin => self.mesh.name.clone(),
+            SceneSource::File(p) => {
+                p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+            }
+        }
+    }
+}

@@ -1,0 +1,63 @@
+//! Keyboard shortcuts: one table, used both to handle keys and to list them in the Help window.
+
+use egui::{Key, KeyboardShortcut, Modifiers};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    Open,
+    OpenPath,
+    SavePng,
+    ExportStats,
+    FrameMesh,
+    ResetView,
+    View(usize),
+    ToggleBoxes,
+    DepthUp,
+    DepthDown,
+    NextStrategy,
+    NextColormap,
+    Help,
+}
+
+pub const SHORTCUTS: &[(KeyboardShortcut, Action, &str)] = &[
+    (KeyboardShortcut::new(Modifiers::COMMAND, Key::O), Action::Open, "Open a mesh (file dialog)"),
+    (KeyboardShortcut::new(Modifiers::COMMAND, Key::L), Action::OpenPath, "Open a mesh by typing its path"),
+    (KeyboardShortcut::new(Modifiers::COMMAND, Key::S), Action::SavePng, "Save the view as PNG"),
+    (KeyboardShortcut::new(Modifiers::COMMAND, Key::E), Action::ExportStats, "Export the statistics (CSV / JSON)"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::F), Action::FrameMesh, "Frame the mesh"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::R), Action::ResetView, "Reset the camera"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::Num1), Action::View(0), "Normals view"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::Num2), Action::View(1), "Depth view"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::Num3), Action::View(2), "Heatmap: nodes visited"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::Num4), Action::View(3), "Heatmap: triangle tests"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::Num5), Action::View(4), "Heatmap: combined cost"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::B), Action::ToggleBoxes, "Show / hide node boxes"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::CloseBracket), Action::DepthUp, "Boxes one level deeper"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::OpenBracket), Action::DepthDown, "Boxes one level shallower"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::S), Action::NextStrategy, "Next split strategy"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::C), Action::NextColormap, "Next colour map"),
+    (KeyboardShortcut::new(Modifiers::NONE, Key::F1), Action::Help, "This help"),
+];
+
+/// Mouse controls, listed in the Help window.
+pub const MOUSE: &[(&str, &str)] = &[
+    ("Left drag", "Orbit"),
+    ("Right or middle drag", "Pan"),
+    ("Wheel", "Zoom"),
+    ("Hover", "Exact counts of the pixel's ray"),
+    ("Drop an .obj", "Open it"),
+];
+
+/// The actions whose keys were pressed this frame. Single-key shortcuts are ignored while a text
+/// field has the keyboard.
+pub fn pressed(ctx: &egui::Context) -> Vec<Action> {
+    let typing = ctx.egui_wants_keyboard_input();
+    ctx.input_mut(|i| {
+        SHORTCUTS
+            .iter()
+            .filter(|(s, _, _)| !(typing && s.modifiers == Modifiers::NONE))
+            .filter(|(s, _, _)| i.consume_shortcut(s))
+            .map(|(_, a, _)| *a)
+            .collect()
+    })
+}

@@ -1,0 +1,169 @@
+//! The desktop app driven through egui_kittest, without a display: what a user sees and does.
+//! Built by the `ui-tests` package (see its Cargo.toml); snapshots live in `tests/snapshots/`.
+
+use bvhscope::app::{AppOptions, BvhscopeApp, MessageKind, SceneSource};
+use bvhscope::bvh::SplitStrategy;
+use egui::accesskit::Role;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+fn harness() -> Harness<'static, BvhscopeApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1400.0, 860.0))
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()))
+}
+
+/// Step the app until `done` holds (background jobs report asynchronously).
+fn run_until(h: &mut Harness<'_, BvhscopeApp>, what: &str, done: impl Fn(&BvhscopeApp) -> bool) {
+    let start = Instant::now();
+    while !done(h.state()) {
+        assert!(start.elapsed() < Duration::from_secs(120), "timed out waiting for {what}");
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    h.step();
+    h.step();
+}
+
+fn idle(app: &BvhscopeApp) -> bool {
+    app.current_bvh().is_some() && !app.jobs.is_busy() && app.shown.as_ref().is_some_and(|s| s.frame.is_complete())
+}
+
+fn temp_file(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bvhscope-ui-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn starts_on_the_builtin_scene_and_shows_its_triangle_count() {
+    let mut h = harness();
+    run_until(&mut h, "the first full frame", idle);
+    assert_eq!(h.state().scene.source, SceneSource::Builtin);
+    let triangles = h.state().scene.report.triangles;
+    assert!(triangles > 20_000);
+    h.get_by_label("Triangles");
+    h.get_by_label(&triangles.to_string());
+    h.get_by_label_contains("full resolution");
+}
+
+#[test]
+fn choosing_another_strategy_rebuilds_and_changes_the_node_count() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let before = h.state().current_bvh().unwrap().stats.nodes;
+    h.get_by_label(&before.to_string());
+
+    h.get_by_role_and_label(Role::ComboBox, "Split strategy").click();
+    h.run_steps(3);
+    h.get_by_label("Midpoint").click();
+    run_until(&mut h, "the midpoint build", |a| {
+        a.current_bvh().is_some_and(|b| b.bvh.params.strategy == SplitStrategy::Midpoint) && idle(a)
+    });
+    let after = h.state().current_bvh().unwrap().stats.nodes;
+    assert_ne!(before, after, "midpoint and SAH trees differ in size here");
+    h.get_by_label(&after.to_string());
+    // The previous strategy's figures stay next to the new ones.
+    h.get_by_label("before: SAH binned");
+    h.get_by_label(&before.to_string());
+}
+
+#[test]
+fn moving_the_depth_slider_changes_the_number_of_boxes_drawn() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.get_by_label("Show node boxes").click();
+    h.step();
+    h.step();
+    h.get_by_label("1 boxes drawn"); // depth 0: the root
+    h.get_by_role_and_label(Role::Slider, "Box depth").set_value_accesskit(6.0);
+    h.step();
+    h.step();
+    assert_eq!(h.state().settings.box_depth, 6);
+    let drawn = h.state().boxes_drawn;
+    assert!(drawn > 1 && drawn <= 64, "depth 6 has at most 64 nodes, drew {drawn}");
+    h.get_by_label(&format!("{drawn} boxes drawn"));
+    // The ] key goes one level deeper.
+    h.key_press(egui::Key::CloseBracket);
+    h.step();
+    h.step();
+    assert_eq!(h.state().settings.box_depth, 7);
+    assert!(h.state().boxes_drawn > drawn);
+}
+
+#[test]
+fn switching_to_a_heatmap_view_shows_the_legend() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    assert!(h.query_by_label_contains("Legend:").is_none(), "no legend on the normals view");
+    h.get_by_label("Nodes visited").click();
+    run_until(&mut h, "the heatmap frame", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+    h.get_by_label_contains("Legend: nodes visited per ray");
+    let legend = h.state().shown.as_ref().unwrap().legend.clone().unwrap();
+    assert!(legend.max > legend.min && legend.mean > 0.0);
+    h.get_by_label_contains(&format!("mean {:.2}", legend.mean));
+}
+
+#[test]
+fn opening_a_broken_obj_shows_an_error_and_keeps_the_old_scene() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let triangles = h.state().scene.report.triangles;
+    let nodes = h.state().current_bvh().unwrap().stats.nodes;
+    let broken = temp_file("broken.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n");
+    h.input_mut().dropped_files.push(Arc::new(Dropped(broken.clone())));
+    run_until(&mut h, "the error", |a| a.messages.iter().any(|m| m.kind == MessageKind::Error));
+    h.get_by_label_contains("broken.obj: line 3");
+    assert_eq!(h.state().scene.source, SceneSource::Builtin);
+    h.get_by_label(&triangles.to_string());
+    h.get_by_label(&nodes.to_string());
+}
+
+#[test]
+fn a_mesh_opened_by_typing_its_path_replaces_the_scene() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let tent =
+        temp_file("tent.obj", "v -1 0 -1\nv 1 0 -1\nv 0 1 0\nv -1 0 1\nv 1 0 1\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n");
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::L);
+    h.run_steps(2);
+    h.get_by_label("Path").focus();
+    h.step();
+    h.get_by_label("Path").type_text(tent.to_str().unwrap());
+    h.run_steps(2);
+    h.get_by_label("Open").click();
+    run_until(&mut h, "the tent", |a| a.scene.report.triangles == 4 && idle(a));
+    h.get_by_label("tent.obj");
+    assert!(h.state().settings.recent_files.iter().any(|p| p.ends_with("tent.obj")), "remembered as recent");
+}
+
+#[test]
+fn default_view_snapshot() {
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .wgpu()
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+    run_until(&mut h, "the first full frame", idle);
+    // Timings in the status line and statistics differ run to run; allow those few pixels.
+    let options = egui_kittest::SnapshotOptions::default()
+        .max_failed_pixels(4000)
+        .output_path(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/snapshots"));
+    h.snapshot_options("default_view", &options);
+}
