@@ -113,8 +113,17 @@ pub struct BvhscopeApp {
     /// Boxes drawn by the overlay in the last frame.
     pub boxes_drawn: usize,
     box_cache: Option<BoxCache>,
+    overlay_cache: Option<OverlayCache>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
+}
+
+/// The overlay's triangles for one camera and viewport rectangle (redrawn only when they change).
+struct OverlayCache {
+    boxes: Arc<Vec<(usize, Aabb)>>,
+    camera: Camera,
+    rect: egui::Rect,
+    mesh: Arc<egui::Mesh>,
 }
 
 struct BoxCache {
@@ -145,6 +154,7 @@ impl BvhscopeApp {
             path_window: None,
             boxes_drawn: 0,
             box_cache: None,
+            overlay_cache: None,
             viewport_aspect: aspect,
         };
         if let Some(file) = options.file {
@@ -216,6 +226,23 @@ impl BvhscopeApp {
             self.box_cache = Some(BoxCache { bvh, depth, leaves_above, boxes });
         }
         self.box_cache.as_ref().map(|c| c.boxes.clone())
+    }
+
+    /// The overlay mesh of `boxes` seen by `camera` in `rect` (cached).
+    pub fn overlay_mesh(
+        &mut self,
+        boxes: Arc<Vec<(usize, Aabb)>>,
+        camera: Camera,
+        rect: egui::Rect,
+    ) -> Arc<egui::Mesh> {
+        if let Some(c) = &self.overlay_cache {
+            if Arc::ptr_eq(&c.boxes, &boxes) && c.camera == camera && c.rect == rect {
+                return c.mesh.clone();
+            }
+        }
+        let mesh = Arc::new(overlay::boxes_mesh(&boxes, &camera, rect, 1.2));
+        self.overlay_cache = Some(OverlayCache { boxes, camera, rect, mesh: mesh.clone() });
+        mesh
     }
 
     /// Figures of the current strategy for the statistics panel.

@@ -61,3 +61,57 @@ impl Settings {
         self.recent_files.truncate(MAX_RECENT);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashMap;
+
+    /// eframe's storage in memory, to check what the app saves comes back on the next start.
+    #[derive(Default)]
+    struct MemoryStorage(HashMap<String, String>);
+
+    impl eframe::Storage for MemoryStorage {
+        fn get_string(&self, key: &str) -> Option<String> {
+            self.0.get(key).cloned()
+        }
+        fn set_string(&mut self, key: &str, value: String) {
+            self.0.insert(key.to_string(), value);
+        }
+        fn remove_string(&mut self, key: &str) {
+            self.0.remove(key);
+        }
+        fn flush(&mut self) {}
+    }
+
+    #[test]
+    fn settings_and_recent_files_survive_a_restart() {
+        let mut s = Settings::default();
+        s.build.strategy = crate::bvh::SplitStrategy::Midpoint;
+        s.view = View::TriTests;
+        s.colormap = ColorMap::Turbo;
+        s.auto_range = false;
+        s.fixed_range = (2.0, 40.0);
+        for i in 0..12 {
+            s.remember(PathBuf::from(format!("/nonexistent/mesh{i}.obj")));
+        }
+        s.remember(PathBuf::from("/nonexistent/mesh3.obj"));
+        assert_eq!(s.recent_files.len(), MAX_RECENT);
+        assert_eq!(s.recent_files[0], PathBuf::from("/nonexistent/mesh3.obj"), "reopened file moves to the top");
+        assert_eq!(s.recent_files.iter().filter(|p| p.ends_with("mesh3.obj")).count(), 1);
+
+        let mut storage = MemoryStorage::default();
+        eframe::set_value(&mut storage, eframe::APP_KEY, &s);
+        let back: Settings = eframe::get_value(&storage, eframe::APP_KEY).expect("saved settings load");
+        assert_eq!(back, s);
+    }
+
+    #[test]
+    fn settings_from_an_older_version_fill_missing_fields_with_defaults() {
+        let mut storage = MemoryStorage::default();
+        eframe::Storage::set_string(&mut storage, eframe::APP_KEY, "(view: Depth)".into());
+        let back: Settings = eframe::get_value(&storage, eframe::APP_KEY).expect("partial settings load");
+        assert_eq!(back.view, View::Depth);
+        assert_eq!(back.build, BuildParams::default());
+    }
+}

@@ -3,7 +3,7 @@
 //! show (camera, BVH, view, size) differs from the last request.
 
 use super::jobs::RenderRequest;
-use super::{overlay, BvhscopeApp, MessageKind};
+use super::{BvhscopeApp, MessageKind};
 use crate::render::legend::fmt_value;
 use crate::render::{Frame, Legend};
 use egui::{Color32, PointerButton, Pos2, Rect, Sense, Stroke, Vec2};
@@ -55,9 +55,9 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     app.boxes_drawn = 0;
     if app.settings.show_boxes {
         if let (Some(boxes), Some(camera)) = (app.overlay_boxes(), app.shown.as_ref().map(|s| s.camera)) {
-            let mesh = overlay::boxes_mesh(&boxes, &camera, rect, 1.2);
             app.boxes_drawn = boxes.len();
-            painter.add(egui::Shape::mesh(mesh));
+            let mesh = app.overlay_mesh(boxes, camera, rect);
+            painter.add(egui::Shape::Mesh(mesh));
         }
     }
 

@@ -155,6 +155,32 @@ fn a_mesh_opened_by_typing_its_path_replaces_the_scene() {
 }
 
 #[test]
+fn the_view_and_the_statistics_can_be_exported() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.get_by_label("Triangle tests").click();
+    run_until(&mut h, "the heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+    let dir = temp_file("x", "").parent().unwrap().to_path_buf();
+    let png = dir.join("view.png");
+    let csv = dir.join("stats.csv");
+    let json = dir.join("stats.json");
+    h.state_mut().picked(bvhscope::app::Pick::SavePng, png.clone());
+    h.state_mut().picked(bvhscope::app::Pick::SaveStatsCsv, csv.clone());
+    h.state_mut().picked(bvhscope::app::Pick::SaveStatsJson, json.clone());
+    h.run_steps(3); // a new egui Area is measured, unseen, in its first frame
+    let frame = h.state().shown.as_ref().unwrap().frame.clone();
+    let img = image::open(&png).expect("PNG written").to_rgb8();
+    assert_eq!(img.width(), frame.width.max(176));
+    assert!(img.height() > frame.height, "the heatmap PNG carries its legend below the image");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("which,strategy,triangles"), "{text}");
+    assert!(text.lines().nth(1).unwrap().starts_with("current,SAH binned,"), "{text}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["strategies"][0]["tree"]["nodes"], h.state().current_bvh().unwrap().stats.nodes);
+    assert_eq!(h.query_all_by_label_contains("Note: Saved").count(), 3, "each save is confirmed on screen");
+}
+
+#[test]
 fn default_view_snapshot() {
     let mut h = Harness::builder()
         .with_size(egui::vec2(1200.0, 760.0))
