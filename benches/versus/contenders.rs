@@ -1,0 +1,336 @@
+//! Every implementation under test, behind one trait: build (timed) and trace one ray.
+
+use crate::rays::RaySpec;
+use bvhscope::bvh::{Accelerator, BuildParams, Bvh, NoStats, RayCounters, SplitStrategy, TraceOptions, TreeStats};
+use bvhscope::geometry::{intersect_triangle, Ray, TriangleTest};
+use bvhscope::mesh::Mesh;
+use glam::{Vec3, Vec3A};
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+/// Closest-hit tracing of one ray; true when something was hit.
+pub trait Tracer: Sync + Send {
+    fn trace(&self, r: &RaySpec) -> bool;
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    Ours,
+    ObvhsBvh2,
+    ObvhsCwbvh,
+    BvhCrate,
+}
+
+pub struct Built {
+    pub tracer: Box<dyn Tracer>,
+    pub sah_cost: Option<f64>,
+    /// Nodes + primitive indices, bytes per triangle.
+    pub bytes_per_tri: Option<f64>,
+}
+
+/// A named way to build a tracer; `build` returns the structure and the time of the build proper
+/// (input conversion to the library's own types is not timed).
+pub struct Contender {
+    pub name: String,
+    pub family: Family,
+    pub build: Box<dyn Fn(&Mesh) -> (Built, Duration) + Sync>,
+    /// Slow builds are skipped on big meshes in quick mode.
+    pub slow_build: bool,
+}
+
+// ---------------------------------------------------------------- ours
+
+struct Ours<S> {
+    bvh: Bvh,
+    opts: TraceOptions,
+    _stats: std::marker::PhantomData<S>,
+}
+
+impl<S: bvhscope::bvh::TraversalStats + Default + Sync + Send> Tracer for Ours<S> {
+    #[inline]
+    fn trace(&self, r: &RaySpec) -> bool {
+        let mut ray = Ray::new(r.origin, r.dir);
+        let mut stats = S::default();
+        let hit = self.bvh.closest_hit(&mut ray, self.opts, &mut stats).is_some();
+        black_box(&stats);
+        hit
+    }
+}
+
+pub fn ours(strategy: SplitStrategy) -> Contender {
+    Contender {
+        name: format!("bvhscope {} (BVH2)", strategy.short_name()),
+        family: Family::Ours,
+        slow_build: strategy == SplitStrategy::SahSweep,
+        build: Box::new(move |mesh| {
+            let t = Instant::now();
+            let bvh = Bvh::build(mesh, &BuildParams::with_strategy(strategy));
+            let took = t.elapsed();
+            let stats = TreeStats::of(&bvh);
+            let built = Built {
+                sah_cost: Some(stats.sah_cost),
+                bytes_per_tri: Some(stats.memory_bytes as f64 / mesh.triangle_count() as f64),
+                tracer: Box::new(Ours::<NoStats> { bvh, opts: TraceOptions::default(), _stats: Default::default() }),
+            };
+            (built, took)
+        }),
+    }
+}
+
+/// Our SAH BVH2 traversed with the heatmap counters on, to measure what counting costs.
+pub fn ours_counting() -> Contender {
+    Contender {
+        name: "bvhscope sah (BVH2), counting".into(),
+        family: Family::Ours,
+        slow_build: false,
+        build: Box::new(|mesh| {
+            let t = Instant::now();
+            let bvh = Bvh::build(mesh, &BuildParams::default());
+            let took = t.elapsed();
+            let tracer =
+                Box::new(Ours::<RayCounters> { bvh, opts: TraceOptions::default(), _stats: Default::default() });
+            (Built { tracer, sah_cost: None, bytes_per_tri: None }, took)
+        }),
+    }
+}
+
+// ---------------------------------------------------------------- obvhs
+
+fn obvhs_tris(mesh: &Mesh) -> Vec<obvhs::triangle::Triangle> {
+    (0..mesh.triangle_count() as u32)
+        .map(|i| {
+            let [a, b, c] = mesh.triangle(i);
+            obvhs::triangle::Triangle { v0: a.into(), v1: b.into(), v2: c.into() }
+        })
+        .collect()
+}
+
+fn obvhs_ray(r: &RaySpec) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new_inf(Vec3A::from(r.origin), Vec3A::from(r.dir))
+}
+
+struct ObvhsBvh2 {
+    bvh: obvhs::bvh2::Bvh2,
+    tris: Vec<obvhs::triangle::Triangle>,
+}
+
+impl Tracer for ObvhsBvh2 {
+    #[inline]
+    fn trace(&self, r: &RaySpec) -> bool {
+        let mut hit = obvhs::ray::RayHit::none();
+        self.bvh.ray_traverse(obvhs_ray(r), &mut hit, |ray, id| self.tris[id].intersect(ray))
+    }
+}
+
+struct ObvhsCw {
+    bvh: obvhs::cwbvh::CwBvh,
+    tris: Vec<obvhs::triangle::Triangle>,
+}
+
+impl Tracer for ObvhsCw {
+    #[inline]
+    fn trace(&self, r: &RaySpec) -> bool {
+        let mut hit = obvhs::ray::RayHit::none();
+        self.bvh.ray_traverse(obvhs_ray(r), &mut hit, |ray, id| self.tris[id].intersect(ray))
+    }
+}
+
+/// SAH cost of a binary tree given as (bounds, children or None for a leaf with `n` prims).
+fn sah_of<N>(root: usize, node: impl Fn(usize) -> (bvhscope::geometry::Aabb, Option<(usize, usize)>, u32)) -> f64 {
+    let root_area = node(root).0.area() as f64;
+    let mut cost = 0.0;
+    let mut stack = vec![root];
+    while let Some(i) = stack.pop() {
+        let (b, children, n) = node(i);
+        let rel = b.area() as f64 / root_area;
+        match children {
+            Some((l, r)) => {
+                cost += rel; // C_trav = 1
+                stack.push(l);
+                stack.push(r);
+            }
+            None => cost += n as f64 * rel, // C_isect = 1
+        }
+    }
+    let _ = std::marker::PhantomData::<N>;
+    cost
+}
+
+fn obvhs_presets() -> Vec<(&'static str, obvhs::BvhBuildParams)> {
+    use obvhs::BvhBuildParams as P;
+    vec![
+        ("fastest", P::fastest_build()),
+        ("very fast", P::very_fast_build()),
+        ("fast", P::fast_build()),
+        ("medium", P::medium_build()),
+        ("slow", P::slow_build()),
+    ]
+}
+
+pub fn obvhs_all() -> Vec<Contender> {
+    let mut v = Vec::new();
+    for (name, params) in obvhs_presets() {
+        v.push(Contender {
+            name: format!("obvhs {name} (BVH2)"),
+            family: Family::ObvhsBvh2,
+            slow_build: name == "slow",
+            build: Box::new(move |mesh| {
+                let tris = obvhs_tris(mesh);
+                let t = Instant::now();
+                let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
+                let tris: Vec<_> = bvh.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
+                let took = t.elapsed();
+                let node = |i: usize| {
+                    let n = &bvh.nodes[i];
+                    let b = bvhscope::geometry::Aabb::new(Vec3::from(n.aabb.min), Vec3::from(n.aabb.max));
+                    let children = (n.prim_count == 0).then(|| (n.first_index as usize, n.first_index as usize + 1));
+                    (b, children, n.prim_count)
+                };
+                let sah = sah_of::<()>(0, node);
+                let bytes = (bvh.nodes.len() * std::mem::size_of::<obvhs::bvh2::node::Bvh2Node>()
+                    + bvh.primitive_indices.len() * 4) as f64
+                    / mesh.triangle_count() as f64;
+                (
+                    Built {
+                        tracer: Box::new(ObvhsBvh2 { bvh, tris }),
+                        sah_cost: Some(sah),
+                        bytes_per_tri: Some(bytes),
+                    },
+                    took,
+                )
+            }),
+        });
+    }
+    for (name, params) in obvhs_presets().into_iter().skip(1) {
+        v.push(Contender {
+            name: format!("obvhs {name} (CWBVH)"),
+            family: Family::ObvhsCwbvh,
+            slow_build: name == "slow",
+            build: Box::new(move |mesh| {
+                let tris = obvhs_tris(mesh);
+                let t = Instant::now();
+                let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, params, &mut Duration::default());
+                let tris: Vec<_> = bvh.primitive_indices.iter().map(|&i| tris[i as usize]).collect();
+                let took = t.elapsed();
+                let bytes = (bvh.nodes.len() * std::mem::size_of::<obvhs::cwbvh::node::CwBvhNode>()
+                    + bvh.primitive_indices.len() * 4) as f64
+                    / mesh.triangle_count() as f64;
+                (Built { tracer: Box::new(ObvhsCw { bvh, tris }), sah_cost: None, bytes_per_tri: Some(bytes) }, took)
+            }),
+        });
+    }
+    v
+}
+
+// ---------------------------------------------------------------- the bvh crate
+
+#[derive(Clone)]
+struct BTri {
+    v: [Vec3; 3],
+    node: usize,
+}
+
+impl bvh::aabb::Bounded<f32, 3> for BTri {
+    fn aabb(&self) -> bvh::aabb::Aabb<f32, 3> {
+        let lo = self.v[0].min(self.v[1]).min(self.v[2]);
+        let hi = self.v[0].max(self.v[1]).max(self.v[2]);
+        bvh::aabb::Aabb::with_bounds(nalgebra::Point3::new(lo.x, lo.y, lo.z), nalgebra::Point3::new(hi.x, hi.y, hi.z))
+    }
+}
+
+impl bvh::bounding_hierarchy::BHShape<f32, 3> for BTri {
+    fn set_bh_node_index(&mut self, i: usize) {
+        self.node = i;
+    }
+    fn bh_node_index(&self) -> usize {
+        self.node
+    }
+}
+
+struct BvhCrate {
+    bvh: bvh::bvh::Bvh<f32, 3>,
+    shapes: Vec<BTri>,
+}
+
+impl Tracer for BvhCrate {
+    #[inline]
+    fn trace(&self, r: &RaySpec) -> bool {
+        let ray = bvh::ray::Ray::new(
+            nalgebra::Point3::new(r.origin.x, r.origin.y, r.origin.z),
+            nalgebra::Vector3::new(r.dir.x, r.dir.y, r.dir.z),
+        );
+        // Its own triangle test culls back faces; ours does not, and hit counts must agree, so the
+        // closest-hit loop over its candidates uses our watertight test.
+        let mut ours = Ray::new(r.origin, r.dir);
+        let mut hit = false;
+        for s in self.bvh.traverse_iterator(&ray, &self.shapes) {
+            if let Some(h) = intersect_triangle(TriangleTest::Watertight, &ours, &s.v) {
+                ours.t_max = h.t;
+                hit = true;
+            }
+        }
+        hit
+    }
+}
+
+fn aabb_of(a: &bvh::aabb::Aabb<f32, 3>) -> bvhscope::geometry::Aabb {
+    bvhscope::geometry::Aabb::new(Vec3::new(a.min.x, a.min.y, a.min.z), Vec3::new(a.max.x, a.max.y, a.max.z))
+}
+
+fn par_executor(l: bvh::bvh::BvhNodeBuildArgs<'_, BTri, f32, 3>, r: bvh::bvh::BvhNodeBuildArgs<'_, BTri, f32, 3>) {
+    if l.node_count() + r.node_count() < 4096 {
+        l.build();
+        r.build();
+    } else {
+        rayon::join(|| l.build_with_executor(par_executor), || r.build_with_executor(par_executor));
+    }
+}
+
+pub fn bvh_crate() -> Contender {
+    Contender {
+        name: "bvh crate SAH".into(),
+        family: Family::BvhCrate,
+        slow_build: false,
+        build: Box::new(|mesh| {
+            let mut shapes: Vec<BTri> =
+                (0..mesh.triangle_count() as u32).map(|i| BTri { v: mesh.triangle(i), node: 0 }).collect();
+            let t = Instant::now();
+            let bvh = if rayon::current_num_threads() > 1 {
+                bvh::bvh::Bvh::build_with_executor(&mut shapes, par_executor)
+            } else {
+                bvh::bvh::Bvh::build(&mut shapes)
+            };
+            let took = t.elapsed();
+            // SAH over its binary tree: node boxes are stored in the parent (one shape per leaf).
+            let nodes = &bvh.nodes;
+            let root_box = match &nodes[0] {
+                bvh::bvh::BvhNode::Node { child_l_aabb, child_r_aabb, .. } => {
+                    aabb_of(child_l_aabb).union(aabb_of(child_r_aabb))
+                }
+                bvh::bvh::BvhNode::Leaf { shape_index, .. } => {
+                    aabb_of(&bvh::aabb::Bounded::aabb(&shapes[*shape_index]))
+                }
+            };
+            let mut boxes = vec![bvhscope::geometry::Aabb::EMPTY; nodes.len()];
+            boxes[0] = root_box;
+            for n in nodes {
+                if let bvh::bvh::BvhNode::Node { child_l_index, child_l_aabb, child_r_index, child_r_aabb, .. } = n {
+                    boxes[*child_l_index] = aabb_of(child_l_aabb);
+                    boxes[*child_r_index] = aabb_of(child_r_aabb);
+                }
+            }
+            let sah = sah_of::<()>(0, |i| match &nodes[i] {
+                bvh::bvh::BvhNode::Node { child_l_index, child_r_index, .. } => {
+                    (boxes[i], Some((*child_l_index, *child_r_index)), 0)
+                }
+                bvh::bvh::BvhNode::Leaf { .. } => (boxes[i], None, 1),
+            });
+            let bytes =
+                (nodes.len() * std::mem::size_of::<bvh::bvh::BvhNode<f32, 3>>()) as f64 / mesh.triangle_count() as f64;
+            (
+                Built { tracer: Box::new(BvhCrate { bvh, shapes }), sah_cost: Some(sah), bytes_per_tri: Some(bytes) },
+                took,
+            )
+        }),
+    }
+}

@@ -1,0 +1,275 @@
+//! `cargo bench --bench versus`: bvhscope against obvhs and the bvh crate on the same meshes and
+//! the same rays. Prints one markdown table per mesh and closing ratio lines. Every time is the
+//! median of several runs; hit counts are printed so nobody wins by missing.
+//! `BENCH_QUICK=1` runs a reduced set (under two minutes on 2 cores).
+
+mod contenders;
+mod rays;
+mod scenes;
+
+use bvhscope::mesh::Mesh;
+use contenders::{Contender, Family, Tracer};
+use rayon::prelude::*;
+use rayon::{ThreadPool, ThreadPoolBuilder};
+use rays::RaySpec;
+use std::fmt::Write;
+use std::time::{Duration, Instant};
+
+struct Settings {
+    quick: bool,
+    primary_size: u32,
+    incoherent: usize,
+    reps: usize,
+}
+
+#[derive(Default, Clone)]
+struct Row {
+    name: String,
+    family: Option<Family>,
+    build_1t: f64,
+    build_nt: f64,
+    sah: Option<f64>,
+    bytes: Option<f64>,
+    p1: f64,
+    pn: f64,
+    p_hits: usize,
+    i1: f64,
+    i_n: f64,
+    i_hits: usize,
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Trace all rays on the pool's threads; returns (time, hits).
+fn trace(pool: &ThreadPool, rays: &[RaySpec], t: &dyn Tracer) -> (Duration, usize) {
+    pool.install(|| {
+        let start = Instant::now();
+        let hits = rays.par_chunks(1024).map(|c| c.iter().filter(|r| t.trace(r)).count()).sum();
+        (start.elapsed(), hits)
+    })
+}
+
+/// Median MRays/s over `reps` runs, and the hit count.
+fn mrays(pool: &ThreadPool, rays: &[RaySpec], t: &dyn Tracer, reps: usize) -> (f64, usize) {
+    let mut hits = 0;
+    let times: Vec<f64> = (0..reps)
+        .map(|_| {
+            let (d, h) = trace(pool, rays, t);
+            hits = h;
+            rays.len() as f64 / d.as_secs_f64() / 1e6
+        })
+        .collect();
+    (median(times), hits)
+}
+
+fn run_mesh(mesh: &Mesh, contenders: &[Contender], s: &Settings, one: &ThreadPool, all: &ThreadPool) -> Vec<Row> {
+    let primary = rays::primary(mesh, s.primary_size);
+    let incoherent = rays::incoherent(mesh, s.incoherent, 0x5EED);
+    let mut rows = Vec::new();
+    for c in contenders {
+        if s.quick && c.slow_build && mesh.triangle_count() > 200_000 {
+            continue;
+        }
+        eprintln!("  {} ...", c.name);
+        let build_reps = if mesh.triangle_count() > 1_000_000 { 1 } else { s.reps };
+        let b1 = median((0..build_reps).map(|_| ms(one.install(|| (c.build)(mesh)).1)).collect());
+        let mut built = None;
+        let bn = median(
+            (0..build_reps)
+                .map(|_| {
+                    let (b, d) = all.install(|| (c.build)(mesh));
+                    built = Some(b);
+                    ms(d)
+                })
+                .collect(),
+        );
+        let Some(built) = built else { continue };
+        let t = built.tracer.as_ref();
+        // The bvh crate is slow on incoherent rays of big meshes: fewer repetitions there.
+        let reps = if c.family == Family::BvhCrate { 1 } else { s.reps };
+        let (p1, p_hits) = mrays(one, &primary, t, reps);
+        let (pn, _) = mrays(all, &primary, t, reps);
+        let (i1, i_hits) = mrays(one, &incoherent, t, reps);
+        let (i_n, _) = mrays(all, &incoherent, t, reps);
+        rows.push(Row {
+            name: c.name.clone(),
+            family: Some(c.family),
+            build_1t: b1,
+            build_nt: bn,
+            sah: built.sah_cost,
+            bytes: built.bytes_per_tri,
+            p1,
+            pn,
+            p_hits,
+            i1,
+            i_n,
+            i_hits,
+        });
+    }
+    rows
+}
+
+fn table(mesh: &Mesh, rows: &[Row], s: &Settings, threads: usize) -> String {
+    let n = mesh.triangle_count() as f64;
+    let mut o = String::new();
+    let _ = writeln!(o, "\n### {} ({} triangles)\n", mesh.name, mesh.triangle_count());
+    let _ = writeln!(
+        o,
+        "primary: {0}×{0} pinhole frame; incoherent: {1} rays from the surface; {2} threads for “NT”.\n",
+        s.primary_size, s.incoherent, threads
+    );
+    let _ = writeln!(o, "| implementation | build 1T ms | build NT ms | Mtri/s NT | SAH cost | B/tri | primary 1T MRays/s | primary NT | primary hits | incoherent 1T MRays/s | incoherent NT | incoherent hits |");
+    let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in rows {
+        let _ = writeln!(
+            o,
+            "| {} | {:.1} | {:.1} | {:.2} | {} | {} | {:.2} | {:.2} | {} | {:.2} | {:.2} | {} |",
+            r.name,
+            r.build_1t,
+            r.build_nt,
+            n / r.build_nt / 1e3,
+            r.sah.map_or("—".into(), |v| format!("{v:.2}")),
+            r.bytes.map_or("—".into(), |v| format!("{v:.1}")),
+            r.p1,
+            r.pn,
+            r.p_hits,
+            r.i1,
+            r.i_n,
+            r.i_hits
+        );
+    }
+    // Everyone must hit the same rays (±0.1%).
+    for (label, hits) in [
+        ("primary", rows.iter().map(|r| r.p_hits).collect::<Vec<_>>()),
+        ("incoherent", rows.iter().map(|r| r.i_hits).collect()),
+    ] {
+        let (lo, hi) = (hits.iter().min().copied().unwrap_or(0), hits.iter().max().copied().unwrap_or(0));
+        let spread = (hi - lo) as f64 / hi.max(1) as f64;
+        let verdict = if spread <= 1e-3 { "agree" } else { "DISAGREE" };
+        let _ = writeln!(o, "\n{label} hit counts {verdict}: {lo}..{hi} ({:.3}% spread)", spread * 100.0);
+    }
+    o
+}
+
+fn best<'a>(rows: &'a [Row], pick: impl Fn(&Row) -> bool, key: impl Fn(&Row) -> f64) -> Option<&'a Row> {
+    rows.iter().filter(|r| pick(r)).max_by(|a, b| key(a).total_cmp(&key(b)))
+}
+
+fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
+    let mut o = String::new();
+    let name = mesh.name.split_whitespace().next().unwrap_or("mesh").to_lowercase();
+    let ours = |r: &Row| r.family == Some(Family::Ours) && !r.name.contains("counting");
+    let is = |f: Family| move |r: &Row| r.family == Some(f);
+    let mut line = |label: &str, a: Option<&Row>, b: Option<&Row>, key: &dyn Fn(&Row) -> f64| {
+        if let (Some(a), Some(b)) = (a, b) {
+            let _ = writeln!(o, "ratio {label} {name}: {} / {} = {:.2}", a.name, b.name, key(a) / key(b));
+        }
+    };
+    for (label, key) in [
+        ("primary 1T", &(|r: &Row| r.p1) as &dyn Fn(&Row) -> f64),
+        ("primary NT", &|r: &Row| r.pn),
+        ("incoherent 1T", &|r: &Row| r.i1),
+        ("incoherent NT", &|r: &Row| r.i_n),
+    ] {
+        let our_best = best(rows, ours, key);
+        line(&format!("{label} best/obvhs-best-BVH2"), our_best, best(rows, is(Family::ObvhsBvh2), key), key);
+        line(&format!("{label} best/obvhs-best-CWBVH"), our_best, best(rows, is(Family::ObvhsCwbvh), key), key);
+        let our_sah = rows.iter().find(|r| r.name.starts_with("bvhscope sah (BVH2)"));
+        line(&format!("{label} sah-BVH2/bvh-crate"), our_sah, best(rows, is(Family::BvhCrate), key), key);
+    }
+    let tris_per_s = |r: &Row| 1.0 / r.build_nt;
+    let our_sah = rows.iter().find(|r| r.name.starts_with("bvhscope sah ("));
+    let fastest = rows.iter().find(|r| r.name == "obvhs fastest (BVH2)");
+    line("build NT triangles/s sah/obvhs-fastest", our_sah, fastest, &tris_per_s);
+    let medium = rows.iter().find(|r| r.name == "obvhs medium (BVH2)");
+    if let (Some(a), Some(b)) = (our_sah, medium) {
+        let _ = writeln!(
+            o,
+            "SAH cost {name}: {} {:.2} vs {} {:.2}",
+            a.name,
+            a.sah.unwrap_or(f64::NAN),
+            b.name,
+            b.sah.unwrap_or(f64::NAN)
+        );
+    }
+    let plain = rows.iter().find(|r| r.name == "bvhscope sah (BVH2)");
+    let counting = rows.iter().find(|r| r.name == "bvhscope sah (BVH2), counting");
+    if let (Some(p), Some(c)) = (plain, counting) {
+        let _ = writeln!(
+            o,
+            "counting overhead {name}: primary 1T {:+.1}%, incoherent 1T {:+.1}%",
+            (p.p1 / c.p1 - 1.0) * 100.0,
+            (p.i1 / c.i1 - 1.0) * 100.0
+        );
+    }
+    for r in rows.iter().filter(|r| ours(r)) {
+        if let Some(b) = r.bytes {
+            let _ = writeln!(o, "memory {name}: {} {:.1} bytes per triangle (nodes + indices)", r.name, b);
+        }
+    }
+    o
+}
+
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    format!("{cpu}, {} threads available", std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; nothing else is accepted.
+    let quick = std::env::var("BENCH_QUICK").is_ok_and(|v| v == "1");
+    let s = if quick {
+        Settings { quick, primary_size: 512, incoherent: 200_000, reps: 1 }
+    } else {
+        Settings { quick, primary_size: 1024, incoherent: 1_000_000, reps: 3 }
+    };
+    let one = ThreadPoolBuilder::new().num_threads(1).build().expect("a one-thread pool");
+    let all = ThreadPoolBuilder::new().build().expect("a pool");
+    let threads = all.current_num_threads();
+
+    let mut contenders = vec![];
+    for strategy in bvhscope::bvh::SplitStrategy::ALL {
+        contenders.push(contenders::ours(strategy));
+    }
+    contenders.push(contenders::ours_counting());
+    contenders.extend(contenders::obvhs_all());
+    contenders.push(contenders::bvh_crate());
+
+    let mut meshes: Vec<Mesh> = Vec::new();
+    meshes.extend(scenes::shared("stanford-bunny.obj"));
+    meshes.extend(scenes::shared("beast.obj"));
+    meshes.push(scenes::teapot_in_stadium());
+    if !quick {
+        meshes.push(scenes::big_knot());
+    }
+
+    let started = Instant::now();
+    let mut out = String::new();
+    let _ =
+        writeln!(out, "## versus ({})\n\nmachine: {}\n", if quick { "BENCH_QUICK=1" } else { "full run" }, machine());
+    let mut closing = String::new();
+    for mesh in &meshes {
+        eprintln!("{} ({} triangles)", mesh.name, mesh.triangle_count());
+        let rows = run_mesh(mesh, &contenders, &s, &one, &all);
+        let t = table(mesh, &rows, &s, threads);
+        print!("{t}");
+        out += &t;
+        closing += &ratios(mesh, &rows);
+    }
+    println!("\n{closing}");
+    println!("total time {:.0} s", started.elapsed().as_secs_f64());
+}
