@@ -3,7 +3,8 @@
 mod common;
 
 use bvhscope::bvh::{
-    Accelerator, BuildParams, Bvh, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions, TraversalOrder,
+    Accelerator, AnyBvh, BuildParams, Layout, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions,
+    TraversalOrder, TreeView,
 };
 use bvhscope::geometry::{Ray, TriangleTest};
 use bvhscope::mesh::Mesh;
@@ -21,7 +22,7 @@ fn all_options() -> Vec<TraceOptions> {
 }
 
 /// Compare one ray on every strategy's BVH against the linear scan.
-fn check_ray(mesh: &Mesh, bvhs: &[Bvh], linear: &LinearScan, ray: Ray) {
+fn check_ray(mesh: &Mesh, bvhs: &[AnyBvh], linear: &LinearScan, ray: Ray) {
     for opts in all_options() {
         let mut r = ray;
         let expected = linear.closest_hit(&mut r, opts, &mut NoStats);
@@ -29,7 +30,8 @@ fn check_ray(mesh: &Mesh, bvhs: &[Bvh], linear: &LinearScan, ray: Ray) {
             let mut r = ray;
             let mut counters = RayCounters::default();
             let got = bvh.closest_hit(&mut r, opts, &mut counters);
-            let what = format!("{:?} {:?} ray {:?}", bvh.params.strategy, opts, ray);
+            let p = bvh.params();
+            let what = format!("{:?} {:?} leaf {} {:?} ray {:?}", p.strategy, p.layout, p.max_leaf_size, opts, ray);
             match (expected, got) {
                 (None, None) => {}
                 (Some(e), Some(g)) => {
@@ -51,18 +53,19 @@ fn check_ray(mesh: &Mesh, bvhs: &[Bvh], linear: &LinearScan, ray: Ray) {
     }
 }
 
-fn build_all(mesh: &Mesh) -> Vec<Bvh> {
+/// Every strategy in both layouts: default parameters, plus odd ones (leaf size 1 and 7, few bins).
+fn build_all(mesh: &Mesh) -> Vec<AnyBvh> {
     SplitStrategy::ALL
         .into_iter()
         .flat_map(|s| {
-            // Default parameters, plus odd ones: leaf size 1 and 7, few bins.
             [
                 BuildParams::with_strategy(s),
                 BuildParams { max_leaf_size: 1, sah_bins: 4, ..BuildParams::with_strategy(s) },
                 BuildParams { max_leaf_size: 7, sah_bins: 3, ..BuildParams::with_strategy(s) },
             ]
         })
-        .map(|p| Bvh::build(mesh, &p))
+        .flat_map(|p| Layout::ALL.map(|layout| BuildParams { layout, ..p }))
+        .map(|p| AnyBvh::build(mesh, &p))
         .collect()
 }
 
@@ -111,7 +114,7 @@ proptest! {
         prop_assume!(mesh.triangle_count() > 0);
         let bvhs = build_all(&mesh);
         for bvh in &bvhs {
-            common::check_invariants(bvh, &mesh);
+            common::check_any(bvh, &mesh);
         }
         let linear = LinearScan::new(&mesh);
         for (origin, dir, target, u, v) in rays {
@@ -173,8 +176,8 @@ fn identical_triangles_build_a_bounded_tree() {
     let n = 1_000_000u32;
     let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
     let mesh = Mesh::from_triangles("same", positions, vec![[0, 1, 2]; n as usize]);
-    for s in SplitStrategy::ALL {
-        let bvh = Bvh::build(&mesh, &BuildParams::with_strategy(s));
+    for (s, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| Layout::ALL.map(|l| (s, l))) {
+        let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(s) });
         let stats = bvhscope::bvh::TreeStats::of(&bvh);
         assert!(stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32, "{s:?} depth {}", stats.max_depth);
         assert!(stats.leaf_size_histogram.len() <= 5, "{s:?} leaf sizes");
@@ -201,15 +204,21 @@ fn exponentially_spaced_triangles_stay_within_the_stack_depth() {
     }
     let mesh = Mesh::from_triangles("exp", positions, triangles);
     let linear = LinearScan::new(&mesh);
-    let bvh =
-        Bvh::build(&mesh, &BuildParams { max_leaf_size: 1, ..BuildParams::with_strategy(SplitStrategy::Midpoint) });
-    let stats = bvhscope::bvh::TreeStats::of(&bvh);
-    assert!(stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32);
-    assert!(stats.depth_limited_splits > 0, "this input must reach the depth limit: {stats:?}");
-    common::check_invariants(&bvh, &mesh);
+    let bvhs: Vec<AnyBvh> = Layout::ALL
+        .map(|layout| {
+            let p = BuildParams { max_leaf_size: 1, layout, ..BuildParams::with_strategy(SplitStrategy::Midpoint) };
+            AnyBvh::build(&mesh, &p)
+        })
+        .into();
+    for bvh in &bvhs {
+        let stats = bvhscope::bvh::TreeStats::of(bvh);
+        assert!(stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32);
+        assert!(stats.depth_limited_splits > 0, "this input must reach the depth limit: {stats:?}");
+        common::check_any(bvh, &mesh);
+    }
     for i in 0..50 {
         let ray = Ray::new(Vec3::new(-1.0, 0.1 + i as f32 * 0.01, 0.2), Vec3::new(1.0, 1e-20, 0.0));
-        check_ray(&mesh, std::slice::from_ref(&bvh), &linear, ray);
+        check_ray(&mesh, &bvhs, &linear, ray);
     }
 }
 
@@ -226,7 +235,7 @@ fn empty_mesh_builds_and_misses() {
 struct SharedCase {
     name: &'static str,
     mesh: Mesh,
-    bvhs: Vec<Bvh>,
+    bvhs: Vec<AnyBvh>,
     linear: LinearScan,
 }
 
@@ -249,10 +258,13 @@ fn shared_cases() -> &'static [SharedCase] {
         .into_iter()
         .map(|name| {
             let mesh = common::shared_mesh(name).unwrap();
-            let bvhs: Vec<Bvh> =
-                SplitStrategy::ALL.into_iter().map(|s| Bvh::build(&mesh, &BuildParams::with_strategy(s))).collect();
+            let bvhs: Vec<AnyBvh> = SplitStrategy::ALL
+                .into_iter()
+                .flat_map(|s| Layout::ALL.map(|layout| BuildParams { layout, ..BuildParams::with_strategy(s) }))
+                .map(|p| AnyBvh::build(&mesh, &p))
+                .collect();
             for bvh in &bvhs {
-                common::check_invariants(bvh, &mesh);
+                common::check_any(bvh, &mesh);
             }
             let linear = LinearScan::new(&mesh);
             SharedCase { name, mesh, bvhs, linear }

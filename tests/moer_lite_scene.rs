@@ -3,7 +3,7 @@
 
 mod common;
 
-use bvhscope::bvh::{BuildParams, Bvh, LinearScan, SplitStrategy, TraceOptions, TraversalOrder};
+use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy, TraceOptions, TraversalOrder};
 use bvhscope::render::{render, view_image, Camera, ColorMap, HeatRange, RenderSettings, View};
 use glam::Vec3;
 
@@ -28,12 +28,14 @@ fn moer_lite_scene_matches_linear_for_every_strategy() {
     assert!(hits > 50_000, "the monkey covers a good part of the frame ({hits} pixels)");
     let (ref_img, _) = view_image(&reference, View::Normals, ColorMap::Viridis, HeatRange::Auto, Default::default());
 
-    for strategy in SplitStrategy::ALL {
-        let bvh = Bvh::build(&mesh, &BuildParams::with_strategy(strategy));
-        for order in TraversalOrder::ALL {
+    for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| Layout::ALL.map(|l| (s, l))) {
+        let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
+        // The wide layout always visits the nearest child first; one order is enough there.
+        let orders: &[TraversalOrder] = if layout == Layout::Binary { &TraversalOrder::ALL } else { &[TraversalOrder::EntryDistance] };
+        for &order in orders {
             let s = RenderSettings { trace: TraceOptions { order, ..settings.trace }, ..settings };
             let frame = render(&bvh, &mesh, &camera, &s);
-            assert_eq!(frame.hit_mask(), ref_mask, "{strategy:?} {order:?}: hit mask differs");
+            assert_eq!(frame.hit_mask(), ref_mask, "{strategy:?} {layout:?} {order:?}: hit mask differs");
             let (img, _) = view_image(&frame, View::Normals, ColorMap::Viridis, HeatRange::Auto, Default::default());
             // Identical except where two triangles tie at a shared edge, where the interpolated
             // normals agree up to rounding.
@@ -42,13 +44,13 @@ fn moer_lite_scene_matches_linear_for_every_strategy() {
                 .zip(ref_img.pixels())
                 .filter(|(a, b)| a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 1))
                 .count();
-            assert_eq!(off, 0, "{strategy:?} {order:?}: {off} normal pixels differ");
+            assert_eq!(off, 0, "{strategy:?} {layout:?} {order:?}: {off} normal pixels differ");
             let same_t = frame
                 .samples
                 .iter()
                 .zip(&reference.samples)
                 .all(|(a, b)| a.t == b.t || (a.t - b.t).abs() <= 1e-5 * b.t);
-            assert!(same_t, "{strategy:?} {order:?}: depths differ");
+            assert!(same_t, "{strategy:?} {layout:?} {order:?}: depths differ");
         }
     }
 }

@@ -1,7 +1,9 @@
 //! Every implementation under test, behind one trait: build (timed) and trace one ray.
 
 use crate::rays::RaySpec;
-use bvhscope::bvh::{Accelerator, BuildParams, Bvh, NoStats, RayCounters, SplitStrategy, TraceOptions, TreeStats};
+use bvhscope::bvh::{
+    Accelerator, AnyBvh, BuildParams, Layout, NoStats, RayCounters, SplitStrategy, TraceOptions, TreeStats,
+};
 use bvhscope::geometry::{intersect_triangle, Ray, TriangleTest};
 use bvhscope::mesh::Mesh;
 use glam::{Vec3, Vec3A};
@@ -40,56 +42,52 @@ pub struct Contender {
 
 // ---------------------------------------------------------------- ours
 
-struct Ours<S> {
-    bvh: Bvh,
+struct Ours<A, S> {
+    accel: A,
     opts: TraceOptions,
     _stats: std::marker::PhantomData<S>,
 }
 
-impl<S: bvhscope::bvh::TraversalStats + Default + Sync + Send> Tracer for Ours<S> {
+impl<A: Accelerator + Send, S: bvhscope::bvh::TraversalStats + Default + Sync + Send> Tracer for Ours<A, S> {
     #[inline]
     fn trace(&self, r: &RaySpec) -> bool {
         let mut ray = Ray::new(r.origin, r.dir);
         let mut stats = S::default();
-        let hit = self.bvh.closest_hit(&mut ray, self.opts, &mut stats).is_some();
+        let hit = self.accel.closest_hit(&mut ray, self.opts, &mut stats).is_some();
         black_box(&stats);
         hit
     }
 }
 
-pub fn ours(strategy: SplitStrategy) -> Contender {
+fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(bvh: AnyBvh) -> Box<dyn Tracer> {
+    let opts = TraceOptions::default();
+    match bvh {
+        AnyBvh::Binary(accel) => Box::new(Ours::<_, S> { accel, opts, _stats: Default::default() }),
+        AnyBvh::Wide(accel) => Box::new(Ours::<_, S> { accel, opts, _stats: Default::default() }),
+    }
+}
+
+/// Our BVH with one strategy and layout; `counting` traverses with the heatmap counters on.
+pub fn ours(strategy: SplitStrategy, layout: Layout, counting: bool) -> Contender {
+    let layout_name = match layout {
+        Layout::Binary => "BVH2",
+        Layout::Wide4 => "BVH4",
+    };
     Contender {
-        name: format!("bvhscope {} (BVH2)", strategy.short_name()),
+        name: format!("bvhscope {} ({layout_name}){}", strategy.short_name(), if counting { ", counting" } else { "" }),
         family: Family::Ours,
         slow_build: strategy == SplitStrategy::SahSweep,
         build: Box::new(move |mesh| {
             let t = Instant::now();
-            let bvh = Bvh::build(mesh, &BuildParams::with_strategy(strategy));
+            let bvh = AnyBvh::build(mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
             let took = t.elapsed();
             let stats = TreeStats::of(&bvh);
             let built = Built {
                 sah_cost: Some(stats.sah_cost),
                 bytes_per_tri: Some(stats.memory_bytes as f64 / mesh.triangle_count() as f64),
-                tracer: Box::new(Ours::<NoStats> { bvh, opts: TraceOptions::default(), _stats: Default::default() }),
+                tracer: if counting { tracer::<RayCounters>(bvh) } else { tracer::<NoStats>(bvh) },
             };
             (built, took)
-        }),
-    }
-}
-
-/// Our SAH BVH2 traversed with the heatmap counters on, to measure what counting costs.
-pub fn ours_counting() -> Contender {
-    Contender {
-        name: "bvhscope sah (BVH2), counting".into(),
-        family: Family::Ours,
-        slow_build: false,
-        build: Box::new(|mesh| {
-            let t = Instant::now();
-            let bvh = Bvh::build(mesh, &BuildParams::default());
-            let took = t.elapsed();
-            let tracer =
-                Box::new(Ours::<RayCounters> { bvh, opts: TraceOptions::default(), _stats: Default::default() });
-            (Built { tracer, sah_cost: None, bytes_per_tri: None }, took)
         }),
     }
 }

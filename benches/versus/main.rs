@@ -1,7 +1,8 @@
 //! `cargo bench --bench versus`: bvhscope against obvhs and the bvh crate on the same meshes and
 //! the same rays. Prints one markdown table per mesh and closing ratio lines. Every time is the
 //! median of several runs; hit counts are printed so nobody wins by missing.
-//! `BENCH_QUICK=1` runs a reduced set (under two minutes on 2 cores).
+//! `BENCH_QUICK=1` runs a reduced set (under two minutes on 2 cores). For iterating on one thing:
+//! `BENCH_ONLY=sah,medium` keeps contenders whose names contain a word, `BENCH_MESH=bunny` one mesh.
 
 mod contenders;
 mod rays;
@@ -181,11 +182,11 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
         let our_best = best(rows, ours, key);
         line(&format!("{label} best/obvhs-best-BVH2"), our_best, best(rows, is(Family::ObvhsBvh2), key), key);
         line(&format!("{label} best/obvhs-best-CWBVH"), our_best, best(rows, is(Family::ObvhsCwbvh), key), key);
-        let our_sah = rows.iter().find(|r| r.name.starts_with("bvhscope sah (BVH2)"));
+        let our_sah = rows.iter().find(|r| r.name == "bvhscope sah (BVH2)");
         line(&format!("{label} sah-BVH2/bvh-crate"), our_sah, best(rows, is(Family::BvhCrate), key), key);
     }
     let tris_per_s = |r: &Row| 1.0 / r.build_nt;
-    let our_sah = rows.iter().find(|r| r.name.starts_with("bvhscope sah ("));
+    let our_sah = rows.iter().find(|r| r.name == "bvhscope sah (BVH2)");
     let fastest = rows.iter().find(|r| r.name == "obvhs fastest (BVH2)");
     line("build NT triangles/s sah/obvhs-fastest", our_sah, fastest, &tris_per_s);
     let medium = rows.iter().find(|r| r.name == "obvhs medium (BVH2)");
@@ -242,12 +243,21 @@ fn main() {
     let threads = all.current_num_threads();
 
     let mut contenders = vec![];
-    for strategy in bvhscope::bvh::SplitStrategy::ALL {
-        contenders.push(contenders::ours(strategy));
+    use bvhscope::bvh::{Layout, SplitStrategy};
+    for layout in Layout::ALL {
+        for strategy in SplitStrategy::ALL {
+            contenders.push(contenders::ours(strategy, layout, false));
+        }
     }
-    contenders.push(contenders::ours_counting());
+    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, true));
+    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, true));
     contenders.extend(contenders::obvhs_all());
     contenders.push(contenders::bvh_crate());
+    // BENCH_ONLY=a,b keeps contenders whose name contains one of the words (for quick iteration).
+    if let Ok(only) = std::env::var("BENCH_ONLY") {
+        let words: Vec<String> = only.split(',').map(|w| w.trim().to_lowercase()).collect();
+        contenders.retain(|c| words.iter().any(|w| c.name.to_lowercase().contains(w.as_str())));
+    }
 
     let mut meshes: Vec<Mesh> = Vec::new();
     meshes.extend(scenes::shared("stanford-bunny.obj"));
@@ -257,6 +267,10 @@ fn main() {
         meshes.push(scenes::big_knot());
     }
 
+    // BENCH_MESH=word keeps meshes whose name contains it.
+    if let Ok(m) = std::env::var("BENCH_MESH") {
+        meshes.retain(|mesh| mesh.name.to_lowercase().contains(&m.to_lowercase()));
+    }
     let started = Instant::now();
     let mut out = String::new();
     let _ =

@@ -3,7 +3,7 @@
 //! running one of that kind, and results of superseded jobs are dropped by id.
 
 use super::scene::{Scene, SceneSource};
-use crate::bvh::{BuildParams, Bvh};
+use crate::bvh::{AnyBvh, BuildParams};
 use crate::bvh::{SahCost, TraceOptions};
 use crate::mesh::{load_obj, Mesh};
 use crate::render::{
@@ -27,7 +27,7 @@ pub struct ViewStyle {
 
 #[derive(Clone)]
 pub struct RenderRequest {
-    pub bvh: Arc<Bvh>,
+    pub bvh: Arc<AnyBvh>,
     pub mesh: Arc<Mesh>,
     pub camera: Camera,
     pub trace: TraceOptions,
@@ -68,7 +68,7 @@ pub enum Pick {
 
 pub enum JobEvent {
     Loaded(Result<Scene, String>),
-    Built { scene_id: u64, params: BuildParams, result: Result<Arc<Bvh>, Cancelled> },
+    Built { scene_id: u64, params: BuildParams, result: Result<Arc<AnyBvh>, Cancelled> },
     Pass(PassOutput),
     Picked { pick: Pick, path: Option<PathBuf>, took: Duration },
 }
@@ -156,7 +156,7 @@ impl Jobs {
         let job = self.start(format!("Building ({})", params.strategy.label()));
         let (send, control) = (self.sender(job.id), job.control.clone());
         std::thread::spawn(move || {
-            let result = Bvh::build_controlled(&mesh, &params, &control).map(Arc::new);
+            let result = AnyBvh::build_controlled(&mesh, &params, &control).map(Arc::new);
             send(JobEvent::Built { scene_id, params, result });
         });
         self.build = Some(job);

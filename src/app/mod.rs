@@ -17,13 +17,18 @@ pub use orbit::OrbitCamera;
 pub use scene::{Scene, SceneSource};
 pub use settings::Settings;
 
-use crate::bvh::{Bvh, SplitStrategy, TreeStats};
+use crate::bvh::{AnyBvh, SplitStrategy, TreeStats, TreeView};
 use crate::geometry::Aabb;
 use crate::render::{Camera, ColorMap, Frame, Legend, RaySummary, View};
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+/// "SAH binned, 4-wide SIMD": the strategy and layout of a build, for the statistics columns.
+fn figures_label(p: &crate::bvh::BuildParams) -> String {
+    format!("{}, {}", p.strategy.label(), p.layout.short_name())
+}
 
 /// How the app starts.
 #[derive(Clone, Debug, Default)]
@@ -60,7 +65,7 @@ pub struct Shown {
 
 /// The BVH of the current scene.
 pub struct BuiltBvh {
-    pub bvh: Arc<Bvh>,
+    pub bvh: Arc<AnyBvh>,
     pub stats: TreeStats,
     pub scene_id: u64,
 }
@@ -127,7 +132,7 @@ struct OverlayCache {
 }
 
 struct BoxCache {
-    bvh: Arc<Bvh>,
+    bvh: Arc<AnyBvh>,
     depth: u32,
     leaves_above: bool,
     boxes: Arc<Vec<(usize, Aabb)>>,
@@ -207,7 +212,7 @@ impl BvhscopeApp {
     /// Start a build when the settings or the scene differ from what was built or is building.
     pub fn ensure_build(&mut self) {
         let wanted = (self.settings.build, self.scene_id);
-        let have = self.current_bvh().is_some_and(|b| b.bvh.params == self.settings.build);
+        let have = self.current_bvh().is_some_and(|b| *b.bvh.params() == self.settings.build);
         if !have && self.jobs.last_build != Some(wanted) {
             self.jobs.build(self.scene.mesh.clone(), self.settings.build, self.scene_id);
         }
@@ -248,7 +253,7 @@ impl BvhscopeApp {
     /// Figures of the current strategy for the statistics panel.
     pub fn current_figures(&self) -> Option<StrategyFigures> {
         self.current_bvh().map(|b| StrategyFigures {
-            label: b.bvh.params.strategy.label().to_string(),
+            label: figures_label(b.bvh.params()),
             stats: b.stats.clone(),
             rays: self.rays,
         })
@@ -279,11 +284,11 @@ impl BvhscopeApp {
             JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
             JobEvent::Built { scene_id, result: Ok(bvh), .. } if scene_id == self.scene_id => {
                 if let Some(old) = self.current_figures() {
-                    if self.current_bvh().is_some_and(|b| b.bvh.params != bvh.params) {
+                    if self.current_bvh().is_some_and(|b| b.bvh.params() != bvh.params()) {
                         self.previous = Some(old);
                     }
                 }
-                let stats = TreeStats::of(&bvh);
+                let stats = TreeStats::of(bvh.as_ref());
                 self.built = Some(BuiltBvh { bvh, stats, scene_id });
                 self.rays = None;
             }

@@ -39,7 +39,36 @@ impl Default for SahCost {
     }
 }
 
+/// How the built tree is laid out for traversal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Layout {
+    /// The binary BVH as built: two children per node, the handout's structure.
+    Binary,
+    /// The binary BVH collapsed into 4-wide nodes traversed with SIMD box tests (`bvh::wide`).
+    #[default]
+    Wide4,
+}
+
+impl Layout {
+    pub const ALL: [Layout; 2] = [Layout::Binary, Layout::Wide4];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Layout::Binary => "binary",
+            Layout::Wide4 => "4-wide SIMD",
+        }
+    }
+
+    pub fn short_name(self) -> &'static str {
+        match self {
+            Layout::Binary => "binary",
+            Layout::Wide4 => "wide4",
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct BuildParams {
     pub strategy: SplitStrategy,
     /// Most triangles in a leaf (default 4). The SAH strategies may stop earlier when a leaf is
@@ -48,11 +77,18 @@ pub struct BuildParams {
     /// Bins per axis for `SahBinned` (default 16).
     pub sah_bins: u32,
     pub cost: SahCost,
+    pub layout: Layout,
 }
 
 impl Default for BuildParams {
     fn default() -> Self {
-        Self { strategy: SplitStrategy::SahBinned, max_leaf_size: 4, sah_bins: 16, cost: SahCost::default() }
+        Self {
+            strategy: SplitStrategy::SahBinned,
+            max_leaf_size: 4,
+            sah_bins: 16,
+            cost: SahCost::default(),
+            layout: Layout::default(),
+        }
     }
 }
 
@@ -71,6 +107,8 @@ pub struct BuildReport {
     pub split_time: Duration,
     /// Copying triangles into leaf order.
     pub reorder_time: Duration,
+    /// Collapsing the binary tree into wide nodes (wide layout only).
+    pub collapse_time: Duration,
     /// Nodes where the strategy found no useful split (midpoint with an empty side, SAH with
     /// coincident centroids) and an equal-count split was used instead.
     pub fallback_splits: u32,
@@ -80,7 +118,7 @@ pub struct BuildReport {
 
 impl BuildReport {
     pub fn total_time(&self) -> Duration {
-        self.setup_time + self.split_time + self.reorder_time
+        self.setup_time + self.split_time + self.reorder_time + self.collapse_time
     }
 }
 

@@ -3,18 +3,25 @@
 //! every BVH is checked against.
 
 mod accel;
+mod any;
 mod build;
 mod counters;
 mod linear;
 mod node;
 pub mod split;
+mod stack;
 mod stats;
 mod traverse;
+pub mod tree;
+pub mod wide;
 
 pub use accel::{Accelerator, Hit, TraceOptions, TraversalOrder};
-pub use build::{BuildParams, BuildReport, SahCost, MAX_LEAF_SIZE_LIMIT};
+pub use any::AnyBvh;
+pub use build::{BuildParams, BuildReport, Layout, SahCost, MAX_LEAF_SIZE_LIMIT};
 pub use counters::{NoStats, RayCounters, TraversalStats};
 pub use linear::LinearScan;
 pub use node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 pub use split::SplitStrategy;
 pub use stats::TreeStats;
+pub use tree::{NodeKind, NodeView, TreeView};
+pub use wide::WideBvh;

@@ -68,29 +68,40 @@ impl Bvh {
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<BvhNode>() + self.prim_ids.len() * 4
     }
+}
 
-    /// Visit every node with its depth (root = 0), depth-first, without recursion.
-    pub fn for_each_node(&self, mut f: impl FnMut(usize, &BvhNode, u32)) {
+impl super::tree::TreeView for Bvh {
+    fn walk(&self, f: &mut dyn FnMut(&super::tree::NodeView) -> bool) {
+        use super::tree::{NodeKind, NodeView};
         let mut stack = vec![(0usize, 0u32)];
         while let Some((i, depth)) = stack.pop() {
             let n = &self.nodes[i];
-            f(i, n, depth);
-            if !n.is_leaf() {
+            let kind = if n.is_leaf() || self.prim_ids.is_empty() {
+                NodeKind::Leaf { count: n.count as u32 }
+            } else {
+                NodeKind::Interior
+            };
+            let descend = f(&NodeView { id: i, bounds: n.bounds, depth, kind });
+            if descend && kind == NodeKind::Interior {
                 stack.push((n.index as usize + 1, depth + 1));
                 stack.push((n.index as usize, depth + 1));
             }
         }
     }
 
-    /// Bounds of every node at exactly `depth`, and optionally of leaves above it: what the app's
-    /// box overlay draws.
-    pub fn boxes_at_depth(&self, depth: u32, include_shallower_leaves: bool) -> Vec<(usize, Aabb)> {
-        let mut out = Vec::new();
-        self.for_each_node(|i, n, d| {
-            if d == depth || (include_shallower_leaves && n.is_leaf() && d < depth) {
-                out.push((i, n.bounds));
-            }
-        });
-        out
+    fn triangle_count(&self) -> usize {
+        self.prim_ids.len()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        Bvh::memory_bytes(self)
+    }
+
+    fn params(&self) -> &BuildParams {
+        &self.params
+    }
+
+    fn report(&self) -> &BuildReport {
+        &self.report
     }
 }

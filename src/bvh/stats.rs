@@ -5,7 +5,8 @@
 //! ray hitting the root box with a uniformly random origin and direction, it estimates the expected
 //! traversal steps plus triangle tests (with unit constants), ignoring early termination.
 
-use super::{Bvh, SahCost};
+use super::tree::{NodeKind, TreeView};
+use super::SahCost;
 use std::time::Duration;
 
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -36,31 +37,36 @@ fn ms(d: Duration) -> f64 {
 }
 
 impl TreeStats {
-    pub fn of(bvh: &Bvh) -> TreeStats {
-        let c = bvh.params.cost;
-        let root_area = bvh.root_bounds().area() as f64;
+    /// Statistics of any hierarchy (binary or wide). `nodes` counts interior nodes and leaves.
+    pub fn of(tree: &(impl TreeView + ?Sized)) -> TreeStats {
+        let c = tree.params().cost;
+        let report = tree.report();
+        let mut root_area = 0f64;
         let mut s = TreeStats {
-            triangles: bvh.prim_ids.len(),
-            nodes: bvh.nodes.len(),
+            triangles: tree.triangle_count(),
             sah_constants: c,
-            memory_bytes: bvh.memory_bytes(),
-            build_setup_ms: ms(bvh.report.setup_time),
-            build_split_ms: ms(bvh.report.split_time),
-            build_reorder_ms: ms(bvh.report.reorder_time),
-            build_total_ms: ms(bvh.report.total_time()),
-            fallback_splits: bvh.report.fallback_splits,
-            depth_limited_splits: bvh.report.depth_limited_splits,
+            memory_bytes: tree.memory_bytes(),
+            build_setup_ms: ms(report.setup_time),
+            build_split_ms: ms(report.split_time),
+            build_reorder_ms: ms(report.reorder_time + report.collapse_time),
+            build_total_ms: ms(report.total_time()),
+            fallback_splits: report.fallback_splits,
+            depth_limited_splits: report.depth_limited_splits,
             ..Default::default()
         };
         let mut depth_sum = 0u64;
         let mut cost = 0f64;
-        bvh.for_each_node(|_, n, depth| {
+        tree.walk(&mut |n| {
+            if n.depth == 0 {
+                root_area = n.bounds.area() as f64;
+            }
             let rel = if root_area > 0.0 { n.bounds.area() as f64 / root_area } else { 0.0 };
-            if n.is_leaf() {
+            s.nodes += 1;
+            if let NodeKind::Leaf { count } = n.kind {
                 s.leaves += 1;
-                depth_sum += depth as u64;
-                s.max_depth = s.max_depth.max(depth);
-                let k = n.count as usize;
+                depth_sum += n.depth as u64;
+                s.max_depth = s.max_depth.max(n.depth);
+                let k = count as usize;
                 if s.leaf_size_histogram.len() <= k {
                     s.leaf_size_histogram.resize(k + 1, 0);
                 }
@@ -70,6 +76,7 @@ impl TreeStats {
                 s.interior_nodes += 1;
                 cost += c.traversal as f64 * rel;
             }
+            true
         });
         s.mean_leaf_depth = if s.leaves > 0 { depth_sum as f64 / s.leaves as f64 } else { 0.0 };
         s.sah_cost = cost;

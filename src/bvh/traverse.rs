@@ -9,6 +9,7 @@
 //! per node. Layout and loop follow pbrt-v4 §7.3.5 ("BVHAggregate::Intersect").
 
 use super::node::{Bvh, TRAVERSAL_STACK_SIZE};
+use super::stack::TraversalStack;
 use super::{Accelerator, Hit, TraceOptions, TraversalOrder, TraversalStats};
 use crate::geometry::{MollerTrumbore, Ray, TriangleIntersector, TriangleTest, Watertight};
 
@@ -30,8 +31,7 @@ impl Bvh {
         }
         let prepared = T::prepare(ray);
         let mut best: Option<(usize, crate::geometry::TriangleHit)> = None;
-        let mut stack = [(0u32, 0f32); TRAVERSAL_STACK_SIZE];
-        let mut sp = 0usize;
+        let mut stack = TraversalStack::<TRAVERSAL_STACK_SIZE>::new();
         let mut current = 0usize;
         loop {
             let node = &nodes[current];
@@ -61,8 +61,7 @@ impl Bvh {
                 if hit_l && hit_r {
                     let right_first = if BY_DISTANCE { r0 < l0 } else { dir_neg[node.axis as usize] };
                     let (near, far, far_t) = if right_first { (left + 1, left, l0) } else { (left, left + 1, r0) };
-                    stack[sp] = (far as u32, far_t);
-                    sp += 1;
+                    stack.push((far as u32, far_t));
                     current = near;
                     continue;
                 } else if hit_l {
@@ -75,11 +74,9 @@ impl Bvh {
             }
             // Pop the next node that can still hold a hit nearer than the best so far.
             loop {
-                if sp == 0 {
+                let Some((n, t_enter)) = stack.pop() else {
                     return best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] });
-                }
-                sp -= 1;
-                let (n, t_enter) = stack[sp];
+                };
                 if t_enter <= ray.t_max {
                     current = n as usize;
                     break;

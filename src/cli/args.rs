@@ -1,7 +1,7 @@
 //! Arguments shared by the subcommands, and clap's value lists for the core's enums (so `--help`
 //! lists every strategy, view, order, test and colour map under its kebab-case name).
 
-use crate::bvh::{BuildParams, SahCost, SplitStrategy, TraceOptions, TraversalOrder};
+use crate::bvh::{BuildParams, Layout, SahCost, SplitStrategy, TraceOptions, TraversalOrder};
 use crate::geometry::{Aabb, TriangleTest};
 use crate::render::{Camera, ColorMap, View};
 use clap::builder::PossibleValue;
@@ -14,6 +14,15 @@ impl ValueEnum for SplitStrategy {
     }
     fn to_possible_value(&self) -> Option<PossibleValue> {
         Some(PossibleValue::new(self.short_name()).help(self.description()))
+    }
+}
+
+impl ValueEnum for Layout {
+    fn value_variants<'a>() -> &'a [Self] {
+        &Layout::ALL
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(self.short_name()).help(self.label()))
     }
 }
 
@@ -76,7 +85,11 @@ pub struct BuildArgs {
     /// SAH cost of one traversal step (relative to one triangle test).
     #[arg(long, default_value_t = 1.0)]
     pub traversal_cost: f32,
-    /// Child visited first at interior nodes.
+    /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
+    #[arg(long, value_enum)]
+    pub layout: Option<Layout>,
+    /// Child visited first at interior nodes of the binary layout (the wide one always takes the
+    /// nearest first).
     #[arg(long, value_enum, default_value = "entry-distance")]
     pub order: TraversalOrder,
     /// Ray–triangle test.
@@ -86,8 +99,13 @@ pub struct BuildArgs {
 
 impl BuildArgs {
     pub fn params(&self, strategy: SplitStrategy) -> BuildParams {
+        self.params_with(strategy, self.layout.unwrap_or_default())
+    }
+
+    pub fn params_with(&self, strategy: SplitStrategy, layout: Layout) -> BuildParams {
         BuildParams {
             strategy,
+            layout,
             max_leaf_size: self.max_leaf_size,
             sah_bins: self.bins,
             cost: SahCost { traversal: self.traversal_cost, ..SahCost::default() },

@@ -8,7 +8,7 @@
 
 use super::args::{BuildArgs, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{Accelerator, Bvh, LinearScan, NoStats, SplitStrategy, TraceOptions, TreeStats};
+use crate::bvh::{Accelerator, AnyBvh, Layout, LinearScan, NoStats, SplitStrategy, TraceOptions, TreeStats};
 use crate::mesh::Mesh;
 use crate::render::{render, Camera, RenderSettings};
 use clap::{Args, ValueEnum};
@@ -107,9 +107,14 @@ pub fn compare_rows(
     let plain = RenderSettings { trace: build.trace(), count: false, progressive: false };
     let counting = RenderSettings { count: true, ..plain };
     let mut rows = Vec::new();
-    for strategy in SplitStrategy::ALL {
-        let params = build.params(strategy);
-        let bvh = progress::with_spinner(&format!("building {}", strategy.label()), || Bvh::build(mesh, &params));
+    let layouts: Vec<Layout> = match build.layout {
+        Some(l) => vec![l],
+        None => Layout::ALL.to_vec(),
+    };
+    for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))) {
+        let params = build.params_with(strategy, layout);
+        let name = format!("{} ({})", strategy.label(), layout.short_name());
+        let bvh = progress::with_spinner(&format!("building {name}"), || AnyBvh::build(mesh, &params));
         let stats = TreeStats::of(&bvh);
         let frame = render(&bvh, mesh, camera, &counting);
         let summary = frame.ray_summary();
@@ -122,7 +127,7 @@ pub fn compare_rows(
             .collect();
         let frame_ms = median(times);
         rows.push(CompareRow {
-            name: strategy.label().to_string(),
+            name,
             build_ms: Some(stats.build_total_ms),
             nodes: stats.nodes,
             max_depth: stats.max_depth,

@@ -2,7 +2,7 @@
 
 use super::args::{BuildArgs, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::Bvh;
+use crate::bvh::AnyBvh;
 use crate::render::{draw_legend, render_progressive, view_image, ColorMap, HeatRange, RenderSettings, View};
 use crate::work::WorkControl;
 use clap::Args;
@@ -43,7 +43,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let (mesh, _) = load_mesh(&a.mesh)?;
     let camera = a.view_args.camera(&mesh.bounds())?;
     let params = a.build.params(a.build.strategy);
-    let bvh = progress::with_spinner("building the BVH", || Bvh::build(&mesh, &params));
+    let bvh = progress::with_spinner("building the BVH", || AnyBvh::build(&mesh, &params));
     let settings = RenderSettings { trace: a.build.trace(), count: a.view.is_heatmap(), progressive: false };
     let total = camera.width as u64 * camera.height as u64;
     let control = WorkControl::new();

@@ -2,7 +2,7 @@
 
 use super::args::BuildArgs;
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{Bvh, TreeStats};
+use crate::bvh::{AnyBvh, TreeStats};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -26,7 +26,7 @@ pub struct StatsArgs {
 pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     let (mesh, report) = load_mesh(&a.mesh)?;
     let params = a.build.params(a.build.strategy);
-    let bvh = progress::with_spinner("building the BVH", || Bvh::build(&mesh, &params));
+    let bvh = progress::with_spinner("building the BVH", || AnyBvh::build(&mesh, &params));
     let s = TreeStats::of(&bvh);
     match a.format {
         StatsFormat::Json => {
@@ -50,7 +50,7 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
     let _ = writeln!(
         o,
         "strategy        {} (max leaf size {}, {} SAH bins)",
-        params.strategy.label(),
+        format!("{}, {} layout", params.strategy.label(), params.layout.label()),
         params.max_leaf_size,
         params.sah_bins
     );

@@ -54,14 +54,15 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Watertight;
 
+/// The per-ray shear of the watertight test as three rows: for a vertex relative to the origin
+/// `a`, the sheared coordinates are `(a·rx, a·ry, a·rz)` = `(a[kx] - Sx·a[kz], a[ky] - Sy·a[kz],
+/// Sz·a[kz])`. The extra terms are products with exactly 0 or 1, so the results are bit-identical
+/// to the paper's indexed form, without indexing by a run-time axis in the inner loop.
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    rx: Vec3,
+    ry: Vec3,
+    rz: Vec3,
 }
 
 impl TriangleIntersector for Watertight {
@@ -84,7 +85,10 @@ impl TriangleIntersector for Watertight {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        WatertightRay { kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
+        let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+        let unit = |k: usize| Vec3::from_array(std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 }));
+        let rz_axis = unit(kz);
+        WatertightRay { rx: unit(kx) - rz_axis * sx, ry: unit(ky) - rz_axis * sy, rz: rz_axis * sz }
     }
 
     #[inline(always)]
@@ -93,9 +97,9 @@ impl TriangleIntersector for Watertight {
         let a = tri[0] - o;
         let b = tri[1] - o;
         let c = tri[2] - o;
-        let (ax, ay) = (a[p.kx] - p.sx * a[p.kz], a[p.ky] - p.sy * a[p.kz]);
-        let (bx, by) = (b[p.kx] - p.sx * b[p.kz], b[p.ky] - p.sy * b[p.kz]);
-        let (cx, cy) = (c[p.kx] - p.sx * c[p.kz], c[p.ky] - p.sy * c[p.kz]);
+        let (ax, ay) = (a.dot(p.rx), a.dot(p.ry));
+        let (bx, by) = (b.dot(p.rx), b.dot(p.ry));
+        let (cx, cy) = (c.dot(p.rx), c.dot(p.ry));
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
@@ -113,10 +117,7 @@ impl TriangleIntersector for Watertight {
         if det == 0.0 {
             return None;
         }
-        let az = p.sz * a[p.kz];
-        let bz = p.sz * b[p.kz];
-        let cz = p.sz * c[p.kz];
-        let t_scaled = u * az + v * bz + w * cz;
+        let t_scaled = u * a.dot(p.rz) + v * b.dot(p.rz) + w * c.dot(p.rz);
         let inv_det = 1.0 / det;
         let t = t_scaled * inv_det;
         if !(t >= ray.t_min && t < ray.t_max) {

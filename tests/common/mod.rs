@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use bvhscope::bvh::{Bvh, BvhNode};
+use bvhscope::bvh::{AnyBvh, Bvh, BvhNode, WideBvh};
 use bvhscope::geometry::Aabb;
 use bvhscope::mesh::{load_obj, Mesh};
 use std::path::PathBuf;
@@ -25,18 +25,80 @@ pub fn shared_mesh(name: &str) -> Option<Mesh> {
     Some(load_obj(&path).unwrap_or_else(|e| panic!("{e}")).0)
 }
 
-/// The structure every BVH must have, whatever the strategy.
-pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
+/// The structure every BVH must have, whatever the strategy and layout.
+pub fn check_any(bvh: &AnyBvh, mesh: &Mesh) {
+    match bvh {
+        AnyBvh::Binary(b) => check_invariants(b, mesh),
+        AnyBvh::Wide(w) => check_wide(w, mesh),
+    }
+}
+
+fn check_prims(prim_ids: &[u32], tris: &[[glam::Vec3; 3]], mesh: &Mesh) {
     let n = mesh.triangle_count();
-    assert_eq!(bvh.prim_ids.len(), n, "primitive array length");
+    assert_eq!(prim_ids.len(), n, "primitive array length");
     let mut seen = vec![0u32; n];
-    for &p in &bvh.prim_ids {
+    for &p in prim_ids {
         seen[p as usize] += 1;
     }
     assert!(seen.iter().all(|&c| c == 1), "prim_ids is not a permutation");
-    for (i, &p) in bvh.prim_ids.iter().enumerate() {
-        assert_eq!(bvh.tris[i], mesh.triangle(p), "reordered triangle {i}");
+    for (i, &p) in prim_ids.iter().enumerate() {
+        assert_eq!(tris[i], mesh.triangle(p), "reordered triangle {i}");
     }
+}
+
+fn check_tiling(mut ranges: Vec<std::ops::Range<usize>>, n: usize) {
+    ranges.sort_by_key(|r| r.start);
+    let mut next = 0;
+    for r in &ranges {
+        assert_eq!(r.start, next, "leaf ranges must tile the primitive array without gaps or overlap");
+        next = r.end;
+    }
+    assert_eq!(next, n, "leaf ranges must cover every triangle");
+}
+
+/// The wide layout: every slot box inside its parent's, leaf ranges tiling the triangles, each
+/// node reached exactly once, valid masks matching the slots.
+pub fn check_wide(w: &WideBvh, mesh: &Mesh) {
+    check_prims(&w.prim_ids, &w.tris, mesh);
+    let mut ranges = Vec::new();
+    let mut reached = vec![0u32; w.nodes.len()];
+    let mut stack = vec![(0usize, w.root_bounds)];
+    while let Some((i, parent)) = stack.pop() {
+        reached[i] += 1;
+        let node = &w.nodes[i];
+        for slot in 0..4 {
+            let used = node.valid & (1 << slot) != 0;
+            if !used {
+                assert!(node.slot_bounds(slot).is_empty(), "empty slot {slot} of node {i} must have an inverted box");
+                continue;
+            }
+            let b = node.slot_bounds(slot);
+            assert!(parent.contains_box(&b), "slot {slot} of node {i} sticks out of its parent");
+            let (child, count) = (node.child[slot] as usize, node.count[slot] as usize);
+            if count > 0 {
+                assert!(count as u32 <= w.params.max_leaf_size);
+                for t in &w.tris[child..child + count] {
+                    for v in t {
+                        assert!(b.contains_box(&Aabb::new(*v, *v)), "leaf slot does not contain its triangle");
+                    }
+                }
+                ranges.push(child..child + count);
+            } else {
+                assert!(child > i && child < w.nodes.len(), "child index");
+                stack.push((child, b));
+            }
+        }
+    }
+    if !w.prim_ids.is_empty() {
+        assert!(reached.iter().all(|&c| c == 1), "every wide node is reached exactly once");
+    }
+    check_tiling(ranges, mesh.triangle_count());
+}
+
+/// The structure every binary BVH must have, whatever the strategy.
+pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
+    let n = mesh.triangle_count();
+    check_prims(&bvh.prim_ids, &bvh.tris, mesh);
 
     let mut leaf_ranges = Vec::new();
     let mut reached = 0usize;
@@ -63,11 +125,5 @@ pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
         }
     }
     assert_eq!(reached, bvh.nodes.len(), "every node is reachable exactly once");
-    leaf_ranges.sort_by_key(|r| r.start);
-    let mut next = 0;
-    for r in &leaf_ranges {
-        assert_eq!(r.start, next, "leaf ranges must tile the primitive array without gaps or overlap");
-        next = r.end;
-    }
-    assert_eq!(next, n, "leaf ranges must cover every triangle");
+    check_tiling(leaf_ranges, n);
 }

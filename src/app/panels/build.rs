@@ -2,7 +2,7 @@
 //! rebuilds (or re-renders) in the background.
 
 use crate::app::BvhscopeApp;
-use crate::bvh::{SplitStrategy, TraversalOrder};
+use crate::bvh::{Layout, SplitStrategy, TraversalOrder};
 use crate::geometry::TriangleTest;
 
 pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
@@ -30,7 +30,15 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         .on_hover_text("Cost of one traversal step relative to one triangle test (1 = equal).");
 
     ui.add_space(4.0);
-    ui.label("Traversal order");
+    ui.label("Layout");
+    for l in Layout::ALL {
+        let tip = match l {
+            Layout::Binary => "The binary BVH as built (two children per node), as in the handout",
+            Layout::Wide4 => "Collapsed into 4-wide nodes whose boxes are tested together with SIMD: faster",
+        };
+        ui.radio_value(&mut s.build.layout, l, l.label()).on_hover_text(tip);
+    }
+    ui.label("Traversal order (binary layout)");
     for o in TraversalOrder::ALL {
         let tip = match o {
             TraversalOrder::SplitAxisSign => {

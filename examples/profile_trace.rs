@@ -1,0 +1,83 @@
+//! A profiling driver: traces the bunny's primary and incoherent rays with the wide SAH BVH on
+//! one thread, many times over, for `perf record` / `valgrind --tool=callgrind`.
+//! `cargo run --release --example profile_trace -- [binary|wide4] [primary|incoherent|build]`
+
+use bvhscope::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, TraceOptions};
+use bvhscope::geometry::Ray;
+use bvhscope::mesh::load_obj;
+use bvhscope::render::Camera;
+use glam::Vec3;
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let layout = if args.get(1).is_some_and(|a| a == "binary") { Layout::Binary } else { Layout::Wide4 };
+    let what = args.get(2).map_or("primary", |s| s.as_str());
+    let path = args.get(3).map_or("../shared/models/stanford-bunny.obj", |s| s.as_str());
+    let (mesh, _) = load_obj(path).unwrap_or_else(|e| panic!("{e}"));
+    let mut params = BuildParams { layout, ..BuildParams::default() };
+    if let Ok(c) = std::env::var("COST") {
+        params.cost.traversal = c.parse().expect("COST is a number");
+    }
+    if let Ok(l) = std::env::var("LEAF") {
+        params.max_leaf_size = l.parse().expect("LEAF is a number");
+    }
+    if what == "build" {
+        let t = Instant::now();
+        for _ in 0..20 {
+            std::hint::black_box(AnyBvh::build(&mesh, &params));
+        }
+        println!("build: {:.2} ms each", t.elapsed().as_secs_f64() * 1e3 / 20.0);
+        return;
+    }
+    let bvh = AnyBvh::build(&mesh, &params);
+    let rays: Vec<Ray> = if what == "primary" {
+        let cam = Camera::framing_from(&mesh.bounds(), 1024, 1024, Vec3::new(0.45, 0.35, 1.0));
+        let g = cam.ray_gen();
+        (0..1024 * 1024).map(|i| g.pixel_ray(i % 1024, i / 1024)).collect()
+    } else {
+        let mut s = 12345u64;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..1_000_000)
+            .map(|_| {
+                let t = mesh.triangle((rnd() * mesh.triangle_count() as f32) as u32 % mesh.triangle_count() as u32);
+                let p = (t[0] + t[1] + t[2]) / 3.0;
+                let d = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(Vec3::X);
+                Ray::new(p + d * 1e-4, d)
+            })
+            .collect()
+    };
+    let mut c = bvhscope::bvh::RayCounters::default();
+    for r in &rays {
+        let mut r = *r;
+        let mut one = bvhscope::bvh::RayCounters::default();
+        bvh.closest_hit(&mut r, TraceOptions::default(), &mut one);
+        c.nodes_visited += one.nodes_visited;
+        c.box_tests += one.box_tests;
+        c.leaves_visited += one.leaves_visited;
+        c.triangle_tests += one.triangle_tests;
+    }
+    let n = rays.len() as f64;
+    println!(
+        "per ray: {:.2} nodes, {:.2} box tests, {:.2} leaves, {:.2} triangle tests",
+        c.nodes_visited as f64 / n,
+        c.box_tests as f64 / n,
+        c.leaves_visited as f64 / n,
+        c.triangle_tests as f64 / n
+    );
+    let t = Instant::now();
+    let mut hits = 0;
+    for _ in 0..5 {
+        for r in &rays {
+            let mut r = *r;
+            hits += bvh.closest_hit(&mut r, TraceOptions::default(), &mut NoStats).is_some() as usize;
+        }
+    }
+    let secs = t.elapsed().as_secs_f64();
+    println!("{what} {layout:?}: {:.2} MRays/s, {hits} hits", 5.0 * rays.len() as f64 / secs / 1e6);
+}

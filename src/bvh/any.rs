@@ -1,0 +1,74 @@
+//! A built BVH in either layout behind one type: what the app, the CLI and the tests hold.
+
+use super::tree::{NodeView, TreeView};
+use super::wide::WideBvh;
+use super::{Accelerator, BuildParams, BuildReport, Bvh, Hit, Layout, TraceOptions, TraversalStats};
+use crate::mesh::Mesh;
+use crate::work::{Cancelled, WorkControl};
+
+#[derive(Clone, Debug)]
+pub enum AnyBvh {
+    Binary(Bvh),
+    Wide(WideBvh),
+}
+
+impl AnyBvh {
+    /// Build the binary BVH with `params.strategy`, then lay it out as `params.layout` says.
+    pub fn build(mesh: &Mesh, params: &BuildParams) -> AnyBvh {
+        match Self::build_controlled(mesh, params, &WorkControl::new()) {
+            Ok(b) => b,
+            Err(Cancelled) => unreachable!("nobody else holds this control"),
+        }
+    }
+
+    pub fn build_controlled(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<AnyBvh, Cancelled> {
+        let bvh = Bvh::build_controlled(mesh, params, control)?;
+        Ok(match params.layout {
+            Layout::Binary => AnyBvh::Binary(bvh),
+            Layout::Wide4 => AnyBvh::Wide(WideBvh::from_binary(bvh)),
+        })
+    }
+
+    fn tree(&self) -> &dyn TreeView {
+        match self {
+            AnyBvh::Binary(b) => b,
+            AnyBvh::Wide(w) => w,
+        }
+    }
+}
+
+impl Accelerator for AnyBvh {
+    #[inline]
+    fn closest_hit<S: TraversalStats>(&self, ray: &mut crate::geometry::Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
+        match self {
+            AnyBvh::Binary(b) => b.closest_hit(ray, opts, stats),
+            AnyBvh::Wide(w) => w.closest_hit(ray, opts, stats),
+        }
+    }
+
+    #[inline]
+    fn any_hit<S: TraversalStats>(&self, ray: &crate::geometry::Ray, opts: TraceOptions, stats: &mut S) -> bool {
+        match self {
+            AnyBvh::Binary(b) => b.any_hit(ray, opts, stats),
+            AnyBvh::Wide(w) => w.any_hit(ray, opts, stats),
+        }
+    }
+}
+
+impl TreeView for AnyBvh {
+    fn walk(&self, f: &mut dyn FnMut(&NodeView) -> bool) {
+        self.tree().walk(f)
+    }
+    fn triangle_count(&self) -> usize {
+        self.tree().triangle_count()
+    }
+    fn memory_bytes(&self) -> usize {
+        self.tree().memory_bytes()
+    }
+    fn params(&self) -> &BuildParams {
+        self.tree().params()
+    }
+    fn report(&self) -> &BuildReport {
+        self.tree().report()
+    }
+}
