@@ -31,7 +31,8 @@ fn moer_lite_scene_matches_linear_for_every_strategy() {
     for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| Layout::ALL.map(|l| (s, l))) {
         let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
         // The wide layout always visits the nearest child first; one order is enough there.
-        let orders: &[TraversalOrder] = if layout == Layout::Binary { &TraversalOrder::ALL } else { &[TraversalOrder::EntryDistance] };
+        let orders: &[TraversalOrder] =
+            if layout == Layout::Binary { &TraversalOrder::ALL } else { &[TraversalOrder::EntryDistance] };
         for &order in orders {
             let s = RenderSettings { trace: TraceOptions { order, ..settings.trace }, ..settings };
             let frame = render(&bvh, &mesh, &camera, &s);

@@ -39,7 +39,12 @@ impl AnyBvh {
 
 impl Accelerator for AnyBvh {
     #[inline]
-    fn closest_hit<S: TraversalStats>(&self, ray: &mut crate::geometry::Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
+    fn closest_hit<S: TraversalStats>(
+        &self,
+        ray: &mut crate::geometry::Ray,
+        opts: TraceOptions,
+        stats: &mut S,
+    ) -> Option<Hit> {
         match self {
             AnyBvh::Binary(b) => b.closest_hit(ray, opts, stats),
             AnyBvh::Wide(w) => w.closest_hit(ray, opts, stats),

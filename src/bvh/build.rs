@@ -160,41 +160,170 @@ impl Bvh {
         control.check()?;
 
         let t1 = Instant::now();
-        let mut report = BuildReport { setup_time, ..Default::default() };
-        let nodes = build_nodes(&mut prims, &params, &mut report, control)?;
-        report.split_time = t1.elapsed();
+        let (nodes, over) = build_subtree(&mut prims, 0, 0, &params, control)?;
+        let mut report = BuildReport {
+            setup_time,
+            split_time: t1.elapsed(),
+            fallback_splits: over.fallback,
+            depth_limited_splits: over.depth_limited,
+            ..Default::default()
+        };
 
         let t2 = Instant::now();
         let prim_ids: Vec<u32> = prims.iter().map(|p| p.index).collect();
-        let tris = prim_ids.iter().map(|&i| mesh.triangle(i)).collect();
+        let tris = prim_ids.par_iter().with_min_len(4096).map(|&i| mesh.triangle(i)).collect();
         report.reorder_time = t2.elapsed();
         Ok(Bvh { nodes, prim_ids, tris, params, report })
     }
 }
 
+/// Bounds and centroid bounds of a range (in parallel for big ranges).
 fn node_info(prims: &[BuildPrim]) -> NodeInfo {
-    let mut bounds = Aabb::EMPTY;
-    let mut centroid_bounds = Aabb::EMPTY;
-    for p in prims {
-        bounds = bounds.union(p.bounds);
-        centroid_bounds = centroid_bounds.grow(p.centroid);
+    let fold = |acc: NodeInfo, p: &BuildPrim| NodeInfo {
+        bounds: acc.bounds.union(p.bounds),
+        centroid_bounds: acc.centroid_bounds.grow(p.centroid),
+    };
+    let empty = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY };
+    if prims.len() >= PARALLEL_MIN_PRIMS {
+        prims.par_chunks(4096).map(|c| c.iter().fold(empty, fold)).reduce(
+            || empty,
+            |a, b| NodeInfo {
+                bounds: a.bounds.union(b.bounds),
+                centroid_bounds: a.centroid_bounds.union(b.centroid_bounds),
+            },
+        )
+    } else {
+        prims.iter().fold(empty, fold)
     }
-    NodeInfo { bounds, centroid_bounds }
 }
 
-fn build_nodes(
-    prims: &mut [BuildPrim],
+/// Nodes where the driver overrode or replaced the strategy's answer.
+#[derive(Clone, Copy, Debug, Default)]
+struct Overrides {
+    fallback: u32,
+    depth_limited: u32,
+}
+
+impl std::ops::AddAssign for Overrides {
+    fn add_assign(&mut self, o: Overrides) {
+        self.fallback += o.fallback;
+        self.depth_limited += o.depth_limited;
+    }
+}
+
+/// The split of one node: the strategy's answer, checked and, where needed, replaced.
+fn decide(
+    range: &mut [BuildPrim],
+    info: &NodeInfo,
+    depth: u32,
     params: &BuildParams,
-    report: &mut BuildReport,
+    scratch: &mut SplitScratch,
+    over: &mut Overrides,
+) -> SplitDecision {
+    let n = range.len();
+    if n == 1 {
+        return SplitDecision::Leaf;
+    }
+    if depth >= HEURISTIC_DEPTH_LIMIT {
+        over.depth_limited += 1;
+        return split::split_equal_count(range, info);
+    }
+    let d = match params.strategy {
+        SplitStrategy::Midpoint | SplitStrategy::EqualCount if n <= params.max_leaf_size as usize => {
+            SplitDecision::Leaf
+        }
+        SplitStrategy::Midpoint => split::split_midpoint(range, info),
+        SplitStrategy::EqualCount => split::split_equal_count(range, info),
+        SplitStrategy::SahBinned => split::split_sah_binned(range, info, params, scratch),
+        SplitStrategy::SahSweep => split::split_sah_sweep(range, info, params, scratch),
+    };
+    match d {
+        // No useful split, but the triangles fit in a leaf: that is the best we can do
+        // (e.g. the two halves of a quad whose diagonal spans its box share a centroid).
+        SplitDecision::Fallback if n <= params.max_leaf_size as usize => SplitDecision::Leaf,
+        // A strategy may only ask for a leaf that fits; otherwise split it anyway.
+        SplitDecision::Leaf if n > params.max_leaf_size as usize => {
+            over.fallback += 1;
+            split::split_equal_count(range, info)
+        }
+        // A split must leave both sides non-empty; treat anything else like a fallback.
+        SplitDecision::Fallback | SplitDecision::Split { .. } if !matches!(d, SplitDecision::Split { mid, .. } if mid > 0 && mid < n) =>
+        {
+            over.fallback += 1;
+            split::split_equal_count(range, info)
+        }
+        d => d,
+    }
+}
+
+/// Subtrees at least this big are split in parallel (`rayon::join`) ...
+const PARALLEL_MIN_PRIMS: usize = 4096;
+/// ... down to this depth, which bounds the recursion; deeper work uses the explicit stack.
+const PARALLEL_MAX_DEPTH: u32 = 16;
+
+/// Build the subtree over `prims`, which start at `offset` in the full primitive array. Node 0 of
+/// the result is the subtree's root; leaf indices are global, child indices local.
+fn build_subtree(
+    prims: &mut [BuildPrim],
+    offset: u32,
+    depth: u32,
+    params: &BuildParams,
     control: &WorkControl,
-) -> Result<Vec<BvhNode>, Cancelled> {
+) -> Result<(Vec<BvhNode>, Overrides), Cancelled> {
+    if prims.len() < PARALLEL_MIN_PRIMS || depth >= PARALLEL_MAX_DEPTH {
+        return build_sequential(prims, offset, depth, params, control);
+    }
+    control.check()?;
+    let info = node_info(prims);
+    let mut over = Overrides::default();
+    let decision = decide(prims, &info, depth, params, &mut SplitScratch::default(), &mut over);
+    let SplitDecision::Split { axis, mid } = decision else {
+        return build_sequential(prims, offset, depth, params, control);
+    };
+    let (l, r) = prims.split_at_mut(mid);
+    let (left, right) = rayon::join(
+        || build_subtree(l, offset, depth + 1, params, control),
+        || build_subtree(r, offset + mid as u32, depth + 1, params, control),
+    );
+    let ((left, lo), (right, ro)) = (left?, right?);
+    over += lo;
+    over += ro;
+    // Layout [parent, left root, right root, rest of left, rest of right]: the children stay a
+    // pair, and each subtree's own pairs stay pairs after the shift.
+    let a = left.len() as u32;
+    let remap = |n: &BvhNode, shift: u32| -> BvhNode {
+        if n.is_leaf() {
+            *n
+        } else {
+            BvhNode { index: n.index + shift, ..*n }
+        }
+    };
+    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+    nodes.push(BvhNode::interior(info.bounds, 1, axis));
+    // Local index i ≥ 1 of the left subtree goes to i + 2; of the right subtree to i + a + 1.
+    nodes.push(remap(&left[0], 2));
+    nodes.push(remap(&right[0], a + 1));
+    nodes.extend(left[1..].iter().map(|n| remap(n, 2)));
+    nodes.extend(right[1..].iter().map(|n| remap(n, a + 1)));
+    Ok((nodes, over))
+}
+
+/// Build a subtree with an explicit work stack (no recursion, however deep the tree).
+fn build_sequential(
+    prims: &mut [BuildPrim],
+    offset: u32,
+    depth0: u32,
+    params: &BuildParams,
+    control: &WorkControl,
+) -> Result<(Vec<BvhNode>, Overrides), Cancelled> {
     let mut nodes = Vec::with_capacity((2 * prims.len() / params.max_leaf_size.max(1) as usize).max(1));
-    nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
+    nodes.push(BvhNode::leaf(Aabb::EMPTY, offset, 0));
+    let mut over = Overrides::default();
     if prims.is_empty() {
-        return Ok(nodes); // one empty leaf: every ray misses its empty box
+        return Ok((nodes, over)); // one empty leaf: every ray misses its empty box
     }
     let mut scratch = SplitScratch::default();
-    let mut stack = vec![Task { node: 0, start: 0, end: prims.len() as u32, depth: 0 }];
+    let mut stack = vec![Task { node: 0, start: 0, end: prims.len() as u32, depth: depth0 }];
     let mut steps = 0u32;
     while let Some(task) = stack.pop() {
         steps += 1;
@@ -204,40 +333,7 @@ fn build_nodes(
         let range = &mut prims[task.start as usize..task.end as usize];
         let info = node_info(range);
         let n = range.len();
-        let decision = if n == 1 {
-            SplitDecision::Leaf
-        } else if task.depth >= HEURISTIC_DEPTH_LIMIT {
-            report.depth_limited_splits += 1;
-            split::split_equal_count(range, &info)
-        } else {
-            let d = match params.strategy {
-                SplitStrategy::Midpoint | SplitStrategy::EqualCount if n <= params.max_leaf_size as usize => {
-                    SplitDecision::Leaf
-                }
-                SplitStrategy::Midpoint => split::split_midpoint(range, &info),
-                SplitStrategy::EqualCount => split::split_equal_count(range, &info),
-                SplitStrategy::SahBinned => split::split_sah_binned(range, &info, params),
-                SplitStrategy::SahSweep => split::split_sah_sweep(range, &info, params, &mut scratch),
-            };
-            match d {
-                // No useful split, but the triangles fit in a leaf: that is the best we can do
-                // (e.g. the two halves of a quad whose diagonal spans its box share a centroid).
-                SplitDecision::Fallback if n <= params.max_leaf_size as usize => SplitDecision::Leaf,
-                // A strategy may only ask for a leaf that fits; otherwise split it anyway.
-                SplitDecision::Leaf if n > params.max_leaf_size as usize => {
-                    report.fallback_splits += 1;
-                    split::split_equal_count(range, &info)
-                }
-                // A split must leave both sides non-empty; treat anything else like a fallback.
-                SplitDecision::Fallback | SplitDecision::Split { .. } if !matches!(d, SplitDecision::Split { mid, .. } if mid > 0 && mid < n) =>
-                {
-                    report.fallback_splits += 1;
-                    split::split_equal_count(range, &info)
-                }
-                d => d,
-            }
-        };
-        match decision {
+        match decide(range, &info, task.depth, params, &mut scratch, &mut over) {
             SplitDecision::Split { axis, mid } => {
                 let left = nodes.len() as u32;
                 nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
@@ -250,12 +346,12 @@ fn build_nodes(
                 stack.push(Task { node: left, start: task.start, end: mid, depth });
             }
             _ => {
-                nodes[task.node as usize] = BvhNode::leaf(info.bounds, task.start, n as u16);
+                nodes[task.node as usize] = BvhNode::leaf(info.bounds, offset + task.start, n as u16);
                 control.add_done(n as u64);
             }
         }
     }
-    Ok(nodes)
+    Ok((nodes, over))
 }
 
 #[cfg(test)]

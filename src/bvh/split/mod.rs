@@ -111,6 +111,7 @@ pub enum SplitDecision {
 #[derive(Default)]
 pub struct SplitScratch {
     pub areas: Vec<f32>,
+    pub bins: Vec<sah_binned::Bin>,
 }
 
 /// Move the elements satisfying `left` to the front; returns how many there are. Unstable.

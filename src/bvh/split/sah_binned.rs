@@ -1,14 +1,26 @@
 //! Binned SAH: on each axis, drop centroids into `bins` equal-width bins, sweep the bins to get the
 //! cost of each of the `bins - 1` planes, and keep the cheapest plane of all three axes — or make a
 //! leaf when that is cheaper. Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies"
-//! (RT 2007); pbrt-v4 §7.3.2.
+//! (RT 2007); pbrt-v4 §7.3.2. The bins live in the build's scratch memory and all three axes are
+//! binned in one pass over the triangles, so a node costs O(n + bins), with no per-node allocation.
 
-use super::{partition, BuildPrim, NodeInfo, SplitDecision};
+use super::{partition, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 
-/// Upper bound on the bin count (keeps the per-node bin arrays on the stack).
+/// Upper bound on the bin count.
 pub const MAX_BINS: usize = 256;
+
+/// One bin: the triangles' bounds and count.
+#[derive(Clone, Copy, Debug)]
+pub struct Bin {
+    bounds: Aabb,
+    count: u32,
+}
+
+impl Bin {
+    const EMPTY: Bin = Bin { bounds: Aabb::EMPTY, count: 0 };
+}
 
 #[inline]
 fn bin_of(c: f32, lo: f32, scale: f32, bins: usize) -> usize {
@@ -16,44 +28,51 @@ fn bin_of(c: f32, lo: f32, scale: f32, bins: usize) -> usize {
     ((c - lo) * scale).max(0.0).min((bins - 1) as f32) as usize
 }
 
-pub fn split_sah_binned(prims: &mut [BuildPrim], node: &NodeInfo, params: &BuildParams) -> SplitDecision {
-    let bins = (params.sah_bins as usize).clamp(2, MAX_BINS);
-    let cb = node.centroid_bounds;
+pub fn split_sah_binned(
+    prims: &mut [BuildPrim],
+    node: &NodeInfo,
+    params: &BuildParams,
+    scratch: &mut SplitScratch,
+) -> SplitDecision {
     let n = prims.len();
-    let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, plane)
-    let mut counts = [0u32; MAX_BINS];
-    let mut boxes = [Aabb::EMPTY; MAX_BINS];
-    let mut right_area = [0f32; MAX_BINS];
-    let mut right_count = [0u32; MAX_BINS];
-    for axis in 0..3 {
-        let extent = cb.max[axis] - cb.min[axis];
-        if !(extent > 0.0) {
-            continue;
+    // A node of n triangles can use at most n non-empty bins per axis; sweeping more only costs
+    // time in the many small nodes near the leaves (the same planes are found).
+    let bins = (params.sah_bins as usize).min(n.max(4)).clamp(2, MAX_BINS);
+    let cb = node.centroid_bounds;
+    let extent = cb.max - cb.min;
+    // Axes with no extent cannot be split by a plane; their scale 0 puts everything in bin 0.
+    let scale: [f32; 3] = std::array::from_fn(|a| if extent[a] > 0.0 { bins as f32 / extent[a] } else { 0.0 });
+    let all = &mut scratch.bins;
+    all.clear();
+    all.resize(3 * bins, Bin::EMPTY);
+    for p in prims.iter() {
+        for axis in 0..3 {
+            let b = axis * bins + bin_of(p.centroid[axis], cb.min[axis], scale[axis], bins);
+            all[b].count += 1;
+            all[b].bounds = all[b].bounds.union(p.bounds);
         }
-        let scale = bins as f32 / extent;
-        counts[..bins].fill(0);
-        boxes[..bins].fill(Aabb::EMPTY);
-        for p in prims.iter() {
-            let b = bin_of(p.centroid[axis], cb.min[axis], scale, bins);
-            counts[b] += 1;
-            boxes[b] = boxes[b].union(p.bounds);
-        }
-        // right_*[i]: everything in bins i.. ; plane i separates bins ..i from i..
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+    }
+    let right_area = &mut scratch.areas;
+    right_area.clear();
+    right_area.resize(bins, 0.0);
+    let mut best: Option<(f32, usize, usize)> = None; // (weighted cost, axis, plane)
+    for axis in (0..3).filter(|&a| extent[a] > 0.0) {
+        let b = &all[axis * bins..(axis + 1) * bins];
+        // right_area[i]: area of bins i..; plane i separates bins ..i from i..
+        let mut acc = Aabb::EMPTY;
         for i in (1..bins).rev() {
-            acc = acc.union(boxes[i]);
-            cnt += counts[i];
+            acc = acc.union(b[i].bounds);
             right_area[i] = acc.area();
-            right_count[i] = cnt;
         }
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        let (mut acc, mut left) = (Aabb::EMPTY, 0u32);
         for i in 1..bins {
-            acc = acc.union(boxes[i - 1]);
-            cnt += counts[i - 1];
-            if cnt == 0 || right_count[i] == 0 {
+            acc = acc.union(b[i - 1].bounds);
+            left += b[i - 1].count;
+            let right = n as u32 - left;
+            if left == 0 || right == 0 {
                 continue;
             }
-            let cost = acc.area() * cnt as f32 + right_area[i] * right_count[i] as f32;
+            let cost = acc.area() * left as f32 + right_area[i] * right as f32;
             if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, axis, i));
             }
@@ -62,13 +81,12 @@ pub fn split_sah_binned(prims: &mut [BuildPrim], node: &NodeInfo, params: &Build
     let Some((weighted, axis, plane)) = best else {
         return SplitDecision::Fallback; // all centroids coincide
     };
-    let area = node.bounds.area();
-    let split_cost = params.cost.traversal + params.cost.intersection * weighted / area;
+    let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
     let leaf_cost = params.cost.intersection * n as f32;
     if n <= params.max_leaf_size as usize && leaf_cost <= split_cost {
         return SplitDecision::Leaf;
     }
-    let scale = bins as f32 / (cb.max[axis] - cb.min[axis]);
-    let mid = partition(prims, |p| bin_of(p.centroid[axis], cb.min[axis], scale, bins) < plane);
+    let (lo, s) = (cb.min[axis], scale[axis]);
+    let mid = partition(prims, |p| bin_of(p.centroid[axis], lo, s, bins) < plane);
     SplitDecision::Split { axis: axis as u8, mid }
 }

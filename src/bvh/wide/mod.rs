@@ -98,9 +98,9 @@ impl WideBvh {
                 kids[1] = r;
                 let mut n = 2;
                 while n < WIDTH {
-                    let open = (0..n).filter(|&k| !b[kids[k]].is_leaf()).max_by(|&x, &y| {
-                        b[kids[x]].bounds.area().total_cmp(&b[kids[y]].bounds.area())
-                    });
+                    let open = (0..n)
+                        .filter(|&k| !b[kids[k]].is_leaf())
+                        .max_by(|&x, &y| b[kids[x]].bounds.area().total_cmp(&b[kids[y]].bounds.area()));
                     let Some(k) = open else { break };
                     let first = b[kids[k]].index as usize;
                     kids[k] = first;

@@ -88,7 +88,11 @@ impl WideBvh {
         }
     }
 
-    fn closest<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(&self, ray: &mut Ray, stats: &mut S) -> Option<Hit> {
+    fn closest<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
         stats.box_tests(1);
         if self.prim_ids.is_empty() || self.root_bounds.intersect(ray).is_none() {
             return None;
@@ -182,7 +186,12 @@ impl WideBvh {
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
     }
 
-    fn dispatch<const ANY: bool, S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
+    fn dispatch<const ANY: bool, S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        opts: TraceOptions,
+        stats: &mut S,
+    ) -> Option<Hit> {
         // Children are always taken nearest first here; `opts.order` applies to the binary layout.
         match opts.test {
             TriangleTest::Watertight => self.closest::<Watertight, ANY, S>(ray, stats),
