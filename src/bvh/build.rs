@@ -9,6 +9,7 @@ use super::split::{self, BuildPrim, NodeInfo, SplitDecision, SplitScratch, Split
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
 use crate::work::{Cancelled, WorkControl};
+use glam::Vec3A;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -152,7 +153,7 @@ impl Bvh {
         let make = |i: usize| {
             let tri = mesh.triangle(i as u32);
             let bounds = Aabb::from_points(&tri);
-            BuildPrim { bounds, centroid: bounds.center(), index: i as u32 }
+            BuildPrim::new(bounds, i as u32)
         };
         let mut prims: Vec<BuildPrim> =
             if n >= 1 << 16 { (0..n).into_par_iter().map(make).collect() } else { (0..n).map(make).collect() };
@@ -177,24 +178,45 @@ impl Bvh {
     }
 }
 
-/// Bounds and centroid bounds of a range (in parallel for big ranges).
-fn node_info(prims: &[BuildPrim]) -> NodeInfo {
-    let fold = |acc: NodeInfo, p: &BuildPrim| NodeInfo {
-        bounds: acc.bounds.union(p.bounds),
-        centroid_bounds: acc.centroid_bounds.grow(p.centroid),
-    };
-    let empty = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY };
-    if prims.len() >= PARALLEL_MIN_PRIMS {
-        prims.par_chunks(4096).map(|c| c.iter().fold(empty, fold)).reduce(
-            || empty,
-            |a, b| NodeInfo {
-                bounds: a.bounds.union(b.bounds),
-                centroid_bounds: a.centroid_bounds.union(b.centroid_bounds),
-            },
-        )
-    } else {
-        prims.iter().fold(empty, fold)
+/// Bounds and centroid bounds of a range (in parallel for big ranges), in SIMD form.
+#[derive(Clone, Copy)]
+struct Extents {
+    min: Vec3A,
+    max: Vec3A,
+    cmin: Vec3A,
+    cmax: Vec3A,
+}
+
+impl Extents {
+    const EMPTY: Extents =
+        Extents { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY, cmin: Vec3A::INFINITY, cmax: Vec3A::NEG_INFINITY };
+
+    #[inline(always)]
+    fn add(self, p: &BuildPrim) -> Extents {
+        let c = p.centroid();
+        Extents { min: self.min.min(p.min), max: self.max.max(p.max), cmin: self.cmin.min(c), cmax: self.cmax.max(c) }
     }
+
+    fn merge(self, o: Extents) -> Extents {
+        Extents {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+            cmin: self.cmin.min(o.cmin),
+            cmax: self.cmax.max(o.cmax),
+        }
+    }
+}
+
+fn node_info(prims: &[BuildPrim]) -> NodeInfo {
+    let e = if prims.len() >= PARALLEL_MIN_PRIMS {
+        prims
+            .par_chunks(4096)
+            .map(|c| c.iter().fold(Extents::EMPTY, Extents::add))
+            .reduce(|| Extents::EMPTY, Extents::merge)
+    } else {
+        prims.iter().fold(Extents::EMPTY, Extents::add)
+    };
+    NodeInfo { bounds: Aabb::new(e.min.into(), e.max.into()), centroid_bounds: Aabb::new(e.cmin.into(), e.cmax.into()) }
 }
 
 /// Nodes where the driver overrode or replaced the strategy's answer.

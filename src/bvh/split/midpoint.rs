@@ -7,7 +7,7 @@ use super::{partition, BuildPrim, NodeInfo, SplitDecision};
 pub fn split_midpoint(prims: &mut [BuildPrim], node: &NodeInfo) -> SplitDecision {
     let axis = node.centroid_bounds.widest_axis();
     let pivot = node.centroid_bounds.center()[axis];
-    let mid = partition(prims, |p| p.centroid[axis] < pivot);
+    let mid = partition(prims, |p| p.centroid()[axis] < pivot);
     if mid == 0 || mid == prims.len() {
         SplitDecision::Fallback
     } else {

@@ -6,20 +6,44 @@
 
 use super::{partition, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
 use crate::bvh::BuildParams;
-use crate::geometry::Aabb;
+use glam::{Vec3, Vec3A};
 
 /// Upper bound on the bin count.
 pub const MAX_BINS: usize = 256;
 
-/// One bin: the triangles' bounds and count.
+/// One bin: the triangles' bounds (SIMD layout) and count.
 #[derive(Clone, Copy, Debug)]
 pub struct Bin {
-    bounds: Aabb,
+    min: Vec3A,
+    max: Vec3A,
     count: u32,
 }
 
 impl Bin {
-    const EMPTY: Bin = Bin { bounds: Aabb::EMPTY, count: 0 };
+    const EMPTY: Bin = Bin { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY, count: 0 };
+}
+
+/// A running union of boxes in SIMD layout, with the surface area of the SAH.
+#[derive(Clone, Copy)]
+struct Acc {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Acc {
+    const EMPTY: Acc = Acc { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
+
+    #[inline(always)]
+    fn add(&mut self, b: &Bin) {
+        self.min = self.min.min(b.min);
+        self.max = self.max.max(b.max);
+    }
+
+    #[inline(always)]
+    fn area(&self) -> f32 {
+        let e = (self.max - self.min).max(Vec3A::ZERO);
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
 }
 
 #[inline]
@@ -45,11 +69,15 @@ pub fn split_sah_binned(
     let all = &mut scratch.bins;
     all.clear();
     all.resize(3 * bins, Bin::EMPTY);
+    let (lo, sc, top) = (Vec3A::from(cb.min), Vec3A::from(Vec3::from(scale)), Vec3A::splat((bins - 1) as f32));
     for p in prims.iter() {
-        for axis in 0..3 {
-            let b = axis * bins + bin_of(p.centroid[axis], cb.min[axis], scale[axis], bins);
-            all[b].count += 1;
-            all[b].bounds = all[b].bounds.union(p.bounds);
+        // All three bin indices at once; the float-to-int cast saturates and maps NaN to 0.
+        let idx = ((p.centroid() - lo) * sc).max(Vec3A::ZERO).min(top).as_uvec3();
+        for (axis, i) in idx.to_array().into_iter().enumerate() {
+            let bin = &mut all[axis * bins + i as usize];
+            bin.count += 1;
+            bin.min = bin.min.min(p.min);
+            bin.max = bin.max.max(p.max);
         }
     }
     let right_area = &mut scratch.areas;
@@ -59,14 +87,14 @@ pub fn split_sah_binned(
     for axis in (0..3).filter(|&a| extent[a] > 0.0) {
         let b = &all[axis * bins..(axis + 1) * bins];
         // right_area[i]: area of bins i..; plane i separates bins ..i from i..
-        let mut acc = Aabb::EMPTY;
+        let mut acc = Acc::EMPTY;
         for i in (1..bins).rev() {
-            acc = acc.union(b[i].bounds);
+            acc.add(&b[i]);
             right_area[i] = acc.area();
         }
-        let (mut acc, mut left) = (Aabb::EMPTY, 0u32);
+        let (mut acc, mut left) = (Acc::EMPTY, 0u32);
         for i in 1..bins {
-            acc = acc.union(b[i - 1].bounds);
+            acc.add(&b[i - 1]);
             left += b[i - 1].count;
             let right = n as u32 - left;
             if left == 0 || right == 0 {
@@ -87,6 +115,7 @@ pub fn split_sah_binned(
         return SplitDecision::Leaf;
     }
     let (lo, s) = (cb.min[axis], scale[axis]);
-    let mid = partition(prims, |p| bin_of(p.centroid[axis], lo, s, bins) < plane);
+    // Same arithmetic as the binning above (SIMD there, scalar here: IEEE gives equal results).
+    let mid = partition(prims, |p| bin_of(p.centroid()[axis], lo, s, bins) < plane);
     SplitDecision::Split { axis: axis as u8, mid }
 }

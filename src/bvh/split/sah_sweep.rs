@@ -8,7 +8,7 @@ use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 
 fn sort_on(prims: &mut [BuildPrim], axis: usize) {
-    prims.sort_unstable_by(|a, b| a.centroid[axis].total_cmp(&b.centroid[axis]).then(a.index.cmp(&b.index)));
+    prims.sort_unstable_by(|a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]).then(a.index.cmp(&b.index)));
 }
 
 pub fn split_sah_sweep(
@@ -32,14 +32,14 @@ pub fn split_sah_sweep(
         // right_area[i] = area of prims[i..]
         let mut acc = Aabb::EMPTY;
         for i in (1..n).rev() {
-            acc = acc.union(prims[i].bounds);
+            acc = acc.union(prims[i].bounds());
             right_area[i] = acc.area();
         }
         let mut acc = Aabb::EMPTY;
         for i in 1..n {
-            acc = acc.union(prims[i - 1].bounds);
+            acc = acc.union(prims[i - 1].bounds());
             // Only split between distinct centroids, so the split is a plane, as in the binned case.
-            if prims[i - 1].centroid[axis] == prims[i].centroid[axis] {
+            if prims[i - 1].centroid()[axis] == prims[i].centroid()[axis] {
                 continue;
             }
             let cost = acc.area() * i as f32 + right_area[i] * (n - i) as f32;
