@@ -29,7 +29,9 @@ impl Bvh {
         if !(t0 <= t1) {
             return None;
         }
-        let prepared = T::prepare(ray);
+        // The triangle test's per-ray setup waits for the first leaf: most rays that miss never
+        // reach one.
+        let mut prepared: Option<T::Prepared> = None;
         let mut best: Option<(usize, crate::geometry::TriangleHit)> = None;
         let mut stack = TraversalStack::<TRAVERSAL_STACK_SIZE>::new();
         let mut current = 0usize;
@@ -40,7 +42,7 @@ impl Bvh {
                 stats.leaf_visited();
                 stats.triangle_tests(node.count as u32);
                 for i in node.prims() {
-                    if let Some(h) = T::intersect(&prepared, ray, &self.tris[i]) {
+                    if let Some(h) = T::intersect(prepared.get_or_insert_with(|| T::prepare(ray)), ray, &self.tris[i]) {
                         ray.t_max = h.t;
                         best = Some((i, h));
                         if ANY {

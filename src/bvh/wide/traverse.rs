@@ -98,7 +98,9 @@ impl WideBvh {
             return None;
         }
         let sray = SimdRay::new(ray);
-        let prepared = T::prepare(ray);
+        // The triangle test's per-ray setup waits for the first leaf: most rays that miss never
+        // reach one.
+        let mut prepared: Option<T::Prepared> = None;
         let mut best: Option<(usize, TriangleHit)> = None;
         let mut stack = TraversalStack::<STACK>::new();
         let mut cur = 0u32;
@@ -164,7 +166,7 @@ impl WideBvh {
             stats.leaf_visited();
             stats.triangle_tests(count as u32);
             for (i, tri) in self.tris[first..first + count].iter().enumerate() {
-                if let Some(h) = T::intersect(&prepared, ray, tri) {
+                if let Some(h) = T::intersect(prepared.get_or_insert_with(|| T::prepare(ray)), ray, tri) {
                     ray.t_max = h.t;
                     best = Some((first + i, h));
                     if ANY {
