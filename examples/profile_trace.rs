@@ -19,6 +19,12 @@ fn main() {
     if let Ok(c) = std::env::var("COST") {
         params.cost.traversal = c.parse().expect("COST is a number");
     }
+    if let Ok(b) = std::env::var("BINS") {
+        params.sah_bins = b.parse().expect("BINS is a number");
+    }
+    if std::env::var("SWEEP").is_ok() {
+        params.strategy = bvhscope::bvh::SplitStrategy::SahSweep;
+    }
     if let Ok(l) = std::env::var("LEAF") {
         params.max_leaf_size = l.parse().expect("LEAF is a number");
     }

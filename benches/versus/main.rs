@@ -218,6 +218,56 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
     o
 }
 
+/// The figures the README quotes for the app: a full 1280×720 normal frame of the bunny (the app's
+/// default wide layout, all threads), load + SAH build of the 2M-triangle mesh from an OBJ file,
+/// and a strategy switch (a rebuild) on it.
+fn app_figures(meshes: &[Mesh], all: &ThreadPool) -> String {
+    use bvhscope::bvh::{AnyBvh, BuildParams, SplitStrategy};
+    use bvhscope::render::{render, Camera, RenderSettings};
+    let mut o = String::from("\n### App figures (all threads)\n\n");
+    if let Some(bunny) = meshes.iter().find(|m| m.name.contains("bunny")) {
+        let bvh = all.install(|| AnyBvh::build(bunny, &BuildParams::default()));
+        let cam = Camera::framing(&bunny.bounds(), 1280, 720);
+        let settings = RenderSettings::default();
+        let times: Vec<f64> = (0..9)
+            .map(|_| {
+                let t = Instant::now();
+                std::hint::black_box(all.install(|| render(&bvh, bunny, &cam, &settings)));
+                ms(t.elapsed())
+            })
+            .collect();
+        let _ = writeln!(o, "- full 1280×720 normal frame of the bunny (wide SAH, shading included): median {:.1} ms of 9", median(times));
+    }
+    if let Some(big) = meshes.iter().find(|m| m.triangle_count() > 1_000_000) {
+        let path = std::env::temp_dir().join(format!("bvhscope-bench-{}.obj", std::process::id()));
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&path).expect("temp file"));
+        bvhscope::mesh::write_obj(big, &mut f).expect("write OBJ");
+        drop(f);
+        let t = Instant::now();
+        let (mesh, _) = all.install(|| bvhscope::mesh::load_obj(&path)).expect("read back");
+        let load = ms(t.elapsed());
+        let t = Instant::now();
+        let bvh = all.install(|| AnyBvh::build(&mesh, &BuildParams::default()));
+        let build = ms(t.elapsed());
+        let _ = writeln!(
+            o,
+            "- {} triangles from an OBJ file: load {:.0} ms + SAH build (wide) {:.0} ms = {:.2} s",
+            mesh.triangle_count(),
+            load,
+            build,
+            (load + build) / 1e3
+        );
+        drop(bvh);
+        for s in [SplitStrategy::Midpoint, SplitStrategy::SahBinned] {
+            let t = Instant::now();
+            std::hint::black_box(all.install(|| AnyBvh::build(&mesh, &BuildParams::with_strategy(s))));
+            let _ = writeln!(o, "- strategy switch to {} on it (a full rebuild, wide layout): {:.0} ms", s.label(), ms(t.elapsed()));
+        }
+        let _ = std::fs::remove_file(&path);
+    }
+    o
+}
+
 fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -285,5 +335,8 @@ fn main() {
         closing += &ratios(mesh, &rows);
     }
     println!("\n{closing}");
+    if !quick {
+        println!("{}", app_figures(&meshes, &all));
+    }
     println!("total time {:.0} s", started.elapsed().as_secs_f64());
 }

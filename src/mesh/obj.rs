@@ -191,6 +191,41 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
     Ok((mesh, report))
 }
 
+/// Write a mesh as OBJ text: one `o` per group, positions, normals and uvs when present.
+pub fn write_obj(mesh: &Mesh, out: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(out, "# {} — written by bvhscope", mesh.name)?;
+    for p in &mesh.positions {
+        writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    for t in &mesh.uvs {
+        writeln!(out, "vt {} {}", t.x, t.y)?;
+    }
+    for n in &mesh.normals {
+        writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+    }
+    let corner = |i: u32| {
+        let i = i + 1;
+        match (mesh.uvs.is_empty(), mesh.normals.is_empty()) {
+            (true, true) => format!("{i}"),
+            (false, true) => format!("{i}/{i}"),
+            (true, false) => format!("{i}//{i}"),
+            (false, false) => format!("{i}/{i}/{i}"),
+        }
+    };
+    let groups = if mesh.groups.is_empty() {
+        vec![super::MeshGroup { name: mesh.name.clone(), triangles: 0..mesh.triangles.len() as u32 }]
+    } else {
+        mesh.groups.clone()
+    };
+    for g in &groups {
+        writeln!(out, "o {}", g.name.replace(char::is_whitespace, "_"))?;
+        for t in &mesh.triangles[g.triangles.start as usize..g.triangles.end as usize] {
+            writeln!(out, "f {} {} {}", corner(t[0]), corner(t[1]), corner(t[2]))?;
+        }
+    }
+    Ok(())
+}
+
 fn mesh_name(path: &Path) -> String {
     path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
 }
@@ -385,6 +420,22 @@ mod tests {
         assert!(matches!(err(""), MeshError::NoTriangles { .. }));
         let e = err("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
         assert!(matches!(e, MeshError::NoTriangles { degenerate: 1, .. }), "{e}");
+    }
+
+    #[test]
+    fn written_obj_reads_back_the_same_mesh() {
+        let mut m = crate::mesh::generate::torus(2.0, 0.5, 12, 6);
+        m.name = "ring".into();
+        let mut text = Vec::new();
+        write_obj(&m, &mut text).unwrap();
+        let (back, report) = parse_obj("ring.obj", std::str::from_utf8(&text).unwrap()).unwrap();
+        assert_eq!(report.triangles, m.triangles.len());
+        assert!(report.has_normals && report.has_uvs);
+        for i in 0..m.triangle_count() as u32 {
+            let (a, b) = (m.triangle(i), back.triangle(i));
+            assert!(a.iter().zip(&b).all(|(p, q)| (*p - *q).length() < 1e-5), "triangle {i}");
+        }
+        assert_eq!(back.groups[0].name, "torus");
     }
 
     #[test]
