@@ -86,7 +86,16 @@ fn render_writes_a_png_of_the_requested_size_with_legend_for_heatmaps() {
 
 #[test]
 fn stats_and_compare_print_their_tables() {
-    let out = bvhscope(&["stats", tent().to_str().unwrap(), "--strategy", "equal-count", "--max-leaf-size", "1"]);
+    let out = bvhscope(&[
+        "stats",
+        tent().to_str().unwrap(),
+        "--strategy",
+        "equal-count",
+        "--max-leaf-size",
+        "1",
+        "--layout",
+        "binary",
+    ]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("nodes           7 (3 interior, 4 leaves)"), "{text}");
 
@@ -94,15 +103,28 @@ fn stats_and_compare_print_their_tables() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     let rows = v["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 5, "four strategies and the linear scan");
-    assert_eq!(rows[4]["name"], "Linear scan");
-    assert_eq!(rows[4]["tri_tests_per_ray"], 4.0);
+    assert_eq!(rows.len(), 9, "four strategies in two layouts, and the linear scan");
+    assert_eq!(rows[0]["name"], "Midpoint (binary)");
+    assert_eq!(rows[1]["name"], "Midpoint (wide4)");
+    assert_eq!(rows[8]["name"], "Linear scan");
+    assert_eq!(rows[8]["tri_tests_per_ray"], 4.0);
     for r in rows {
         assert!(r["frame_ms"].as_f64().unwrap() > 0.0);
     }
 
-    let out = bvhscope(&["compare", tent().to_str().unwrap(), "--size", "40x30", "--runs", "1", "--format", "csv"]);
+    let out = bvhscope(&[
+        "compare",
+        tent().to_str().unwrap(),
+        "--size",
+        "40x30",
+        "--runs",
+        "1",
+        "--format",
+        "csv",
+        "--layout",
+        "wide4",
+    ]);
     let csv = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(csv.lines().count(), 6, "{csv}");
+    assert_eq!(csv.lines().count(), 6, "header, four strategies in the chosen layout, linear: {csv}");
     assert!(csv.starts_with("strategy,build_ms"));
 }

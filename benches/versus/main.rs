@@ -2,7 +2,8 @@
 //! the same rays. Prints one markdown table per mesh and closing ratio lines. Every time is the
 //! median of several runs; hit counts are printed so nobody wins by missing.
 //! `BENCH_QUICK=1` runs a reduced set (under two minutes on 2 cores). For iterating on one thing:
-//! `BENCH_ONLY=sah,medium` keeps contenders whose names contain a word, `BENCH_MESH=bunny` one mesh.
+//! `BENCH_ONLY=sah,medium` keeps contenders whose names contain a word, `BENCH_MESH=bunny` one mesh,
+//! `BENCH_APP=1` prints only the app figures.
 
 mod contenders;
 mod rays;
@@ -236,34 +237,52 @@ fn app_figures(meshes: &[Mesh], all: &ThreadPool) -> String {
                 ms(t.elapsed())
             })
             .collect();
-        let _ = writeln!(o, "- full 1280×720 normal frame of the bunny (wide SAH, shading included): median {:.1} ms of 9", median(times));
-    }
-    if let Some(big) = meshes.iter().find(|m| m.triangle_count() > 1_000_000) {
-        let path = std::env::temp_dir().join(format!("bvhscope-bench-{}.obj", std::process::id()));
-        let mut f = std::io::BufWriter::new(std::fs::File::create(&path).expect("temp file"));
-        bvhscope::mesh::write_obj(big, &mut f).expect("write OBJ");
-        drop(f);
-        let t = Instant::now();
-        let (mesh, _) = all.install(|| bvhscope::mesh::load_obj(&path)).expect("read back");
-        let load = ms(t.elapsed());
-        let t = Instant::now();
-        let bvh = all.install(|| AnyBvh::build(&mesh, &BuildParams::default()));
-        let build = ms(t.elapsed());
         let _ = writeln!(
             o,
-            "- {} triangles from an OBJ file: load {:.0} ms + SAH build (wide) {:.0} ms = {:.2} s",
-            mesh.triangle_count(),
-            load,
-            build,
-            (load + build) / 1e3
+            "- full 1280×720 normal frame of the bunny (wide SAH, shading included): median {:.1} ms of 9",
+            median(times)
         );
-        drop(bvh);
+    }
+    if let Some(big) = meshes.iter().find(|m| m.triangle_count() > 1_000_000) {
+        let mut bare = big.clone();
+        bare.normals.clear();
+        bare.uvs.clear();
+        for (label, m) in [("with normals and uvs", big), ("positions and faces only", &bare)] {
+            let path = std::env::temp_dir().join(format!("bvhscope-bench-{}.obj", std::process::id()));
+            let mut f = std::io::BufWriter::new(std::fs::File::create(&path).expect("temp file"));
+            bvhscope::mesh::write_obj(m, &mut f).expect("write OBJ");
+            // Flush to disk first, so the load is not timed against the write-back of the file.
+            f.into_inner().expect("flush").sync_all().expect("sync");
+            let size = std::fs::metadata(&path).map_or(0, |m| m.len());
+            let t = Instant::now();
+            let (mesh, _) = all.install(|| bvhscope::mesh::load_obj(&path)).expect("read back");
+            let load = ms(t.elapsed());
+            let t = Instant::now();
+            let bvh = all.install(|| AnyBvh::build(&mesh, &BuildParams::default()));
+            let build = ms(t.elapsed());
+            let _ = writeln!(
+                o,
+                "- {} triangles from an OBJ file {label} ({:.0} MB): load {:.0} ms + SAH build (wide) {:.0} ms = {:.2} s",
+                mesh.triangle_count(),
+                size as f64 / 1e6,
+                load,
+                build,
+                (load + build) / 1e3
+            );
+            drop(bvh);
+            let _ = std::fs::remove_file(&path);
+        }
+        let mesh = big;
         for s in [SplitStrategy::Midpoint, SplitStrategy::SahBinned] {
             let t = Instant::now();
             std::hint::black_box(all.install(|| AnyBvh::build(&mesh, &BuildParams::with_strategy(s))));
-            let _ = writeln!(o, "- strategy switch to {} on it (a full rebuild, wide layout): {:.0} ms", s.label(), ms(t.elapsed()));
+            let _ = writeln!(
+                o,
+                "- strategy switch to {} on it (a full rebuild, wide layout): {:.0} ms",
+                s.label(),
+                ms(t.elapsed())
+            );
         }
-        let _ = std::fs::remove_file(&path);
     }
     o
 }
@@ -309,12 +328,18 @@ fn main() {
         contenders.retain(|c| words.iter().any(|w| c.name.to_lowercase().contains(w.as_str())));
     }
 
+    // BENCH_APP=1: only the app figures (frame time, 2M load + build, strategy switch).
+    let app_only = std::env::var("BENCH_APP").is_ok_and(|v| v == "1");
     let mut meshes: Vec<Mesh> = Vec::new();
     meshes.extend(scenes::shared("stanford-bunny.obj"));
     meshes.extend(scenes::shared("beast.obj"));
     meshes.push(scenes::teapot_in_stadium());
-    if !quick {
+    if !quick || app_only {
         meshes.push(scenes::big_knot());
+    }
+    if app_only {
+        println!("{}", app_figures(&meshes, &all));
+        return;
     }
 
     // BENCH_MESH=word keeps meshes whose name contains it.

@@ -65,7 +65,17 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         },
     })?;
     let hits = frame.samples.iter().filter(|s| s.is_hit()).count();
-    eprint!("wrote {} ({}x{}, {} of {} pixels hit", a.output.display(), camera.width, camera.height, hits, total);
+    let legend_note = if legend.is_some() { " with the legend below" } else { "" };
+    eprint!(
+        "wrote {} ({}x{} image, {}x{} render{legend_note}; {} of {} pixels hit",
+        a.output.display(),
+        img.width(),
+        img.height(),
+        camera.width,
+        camera.height,
+        hits,
+        total
+    );
     if let Some(l) = legend {
         eprint!("; {}: min {} mean {:.2} max {}", l.title, l.min, l.mean, l.max);
     }

@@ -1,7 +1,7 @@
 //! OBJ loading through `tobj`, with errors that name the file and, where known, the line.
 //!
 //! We read the file ourselves (to tell a missing file from a directory from binary data) and hand
-//! the text to tobj. tobj reports *what* failed but not *where*; on failure we scan the text once
+//! it to tobj. tobj reports *what* failed but not *where*; on failure we scan the text once
 //! for the first line showing that fault, so the user can open the file at the right place.
 
 use super::{Mesh, MeshGroup};
@@ -73,32 +73,72 @@ pub struct LoadReport {
 }
 
 /// Load an OBJ file: polygons are triangulated, groups kept, zero-area triangles skipped.
+///
+/// The file is streamed into tobj (a 2M-triangle OBJ is a quarter of a gigabyte; holding it as
+/// one string would only cost time). Only when something is wrong is it read again as text, to
+/// tell binary data from text and to find the offending line.
 pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
     let start = Instant::now();
-    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
+    let io = |e: std::io::Error| match e.kind() {
         std::io::ErrorKind::NotFound => MeshError::NotFound { path: path.into() },
         _ => MeshError::Io { path: path.into(), source: e },
-    })?;
-    if meta.is_dir() {
+    };
+    if std::fs::metadata(path).map_err(io)?.is_dir() {
         return Err(MeshError::IsDirectory { path: path.into() });
     }
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io { path: path.into(), source: e })?;
-    let text = match std::str::from_utf8(&bytes) {
-        Ok(t) => t,
-        Err(e) => return Err(MeshError::NotText { path: path.into(), line: line_at(&bytes, e.valid_up_to()) }),
-    };
-    let (mesh, mut report) = parse_obj(path, text)?;
-    report.load_time = start.elapsed();
-    Ok((mesh, report))
+    let file = std::fs::File::open(path).map_err(io)?;
+    let streamed = load_models(&mut std::io::BufReader::with_capacity(1 << 20, file)).map_err(Problem::Tobj);
+    match streamed.and_then(|models| build_mesh(path, models)) {
+        Ok((mesh, mut report)) => {
+            report.load_time = start.elapsed();
+            Ok((mesh, report))
+        }
+        Err(problem) => {
+            let bytes = std::fs::read(path).map_err(io)?;
+            let text = match std::str::from_utf8(&bytes) {
+                Ok(t) => t,
+                Err(e) => return Err(MeshError::NotText { path: path.into(), line: line_at(&bytes, e.valid_up_to()) }),
+            };
+            Err(explain(path, text, problem))
+        }
+    }
 }
 
 /// Parse OBJ text; `path` is used for the mesh name and in error messages.
 pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
+    load_models(&mut Cursor::new(text.as_bytes()))
+        .map_err(Problem::Tobj)
+        .and_then(|models| build_mesh(path, models))
+        .map_err(|problem| explain(path, text, problem))
+}
+
+/// What went wrong before the text was looked at for line numbers.
+enum Problem {
+    Tobj(tobj::LoadError),
+    /// (what, OBJ keyword, values per line)
+    NonFinite(&'static str, &'static str, usize),
+    NoTriangles {
+        degenerate: usize,
+    },
+}
+
+/// Turn a problem into an error naming the file and, where it can be found, the line.
+fn explain(path: &Path, text: &str, problem: Problem) -> MeshError {
     if let Some(pos) = text.bytes().position(|b| b == 0) {
-        return Err(MeshError::NotText { path: path.into(), line: line_at(text.as_bytes(), pos) });
+        return MeshError::NotText { path: path.into(), line: line_at(text.as_bytes(), pos) };
     }
+    match problem {
+        Problem::Tobj(e) => diagnose(path, text, e),
+        Problem::NonFinite(what, keyword, min) => {
+            MeshError::NonFinite { path: path.into(), line: first_bad_line(text, keyword, min), what }
+        }
+        Problem::NoTriangles { degenerate } => MeshError::NoTriangles { path: path.into(), degenerate },
+    }
+}
+
+fn load_models(reader: &mut impl std::io::BufRead) -> Result<Vec<tobj::Model>, tobj::LoadError> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -107,13 +147,11 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
         ..Default::default()
     };
     // Materials are not needed to show a BVH; a missing .mtl must not fail the load.
-    let loaded =
-        tobj::load_obj_buf(&mut Cursor::new(text.as_bytes()), &options, |_| Err(tobj::LoadError::OpenFileFailed));
-    let models = match loaded {
-        Ok((models, _materials)) => models,
-        Err(e) => return Err(diagnose(path, text, e)),
-    };
+    tobj::load_obj_buf(reader, &options, |_| Err(tobj::LoadError::OpenFileFailed)).map(|(models, _)| models)
+}
 
+/// tobj's models as one mesh: groups kept, zero-area triangles left out and counted.
+fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport), Problem> {
     let mut mesh = Mesh { name: mesh_name(path), ..Default::default() };
     let has_normals = models.iter().any(|m| !m.mesh.normals.is_empty());
     let has_uvs = models.iter().any(|m| !m.mesh.texcoords.is_empty());
@@ -155,28 +193,16 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
     }
 
     if mesh.positions.iter().any(|p| !p.is_finite()) {
-        return Err(MeshError::NonFinite {
-            path: path.into(),
-            line: first_bad_line(text, "v", 3),
-            what: "a vertex position",
-        });
+        return Err(Problem::NonFinite("a vertex position", "v", 3));
     }
     if mesh.normals.iter().any(|n| !n.is_finite()) {
-        return Err(MeshError::NonFinite {
-            path: path.into(),
-            line: first_bad_line(text, "vn", 3),
-            what: "a vertex normal",
-        });
+        return Err(Problem::NonFinite("a vertex normal", "vn", 3));
     }
     if mesh.uvs.iter().any(|t| !t.is_finite()) {
-        return Err(MeshError::NonFinite {
-            path: path.into(),
-            line: first_bad_line(text, "vt", 1),
-            what: "a texture coordinate",
-        });
+        return Err(Problem::NonFinite("a texture coordinate", "vt", 1));
     }
     if mesh.triangles.is_empty() {
-        return Err(MeshError::NoTriangles { path: path.into(), degenerate });
+        return Err(Problem::NoTriangles { degenerate });
     }
     let report = LoadReport {
         path: path.into(),

@@ -16,7 +16,9 @@ pub fn shared_models() -> Option<PathBuf> {
     if std::env::var("CI").is_ok_and(|v| v == "true") {
         panic!("CI=true but the shared test meshes are missing: {}", dir.display());
     }
-    eprintln!("notice: {} not found; skipping tests on shared meshes", dir.display());
+    // Written to stderr directly: libtest captures `eprintln!` of passing tests, not this.
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "notice: {} not found; skipping tests on shared meshes", dir.display());
     None
 }
 

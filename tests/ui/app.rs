@@ -2,7 +2,7 @@
 //! Built by the `ui-tests` package (see its Cargo.toml); snapshots live in `tests/snapshots/`.
 
 use bvhscope::app::{AppOptions, BvhscopeApp, MessageKind, SceneSource};
-use bvhscope::bvh::SplitStrategy;
+use bvhscope::bvh::{SplitStrategy, TreeView};
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -75,13 +75,13 @@ fn choosing_another_strategy_rebuilds_and_changes_the_node_count() {
     h.run_steps(3);
     h.get_by_label("Midpoint").click();
     run_until(&mut h, "the midpoint build", |a| {
-        a.current_bvh().is_some_and(|b| b.bvh.params.strategy == SplitStrategy::Midpoint) && idle(a)
+        a.current_bvh().is_some_and(|b| b.bvh.params().strategy == SplitStrategy::Midpoint) && idle(a)
     });
     let after = h.state().current_bvh().unwrap().stats.nodes;
     assert_ne!(before, after, "midpoint and SAH trees differ in size here");
     h.get_by_label(&after.to_string());
     // The previous strategy's figures stay next to the new ones.
-    h.get_by_label("before: SAH binned");
+    h.get_by_label("before: SAH binned, wide4");
     h.get_by_label(&before.to_string());
 }
 
@@ -98,7 +98,8 @@ fn moving_the_depth_slider_changes_the_number_of_boxes_drawn() {
     h.step();
     assert_eq!(h.state().settings.box_depth, 6);
     let drawn = h.state().boxes_drawn;
-    assert!(drawn > 1 && drawn <= 64, "depth 6 has at most 64 nodes, drew {drawn}");
+    // The default layout is 4-wide: depth 6 holds at most 4^6 nodes.
+    assert!(drawn > 64 && drawn <= 4096, "depth 6 of a 4-wide tree, drew {drawn}");
     h.get_by_label(&format!("{drawn} boxes drawn"));
     // The ] key goes one level deeper.
     h.key_press(egui::Key::CloseBracket);
