@@ -30,12 +30,15 @@ pub struct Built {
     pub bytes_per_tri: Option<f64>,
 }
 
+/// Builds a tracer and says how long the build proper took.
+pub type BuildFn = Box<dyn Fn(&Mesh) -> (Built, Duration) + Sync>;
+
 /// A named way to build a tracer; `build` returns the structure and the time of the build proper
 /// (input conversion to the library's own types is not timed).
 pub struct Contender {
     pub name: String,
     pub family: Family,
-    pub build: Box<dyn Fn(&Mesh) -> (Built, Duration) + Sync>,
+    pub build: BuildFn,
     /// Slow builds are skipped on big meshes in quick mode.
     pub slow_build: bool,
 }

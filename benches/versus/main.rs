@@ -160,7 +160,7 @@ fn table(mesh: &Mesh, rows: &[Row], s: &Settings, threads: usize) -> String {
     o
 }
 
-fn best<'a>(rows: &'a [Row], pick: impl Fn(&Row) -> bool, key: impl Fn(&Row) -> f64) -> Option<&'a Row> {
+fn best(rows: &[Row], pick: impl Fn(&Row) -> bool, key: impl Fn(&Row) -> f64) -> Option<&Row> {
     rows.iter().filter(|r| pick(r)).max_by(|a, b| key(a).total_cmp(&key(b)))
 }
 
@@ -275,7 +275,7 @@ fn app_figures(meshes: &[Mesh], all: &ThreadPool) -> String {
         let mesh = big;
         for s in [SplitStrategy::Midpoint, SplitStrategy::SahBinned] {
             let t = Instant::now();
-            std::hint::black_box(all.install(|| AnyBvh::build(&mesh, &BuildParams::with_strategy(s))));
+            std::hint::black_box(all.install(|| AnyBvh::build(mesh, &BuildParams::with_strategy(s))));
             let _ = writeln!(
                 o,
                 "- strategy switch to {} on it (a full rebuild, wide layout): {:.0} ms",

@@ -349,7 +349,7 @@ fn build_sequential(
     let mut steps = 0u32;
     while let Some(task) = stack.pop() {
         steps += 1;
-        if steps % 256 == 0 {
+        if steps.is_multiple_of(256) {
             control.check()?;
         }
         let range = &mut prims[task.start as usize..task.end as usize];

@@ -49,8 +49,9 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
     );
     let _ = writeln!(
         o,
-        "strategy        {} (max leaf size {}, {} SAH bins)",
-        format!("{}, {} layout", params.strategy.label(), params.layout.label()),
+        "strategy        {}, {} layout (max leaf size {}, {} SAH bins)",
+        params.strategy.label(),
+        params.layout.label(),
         params.max_leaf_size,
         params.sah_bins
     );

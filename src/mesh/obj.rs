@@ -139,13 +139,7 @@ fn explain(path: &Path, text: &str, problem: Problem) -> MeshError {
 }
 
 fn load_models(reader: &mut impl std::io::BufRead) -> Result<Vec<tobj::Model>, tobj::LoadError> {
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-        ..Default::default()
-    };
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     // Materials are not needed to show a BVH; a missing .mtl must not fail the load.
     tobj::load_obj_buf(reader, &options, |_| Err(tobj::LoadError::OpenFileFailed)).map(|(models, _)| models)
 }

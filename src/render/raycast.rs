@@ -102,10 +102,10 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
             let rows = (samples.len() / w as usize) as u32;
             let mut traced = 0u64;
             for x0 in (0..w).step_by(TILE as usize) {
-                for dy in (0..rows).filter(|dy| (y0 + dy) % stride == 0) {
+                for dy in (0..rows).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
                     let y = y0 + dy;
                     for x in (x0..(x0 + TILE).min(w)).step_by(stride as usize) {
-                        if previous != 0 && x % previous == 0 && y % previous == 0 {
+                        if previous != 0 && x.is_multiple_of(previous) && y.is_multiple_of(previous) {
                             continue;
                         }
                         let mut ray = gen.pixel_ray(x, y);

@@ -4,7 +4,7 @@
 //! (RT 2007); pbrt-v4 §7.3.2. The bins live in the build's scratch memory and all three axes are
 //! binned in one pass over the triangles, so a node costs O(n + bins), with no per-node allocation.
 
-use super::{partition, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
+use super::{leaf_is_cheaper, partition, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
 use crate::bvh::BuildParams;
 use glam::{Vec3, Vec3A};
 
@@ -109,9 +109,7 @@ pub fn split_sah_binned(
     let Some((weighted, axis, plane)) = best else {
         return SplitDecision::Fallback; // all centroids coincide
     };
-    let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
-    let leaf_cost = params.cost.intersection * n as f32;
-    if n <= params.max_leaf_size as usize && leaf_cost <= split_cost {
+    if leaf_is_cheaper(n, weighted, node, params) {
         return SplitDecision::Leaf;
     }
     let (lo, s) = (cb.min[axis], scale[axis]);

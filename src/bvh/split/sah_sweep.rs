@@ -3,7 +3,7 @@
 //! ray tracing using space subdivision" (The Visual Computer, 1990); Wald 2007 §3 for the sweep.
 //! O(n log n) per node; use the binned version for big meshes in interactive work.
 
-use super::{BuildPrim, NodeInfo, SplitDecision, SplitScratch};
+use super::{leaf_is_cheaper, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 
@@ -51,9 +51,7 @@ pub fn split_sah_sweep(
     let Some((weighted, axis, mid)) = best else {
         return SplitDecision::Fallback;
     };
-    let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
-    let leaf_cost = params.cost.intersection * n as f32;
-    if n <= params.max_leaf_size as usize && leaf_cost <= split_cost {
+    if leaf_is_cheaper(n, weighted, node, params) {
         return SplitDecision::Leaf;
     }
     if sorted_on != Some(axis) {
