@@ -134,6 +134,7 @@ pub struct SplitScratch {
 /// The SAH's leaf-or-split decision: a leaf (allowed only up to the maximum leaf size) costs
 /// C_isect·n; the best split costs C_trav + C_isect·(A_L·n_L + A_R·n_R)/A, where `weighted` is the
 /// sum in parentheses.
+#[inline]
 pub(crate) fn leaf_is_cheaper(n: usize, weighted: f32, node: &NodeInfo, params: &crate::bvh::BuildParams) -> bool {
     let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
     let leaf_cost = params.cost.intersection * n as f32;

@@ -2,14 +2,19 @@
 //! cost of each of the `bins - 1` planes, and keep the cheapest plane of all three axes — or make a
 //! leaf when that is cheaper. Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies"
 //! (RT 2007); pbrt-v4 §7.3.2. The bins live in the build's scratch memory and all three axes are
-//! binned in one pass over the triangles, so a node costs O(n + bins), with no per-node allocation.
+//! binned in one pass over the triangles, so a node costs O(n + bins), with no per-node allocation
+//! below the top levels; big nodes are binned in parallel chunks.
 
 use super::{leaf_is_cheaper, partition, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
 use crate::bvh::BuildParams;
 use glam::{Vec3, Vec3A};
+use rayon::prelude::*;
 
 /// Upper bound on the bin count.
 pub const MAX_BINS: usize = 256;
+
+/// Nodes with at least this many triangles are binned in parallel.
+const PARALLEL_BINNING_MIN: usize = 1 << 15;
 
 /// One bin: the triangles' bounds (SIMD layout) and count.
 #[derive(Clone, Copy, Debug)]
@@ -66,19 +71,45 @@ pub fn split_sah_binned(
     let extent = cb.max - cb.min;
     // Axes with no extent cannot be split by a plane; their scale 0 puts everything in bin 0.
     let scale: [f32; 3] = std::array::from_fn(|a| if extent[a] > 0.0 { bins as f32 / extent[a] } else { 0.0 });
+    let (lo, sc, top) = (Vec3A::from(cb.min), Vec3A::from(Vec3::from(scale)), Vec3A::splat((bins - 1) as f32));
+    let bin_into = |all: &mut [Bin], chunk: &[BuildPrim]| {
+        for p in chunk {
+            // All three bin indices at once; the float-to-int cast saturates and maps NaN to 0.
+            let idx = ((p.centroid() - lo) * sc).max(Vec3A::ZERO).min(top).as_uvec3();
+            for (axis, i) in idx.to_array().into_iter().enumerate() {
+                let bin = &mut all[axis * bins + i as usize];
+                bin.count += 1;
+                bin.min = bin.min.min(p.min);
+                bin.max = bin.max.max(p.max);
+            }
+        }
+    };
     let all = &mut scratch.bins;
     all.clear();
     all.resize(3 * bins, Bin::EMPTY);
-    let (lo, sc, top) = (Vec3A::from(cb.min), Vec3A::from(Vec3::from(scale)), Vec3A::splat((bins - 1) as f32));
-    for p in prims.iter() {
-        // All three bin indices at once; the float-to-int cast saturates and maps NaN to 0.
-        let idx = ((p.centroid() - lo) * sc).max(Vec3A::ZERO).min(top).as_uvec3();
-        for (axis, i) in idx.to_array().into_iter().enumerate() {
-            let bin = &mut all[axis * bins + i as usize];
-            bin.count += 1;
-            bin.min = bin.min.min(p.min);
-            bin.max = bin.max.max(p.max);
+    if n >= PARALLEL_BINNING_MIN {
+        // Big nodes (the top of the tree, where the parallel subtrees have not started yet) are
+        // binned in parallel chunks whose bins are then merged.
+        let merged = prims
+            .par_chunks(PARALLEL_BINNING_MIN / 4)
+            .map(|chunk| {
+                let mut local = vec![Bin::EMPTY; 3 * bins];
+                bin_into(&mut local, chunk);
+                local
+            })
+            .reduce_with(|mut a, b| {
+                for (x, y) in a.iter_mut().zip(&b) {
+                    x.count += y.count;
+                    x.min = x.min.min(y.min);
+                    x.max = x.max.max(y.max);
+                }
+                a
+            });
+        if let Some(m) = merged {
+            all.copy_from_slice(&m);
         }
+    } else {
+        bin_into(all, prims);
     }
     let right_area = &mut scratch.areas;
     right_area.clear();

@@ -6,6 +6,11 @@
 //! largest box first removes the most expected traversal cost under the SAH; the rule is the
 //! greedy collapse of Wald, Benthin & Boulos, "Getting Rid of Packets" (RT 2008), and Pinto,
 //! "Fast BVH collapse" (2010). Leaves and the triangle order are those of the binary BVH.
+//!
+//! Triangles are stored in leaf order, vertices inline (36 bytes each, no index indirection), so a
+//! leaf is one contiguous read. They are not precomputed into edge form: the watertight test needs
+//! the vertices themselves, and rebuilding them from stored edges would change its rounding and so
+//! lose the guarantee that rays through shared edges hit.
 
 mod traverse;
 
