@@ -38,7 +38,7 @@ fn main() {
     }
     let bvh = AnyBvh::build(&mesh, &params);
     let rays: Vec<Ray> = if what == "primary" {
-        let cam = Camera::framing_from(&mesh.bounds(), 1024, 1024, Vec3::new(0.45, 0.35, 1.0));
+        let cam = Camera::framing_from(&mesh.bounds(), 1024, 1024, Vec3::new(0.45, 0.35, 1.0), 45.0);
         let g = cam.ray_gen();
         (0..1024 * 1024).map(|i| g.pixel_ray(i % 1024, i / 1024)).collect()
     } else {

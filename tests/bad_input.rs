@@ -56,6 +56,25 @@ fn index_out_of_range() {
     let e = load_err(&p);
     assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(5), .. }), "{e}");
     assert!(e.to_string().contains("normal 2"), "{e}");
+    // tobj ignores texture/normal indices when the file declares none; we do not.
+    for (name, text, line) in [
+        ("undeclared-vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3\n", 4),
+        ("zero-normal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1//0 2 3\n", 5),
+        ("negative-vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/-5 2 3\n", 4),
+    ] {
+        let p = temp_file(name, text.as_bytes());
+        let e = load_err(&p);
+        assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(l), .. } if l == line), "{name}: {e}");
+    }
+}
+
+#[test]
+fn coordinates_too_large_to_trace() {
+    let p = temp_file("huge.obj", b"v 0 0 0\nv 1e13 0 0\nv 0 1 0\nf 1 2 3\n");
+    let e = load_err(&p);
+    assert!(matches!(e, MeshError::TooLarge { line: Some(2), .. }), "{e}");
+    let p = temp_file("large-ok.obj", b"v 0 0 0\nv 1e9 0 0\nv 0 1e9 0\nf 1 2 3\n");
+    assert!(load_obj(&p).is_ok());
 }
 
 #[test]

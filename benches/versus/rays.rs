@@ -13,7 +13,7 @@ pub struct RaySpec {
 
 /// One ray per pixel of a `size`×`size` frame that frames the mesh from a fixed oblique direction.
 pub fn primary(mesh: &Mesh, size: u32) -> Vec<RaySpec> {
-    let cam = Camera::framing_from(&mesh.bounds(), size, size, Vec3::new(0.45, 0.35, 1.0));
+    let cam = Camera::framing_from(&mesh.bounds(), size, size, Vec3::new(0.45, 0.35, 1.0), 45.0);
     let g = cam.ray_gen();
     (0..size * size)
         .map(|i| {

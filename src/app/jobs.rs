@@ -49,6 +49,8 @@ impl RenderRequest {
 
 /// One finished render pass, ready to show.
 pub struct PassOutput {
+    /// The BVH that traced the frame.
+    pub bvh: Arc<AnyBvh>,
     pub frame: Arc<Frame>,
     pub image: egui::ColorImage,
     pub legend: Option<Legend>,
@@ -132,11 +134,9 @@ impl Jobs {
         self.load.is_some() || self.build.is_some() || self.render.is_some()
     }
 
-    /// Load an OBJ in the background.
+    /// Load an OBJ in the background. A newer load supersedes an older one: the older one cannot be
+    /// stopped inside the parser, but its result is dropped (`poll` keeps only the current job's).
     pub fn load(&mut self, path: PathBuf) {
-        if let Some(old) = self.load.take() {
-            old.control.cancel();
-        }
         let job = self.start(format!("Loading {}", path.display()));
         let send = self.sender(job.id);
         std::thread::spawn(move || {
@@ -163,6 +163,14 @@ impl Jobs {
         self.last_build = Some((params, scene_id));
     }
 
+    /// Cancel the running build, if any (its result will be ignored).
+    pub fn cancel_build(&mut self) {
+        if let Some(old) = self.build.take() {
+            old.control.cancel();
+            self.last_build = None;
+        }
+    }
+
     /// Render progressively in the background; a running render is cancelled.
     pub fn render(&mut self, req: RenderRequest) {
         if let Some(old) = self.render.take() {
@@ -179,6 +187,7 @@ impl Jobs {
                 let (img, legend) = view_image(frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
                 send(JobEvent::Pass(PassOutput {
+                    bvh: r.bvh.clone(),
                     frame: Arc::new(frame.clone()),
                     image,
                     legend,

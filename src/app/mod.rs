@@ -213,7 +213,10 @@ impl BvhscopeApp {
     pub fn ensure_build(&mut self) {
         let wanted = (self.settings.build, self.scene_id);
         let have = self.current_bvh().is_some_and(|b| *b.bvh.params() == self.settings.build);
-        if !have && self.jobs.last_build != Some(wanted) {
+        if have {
+            // Switched back to what is built while another build ran: that build is not wanted.
+            self.jobs.cancel_build();
+        } else if self.jobs.last_build != Some(wanted) {
             self.jobs.build(self.scene.mesh.clone(), self.settings.build, self.scene_id);
         }
     }
@@ -331,7 +334,11 @@ impl BvhscopeApp {
         let rays_per_s = p.info.rays as f64 / p.info.pass_time.as_secs_f64().max(1e-9);
         if p.info.stride == 1 {
             self.last_full_frame = Some(p.info.elapsed);
-            self.rays = Some(p.frame.ray_summary());
+            // Per-ray figures belong to the BVH that traced them; a pass of an older BVH that
+            // arrives after a rebuild must not be shown (or remembered) under the new strategy.
+            if self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
+                self.rays = Some(p.frame.ray_summary());
+            }
         }
         let texture = match self.shown.take() {
             Some(mut s) => {

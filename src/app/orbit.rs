@@ -79,7 +79,7 @@ impl OrbitCamera {
         *self = Self {
             yaw: self.yaw,
             pitch: self.pitch,
-            ..Self::from_camera(&Camera::framing_from(bounds, w, h, self.direction()))
+            ..Self::from_camera(&Camera::framing_from(bounds, w, h, self.direction(), self.vfov_deg))
         };
     }
 }

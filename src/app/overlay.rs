@@ -178,10 +178,13 @@ mod tests {
             (2, Aabb::new(Vec3::splat(-0.5), Vec3::splat(0.5))),
         ];
         let m = boxes_mesh(&boxes, &camera(), rect(), 1.0);
-        // Seen head-on, 4 edges of each box are parallel to the view axis... but still have length
-        // except the ones pointing exactly at the centre; all 24 edges project to some length here.
-        assert_eq!(m.vertices.len() % 4, 0);
-        assert!(m.vertices.len() / 4 >= 16 && m.vertices.len() / 4 <= 24);
+        // Both boxes lie wholly in front of the camera and inside the view; the edges along the
+        // view axis are off-centre, so they project to real segments too: 2 × 12 quads.
+        assert_eq!(m.vertices.len(), 24 * 4);
+        assert_eq!(m.indices.len(), 24 * 6);
+        // A box behind the camera adds nothing.
+        let behind = vec![(3, Aabb::new(Vec3::new(-1.0, -1.0, 6.0), Vec3::new(1.0, 1.0, 8.0)))];
+        assert_eq!(boxes_mesh(&behind, &camera(), rect(), 1.0).vertices.len(), 0);
         assert_ne!(node_color(1), node_color(2));
     }
 }

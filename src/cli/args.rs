@@ -82,8 +82,8 @@ pub struct BuildArgs {
     /// Bins per axis for the binned SAH (2..=256).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(2..=256))]
     pub bins: u32,
-    /// SAH cost of one traversal step (relative to one triangle test).
-    #[arg(long, default_value_t = 1.0)]
+    /// SAH cost of one traversal step (relative to one triangle test), a positive number.
+    #[arg(long, default_value_t = 1.0, value_parser = parse_positive)]
     pub traversal_cost: f32,
     /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
     #[arg(long, value_enum)]
@@ -126,8 +126,8 @@ pub struct ViewArgs {
     /// Camera as EYE:TARGET[:UP], each X,Y,Z (e.g. 0,1,5:0,0,0). Default: frames the mesh.
     #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     pub camera: Option<(Vec3, Vec3, Vec3)>,
-    /// Vertical field of view in degrees.
-    #[arg(long, default_value_t = 45.0)]
+    /// Vertical field of view in degrees (between 0 and 180).
+    #[arg(long, default_value_t = 45.0, value_parser = parse_fov)]
     pub fov: f32,
 }
 
@@ -136,10 +136,26 @@ impl ViewArgs {
         let (w, h) = self.size;
         let cam = match self.camera {
             Some((position, look_at, up)) => Camera { position, look_at, up, vfov_deg: self.fov, width: w, height: h },
-            None => Camera { vfov_deg: self.fov, ..Camera::framing(bounds, w, h) },
+            None => Camera::framing_from(bounds, w, h, Camera::DEFAULT_VIEW_FROM, self.fov),
         };
         cam.validate().map_err(|e| super::CliError::Usage(format!("--camera: {e}")))?;
         Ok(cam)
+    }
+}
+
+/// A vertical field of view strictly between 0 and 180 degrees.
+pub fn parse_fov(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
+        _ => Err(format!("'{s}' is not an angle between 0 and 180 degrees")),
+    }
+}
+
+/// A finite number greater than zero.
+pub fn parse_positive(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a positive number")),
     }
 }
 
@@ -148,8 +164,8 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
     let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("'{s}' is not WIDTHxHEIGHT"));
     let (w, h) = (parse(w)?, parse(h)?);
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(format!("'{s}': width and height must be 1..=16384"));
+    if w == 0 || h == 0 || w > 16384 || h > 16384 || w as u64 * h as u64 > crate::render::Camera::MAX_PIXELS {
+        return Err(format!("'{s}': width and height must be 1..=16384, and the image at most 40 megapixels"));
     }
     Ok((w, h))
 }
@@ -188,5 +204,8 @@ mod tests {
         assert_eq!((e, t, u), (Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y));
         assert_eq!(parse_camera("1,2,3:4,5,6:0,0,1").unwrap().2, Vec3::Z);
         assert!(parse_camera("1,2:0,0,0").is_err() && parse_camera("nan,0,0:0,0,0").is_err());
+        assert_eq!(parse_positive("2.5"), Ok(2.5));
+        assert!(parse_positive("nan").is_err() && parse_positive("inf").is_err() && parse_positive("-1").is_err());
+        assert!(parse_positive("0").is_err());
     }
 }

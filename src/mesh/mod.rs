@@ -6,4 +6,4 @@ mod mesh;
 mod obj;
 
 pub use mesh::{Mesh, MeshGroup, SurfaceInteraction};
-pub use obj::{load_obj, parse_obj, write_obj, LoadReport, MeshError};
+pub use obj::{load_obj, parse_obj, write_obj, LoadReport, MeshError, MAX_COORDINATE};

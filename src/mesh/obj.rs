@@ -29,6 +29,8 @@ pub enum MeshError {
     IndexOutOfRange { path: PathBuf, line: Option<usize>, message: String },
     #[error("{}{}: {what} has a NaN or infinite coordinate", .path.display(), LineSuffix(*.line))]
     NonFinite { path: PathBuf, line: Option<usize>, what: &'static str },
+    #[error("{}{}: a vertex coordinate exceeds ±{MAX_COORDINATE:e}, too large to trace in single precision (scale the mesh down)", .path.display(), LineSuffix(*.line))]
+    TooLarge { path: PathBuf, line: Option<usize> },
     #[error("{}: no triangles{}", .path.display(), if *.degenerate > 0 { format!(" (all {} faces are degenerate)", .degenerate) } else { String::new() })]
     NoTriangles { path: PathBuf, degenerate: usize },
 }
@@ -40,7 +42,8 @@ impl MeshError {
             MeshError::NotText { line, .. } => Some(*line),
             MeshError::Parse { line, .. }
             | MeshError::IndexOutOfRange { line, .. }
-            | MeshError::NonFinite { line, .. } => *line,
+            | MeshError::NonFinite { line, .. }
+            | MeshError::TooLarge { line, .. } => *line,
             _ => None,
         }
     }
@@ -56,6 +59,11 @@ impl fmt::Display for LineSuffix {
         }
     }
 }
+
+/// Largest coordinate magnitude accepted. The triangle tests multiply three coordinates
+/// together (edge functions times depth), so beyond about 1e12 single precision overflows and
+/// rays silently miss; 1e10 leaves a wide margin.
+pub const MAX_COORDINATE: f32 = 1e10;
 
 /// What loading found, for the UI's status line and the CLI's report.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -88,9 +96,16 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
         return Err(MeshError::IsDirectory { path: path.into() });
     }
     let file = std::fs::File::open(path).map_err(io)?;
-    let streamed = load_models(&mut std::io::BufReader::with_capacity(1 << 20, file)).map_err(Problem::Tobj);
+    let mut reader = SlashWatch { inner: std::io::BufReader::with_capacity(1 << 20, file), slash: false };
+    let streamed = load_models(&mut reader).map_err(Problem::Tobj);
     match streamed.and_then(|models| build_mesh(path, models)) {
         Ok((mesh, mut report)) => {
+            // tobj ignores texture and normal indices when the file declares none. They can only
+            // be there if a '/' passed by, so only then is the file read again to look.
+            if reader.slash && (!report.has_uvs || !report.has_normals) {
+                let text = std::fs::read_to_string(path).map_err(io)?;
+                check_unchecked_indices(path, &text, &report)?;
+            }
             report.load_time = start.elapsed();
             Ok((mesh, report))
         }
@@ -108,10 +123,54 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
 /// Parse OBJ text; `path` is used for the mesh name and in error messages.
 pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
-    load_models(&mut Cursor::new(text.as_bytes()))
+    let (mesh, report) = load_models(&mut Cursor::new(text.as_bytes()))
         .map_err(Problem::Tobj)
         .and_then(|models| build_mesh(path, models))
-        .map_err(|problem| explain(path, text, problem))
+        .map_err(|problem| explain(path, text, problem))?;
+    check_unchecked_indices(path, text, &report)?;
+    Ok((mesh, report))
+}
+
+/// Texture and normal indices tobj did not check (it ignores them when none are declared).
+fn check_unchecked_indices(path: &Path, text: &str, report: &LoadReport) -> Result<(), MeshError> {
+    for (missing, which) in [(!report.has_uvs, Corner::TexCoord), (!report.has_normals, Corner::Normal)] {
+        if missing {
+            if let Some((line, message)) = first_bad_face(text, Some(which)) {
+                return Err(MeshError::IndexOutOfRange { path: path.into(), line: Some(line), message });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A reader that notes whether a '/' went past: only then can a face refer to texture
+/// coordinates or normals.
+struct SlashWatch<R> {
+    inner: R,
+    slash: bool,
+}
+
+impl<R: std::io::BufRead> std::io::Read for SlashWatch<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.slash |= buf[..n].contains(&b'/');
+        Ok(n)
+    }
+}
+
+impl<R: std::io::BufRead> std::io::BufRead for SlashWatch<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        self.inner.fill_buf()
+    }
+
+    fn consume(&mut self, amt: usize) {
+        if !self.slash {
+            if let Ok(buf) = self.inner.fill_buf() {
+                self.slash = buf[..amt.min(buf.len())].contains(&b'/');
+            }
+        }
+        self.inner.consume(amt)
+    }
 }
 
 /// What went wrong before the text was looked at for line numbers.
@@ -119,6 +178,7 @@ enum Problem {
     Tobj(tobj::LoadError),
     /// (what, OBJ keyword, values per line)
     NonFinite(&'static str, &'static str, usize),
+    TooLarge,
     NoTriangles {
         degenerate: usize,
     },
@@ -135,6 +195,13 @@ fn explain(path: &Path, text: &str, problem: Problem) -> MeshError {
             MeshError::NonFinite { path: path.into(), line: first_bad_line(text, keyword, min), what }
         }
         Problem::NoTriangles { degenerate } => MeshError::NoTriangles { path: path.into(), degenerate },
+        Problem::TooLarge => {
+            let line = statements(text).find_map(|(n, k, args)| {
+                let big = args.iter().take(3).any(|a| a.parse::<f32>().is_ok_and(|x| x.abs() > MAX_COORDINATE));
+                (k == "v" && big).then_some(n)
+            });
+            MeshError::TooLarge { path: path.into(), line }
+        }
     }
 }
 
@@ -188,6 +255,9 @@ fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport
 
     if mesh.positions.iter().any(|p| !p.is_finite()) {
         return Err(Problem::NonFinite("a vertex position", "v", 3));
+    }
+    if mesh.positions.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+        return Err(Problem::TooLarge);
     }
     if mesh.normals.iter().any(|n| !n.is_finite()) {
         return Err(Problem::NonFinite("a vertex normal", "vn", 3));
@@ -303,6 +373,9 @@ fn first_bad_face(text: &str, which: Option<Corner>) -> Option<(usize, String)> 
                     return Some((n, format!("a face needs at least 3 corners, this one has {}", args.len())));
                 }
                 for corner in &args {
+                    if which.is_none() && corner.split('/').count() > 3 {
+                        return Some((n, format!("face corner '{corner}' has more than three indices")));
+                    }
                     for (slot, part) in corner.split('/').enumerate().take(3) {
                         if part.is_empty() && slot > 0 {
                             continue;
@@ -426,6 +499,20 @@ mod tests {
         assert!(e.to_string().contains("vertex 9"), "{e}");
         let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
         assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(4), .. }), "{e}");
+    }
+
+    #[test]
+    fn texture_and_normal_indices_are_checked_even_when_none_are_declared() {
+        for (text, line) in [
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3\n", 4),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1//0 2 3\n", 5),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/-5 2 3\n", 4),
+        ] {
+            let e = err(text);
+            assert!(matches!(e, MeshError::IndexOutOfRange { line: Some(l), .. } if l == line), "{text:?}: {e}");
+        }
+        let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n");
+        assert_eq!(e.line(), Some(4), "{e}");
     }
 
     #[test]

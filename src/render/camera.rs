@@ -25,7 +25,7 @@ pub enum CameraError {
     BadUp,
     #[error("vertical field of view must be between 0 and 180 degrees (got {0})")]
     BadFov(f32),
-    #[error("image size must be at least 1x1 and at most 16384x16384 (got {0}x{1})")]
+    #[error("image size must be at least 1x1, at most 16384 on a side and 40 megapixels (got {0}x{1})")]
     BadSize(u32, u32),
 }
 
@@ -72,7 +72,9 @@ impl Camera {
         if !(self.vfov_deg > 0.0 && self.vfov_deg < 180.0) {
             return Err(CameraError::BadFov(self.vfov_deg));
         }
-        if self.width == 0 || self.height == 0 || self.width > 16384 || self.height > 16384 {
+        let pixels = self.width as u64 * self.height as u64;
+        if self.width == 0 || self.height == 0 || self.width > 16384 || self.height > 16384 || pixels > Self::MAX_PIXELS
+        {
             return Err(CameraError::BadSize(self.width, self.height));
         }
         Ok(())
@@ -98,16 +100,24 @@ impl Camera {
         }
     }
 
+    /// Largest image: a frame keeps about 36 bytes per pixel, so this is about 1.4 GB.
+    pub const MAX_PIXELS: u64 = 40_000_000;
+
+    /// The direction the default view looks from: front, right, above.
+    pub const DEFAULT_VIEW_FROM: Vec3 = Vec3::new(0.45, 0.35, 1.0);
+    pub const DEFAULT_VFOV_DEG: f32 = 45.0;
+
     /// A camera that shows all of `bounds` from a fixed oblique direction (front, right, above),
-    /// with +y up: the default view of the CLI and the app.
+    /// with +y up and a 45° vertical field of view: the default view of the CLI and the app.
     pub fn framing(bounds: &Aabb, width: u32, height: u32) -> Camera {
-        Self::framing_from(bounds, width, height, Vec3::new(0.45, 0.35, 1.0))
+        Self::framing_from(bounds, width, height, Self::DEFAULT_VIEW_FROM, Self::DEFAULT_VFOV_DEG)
     }
 
-    /// Like `framing`, looking along `-from`: the closest camera distance at which all eight
-    /// corners of the box lie inside 95% of the image (found by bisection).
-    pub fn framing_from(bounds: &Aabb, width: u32, height: u32, from: Vec3) -> Camera {
-        let vfov_deg = 45.0f32;
+    /// Like `framing`, looking along `-from` with the given vertical field of view: the closest
+    /// camera distance at which all eight corners of the box lie inside 95% of the image (found by
+    /// bisection).
+    pub fn framing_from(bounds: &Aabb, width: u32, height: u32, from: Vec3, vfov_deg: f32) -> Camera {
+        let vfov_deg = if vfov_deg > 0.0 && vfov_deg < 180.0 { vfov_deg } else { Self::DEFAULT_VFOV_DEG };
         let (width, height) = (width.max(1), height.max(1));
         let b = if bounds.is_empty() { Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)) } else { *bounds };
         let center = b.center();
@@ -174,11 +184,12 @@ mod tests {
     #[test]
     fn framing_contains_the_box() {
         let b = Aabb::new(Vec3::new(-1.0, 0.0, -2.0), Vec3::new(3.0, 1.0, 0.5));
-        for (w, h) in [(640, 480), (300, 900)] {
-            let cam = Camera::framing(&b, w, h);
+        for (w, h, fov) in [(640, 480, 45.0), (300, 900, 45.0), (640, 480, 10.0), (640, 480, 120.0)] {
+            let cam = Camera::framing_from(&b, w, h, Camera::DEFAULT_VIEW_FROM, fov);
+            assert_eq!(cam.vfov_deg, fov);
             cam.validate().unwrap();
-            let g = cam.ray_gen();
-            // Every box corner projects inside the image.
+            // Every box corner projects inside the image, and the box fills it (framed, not lost).
+            let mut widest = 0f32;
             let fwd = (cam.look_at - cam.position).normalize();
             let right = fwd.cross(Vec3::Y).normalize();
             let up = right.cross(fwd);
@@ -192,12 +203,11 @@ mod tests {
                 let d = c - cam.position;
                 let z = d.dot(fwd);
                 assert!(z > 0.0);
-                assert!(
-                    (d.dot(right) / z).abs() <= t * cam.aspect() && (d.dot(up) / z).abs() <= t,
-                    "corner {c} outside for {w}x{h}"
-                );
+                let (sx, sy) = ((d.dot(right) / z).abs() / (t * cam.aspect()), (d.dot(up) / z).abs() / t);
+                assert!(sx <= 1.0 && sy <= 1.0, "corner {c} outside for {w}x{h} at {fov}°");
+                widest = widest.max(sx).max(sy);
             }
-            let _ = g;
+            assert!(widest > 0.9, "the box fills the view at {fov}° ({widest})");
         }
     }
 
@@ -208,6 +218,11 @@ mod tests {
         assert_eq!(Camera { up: Vec3::Z, ..ok }.validate(), Err(CameraError::BadUp));
         assert_eq!(Camera { vfov_deg: 180.0, ..ok }.validate(), Err(CameraError::BadFov(180.0)));
         assert_eq!(Camera { width: 0, ..ok }.validate(), Err(CameraError::BadSize(0, 8)));
+        assert_eq!(
+            Camera { width: 16384, height: 16384, ..ok }.validate(),
+            Err(CameraError::BadSize(16384, 16384)),
+            "over the pixel budget"
+        );
         assert_eq!(Camera { position: Vec3::NAN, ..ok }.validate(), Err(CameraError::NotFinite));
     }
 }

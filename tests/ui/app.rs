@@ -86,6 +86,30 @@ fn choosing_another_strategy_rebuilds_and_changes_the_node_count() {
 }
 
 #[test]
+fn switching_back_before_a_build_finishes_cancels_it() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let sah_nodes = h.state().current_bvh().unwrap().stats.nodes;
+    // Choose midpoint, then SAH again before the midpoint build can finish (it takes
+    // milliseconds; these two requests are microseconds apart).
+    h.state_mut().settings.build.strategy = SplitStrategy::Midpoint;
+    h.state_mut().ensure_build();
+    assert!(h.state().jobs.build.is_some(), "the midpoint build runs");
+    h.state_mut().settings.build.strategy = SplitStrategy::SahBinned;
+    h.state_mut().ensure_build();
+    assert!(h.state().jobs.build.is_none(), "the midpoint build is cancelled");
+    run_until(&mut h, "quiet", idle);
+    for _ in 0..20 {
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let b = h.state().current_bvh().unwrap();
+    assert_eq!(b.bvh.params().strategy, SplitStrategy::SahBinned);
+    assert_eq!(b.stats.nodes, sah_nodes);
+    assert!(h.state().previous.is_none(), "no strategy the user did not keep appears as 'before'");
+}
+
+#[test]
 fn moving_the_depth_slider_changes_the_number_of_boxes_drawn() {
     let mut h = harness();
     run_until(&mut h, "the first build", idle);

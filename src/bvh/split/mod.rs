@@ -72,10 +72,6 @@ impl SplitStrategy {
             }
         }
     }
-
-    pub fn from_short_name(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.short_name() == s)
-    }
 }
 
 /// A triangle as the builder sees it: its bounds in SIMD registers' layout (a box union is two
@@ -177,12 +173,5 @@ mod tests {
         let mut all = vec![1, 2];
         assert_eq!(partition(&mut all, |_| true), 2);
         assert_eq!(partition(&mut all, |_| false), 0);
-    }
-
-    #[test]
-    fn short_names_round_trip() {
-        for s in SplitStrategy::ALL {
-            assert_eq!(SplitStrategy::from_short_name(s.short_name()), Some(s));
-        }
     }
 }
