@@ -26,9 +26,7 @@ pub struct Projector {
 
 impl Projector {
     pub fn new(camera: &Camera, rect: Rect, near: f32) -> Self {
-        let forward = (camera.look_at - camera.position).normalize();
-        let right = forward.cross(camera.up).normalize();
-        let up = right.cross(forward);
+        let (forward, right, up) = camera.basis();
         let tan_v = (camera.vfov_deg.to_radians() * 0.5).tan();
         let tan_h = tan_v * camera.aspect();
         Self {

@@ -394,4 +394,22 @@ mod tests {
         cancelled.cancel();
         assert_eq!(Bvh::build_controlled(&mesh, &BuildParams::default(), &cancelled).unwrap_err(), Cancelled);
     }
+
+    #[test]
+    fn a_build_cancelled_while_running_stops() {
+        // A million triangles: the build runs long enough to be cancelled once it has made leaves.
+        let mesh = torus(2.0, 0.5, 1024, 512);
+        let control = WorkControl::new();
+        let result = std::thread::scope(|s| {
+            let build = s
+                .spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(SplitStrategy::SahSweep), &control));
+            while control.done() == 0 && !build.is_finished() {
+                std::thread::yield_now();
+            }
+            control.cancel();
+            build.join().expect("the build thread does not panic")
+        });
+        assert_eq!(result.unwrap_err(), Cancelled, "cancelled part-way, after {} triangles", control.done());
+        assert!(control.done() < mesh.triangle_count() as u64);
+    }
 }

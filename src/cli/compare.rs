@@ -115,16 +115,18 @@ pub fn compare_rows(
         let params = build.params_with(strategy, layout);
         let name = format!("{} ({})", strategy.label(), layout.short_name());
         let bvh = progress::with_spinner(&format!("building {name}"), || AnyBvh::build(mesh, &params));
-        let stats = TreeStats::of(&bvh);
-        let frame = render(&bvh, mesh, camera, &counting);
-        let summary = frame.ray_summary();
-        let times: Vec<f64> = (0..runs)
-            .map(|_| {
-                let t = Instant::now();
-                std::hint::black_box(render(&bvh, mesh, camera, &plain));
-                ms(t.elapsed())
-            })
-            .collect();
+        let (stats, summary, times) = progress::with_spinner(&format!("tracing {name}"), || {
+            let stats = TreeStats::of(&bvh);
+            let summary = render(&bvh, mesh, camera, &counting).ray_summary();
+            let times: Vec<f64> = (0..runs)
+                .map(|_| {
+                    let t = Instant::now();
+                    std::hint::black_box(render(&bvh, mesh, camera, &plain));
+                    ms(t.elapsed())
+                })
+                .collect();
+            (stats, summary, times)
+        });
         let frame_ms = median(times);
         rows.push(CompareRow {
             name,

@@ -335,20 +335,22 @@ fn statements(text: &str) -> impl Iterator<Item = (usize, &str, Vec<&str>)> {
     })
 }
 
-/// First `keyword` line whose first `min` values are missing, unparsable or not finite.
-fn first_bad_line(text: &str, keyword: &str, min: usize) -> Option<usize> {
+/// First `keyword` line with fewer than `min` values, or whose first values fail `ok`.
+fn first_line_where(text: &str, keyword: &str, min: usize, ok: impl Fn(&str) -> bool) -> Option<usize> {
     statements(text).find_map(|(n, k, args)| {
-        let bad = args.len() < min || args.iter().take(3).any(|a| a.parse::<f32>().map_or(true, |x| !x.is_finite()));
+        let bad = args.len() < min || !args.iter().take(3).all(|a| ok(a));
         (k == keyword && bad).then_some(n)
     })
 }
 
+/// First `keyword` line whose first `min` values are missing, unparsable or not finite.
+fn first_bad_line(text: &str, keyword: &str, min: usize) -> Option<usize> {
+    first_line_where(text, keyword, min, |a| a.parse::<f32>().is_ok_and(f32::is_finite))
+}
+
 /// First `keyword` line with a value that does not parse (or too few values).
 fn first_unparsable_line(text: &str, keyword: &str, min: usize) -> Option<usize> {
-    statements(text).find_map(|(n, k, args)| {
-        let bad = args.len() < min || args.iter().take(3).any(|a| a.parse::<f32>().is_err());
-        (k == keyword && bad).then_some(n)
-    })
+    first_line_where(text, keyword, min, |a| a.parse::<f32>().is_ok())
 }
 
 /// Which attribute of a face corner (`v/vt/vn`) a check is about.

@@ -84,11 +84,16 @@ impl Camera {
         self.width as f32 / self.height as f32
     }
 
-    /// The ray generator; the camera must be valid (`validate`).
-    pub fn ray_gen(&self) -> RayGen {
+    /// Unit forward, right and up vectors of a valid camera (right-handed: right = forward × up).
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
         let forward = (self.look_at - self.position).normalize();
         let right = forward.cross(self.up).normalize();
-        let up = right.cross(forward);
+        (forward, right, right.cross(forward))
+    }
+
+    /// The ray generator; the camera must be valid (`validate`).
+    pub fn ray_gen(&self) -> RayGen {
+        let (forward, right, up) = self.basis();
         let tan_half = (self.vfov_deg.to_radians() * 0.5).tan();
         RayGen {
             origin: self.position,
