@@ -12,4 +12,5 @@ pub mod cli;
 pub mod geometry;
 pub mod mesh;
 pub mod render;
+pub mod scene;
 pub mod work;

@@ -2,13 +2,14 @@
 //! and report over one channel; the UI thread only polls. Starting a job of a kind cancels the
 //! running one of that kind, and results of superseded jobs are dropped by id.
 
-use super::scene::{Scene, SceneSource};
+use super::scene::Scene;
 use crate::bvh::{AnyBvh, BuildParams};
 use crate::bvh::{SahCost, TraceOptions};
-use crate::mesh::{load_obj, Mesh};
+use crate::mesh::Mesh;
 use crate::render::{
     render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, Legend, PassInfo, RenderSettings, View,
 };
+use crate::scene::load_any;
 use crate::work::{Cancelled, WorkControl};
 use std::path::PathBuf;
 use std::sync::mpsc::{channel, Receiver, Sender};
@@ -66,6 +67,7 @@ pub enum Pick {
     SavePng,
     SaveStatsCsv,
     SaveStatsJson,
+    SaveScene,
 }
 
 pub enum JobEvent {
@@ -140,9 +142,7 @@ impl Jobs {
         let job = self.start(format!("Loading {}", path.display()));
         let send = self.sender(job.id);
         std::thread::spawn(move || {
-            let result = load_obj(&path)
-                .map(|(mesh, report)| Scene::new(Arc::new(mesh), report, SceneSource::File(path)))
-                .map_err(|e| e.to_string());
+            let result = load_any(&path).map(|l| Scene::from_loaded(l, path)).map_err(|e| e.to_string());
             send(JobEvent::Loaded(result));
         });
         self.load = Some(job);
@@ -215,7 +215,10 @@ impl Jobs {
             let dialog = rfd::AsyncFileDialog::new();
             let fut = async move {
                 match pick {
-                    Pick::Open => dialog.add_filter("Wavefront OBJ", &["obj", "OBJ"]).pick_file().await,
+                    Pick::Open => dialog.add_filter("Meshes and scenes", &["obj", "OBJ", "json"]).pick_file().await,
+                    Pick::SaveScene => {
+                        dialog.add_filter("bvhscope scene", &["json"]).set_file_name(&name).save_file().await
+                    }
                     Pick::SavePng => dialog.add_filter("PNG image", &["png"]).set_file_name(&name).save_file().await,
                     Pick::SaveStatsCsv => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
                     Pick::SaveStatsJson => dialog.add_filter("JSON", &["json"]).set_file_name(&name).save_file().await,

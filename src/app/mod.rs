@@ -81,6 +81,7 @@ pub struct StrategyFigures {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MessageKind {
     Info,
+    Warning,
     Error,
 }
 
@@ -186,12 +187,40 @@ impl BvhscopeApp {
     }
 
     fn set_scene(&mut self, scene: Scene) {
+        for w in &scene.warnings {
+            self.message(MessageKind::Warning, format!("{}: {w}", scene.title()));
+        }
+        // A scene file brings its camera and the BVH settings to start with.
+        self.orbit = match &scene.camera {
+            Some(c) => OrbitCamera::from_camera(c),
+            None => OrbitCamera::home(&scene.mesh.bounds(), self.viewport_aspect),
+        };
+        if let Some(b) = scene.build {
+            self.settings.build = b;
+        }
         self.scene = scene;
         self.scene_id += 1;
         self.previous = None;
         self.rays = None;
-        self.orbit = OrbitCamera::home(&self.scene.mesh.bounds(), self.viewport_aspect);
         self.ensure_build();
+    }
+
+    /// The current camera, meshes and BVH settings as a scene file (not for the built-in scene,
+    /// which has no file to refer to).
+    pub fn scene_file_text(&self) -> Result<String, String> {
+        let meshes = match (&self.scene.desc, &self.scene.source) {
+            (Some(desc), _) => desc.meshes.clone(),
+            (None, SceneSource::File(p)) => {
+                let file = p.canonicalize().unwrap_or_else(|_| p.clone());
+                vec![crate::scene::SceneMesh { file, transform: glam::Affine3A::IDENTITY }]
+            }
+            (None, SceneSource::Builtin) => {
+                return Err("the built-in scene has no mesh file a scene could refer to; open a mesh first".into())
+            }
+        };
+        let (w, h) = self.shown.as_ref().map_or((1280, 720), |s| (s.camera.width, s.camera.height));
+        let camera = self.orbit.camera(w, h);
+        Ok(crate::scene::write_scene_file(&camera, &meshes, &self.settings.build))
     }
 
     /// The style the next render uses.
@@ -322,6 +351,9 @@ impl BvhscopeApp {
             Pick::SavePng => export::save_png(self, &path),
             Pick::SaveStatsCsv => export::save_stats(self, &path, export::StatsFormat::Csv),
             Pick::SaveStatsJson => export::save_stats(self, &path, export::StatsFormat::Json),
+            Pick::SaveScene => self
+                .scene_file_text()
+                .and_then(|t| std::fs::write(&path, t).map_err(|e| format!("{}: cannot write: {e}", path.display()))),
         };
         match result {
             Ok(()) => self.message(MessageKind::Info, format!("Saved {}", path.display())),
@@ -366,7 +398,7 @@ impl BvhscopeApp {
             self.act(action);
         }
         // Info messages fade out; errors stay until dismissed.
-        self.messages.retain(|m| m.kind == MessageKind::Error || m.at.elapsed() < Duration::from_secs(6));
+        self.messages.retain(|m| m.kind != MessageKind::Info || m.at.elapsed() < Duration::from_secs(6));
     }
 
     pub fn act(&mut self, action: shortcuts::Action) {

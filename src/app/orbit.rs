@@ -24,7 +24,8 @@ impl OrbitCamera {
         Self::from_camera(&Camera::framing(bounds, w, h))
     }
 
-    fn from_camera(c: &Camera) -> Self {
+    /// The orbit that reproduces a camera (up is taken as +y).
+    pub fn from_camera(c: &Camera) -> Self {
         let offset = c.position - c.look_at;
         let distance = offset.length();
         let d = offset / distance;

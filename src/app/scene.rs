@@ -1,6 +1,9 @@
 //! The mesh on screen and where it came from.
 
+use crate::bvh::BuildParams;
 use crate::mesh::{generate, LoadReport, Mesh};
+use crate::render::Camera;
+use crate::scene::{Loaded, SceneDesc};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -15,11 +18,29 @@ pub struct Scene {
     pub mesh: Arc<Mesh>,
     pub report: LoadReport,
     pub source: SceneSource,
+    /// What a scene file adds: its camera, BVH settings, meshes and warnings.
+    pub camera: Option<Camera>,
+    pub build: Option<BuildParams>,
+    pub desc: Option<SceneDesc>,
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
     pub fn new(mesh: Arc<Mesh>, report: LoadReport, source: SceneSource) -> Self {
-        Self { mesh, report, source }
+        Self { mesh, report, source, camera: None, build: None, desc: None, warnings: Vec::new() }
+    }
+
+    /// A loaded OBJ or scene file.
+    pub fn from_loaded(l: Loaded, path: PathBuf) -> Self {
+        Self {
+            mesh: Arc::new(l.mesh),
+            report: l.report,
+            source: SceneSource::File(path),
+            camera: l.camera,
+            build: l.build,
+            desc: l.scene,
+            warnings: l.warnings,
+        }
     }
 
     /// The scene shown when no file is given.

@@ -198,6 +198,7 @@ fn messages(app: &mut BvhscopeApp, ui: &egui::Ui, rect: Rect) {
             for (i, m) in app.messages.iter().enumerate() {
                 let (fill, title) = match m.kind {
                     MessageKind::Error => (Color32::from_rgb(110, 24, 24), "Error"),
+                    MessageKind::Warning => (Color32::from_rgb(110, 80, 10), "Warning"),
                     MessageKind::Info => (Color32::from_rgb(24, 60, 100), "Note"),
                 };
                 egui::Frame::new().fill(fill).inner_margin(8.0).corner_radius(4.0).show(ui, |ui| {

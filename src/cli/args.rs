@@ -120,9 +120,9 @@ impl BuildArgs {
 /// The camera and image size of a render.
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
-    pub size: (u32, u32),
+    /// Image size, WIDTHxHEIGHT [default: the scene's, else 1280x720].
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
     /// Camera as EYE:TARGET[:UP], each X,Y,Z (e.g. 0,1,5:0,0,0). Default: frames the mesh.
     #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     pub camera: Option<(Vec3, Vec3, Vec3)>,
@@ -132,11 +132,16 @@ pub struct ViewArgs {
 }
 
 impl ViewArgs {
-    pub fn camera(&self, bounds: &Aabb) -> Result<Camera, super::CliError> {
-        let (w, h) = self.size;
-        let cam = match self.camera {
-            Some((position, look_at, up)) => Camera { position, look_at, up, vfov_deg: self.fov, width: w, height: h },
-            None => Camera::framing_from(bounds, w, h, Camera::DEFAULT_VIEW_FROM, self.fov),
+    /// The camera: `--camera` if given, else the scene's, else one framing the mesh; the size is
+    /// `--size`, else the scene's, else 1280x720.
+    pub fn camera(&self, bounds: &Aabb, scene: Option<&Camera>) -> Result<Camera, super::CliError> {
+        let (w, h) = self.size.or(scene.map(|c| (c.width, c.height))).unwrap_or((1280, 720));
+        let cam = match (self.camera, scene) {
+            (Some((position, look_at, up)), _) => {
+                Camera { position, look_at, up, vfov_deg: self.fov, width: w, height: h }
+            }
+            (None, Some(c)) => Camera { width: w, height: h, ..*c },
+            (None, None) => Camera::framing_from(bounds, w, h, Camera::DEFAULT_VIEW_FROM, self.fov),
         };
         cam.validate().map_err(|e| super::CliError::Usage(format!("--camera: {e}")))?;
         Ok(cam)

@@ -26,7 +26,7 @@ pub enum CompareFormat {
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// The mesh (.obj).
+    /// The mesh (.obj) or scene (.json: bvhscope's or Moer-lite's).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
@@ -172,8 +172,9 @@ fn opt(v: Option<f64>, digits: usize) -> String {
 }
 
 pub fn run(a: &CompareArgs) -> Result<(), CliError> {
-    let (mesh, _) = load_mesh(&a.mesh)?;
-    let camera = a.view_args.camera(&mesh.bounds())?;
+    let loaded = load_mesh(&a.mesh)?;
+    let mesh = loaded.mesh;
+    let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
     let rows = compare_rows(&mesh, &camera, &a.build, a.runs, Duration::from_secs(10));
     let rays = camera.width as usize * camera.height as usize;
     let threads = rayon::current_num_threads();

@@ -10,7 +10,8 @@ mod stats;
 pub use args::{parse_camera, parse_size, BuildArgs};
 pub use compare::{compare_rows, CompareRow};
 
-use crate::mesh::{load_obj, LoadReport, Mesh, MeshError};
+use crate::mesh::MeshError;
+use crate::scene::{load_any, Loaded, SceneError};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 
@@ -23,7 +24,7 @@ use std::path::{Path, PathBuf};
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// A mesh (.obj) to open in the desktop app.
+    /// A mesh (.obj) or scene (.json) to open in the desktop app.
     pub file: Option<PathBuf>,
 }
 
@@ -42,20 +43,38 @@ pub enum Command {
 pub enum CliError {
     #[error(transparent)]
     Mesh(#[from] MeshError),
+    #[error(transparent)]
+    Scene(SceneError),
     #[error("{0}")]
     Usage(String),
     #[error("{}: cannot write: {source}", .path.display())]
     Write { path: PathBuf, source: std::io::Error },
 }
 
-/// Load a mesh with a spinner when it takes over a second, and print what the loader skipped.
-pub(crate) fn load_mesh(path: &Path) -> Result<(Mesh, LoadReport), CliError> {
+/// Load a mesh or a scene with a spinner when it takes over a second, and print what was skipped.
+pub(crate) fn load_mesh(path: &Path) -> Result<Loaded, CliError> {
     let label = format!("loading {}", path.display());
-    let (mesh, report) = progress::with_spinner(&label, || load_obj(path))?;
-    if report.degenerate_skipped > 0 {
-        eprintln!("note: {}: {} degenerate (zero-area) triangles skipped", path.display(), report.degenerate_skipped);
+    let loaded = progress::with_spinner(&label, || load_any(path))?;
+    if loaded.report.degenerate_skipped > 0 {
+        eprintln!(
+            "note: {}: {} degenerate (zero-area) triangles skipped",
+            path.display(),
+            loaded.report.degenerate_skipped
+        );
     }
-    Ok((mesh, report))
+    for w in &loaded.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+    Ok(loaded)
+}
+
+impl From<SceneError> for CliError {
+    fn from(e: SceneError) -> Self {
+        match e {
+            SceneError::Mesh(m) => CliError::Mesh(m),
+            other => CliError::Scene(other),
+        }
+    }
 }
 
 /// Run a parsed subcommand.

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The mesh (.obj).
+    /// The mesh (.obj) or scene (.json: bvhscope's or Moer-lite's).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
@@ -40,8 +40,9 @@ fn parse_range(s: &str) -> Result<(f32, f32), String> {
 }
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
-    let (mesh, _) = load_mesh(&a.mesh)?;
-    let camera = a.view_args.camera(&mesh.bounds())?;
+    let loaded = load_mesh(&a.mesh)?;
+    let mesh = loaded.mesh;
+    let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
     let params = a.build.params(a.build.strategy);
     let bvh = progress::with_spinner("building the BVH", || AnyBvh::build(&mesh, &params));
     let settings = RenderSettings { trace: a.build.trace(), count: a.view.is_heatmap(), progressive: false };

@@ -15,7 +15,7 @@ pub enum StatsFormat {
 
 #[derive(Args, Debug)]
 pub struct StatsArgs {
-    /// The mesh (.obj).
+    /// The mesh (.obj) or scene (.json: bvhscope's or Moer-lite's).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
@@ -24,7 +24,8 @@ pub struct StatsArgs {
 }
 
 pub fn run(a: &StatsArgs) -> Result<(), CliError> {
-    let (mesh, report) = load_mesh(&a.mesh)?;
+    let loaded = load_mesh(&a.mesh)?;
+    let (mesh, report) = (loaded.mesh, loaded.report);
     let params = a.build.params(a.build.strategy);
     let bvh = progress::with_spinner("building the BVH", || AnyBvh::build(&mesh, &params));
     let s = TreeStats::of(&bvh);

@@ -206,6 +206,50 @@ fn the_view_and_the_statistics_can_be_exported() {
 }
 
 #[test]
+fn a_scene_file_brings_its_camera_and_settings_and_can_be_saved_back() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let tent = temp_file(
+        "scene-tent.obj",
+        "v -1 0 -1\nv 1 0 -1\nv 0 1 0\nv -1 0 1\nv 1 0 1\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n",
+    );
+    let scene = temp_file(
+        "tents.json",
+        &format!(
+            r#"{{"camera": {{"position": [3, 2, 6], "look_at": [0, 0.5, 0], "vertical_fov": 40, "size": [320, 200]}},
+                "meshes": [{{"file": "{0}"}}, {{"file": "{0}", "transform": {{"translate": [3, 0, 0]}}}}],
+                "bvh": {{"strategy": "midpoint", "layout": "binary"}}}}"#,
+            tent.display()
+        ),
+    );
+    h.input_mut().dropped_files.push(Arc::new(Dropped(scene.clone())));
+    run_until(&mut h, "the scene", |a| a.scene.report.triangles == 8 && idle(a));
+    let app = h.state();
+    assert_eq!(app.settings.build.strategy, SplitStrategy::Midpoint, "the scene's BVH settings");
+    assert_eq!(app.settings.build.layout, bvhscope::bvh::Layout::Binary);
+    let cam = app.orbit.camera(320, 200);
+    assert!((cam.position - glam::Vec3::new(3.0, 2.0, 6.0)).length() < 1e-4, "the scene's camera: {}", cam.position);
+    assert_eq!(cam.vfov_deg, 40.0);
+
+    let saved = scene.with_file_name("saved.json");
+    h.state_mut().picked(bvhscope::app::Pick::SaveScene, saved.clone());
+    let back = bvhscope::scene::load_any(&saved).expect("the saved scene loads");
+    assert_eq!(back.mesh.triangle_count(), 8);
+    assert_eq!(back.build.unwrap().strategy, SplitStrategy::Midpoint);
+    assert!((back.camera.unwrap().position - cam.position).length() < 1e-4);
+}
+
+#[test]
+fn the_builtin_scene_cannot_be_saved_as_a_scene_file() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let path = std::env::temp_dir().join(format!("bvhscope-ui-builtin-{}.json", std::process::id()));
+    h.state_mut().picked(bvhscope::app::Pick::SaveScene, path.clone());
+    assert!(!path.exists());
+    assert!(h.state().messages.iter().any(|m| m.kind == MessageKind::Error && m.text.contains("built-in")));
+}
+
+#[test]
 fn default_view_snapshot() {
     let mut h = Harness::builder()
         .with_size(egui::vec2(1200.0, 760.0))

@@ -46,6 +46,14 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
                 let name = crate::app::export::default_name(app, "json");
                 app.jobs.pick_file(Pick::SaveStatsJson, &name);
             }
+            if ui
+                .button("Save scene as…")
+                .on_hover_text("The camera, the meshes and the BVH settings, as a scene file")
+                .clicked()
+            {
+                let name = format!("{}.json", app.scene.title().trim_end_matches(".obj").trim_end_matches(".json"));
+                app.jobs.pick_file(Pick::SaveScene, &name);
+            }
             if ui.button("Save to a typed path…").clicked() {
                 app.path_window = Some(PathWindow {
                     pick: Pick::SavePng,

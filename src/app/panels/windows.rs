@@ -32,6 +32,7 @@ pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
         Pick::SavePng => "Save the view as PNG",
         Pick::SaveStatsCsv => "Export statistics (CSV)",
         Pick::SaveStatsJson => "Export statistics (JSON)",
+        Pick::SaveScene => "Save the scene",
     };
     let mut keep = true;
     let mut chosen = None;

@@ -1,0 +1,155 @@
+//! Scenes: several meshes, each placed by a transform, with a camera and the BVH settings to start
+//! with. Two formats are read: bvhscope's own scene file (`scene_file.rs`) and the Moer-lite
+//! renderer's `scene.json` (`moer_lite.rs`). A scene is flattened into one mesh (`flatten.rs`) for
+//! the single-level BVH.
+
+mod flatten;
+mod moer_lite;
+mod scene_file;
+
+pub use flatten::{flatten, load_any, Loaded};
+pub use scene_file::{parse_scene_file, write_scene_file};
+
+use crate::bvh::BuildParams;
+use crate::mesh::MeshError;
+use crate::render::Camera;
+use glam::{Affine3A, Vec3};
+use std::path::{Path, PathBuf};
+
+/// One mesh of a scene: its OBJ file (absolute, or relative to the scene file) and placement.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneMesh {
+    pub file: PathBuf,
+    pub transform: Affine3A,
+}
+
+/// A scene as described by a file, before its meshes are loaded.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneDesc {
+    pub camera: Option<Camera>,
+    pub meshes: Vec<SceneMesh>,
+    pub build: Option<BuildParams>,
+    /// Things in the file that were skipped (e.g. analytic shapes), said to the user.
+    pub warnings: Vec<String>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("{}: no such file", .path.display())]
+    NotFound { path: PathBuf },
+    #[error("{}: cannot read: {source}", .path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{}: line {line}: not valid JSON: {message}", .path.display())]
+    Json { path: PathBuf, line: usize, message: String },
+    #[error("{}: {field}: {message}", .path.display())]
+    Field { path: PathBuf, field: String, message: String },
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+}
+
+/// Translation, rotation about an axis, and scale, applied as world = T·R·S·p (Moer-lite's order).
+pub fn trs(translate: Vec3, axis: Vec3, radians: f32, scale: Vec3) -> Affine3A {
+    let rotation = match axis.try_normalize() {
+        Some(a) if radians != 0.0 => glam::Quat::from_axis_angle(a, radians),
+        _ => glam::Quat::IDENTITY,
+    };
+    Affine3A::from_scale_rotation_translation(scale, rotation, translate)
+}
+
+/// Read a JSON file, with errors that name the file and the line.
+fn read_json(path: &Path) -> Result<serde_json::Value, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => SceneError::NotFound { path: path.into() },
+        _ => SceneError::Io { path: path.into(), source: e },
+    })?;
+    serde_json::from_str(&text).map_err(|e| SceneError::Json {
+        path: path.into(),
+        line: e.line(),
+        message: e.to_string(),
+    })
+}
+
+/// Which format a scene file is in.
+pub fn describe(path: &Path) -> Result<SceneDesc, SceneError> {
+    let json = read_json(path)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let field = Fields { path };
+    if moer_lite::looks_like(&json) {
+        moer_lite::describe(&json, base, &field)
+    } else {
+        scene_file::describe(&json, base, &field)
+    }
+}
+
+/// Typed reading of JSON values, with errors naming the field (`camera.transform.position`).
+pub(crate) struct Fields<'a> {
+    path: &'a Path,
+}
+
+impl Fields<'_> {
+    pub fn err(&self, field: &str, message: impl Into<String>) -> SceneError {
+        SceneError::Field { path: self.path.into(), field: field.to_string(), message: message.into() }
+    }
+
+    pub fn number(&self, v: &serde_json::Value, field: &str) -> Result<f32, SceneError> {
+        match v.as_f64() {
+            Some(x) if x.is_finite() => Ok(x as f32),
+            _ => Err(self.err(field, format!("expected a number, found {}", kind(v)))),
+        }
+    }
+
+    pub fn vec3(&self, v: &serde_json::Value, field: &str) -> Result<Vec3, SceneError> {
+        match v.as_array() {
+            Some(a) if a.len() == 3 => {
+                let c: Result<Vec<f32>, _> =
+                    a.iter().enumerate().map(|(i, x)| self.number(x, &format!("{field}[{i}]"))).collect();
+                let c = c?;
+                Ok(Vec3::new(c[0], c[1], c[2]))
+            }
+            _ => Err(self.err(field, format!("expected [x, y, z], found {}", kind(v)))),
+        }
+    }
+
+    /// A required member of an object.
+    pub fn get<'v>(
+        &self,
+        v: &'v serde_json::Value,
+        parent: &str,
+        key: &str,
+    ) -> Result<&'v serde_json::Value, SceneError> {
+        let field = join(parent, key);
+        match v.as_object() {
+            Some(o) => o.get(key).ok_or_else(|| self.err(&field, "missing")),
+            None => Err(self.err(parent, format!("expected an object, found {}", kind(v)))),
+        }
+    }
+}
+
+pub(crate) fn join(parent: &str, key: &str) -> String {
+    if parent.is_empty() {
+        key.to_string()
+    } else {
+        format!("{parent}.{key}")
+    }
+}
+
+pub(crate) fn kind(v: &serde_json::Value) -> &'static str {
+    match v {
+        serde_json::Value::Null => "null",
+        serde_json::Value::Bool(_) => "a boolean",
+        serde_json::Value::Number(_) => "a number",
+        serde_json::Value::String(_) => "a string",
+        serde_json::Value::Array(_) => "an array",
+        serde_json::Value::Object(_) => "an object",
+    }
+}
+
+/// A mesh path from a scene file: relative paths are relative to the scene file's folder.
+pub(crate) fn resolve(base: &Path, file: &str) -> PathBuf {
+    let p = PathBuf::from(file);
+    if p.is_absolute() {
+        p
+    } else {
+        base.join(p)
+    }
+}

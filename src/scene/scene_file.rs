@@ -1,0 +1,190 @@
+//! bvhscope's scene file (JSON): a camera, any number of meshes with transforms, and the BVH
+//! settings to start with. The README documents the format; every field is checked and an error
+//! names it (`meshes[1].transform.rotate.degrees: expected a number, found a string`).
+
+use super::{join, kind, resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
+use crate::bvh::{BuildParams, Layout, SplitStrategy};
+use crate::render::Camera;
+use glam::{Affine3A, Mat4, Vec3};
+use std::path::Path;
+
+pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Result<SceneDesc, SceneError> {
+    let root =
+        json.as_object().ok_or_else(|| f.err("(top level)", format!("expected an object, found {}", kind(json))))?;
+    for key in root.keys() {
+        if !["camera", "meshes", "bvh", "comment"].contains(&key.as_str()) {
+            return Err(f.err(key, "unknown field (expected camera, meshes, bvh, comment)"));
+        }
+    }
+    let camera = root.get("camera").map(|c| camera(c, f)).transpose()?;
+    let meshes_json = f.get(json, "", "meshes")?;
+    let list = meshes_json
+        .as_array()
+        .ok_or_else(|| f.err("meshes", format!("expected an array, found {}", kind(meshes_json))))?;
+    let mut meshes = Vec::new();
+    for (i, m) in list.iter().enumerate() {
+        let field = format!("meshes[{i}]");
+        let file = f.get(m, &field, "file")?;
+        let file = file
+            .as_str()
+            .ok_or_else(|| f.err(&join(&field, "file"), format!("expected a path, found {}", kind(file))))?;
+        let transform = match m.get("transform") {
+            Some(t) => transform(t, &join(&field, "transform"), f)?,
+            None => Affine3A::IDENTITY,
+        };
+        meshes.push(SceneMesh { file: resolve(base, file), transform });
+    }
+    let build = root.get("bvh").map(|b| bvh(b, f)).transpose()?;
+    Ok(SceneDesc { camera, meshes, build, warnings: Vec::new() })
+}
+
+fn camera(c: &serde_json::Value, f: &Fields) -> Result<Camera, SceneError> {
+    let size = f.get(c, "camera", "size")?;
+    let (w, h) = match size.as_array().map(|a| a.iter().map(|x| x.as_u64()).collect::<Vec<_>>()) {
+        Some(v) if v.len() == 2 && v.iter().all(|x| x.is_some_and(|x| (1..=16384).contains(&x))) => {
+            (v[0].unwrap_or(1) as u32, v[1].unwrap_or(1) as u32)
+        }
+        _ => return Err(f.err("camera.size", "expected [width, height], whole numbers 1..=16384")),
+    };
+    let cam = Camera {
+        position: f.vec3(f.get(c, "camera", "position")?, "camera.position")?,
+        look_at: f.vec3(f.get(c, "camera", "look_at")?, "camera.look_at")?,
+        up: match c.get("up") {
+            Some(u) => f.vec3(u, "camera.up")?,
+            None => Vec3::Y,
+        },
+        vfov_deg: match c.get("vertical_fov") {
+            Some(v) => f.number(v, "camera.vertical_fov")?,
+            None => Camera::DEFAULT_VFOV_DEG,
+        },
+        width: w,
+        height: h,
+    };
+    cam.validate().map_err(|e| f.err("camera", e.to_string()))?;
+    Ok(cam)
+}
+
+/// `{"translate": [..], "rotate": {"axis": [..], "degrees": a}, "scale": s | [..]}` or
+/// `{"matrix": [[4 numbers] × 4]}` (row-major, last row 0 0 0 1).
+fn transform(t: &serde_json::Value, field: &str, f: &Fields) -> Result<Affine3A, SceneError> {
+    let o = t.as_object().ok_or_else(|| f.err(field, format!("expected an object, found {}", kind(t))))?;
+    if let Some(m) = o.get("matrix") {
+        if o.len() > 1 {
+            return Err(f.err(field, "give either matrix or translate/rotate/scale, not both"));
+        }
+        let mf = join(field, "matrix");
+        let rows = m.as_array().filter(|r| r.len() == 4).ok_or_else(|| f.err(&mf, "expected 4 rows of 4 numbers"))?;
+        let mut v = [[0f32; 4]; 4];
+        for (i, row) in rows.iter().enumerate() {
+            let r = row
+                .as_array()
+                .filter(|r| r.len() == 4)
+                .ok_or_else(|| f.err(&format!("{mf}[{i}]"), "expected 4 numbers"))?;
+            for (j, x) in r.iter().enumerate() {
+                v[i][j] = f.number(x, &format!("{mf}[{i}][{j}]"))?;
+            }
+        }
+        if v[3] != [0.0, 0.0, 0.0, 1.0] {
+            return Err(f.err(&format!("{mf}[3]"), "the last row must be [0, 0, 0, 1] (no projection)"));
+        }
+        let m = Mat4::from_cols_array_2d(&v).transpose();
+        if !(m.determinant().abs() > 1e-12) {
+            return Err(f.err(&mf, "the matrix is singular (it flattens the mesh)"));
+        }
+        return Ok(Affine3A::from_mat4(m));
+    }
+    for key in o.keys() {
+        if !["translate", "rotate", "scale"].contains(&key.as_str()) {
+            return Err(f.err(&join(field, key), "unknown field (expected translate, rotate, scale or matrix)"));
+        }
+    }
+    let translate = o.get("translate").map(|v| f.vec3(v, &join(field, "translate"))).transpose()?.unwrap_or(Vec3::ZERO);
+    let (axis, degrees) = match o.get("rotate") {
+        Some(r) => {
+            let rf = join(field, "rotate");
+            let axis = f.vec3(f.get(r, &rf, "axis")?, &join(&rf, "axis"))?;
+            if axis.length_squared() == 0.0 {
+                return Err(f.err(&join(&rf, "axis"), "the rotation axis is zero"));
+            }
+            (axis, f.number(f.get(r, &rf, "degrees")?, &join(&rf, "degrees"))?)
+        }
+        None => (Vec3::Y, 0.0),
+    };
+    let scale = match o.get("scale") {
+        Some(s) if s.is_number() => Vec3::splat(f.number(s, &join(field, "scale"))?),
+        Some(s) => f.vec3(s, &join(field, "scale"))?,
+        None => Vec3::ONE,
+    };
+    if scale.cmpeq(Vec3::ZERO).any() {
+        return Err(f.err(&join(field, "scale"), "a scale of 0 flattens the mesh"));
+    }
+    Ok(trs(translate, axis, degrees.to_radians(), scale))
+}
+
+fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
+    let o = b.as_object().ok_or_else(|| f.err("bvh", format!("expected an object, found {}", kind(b))))?;
+    let mut p = BuildParams::default();
+    for (key, v) in o {
+        let field = join("bvh", key);
+        match key.as_str() {
+            "strategy" => {
+                let s = v.as_str().unwrap_or_default();
+                p.strategy = SplitStrategy::ALL.into_iter().find(|k| k.short_name() == s).ok_or_else(|| {
+                    let names: Vec<&str> = SplitStrategy::ALL.iter().map(|k| k.short_name()).collect();
+                    f.err(&field, format!("expected one of {}", names.join(", ")))
+                })?;
+            }
+            "layout" => {
+                let s = v.as_str().unwrap_or_default();
+                p.layout = Layout::ALL
+                    .into_iter()
+                    .find(|l| l.short_name() == s)
+                    .ok_or_else(|| f.err(&field, "expected binary or wide4"))?;
+            }
+            "max_leaf_size" => match v.as_u64() {
+                Some(n @ 1..=255) => p.max_leaf_size = n as u32,
+                _ => return Err(f.err(&field, "expected a whole number 1..=255")),
+            },
+            "bins" => match v.as_u64() {
+                Some(n @ 2..=256) => p.sah_bins = n as u32,
+                _ => return Err(f.err(&field, "expected a whole number 2..=256")),
+            },
+            _ => return Err(f.err(&field, "unknown field (expected strategy, layout, max_leaf_size, bins)")),
+        }
+    }
+    Ok(p)
+}
+
+/// Parse a scene file's text (for tests and tools; `path` names it in errors and anchors paths).
+pub fn parse_scene_file(path: &Path, text: &str) -> Result<SceneDesc, SceneError> {
+    let json: serde_json::Value = serde_json::from_str(text).map_err(|e| SceneError::Json {
+        path: path.into(),
+        line: e.line(),
+        message: e.to_string(),
+    })?;
+    describe(&json, path.parent().unwrap_or(Path::new(".")), &Fields { path })
+}
+
+/// A scene file for a camera, the meshes (paths written as given) and BVH settings.
+pub fn write_scene_file(camera: &Camera, meshes: &[super::SceneMesh], build: &BuildParams) -> String {
+    let v3 = |v: Vec3| serde_json::json!([v.x, v.y, v.z]);
+    let meshes: Vec<serde_json::Value> = meshes
+        .iter()
+        .map(|m| {
+            let rows = Mat4::from(m.transform).transpose().to_cols_array_2d();
+            serde_json::json!({ "file": m.file.to_string_lossy(), "transform": { "matrix": rows } })
+        })
+        .collect();
+    let v = serde_json::json!({
+        "camera": {
+            "position": v3(camera.position), "look_at": v3(camera.look_at), "up": v3(camera.up),
+            "vertical_fov": camera.vfov_deg, "size": [camera.width, camera.height],
+        },
+        "meshes": meshes,
+        "bvh": {
+            "strategy": build.strategy.short_name(), "layout": build.layout.short_name(),
+            "max_leaf_size": build.max_leaf_size, "bins": build.sah_bins,
+        },
+    });
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
