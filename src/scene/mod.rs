@@ -110,6 +110,15 @@ impl Fields<'_> {
         }
     }
 
+    /// An image size `[width, height]`, whole numbers 1..=16384.
+    pub fn size(&self, v: &serde_json::Value, field: &str) -> Result<(u32, u32), SceneError> {
+        let dims: Option<Vec<u64>> = v.as_array().and_then(|a| a.iter().map(|x| x.as_u64()).collect());
+        match dims.as_deref() {
+            Some(&[w, h]) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w as u32, h as u32)),
+            _ => Err(self.err(field, "expected [width, height], whole numbers 1..=16384")),
+        }
+    }
+
     /// A required member of an object.
     pub fn get<'v>(
         &self,

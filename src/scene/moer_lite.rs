@@ -25,13 +25,7 @@ pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Res
     }
     let t = f.get(c, "camera", "transform")?;
     let film = f.get(c, "camera", "film")?;
-    let size = f.get(film, "camera.film", "size")?;
-    let (w, h) = match size.as_array().map(|a| a.iter().map(|x| x.as_u64()).collect::<Vec<_>>()) {
-        Some(v) if v.len() == 2 && v.iter().all(|x| x.is_some_and(|x| (1..=16384).contains(&x))) => {
-            (v[0].unwrap_or(1) as u32, v[1].unwrap_or(1) as u32)
-        }
-        _ => return Err(f.err("camera.film.size", "expected [width, height], whole numbers 1..=16384")),
-    };
+    let (w, h) = f.size(f.get(film, "camera.film", "size")?, "camera.film.size")?;
     let camera = Camera {
         position: f.vec3(f.get(t, "camera.transform", "position")?, "camera.transform.position")?,
         look_at: f.vec3(f.get(t, "camera.transform", "lookAt")?, "camera.transform.lookAt")?,

@@ -39,13 +39,7 @@ pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Res
 }
 
 fn camera(c: &serde_json::Value, f: &Fields) -> Result<Camera, SceneError> {
-    let size = f.get(c, "camera", "size")?;
-    let (w, h) = match size.as_array().map(|a| a.iter().map(|x| x.as_u64()).collect::<Vec<_>>()) {
-        Some(v) if v.len() == 2 && v.iter().all(|x| x.is_some_and(|x| (1..=16384).contains(&x))) => {
-            (v[0].unwrap_or(1) as u32, v[1].unwrap_or(1) as u32)
-        }
-        _ => return Err(f.err("camera.size", "expected [width, height], whole numbers 1..=16384")),
-    };
+    let (w, h) = f.size(f.get(c, "camera", "size")?, "camera.size")?;
     let cam = Camera {
         position: f.vec3(f.get(c, "camera", "position")?, "camera.position")?,
         look_at: f.vec3(f.get(c, "camera", "look_at")?, "camera.look_at")?,
