@@ -4,6 +4,7 @@ pub mod generate;
 #[allow(clippy::module_inception)]
 mod mesh;
 mod obj;
+mod obj_lines;
 
 pub use mesh::{Mesh, MeshGroup, SurfaceInteraction};
 pub use obj::{load_obj, parse_obj, write_obj, LoadReport, MeshError, MAX_COORDINATE};
