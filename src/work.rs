@@ -57,10 +57,6 @@ impl WorkControl {
         self.done.load(Ordering::Relaxed)
     }
 
-    pub fn reset_done(&self) {
-        self.done.store(0, Ordering::Relaxed);
-    }
-
     /// Progress in [0, 1] (0 while the total is unknown).
     pub fn fraction(&self) -> f32 {
         let t = self.total();

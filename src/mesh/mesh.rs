@@ -64,11 +64,6 @@ impl Mesh {
         self.triangles.iter().flatten().fold(Aabb::EMPTY, |b, &i| b.grow(self.positions[i as usize]))
     }
 
-    /// The group a triangle belongs to.
-    pub fn group_of(&self, prim: u32) -> Option<&MeshGroup> {
-        self.groups.iter().find(|g| g.triangles.contains(&prim))
-    }
-
     /// The handout's `fillIntersection`: position, normals and uv of a hit.
     pub fn fill_intersection(&self, ray: &Ray, prim: u32, hit: TriangleHit) -> SurfaceInteraction {
         let idx = self.triangles[prim as usize];
