@@ -171,7 +171,7 @@ impl Bvh {
         };
 
         let t2 = Instant::now();
-        let prim_ids: Vec<u32> = prims.iter().map(|p| p.index).collect();
+        let prim_ids: Vec<u32> = prims.iter().map(|p| p.index()).collect();
         let tris = prim_ids.par_iter().with_min_len(4096).map(|&i| mesh.triangle(i)).collect();
         report.reorder_time = t2.elapsed();
         Ok(Bvh { nodes, prim_ids, tris, params, report })
@@ -194,7 +194,7 @@ impl Extents {
     #[inline(always)]
     fn add(self, p: &BuildPrim) -> Extents {
         let c = p.centroid();
-        Extents { min: self.min.min(p.min), max: self.max.max(p.max), cmin: self.cmin.min(c), cmax: self.cmax.max(c) }
+        Extents { min: self.min.min(p.min()), max: self.max.max(p.max()), cmin: self.cmin.min(c), cmax: self.cmax.max(c) }
     }
 
     fn merge(self, o: Extents) -> Extents {

@@ -9,7 +9,7 @@ pub fn split_equal_count(prims: &mut [BuildPrim], node: &NodeInfo) -> SplitDecis
     let mid = prims.len() / 2;
     // Ties broken by index so the result does not depend on the input order's accidents.
     prims.select_nth_unstable_by(mid, |a, b| {
-        a.centroid()[axis].total_cmp(&b.centroid()[axis]).then(a.index.cmp(&b.index))
+        a.centroid()[axis].total_cmp(&b.centroid()[axis]).then(a.index().cmp(&b.index()))
     });
     SplitDecision::Split { axis: axis as u8, mid }
 }

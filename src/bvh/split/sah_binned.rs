@@ -51,12 +51,6 @@ impl Acc {
     }
 }
 
-#[inline]
-fn bin_of(c: f32, lo: f32, scale: f32, bins: usize) -> usize {
-    // `as usize` saturates (and maps NaN to 0), so the index is always in range.
-    ((c - lo) * scale).max(0.0).min((bins - 1) as f32) as usize
-}
-
 pub fn split_sah_binned(
     prims: &mut [BuildPrim],
     node: &NodeInfo,
@@ -79,8 +73,8 @@ pub fn split_sah_binned(
             for (axis, i) in idx.to_array().into_iter().enumerate() {
                 let bin = &mut all[axis * bins + i as usize];
                 bin.count += 1;
-                bin.min = bin.min.min(p.min);
-                bin.max = bin.max.max(p.max);
+                bin.min = bin.min.min(p.min());
+                bin.max = bin.max.max(p.max());
             }
         }
     };
@@ -143,8 +137,15 @@ pub fn split_sah_binned(
     if leaf_is_cheaper(n, weighted, node, params) {
         return SplitDecision::Leaf;
     }
-    let (lo, s) = (cb.min[axis], scale[axis]);
+    let (lo, s, plane) = (cb.min[axis], scale[axis], plane as f32);
     // Same arithmetic as the binning above (SIMD there, scalar here: IEEE gives equal results).
-    let mid = partition(prims, |p| bin_of(p.centroid()[axis], lo, s, bins) < plane);
+    // For an integer plane in 1..bins, floor(clamp(x, 0, bins - 1)) < plane ⟺ x < plane, so the
+    // clamp and the cast can be skipped; `!(x >= plane)` sends NaN left, as its bin 0 would.
+    let mid = partition(prims, |p| !((p.centroid()[axis] - lo) * s >= plane));
+    debug_assert_eq!(
+        mid,
+        all[axis * bins..axis * bins + plane as usize].iter().map(|b| b.count as usize).sum::<usize>(),
+        "the partition sends left exactly the triangles binned left of the plane"
+    );
     SplitDecision::Split { axis: axis as u8, mid }
 }

@@ -8,7 +8,7 @@ use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 
 fn sort_on(prims: &mut [BuildPrim], axis: usize) {
-    prims.sort_unstable_by(|a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]).then(a.index.cmp(&b.index)));
+    prims.sort_unstable_by(|a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]).then(a.index().cmp(&b.index())));
 }
 
 pub fn split_sah_sweep(

@@ -88,8 +88,12 @@ impl WideBvh {
     pub fn from_binary(bvh: Bvh) -> WideBvh {
         let start = Instant::now();
         let root_bounds = bvh.root_bounds();
-        let mut nodes = vec![WideNode::EMPTY];
         let b = &bvh.nodes;
+        // Each wide node takes the place of up to three binary interior nodes (of which a binary
+        // tree of k nodes has (k - 1) / 2); reserving that third up front avoids regrowing a vector
+        // of 128-byte nodes several times on big meshes.
+        let mut nodes = Vec::with_capacity(b.len() / 6 + 1);
+        nodes.push(WideNode::EMPTY);
         if b[0].is_leaf() || bvh.prim_ids.is_empty() {
             if b[0].count > 0 {
                 nodes[0].set(0, b[0].bounds, b[0].index, b[0].count as u8);
