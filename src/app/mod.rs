@@ -212,7 +212,7 @@ impl BvhscopeApp {
             (Some(desc), _) => desc.meshes.clone(),
             (None, SceneSource::File(p)) => {
                 let file = p.canonicalize().unwrap_or_else(|_| p.clone());
-                vec![crate::scene::SceneMesh { file, transform: glam::Affine3A::IDENTITY }]
+                vec![crate::scene::SceneMesh::new(file, glam::Affine3A::IDENTITY)]
             }
             (None, SceneSource::Builtin) => {
                 return Err("the built-in scene has no mesh file a scene could refer to; open a mesh first".into())

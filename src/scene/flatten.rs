@@ -59,10 +59,12 @@ pub fn flatten(scene_path: &Path, desc: &SceneDesc) -> Result<(Mesh, LoadReport)
     let mut report = LoadReport { path: scene_path.into(), ..Default::default() };
     for (i, m) in desc.meshes.iter().enumerate() {
         if !cache.contains_key(&m.file) {
-            let loaded = load_obj(&m.file).map_err(|e| SceneError::Field {
-                path: scene_path.into(),
-                field: format!("meshes[{i}].file"),
-                message: e.to_string(),
+            let loaded = load_obj(&m.file).map_err(|e| {
+                let hint = match (&e, &m.if_missing) {
+                    (crate::mesh::MeshError::NotFound { .. }, Some(hint)) => format!(" ({hint})"),
+                    _ => String::new(),
+                };
+                SceneError::Field { path: scene_path.into(), field: format!("meshes[{i}].file"), message: format!("{e}{hint}") }
             })?;
             cache.insert(m.file.clone(), loaded);
         }

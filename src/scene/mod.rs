@@ -21,6 +21,15 @@ use std::path::{Path, PathBuf};
 pub struct SceneMesh {
     pub file: PathBuf,
     pub transform: Affine3A,
+    /// Said with the error when the file does not exist (e.g. where to get a mesh that is not
+    /// shipped with bvhscope).
+    pub if_missing: Option<String>,
+}
+
+impl SceneMesh {
+    pub fn new(file: PathBuf, transform: Affine3A) -> Self {
+        Self { file, transform, if_missing: None }
+    }
 }
 
 /// A scene as described by a file, before its meshes are loaded.
@@ -29,6 +38,8 @@ pub struct SceneDesc {
     pub camera: Option<Camera>,
     pub meshes: Vec<SceneMesh>,
     pub build: Option<BuildParams>,
+    /// What the scene is for, in a sentence or two (shown when it is opened).
+    pub note: Option<String>,
     /// Things in the file that were skipped (e.g. analytic shapes), said to the user.
     pub warnings: Vec<String>,
 }

@@ -83,7 +83,7 @@ pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Res
                 trs(vec("translate", Vec3::ZERO)?, axis, radian, scale)
             }
         };
-        desc.meshes.push(SceneMesh { file: resolve(base, file), transform });
+        desc.meshes.push(SceneMesh::new(resolve(base, file), transform));
     }
     if !skipped.is_empty() {
         desc.warnings.push(format!("analytic shapes are not supported yet and were skipped: {}", skipped.join(", ")));

@@ -12,8 +12,8 @@ pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Res
     let root =
         json.as_object().ok_or_else(|| f.err("(top level)", format!("expected an object, found {}", kind(json))))?;
     for key in root.keys() {
-        if !["camera", "meshes", "bvh", "comment"].contains(&key.as_str()) {
-            return Err(f.err(key, "unknown field (expected camera, meshes, bvh, comment)"));
+        if !["camera", "meshes", "bvh", "note", "comment"].contains(&key.as_str()) {
+            return Err(f.err(key, "unknown field (expected camera, meshes, bvh, note, comment)"));
         }
     }
     let camera = root.get("camera").map(|c| camera(c, f)).transpose()?;
@@ -24,6 +24,11 @@ pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Res
     let mut meshes = Vec::new();
     for (i, m) in list.iter().enumerate() {
         let field = format!("meshes[{i}]");
+        if let Some(o) = m.as_object() {
+            if let Some(key) = o.keys().find(|k| !["file", "transform", "if_missing"].contains(&k.as_str())) {
+                return Err(f.err(&join(&field, key), "unknown field (expected file, transform, if_missing)"));
+            }
+        }
         let file = f.get(m, &field, "file")?;
         let file = file
             .as_str()
@@ -32,10 +37,16 @@ pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Res
             Some(t) => transform(t, &join(&field, "transform"), f)?,
             None => Affine3A::IDENTITY,
         };
-        meshes.push(SceneMesh { file: resolve(base, file), transform });
+        let if_missing = m.get("if_missing").map(|v| text(v, &join(&field, "if_missing"), f)).transpose()?;
+        meshes.push(SceneMesh { file: resolve(base, file), transform, if_missing });
     }
     let build = root.get("bvh").map(|b| bvh(b, f)).transpose()?;
-    Ok(SceneDesc { camera, meshes, build, warnings: Vec::new() })
+    let note = root.get("note").map(|v| text(v, "note", f)).transpose()?;
+    Ok(SceneDesc { camera, meshes, build, note, warnings: Vec::new() })
+}
+
+fn text(v: &serde_json::Value, field: &str, f: &Fields) -> Result<String, SceneError> {
+    v.as_str().map(str::to_string).ok_or_else(|| f.err(field, format!("expected a string, found {}", kind(v))))
 }
 
 fn camera(c: &serde_json::Value, f: &Fields) -> Result<Camera, SceneError> {
