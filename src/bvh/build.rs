@@ -143,11 +143,7 @@ impl Bvh {
     /// and a cancel request stops the build within a few hundred nodes.
     pub fn build_controlled(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<Bvh, Cancelled> {
         let t0 = Instant::now();
-        let params = BuildParams {
-            max_leaf_size: params.max_leaf_size.clamp(1, MAX_LEAF_SIZE_LIMIT),
-            sah_bins: params.sah_bins.clamp(2, split::sah_binned_max_bins() as u32),
-            ..*params
-        };
+        let params = params.clamped();
         let n = mesh.triangle_count();
         control.set_total(n as u64);
         let make = |i: usize| {
@@ -160,15 +156,8 @@ impl Bvh {
         let setup_time = t0.elapsed();
         control.check()?;
 
-        let t1 = Instant::now();
-        let (nodes, over) = build_subtree(&mut prims, 0, 0, &params, control)?;
-        let mut report = BuildReport {
-            setup_time,
-            split_time: t1.elapsed(),
-            fallback_splits: over.fallback,
-            depth_limited_splits: over.depth_limited,
-            ..Default::default()
-        };
+        let (nodes, mut report) = build_nodes(&mut prims, &params, control)?;
+        report.setup_time = setup_time;
 
         let t2 = Instant::now();
         let prim_ids: Vec<u32> = prims.iter().map(|p| p.index()).collect();
@@ -176,6 +165,54 @@ impl Bvh {
         report.reorder_time = t2.elapsed();
         Ok(Bvh { nodes, prim_ids, tris, params, report })
     }
+}
+
+impl BuildParams {
+    /// The parameters with every field in the range the builder accepts.
+    fn clamped(&self) -> BuildParams {
+        BuildParams {
+            max_leaf_size: self.max_leaf_size.clamp(1, MAX_LEAF_SIZE_LIMIT),
+            sah_bins: self.sah_bins.clamp(2, split::sah_binned_max_bins() as u32),
+            ..*self
+        }
+    }
+}
+
+/// A binary BVH over arbitrary boxes (the top level of a two-level BVH, whose "primitives" are
+/// instances): the nodes, and for each leaf slot the index of its box in `boxes`. Leaf `index`
+/// fields point into that order, as they point into `Bvh::prim_ids` for triangles.
+pub fn build_over_boxes(
+    boxes: &[Aabb],
+    params: &BuildParams,
+    control: &WorkControl,
+) -> Result<(Vec<BvhNode>, Vec<u32>, BuildReport), Cancelled> {
+    let t0 = Instant::now();
+    let params = params.clamped();
+    let mut prims: Vec<BuildPrim> = boxes.iter().enumerate().map(|(i, b)| BuildPrim::new(*b, i as u32)).collect();
+    control.set_total(boxes.len() as u64);
+    let setup_time = t0.elapsed();
+    let (nodes, mut report) = build_nodes(&mut prims, &params, control)?;
+    report.setup_time = setup_time;
+    Ok((nodes, prims.iter().map(|p| p.index()).collect(), report))
+}
+
+/// The top-down splitting over prepared primitives, which it leaves in leaf order.
+fn build_nodes(
+    prims: &mut [BuildPrim],
+    params: &BuildParams,
+    control: &WorkControl,
+) -> Result<(Vec<BvhNode>, BuildReport), Cancelled> {
+    let t1 = Instant::now();
+    let (nodes, over) = build_subtree(prims, 0, 0, params, control)?;
+    Ok((
+        nodes,
+        BuildReport {
+            split_time: t1.elapsed(),
+            fallback_splits: over.fallback,
+            depth_limited_splits: over.depth_limited,
+            ..Default::default()
+        },
+    ))
 }
 
 /// Bounds and centroid bounds of a range (in parallel for big ranges), in SIMD form.
@@ -194,7 +231,12 @@ impl Extents {
     #[inline(always)]
     fn add(self, p: &BuildPrim) -> Extents {
         let c = p.centroid();
-        Extents { min: self.min.min(p.min()), max: self.max.max(p.max()), cmin: self.cmin.min(c), cmax: self.cmax.max(c) }
+        Extents {
+            min: self.min.min(p.min()),
+            max: self.max.max(p.max()),
+            cmin: self.cmin.min(c),
+            cmax: self.cmax.max(c),
+        }
     }
 
     fn merge(self, o: Extents) -> Extents {

@@ -8,6 +8,21 @@ pub trait TraversalStats {
     fn leaf_visited(&mut self);
     fn box_tests(&mut self, n: u32);
     fn triangle_tests(&mut self, n: u32);
+
+    /// A node of the top level of a two-level BVH (`TwoLevelBvh`). The work of both levels counts
+    /// in the totals above; a sink that tells the levels apart also counts it here.
+    #[inline(always)]
+    fn top_node_visited(&mut self) {
+        self.node_visited();
+    }
+    /// Box tests of the top level (also counted in the totals).
+    #[inline(always)]
+    fn top_box_tests(&mut self, n: u32) {
+        self.box_tests(n);
+    }
+    /// The ray was transformed into an instance's object space to enter its mesh's BVH.
+    #[inline(always)]
+    fn instance_entered(&mut self) {}
 }
 
 /// The sink of the plain traversal: counts nothing, costs nothing.
@@ -36,6 +51,12 @@ pub struct RayCounters {
     pub leaves_visited: u32,
     /// Ray–triangle tests.
     pub triangle_tests: u32,
+    /// Of `nodes_visited`, those in the top level of a two-level BVH (0 for a single BVH).
+    pub top_nodes_visited: u32,
+    /// Of `box_tests`, those in the top level of a two-level BVH.
+    pub top_box_tests: u32,
+    /// Instances whose mesh BVH the ray entered.
+    pub instances_entered: u32,
 }
 
 impl TraversalStats for RayCounters {
@@ -55,9 +76,39 @@ impl TraversalStats for RayCounters {
     fn triangle_tests(&mut self, n: u32) {
         self.triangle_tests += n;
     }
+    #[inline(always)]
+    fn top_node_visited(&mut self) {
+        self.nodes_visited += 1;
+        self.top_nodes_visited += 1;
+    }
+    #[inline(always)]
+    fn top_box_tests(&mut self, n: u32) {
+        self.box_tests += n;
+        self.top_box_tests += n;
+    }
+    #[inline(always)]
+    fn instance_entered(&mut self) {
+        self.instances_entered += 1;
+    }
 }
 
 impl RayCounters {
+    /// No work (a `const` for static initialisers).
+    pub const ZERO: RayCounters = RayCounters {
+        nodes_visited: 0,
+        box_tests: 0,
+        leaves_visited: 0,
+        triangle_tests: 0,
+        top_nodes_visited: 0,
+        top_box_tests: 0,
+        instances_entered: 0,
+    };
+
+    /// Nodes visited in the bottom level (a single BVH's nodes are all bottom level).
+    pub fn bottom_nodes_visited(&self) -> u32 {
+        self.nodes_visited - self.top_nodes_visited
+    }
+
     /// Combined cost of the ray under the SAH's own cost model: traversal steps plus triangle
     /// tests, weighted by the same constants the builder used.
     pub fn cost(&self, c: crate::bvh::SahCost) -> f32 {

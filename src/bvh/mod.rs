@@ -13,6 +13,7 @@ mod stack;
 mod stats;
 mod traverse;
 pub mod tree;
+pub mod two_level;
 pub mod wide;
 
 pub use accel::{Accelerator, Hit, TraceOptions, TraversalOrder};
@@ -24,4 +25,5 @@ pub use node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 pub use split::SplitStrategy;
 pub use stats::TreeStats;
 pub use tree::{NodeKind, NodeView, TreeView};
+pub use two_level::TwoLevelBvh;
 pub use wide::WideBvh;

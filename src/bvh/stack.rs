@@ -53,6 +53,20 @@ impl<const N: usize> TraversalStack<N> {
     }
 }
 
+impl<const N: usize> TraversalStack<N> {
+    /// Pop entries until one the ray enters no later than `t_max` (the closest hit so far): the
+    /// next node worth visiting. Entries beyond it are dropped: nothing in them can be nearer.
+    #[inline(always)]
+    pub fn pop_nearer(&mut self, t_max: f32) -> Option<u32> {
+        while let Some((node, t_enter)) = self.pop() {
+            if t_enter <= t_max {
+                return Some(node);
+            }
+        }
+        None
+    }
+}
+
 impl<const N: usize> Default for TraversalStack<N> {
     fn default() -> Self {
         Self::new()
@@ -74,6 +88,17 @@ mod tests {
         assert_eq!(s.pop(), Some((3, 3.0)));
         assert_eq!(s.pop(), Some((1, 1.0)));
         assert_eq!(s.pop(), None);
+    }
+
+    #[test]
+    fn pop_nearer_skips_entries_beyond_the_closest_hit() {
+        let mut s = TraversalStack::<4>::new();
+        for (i, t) in [(1, 1.0), (2, 5.0), (3, 2.0), (4, 9.0)] {
+            s.push((i, t));
+        }
+        assert_eq!(s.pop_nearer(3.0), Some(3));
+        assert_eq!(s.pop_nearer(3.0), Some(1), "entry 2 (5.0) is beyond 3.0");
+        assert_eq!(s.pop_nearer(f32::INFINITY), None);
     }
 
     #[test]

@@ -74,15 +74,10 @@ impl Bvh {
                     continue;
                 }
             }
-            // Pop the next node that can still hold a hit nearer than the best so far.
-            loop {
-                let Some((n, t_enter)) = stack.pop() else {
-                    return best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] });
-                };
-                if t_enter <= ray.t_max {
-                    current = n as usize;
-                    break;
-                }
+            // The next node that can still hold a hit nearer than the best so far.
+            match stack.pop_nearer(ray.t_max) {
+                Some(n) => current = n as usize,
+                None => break,
             }
         }
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })

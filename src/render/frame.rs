@@ -18,12 +18,8 @@ pub struct PixelSample {
 }
 
 impl PixelSample {
-    pub const MISS: PixelSample = PixelSample {
-        t: f32::INFINITY,
-        normal: Vec3::ZERO,
-        prim: u32::MAX,
-        counters: RayCounters { nodes_visited: 0, box_tests: 0, leaves_visited: 0, triangle_tests: 0 },
-    };
+    pub const MISS: PixelSample =
+        PixelSample { t: f32::INFINITY, normal: Vec3::ZERO, prim: u32::MAX, counters: RayCounters::ZERO };
 
     pub fn is_hit(&self) -> bool {
         self.prim != u32::MAX

@@ -1,16 +1,36 @@
-//! Turning a scene into one mesh for the single-level BVH: every mesh loaded once, every placement
-//! applied (positions by the transform, normals by its inverse transpose).
+//! Opening a scene: every distinct mesh file loaded once (what the two-level BVH instances), and the
+//! scene flattened into one mesh for the single-level BVH: every placement applied (positions by
+//! the transform, normals by its inverse transpose).
 
 use super::{describe, SceneDesc, SceneError};
 use crate::bvh::BuildParams;
 use crate::mesh::{load_obj, LoadReport, Mesh, MeshGroup};
 use crate::render::Camera;
+use glam::Affine3A;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The meshes of a scene, each loaded once, and their placements: what the two-level BVH is
+/// built from.
+#[derive(Clone, Debug)]
+pub struct SceneInstances {
+    pub meshes: Vec<Arc<Mesh>>,
+    /// (index into `meshes`, object-to-world transform), in the scene file's order.
+    pub placements: Vec<(u32, Affine3A)>,
+}
+
+impl SceneInstances {
+    pub fn mesh_refs(&self) -> Vec<&Mesh> {
+        self.meshes.iter().map(|m| &**m).collect()
+    }
+}
 
 /// What opening a file gives: the mesh to build over, and what a scene file adds.
 #[derive(Clone, Debug)]
 pub struct Loaded {
+    /// The whole scene as one mesh (for the single-level BVH, and for shading: its triangle ids are
+    /// the two-level BVH's global ids).
     pub mesh: Mesh,
     pub report: LoadReport,
     pub camera: Option<Camera>,
@@ -18,6 +38,8 @@ pub struct Loaded {
     pub warnings: Vec<String>,
     /// The scene's description, when the file was a scene.
     pub scene: Option<SceneDesc>,
+    /// The scene's meshes and placements, when the file was a scene.
+    pub instances: Option<SceneInstances>,
 }
 
 /// Open an OBJ, or a scene file (`.json`: bvhscope's format or Moer-lite's).
@@ -26,11 +48,23 @@ pub fn load_any(path: impl AsRef<Path>) -> Result<Loaded, SceneError> {
     let is_scene = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
     if !is_scene {
         let (mesh, report) = load_obj(path)?;
-        return Ok(Loaded { mesh, report, camera: None, build: None, warnings: Vec::new(), scene: None });
+        return Ok(Loaded {
+            mesh,
+            report,
+            camera: None,
+            build: None,
+            warnings: Vec::new(),
+            scene: None,
+            instances: None,
+        });
     }
     let start = std::time::Instant::now();
     let desc = describe(path)?;
-    let (mesh, mut report) = flatten(path, &desc)?;
+    let (instances, mut report) = load_instances(path, &desc)?;
+    let mesh = flatten(path, &instances)?;
+    report.vertices = mesh.positions.len();
+    report.triangles = mesh.triangles.len();
+    report.groups = mesh.groups.len();
     report.load_time = start.elapsed();
     Ok(Loaded {
         mesh,
@@ -39,11 +73,12 @@ pub fn load_any(path: impl AsRef<Path>) -> Result<Loaded, SceneError> {
         build: desc.build,
         warnings: desc.warnings.clone(),
         scene: Some(desc),
+        instances: Some(instances),
     })
 }
 
-/// One mesh holding every placed mesh of the scene; each placement is a group named after its file.
-pub fn flatten(scene_path: &Path, desc: &SceneDesc) -> Result<(Mesh, LoadReport), SceneError> {
+/// Load every distinct mesh file of the scene once.
+pub fn load_instances(scene_path: &Path, desc: &SceneDesc) -> Result<(SceneInstances, LoadReport), SceneError> {
     if desc.meshes.is_empty() {
         return Err(SceneError::Field {
             path: scene_path.into(),
@@ -51,45 +86,65 @@ pub fn flatten(scene_path: &Path, desc: &SceneDesc) -> Result<(Mesh, LoadReport)
             message: "the scene has no meshes".into(),
         });
     }
-    let mut cache: HashMap<PathBuf, (Mesh, LoadReport)> = HashMap::new();
+    let mut index: HashMap<PathBuf, u32> = HashMap::new();
+    let mut out = SceneInstances { meshes: Vec::new(), placements: Vec::new() };
+    let mut report = LoadReport { path: scene_path.into(), ..Default::default() };
+    for (i, m) in desc.meshes.iter().enumerate() {
+        let k = match index.get(&m.file) {
+            Some(&k) => k,
+            None => {
+                let (mesh, r) = load_obj(&m.file).map_err(|e| {
+                    let hint = match (&e, &m.if_missing) {
+                        (crate::mesh::MeshError::NotFound { .. }, Some(hint)) => format!(" ({hint})"),
+                        _ => String::new(),
+                    };
+                    SceneError::Field {
+                        path: scene_path.into(),
+                        field: format!("meshes[{i}].file"),
+                        message: format!("{e}{hint}"),
+                    }
+                })?;
+                report.degenerate_skipped += r.degenerate_skipped;
+                report.has_normals |= r.has_normals;
+                report.has_uvs |= r.has_uvs;
+                out.meshes.push(Arc::new(mesh));
+                index.insert(m.file.clone(), out.meshes.len() as u32 - 1);
+                out.meshes.len() as u32 - 1
+            }
+        };
+        out.placements.push((k, m.transform));
+    }
+    Ok((out, report))
+}
+
+/// One mesh holding every placed mesh of the scene, in placement order; each placement is a group
+/// named after its mesh.
+pub fn flatten(scene_path: &Path, scene: &SceneInstances) -> Result<Mesh, SceneError> {
     let mut out = Mesh {
         name: scene_path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
         ..Default::default()
     };
-    let mut report = LoadReport { path: scene_path.into(), ..Default::default() };
-    for (i, m) in desc.meshes.iter().enumerate() {
-        if !cache.contains_key(&m.file) {
-            let loaded = load_obj(&m.file).map_err(|e| {
-                let hint = match (&e, &m.if_missing) {
-                    (crate::mesh::MeshError::NotFound { .. }, Some(hint)) => format!(" ({hint})"),
-                    _ => String::new(),
-                };
-                SceneError::Field { path: scene_path.into(), field: format!("meshes[{i}].file"), message: format!("{e}{hint}") }
-            })?;
-            cache.insert(m.file.clone(), loaded);
-        }
-        let (mesh, r) = &cache[&m.file];
-        report.degenerate_skipped += r.degenerate_skipped;
-        report.has_normals |= r.has_normals;
-        report.has_uvs |= r.has_uvs;
+    let has_normals = scene.meshes.iter().any(|m| !m.normals.is_empty());
+    for (i, &(k, transform)) in scene.placements.iter().enumerate() {
+        let mesh = &scene.meshes[k as usize];
         let base = out.positions.len() as u32;
         let first = out.triangles.len() as u32;
-        out.positions.extend(mesh.positions.iter().map(|&p| m.transform.transform_point3(p)));
-        let normal_matrix = glam::Mat3::from(m.transform.matrix3).inverse().transpose();
-        out.normals.extend(
-            (0..mesh.positions.len())
-                .map(|v| mesh.normals.get(v).map_or(glam::Vec3::ZERO, |&n| (normal_matrix * n).normalize_or_zero())),
-        );
+        out.positions.extend(mesh.positions.iter().map(|&p| transform.transform_point3(p)));
+        if has_normals {
+            let normal_matrix = glam::Mat3::from(transform.matrix3).inverse().transpose();
+            out.normals.extend(
+                (0..mesh.positions.len()).map(|v| {
+                    mesh.normals.get(v).map_or(glam::Vec3::ZERO, |&n| (normal_matrix * n).normalize_or_zero())
+                }),
+            );
+        }
         if !mesh.uvs.is_empty() {
             out.uvs.resize(base as usize, glam::Vec2::ZERO);
             out.uvs.extend(&mesh.uvs);
         }
         out.triangles.extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
-        let name = m.file.file_stem().map_or_else(|| format!("mesh {i}"), |s| s.to_string_lossy().into_owned());
+        let name = if mesh.name.is_empty() { format!("mesh {i}") } else { mesh.name.clone() };
         out.groups.push(MeshGroup { name, triangles: first..out.triangles.len() as u32 });
-    }
-    if !report.has_normals {
-        out.normals.clear(); // no file had normals: the geometric normal serves
     }
     if !out.uvs.is_empty() {
         out.uvs.resize(out.positions.len(), glam::Vec2::ZERO);
@@ -101,8 +156,5 @@ pub fn flatten(scene_path: &Path, desc: &SceneDesc) -> Result<(Mesh, LoadReport)
             message: "a transform moves the mesh beyond the coordinates that can be traced".into(),
         });
     }
-    report.vertices = out.positions.len();
-    report.triangles = out.triangles.len();
-    report.groups = out.groups.len();
-    Ok((out, report))
+    Ok(out)
 }

@@ -7,7 +7,7 @@ mod flatten;
 mod moer_lite;
 mod scene_file;
 
-pub use flatten::{flatten, load_any, Loaded};
+pub use flatten::{flatten, load_any, load_instances, Loaded, SceneInstances};
 pub use scene_file::{parse_scene_file, write_scene_file};
 
 use crate::bvh::BuildParams;

@@ -113,15 +113,12 @@ impl WideBvh {
                 let (enter, mask) = sray.hit(node, ray.t_min, ray.t_max);
                 if mask == 0 {
                     // Nothing hit here: continue with the nearest useful entry of the stack.
-                    loop {
-                        match stack.pop() {
-                            None => break 'traversal,
-                            Some((r, t)) if t <= ray.t_max => {
-                                cur = r;
-                                continue 'traversal;
-                            }
-                            Some(_) => {}
+                    match stack.pop_nearer(ray.t_max) {
+                        Some(r) => {
+                            cur = r;
+                            continue 'traversal;
                         }
+                        None => break 'traversal,
                     }
                 }
                 let s0 = mask.trailing_zeros() as usize;
@@ -174,15 +171,9 @@ impl WideBvh {
                     }
                 }
             }
-            loop {
-                match stack.pop() {
-                    None => break 'traversal,
-                    Some((r, t)) if t <= ray.t_max => {
-                        cur = r;
-                        break;
-                    }
-                    Some(_) => {}
-                }
+            match stack.pop_nearer(ray.t_max) {
+                Some(r) => cur = r,
+                None => break 'traversal,
             }
         }
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
