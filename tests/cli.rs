@@ -128,3 +128,39 @@ fn stats_and_compare_print_their_tables() {
     assert_eq!(csv.lines().count(), 6, "header, four strategies in the chosen layout, linear: {csv}");
     assert!(csv.starts_with("strategy,build_ms"));
 }
+
+#[test]
+fn a_scene_renders_and_reports_two_levels() {
+    // Three placements of the tent: two of the same file moved and turned, one more.
+    let mesh = tent();
+    let scene = tmp("tents.json");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"{{"note": "three tents", "meshes": [
+                {{"file": "{0}"}},
+                {{"file": "{0}", "transform": {{"translate": [3, 0, 0], "rotate": {{"axis": [0, 1, 0], "degrees": 30}}}}}},
+                {{"file": "{0}", "transform": {{"translate": [-3, 0, 0], "scale": 0.5}}}}]}}"#,
+            mesh.display()
+        ),
+    )
+    .unwrap();
+    let s = scene.to_str().unwrap();
+    let out = bvhscope(&["stats", s, "--two-level", "--top-strategy", "midpoint"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("3 placements of 1 meshes: 12 triangles as placed, 4 stored"), "{text}");
+    assert!(text.contains("top level       Midpoint"), "{text}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("three tents"), "the scene's note is shown");
+
+    let png = tmp("tents-top.png");
+    let out =
+        bvhscope(&["render", s, "--two-level", "--view", "top-visits", "--size", "64x48", "-o", png.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("top-level nodes visited per ray"), "{err}");
+    assert!(image::open(&png).is_ok());
+
+    let out = bvhscope(&["render", s, "--top-strategy", "sah", "-o", png.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "top-level options need --two-level");
+}

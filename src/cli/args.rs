@@ -1,7 +1,7 @@
 //! Arguments shared by the subcommands, and clap's value lists for the core's enums (so `--help`
 //! lists every strategy, view, order, test and colour map under its kebab-case name).
 
-use crate::bvh::{BuildParams, Layout, SahCost, SplitStrategy, TraceOptions, TraversalOrder};
+use crate::bvh::{BuildParams, Layout, SahCost, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder};
 use crate::geometry::{Aabb, TriangleTest};
 use crate::render::{Camera, ColorMap, View};
 use clap::builder::PossibleValue;
@@ -95,6 +95,16 @@ pub struct BuildArgs {
     /// Ray–triangle test.
     #[arg(long = "triangle-test", value_enum, default_value = "watertight")]
     pub test: TriangleTest,
+    /// Build two levels: a top-level BVH over the scene's mesh placements and one BVH per mesh
+    /// (the options above then apply to the meshes' BVHs). An OBJ is one placement of itself.
+    #[arg(long)]
+    pub two_level: bool,
+    /// Split strategy of the top level [default: --strategy].
+    #[arg(long, value_enum, requires = "two_level")]
+    pub top_strategy: Option<SplitStrategy>,
+    /// Most placements in a top-level leaf (1..=255).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=255), requires = "two_level")]
+    pub top_max_leaf_size: u32,
 }
 
 impl BuildArgs {
@@ -110,6 +120,18 @@ impl BuildArgs {
             sah_bins: self.bins,
             cost: SahCost { traversal: self.traversal_cost, ..SahCost::default() },
         }
+    }
+
+    /// What to build: one BVH with `params`, or (with `--two-level`) two levels whose bottom
+    /// uses `params`.
+    pub fn scene_build(&self, params: BuildParams) -> SceneBuild {
+        let top = self.two_level.then(|| BuildParams {
+            strategy: self.top_strategy.unwrap_or(params.strategy),
+            max_leaf_size: self.top_max_leaf_size,
+            layout: Layout::Binary,
+            ..params
+        });
+        SceneBuild { bvh: params, top }
     }
 
     pub fn trace(&self) -> TraceOptions {

@@ -65,7 +65,34 @@ pub(crate) fn load_mesh(path: &Path) -> Result<Loaded, CliError> {
     for w in &loaded.warnings {
         eprintln!("warning: {}: {w}", path.display());
     }
+    if let Some(note) = loaded.scene.as_ref().and_then(|s| s.note.as_ref()) {
+        eprintln!("about this scene: {note}");
+    }
     Ok(loaded)
+}
+
+/// Build what `build` asks for over a loaded file; for two levels an OBJ is one placement of itself.
+pub(crate) fn build_scene(loaded: &Loaded, build: &crate::bvh::SceneBuild) -> crate::bvh::SceneBvh {
+    let single;
+    let instances = match &loaded.instances {
+        Some(i) => i,
+        None => {
+            single = crate::scene::SceneInstances {
+                meshes: vec![std::sync::Arc::new(loaded.mesh.clone())],
+                placements: vec![(0, glam::Affine3A::IDENTITY)],
+            };
+            &single
+        }
+    };
+    let meshes = instances.mesh_refs();
+    let label = if build.top.is_some() { "building the two-level BVH" } else { "building the BVH" };
+    progress::with_spinner(label, || {
+        let control = crate::work::WorkControl::new();
+        match crate::bvh::SceneBvh::build(&loaded.mesh, Some((&meshes, &instances.placements)), build, &control) {
+            Ok(b) => b,
+            Err(crate::work::Cancelled) => unreachable!("nobody else holds this control"),
+        }
+    })
 }
 
 impl From<SceneError> for CliError {

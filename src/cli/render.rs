@@ -1,8 +1,7 @@
 //! `bvhscope render`: ray-cast a mesh to a PNG.
 
 use super::args::{BuildArgs, ViewArgs};
-use super::{load_mesh, progress, CliError};
-use crate::bvh::AnyBvh;
+use super::{build_scene, load_mesh, progress, CliError};
 use crate::render::{draw_legend, render_progressive, view_image, ColorMap, HeatRange, RenderSettings, View};
 use crate::work::WorkControl;
 use clap::Args;
@@ -41,10 +40,10 @@ fn parse_range(s: &str) -> Result<(f32, f32), String> {
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
-    let mesh = loaded.mesh;
+    let mesh = &loaded.mesh;
     let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
     let params = a.build.params(a.build.strategy);
-    let bvh = progress::with_spinner("building the BVH", || AnyBvh::build(&mesh, &params));
+    let bvh = build_scene(&loaded, &a.build.scene_build(params));
     let settings = RenderSettings { trace: a.build.trace(), count: a.view.is_heatmap(), progressive: false };
     let total = camera.width as u64 * camera.height as u64;
     let control = WorkControl::new();

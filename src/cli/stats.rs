@@ -1,8 +1,8 @@
 //! `bvhscope stats`: the statistics of one BVH.
 
 use super::args::BuildArgs;
-use super::{load_mesh, progress, CliError};
-use crate::bvh::{AnyBvh, TreeStats};
+use super::{build_scene, load_mesh, CliError};
+use crate::bvh::{SceneBvh, TreeStats, TreeView};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -25,18 +25,95 @@ pub struct StatsArgs {
 
 pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
-    let (mesh, report) = (loaded.mesh, loaded.report);
     let params = a.build.params(a.build.strategy);
-    let bvh = progress::with_spinner("building the BVH", || AnyBvh::build(&mesh, &params));
-    let s = TreeStats::of(&bvh);
-    match a.format {
-        StatsFormat::Json => {
-            let v = serde_json::json!({ "mesh": report, "params": params, "stats": s });
+    let bvh = build_scene(&loaded, &a.build.scene_build(params));
+    let report = &loaded.report;
+    match (&bvh, a.format) {
+        (SceneBvh::Single(b), StatsFormat::Json) => {
+            let v = serde_json::json!({ "mesh": report, "params": params, "stats": TreeStats::of(b) });
             println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
-        StatsFormat::Text => print!("{}", format_text(&report, &params, &s)),
+        (SceneBvh::Single(b), StatsFormat::Text) => print!("{}", format_text(report, &params, &TreeStats::of(b))),
+        (SceneBvh::TwoLevel(t), format) => {
+            let top = TreeStats::of(&t.top);
+            let names = loaded.instances.as_ref().map(|i| i.meshes.iter().map(|m| m.name.clone()).collect::<Vec<_>>());
+            let bottom: Vec<(String, TreeStats)> = t
+                .bottom
+                .iter()
+                .enumerate()
+                .map(|(k, b)| {
+                    let name = names
+                        .as_ref()
+                        .and_then(|n| n.get(k).cloned())
+                        .unwrap_or_else(|| report.path.display().to_string());
+                    (name, TreeStats::of(b))
+                })
+                .collect();
+            if let StatsFormat::Json = format {
+                let bottom_json: Vec<_> =
+                    bottom.iter().map(|(name, s)| serde_json::json!({ "mesh": name, "stats": s })).collect();
+                let v = serde_json::json!({
+                    "scene": report, "instances": t.instances.len(), "memory_bytes": t.memory_bytes(),
+                    "top": { "params": t.top.params, "stats": top }, "bottom": { "params": params, "meshes": bottom_json },
+                });
+                println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
+            } else {
+                print!("{}", format_two_level(report, t, &top, &bottom));
+            }
+        }
     }
     Ok(())
+}
+
+/// A two-level BVH's statistics: the top level over placements, then each mesh's BVH.
+fn format_two_level(
+    report: &crate::mesh::LoadReport,
+    t: &crate::bvh::TwoLevelBvh,
+    top: &TreeStats,
+    bottom: &[(String, TreeStats)],
+) -> String {
+    let mut o = String::new();
+    let _ = writeln!(o, "scene           {}", report.path.display());
+    let _ = writeln!(
+        o,
+        "two levels      {} placements of {} meshes: {} triangles as placed, {} stored",
+        t.instances.len(),
+        t.bottom.len(),
+        t.instanced_triangle_count(),
+        t.bottom.iter().map(|b| b.triangle_count()).sum::<usize>()
+    );
+    let _ = writeln!(
+        o,
+        "build           {:.2} ms (mesh BVHs {:.2}, top level {:.2})",
+        (t.bottom_time + t.top_time).as_secs_f64() * 1e3,
+        t.bottom_time.as_secs_f64() * 1e3,
+        t.top_time.as_secs_f64() * 1e3
+    );
+    let _ = writeln!(o, "memory          {} bytes (every node and index array, each mesh BVH once)", t.memory_bytes());
+    let p = &t.top.params;
+    let _ = writeln!(o, "top level       {}, max {} placements per leaf", p.strategy.label(), p.max_leaf_size);
+    let _ = writeln!(
+        o,
+        "                {} nodes ({} leaves), depth max {}, SAH cost {:.3}",
+        top.nodes, top.leaves, top.max_depth, top.sah_cost
+    );
+    let b = t.bottom_params();
+    let _ = writeln!(
+        o,
+        "bottom level    {}, {} layout (max leaf size {}, {} SAH bins)",
+        b.strategy.label(),
+        b.layout.label(),
+        b.max_leaf_size,
+        b.sah_bins
+    );
+    for (name, s) in bottom {
+        let _ = writeln!(
+            o,
+            "  {name}: {} triangles, {} nodes, depth max {}, SAH cost {:.3}",
+            s.triangles, s.nodes, s.max_depth, s.sah_cost
+        );
+    }
+    o
 }
 
 /// The statistics as a human-readable block.

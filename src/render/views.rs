@@ -16,10 +16,30 @@ pub enum View {
     TriTests,
     /// traversal-cost·nodes + intersection-cost·triangle tests, with the SAH constants.
     Cost,
+    /// Nodes visited per ray in the top level of a two-level BVH.
+    TopVisits,
+    /// Nodes visited per ray in the bottom level (the meshes' BVHs).
+    BottomVisits,
+    /// Instances whose mesh BVH the ray entered.
+    Instances,
 }
 
 impl View {
-    pub const ALL: [View; 5] = [View::Normals, View::Depth, View::Visits, View::TriTests, View::Cost];
+    pub const ALL: [View; 8] = [
+        View::Normals,
+        View::Depth,
+        View::Visits,
+        View::TriTests,
+        View::Cost,
+        View::TopVisits,
+        View::BottomVisits,
+        View::Instances,
+    ];
+
+    /// Whether the view is about the levels of a two-level BVH (all zero for a single BVH).
+    pub fn is_per_level(self) -> bool {
+        matches!(self, View::TopVisits | View::BottomVisits | View::Instances)
+    }
 
     pub fn short_name(self) -> &'static str {
         match self {
@@ -28,6 +48,9 @@ impl View {
             View::Visits => "visits",
             View::TriTests => "tri-tests",
             View::Cost => "cost",
+            View::TopVisits => "top-visits",
+            View::BottomVisits => "bottom-visits",
+            View::Instances => "instances",
         }
     }
 
@@ -38,11 +61,14 @@ impl View {
             View::Visits => "Nodes visited",
             View::TriTests => "Triangle tests",
             View::Cost => "Combined cost",
+            View::TopVisits => "Top-level nodes visited",
+            View::BottomVisits => "Bottom-level nodes visited",
+            View::Instances => "Instances entered",
         }
     }
 
     pub fn is_heatmap(self) -> bool {
-        matches!(self, View::Visits | View::TriTests | View::Cost)
+        !matches!(self, View::Normals | View::Depth)
     }
 
     /// The heatmap's value for one ray.
@@ -51,6 +77,9 @@ impl View {
             View::Visits => s.counters.nodes_visited as f32,
             View::TriTests => s.counters.triangle_tests as f32,
             View::Cost => s.counters.cost(cost),
+            View::TopVisits => s.counters.top_nodes_visited as f32,
+            View::BottomVisits => s.counters.bottom_nodes_visited() as f32,
+            View::Instances => s.counters.instances_entered as f32,
             View::Normals | View::Depth => 0.0,
         }
     }
