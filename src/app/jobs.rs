@@ -3,13 +3,13 @@
 //! running one of that kind, and results of superseded jobs are dropped by id.
 
 use super::scene::Scene;
-use crate::bvh::{AnyBvh, BuildParams};
 use crate::bvh::{SahCost, TraceOptions};
+use crate::bvh::{SceneBuild, SceneBvh};
 use crate::mesh::Mesh;
 use crate::render::{
     render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, Legend, PassInfo, RenderSettings, View,
 };
-use crate::scene::load_any;
+use crate::scene::{load_any, SceneInstances};
 use crate::work::{Cancelled, WorkControl};
 use std::path::PathBuf;
 use std::sync::mpsc::{channel, Receiver, Sender};
@@ -28,7 +28,7 @@ pub struct ViewStyle {
 
 #[derive(Clone)]
 pub struct RenderRequest {
-    pub bvh: Arc<AnyBvh>,
+    pub bvh: Arc<SceneBvh>,
     pub mesh: Arc<Mesh>,
     pub camera: Camera,
     pub trace: TraceOptions,
@@ -51,7 +51,7 @@ impl RenderRequest {
 /// One finished render pass, ready to show.
 pub struct PassOutput {
     /// The BVH that traced the frame.
-    pub bvh: Arc<AnyBvh>,
+    pub bvh: Arc<SceneBvh>,
     pub frame: Arc<Frame>,
     pub image: egui::ColorImage,
     pub legend: Option<Legend>,
@@ -72,7 +72,7 @@ pub enum Pick {
 
 pub enum JobEvent {
     Loaded(Result<Scene, String>),
-    Built { scene_id: u64, params: BuildParams, result: Result<Arc<AnyBvh>, Cancelled> },
+    Built { scene_id: u64, params: SceneBuild, result: Result<Arc<SceneBvh>, Cancelled> },
     Pass(PassOutput),
     Picked { pick: Pick, path: Option<PathBuf>, took: Duration },
 }
@@ -97,7 +97,7 @@ pub struct Jobs {
     /// The last render started (to tell whether a new one is needed).
     pub last_render: Option<RenderRequest>,
     /// The last build started: its parameters and scene.
-    pub last_build: Option<(BuildParams, u64)>,
+    pub last_build: Option<(SceneBuild, u64)>,
 }
 
 impl Jobs {
@@ -148,15 +148,22 @@ impl Jobs {
         self.load = Some(job);
     }
 
-    /// Build a BVH in the background; a running build is cancelled.
-    pub fn build(&mut self, mesh: Arc<Mesh>, params: BuildParams, scene_id: u64) {
+    /// Build a BVH (or two levels, over `instances`) in the background; a running build is
+    /// cancelled.
+    pub fn build(&mut self, mesh: Arc<Mesh>, instances: Option<SceneInstances>, params: SceneBuild, scene_id: u64) {
         if let Some(old) = self.build.take() {
             old.control.cancel();
         }
-        let job = self.start(format!("Building ({})", params.strategy.label()));
+        let label = match params.top {
+            Some(top) => format!("Building two levels ({} over {})", top.strategy.label(), params.bvh.strategy.label()),
+            None => format!("Building ({})", params.bvh.strategy.label()),
+        };
+        let job = self.start(label);
         let (send, control) = (self.sender(job.id), job.control.clone());
         std::thread::spawn(move || {
-            let result = AnyBvh::build_controlled(&mesh, &params, &control).map(Arc::new);
+            let meshes = instances.as_ref().map(|i| i.mesh_refs());
+            let placed = instances.as_ref().zip(meshes.as_ref()).map(|(i, m)| (&m[..], &i.placements[..]));
+            let result = SceneBvh::build(&mesh, placed, &params, &control).map(Arc::new);
             send(JobEvent::Built { scene_id, params, result });
         });
         self.build = Some(job);

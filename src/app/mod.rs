@@ -14,10 +14,11 @@ mod viewport;
 
 pub use jobs::Pick;
 pub use orbit::OrbitCamera;
+pub use overlay::OverlayBox;
 pub use scene::{Scene, SceneSource};
-pub use settings::Settings;
+pub use settings::{BoxLevel, Settings};
 
-use crate::bvh::{AnyBvh, SplitStrategy, TreeStats, TreeView};
+use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TreeStats, TreeView};
 use crate::geometry::Aabb;
 use crate::render::{Camera, ColorMap, Frame, Legend, RaySummary, View};
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
@@ -26,8 +27,12 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// "SAH binned, 4-wide SIMD": the strategy and layout of a build, for the statistics columns.
-fn figures_label(p: &crate::bvh::BuildParams) -> String {
-    format!("{}, {}", p.strategy.label(), p.layout.short_name())
+fn figures_label(p: &SceneBuild) -> String {
+    let one = format!("{}, {}", p.bvh.strategy.label(), p.bvh.layout.short_name());
+    match p.top {
+        Some(top) => format!("top {} / {one}", top.strategy.label()),
+        None => one,
+    }
 }
 
 /// How the app starts.
@@ -65,9 +70,22 @@ pub struct Shown {
 
 /// The BVH of the current scene.
 pub struct BuiltBvh {
-    pub bvh: Arc<AnyBvh>,
+    pub bvh: Arc<SceneBvh>,
+    /// Of the single BVH, or of the top level of two.
     pub stats: TreeStats,
+    /// Two levels: each mesh's name and its BVH's statistics.
+    pub bottom: Vec<(String, TreeStats)>,
     pub scene_id: u64,
+}
+
+impl BuiltBvh {
+    /// Deepest level of the bottom BVHs (or of the single BVH): the box depth slider's end.
+    pub fn bottom_max_depth(&self) -> u32 {
+        match self.bvh.two_level() {
+            Some(_) => self.bottom.iter().map(|(_, s)| s.max_depth).max().unwrap_or(0),
+            None => self.stats.max_depth,
+        }
+    }
 }
 
 /// One strategy's figures for the statistics panel (the current one and the one before).
@@ -126,17 +144,17 @@ pub struct BvhscopeApp {
 
 /// The overlay's triangles for one camera and viewport rectangle (redrawn only when they change).
 struct OverlayCache {
-    boxes: Arc<Vec<(usize, Aabb)>>,
+    boxes: Arc<Vec<OverlayBox>>,
     camera: Camera,
     rect: egui::Rect,
     mesh: Arc<egui::Mesh>,
 }
 
 struct BoxCache {
-    bvh: Arc<AnyBvh>,
-    depth: u32,
-    leaves_above: bool,
-    boxes: Arc<Vec<(usize, Aabb)>>,
+    bvh: Arc<SceneBvh>,
+    /// (level, top depth, bottom depth, leaves above)
+    key: (BoxLevel, u32, u32, bool),
+    boxes: Arc<Vec<OverlayBox>>,
 }
 
 impl BvhscopeApp {
@@ -198,6 +216,9 @@ impl BvhscopeApp {
         if let Some(b) = scene.build {
             self.settings.build = b;
         }
+        if let Some(note) = scene.desc.as_ref().and_then(|d| d.note.as_ref()) {
+            self.message(MessageKind::Info, format!("{}: {note}", scene.title()));
+        }
         self.scene = scene;
         self.scene_id += 1;
         self.previous = None;
@@ -238,40 +259,67 @@ impl BvhscopeApp {
         self.built.as_ref().filter(|b| b.scene_id == self.scene_id)
     }
 
+    /// Whether the scene can be built as two levels (it came from a scene file).
+    pub fn has_instances(&self) -> bool {
+        self.scene.instances.is_some()
+    }
+
+    /// What the settings ask to build for the current scene.
+    pub fn wanted_build(&self) -> SceneBuild {
+        let top = (self.settings.two_level && self.has_instances())
+            .then_some(crate::bvh::BuildParams { layout: crate::bvh::Layout::Binary, ..self.settings.top_build });
+        SceneBuild { bvh: self.settings.build, top }
+    }
+
     /// Start a build when the settings or the scene differ from what was built or is building.
     pub fn ensure_build(&mut self) {
-        let wanted = (self.settings.build, self.scene_id);
-        let have = self.current_bvh().is_some_and(|b| *b.bvh.params() == self.settings.build);
+        let build = self.wanted_build();
+        let wanted = (build, self.scene_id);
+        let have = self.current_bvh().is_some_and(|b| b.bvh.build_params() == build);
         if have {
             // Switched back to what is built while another build ran: that build is not wanted.
             self.jobs.cancel_build();
         } else if self.jobs.last_build != Some(wanted) {
-            self.jobs.build(self.scene.mesh.clone(), self.settings.build, self.scene_id);
+            let instances = if build.top.is_some() { self.scene.instances.clone() } else { None };
+            self.jobs.build(self.scene.mesh.clone(), instances, build, self.scene_id);
         }
     }
 
-    /// The boxes of the overlay for the current BVH and settings (cached).
-    pub fn overlay_boxes(&mut self) -> Option<Arc<Vec<(usize, Aabb)>>> {
+    /// The boxes of the overlay for the current BVH and settings (cached): the single BVH's at
+    /// the box depth, or for two levels the top level's and/or the bottom level's, each at its
+    /// own depth.
+    pub fn overlay_boxes(&mut self) -> Option<Arc<Vec<OverlayBox>>> {
         let bvh = self.current_bvh()?.bvh.clone();
-        let (depth, leaves_above) = (self.settings.box_depth, self.settings.boxes_leaves_above);
-        let fresh = self
-            .box_cache
-            .as_ref()
-            .is_some_and(|c| Arc::ptr_eq(&c.bvh, &bvh) && c.depth == depth && c.leaves_above == leaves_above);
+        let s = &self.settings;
+        let key = (s.box_level, s.top_box_depth, s.box_depth, s.boxes_leaves_above);
+        let fresh = self.box_cache.as_ref().is_some_and(|c| Arc::ptr_eq(&c.bvh, &bvh) && c.key == key);
         if !fresh {
-            let boxes = Arc::new(bvh.boxes_at_depth(depth, leaves_above));
-            self.box_cache = Some(BoxCache { bvh, depth, leaves_above, boxes });
+            let (level, top_depth, depth, leaves_above) = key;
+            let world = |top: bool| move |(id, b): (usize, Aabb)| OverlayBox { top, ..OverlayBox::world(id, &b) };
+            let boxes = match bvh.two_level() {
+                None => bvh.tree().boxes_at_depth(depth, leaves_above).into_iter().map(world(false)).collect(),
+                Some(t) => {
+                    let mut v: Vec<OverlayBox> = Vec::new();
+                    if level.shows_bottom() {
+                        v.extend(t.bottom_boxes_at_depth(depth, leaves_above).into_iter().map(|b| OverlayBox {
+                            id: b.id,
+                            corners: crate::bvh::two_level::placed_corners(&b.bounds, &b.to_world),
+                            top: false,
+                        }));
+                    }
+                    if level.shows_top() {
+                        v.extend(t.top.boxes_at_depth(top_depth, leaves_above).into_iter().map(world(true)));
+                    }
+                    v
+                }
+            };
+            self.box_cache = Some(BoxCache { bvh, key, boxes: Arc::new(boxes) });
         }
         self.box_cache.as_ref().map(|c| c.boxes.clone())
     }
 
     /// The overlay mesh of `boxes` seen by `camera` in `rect` (cached).
-    pub fn overlay_mesh(
-        &mut self,
-        boxes: Arc<Vec<(usize, Aabb)>>,
-        camera: Camera,
-        rect: egui::Rect,
-    ) -> Arc<egui::Mesh> {
+    pub fn overlay_mesh(&mut self, boxes: Arc<Vec<OverlayBox>>, camera: Camera, rect: egui::Rect) -> Arc<egui::Mesh> {
         if let Some(c) = &self.overlay_cache {
             if Arc::ptr_eq(&c.boxes, &boxes) && c.camera == camera && c.rect == rect {
                 return c.mesh.clone();
@@ -285,7 +333,7 @@ impl BvhscopeApp {
     /// Figures of the current strategy for the statistics panel.
     pub fn current_figures(&self) -> Option<StrategyFigures> {
         self.current_bvh().map(|b| StrategyFigures {
-            label: figures_label(b.bvh.params()),
+            label: figures_label(&b.bvh.build_params()),
             stats: b.stats.clone(),
             rays: self.rays,
         })
@@ -316,12 +364,18 @@ impl BvhscopeApp {
             JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
             JobEvent::Built { scene_id, result: Ok(bvh), .. } if scene_id == self.scene_id => {
                 if let Some(old) = self.current_figures() {
-                    if self.current_bvh().is_some_and(|b| b.bvh.params() != bvh.params()) {
+                    if self.current_bvh().is_some_and(|b| b.bvh.build_params() != bvh.build_params()) {
                         self.previous = Some(old);
                     }
                 }
-                let stats = TreeStats::of(bvh.as_ref());
-                self.built = Some(BuiltBvh { bvh, stats, scene_id });
+                let stats = TreeStats::of(bvh.tree());
+                let bottom = match (bvh.two_level(), &self.scene.instances) {
+                    (Some(t), Some(inst)) => {
+                        t.bottom.iter().zip(&inst.meshes).map(|(b, m)| (m.name.clone(), TreeStats::of(b))).collect()
+                    }
+                    _ => Vec::new(),
+                };
+                self.built = Some(BuiltBvh { bvh, stats, bottom, scene_id });
                 self.rays = None;
             }
             JobEvent::Built { .. } => {}
@@ -413,7 +467,7 @@ impl BvhscopeApp {
             A::View(i) => self.settings.view = View::ALL[i.min(View::ALL.len() - 1)],
             A::ToggleBoxes => self.settings.show_boxes = !self.settings.show_boxes,
             A::DepthUp => {
-                let max = self.current_bvh().map_or(0, |b| b.stats.max_depth);
+                let max = self.current_bvh().map_or(0, |b| b.bottom_max_depth());
                 self.settings.box_depth = (self.settings.box_depth + 1).min(max);
                 self.settings.show_boxes = true;
             }

@@ -68,16 +68,27 @@ impl Projector {
         Some((self.to_screen(a), self.to_screen(b)))
     }
 
-    /// The 12 edges of a box, clipped and projected.
-    pub fn box_edges(&self, b: &Aabb) -> impl Iterator<Item = (Pos2, Pos2)> + '_ {
-        let corners: [Vec3; 8] = std::array::from_fn(|k| {
-            self.to_camera(Vec3::new(
-                if k & 1 == 0 { b.min.x } else { b.max.x },
-                if k & 2 == 0 { b.min.y } else { b.max.y },
-                if k & 4 == 0 { b.min.z } else { b.max.z },
-            ))
-        });
+    /// The 12 edges of a box given by its corners (`Aabb::corners` order), clipped and projected.
+    pub fn box_edges(&self, corners: &[Vec3; 8]) -> impl Iterator<Item = (Pos2, Pos2)> + '_ {
+        let corners = corners.map(|c| self.to_camera(c));
         EDGES.iter().filter_map(move |&(i, j)| self.clip_segment(corners[i], corners[j]))
+    }
+}
+
+/// A box to draw: a node's box, as its eight world-space corners (an instance's transform makes
+/// an axis-aligned box of the mesh a parallelepiped in the world).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OverlayBox {
+    /// Picks the colour.
+    pub id: usize,
+    pub corners: [Vec3; 8],
+    /// A top-level box of a two-level BVH: drawn white and twice as thick.
+    pub top: bool,
+}
+
+impl OverlayBox {
+    pub fn world(id: usize, b: &Aabb) -> Self {
+        Self { id, corners: b.corners(), top: false }
     }
 }
 
@@ -89,15 +100,16 @@ pub fn node_color(node: usize) -> Color32 {
 
 /// All boxes as one mesh of thin quads: far cheaper for egui than 12 line shapes per box, which
 /// keeps 10,000 boxes smooth.
-pub fn boxes_mesh(boxes: &[(usize, Aabb)], camera: &Camera, rect: Rect, width: f32) -> Mesh {
-    let extent = boxes.iter().fold(Aabb::EMPTY, |acc, (_, b)| acc.union(*b)).extent().length().max(1e-6);
+pub fn boxes_mesh(boxes: &[OverlayBox], camera: &Camera, rect: Rect, width: f32) -> Mesh {
+    let extent =
+        boxes.iter().flat_map(|b| b.corners).fold(Aabb::EMPTY, |acc, c| acc.grow(c)).extent().length().max(1e-6);
     let near = (extent * 1e-4).max((camera.position - camera.look_at).length() * 1e-4);
     let projector = Projector::new(camera, rect, near);
     let clip = rect.expand(rect.width().max(rect.height()));
     let mut mesh = Mesh::default();
-    for (node, b) in boxes {
-        let color = node_color(*node);
-        for (p, q) in projector.box_edges(b) {
+    for b in boxes {
+        let (color, width) = if b.top { (Color32::WHITE, width * 2.0) } else { (node_color(b.id), width) };
+        for (p, q) in projector.box_edges(&b.corners) {
             // Segments far outside the view are dropped; egui clips the rest to the viewport.
             if !clip.contains(p) && !clip.contains(q) && !Rect::from_two_pos(p, q).intersects(rect) {
                 continue;
@@ -164,7 +176,7 @@ mod tests {
         assert!((b.x - 110.0).abs() < 1e-3, "the visible end projects normally: {b:?}");
         // A box around the camera still yields finite, clipped edges.
         let around = Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0));
-        let edges: Vec<_> = p.box_edges(&around).collect();
+        let edges: Vec<_> = p.box_edges(&around.corners()).collect();
         assert!(!edges.is_empty() && edges.len() < 12);
         assert!(edges.iter().all(|(a, b)| a.x.is_finite() && a.y.is_finite() && b.x.is_finite() && b.y.is_finite()));
     }
@@ -172,8 +184,8 @@ mod tests {
     #[test]
     fn mesh_has_one_quad_per_visible_edge() {
         let boxes = vec![
-            (1, Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))),
-            (2, Aabb::new(Vec3::splat(-0.5), Vec3::splat(0.5))),
+            OverlayBox::world(1, &Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))),
+            OverlayBox::world(2, &Aabb::new(Vec3::splat(-0.5), Vec3::splat(0.5))),
         ];
         let m = boxes_mesh(&boxes, &camera(), rect(), 1.0);
         // Both boxes lie wholly in front of the camera and inside the view; the edges along the
@@ -181,7 +193,7 @@ mod tests {
         assert_eq!(m.vertices.len(), 24 * 4);
         assert_eq!(m.indices.len(), 24 * 6);
         // A box behind the camera adds nothing.
-        let behind = vec![(3, Aabb::new(Vec3::new(-1.0, -1.0, 6.0), Vec3::new(1.0, 1.0, 8.0)))];
+        let behind = vec![OverlayBox::world(3, &Aabb::new(Vec3::new(-1.0, -1.0, 6.0), Vec3::new(1.0, 1.0, 8.0)))];
         assert_eq!(boxes_mesh(&behind, &camera(), rect(), 1.0).vertices.len(), 0);
         assert_ne!(node_color(1), node_color(2));
     }

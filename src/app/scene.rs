@@ -3,7 +3,7 @@
 use crate::bvh::BuildParams;
 use crate::mesh::{generate, LoadReport, Mesh};
 use crate::render::Camera;
-use crate::scene::{Loaded, SceneDesc};
+use crate::scene::{Loaded, SceneDesc, SceneInstances};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -23,11 +23,13 @@ pub struct Scene {
     pub build: Option<BuildParams>,
     pub desc: Option<SceneDesc>,
     pub warnings: Vec<String>,
+    /// A scene file's meshes and placements (what a two-level BVH is built over).
+    pub instances: Option<SceneInstances>,
 }
 
 impl Scene {
     pub fn new(mesh: Arc<Mesh>, report: LoadReport, source: SceneSource) -> Self {
-        Self { mesh, report, source, camera: None, build: None, desc: None, warnings: Vec::new() }
+        Self { mesh, report, source, camera: None, build: None, desc: None, warnings: Vec::new(), instances: None }
     }
 
     /// A loaded OBJ or scene file.
@@ -40,6 +42,7 @@ impl Scene {
             build: l.build,
             desc: l.scene,
             warnings: l.warnings,
+            instances: l.instances,
         }
     }
 

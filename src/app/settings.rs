@@ -1,6 +1,6 @@
 //! What the user chose, remembered across runs (eframe persistence).
 
-use crate::bvh::{BuildParams, TraceOptions};
+use crate::bvh::{BuildParams, Layout, TraceOptions};
 use crate::render::{ColorMap, HeatRange, View};
 use std::path::PathBuf;
 
@@ -10,7 +10,16 @@ pub const MAX_RECENT: usize = 10;
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct Settings {
+    /// The single BVH's parameters, or the bottom level's (each mesh's BVH) with two levels.
     pub build: BuildParams,
+    /// For scene files: a top-level BVH over the mesh placements over one BVH per mesh.
+    pub two_level: bool,
+    /// The top level's parameters (always the binary layout).
+    pub top_build: BuildParams,
+    /// Which level's boxes the overlay draws (two-level BVH).
+    pub box_level: BoxLevel,
+    /// Depth of the top level's boxes (`box_depth` is the bottom level's, or the single BVH's).
+    pub top_box_depth: u32,
     pub trace: TraceOptions,
     pub view: View,
     pub colormap: ColorMap,
@@ -30,6 +39,10 @@ impl Default for Settings {
     fn default() -> Self {
         Self {
             build: BuildParams::default(),
+            two_level: true,
+            top_build: BuildParams { max_leaf_size: 1, layout: Layout::Binary, ..BuildParams::default() },
+            box_level: BoxLevel::Both,
+            top_box_depth: 1,
             trace: TraceOptions::default(),
             view: View::Normals,
             colormap: ColorMap::Viridis,
@@ -41,6 +54,35 @@ impl Default for Settings {
             progressive: true,
             recent_files: Vec::new(),
         }
+    }
+}
+
+/// The overlay's choice of level for a two-level BVH.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum BoxLevel {
+    Top,
+    Bottom,
+    #[default]
+    Both,
+}
+
+impl BoxLevel {
+    pub const ALL: [BoxLevel; 3] = [BoxLevel::Top, BoxLevel::Bottom, BoxLevel::Both];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            BoxLevel::Top => "Top level",
+            BoxLevel::Bottom => "Bottom level",
+            BoxLevel::Both => "Both",
+        }
+    }
+
+    pub fn shows_top(self) -> bool {
+        self != BoxLevel::Bottom
+    }
+
+    pub fn shows_bottom(self) -> bool {
+        self != BoxLevel::Top
     }
 }
 

@@ -18,6 +18,9 @@ pub struct SceneBuild {
     pub top: Option<BuildParams>,
 }
 
+/// A scene's meshes and their placements (mesh index, object-to-world transform).
+pub type Placements<'a> = (&'a [&'a Mesh], &'a [(u32, Affine3A)]);
+
 #[derive(Clone, Debug)]
 pub enum SceneBvh {
     Single(AnyBvh),
@@ -29,7 +32,7 @@ impl SceneBvh {
     /// `build.top` is given and there are placements; otherwise the single level is built).
     pub fn build(
         flat: &Mesh,
-        instances: Option<(&[&Mesh], &[(u32, Affine3A)])>,
+        instances: Option<Placements>,
         build: &SceneBuild,
         control: &WorkControl,
     ) -> Result<SceneBvh, Cancelled> {
@@ -45,7 +48,7 @@ impl SceneBvh {
     pub fn build_params(&self) -> SceneBuild {
         match self {
             SceneBvh::Single(b) => SceneBuild { bvh: *b.params(), top: None },
-            SceneBvh::TwoLevel(t) => SceneBuild { bvh: *t.bottom_params(), top: Some(t.top.params) },
+            SceneBvh::TwoLevel(t) => SceneBuild { bvh: t.bottom_params, top: Some(t.top.params) },
         }
     }
 

@@ -81,6 +81,8 @@ pub struct TwoLevelBvh {
     pub bottom: Vec<AnyBvh>,
     pub instances: Vec<Instance>,
     pub top: TopLevel,
+    /// The parameters every mesh BVH was built with.
+    pub bottom_params: BuildParams,
     /// Building the mesh BVHs (all of them) and the top level.
     pub bottom_time: Duration,
     pub top_time: Duration,
@@ -118,7 +120,8 @@ impl TwoLevelBvh {
         let boxes: Vec<Aabb> = instances.iter().map(|i| i.bounds).collect();
         let (nodes, order, report) = build_over_boxes(&boxes, top, control)?;
         let top = TopLevel { nodes, order, params: BuildParams { layout: super::Layout::Binary, ..*top }, report };
-        Ok(TwoLevelBvh { bottom: bottom_bvhs, instances, top, bottom_time, top_time: t1.elapsed() })
+        let bottom_params = bottom_bvhs.first().map_or(*bottom, |b| *b.params());
+        Ok(TwoLevelBvh { bottom: bottom_bvhs, instances, top, bottom_params, bottom_time, top_time: t1.elapsed() })
     }
 
     /// Triangles as the rays see them: every instance counts its mesh's triangles.
@@ -131,10 +134,6 @@ impl TwoLevelBvh {
         self.top.memory_bytes()
             + self.instances.len() * std::mem::size_of::<Instance>()
             + self.bottom.iter().map(|b| b.memory_bytes()).sum::<usize>()
-    }
-
-    pub fn bottom_params(&self) -> &BuildParams {
-        self.bottom.first().map_or(&self.top.params, |b| b.params())
     }
 
     /// The bottom level's boxes at `depth` (in each mesh's BVH), for every instance. A mesh's boxes
@@ -257,13 +256,7 @@ impl Accelerator for TwoLevelBvh {
 /// The world-space corners of a box placed by a transform (corner k: x from bit 0, y from bit 1,
 /// z from bit 2), for drawing.
 pub fn placed_corners(b: &Aabb, to_world: &Affine3A) -> [Vec3; 8] {
-    std::array::from_fn(|k| {
-        to_world.transform_point3(Vec3::new(
-            if k & 1 == 0 { b.min.x } else { b.max.x },
-            if k & 2 == 0 { b.min.y } else { b.max.y },
-            if k & 4 == 0 { b.min.z } else { b.max.z },
-        ))
-    })
+    b.corners().map(|c| to_world.transform_point3(c))
 }
 
 /// The top level's leaves, as the statistics see them: how many instances each holds.

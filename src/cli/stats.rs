@@ -97,7 +97,7 @@ fn format_two_level(
         "                {} nodes ({} leaves), depth max {}, SAH cost {:.3}",
         top.nodes, top.leaves, top.max_depth, top.sah_cost
     );
-    let b = t.bottom_params();
+    let b = &t.bottom_params;
     let _ = writeln!(
         o,
         "bottom level    {}, {} layout (max leaf size {}, {} SAH bins)",

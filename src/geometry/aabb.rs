@@ -63,6 +63,17 @@ impl Aabb {
     }
 
     #[inline]
+    /// The eight corners; corner k takes x from `max` if bit 0 of k is set, y if bit 1, z if bit 2.
+    pub fn corners(&self) -> [Vec3; 8] {
+        std::array::from_fn(|k| {
+            Vec3::new(
+                if k & 1 == 0 { self.min.x } else { self.max.x },
+                if k & 2 == 0 { self.min.y } else { self.max.y },
+                if k & 4 == 0 { self.min.z } else { self.max.z },
+            )
+        })
+    }
+
     pub fn center(&self) -> Vec3 {
         (self.min + self.max) * 0.5
     }

@@ -89,18 +89,23 @@ pub struct RaySummary {
     pub mean_box_tests: f64,
     pub mean_triangle_tests: f64,
     pub max_triangle_tests: u32,
+    /// Two-level BVH: top-level nodes visited and instances entered per ray (0 for one BVH).
+    pub mean_top_nodes_visited: f64,
+    pub mean_instances_entered: f64,
 }
 
 impl Frame {
     pub fn ray_summary(&self) -> RaySummary {
         let mut s = RaySummary::default();
-        let (mut nodes, mut boxes, mut tris) = (0u64, 0u64, 0u64);
+        let (mut nodes, mut boxes, mut tris, mut top, mut inst) = (0u64, 0u64, 0u64, 0u64, 0u64);
         for p in self.traced() {
             s.rays += 1;
             s.hits += p.is_hit() as u64;
             nodes += p.counters.nodes_visited as u64;
             boxes += p.counters.box_tests as u64;
             tris += p.counters.triangle_tests as u64;
+            top += p.counters.top_nodes_visited as u64;
+            inst += p.counters.instances_entered as u64;
             s.max_nodes_visited = s.max_nodes_visited.max(p.counters.nodes_visited);
             s.max_triangle_tests = s.max_triangle_tests.max(p.counters.triangle_tests);
         }
@@ -108,6 +113,8 @@ impl Frame {
         s.mean_nodes_visited = nodes as f64 / n;
         s.mean_box_tests = boxes as f64 / n;
         s.mean_triangle_tests = tris as f64 / n;
+        s.mean_top_nodes_visited = top as f64 / n;
+        s.mean_instances_entered = inst as f64 / n;
         s
     }
 }

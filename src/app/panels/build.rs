@@ -7,7 +7,30 @@ use crate::geometry::TriangleTest;
 
 pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("Build");
+    let has_instances = app.has_instances();
+    let placements = app.scene.instances.as_ref().map_or(0, |i| i.placements.len());
+    let meshes = app.scene.instances.as_ref().map_or(0, |i| i.meshes.len());
     let s = &mut app.settings;
+    if has_instances {
+        ui.checkbox(&mut s.two_level, format!("Two levels: {placements} placements of {meshes} meshes"))
+            .on_hover_text("A top-level BVH over the scene's mesh placements, and one BVH per mesh built once however often it is placed. Off: one BVH over the whole scene flattened.");
+        if s.two_level {
+            ui.horizontal(|ui| {
+                let label = ui.label("Top level");
+                egui::ComboBox::from_id_salt("top-strategy")
+                    .selected_text(s.top_build.strategy.label())
+                    .show_ui(ui, |ui| {
+                        for k in SplitStrategy::ALL {
+                            ui.selectable_value(&mut s.top_build.strategy, k, k.label()).on_hover_text(k.description());
+                        }
+                    })
+                    .response
+                    .labelled_by(label.id);
+            });
+            ui.add(egui::Slider::new(&mut s.top_build.max_leaf_size, 1..=16).text("Placements per leaf"));
+            ui.label("Bottom level (each mesh's BVH)");
+        }
+    }
     let label = ui.label("Split strategy");
     egui::ComboBox::from_id_salt("strategy")
         .selected_text(s.build.strategy.label())
