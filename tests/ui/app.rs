@@ -2,7 +2,7 @@
 //! Built by the `ui-tests` package (see its Cargo.toml); snapshots live in `tests/snapshots/`.
 
 use bvhscope::app::{AppOptions, BvhscopeApp, MessageKind, SceneSource};
-use bvhscope::bvh::{SplitStrategy, TreeView};
+use bvhscope::bvh::SplitStrategy;
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -75,7 +75,7 @@ fn choosing_another_strategy_rebuilds_and_changes_the_node_count() {
     h.run_steps(3);
     h.get_by_label("Midpoint").click();
     run_until(&mut h, "the midpoint build", |a| {
-        a.current_bvh().is_some_and(|b| b.bvh.params().strategy == SplitStrategy::Midpoint) && idle(a)
+        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint) && idle(a)
     });
     let after = h.state().current_bvh().unwrap().stats.nodes;
     assert_ne!(before, after, "midpoint and SAH trees differ in size here");
@@ -104,7 +104,7 @@ fn switching_back_before_a_build_finishes_cancels_it() {
         std::thread::sleep(Duration::from_millis(5));
     }
     let b = h.state().current_bvh().unwrap();
-    assert_eq!(b.bvh.params().strategy, SplitStrategy::SahBinned);
+    assert_eq!(b.bvh.build_params().bvh.strategy, SplitStrategy::SahBinned);
     assert_eq!(b.stats.nodes, sah_nodes);
     assert!(h.state().previous.is_none(), "no strategy the user did not keep appears as 'before'");
 }
@@ -237,6 +237,74 @@ fn a_scene_file_brings_its_camera_and_settings_and_can_be_saved_back() {
     assert_eq!(back.mesh.triangle_count(), 8);
     assert_eq!(back.build.unwrap().strategy, SplitStrategy::Midpoint);
     assert!((back.camera.unwrap().position - cam.position).length() < 1e-4);
+}
+
+#[test]
+fn a_scene_with_placements_builds_two_levels_shown_level_by_level() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    assert!(h.query_by_label("Top-level nodes visited").is_none(), "no levels for one mesh");
+    let tent = temp_file(
+        "levels-tent.obj",
+        "v -1 0 -1\nv 1 0 -1\nv 0 1 0\nv -1 0 1\nv 1 0 1\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n",
+    );
+    let placements: Vec<String> = (0..6)
+        .map(|i| {
+            format!(
+                r#"{{"file": "{}", "transform": {{"translate": [{}, 0, {}]}}}}"#,
+                tent.display(),
+                (i % 3) * 3,
+                (i / 3) * 3
+            )
+        })
+        .collect();
+    let scene = temp_file(
+        "levels.json",
+        &format!(
+            r#"{{"note": "six tents", "camera": {{"position": [3, 6, 12], "look_at": [3, 0, 1.5], "size": [320, 200]}},
+                "meshes": [{}]}}"#,
+            placements.join(",")
+        ),
+    );
+    h.input_mut().dropped_files.push(Arc::new(Dropped(scene)));
+    let two_level = |a: &BvhscopeApp| a.current_bvh().is_some_and(|b| b.bvh.two_level().is_some());
+    run_until(&mut h, "the two-level build", |a| a.scene.report.triangles == 24 && two_level(a) && idle(a));
+    h.get_by_label("Two levels: 6 placements of 1 meshes");
+    h.get_by_label("six tents");
+    {
+        let t = h.state().current_bvh().unwrap().bvh.two_level().unwrap();
+        assert_eq!((t.instances.len(), t.bottom.len()), (6, 1), "the tent's BVH is built once");
+    }
+
+    // The top level's own heatmap.
+    h.get_by_label("Top-level nodes visited").click_accesskit();
+    run_until(&mut h, "the top-level heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+    h.get_by_label_contains("Legend: top-level nodes visited per ray");
+    let rays = h.state().rays.expect("per-ray figures");
+    assert!(rays.mean_top_nodes_visited > 0.0 && rays.mean_instances_entered > 0.0);
+
+    // Boxes (their controls are below the fold of the left panel, so accessibility actions click
+    // them): the top level alone at depth 0 is its root; the bottom level adds a root per tent.
+    h.get_by_label("Show node boxes").click_accesskit();
+    h.step();
+    h.get_by_label("Top level").click_accesskit();
+    h.step();
+    h.get_by_role_and_label(Role::Slider, "Top-level depth").set_value_accesskit(0.0);
+    h.get_by_role_and_label(Role::Slider, "Bottom-level depth").set_value_accesskit(0.0);
+    h.step();
+    h.step();
+    assert_eq!(h.state().settings.box_level, bvhscope::app::BoxLevel::Top);
+    assert_eq!(h.state().boxes_drawn, 1);
+    h.get_by_label("Both").click_accesskit();
+    h.step();
+    h.step();
+    assert_eq!(h.state().boxes_drawn, 1 + 6, "the top root and each placement's mesh root");
+
+    // One level again: the scene flattened into one BVH, and no per-level views.
+    h.get_by_label("Two levels: 6 placements of 1 meshes").click();
+    run_until(&mut h, "the single-level build", |a| !two_level(a) && a.current_bvh().is_some() && idle(a));
+    assert!(h.query_by_label("Top-level nodes visited").is_none());
+    assert_eq!(h.state().settings.view, bvhscope::render::View::Visits);
 }
 
 #[test]

@@ -16,7 +16,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             .on_hover_text("A top-level BVH over the scene's mesh placements, and one BVH per mesh built once however often it is placed. Off: one BVH over the whole scene flattened.");
         if s.two_level {
             ui.horizontal(|ui| {
-                let label = ui.label("Top level");
+                let label = ui.label("Top-level strategy");
                 egui::ComboBox::from_id_salt("top-strategy")
                     .selected_text(s.top_build.strategy.label())
                     .show_ui(ui, |ui| {
