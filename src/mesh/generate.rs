@@ -1,6 +1,6 @@
 //! Meshes made by code: the app's built-in scene and the small assets in `assets/`.
 
-use super::Mesh;
+use super::{Mesh, MeshGroup};
 use glam::{Vec2, Vec3};
 use std::f32::consts::TAU;
 
@@ -36,7 +36,7 @@ fn tube(name: &str, curve: impl Fn(f32) -> Vec3, radius: f32, segments: u32, sid
         }
     }
     let n = m.triangles.len() as u32;
-    m.groups.push(super::MeshGroup { name: name.to_string(), triangles: 0..n });
+    m.groups.push(MeshGroup { name: name.to_string(), triangles: 0..n });
     m
 }
 
@@ -68,6 +68,30 @@ pub fn builtin_scene() -> Mesh {
     m
 }
 
+/// A stadium: an open ring of large wall quads around a wide floor disk, 200 units across — the
+/// huge, sparse half of "teapot in a stadium" (the benchmark and `scenes/teapot-in-stadium.json`).
+pub fn stadium() -> Mesh {
+    let mut m = Mesh { name: "stadium".into(), ..Default::default() };
+    let (r, h, n) = (100.0f32, 30.0f32, 128u32);
+    m.positions.push(Vec3::ZERO);
+    for i in 0..n {
+        let a = i as f32 / n as f32 * TAU;
+        let (x, z) = (a.cos() * r, a.sin() * r);
+        m.positions.push(Vec3::new(x, 0.0, z));
+        m.positions.push(Vec3::new(x * 1.2, h, z * 1.2));
+    }
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (b0, t0, b1, t1) = (1 + 2 * i, 2 + 2 * i, 1 + 2 * j, 2 + 2 * j);
+        m.triangles.push([0, b1, b0]); // floor
+        m.triangles.push([b0, b1, t1]); // stands
+        m.triangles.push([b0, t1, t0]);
+    }
+    let t = m.triangles.len() as u32;
+    m.groups.push(MeshGroup { name: "stadium".into(), triangles: 0..t });
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -89,6 +113,40 @@ mod tests {
         for (p, n) in m.positions.iter().zip(&m.normals) {
             let ring = Vec3::new(p.x, 0.0, p.z).normalize() * 2.0;
             assert!((*p - ring).normalize().dot(*n) > 0.999, "normal points away from the ring");
+        }
+    }
+
+    /// Every triangle has a positive area and finite corners.
+    fn assert_no_degenerate(m: &Mesh) {
+        for (i, t) in m.triangles.iter().enumerate() {
+            let tri = t.map(|v| m.positions[v as usize]);
+            assert!(tri.iter().all(|p| p.is_finite()), "{}: triangle {i} is not finite", m.name);
+            assert!(triangle_double_area(&tri) > 1e-6, "{}: triangle {i} is degenerate: {tri:?}", m.name);
+        }
+    }
+
+    fn normal(m: &Mesh, t: &[u32; 3]) -> Vec3 {
+        let [a, b, c] = t.map(|v| m.positions[v as usize]);
+        (b - a).cross(c - a).normalize()
+    }
+
+    #[test]
+    fn stadium_is_a_floor_and_stands_200_units_across() {
+        let m = stadium();
+        assert_eq!(m.triangle_count(), 3 * 128);
+        assert_no_degenerate(&m);
+        let b = m.bounds();
+        assert!((b.min - Vec3::new(-120.0, 0.0, -120.0)).abs().max_element() < 0.1, "{b:?}");
+        assert!((b.max - Vec3::new(120.0, 30.0, 120.0)).abs().max_element() < 0.1, "{b:?}");
+        // The floor faces up, the stands face the middle.
+        for (i, t) in m.triangles.iter().enumerate() {
+            let n = normal(&m, t);
+            let centroid = t.iter().map(|&v| m.positions[v as usize]).sum::<Vec3>() / 3.0;
+            if i % 3 == 0 {
+                assert!(n.y > 0.999, "floor triangle {i}: {n}");
+            } else {
+                assert!(n.dot(-Vec3::new(centroid.x, 0.0, centroid.z)) > 0.0, "stand triangle {i}: {n}");
+            }
         }
     }
 
