@@ -92,6 +92,113 @@ pub fn stadium() -> Mesh {
     m
 }
 
+/// Adds a quad `a b c d` (counter-clockwise seen from the side it faces) as two triangles.
+fn push_quad(m: &mut Mesh, [a, b, c, d]: [Vec3; 4]) {
+    let i = m.positions.len() as u32;
+    m.positions.extend([a, b, c, d]);
+    m.triangles.push([i, i + 1, i + 2]);
+    m.triangles.push([i, i + 2, i + 3]);
+}
+
+/// Closes the group of the triangles added since the last group.
+fn end_group(m: &mut Mesh, name: &str) {
+    let start = m.groups.last().map_or(0, |g| g.triangles.end);
+    m.groups.push(MeshGroup { name: name.to_string(), triangles: start..m.triangles.len() as u32 });
+}
+
+/// A closed box standing on the floor (y = 0): `size` wide, high and deep, turned `degrees` about
+/// its vertical axis, centred on (`x`, `z`). Faces point outwards.
+fn push_block(m: &mut Mesh, x: f32, z: f32, size: Vec3, degrees: f32) {
+    let rot = glam::Quat::from_rotation_y(degrees.to_radians());
+    let h = size * 0.5;
+    // Corner i takes its x side from bit 0, y from bit 1, z from bit 2.
+    let sign = |i: usize, bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
+    let c =
+        |i: usize| rot * Vec3::new(sign(i, 1) * h.x, 0.0, sign(i, 4) * h.z) + Vec3::new(x, (sign(i, 2) + 1.0) * h.y, z);
+    // Each face counter-clockwise seen from outside: -x, +x, -y, +y, -z, +z.
+    for f in [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]] {
+        push_quad(m, f.map(c));
+    }
+}
+
+/// The Cornell box (after Cornell University's classic test scene): a room 5.5 units on a side,
+/// open towards +z, with a short and a tall block turned as in the original. x runs from -2.75
+/// (left wall) to 2.75 (right wall), y from 0 (floor) to 5.5, z from -2.75 (back wall) to 2.75.
+/// Walls face into the room; every part is its own group. Flat walls make flat node boxes, and the
+/// turned blocks fit their axis-aligned boxes loosely.
+pub fn cornell_box() -> Mesh {
+    let mut m = Mesh { name: "cornell box".into(), ..Default::default() };
+    let (s, top) = (2.75f32, 5.5f32);
+    let p = Vec3::new;
+    push_quad(&mut m, [p(-s, 0.0, -s), p(-s, 0.0, s), p(s, 0.0, s), p(s, 0.0, -s)]);
+    end_group(&mut m, "floor");
+    push_quad(&mut m, [p(-s, top, -s), p(s, top, -s), p(s, top, s), p(-s, top, s)]);
+    end_group(&mut m, "ceiling");
+    push_quad(&mut m, [p(-s, 0.0, -s), p(s, 0.0, -s), p(s, top, -s), p(-s, top, -s)]);
+    end_group(&mut m, "back_wall");
+    push_quad(&mut m, [p(-s, 0.0, -s), p(-s, top, -s), p(-s, top, s), p(-s, 0.0, s)]);
+    end_group(&mut m, "left_wall");
+    push_quad(&mut m, [p(s, 0.0, -s), p(s, 0.0, s), p(s, top, s), p(s, top, -s)]);
+    end_group(&mut m, "right_wall");
+    // Placed and turned as the blocks of the original (front right and back left, about ±17°).
+    push_block(&mut m, 0.93, 1.06, Vec3::new(1.65, 1.65, 1.65), -17.0);
+    end_group(&mut m, "short_block");
+    push_block(&mut m, -0.9, -0.76, Vec3::new(1.65, 3.3, 1.65), 17.0);
+    end_group(&mut m, "tall_block");
+    m
+}
+
+/// A bundle of long thin rods (hexagonal lattice, `rings` rings around the middle one, each rod a
+/// closed `sides`-gon prism) laid along the (1, 1, 1) diagonal and centred on the origin. Every
+/// side triangle is a sliver spanning its rod's full `length`, so its axis-aligned box is nearly
+/// the whole scene's and all boxes overlap: the case where axis-aligned BVHs struggle.
+pub fn diagonal_rods(rings: u32, sides: u32, length: f32, radius: f32, spacing: f32) -> Mesh {
+    let sides = sides.max(3);
+    let mut m = Mesh { name: "diagonal rods".into(), ..Default::default() };
+    let axis = Vec3::ONE.normalize();
+    let u = Vec3::new(1.0, -1.0, 0.0).normalize();
+    let v = axis.cross(u);
+    let r = rings as i32;
+    for q in -r..=r {
+        for s in (-r).max(-q - r)..=r.min(-q + r) {
+            let centre = (u * (q as f32 + s as f32 * 0.5) + v * (s as f32 * 0.75f32.sqrt())) * spacing;
+            // Rods are staggered a little along the axis so their ends do not line up.
+            let shift = ((q * 7 + s * 13).rem_euclid(5) - 2) as f32 * 0.02 * length;
+            let ends = [-0.5, 0.5].map(|e| centre + axis * (e * length + shift));
+            let base = m.positions.len() as u32;
+            for end in ends {
+                for j in 0..sides {
+                    let phi = j as f32 / sides as f32 * TAU;
+                    m.positions.push(end + (u * phi.cos() + v * phi.sin()) * radius);
+                }
+            }
+            let (lo, hi) = (base, base + sides);
+            for j in 0..sides {
+                let j1 = (j + 1) % sides;
+                m.triangles.push([lo + j, lo + j1, hi + j1]);
+                m.triangles.push([lo + j, hi + j1, hi + j]);
+            }
+            for j in 1..sides - 1 {
+                m.triangles.push([lo, lo + j + 1, lo + j]);
+                m.triangles.push([hi, hi + j, hi + j + 1]);
+            }
+        }
+    }
+    end_group(&mut m, "diagonal_rods");
+    m
+}
+
+/// The meshes shipped in `assets/` (file name, mesh), written by `cargo run --example make_assets`
+/// and checked against the files by `tests/shipped_scenes.rs`.
+pub fn assets() -> Vec<(&'static str, Mesh)> {
+    vec![
+        ("torus.obj", torus(1.0, 0.35, 48, 24)),
+        ("cornell-box.obj", cornell_box()),
+        ("stadium.obj", stadium()),
+        ("diagonal-rods.obj", diagonal_rods(8, 6, 10.0, 0.03, 0.2)),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -125,6 +232,30 @@ mod tests {
         }
     }
 
+    /// Closed and consistently wound, matching corners by position (the generators do not share
+    /// vertices between faces): every directed edge a→b is met once, and b→a once.
+    fn is_closed(m: &Mesh, triangles: &[[u32; 3]]) -> bool {
+        let key = |v: u32| m.positions[v as usize].to_array().map(f32::to_bits);
+        let mut edges = std::collections::HashMap::new();
+        for t in triangles {
+            for k in 0..3 {
+                *edges.entry((key(t[k]), key(t[(k + 1) % 3]))).or_insert(0) += 1;
+            }
+        }
+        edges.iter().all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
+    }
+
+    /// The volume enclosed by closed triangles (positive when they face outwards).
+    fn signed_volume(m: &Mesh, triangles: &[[u32; 3]]) -> f64 {
+        let p = |v: u32| m.positions[v as usize].as_dvec3();
+        triangles.iter().map(|t| p(t[0]).dot(p(t[1]).cross(p(t[2]))) / 6.0).sum()
+    }
+
+    fn group<'m>(m: &'m Mesh, name: &str) -> &'m [[u32; 3]] {
+        let g = m.groups.iter().find(|g| g.name == name).unwrap_or_else(|| panic!("no group {name}"));
+        &m.triangles[g.triangles.start as usize..g.triangles.end as usize]
+    }
+
     fn normal(m: &Mesh, t: &[u32; 3]) -> Vec3 {
         let [a, b, c] = t.map(|v| m.positions[v as usize]);
         (b - a).cross(c - a).normalize()
@@ -148,6 +279,81 @@ mod tests {
                 assert!(n.dot(-Vec3::new(centroid.x, 0.0, centroid.z)) > 0.0, "stand triangle {i}: {n}");
             }
         }
+    }
+
+    #[test]
+    fn cornell_box_has_its_walls_and_two_closed_blocks() {
+        let m = cornell_box();
+        let names: Vec<&str> = m.groups.iter().map(|g| g.name.as_str()).collect();
+        assert_eq!(names, ["floor", "ceiling", "back_wall", "left_wall", "right_wall", "short_block", "tall_block"]);
+        assert_eq!(m.triangle_count(), 5 * 2 + 2 * 12);
+        assert_eq!(m.groups.last().unwrap().triangles.end as usize, m.triangle_count());
+        assert_no_degenerate(&m);
+        let b = m.bounds();
+        assert_eq!((b.min, b.max), (Vec3::new(-2.75, 0.0, -2.75), Vec3::new(2.75, 5.5, 2.75)));
+        // Walls face into the room.
+        let middle = Vec3::new(0.0, 2.75, 0.0);
+        for wall in ["floor", "ceiling", "back_wall", "left_wall", "right_wall"] {
+            for t in group(&m, wall) {
+                let n = normal(&m, t);
+                let p = m.positions[t[0] as usize];
+                assert!(n.dot(middle - p) > 0.0, "{wall} faces away from the room");
+                assert!(n.abs().max_element() > 0.9999, "{wall} is axis-aligned");
+            }
+        }
+        for (block, height) in [("short_block", 1.65), ("tall_block", 3.3)] {
+            let tris = group(&m, block);
+            assert!(is_closed(&m, tris), "{block} is closed");
+            let expect = 1.65 * 1.65 * height;
+            assert!((signed_volume(&m, tris) - expect).abs() < 1e-4 * expect, "{block} faces outwards");
+            let top = tris.iter().flatten().map(|&v| m.positions[v as usize].y).fold(0.0, f32::max);
+            assert!((top - height as f32).abs() < 1e-5, "{block} is {top} high");
+            // Turned: no face is axis-aligned except top and bottom.
+            assert!(tris.iter().map(|t| normal(&m, t)).all(|n| n.y.abs() > 0.999 || n.x.abs() > 0.1));
+        }
+    }
+
+    #[test]
+    fn diagonal_rods_are_closed_slivers_along_the_diagonal() {
+        let (rings, sides, length, radius) = (2, 5, 10.0, 0.05);
+        let m = diagonal_rods(rings, sides, length, radius, 0.3);
+        let rods = 1 + 3 * rings * (rings + 1);
+        let per_rod = 2 * sides + 2 * (sides - 2);
+        assert_eq!(m.triangle_count() as u32, rods * per_rod);
+        assert_eq!(m.positions.len() as u32, rods * 2 * sides);
+        assert_no_degenerate(&m);
+        // Each rod is a closed prism with outward faces.
+        let prism = 0.5 * sides as f64 * (radius as f64).powi(2) * (TAU as f64 / sides as f64).sin() * length as f64;
+        for rod in m.triangles.chunks(per_rod as usize) {
+            assert!(is_closed(&m, rod));
+            assert!((signed_volume(&m, rod) - prism).abs() < 1e-3 * prism);
+        }
+        // Side triangles span the rod's full length: their boxes are long on every axis.
+        let along = length / 3f32.sqrt();
+        for rod in m.triangles.chunks(per_rod as usize) {
+            for t in &rod[..2 * sides as usize] {
+                let tri = t.map(|v| m.positions[v as usize]);
+                let extent = crate::geometry::Aabb::EMPTY.grow(tri[0]).grow(tri[1]).grow(tri[2]).extent();
+                assert!(extent.min_element() > 0.95 * along, "{extent}");
+            }
+        }
+        // Centred on the origin, laid along (1, 1, 1).
+        let b = m.bounds();
+        assert!((b.min + b.max).abs().max_element() < 0.2 * along, "{b:?}");
+        assert!(b.extent().min_element() > along);
+    }
+
+    #[test]
+    fn assets_are_named_and_sound() {
+        let assets = assets();
+        let names: Vec<&str> = assets.iter().map(|(n, _)| *n).collect();
+        assert_eq!(names, ["torus.obj", "cornell-box.obj", "stadium.obj", "diagonal-rods.obj"]);
+        for (name, m) in &assets {
+            assert!(m.triangle_count() > 0, "{name}");
+            assert_no_degenerate(m);
+        }
+        let torus = &assets[0].1;
+        assert_eq!(torus.normals.len(), torus.positions.len(), "the torus has normals");
     }
 
     #[test]
