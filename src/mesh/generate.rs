@@ -68,9 +68,9 @@ pub fn builtin_scene() -> Mesh {
     m
 }
 
-/// A stadium: an open ring of large wall quads around a wide floor disk, 200 units across — the
-/// huge, sparse half of "teapot in a stadium" (the benchmark and `scenes/teapot-in-stadium.json`).
+/// A floor disk and a ring of stands 240 units across: the huge sparse half of "teapot in a stadium".
 pub fn stadium() -> Mesh {
+    // Used by the benchmark and by scenes/teapot-in-stadium.json (as assets/stadium.obj).
     let mut m = Mesh { name: "stadium".into(), ..Default::default() };
     let (r, h, n) = (100.0f32, 30.0f32, 128u32);
     m.positions.push(Vec3::ZERO);
@@ -121,12 +121,11 @@ fn push_block(m: &mut Mesh, x: f32, z: f32, size: Vec3, degrees: f32) {
     }
 }
 
-/// The Cornell box (after Cornell University's classic test scene): a room 5.5 units on a side,
-/// open towards +z, with a short and a tall block turned as in the original. x runs from -2.75
-/// (left wall) to 2.75 (right wall), y from 0 (floor) to 5.5, z from -2.75 (back wall) to 2.75.
-/// Walls face into the room; every part is its own group. Flat walls make flat node boxes, and the
-/// turned blocks fit their axis-aligned boxes loosely.
+/// The classic Cornell box room with its two turned blocks: flat walls give flat node boxes.
 pub fn cornell_box() -> Mesh {
+    // 5.5 units on a side, open towards +z: x from -2.75 (left wall) to 2.75 (right wall), y from 0
+    // (floor) to 5.5, z from -2.75 (back wall) to 2.75. Walls face into the room; each part is a
+    // group.
     let mut m = Mesh { name: "cornell box".into(), ..Default::default() };
     let (s, top) = (2.75f32, 5.5f32);
     let p = Vec3::new;
@@ -148,11 +147,11 @@ pub fn cornell_box() -> Mesh {
     m
 }
 
-/// A bundle of long thin rods (hexagonal lattice, `rings` rings around the middle one, each rod a
-/// closed `sides`-gon prism) laid along the (1, 1, 1) diagonal and centred on the origin. Every
-/// side triangle is a sliver spanning its rod's full `length`, so its axis-aligned box is nearly
-/// the whole scene's and all boxes overlap: the case where axis-aligned BVHs struggle.
+/// Long thin rods along the (1, 1, 1) diagonal, all sliver triangles: the case where axis-aligned BVHs struggle.
 pub fn diagonal_rods(rings: u32, sides: u32, length: f32, radius: f32, spacing: f32) -> Mesh {
+    // Rods on a hexagonal lattice (`rings` rings around the middle one, `spacing` apart), each a
+    // closed `sides`-gon prism of `radius`, centred on the origin. Every side triangle spans its
+    // rod's full `length`, so its axis-aligned box is nearly the whole scene's and all boxes overlap.
     let sides = sides.max(3);
     let mut m = Mesh { name: "diagonal rods".into(), ..Default::default() };
     let axis = Vec3::ONE.normalize();
@@ -188,8 +187,7 @@ pub fn diagonal_rods(rings: u32, sides: u32, length: f32, radius: f32, spacing: 
     m
 }
 
-/// The meshes shipped in `assets/` (file name, mesh), written by `cargo run --example make_assets`
-/// and checked against the files by `tests/shipped_scenes.rs`.
+/// The meshes in `assets/` (file name, mesh) for the scenes; `cargo run --example make_assets` writes them.
 pub fn assets() -> Vec<(&'static str, Mesh)> {
     vec![
         ("torus.obj", torus(1.0, 0.35, 48, 24)),
