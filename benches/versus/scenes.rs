@@ -15,33 +15,10 @@ pub fn merge(a: &mut Mesh, b: &Mesh, transform: impl Fn(Vec3) -> Vec3) {
     a.groups.push(MeshGroup { name: b.name.clone(), triangles: first..a.triangles.len() as u32 });
 }
 
-/// A stadium: an open ring of large wall quads around a wide floor disk, 200 units across.
-fn stadium() -> Mesh {
-    let mut m = Mesh { name: "stadium".into(), ..Default::default() };
-    let (r, h, n) = (100.0f32, 30.0f32, 128u32);
-    m.positions.push(Vec3::ZERO);
-    for i in 0..n {
-        let a = i as f32 / n as f32 * std::f32::consts::TAU;
-        let (x, z) = (a.cos() * r, a.sin() * r);
-        m.positions.push(Vec3::new(x, 0.0, z));
-        m.positions.push(Vec3::new(x * 1.2, h, z * 1.2));
-    }
-    for i in 0..n {
-        let j = (i + 1) % n;
-        let (b0, t0, b1, t1) = (1 + 2 * i, 2 + 2 * i, 1 + 2 * j, 2 + 2 * j);
-        m.triangles.push([0, b1, b0]); // floor
-        m.triangles.push([b0, b1, t1]); // stands
-        m.triangles.push([b0, t1, t0]);
-    }
-    let t = m.triangles.len() as u32;
-    m.groups.push(MeshGroup { name: "stadium".into(), triangles: 0..t });
-    m
-}
-
 /// "Teapot in a stadium": a small dense mesh at the centre of a huge sparse one — the classic case
 /// where spatial-median splits waste levels on empty space.
 pub fn teapot_in_stadium() -> Mesh {
-    let mut m = stadium();
+    let mut m = generate::stadium();
     let knot = generate::torus_knot(2, 3, 0.22, 1024, 32); // ~65k triangles, ~2 units across
     merge(&mut m, &knot, |p| p + Vec3::new(0.0, 1.5, 0.0));
     m.name = "teapot in a stadium".into();
