@@ -1,15 +1,16 @@
 //! The ready-made scenes in `scenes/` and the generated meshes in `assets/` they use. Every scene
 //! file in the folder is checked (a new one is covered without touching this file): it loads,
 //! builds with every strategy in both layouts, and a small render from its camera hits the same
-//! pixels as the linear scan. The committed assets must be exactly what the generators write, and
+//! pixels as the linear scan, and as the two-level BVH over its placements. The committed assets must be exactly what the generators write, and
 //! a scene whose mesh is missing must say which field and where to get the mesh.
 
 mod common;
 
-use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy};
+use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy, TwoLevelBvh};
 use bvhscope::mesh::{generate, write_obj};
 use bvhscope::render::{render, Camera, RenderSettings};
 use bvhscope::scene::{describe, load_any, SceneError};
+use bvhscope::work::WorkControl;
 use std::path::{Component, Path, PathBuf};
 
 fn root() -> &'static Path {
@@ -111,6 +112,25 @@ fn every_scene_builds_everywhere_and_hits_what_the_linear_scan_hits() {
                 let differ = mask.iter().zip(&reference).filter(|(a, b)| a != b).count();
                 assert_eq!(differ, 0, "{n}, {strategy:?} {layout:?}: {differ} pixels differ from the linear scan");
             }
+            // Two levels (this strategy on both) against the flattened scene's single BVH.
+            let inst = loaded.instances.as_ref().expect("a scene gives its placements");
+            let p = BuildParams { strategy, ..base };
+            let two = TwoLevelBvh::build(&inst.mesh_refs(), &inst.placements, &p, &p, &WorkControl::new()).unwrap();
+            let (a, b) =
+                (render(&two, mesh, &camera, &settings), render(&AnyBvh::build(mesh, &p), mesh, &camera, &settings));
+            let mut differ = 0;
+            for (x, y) in a.samples.iter().zip(&b.samples) {
+                if x.is_hit() != y.is_hit() {
+                    differ += 1;
+                } else if x.is_hit() {
+                    assert!((x.t - y.t).abs() <= 1e-4 * y.t, "{n}, {strategy:?}: two levels t {} vs one {}", x.t, y.t);
+                }
+            }
+            // Rotated placements round differently in object space: allow a grazing ray in 1000.
+            assert!(
+                differ * 1000 <= a.samples.len(),
+                "{n}, {strategy:?}: {differ} pixels differ between two levels and one"
+            );
         }
     }
 }
