@@ -15,11 +15,10 @@ mod viewport;
 pub use jobs::Pick;
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
-pub use scene::{Scene, SceneSource};
+pub use scene::{BuiltBvh, Scene, SceneSource};
 pub use settings::{BoxLevel, Settings};
 
-use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TreeStats, TreeView};
-use crate::geometry::Aabb;
+use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TreeStats};
 use crate::render::{Camera, ColorMap, Frame, Legend, RaySummary, View};
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
 use std::path::PathBuf;
@@ -66,26 +65,6 @@ pub struct Shown {
     pub style: ViewStyle,
     /// Rays per second of the last pass.
     pub rays_per_s: f64,
-}
-
-/// The BVH of the current scene.
-pub struct BuiltBvh {
-    pub bvh: Arc<SceneBvh>,
-    /// Of the single BVH, or of the top level of two.
-    pub stats: TreeStats,
-    /// Two levels: each mesh's name and its BVH's statistics.
-    pub bottom: Vec<(String, TreeStats)>,
-    pub scene_id: u64,
-}
-
-impl BuiltBvh {
-    /// Deepest level of the bottom BVHs (or of the single BVH): the box depth slider's end.
-    pub fn bottom_max_depth(&self) -> u32 {
-        match self.bvh.two_level() {
-            Some(_) => self.bottom.iter().map(|(_, s)| s.max_depth).max().unwrap_or(0),
-            None => self.stats.max_depth,
-        }
-    }
 }
 
 /// One strategy's figures for the statistics panel (the current one and the one before).
@@ -295,24 +274,7 @@ impl BvhscopeApp {
         let fresh = self.box_cache.as_ref().is_some_and(|c| Arc::ptr_eq(&c.bvh, &bvh) && c.key == key);
         if !fresh {
             let (level, top_depth, depth, leaves_above) = key;
-            let world = |top: bool| move |(id, b): (usize, Aabb)| OverlayBox { top, ..OverlayBox::world(id, &b) };
-            let boxes = match bvh.two_level() {
-                None => bvh.tree().boxes_at_depth(depth, leaves_above).into_iter().map(world(false)).collect(),
-                Some(t) => {
-                    let mut v: Vec<OverlayBox> = Vec::new();
-                    if level.shows_bottom() {
-                        v.extend(t.bottom_boxes_at_depth(depth, leaves_above).into_iter().map(|b| OverlayBox {
-                            id: b.id,
-                            corners: crate::bvh::two_level::placed_corners(&b.bounds, &b.to_world),
-                            top: false,
-                        }));
-                    }
-                    if level.shows_top() {
-                        v.extend(t.top.boxes_at_depth(top_depth, leaves_above).into_iter().map(world(true)));
-                    }
-                    v
-                }
-            };
+            let boxes = overlay::boxes_of(&bvh, level, top_depth, depth, leaves_above);
             self.box_cache = Some(BoxCache { bvh, key, boxes: Arc::new(boxes) });
         }
         self.box_cache.as_ref().map(|c| c.boxes.clone())

@@ -2,6 +2,9 @@
 //! projection as the renderer. Edges are clipped against the near plane in camera space before
 //! projection, so a box around or behind the camera draws correctly instead of wrapping around.
 
+use super::settings::BoxLevel;
+use crate::bvh::two_level::placed_corners;
+use crate::bvh::{SceneBvh, TreeView};
 use crate::geometry::Aabb;
 use crate::render::Camera;
 use egui::{Color32, Mesh, Pos2, Rect};
@@ -90,6 +93,27 @@ impl OverlayBox {
     pub fn world(id: usize, b: &Aabb) -> Self {
         Self { id, corners: b.corners(), top: false }
     }
+}
+
+/// The boxes to draw for a built BVH: a single BVH's at `depth`; for two levels the top level's at
+/// `top_depth` and/or each mesh BVH's at `depth` placed by every instance, as `level` says.
+pub fn boxes_of(bvh: &SceneBvh, level: BoxLevel, top_depth: u32, depth: u32, leaves_above: bool) -> Vec<OverlayBox> {
+    let world = |top: bool| move |(id, b): (usize, Aabb)| OverlayBox { top, ..OverlayBox::world(id, &b) };
+    let Some(t) = bvh.two_level() else {
+        return bvh.tree().boxes_at_depth(depth, leaves_above).into_iter().map(world(false)).collect();
+    };
+    let mut v = Vec::new();
+    if level.shows_bottom() {
+        v.extend(t.bottom_boxes_at_depth(depth, leaves_above).into_iter().map(|b| OverlayBox {
+            id: b.id,
+            corners: placed_corners(&b.bounds, &b.to_world),
+            top: false,
+        }));
+    }
+    if level.shows_top() {
+        v.extend(t.top.boxes_at_depth(top_depth, leaves_above).into_iter().map(world(true)));
+    }
+    v
 }
 
 /// A distinct, stable colour per node (golden-ratio hue steps).

@@ -1,6 +1,6 @@
-//! The mesh on screen and where it came from.
+//! The mesh on screen, where it came from, and the BVH built over it.
 
-use crate::bvh::BuildParams;
+use crate::bvh::{BuildParams, SceneBvh, TreeStats};
 use crate::mesh::{generate, LoadReport, Mesh};
 use crate::render::Camera;
 use crate::scene::{Loaded, SceneDesc, SceneInstances};
@@ -67,6 +67,26 @@ impl Scene {
             SceneSource::File(p) => {
                 p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
             }
+        }
+    }
+}
+
+/// The BVH of the current scene.
+pub struct BuiltBvh {
+    pub bvh: Arc<SceneBvh>,
+    /// Of the single BVH, or of the top level of two.
+    pub stats: TreeStats,
+    /// Two levels: each mesh's name and its BVH's statistics.
+    pub bottom: Vec<(String, TreeStats)>,
+    pub scene_id: u64,
+}
+
+impl BuiltBvh {
+    /// Deepest level of the bottom BVHs (or of the single BVH): the box depth slider's end.
+    pub fn bottom_max_depth(&self) -> u32 {
+        match self.bvh.two_level() {
+            Some(_) => self.bottom.iter().map(|(_, s)| s.max_depth).max().unwrap_or(0),
+            None => self.stats.max_depth,
         }
     }
 }
