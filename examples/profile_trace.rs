@@ -76,6 +76,23 @@ fn main() {
         c.leaves_visited as f64 / n,
         c.triangle_tests as f64 / n
     );
+    if std::env::var("PACKET").is_ok() && what == "primary" {
+        // 2×2 pixel blocks of the 1024² frame.
+        let t = Instant::now();
+        let mut hits = 0;
+        for _ in 0..5 {
+            for by in (0..1024).step_by(2) {
+                for bx in (0..1024).step_by(2) {
+                    let idx = [by * 1024 + bx, by * 1024 + bx + 1, (by + 1) * 1024 + bx, (by + 1) * 1024 + bx + 1];
+                    let mut four = idx.map(|i| rays[i]);
+                    let h = bvh.closest_hit4(&mut four, 0b1111, TraceOptions::default());
+                    hits += h.iter().filter(|h| h.is_some()).count();
+                }
+            }
+        }
+        let secs = t.elapsed().as_secs_f64();
+        println!("{what} {layout:?} packets: {:.2} MRays/s, {hits} hits", 5.0 * rays.len() as f64 / secs / 1e6);
+    }
     let t = Instant::now();
     let mut hits = 0;
     for _ in 0..5 {

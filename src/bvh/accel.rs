@@ -1,6 +1,7 @@
 //! The interface shared by every acceleration structure (BVH, linear scan), so the renderer, the
 //! tests and the CLI can swap one for another.
 
+use super::packet::PACKET;
 use super::TraversalStats;
 use crate::geometry::{Ray, TriangleTest};
 
@@ -52,4 +53,17 @@ pub trait Accelerator: Sync {
     fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit>;
     /// Whether anything is hit within the ray's interval (stops at the first hit found).
     fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool;
+
+    /// Closest hits of up to four coherent rays (those whose bit is set in `active`), with the same
+    /// results as `closest_hit` on each. BVHs trace them as one packet (`bvh::packet`); the default
+    /// traces them one by one. Uncounted: heatmaps trace single rays.
+    fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
+        std::array::from_fn(|k| {
+            if active & (1 << k) != 0 {
+                self.closest_hit(&mut rays[k], opts, &mut super::NoStats)
+            } else {
+                None
+            }
+        })
+    }
 }

@@ -1,5 +1,6 @@
 //! A built BVH in either layout behind one type: what the app, the CLI and the tests hold.
 
+use super::packet::PACKET;
 use super::tree::{NodeView, TreeView};
 use super::wide::WideBvh;
 use super::{Accelerator, BuildParams, BuildReport, Bvh, Hit, Layout, TraceOptions, TraversalStats};
@@ -56,6 +57,19 @@ impl Accelerator for AnyBvh {
         match self {
             AnyBvh::Binary(b) => b.any_hit(ray, opts, stats),
             AnyBvh::Wide(w) => w.any_hit(ray, opts, stats),
+        }
+    }
+
+    #[inline]
+    fn closest_hit4(
+        &self,
+        rays: &mut [crate::geometry::Ray; PACKET],
+        active: u8,
+        opts: TraceOptions,
+    ) -> [Option<Hit>; PACKET] {
+        match self {
+            AnyBvh::Binary(b) => Accelerator::closest_hit4(b, rays, active, opts),
+            AnyBvh::Wide(w) => Accelerator::closest_hit4(w, rays, active, opts),
         }
     }
 }

@@ -2,6 +2,7 @@
 //! over the scene's mesh placements. Both give the same triangle ids, so the flattened mesh shades
 //! either.
 
+use super::packet::PACKET;
 use super::tree::TreeView;
 use super::{Accelerator, AnyBvh, BuildParams, Hit, TraceOptions, TraversalStats, TwoLevelBvh};
 use crate::geometry::Ray;
@@ -98,6 +99,14 @@ impl Accelerator for SceneBvh {
         match self {
             SceneBvh::Single(b) => b.any_hit(ray, opts, stats),
             SceneBvh::TwoLevel(t) => t.any_hit(ray, opts, stats),
+        }
+    }
+
+    #[inline]
+    fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
+        match self {
+            SceneBvh::Single(b) => b.closest_hit4(rays, active, opts),
+            SceneBvh::TwoLevel(t) => t.closest_hit4(rays, active, opts),
         }
     }
 }

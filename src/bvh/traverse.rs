@@ -9,6 +9,7 @@
 //! per node. Layout and loop follow pbrt-v4 §7.3.5 ("BVHAggregate::Intersect").
 
 use super::node::{Bvh, TRAVERSAL_STACK_SIZE};
+use super::packet::PACKET;
 use super::stack::TraversalStack;
 use super::{Accelerator, Hit, TraceOptions, TraversalOrder, TraversalStats};
 use crate::geometry::{MollerTrumbore, Ray, TriangleIntersector, TriangleTest, Watertight};
@@ -107,5 +108,9 @@ impl Accelerator for Bvh {
     fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool {
         let mut r = *ray;
         self.dispatch::<true, S>(&mut r, opts, stats).is_some()
+    }
+
+    fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
+        Bvh::closest_hit4(self, rays, active, opts)
     }
 }

@@ -1,10 +1,14 @@
 //! Progressive ray casting: pass 1 traces every 8th pixel in x and y, then every 4th, 2nd, and
 //! finally the rest, each pass tracing only pixels no earlier pass traced, so the full frame costs
 //! one ray per pixel in total. Work is split into bands of 16-pixel-square tiles run on rayon; the
-//! cancel flag is read before each band, and the caller sees the frame after each pass.
+//! cancel flag is read before each band, and the caller sees the frame after each pass. The plain
+//! normal view traces each pass in packets of four rays (2×2 pixels of the pass's grid,
+//! `bvh::packet`); with counters on, every ray is traced alone so each pixel gets its own counts.
 
 use super::{Camera, Frame, PixelSample};
-use crate::bvh::{Accelerator, NoStats, RayCounters, TraceOptions, TraversalStats};
+use crate::bvh::packet::PACKET;
+use crate::bvh::{Accelerator, Hit, NoStats, RayCounters, TraceOptions, TraversalStats};
+use crate::geometry::Ray;
 use crate::mesh::Mesh;
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
@@ -65,7 +69,7 @@ pub fn render_progressive<A: Accelerator>(
         let rays = if settings.count {
             trace_pass::<A, RayCounters>(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
         } else {
-            trace_pass::<A, NoStats>(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
+            trace_pass_packets(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
         };
         control.check()?;
         frame.stride = stride;
@@ -110,20 +114,86 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
                         }
                         let mut ray = gen.pixel_ray(x, y);
                         let mut stats = S::default();
-                        let sample = match accel.closest_hit(&mut ray, trace, &mut stats) {
-                            Some(hit) => {
-                                let si = mesh.fill_intersection(&ray, hit.prim, hit.triangle_hit());
-                                PixelSample {
-                                    t: hit.t,
-                                    normal: si.shading_normal,
-                                    prim: hit.prim,
-                                    counters: stats.into(),
-                                }
-                            }
-                            None => PixelSample { counters: stats.into(), ..PixelSample::MISS },
-                        };
-                        samples[(dy * w + x) as usize] = sample;
+                        let hit = accel.closest_hit(&mut ray, trace, &mut stats);
+                        samples[(dy * w + x) as usize] = sample(mesh, &ray, hit, stats.into());
                         traced += 1;
+                    }
+                }
+            }
+            control.add_done(traced);
+            traced
+        })
+        .sum()
+}
+
+/// The pixel a ray's closest hit (or miss) shows.
+fn sample(mesh: &Mesh, ray: &Ray, hit: Option<Hit>, counters: RayCounters) -> PixelSample {
+    match hit {
+        Some(hit) => {
+            let si = mesh.fill_intersection(ray, hit.prim, hit.triangle_hit());
+            PixelSample { t: hit.t, normal: si.shading_normal, prim: hit.prim, counters }
+        }
+        None => PixelSample { counters, ..PixelSample::MISS },
+    }
+}
+
+/// `trace_pass` without counters, in packets: the pass's pixels grouped in 2×2 blocks of its grid
+/// (every block lies inside one tile, since 2·stride divides the tile size).
+#[allow(clippy::too_many_arguments)]
+fn trace_pass_packets<A: Accelerator>(
+    accel: &A,
+    mesh: &Mesh,
+    camera: &Camera,
+    trace: TraceOptions,
+    frame: &mut Frame,
+    stride: u32,
+    previous: u32,
+    control: &WorkControl,
+) -> u64 {
+    const _: () = assert!(TILE.is_multiple_of(2 * PASS_STRIDES[0]));
+    let gen = camera.ray_gen();
+    let w = frame.width;
+    let band_len = (w * TILE) as usize;
+    frame
+        .samples
+        .par_chunks_mut(band_len)
+        .enumerate()
+        .map(|(band, samples)| {
+            if control.is_cancelled() {
+                return 0;
+            }
+            let y0 = band as u32 * TILE;
+            let rows = (samples.len() / w as usize) as u32;
+            let mut traced = 0u64;
+            for x0 in (0..w).step_by(TILE as usize) {
+                let x_end = (x0 + TILE).min(w);
+                for dy in (0..rows).step_by(2 * stride as usize) {
+                    for x in (x0..x_end).step_by(2 * stride as usize) {
+                        // Lanes: (x, dy), (x + s, dy), (x, dy + s), (x + s, dy + s).
+                        let pixel = |k: usize| (x + stride * (k as u32 & 1), dy + stride * (k as u32 >> 1));
+                        let mut active = 0u8;
+                        for k in 0..PACKET {
+                            let (px, pdy) = pixel(k);
+                            let done_before = previous != 0
+                                && px.is_multiple_of(previous)
+                                && (y0 + pdy).is_multiple_of(previous);
+                            if px < x_end && pdy < rows && !done_before {
+                                active |= 1 << k;
+                            }
+                        }
+                        if active == 0 {
+                            continue;
+                        }
+                        let mut rays = std::array::from_fn(|k| {
+                            let (px, pdy) = pixel(k);
+                            gen.pixel_ray(px.min(w - 1), y0 + pdy.min(rows - 1))
+                        });
+                        let hits = accel.closest_hit4(&mut rays, active, trace);
+                        for k in (0..PACKET).filter(|k| active & (1 << k) != 0) {
+                            let (px, pdy) = pixel(k);
+                            samples[(pdy * w + px) as usize] = sample(mesh, &rays[k], hits[k], RayCounters::default());
+                            traced += 1;
+                        }
                     }
                 }
             }
@@ -187,6 +257,30 @@ mod tests {
         assert_eq!(frame.samples, single.samples);
         assert!(frame.samples.iter().any(|s| s.is_hit()) && frame.samples.iter().any(|s| !s.is_hit()));
         assert!(frame.samples.iter().all(|s| s.counters.box_tests >= 1), "counters recorded");
+    }
+
+    #[test]
+    fn the_plain_view_traced_in_packets_shows_what_single_rays_show() {
+        let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 128, 12);
+        // Odd sizes: packets at the frame's right and bottom edges have inactive lanes.
+        let cam = Camera::framing_from(&mesh.bounds(), 45, 29, Vec3::new(0.3, 0.5, 1.0), 45.0);
+        for layout in crate::bvh::Layout::ALL {
+            let bvh = crate::bvh::AnyBvh::build(&mesh, &BuildParams { layout, ..Default::default() });
+            let mut total = 0;
+            let control = WorkControl::new();
+            let plain = RenderSettings { progressive: true, ..Default::default() };
+            let frame = render_progressive(&bvh, &mesh, &cam, &plain, &control, |_, p| total += p.rays).unwrap();
+            assert_eq!(total, 45 * 29, "{layout:?}: every pixel traced once");
+            assert_eq!(control.done(), 45 * 29);
+            assert_eq!(frame.samples, render(&bvh, &mesh, &cam, &plain).samples, "{layout:?}: passes = one pass");
+            let counted = render(&bvh, &mesh, &cam, &RenderSettings { count: true, ..Default::default() });
+            let hits = frame.samples.iter().filter(|s| s.is_hit()).count();
+            assert!(hits > 100 && hits < 45 * 29, "{layout:?}: {hits} hits");
+            for (i, (p, c)) in frame.samples.iter().zip(&counted.samples).enumerate() {
+                assert_eq!(p.t.to_bits(), c.t.to_bits(), "{layout:?}: pixel {i}");
+                assert_eq!(p.counters, RayCounters::default());
+            }
+        }
     }
 
     #[test]

@@ -14,6 +14,8 @@
 
 mod traverse;
 
+pub(crate) use traverse::{LEAF, STACK};
+
 use super::node::Bvh;
 use super::tree::{NodeKind, NodeView, TreeView};
 use super::{BuildParams, BuildReport};

@@ -8,37 +8,18 @@
 //! measure the same work).
 
 use super::{WideBvh, WideNode, WIDTH};
+use crate::bvh::packet::PACKET;
 use crate::bvh::stack::TraversalStack;
 use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
 use crate::geometry::{MollerTrumbore, Ray, TriangleHit, TriangleIntersector, TriangleTest, Watertight};
 
 const _: () = assert!(WIDTH == 4, "child references pack the slot into two bits");
+use crate::bvh::simd::{max_keep, min_keep};
 use wide::f32x4;
 
 /// Deepest stack a traversal can need: at most three pushes per level (the build bounds the depth
 /// by `TRAVERSAL_STACK_SIZE`).
-const STACK: usize = 3 * crate::bvh::TRAVERSAL_STACK_SIZE + 4;
-
-/// `max(t, acc)` where a NaN `t` (0·inf: the ray lies in a slab plane) leaves `acc` unchanged, the
-/// same rule as the scalar slab test. SSE's maxps returns its second operand on NaN; elsewhere the
-/// NaN-aware `max` is used.
-#[inline(always)]
-fn max_keep(t: f32x4, acc: f32x4) -> f32x4 {
-    if cfg!(any(target_arch = "x86", target_arch = "x86_64")) {
-        t.fast_max(acc)
-    } else {
-        t.max(acc)
-    }
-}
-
-#[inline(always)]
-fn min_keep(t: f32x4, acc: f32x4) -> f32x4 {
-    if cfg!(any(target_arch = "x86", target_arch = "x86_64")) {
-        t.fast_min(acc)
-    } else {
-        t.min(acc)
-    }
-}
+pub(crate) const STACK: usize = 3 * crate::bvh::TRAVERSAL_STACK_SIZE + 4;
 
 /// The ray in SIMD form, with the near/far planes chosen per axis by direction sign.
 struct SimdRay {
@@ -76,11 +57,11 @@ impl SimdRay {
 
 /// A child reference: a wide node index, or `LEAF | (node·4 + slot)` for a leaf slot (its first
 /// triangle and count are read from that node, which is still in cache when the leaf is reached).
-const LEAF: u32 = 1 << 31;
+pub(crate) const LEAF: u32 = 1 << 31;
 
 impl WideBvh {
     #[inline(always)]
-    fn child_ref(node: &WideNode, index: u32, slot: usize) -> u32 {
+    pub(crate) fn child_ref(node: &WideNode, index: u32, slot: usize) -> u32 {
         if node.count[slot] > 0 {
             LEAF | (index << 2 | slot as u32)
         } else {
@@ -201,5 +182,9 @@ impl Accelerator for WideBvh {
     fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool {
         let mut r = *ray;
         self.dispatch::<true, S>(&mut r, opts, stats).is_some()
+    }
+
+    fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
+        WideBvh::closest_hit4(self, rays, active, opts)
     }
 }
