@@ -37,7 +37,8 @@ impl Packet {
         let lanes = |f: &dyn Fn(&Ray) -> f32| f32x4::from([f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3])]);
         let inv = [lanes(&|r| r.inv_dir().x), lanes(&|r| r.inv_dir().y), lanes(&|r| r.inv_dir().z)];
         // `is_sign_negative`, as in the scalar slab test: -0 gives -inf, whose far plane is min.
-        let sign = |v: f32x4| f32x4::from(v.to_array().map(|x| if x.is_sign_negative() { f32::from_bits(!0) } else { 0.0 }));
+        let sign =
+            |v: f32x4| f32x4::from(v.to_array().map(|x| if x.is_sign_negative() { f32::from_bits(!0) } else { 0.0 }));
         Self {
             org: [lanes(&|r| r.origin().x), lanes(&|r| r.origin().y), lanes(&|r| r.origin().z)],
             neg: [sign(inv[0]), sign(inv[1]), sign(inv[2])],
@@ -60,7 +61,7 @@ impl Packet {
             enter = max_keep(near, enter);
             exit = min_keep(far, exit);
         }
-        (enter.simd_le(exit).to_bitmask() as u32, enter)
+        (enter.simd_le(exit).to_bitmask(), enter)
     }
 
     #[inline(always)]
@@ -88,7 +89,14 @@ impl<T: TriangleIntersector> Lanes<T> {
     /// Test triangles `first..first + count` of `tris` against the lanes in `mask`; true when
     /// some lane found a nearer hit.
     #[inline(always)]
-    fn leaf(&mut self, rays: &mut [Ray; PACKET], mask: u32, tris: &[[glam::Vec3; 3]], first: usize, count: usize) -> bool {
+    fn leaf(
+        &mut self,
+        rays: &mut [Ray; PACKET],
+        mask: u32,
+        tris: &[[glam::Vec3; 3]],
+        first: usize,
+        count: usize,
+    ) -> bool {
         let mut found = false;
         for (i, tri) in tris[first..first + count].iter().enumerate() {
             let mut m = mask;
@@ -155,7 +163,12 @@ impl Bvh {
         lanes.hits(&self.prim_ids)
     }
 
-    pub(crate) fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
+    pub(crate) fn closest_hit4(
+        &self,
+        rays: &mut [Ray; PACKET],
+        active: u8,
+        opts: TraceOptions,
+    ) -> [Option<Hit>; PACKET] {
         match opts.test {
             TriangleTest::Watertight => self.closest4::<Watertight>(rays, active),
             TriangleTest::MollerTrumbore => self.closest4::<MollerTrumbore>(rays, active),
@@ -224,10 +237,8 @@ impl WideBvh {
             let lo = [node.min[0][slot], node.min[1][slot], node.min[2][slot]];
             let hi = [node.max[0][slot], node.max[1][slot], node.max[2][slot]];
             let mask = packet.hit(lo, hi, t_max).0 & cur_mask;
-            if mask != 0 {
-                if lanes.leaf(rays, mask, &self.tris, node.child[slot] as usize, node.count[slot] as usize) {
-                    t_max = lanes.t_max();
-                }
+            if mask != 0 && lanes.leaf(rays, mask, &self.tris, node.child[slot] as usize, node.count[slot] as usize) {
+                t_max = lanes.t_max();
             }
             match stack.pop() {
                 Some((r, m)) => (cur, cur_mask) = (r, m.to_bits()),
@@ -237,7 +248,12 @@ impl WideBvh {
         lanes.hits(&self.prim_ids)
     }
 
-    pub(crate) fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
+    pub(crate) fn closest_hit4(
+        &self,
+        rays: &mut [Ray; PACKET],
+        active: u8,
+        opts: TraceOptions,
+    ) -> [Option<Hit>; PACKET] {
         match opts.test {
             TriangleTest::Watertight => self.closest4::<Watertight>(rays, active),
             TriangleTest::MollerTrumbore => self.closest4::<MollerTrumbore>(rays, active),

@@ -174,9 +174,8 @@ fn trace_pass_packets<A: Accelerator>(
                         let mut active = 0u8;
                         for k in 0..PACKET {
                             let (px, pdy) = pixel(k);
-                            let done_before = previous != 0
-                                && px.is_multiple_of(previous)
-                                && (y0 + pdy).is_multiple_of(previous);
+                            let done_before =
+                                previous != 0 && px.is_multiple_of(previous) && (y0 + pdy).is_multiple_of(previous);
                             if px < x_end && pdy < rows && !done_before {
                                 active |= 1 << k;
                             }
