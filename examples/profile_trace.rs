@@ -78,13 +78,15 @@ fn main() {
     );
     if std::env::var("PACKET").is_ok() && what == "primary" {
         // 2×2 pixel blocks of the 1024² frame.
+        let newray = std::env::var_os("NEWRAY").is_some();
         let t = Instant::now();
         let mut hits = 0;
         for _ in 0..5 {
             for by in (0..1024).step_by(2) {
                 for bx in (0..1024).step_by(2) {
                     let idx = [by * 1024 + bx, by * 1024 + bx + 1, (by + 1) * 1024 + bx, (by + 1) * 1024 + bx + 1];
-                    let mut four = idx.map(|i| rays[i]);
+                    let mut four =
+                        idx.map(|i| if newray { Ray::new(rays[i].origin(), rays[i].dir()) } else { rays[i] });
                     let h = bvh.closest_hit4(&mut four, 0b1111, TraceOptions::default());
                     hits += h.iter().filter(|h| h.is_some()).count();
                 }

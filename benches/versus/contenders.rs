@@ -13,6 +13,11 @@ use std::time::{Duration, Instant};
 /// Closest-hit tracing of one ray; true when something was hit.
 pub trait Tracer: Sync + Send {
     fn trace(&self, r: &RaySpec) -> bool;
+
+    /// Trace consecutive rays (a chunk of the ray list, a multiple of 4 long); returns the hits.
+    fn trace_chunk(&self, rays: &[RaySpec]) -> usize {
+        rays.iter().filter(|r| self.trace(r)).count()
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,6 +64,54 @@ impl<A: Accelerator + Send, S: bvhscope::bvh::TraversalStats + Default + Sync + 
         let hit = self.accel.closest_hit(&mut ray, self.opts, &mut stats).is_some();
         black_box(&stats);
         hit
+    }
+}
+
+/// Our BVH traced in packets of four consecutive rays (`Accelerator::closest_hit4`): a 2×2 pixel
+/// block of the primary frame; four unrelated rays of the incoherent set.
+struct OursPackets {
+    bvh: AnyBvh,
+}
+
+impl Tracer for OursPackets {
+    fn trace(&self, r: &RaySpec) -> bool {
+        let mut ray = Ray::new(r.origin, r.dir);
+        self.bvh.closest_hit(&mut ray, TraceOptions::default(), &mut NoStats).is_some()
+    }
+
+    fn trace_chunk(&self, rays: &[RaySpec]) -> usize {
+        let mut hits = 0;
+        let mut four = rays.chunks_exact(4);
+        for c in &mut four {
+            let mut r = [0, 1, 2, 3].map(|k| Ray::new(c[k].origin, c[k].dir));
+            hits += self.bvh.closest_hit4(&mut r, 0b1111, TraceOptions::default()).iter().flatten().count();
+        }
+        hits + four.remainder().iter().filter(|r| self.trace(r)).count()
+    }
+}
+
+/// Our BVH with one strategy and layout, traced in packets of four rays.
+pub fn ours_packets(strategy: SplitStrategy, layout: Layout) -> Contender {
+    let layout_name = match layout {
+        Layout::Binary => "BVH2",
+        Layout::Wide4 => "BVH4",
+    };
+    Contender {
+        name: format!("bvhscope {} ({layout_name}, 2×2 packets)", strategy.short_name()),
+        family: Family::Ours,
+        slow_build: strategy == SplitStrategy::SahSweep,
+        build: Box::new(move |mesh| {
+            let t = Instant::now();
+            let bvh = AnyBvh::build(mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
+            let took = t.elapsed();
+            let stats = TreeStats::of(&bvh);
+            let built = Built {
+                sah_cost: Some(stats.sah_cost),
+                bytes_per_tri: Some(stats.memory_bytes as f64 / mesh.triangle_count() as f64),
+                tracer: Box::new(OursPackets { bvh }),
+            };
+            (built, took)
+        }),
     }
 }
 

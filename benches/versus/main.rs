@@ -53,7 +53,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn trace(pool: &ThreadPool, rays: &[RaySpec], t: &dyn Tracer) -> (Duration, usize) {
     pool.install(|| {
         let start = Instant::now();
-        let hits = rays.par_chunks(1024).map(|c| c.iter().filter(|r| t.trace(r)).count()).sum();
+        let hits = rays.par_chunks(1024).map(|c| t.trace_chunk(c)).sum();
         (start.elapsed(), hits)
     })
 }
@@ -180,11 +180,20 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
         ("incoherent 1T", &|r: &Row| r.i1),
         ("incoherent NT", &|r: &Row| r.i_n),
     ] {
+        // "best" may be a packet row; "best single-ray" leaves packets out, for comparing like
+        // with like (obvhs and the bvh crate trace one ray at a time).
         let our_best = best(rows, ours, key);
-        line(&format!("{label} best/obvhs-best-BVH2"), our_best, best(rows, is(Family::ObvhsBvh2), key), key);
-        line(&format!("{label} best/obvhs-best-CWBVH"), our_best, best(rows, is(Family::ObvhsCwbvh), key), key);
-        let our_sah = rows.iter().find(|r| r.name == "bvhscope sah (BVH2)");
-        line(&format!("{label} sah-BVH2/bvh-crate"), our_sah, best(rows, is(Family::BvhCrate), key), key);
+        let single = |r: &Row| ours(r) && !r.name.contains("packets");
+        let our_single = best(rows, single, key);
+        for (what, a) in [("best", our_best), ("best single-ray", our_single)] {
+            line(&format!("{label} {what}/obvhs-best-BVH2"), a, best(rows, is(Family::ObvhsBvh2), key), key);
+            line(&format!("{label} {what}/obvhs-best-CWBVH"), a, best(rows, is(Family::ObvhsCwbvh), key), key);
+        }
+        for our in ["bvhscope sah (BVH2)", "bvhscope sah (BVH2, 2×2 packets)"] {
+            let a = rows.iter().find(|r| r.name == our);
+            let label = format!("{label} sah-BVH2{}/bvh-crate", if our.contains("packets") { "-packets" } else { "" });
+            line(&label, a, best(rows, is(Family::BvhCrate), key), key);
+        }
     }
     let tris_per_s = |r: &Row| 1.0 / r.build_nt;
     let our_sah = rows.iter().find(|r| r.name == "bvhscope sah (BVH2)");
@@ -211,7 +220,7 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
             (p.i1 / c.i1 - 1.0) * 100.0
         );
     }
-    for r in rows.iter().filter(|r| ours(r)) {
+    for r in rows.iter().filter(|r| ours(r) && !r.name.contains("packets")) {
         if let Some(b) = r.bytes {
             let _ = writeln!(o, "memory {name}: {} {:.1} bytes per triangle (nodes + indices)", r.name, b);
         }
@@ -318,6 +327,7 @@ fn main() {
             contenders.push(contenders::ours(strategy, layout, false));
         }
     }
+    contenders.push(contenders::ours_packets(SplitStrategy::SahBinned, Layout::Binary));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, true));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, true));
     contenders.extend(contenders::obvhs_all());

@@ -11,13 +11,18 @@ pub struct RaySpec {
     pub dir: Vec3,
 }
 
-/// One ray per pixel of a `size`×`size` frame that frames the mesh from a fixed oblique direction.
+/// One ray per pixel of a `size`×`size` frame (`size` even) that frames the mesh from a fixed
+/// oblique direction. The rays come in 2×2 pixel blocks (block rows top to bottom, blocks left to
+/// right, each block's four pixels row by row): every contender traces this same order, and a
+/// packet tracer takes each block's four rays as one packet.
 pub fn primary(mesh: &Mesh, size: u32) -> Vec<RaySpec> {
     let cam = Camera::framing_from(&mesh.bounds(), size, size, Vec3::new(0.45, 0.35, 1.0), 45.0);
     let g = cam.ray_gen();
     (0..size * size)
         .map(|i| {
-            let r = g.pixel_ray(i % size, i / size);
+            let (block, k) = (i / 4, i % 4);
+            let (bx, by) = (block % (size / 2), block / (size / 2));
+            let r = g.pixel_ray(2 * bx + k % 2, 2 * by + k / 2);
             RaySpec { origin: r.origin(), dir: r.dir() }
         })
         .collect()

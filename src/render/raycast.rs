@@ -2,8 +2,9 @@
 //! finally the rest, each pass tracing only pixels no earlier pass traced, so the full frame costs
 //! one ray per pixel in total. Work is split into bands of 16-pixel-square tiles run on rayon; the
 //! cancel flag is read before each band, and the caller sees the frame after each pass. The plain
-//! normal view traces each pass in packets of four rays (2×2 pixels of the pass's grid,
-//! `bvh::packet`); with counters on, every ray is traced alone so each pixel gets its own counts.
+//! normal view hands each pass to the accelerator in fours (2×2 pixels of the pass's grid), which
+//! the binary BVH traces as one packet (`bvh::packet`); with counters on, every ray is traced alone
+//! so each pixel gets its own counts.
 
 use super::{Camera, Frame, PixelSample};
 use crate::bvh::packet::PACKET;

@@ -14,8 +14,6 @@
 
 mod traverse;
 
-pub(crate) use traverse::{LEAF, STACK};
-
 use super::node::Bvh;
 use super::tree::{NodeKind, NodeView, TreeView};
 use super::{BuildParams, BuildReport};

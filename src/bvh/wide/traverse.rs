@@ -8,7 +8,6 @@
 //! measure the same work).
 
 use super::{WideBvh, WideNode, WIDTH};
-use crate::bvh::packet::PACKET;
 use crate::bvh::stack::TraversalStack;
 use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
 use crate::geometry::{MollerTrumbore, Ray, TriangleHit, TriangleIntersector, TriangleTest, Watertight};
@@ -19,7 +18,7 @@ use wide::f32x4;
 
 /// Deepest stack a traversal can need: at most three pushes per level (the build bounds the depth
 /// by `TRAVERSAL_STACK_SIZE`).
-pub(crate) const STACK: usize = 3 * crate::bvh::TRAVERSAL_STACK_SIZE + 4;
+const STACK: usize = 3 * crate::bvh::TRAVERSAL_STACK_SIZE + 4;
 
 /// The ray in SIMD form, with the near/far planes chosen per axis by direction sign.
 struct SimdRay {
@@ -57,11 +56,11 @@ impl SimdRay {
 
 /// A child reference: a wide node index, or `LEAF | (node·4 + slot)` for a leaf slot (its first
 /// triangle and count are read from that node, which is still in cache when the leaf is reached).
-pub(crate) const LEAF: u32 = 1 << 31;
+const LEAF: u32 = 1 << 31;
 
 impl WideBvh {
     #[inline(always)]
-    pub(crate) fn child_ref(node: &WideNode, index: u32, slot: usize) -> u32 {
+    fn child_ref(node: &WideNode, index: u32, slot: usize) -> u32 {
         if node.count[slot] > 0 {
             LEAF | (index << 2 | slot as u32)
         } else {
@@ -182,9 +181,5 @@ impl Accelerator for WideBvh {
     fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool {
         let mut r = *ray;
         self.dispatch::<true, S>(&mut r, opts, stats).is_some()
-    }
-
-    fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
-        WideBvh::closest_hit4(self, rays, active, opts)
     }
 }
