@@ -1,6 +1,6 @@
 //! A profiling driver: traces the bunny's primary and incoherent rays with the wide SAH BVH on
 //! one thread, many times over, for `perf record` / `valgrind --tool=callgrind`.
-//! `cargo run --release --example profile_trace -- [binary|wide4] [primary|incoherent|build]`
+//! `cargo run --release --example profile_trace -- [binary|wide4] [primary|incoherent|build|frame]`
 
 use bvhscope::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, TraceOptions};
 use bvhscope::geometry::Ray;
@@ -37,6 +37,21 @@ fn main() {
         return;
     }
     let bvh = AnyBvh::build(&mesh, &params);
+    if what == "frame" {
+        // The app's full normal frame: 1280×720, all threads, shading included.
+        let cam = Camera::framing(&mesh.bounds(), 1280, 720);
+        let settings = bvhscope::render::RenderSettings::default();
+        let mut times: Vec<f64> = (0..20)
+            .map(|_| {
+                let t = Instant::now();
+                std::hint::black_box(bvhscope::render::render(&bvh, &mesh, &cam, &settings));
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        println!("frame {layout:?}: median {:.1} ms of 20", times[10]);
+        return;
+    }
     let rays: Vec<Ray> = if what == "primary" {
         let cam = Camera::framing_from(&mesh.bounds(), 1024, 1024, Vec3::new(0.45, 0.35, 1.0), 45.0);
         let g = cam.ray_gen();

@@ -54,6 +54,12 @@ pub trait Accelerator: Sync {
     /// Whether anything is hit within the ray's interval (stops at the first hit found).
     fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool;
 
+    /// Whether `closest_hit4` traces a real packet (faster for coherent rays than four single
+    /// rays); when false, callers should trace single rays.
+    fn traces_packets(&self) -> bool {
+        false
+    }
+
     /// Closest hits of up to four coherent rays (those whose bit is set in `active`), with the same
     /// results as `closest_hit` on each. BVHs trace them as one packet (`bvh::packet`); the default
     /// traces them one by one. Uncounted: heatmaps trace single rays.

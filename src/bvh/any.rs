@@ -60,6 +60,10 @@ impl Accelerator for AnyBvh {
         }
     }
 
+    fn traces_packets(&self) -> bool {
+        matches!(self, AnyBvh::Binary(_))
+    }
+
     #[inline]
     fn closest_hit4(
         &self,

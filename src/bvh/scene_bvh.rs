@@ -102,6 +102,10 @@ impl Accelerator for SceneBvh {
         }
     }
 
+    fn traces_packets(&self) -> bool {
+        matches!(self, SceneBvh::Single(b) if b.traces_packets())
+    }
+
     #[inline]
     fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
         match self {

@@ -110,6 +110,10 @@ impl Accelerator for Bvh {
         self.dispatch::<true, S>(&mut r, opts, stats).is_some()
     }
 
+    fn traces_packets(&self) -> bool {
+        true
+    }
+
     fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
         Bvh::closest_hit4(self, rays, active, opts)
     }

@@ -2,9 +2,9 @@
 //! finally the rest, each pass tracing only pixels no earlier pass traced, so the full frame costs
 //! one ray per pixel in total. Work is split into bands of 16-pixel-square tiles run on rayon; the
 //! cancel flag is read before each band, and the caller sees the frame after each pass. The plain
-//! normal view hands each pass to the accelerator in fours (2×2 pixels of the pass's grid), which
-//! the binary BVH traces as one packet (`bvh::packet`); with counters on, every ray is traced alone
-//! so each pixel gets its own counts.
+//! normal view of an accelerator that traces packets (the binary BVH, `bvh::packet`) hands it each
+//! pass in fours (2×2 pixels of the pass's grid); with counters on, or for the wide BVH, every ray
+//! is traced alone.
 
 use super::{Camera, Frame, PixelSample};
 use crate::bvh::packet::PACKET;
@@ -69,8 +69,10 @@ pub fn render_progressive<A: Accelerator>(
         let t = Instant::now();
         let rays = if settings.count {
             trace_pass::<A, RayCounters>(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
-        } else {
+        } else if accel.traces_packets() {
             trace_pass_packets(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
+        } else {
+            trace_pass::<A, NoStats>(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
         };
         control.check()?;
         frame.stride = stride;
@@ -266,6 +268,7 @@ mod tests {
         let cam = Camera::framing_from(&mesh.bounds(), 45, 29, Vec3::new(0.3, 0.5, 1.0), 45.0);
         for layout in crate::bvh::Layout::ALL {
             let bvh = crate::bvh::AnyBvh::build(&mesh, &BuildParams { layout, ..Default::default() });
+            assert_eq!(bvh.traces_packets(), layout == crate::bvh::Layout::Binary);
             let mut total = 0;
             let control = WorkControl::new();
             let plain = RenderSettings { progressive: true, ..Default::default() };
