@@ -90,31 +90,6 @@ impl Tracer for OursPackets {
     }
 }
 
-/// Our BVH with one strategy and layout, traced in packets of four rays.
-pub fn ours_packets(strategy: SplitStrategy, layout: Layout) -> Contender {
-    let layout_name = match layout {
-        Layout::Binary => "BVH2",
-        Layout::Wide4 => "BVH4",
-    };
-    Contender {
-        name: format!("bvhscope {} ({layout_name}, 2×2 packets)", strategy.short_name()),
-        family: Family::Ours,
-        slow_build: strategy == SplitStrategy::SahSweep,
-        build: Box::new(move |mesh| {
-            let t = Instant::now();
-            let bvh = AnyBvh::build(mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
-            let took = t.elapsed();
-            let stats = TreeStats::of(&bvh);
-            let built = Built {
-                sah_cost: Some(stats.sah_cost),
-                bytes_per_tri: Some(stats.memory_bytes as f64 / mesh.triangle_count() as f64),
-                tracer: Box::new(OursPackets { bvh }),
-            };
-            (built, took)
-        }),
-    }
-}
-
 fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(bvh: AnyBvh) -> Box<dyn Tracer> {
     let opts = TraceOptions::default();
     match bvh {
@@ -123,14 +98,27 @@ fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(bv
     }
 }
 
-/// Our BVH with one strategy and layout; `counting` traverses with the heatmap counters on.
-pub fn ours(strategy: SplitStrategy, layout: Layout, counting: bool) -> Contender {
+/// How our rows trace: plain single rays, single rays with the heatmap counters on, or packets of four.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Tracing {
+    Plain,
+    Counting,
+    Packets,
+}
+
+/// Our BVH with one strategy and layout, traced as `tracing` says.
+pub fn ours(strategy: SplitStrategy, layout: Layout, tracing: Tracing) -> Contender {
     let layout_name = match layout {
         Layout::Binary => "BVH2",
         Layout::Wide4 => "BVH4",
     };
+    let name = match tracing {
+        Tracing::Plain => format!("bvhscope {} ({layout_name})", strategy.short_name()),
+        Tracing::Counting => format!("bvhscope {} ({layout_name}), counting", strategy.short_name()),
+        Tracing::Packets => format!("bvhscope {} ({layout_name}, 2×2 packets)", strategy.short_name()),
+    };
     Contender {
-        name: format!("bvhscope {} ({layout_name}){}", strategy.short_name(), if counting { ", counting" } else { "" }),
+        name,
         family: Family::Ours,
         slow_build: strategy == SplitStrategy::SahSweep,
         build: Box::new(move |mesh| {
@@ -141,7 +129,11 @@ pub fn ours(strategy: SplitStrategy, layout: Layout, counting: bool) -> Contende
             let built = Built {
                 sah_cost: Some(stats.sah_cost),
                 bytes_per_tri: Some(stats.memory_bytes as f64 / mesh.triangle_count() as f64),
-                tracer: if counting { tracer::<RayCounters>(bvh) } else { tracer::<NoStats>(bvh) },
+                tracer: match tracing {
+                    Tracing::Plain => tracer::<NoStats>(bvh),
+                    Tracing::Counting => tracer::<RayCounters>(bvh),
+                    Tracing::Packets => Box::new(OursPackets { bvh }),
+                },
             };
             (built, took)
         }),

@@ -10,7 +10,7 @@ mod rays;
 mod scenes;
 
 use bvhscope::mesh::Mesh;
-use contenders::{Contender, Family, Tracer};
+use contenders::{Contender, Family, Tracer, Tracing};
 use rayon::prelude::*;
 use rayon::{ThreadPool, ThreadPoolBuilder};
 use rays::RaySpec;
@@ -329,12 +329,12 @@ fn main() {
     use bvhscope::bvh::{Layout, SplitStrategy};
     for layout in Layout::ALL {
         for strategy in SplitStrategy::ALL {
-            contenders.push(contenders::ours(strategy, layout, false));
+            contenders.push(contenders::ours(strategy, layout, Tracing::Plain));
         }
     }
-    contenders.push(contenders::ours_packets(SplitStrategy::SahBinned, Layout::Binary));
-    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, true));
-    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, true));
+    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Packets));
+    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Counting));
+    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Counting));
     contenders.extend(contenders::obvhs_all());
     contenders.push(contenders::bvh_crate());
     // BENCH_ONLY=a,b keeps contenders whose name contains one of the words (for quick iteration).

@@ -8,7 +8,8 @@
 //! with the same triangle test as single rays, so every lane gets the hit it would get alone (the
 //! same distance; between triangles hit at exactly the same distance either may be reported).
 //!
-//! Packets are for the plain normal view only: heatmaps count per ray, and trace single rays.
+//! Packets are for the renderer's uncounted views only (`bvhscope render` of normals or depth):
+//! heatmaps, and the app, which always counts for its hover read-out, trace single rays.
 //! Incoherent rays would leave a packet half empty at once, so they are traced one by one.
 //!
 //! The 4-wide BVH already spends its SIMD lanes on four child boxes per ray. Packets over it (four

@@ -96,33 +96,46 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
 ) -> u64 {
     let gen = camera.ray_gen();
     let w = frame.width;
-    let band_len = (w * TILE) as usize;
+    for_each_band(frame, control, |y0, rows, samples| {
+        let mut traced = 0u64;
+        for x0 in (0..w).step_by(TILE as usize) {
+            for dy in (0..rows).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
+                let y = y0 + dy;
+                for x in (x0..(x0 + TILE).min(w)).step_by(stride as usize) {
+                    if previous != 0 && x.is_multiple_of(previous) && y.is_multiple_of(previous) {
+                        continue;
+                    }
+                    let mut ray = gen.pixel_ray(x, y);
+                    let mut stats = S::default();
+                    let hit = accel.closest_hit(&mut ray, trace, &mut stats);
+                    samples[(dy * w + x) as usize] = sample(mesh, &ray, hit, stats.into());
+                    traced += 1;
+                }
+            }
+        }
+        traced
+    })
+}
+
+/// Run `trace_band(y0, rows, samples)` on each band of `TILE` rows in parallel (rayon), skipping
+/// bands once the control is cancelled; the closure returns the rays it traced, which are added to
+/// the control's progress and summed.
+fn for_each_band(
+    frame: &mut Frame,
+    control: &WorkControl,
+    trace_band: impl Fn(u32, u32, &mut [PixelSample]) -> u64 + Sync,
+) -> u64 {
+    let w = frame.width;
     frame
         .samples
-        .par_chunks_mut(band_len)
+        .par_chunks_mut((w * TILE) as usize)
         .enumerate()
         .map(|(band, samples)| {
             if control.is_cancelled() {
                 return 0;
             }
-            let y0 = band as u32 * TILE;
             let rows = (samples.len() / w as usize) as u32;
-            let mut traced = 0u64;
-            for x0 in (0..w).step_by(TILE as usize) {
-                for dy in (0..rows).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
-                    let y = y0 + dy;
-                    for x in (x0..(x0 + TILE).min(w)).step_by(stride as usize) {
-                        if previous != 0 && x.is_multiple_of(previous) && y.is_multiple_of(previous) {
-                            continue;
-                        }
-                        let mut ray = gen.pixel_ray(x, y);
-                        let mut stats = S::default();
-                        let hit = accel.closest_hit(&mut ray, trace, &mut stats);
-                        samples[(dy * w + x) as usize] = sample(mesh, &ray, hit, stats.into());
-                        traced += 1;
-                    }
-                }
-            }
+            let traced = trace_band(band as u32 * TILE, rows, samples);
             control.add_done(traced);
             traced
         })
@@ -156,53 +169,41 @@ fn trace_pass_packets<A: Accelerator>(
     const _: () = assert!(TILE.is_multiple_of(2 * PASS_STRIDES[0]));
     let gen = camera.ray_gen();
     let w = frame.width;
-    let band_len = (w * TILE) as usize;
-    frame
-        .samples
-        .par_chunks_mut(band_len)
-        .enumerate()
-        .map(|(band, samples)| {
-            if control.is_cancelled() {
-                return 0;
-            }
-            let y0 = band as u32 * TILE;
-            let rows = (samples.len() / w as usize) as u32;
-            let mut traced = 0u64;
-            for x0 in (0..w).step_by(TILE as usize) {
-                let x_end = (x0 + TILE).min(w);
-                for dy in (0..rows).step_by(2 * stride as usize) {
-                    for x in (x0..x_end).step_by(2 * stride as usize) {
-                        // Lanes: (x, dy), (x + s, dy), (x, dy + s), (x + s, dy + s).
-                        let pixel = |k: usize| (x + stride * (k as u32 & 1), dy + stride * (k as u32 >> 1));
-                        let mut active = 0u8;
-                        for k in 0..PACKET {
-                            let (px, pdy) = pixel(k);
-                            let done_before =
-                                previous != 0 && px.is_multiple_of(previous) && (y0 + pdy).is_multiple_of(previous);
-                            if px < x_end && pdy < rows && !done_before {
-                                active |= 1 << k;
-                            }
+    for_each_band(frame, control, |y0, rows, samples| {
+        let mut traced = 0u64;
+        for x0 in (0..w).step_by(TILE as usize) {
+            let x_end = (x0 + TILE).min(w);
+            for dy in (0..rows).step_by(2 * stride as usize) {
+                for x in (x0..x_end).step_by(2 * stride as usize) {
+                    // Lanes: (x, dy), (x + s, dy), (x, dy + s), (x + s, dy + s).
+                    let pixel = |k: usize| (x + stride * (k as u32 & 1), dy + stride * (k as u32 >> 1));
+                    let mut active = 0u8;
+                    for k in 0..PACKET {
+                        let (px, pdy) = pixel(k);
+                        let done_before =
+                            previous != 0 && px.is_multiple_of(previous) && (y0 + pdy).is_multiple_of(previous);
+                        if px < x_end && pdy < rows && !done_before {
+                            active |= 1 << k;
                         }
-                        if active == 0 {
-                            continue;
-                        }
-                        let mut rays = std::array::from_fn(|k| {
-                            let (px, pdy) = pixel(k);
-                            gen.pixel_ray(px.min(w - 1), y0 + pdy.min(rows - 1))
-                        });
-                        let hits = accel.closest_hit4(&mut rays, active, trace);
-                        for k in (0..PACKET).filter(|k| active & (1 << k) != 0) {
-                            let (px, pdy) = pixel(k);
-                            samples[(pdy * w + px) as usize] = sample(mesh, &rays[k], hits[k], RayCounters::default());
-                            traced += 1;
-                        }
+                    }
+                    if active == 0 {
+                        continue;
+                    }
+                    let mut rays = std::array::from_fn(|k| {
+                        let (px, pdy) = pixel(k);
+                        gen.pixel_ray(px.min(w - 1), y0 + pdy.min(rows - 1))
+                    });
+                    let hits = accel.closest_hit4(&mut rays, active, trace);
+                    for k in (0..PACKET).filter(|k| active & (1 << k) != 0) {
+                        let (px, pdy) = pixel(k);
+                        samples[(pdy * w + px) as usize] = sample(mesh, &rays[k], hits[k], RayCounters::default());
+                        traced += 1;
                     }
                 }
             }
-            control.add_done(traced);
-            traced
-        })
-        .sum()
+        }
+        traced
+    })
 }
 
 impl From<NoStats> for RayCounters {
