@@ -1,6 +1,7 @@
 //! A profiling driver: traces the bunny's primary and incoherent rays with the wide SAH BVH on
 //! one thread, many times over, for `perf record` / `valgrind --tool=callgrind`.
 //! `cargo run --release --example profile_trace -- [binary|wide4] [primary|incoherent|build|frame]`
+//! (`frame` with `PARTS=1` also splits the app's frame into counting, passes and snapshots).
 
 use bvhscope::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, TraceOptions};
 use bvhscope::geometry::Ray;
@@ -38,18 +39,45 @@ fn main() {
     }
     let bvh = AnyBvh::build(&mesh, &params);
     if what == "frame" {
-        // The app's full normal frame: 1280×720, all threads, shading included.
+        // 1280×720, all threads: the renderer's plain frame (shading included), and the app's
+        // (counted, progressive, each pass's image built as the render job builds it).
+        use bvhscope::render::{render, render_passes, view_image, RenderSettings, View};
         let cam = Camera::framing(&mesh.bounds(), 1280, 720);
-        let settings = bvhscope::render::RenderSettings::default();
-        let mut times: Vec<f64> = (0..20)
-            .map(|_| {
-                let t = Instant::now();
-                std::hint::black_box(bvhscope::render::render(&bvh, &mesh, &cam, &settings));
-                t.elapsed().as_secs_f64() * 1e3
-            })
-            .collect();
-        times.sort_by(f64::total_cmp);
-        println!("frame {layout:?}: median {:.1} ms of 20", times[10]);
+        let median = |f: &dyn Fn()| {
+            let mut t: Vec<f64> = (0..20)
+                .map(|_| {
+                    let t = Instant::now();
+                    f();
+                    t.elapsed().as_secs_f64() * 1e3
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            t[10]
+        };
+        let plain = RenderSettings::default();
+        let plain_ms = median(&|| drop(std::hint::black_box(render(&bvh, &mesh, &cam, &plain))));
+        println!("frame {layout:?}, plain: median {plain_ms:.1} ms of 20");
+        let app = RenderSettings { count: true, progressive: true, ..RenderSettings::default() };
+        let app_ms = median(&|| {
+            let control = bvhscope::work::WorkControl::new();
+            let _ = render_passes(&bvh, &mesh, &cam, &app, &control, |f, _| {
+                let style = (View::Normals, Default::default(), Default::default(), Default::default());
+                std::hint::black_box(view_image(&f, style.0, style.1, style.2, style.3));
+            });
+        });
+        println!("frame {layout:?}, as the app renders it: median {app_ms:.1} ms of 20");
+        if std::env::var("PARTS").is_ok() {
+            // Where the app's frame goes beyond the plain one: counting, passes, snapshots.
+            let counted = RenderSettings { count: true, ..RenderSettings::default() };
+            let c_ms = median(&|| drop(std::hint::black_box(render(&bvh, &mesh, &cam, &counted))));
+            let control = bvhscope::work::WorkControl::new();
+            let p_ms =
+                median(&|| drop(bvhscope::render::render_progressive(&bvh, &mesh, &cam, &app, &control, |_, _| {})));
+            let s_ms = median(&|| {
+                let _ = render_passes(&bvh, &mesh, &cam, &app, &control, |f, _| drop(std::hint::black_box(f)));
+            });
+            println!("counted {c_ms:.1}, progressive {p_ms:.1}, with snapshots {s_ms:.1}");
+        }
         return;
     }
     let rays: Vec<Ray> = if what == "primary" {

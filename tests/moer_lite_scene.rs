@@ -47,9 +47,10 @@ fn moer_lite_scene_matches_linear_for_every_strategy() {
                 .count();
             assert_eq!(off, 0, "{strategy:?} {layout:?} {order:?}: {off} normal pixels differ");
             let same_t = frame
-                .samples
+                .full_samples()
+                .unwrap()
                 .iter()
-                .zip(&reference.samples)
+                .zip(reference.full_samples().unwrap())
                 .all(|(a, b)| a.t == b.t || (a.t - b.t).abs() <= 1e-5 * b.t);
             assert!(same_t, "{strategy:?} {layout:?} {order:?}: depths differ");
         }

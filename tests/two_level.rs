@@ -67,9 +67,9 @@ fn translated_instances_give_exactly_the_flattened_hits() {
     for top in every_params().into_iter().filter(|p| p.layout == Layout::Binary) {
         for bottom in every_params() {
             let (two, single) = frames(&scene, &camera, &top, &bottom);
-            let hits = single.samples.iter().filter(|s| s.is_hit()).count();
+            let hits = single.full_samples().unwrap().iter().filter(|s| s.is_hit()).count();
             assert!(hits > 1000, "the camera sees the scene ({hits} hits)");
-            for (i, (a, b)) in two.samples.iter().zip(&single.samples).enumerate() {
+            for (i, (a, b)) in two.full_samples().unwrap().iter().zip(single.full_samples().unwrap()).enumerate() {
                 assert_eq!(
                     (a.prim, a.t.to_bits()),
                     (b.prim, b.t.to_bits()),
@@ -109,16 +109,16 @@ fn rotated_and_scaled_instances_agree_with_the_flattened_scene() {
     };
     let p = BuildParams::default();
     let (two, single) = frames(&scene, &camera, &p, &p);
-    let n = two.samples.len();
+    let n = two.full_samples().unwrap().len();
     let mut mask_diff = 0;
-    for (a, b) in two.samples.iter().zip(&single.samples) {
+    for (a, b) in two.full_samples().unwrap().iter().zip(single.full_samples().unwrap()) {
         if a.is_hit() != b.is_hit() {
             mask_diff += 1;
         } else if a.is_hit() {
             assert!((a.t - b.t).abs() <= 1e-4 * b.t, "distances agree: {} vs {}", a.t, b.t);
         }
     }
-    assert!(single.samples.iter().filter(|s| s.is_hit()).count() > n / 10, "the scene fills the view");
+    assert!(single.full_samples().unwrap().iter().filter(|s| s.is_hit()).count() > n / 10, "the scene fills the view");
     assert!(mask_diff * 1000 <= n, "{mask_diff} of {n} pixels differ in hit or miss");
 }
 
@@ -130,8 +130,8 @@ fn the_moer_lite_scene_two_level_equals_flattened() {
     let camera = Camera { width: 300, height: 200, ..loaded.camera.expect("the scene has a camera") };
     let p = BuildParams::default();
     let (two, single) = frames(&scene, &camera, &p, &p);
-    assert!(single.samples.iter().any(|s| s.is_hit()));
-    for (a, b) in two.samples.iter().zip(&single.samples) {
+    assert!(single.full_samples().unwrap().iter().any(|s| s.is_hit()));
+    for (a, b) in two.full_samples().unwrap().iter().zip(single.full_samples().unwrap()) {
         assert_eq!((a.prim, a.t.to_bits()), (b.prim, b.t.to_bits()));
     }
 }

@@ -7,7 +7,7 @@ use crate::bvh::{SahCost, TraceOptions};
 use crate::bvh::{SceneBuild, SceneBvh};
 use crate::mesh::Mesh;
 use crate::render::{
-    render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, Legend, PassInfo, RenderSettings, View,
+    render_passes, view_image, Camera, ColorMap, Frame, HeatRange, Legend, PassInfo, RenderSettings, View,
 };
 use crate::scene::{load_any, SceneInstances};
 use crate::work::{Cancelled, WorkControl};
@@ -190,18 +190,11 @@ impl Jobs {
             // Always count: the heatmaps and the hover read-out need the counters, and counting
             // costs little next to shading.
             let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive };
-            let _ = render_progressive(&*r.bvh, &r.mesh, &r.camera, &settings, &control, |frame, info| {
-                let (img, legend) = view_image(frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
+            let _ = render_passes(&*r.bvh, &r.mesh, &r.camera, &settings, &control, |frame, info| {
+                let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
-                send(JobEvent::Pass(PassOutput {
-                    bvh: r.bvh.clone(),
-                    frame: Arc::new(frame.clone()),
-                    image,
-                    legend,
-                    info: *info,
-                    camera: r.camera,
-                    style: r.style,
-                }));
+                let (bvh, camera, style) = (r.bvh.clone(), r.camera, r.style);
+                send(JobEvent::Pass(PassOutput { bvh, frame: Arc::new(frame), image, legend, info, camera, style }));
             });
         });
         self.render = Some(job);

@@ -44,7 +44,14 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     // The image, stretched to the viewport while a new size is on its way.
     let painter = ui.painter_at(rect);
     if let Some(shown) = &app.shown {
-        let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+        // A coarse pass's image has a texel per traced pixel; its last row and column may cover
+        // pixels past the frame's edge, which the uv range leaves out.
+        let f = &shown.frame;
+        let ((cols, rows), s) = (f.grid_size(), f.stride.max(1) as f32);
+        let uv = Rect::from_min_max(
+            Pos2::ZERO,
+            Pos2::new(f.width as f32 / (cols as f32 * s), f.height as f32 / (rows as f32 * s)),
+        );
         painter.image(shown.texture.id(), rect, uv, Color32::WHITE);
     } else {
         let busy = app.jobs.build.as_ref().map_or("Preparing…".to_string(), |b| format!("{}…", b.label));
@@ -127,12 +134,13 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
             ui.label("nothing");
         }
         ui.end_row();
-        if frame.counted {
+        if frame.counted() {
+            let c = frame.counters(x, y);
             for (name, v) in [
-                ("Nodes visited", s.counters.nodes_visited),
-                ("Box tests", s.counters.box_tests),
-                ("Leaves visited", s.counters.leaves_visited),
-                ("Triangle tests", s.counters.triangle_tests),
+                ("Nodes visited", c.nodes_visited),
+                ("Box tests", c.box_tests),
+                ("Leaves visited", c.leaves_visited),
+                ("Triangle tests", c.triangle_tests),
             ] {
                 ui.label(name);
                 ui.label(v.to_string());

@@ -64,7 +64,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             other => std::io::Error::other(other.to_string()),
         },
     })?;
-    let hits = frame.samples.iter().filter(|s| s.is_hit()).count();
+    let hits = frame.traced().filter(|(s, _)| s.is_hit()).count();
     let legend_note = if legend.is_some() { " with the legend below" } else { "" };
     eprint!(
         "wrote {} ({}x{} image, {}x{} render{legend_note}; {} of {} pixels hit",

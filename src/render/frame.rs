@@ -1,7 +1,15 @@
-//! The renderer's output: one sample per pixel, refined pass by pass.
+//! The renderer's output: one sample per pixel, refined pass by pass, and the traversal counters
+//! beside it when the render counted.
+//!
+//! Samples and counters live in two arrays, and the counters only when asked for: the plain
+//! view's frame stays small (20 bytes a pixel, 18 MB at 1280×720), and a counted frame is two
+//! allocations under glibc's 32 MiB mmap limit rather than one above it. One array of 48-byte
+//! samples was freshly mapped, faulted in and unmapped on every frame, which cost the app's
+//! frame about 20 ms (BENCHMARKS.md, "The frame regression").
 
 use crate::bvh::RayCounters;
 use glam::Vec3;
+use rayon::prelude::*;
 
 /// What one primary ray found.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -13,13 +21,10 @@ pub struct PixelSample {
     pub normal: Vec3,
     /// The mesh's triangle index, `u32::MAX` for a miss.
     pub prim: u32,
-    /// The traversal's work (zero unless the render counted).
-    pub counters: RayCounters,
 }
 
 impl PixelSample {
-    pub const MISS: PixelSample =
-        PixelSample { t: f32::INFINITY, normal: Vec3::ZERO, prim: u32::MAX, counters: RayCounters::ZERO };
+    pub const MISS: PixelSample = PixelSample { t: f32::INFINITY, normal: Vec3::ZERO, prim: u32::MAX };
 
     pub fn is_hit(&self) -> bool {
         self.prim != u32::MAX
@@ -28,46 +33,138 @@ impl PixelSample {
 
 /// A frame being refined. Until the last pass, only every `stride`-th pixel in x and y has been
 /// traced; `sample` returns the traced pixel covering a given one, so a coarse frame can be shown.
+///
+/// The renderer's working frame stores a slot for every pixel (later passes fill the gaps); a
+/// `snapshot` of a coarse pass stores only the traced pixels, so handing it on costs 1/stride² of
+/// the full frame.
 #[derive(Clone, Debug)]
 pub struct Frame {
     pub width: u32,
     pub height: u32,
-    pub samples: Vec<PixelSample>,
     /// 1 when every pixel was traced; 8, 4 or 2 after a coarse pass; 0 before any pass.
     pub stride: u32,
-    /// Whether the counters were recorded.
-    pub counted: bool,
+    /// Pixel spacing of the stored samples: 1, or `stride` in a snapshot.
+    step: u32,
+    /// Row by row over the stored grid.
+    samples: Vec<PixelSample>,
+    /// One per stored sample when the render counted, else empty.
+    counters: Vec<RayCounters>,
 }
 
 impl Frame {
-    pub fn new(width: u32, height: u32) -> Self {
-        Self {
-            width,
-            height,
-            samples: vec![PixelSample::MISS; width as usize * height as usize],
-            stride: 0,
-            counted: false,
+    /// An untraced full-resolution frame, with counters if `counted`. Its storage is a dropped
+    /// frame's when one large enough was kept (see `Spare`), else fresh; it is filled in parallel
+    /// either way.
+    pub fn new(width: u32, height: u32, counted: bool) -> Self {
+        let n = width as usize * height as usize;
+        let (mut samples, mut counters) = Spare::take(n, counted);
+        samples.par_extend(rayon::iter::repeat_n(PixelSample::MISS, n));
+        if counted {
+            counters.par_extend(rayon::iter::repeat_n(RayCounters::ZERO, n));
         }
+        Self { width, height, stride: 0, step: 1, samples, counters }
     }
 
     pub fn is_complete(&self) -> bool {
         self.stride == 1
     }
 
+    /// Whether the traversal counters were recorded.
+    pub fn counted(&self) -> bool {
+        !self.counters.is_empty()
+    }
+
+    /// Columns and rows of the traced grid (the full size once complete).
+    pub fn grid_size(&self) -> (u32, u32) {
+        let s = self.stride.max(1);
+        (self.width.div_ceil(s), self.height.div_ceil(s))
+    }
+
+    /// Index of the stored slot of traced grid point (gx, gy).
+    #[inline]
+    fn grid_index(&self, gx: u32, gy: u32) -> usize {
+        let per_step = (self.stride.max(1) / self.step) as usize;
+        let cols = self.width.div_ceil(self.step) as usize;
+        gy as usize * per_step * cols + gx as usize * per_step
+    }
+
+    /// The traced sample at grid point (gx, gy), i.e. pixel (gx·stride, gy·stride).
+    #[inline]
+    pub fn grid_sample(&self, gx: u32, gy: u32) -> &PixelSample {
+        &self.samples[self.grid_index(gx, gy)]
+    }
+
+    /// Its counters (zero when the render did not count).
+    #[inline]
+    pub fn grid_counters(&self, gx: u32, gy: u32) -> RayCounters {
+        self.counters.get(self.grid_index(gx, gy)).copied().unwrap_or(RayCounters::ZERO)
+    }
+
     /// The sample shown at pixel (x, y): the nearest traced pixel above-left of it.
     #[inline]
     pub fn sample(&self, x: u32, y: u32) -> &PixelSample {
         let s = self.stride.max(1);
-        let (x, y) = (x - x % s, y - y % s);
-        &self.samples[(y * self.width + x) as usize]
+        self.grid_sample(x / s, y / s)
     }
 
-    /// Iterate the samples actually traced so far (one per `stride`×`stride` block).
-    pub fn traced(&self) -> impl Iterator<Item = &PixelSample> + '_ {
-        let s = self.stride.max(1) as usize;
-        let w = self.width as usize;
-        let rows = if self.stride == 0 { 0 } else { self.height as usize };
-        (0..rows).step_by(s).flat_map(move |y| (0..w).step_by(s).map(move |x| &self.samples[y * w + x]))
+    /// The counters of the ray behind `sample(x, y)`.
+    pub fn counters(&self, x: u32, y: u32) -> RayCounters {
+        let s = self.stride.max(1);
+        self.grid_counters(x / s, y / s)
+    }
+
+    /// Row `gy` of the traced grid: each traced sample with its counters (zero when uncounted).
+    pub fn grid_row(&self, gy: u32) -> impl Iterator<Item = (&PixelSample, RayCounters)> + '_ {
+        let (cols, _) = self.grid_size();
+        let per = (self.stride.max(1) / self.step) as usize;
+        let start = self.grid_index(0, gy);
+        let counters = self.counters.get(start..).unwrap_or_default().iter().step_by(per).copied();
+        let samples = self.samples[start..].iter().step_by(per).take(cols as usize);
+        samples.zip(counters.chain(std::iter::repeat(RayCounters::ZERO)))
+    }
+
+    /// The samples traced so far (one per `stride`×`stride` block) with their counters, row by row.
+    pub fn traced(&self) -> impl Iterator<Item = (&PixelSample, RayCounters)> + '_ {
+        let rows = if self.stride == 0 { 0 } else { self.grid_size().1 };
+        (0..rows).flat_map(move |gy| self.grid_row(gy))
+    }
+
+    /// Every pixel's sample, row by row, of a complete frame (`None` before the last pass).
+    pub fn full_samples(&self) -> Option<&[PixelSample]> {
+        (self.is_complete() && self.step == 1).then_some(&self.samples[..])
+    }
+
+    /// A copy of what has been traced: the whole frame once complete, else only the traced pixels.
+    pub fn snapshot(&self) -> Frame {
+        if self.step == self.stride.max(1) {
+            return self.clone();
+        }
+        let (cols, rows) = self.grid_size();
+        let n = cols as usize * rows as usize;
+        let (mut samples, mut counters) = Spare::take(n, self.counted());
+        // Rows in parallel: the gather is memory-bound.
+        samples.resize(n, PixelSample::MISS);
+        samples.par_chunks_mut(cols as usize).enumerate().for_each(|(gy, row)| {
+            for (to, (from, _)) in row.iter_mut().zip(self.grid_row(gy as u32)) {
+                *to = *from;
+            }
+        });
+        if self.counted() {
+            counters.resize(n, RayCounters::ZERO);
+            counters.par_chunks_mut(cols as usize).enumerate().for_each(|(gy, row)| {
+                for (to, (_, from)) in row.iter_mut().zip(self.grid_row(gy as u32)) {
+                    *to = from;
+                }
+            });
+        }
+        Frame { width: self.width, height: self.height, stride: self.stride, step: self.stride, samples, counters }
+    }
+
+    /// The full-resolution frame's storage, for the renderer to fill: samples and counters
+    /// (empty when not counting), row by row.
+    pub(super) fn slots_mut(&mut self) -> (&mut [PixelSample], &mut [RayCounters]) {
+        debug_assert_eq!(self.step, 1, "only the working frame is traced into");
+        (&mut self.samples, &mut self.counters)
     }
 
     /// Hit mask, row by row (true = hit), at full resolution.
@@ -76,6 +173,71 @@ impl Frame {
             .flat_map(|y| (0..self.width).map(move |x| (x, y)))
             .map(|(x, y)| self.sample(x, y).is_hit())
             .collect()
+    }
+}
+
+impl Drop for Frame {
+    fn drop(&mut self) {
+        Spare::keep(std::mem::take(&mut self.samples), std::mem::take(&mut self.counters));
+    }
+}
+
+/// Storage of recently dropped frames, for new frames and snapshots to reuse. A fresh allocation
+/// of a frame's size is mapped anew by the system allocator, its pages faulted in on first touch
+/// and unmapped again when freed; on this machine that cost more than tracing the bunny's frame
+/// (BENCHMARKS.md, "The frame regression"). The app drops a frame and its three coarse snapshots
+/// per render, so the last `Spare::KEPT` vectors of each kind are kept (first in, first out);
+/// vectors under `Spare::MIN_BYTES` are left to the allocator.
+struct Spare {
+    samples: Vec<Vec<PixelSample>>,
+    counters: Vec<Vec<RayCounters>>,
+}
+
+static SPARE: std::sync::Mutex<Spare> = std::sync::Mutex::new(Spare { samples: Vec::new(), counters: Vec::new() });
+
+impl Spare {
+    const KEPT: usize = 4;
+    const MIN_BYTES: usize = 1 << 20;
+
+    /// Empty vectors able to hold `n` samples, and `n` counters if `counted`: the smallest kept
+    /// ones large enough, else fresh.
+    fn take(n: usize, counted: bool) -> (Vec<PixelSample>, Vec<RayCounters>) {
+        fn smallest_fitting<T>(kept: &mut Vec<Vec<T>>, n: usize) -> Vec<T> {
+            let fitting = kept.iter().enumerate().filter(|(_, v)| v.capacity() >= n);
+            match fitting.min_by_key(|(_, v)| v.capacity()) {
+                Some((i, _)) => kept.remove(i),
+                None => Vec::new(),
+            }
+        }
+        let (mut samples, mut counters) = (Vec::new(), Vec::new());
+        if let Ok(mut spare) = SPARE.lock() {
+            samples = smallest_fitting(&mut spare.samples, n);
+            if counted {
+                counters = smallest_fitting(&mut spare.counters, n);
+            }
+        }
+        samples.clear();
+        samples.reserve_exact(n);
+        counters.clear();
+        counters.reserve_exact(if counted { n } else { 0 });
+        (samples, counters)
+    }
+
+    /// Keep a dropped frame's vectors; the oldest kept ones beyond `KEPT` are freed, outside the lock.
+    fn keep(samples: Vec<PixelSample>, counters: Vec<RayCounters>) {
+        fn push<T>(kept: &mut Vec<Vec<T>>, v: Vec<T>, evicted: &mut Vec<Vec<T>>) {
+            if v.capacity() * size_of::<T>() >= Spare::MIN_BYTES {
+                kept.push(v);
+                if kept.len() > Spare::KEPT {
+                    evicted.push(kept.remove(0));
+                }
+            }
+        }
+        let (mut old_samples, mut old_counters) = (Vec::new(), Vec::new());
+        if let Ok(mut spare) = SPARE.lock() {
+            push(&mut spare.samples, samples, &mut old_samples);
+            push(&mut spare.counters, counters, &mut old_counters);
+        }
     }
 }
 
@@ -98,16 +260,16 @@ impl Frame {
     pub fn ray_summary(&self) -> RaySummary {
         let mut s = RaySummary::default();
         let (mut nodes, mut boxes, mut tris, mut top, mut inst) = (0u64, 0u64, 0u64, 0u64, 0u64);
-        for p in self.traced() {
+        for (p, c) in self.traced() {
             s.rays += 1;
             s.hits += p.is_hit() as u64;
-            nodes += p.counters.nodes_visited as u64;
-            boxes += p.counters.box_tests as u64;
-            tris += p.counters.triangle_tests as u64;
-            top += p.counters.top_nodes_visited as u64;
-            inst += p.counters.instances_entered as u64;
-            s.max_nodes_visited = s.max_nodes_visited.max(p.counters.nodes_visited);
-            s.max_triangle_tests = s.max_triangle_tests.max(p.counters.triangle_tests);
+            nodes += c.nodes_visited as u64;
+            boxes += c.box_tests as u64;
+            tris += c.triangle_tests as u64;
+            top += c.top_nodes_visited as u64;
+            inst += c.instances_entered as u64;
+            s.max_nodes_visited = s.max_nodes_visited.max(c.nodes_visited);
+            s.max_triangle_tests = s.max_triangle_tests.max(c.triangle_tests);
         }
         let n = s.rays.max(1) as f64;
         s.mean_nodes_visited = nodes as f64 / n;
@@ -116,5 +278,85 @@ impl Frame {
         s.mean_top_nodes_visited = top as f64 / n;
         s.mean_instances_entered = inst as f64 / n;
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A frame after a pass of `stride`, each traced pixel's sample naming its pixel.
+    fn traced_frame(w: u32, h: u32, stride: u32, counted: bool) -> Frame {
+        let mut f = Frame::new(w, h, counted);
+        let (samples, counters) = f.slots_mut();
+        for y in (0..h).step_by(stride as usize) {
+            for x in (0..w).step_by(stride as usize) {
+                let i = (y * w + x) as usize;
+                samples[i] = PixelSample { t: x as f32, normal: Vec3::ZERO, prim: y };
+                if counted {
+                    counters[i].nodes_visited = x + 1000 * y;
+                }
+            }
+        }
+        f.stride = stride;
+        f
+    }
+
+    #[test]
+    fn a_snapshot_of_a_coarse_pass_shows_what_the_working_frame_shows() {
+        for (w, h) in [(37, 23), (16, 8), (1, 1), (9, 17)] {
+            for stride in [8, 4, 2, 1] {
+                for counted in [false, true] {
+                    let f = traced_frame(w, h, stride, counted);
+                    let snap = f.snapshot();
+                    assert_eq!(snap.counted(), counted);
+                    assert_eq!(snap.grid_size(), f.grid_size());
+                    let (cols, rows) = f.grid_size();
+                    assert_eq!(snap.samples.len(), (cols * rows) as usize, "only the traced pixels are kept");
+                    for y in 0..h {
+                        for x in 0..w {
+                            let s = snap.sample(x, y);
+                            assert_eq!((s.t as u32, s.prim), (x - x % stride, y - y % stride), "{w}×{h}/{stride}");
+                            assert_eq!(s, f.sample(x, y));
+                            assert_eq!(snap.counters(x, y), f.counters(x, y));
+                        }
+                    }
+                    let traced: Vec<_> = f.traced().collect();
+                    assert_eq!(traced.len(), (cols * rows) as usize);
+                    assert!(traced.iter().eq(snap.traced().collect::<Vec<_>>().iter()));
+                    assert_eq!(snap.ray_summary(), f.ray_summary());
+                    assert_eq!(snap.full_samples().is_some(), stride == 1);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_frame_on_a_dropped_frames_storage_starts_empty() {
+        // Large enough to be kept as a spare (over `Spare::MIN_BYTES` of samples).
+        let (w, h) = (701, 499);
+        let mut f = traced_frame(w, h, 1, true);
+        let (samples, counters) = f.slots_mut();
+        samples.fill(PixelSample { t: 1.0, normal: Vec3::X, prim: 3 });
+        counters.fill(RayCounters { nodes_visited: 9, ..RayCounters::ZERO });
+        drop(f);
+        for (w, h) in [(w, h), (w - 1, h - 2)] {
+            let mut f = Frame::new(w, h, true);
+            let n = (w * h) as usize;
+            let (samples, counters) = f.slots_mut();
+            assert_eq!((samples.len(), counters.len()), (n, n));
+            assert!(samples.iter().all(|s| *s == PixelSample::MISS));
+            assert!(counters.iter().all(|c| *c == RayCounters::ZERO));
+            samples.fill(PixelSample { t: 2.0, normal: Vec3::Y, prim: 4 });
+        }
+    }
+
+    #[test]
+    fn an_untraced_frame_has_no_samples_to_show() {
+        let f = Frame::new(5, 3, true);
+        assert_eq!(f.traced().count(), 0);
+        assert_eq!(f.ray_summary().rays, 0);
+        assert!(f.full_samples().is_none());
+        assert!(!Frame::new(5, 3, false).counted());
     }
 }

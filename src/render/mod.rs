@@ -13,5 +13,5 @@ pub use camera::{Camera, CameraError};
 pub use colormap::ColorMap;
 pub use frame::{Frame, PixelSample, RaySummary};
 pub use legend::draw_legend;
-pub use raycast::{render, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
+pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
 pub use views::{view_image, HeatRange, Legend, View};

@@ -61,8 +61,7 @@ pub fn render_progressive<A: Accelerator>(
 ) -> Result<Frame, Cancelled> {
     let start = Instant::now();
     control.set_total(camera.width as u64 * camera.height as u64);
-    let mut frame = Frame::new(camera.width, camera.height);
-    frame.counted = settings.count;
+    let mut frame = Frame::new(camera.width, camera.height, settings.count);
     let strides: &[u32] = if settings.progressive { &PASS_STRIDES } else { &[1] };
     let mut previous = 0u32;
     for &stride in strides {
@@ -82,6 +81,29 @@ pub fn render_progressive<A: Accelerator>(
     Ok(frame)
 }
 
+/// `render_progressive` for a caller that keeps each pass's frame (the app shows them while it
+/// refines): a coarse pass is handed on as a snapshot of its traced pixels (1/stride² of the frame),
+/// the last pass as the frame itself, uncopied.
+pub fn render_passes<A: Accelerator>(
+    accel: &A,
+    mesh: &Mesh,
+    camera: &Camera,
+    settings: &RenderSettings,
+    control: &WorkControl,
+    mut on_pass: impl FnMut(Frame, PassInfo),
+) -> Result<(), Cancelled> {
+    let mut last = None;
+    let frame = render_progressive(accel, mesh, camera, settings, control, |frame, info| {
+        if frame.is_complete() {
+            last = Some(*info);
+        } else {
+            on_pass(frame.snapshot(), *info);
+        }
+    })?;
+    on_pass(frame, last.expect("the last pass is complete"));
+    Ok(())
+}
+
 /// Trace the pixels on the `stride` grid that the `previous` grid (0: none) did not cover.
 #[allow(clippy::too_many_arguments)]
 fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
@@ -96,7 +118,7 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
 ) -> u64 {
     let gen = camera.ray_gen();
     let w = frame.width;
-    for_each_band(frame, control, |y0, rows, samples| {
+    for_each_band(frame, control, |y0, rows, samples, counters| {
         let mut traced = 0u64;
         for x0 in (0..w).step_by(TILE as usize) {
             for dy in (0..rows).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
@@ -108,7 +130,11 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
                     let mut ray = gen.pixel_ray(x, y);
                     let mut stats = S::default();
                     let hit = accel.closest_hit(&mut ray, trace, &mut stats);
-                    samples[(dy * w + x) as usize] = sample(mesh, &ray, hit, stats.into());
+                    let i = (dy * w + x) as usize;
+                    samples[i] = sample(mesh, &ray, hit);
+                    if let Some(c) = counters.get_mut(i) {
+                        *c = stats.into();
+                    }
                     traced += 1;
                 }
             }
@@ -117,25 +143,33 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
     })
 }
 
-/// Run `trace_band(y0, rows, samples)` on each band of `TILE` rows in parallel (rayon), skipping
-/// bands once the control is cancelled; the closure returns the rays it traced, which are added to
-/// the control's progress and summed.
+/// Run `trace_band(y0, rows, samples, counters)` on each band of `TILE` rows in parallel (rayon),
+/// skipping bands once the control is cancelled; `counters` is the band's counters, or empty when
+/// the frame does not count. The closure returns the rays it traced, which are added to the
+/// control's progress and summed.
 fn for_each_band(
     frame: &mut Frame,
     control: &WorkControl,
-    trace_band: impl Fn(u32, u32, &mut [PixelSample]) -> u64 + Sync,
+    trace_band: impl Fn(u32, u32, &mut [PixelSample], &mut [RayCounters]) -> u64 + Sync,
 ) -> u64 {
-    let w = frame.width;
-    frame
-        .samples
-        .par_chunks_mut((w * TILE) as usize)
+    let band = (frame.width * TILE) as usize;
+    let w = frame.width as usize;
+    let (samples, counters) = frame.slots_mut();
+    let counter_bands: Vec<&mut [RayCounters]> = if counters.is_empty() {
+        samples.chunks(band).map(|_| Default::default()).collect()
+    } else {
+        counters.chunks_mut(band).collect()
+    };
+    samples
+        .par_chunks_mut(band)
+        .zip(counter_bands)
         .enumerate()
-        .map(|(band, samples)| {
+        .map(|(band, (samples, counters))| {
             if control.is_cancelled() {
                 return 0;
             }
-            let rows = (samples.len() / w as usize) as u32;
-            let traced = trace_band(band as u32 * TILE, rows, samples);
+            let rows = (samples.len() / w) as u32;
+            let traced = trace_band(band as u32 * TILE, rows, samples, counters);
             control.add_done(traced);
             traced
         })
@@ -143,13 +177,13 @@ fn for_each_band(
 }
 
 /// The pixel a ray's closest hit (or miss) shows.
-fn sample(mesh: &Mesh, ray: &Ray, hit: Option<Hit>, counters: RayCounters) -> PixelSample {
+fn sample(mesh: &Mesh, ray: &Ray, hit: Option<Hit>) -> PixelSample {
     match hit {
         Some(hit) => {
             let si = mesh.fill_intersection(ray, hit.prim, hit.triangle_hit());
-            PixelSample { t: hit.t, normal: si.shading_normal, prim: hit.prim, counters }
+            PixelSample { t: hit.t, normal: si.shading_normal, prim: hit.prim }
         }
-        None => PixelSample { counters, ..PixelSample::MISS },
+        None => PixelSample::MISS,
     }
 }
 
@@ -169,7 +203,7 @@ fn trace_pass_packets<A: Accelerator>(
     const _: () = assert!(TILE.is_multiple_of(2 * PASS_STRIDES[0]));
     let gen = camera.ray_gen();
     let w = frame.width;
-    for_each_band(frame, control, |y0, rows, samples| {
+    for_each_band(frame, control, |y0, rows, samples, _| {
         let mut traced = 0u64;
         for x0 in (0..w).step_by(TILE as usize) {
             let x_end = (x0 + TILE).min(w);
@@ -196,7 +230,7 @@ fn trace_pass_packets<A: Accelerator>(
                     let hits = accel.closest_hit4(&mut rays, active, trace);
                     for k in (0..PACKET).filter(|k| active & (1 << k) != 0) {
                         let (px, pdy) = pixel(k);
-                        samples[(pdy * w + px) as usize] = sample(mesh, &rays[k], hits[k], RayCounters::default());
+                        samples[(pdy * w + px) as usize] = sample(mesh, &rays[k], hits[k]);
                         traced += 1;
                     }
                 }
@@ -257,9 +291,12 @@ mod tests {
         assert_eq!(total, 37 * 23, "every pixel traced exactly once over all passes");
         assert_eq!(control.done(), 37 * 23);
         let single = render(&bvh, &mesh, &cam, &settings);
-        assert_eq!(frame.samples, single.samples);
-        assert!(frame.samples.iter().any(|s| s.is_hit()) && frame.samples.iter().any(|s| !s.is_hit()));
-        assert!(frame.samples.iter().all(|s| s.counters.box_tests >= 1), "counters recorded");
+        assert_eq!(frame.full_samples(), single.full_samples());
+        assert!(frame.counted() && single.counted());
+        assert!(frame.traced().eq(single.traced()), "the same counters too");
+        let samples = frame.full_samples().unwrap();
+        assert!(samples.iter().any(|s| s.is_hit()) && samples.iter().any(|s| !s.is_hit()));
+        assert!(frame.traced().all(|(_, c)| c.box_tests >= 1), "counters recorded");
     }
 
     #[test]
@@ -276,13 +313,16 @@ mod tests {
             let frame = render_progressive(&bvh, &mesh, &cam, &plain, &control, |_, p| total += p.rays).unwrap();
             assert_eq!(total, 45 * 29, "{layout:?}: every pixel traced once");
             assert_eq!(control.done(), 45 * 29);
-            assert_eq!(frame.samples, render(&bvh, &mesh, &cam, &plain).samples, "{layout:?}: passes = one pass");
+            let one_pass = render(&bvh, &mesh, &cam, &plain);
+            assert_eq!(frame.full_samples(), one_pass.full_samples(), "{layout:?}: passes = one pass");
+            assert!(!frame.counted());
             let counted = render(&bvh, &mesh, &cam, &RenderSettings { count: true, ..Default::default() });
-            let hits = frame.samples.iter().filter(|s| s.is_hit()).count();
+            let samples = frame.full_samples().unwrap();
+            let hits = samples.iter().filter(|s| s.is_hit()).count();
             assert!(hits > 100 && hits < 45 * 29, "{layout:?}: {hits} hits");
-            for (i, (p, c)) in frame.samples.iter().zip(&counted.samples).enumerate() {
+            for (i, (p, c)) in samples.iter().zip(counted.full_samples().unwrap()).enumerate() {
                 assert_eq!(p.t.to_bits(), c.t.to_bits(), "{layout:?}: pixel {i}");
-                assert_eq!(p.counters, RayCounters::default());
+                assert!(counted.counters(i as u32 % 45, i as u32 / 45).box_tests >= 1, "{layout:?}: pixel {i}");
             }
         }
     }

@@ -1,9 +1,10 @@
 //! Turning a frame into pixels: the normal view (n·0.5+0.5, as the handout's normal integrator),
 //! depth, and heatmaps of per-ray work through a perceptual colour map.
 
-use super::{ColorMap, Frame, PixelSample};
-use crate::bvh::SahCost;
+use super::{ColorMap, Frame};
+use crate::bvh::{RayCounters, SahCost};
 use image::RgbImage;
+use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum View {
@@ -72,14 +73,14 @@ impl View {
     }
 
     /// The heatmap's value for one ray.
-    pub fn metric(self, s: &PixelSample, cost: SahCost) -> f32 {
+    pub fn metric(self, c: &RayCounters, cost: SahCost) -> f32 {
         match self {
-            View::Visits => s.counters.nodes_visited as f32,
-            View::TriTests => s.counters.triangle_tests as f32,
-            View::Cost => s.counters.cost(cost),
-            View::TopVisits => s.counters.top_nodes_visited as f32,
-            View::BottomVisits => s.counters.bottom_nodes_visited() as f32,
-            View::Instances => s.counters.instances_entered as f32,
+            View::Visits => c.nodes_visited as f32,
+            View::TriTests => c.triangle_tests as f32,
+            View::Cost => c.cost(cost),
+            View::TopVisits => c.top_nodes_visited as f32,
+            View::BottomVisits => c.bottom_nodes_visited() as f32,
+            View::Instances => c.instances_entered as f32,
             View::Normals | View::Depth => 0.0,
         }
     }
@@ -111,8 +112,8 @@ pub struct Legend {
 /// Min, max and mean of a heatmap metric over the traced rays.
 pub fn metric_stats(frame: &Frame, view: View, cost: SahCost) -> (f32, f32, f64) {
     let (mut lo, mut hi, mut sum, mut n) = (f32::INFINITY, f32::NEG_INFINITY, 0f64, 0u64);
-    for s in frame.traced() {
-        let v = view.metric(s, cost);
+    for (_, c) in frame.traced() {
+        let v = view.metric(&c, cost);
         lo = lo.min(v);
         hi = hi.max(v);
         sum += v as f64;
@@ -125,7 +126,9 @@ pub fn metric_stats(frame: &Frame, view: View, cost: SahCost) -> (f32, f32, f64)
     }
 }
 
-/// The frame as an RGB image in the given view; for heatmaps also the legend's numbers.
+/// The frame as an RGB image in the given view, one pixel per traced pixel (so a coarse pass's image
+/// is 1/stride of the frame in each direction, to be shown stretched); for heatmaps also the
+/// legend's numbers.
 pub fn view_image(
     frame: &Frame,
     view: View,
@@ -133,39 +136,35 @@ pub fn view_image(
     range: HeatRange,
     cost: SahCost,
 ) -> (RgbImage, Option<Legend>) {
-    let (w, h) = (frame.width, frame.height);
+    let black = [0, 0, 0];
     match view {
         View::Normals => (
-            RgbImage::from_fn(w, h, |x, y| {
-                let s = frame.sample(x, y);
+            grid_image(frame, |s, _| {
                 let c = (s.normal * 0.5 + 0.5) * 255.0;
                 if s.is_hit() {
-                    image::Rgb([c.x as u8, c.y as u8, c.z as u8])
+                    [c.x as u8, c.y as u8, c.z as u8]
                 } else {
-                    image::Rgb([0, 0, 0])
+                    black
                 }
             }),
             None,
         ),
         View::Depth => {
             let (mut near, mut far) = (f32::INFINITY, 0f32);
-            for s in frame.traced().filter(|s| s.is_hit()) {
+            for (s, _) in frame.traced().filter(|(s, _)| s.is_hit()) {
                 near = near.min(s.t);
                 far = far.max(s.t);
             }
             let span = (far - near).max(1e-20);
-            (
-                RgbImage::from_fn(w, h, |x, y| {
-                    let s = frame.sample(x, y);
-                    if !s.is_hit() {
-                        return image::Rgb([0, 0, 0]);
-                    }
-                    // Near is bright, far is dim but still distinct from the black background.
-                    let g = (255.0 - 200.0 * (s.t - near) / span) as u8;
-                    image::Rgb([g, g, g])
-                }),
-                None,
-            )
+            let img = grid_image(frame, |s, _| {
+                if !s.is_hit() {
+                    return black;
+                }
+                // Near is bright, far is dim but still distinct from the black background.
+                let g = (255.0 - 200.0 * (s.t - near) / span) as u8;
+                [g, g, g]
+            });
+            (img, None)
         }
         _ => {
             let (min, max, mean) = metric_stats(frame, view, cost);
@@ -174,11 +173,56 @@ pub fn view_image(
                 HeatRange::Fixed { min, max } => (min, max),
             };
             let scale = if hi > lo { 1.0 / (hi - lo) } else { 0.0 };
-            let img = RgbImage::from_fn(w, h, |x, y| {
-                image::Rgb(colormap.map((view.metric(frame.sample(x, y), cost) - lo) * scale))
-            });
+            let img = grid_image(frame, |_, c| colormap.map((view.metric(&c, cost) - lo) * scale));
             let title = format!("{} per ray", view.label().to_lowercase());
             (img, Some(Legend { title, colormap, range_min: lo, range_max: hi, min, max, mean }))
+        }
+    }
+}
+
+/// An image of the frame's traced grid, `pixel(sample, counters)` per grid point, rows in parallel.
+fn grid_image(frame: &Frame, pixel: impl Fn(&super::PixelSample, RayCounters) -> [u8; 3] + Sync) -> RgbImage {
+    let (w, h) = frame.grid_size();
+    let mut buf = vec![0u8; w as usize * h as usize * 3];
+    buf.par_chunks_mut(w as usize * 3).enumerate().for_each(|(gy, row)| {
+        for (rgb, (s, c)) in row.chunks_exact_mut(3).zip(frame.grid_row(gy as u32)) {
+            rgb.copy_from_slice(&pixel(s, c));
+        }
+    });
+    RgbImage::from_raw(w, h, buf).expect("the buffer holds w×h pixels")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::{AnyBvh, BuildParams};
+    use crate::render::{render, render_passes, Camera, RenderSettings};
+    use crate::work::WorkControl;
+
+    #[test]
+    fn a_coarse_pass_gives_one_image_pixel_per_traced_pixel() {
+        let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 128, 12);
+        let cam = Camera::framing_from(&mesh.bounds(), 45, 29, glam::Vec3::new(0.3, 0.5, 1.0), 45.0);
+        let bvh = AnyBvh::build(&mesh, &BuildParams::default());
+        let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
+        let mut passes = Vec::new();
+        render_passes(&bvh, &mesh, &cam, &settings, &WorkControl::new(), |f, _| passes.push(f)).unwrap();
+        assert_eq!(passes.iter().map(|f| f.stride).collect::<Vec<_>>(), [8, 4, 2, 1]);
+        let full = passes.last().unwrap();
+        assert_eq!(full.full_samples(), render(&bvh, &mesh, &cam, &settings).full_samples());
+        let cost = SahCost::default();
+        let range = HeatRange::Fixed { min: 0.0, max: 60.0 };
+        for view in [View::Normals, View::Visits, View::TriTests, View::Cost] {
+            let (reference, _) = view_image(full, view, ColorMap::Viridis, range, cost);
+            assert_eq!(reference.dimensions(), (45, 29));
+            for f in &passes {
+                let (img, _) = view_image(f, view, ColorMap::Viridis, range, cost);
+                let s = f.stride;
+                assert_eq!(img.dimensions(), (45u32.div_ceil(s), 29u32.div_ceil(s)), "{view:?} 1/{s}");
+                for (gx, gy, p) in img.enumerate_pixels() {
+                    assert_eq!(p, reference.get_pixel(gx * s, gy * s), "{view:?} 1/{s}: pixel ({gx}, {gy})");
+                }
+            }
         }
     }
 }

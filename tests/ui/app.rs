@@ -330,3 +330,41 @@ fn default_view_snapshot() {
         .output_path(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/snapshots"));
     h.snapshot_options("default_view", &options);
 }
+
+#[test]
+fn a_coarse_pass_is_shown_in_place_at_its_resolution_snapshot() {
+    use bvhscope::render::{render_passes, view_image, RenderSettings};
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1200.0, 760.0))
+        .wgpu()
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+    run_until(&mut h, "the first full frame", idle);
+    // The 1/8 pass of the frame on screen, put where the render job would put it.
+    let app = h.state();
+    let (bvh, mesh, shown) =
+        (app.current_bvh().unwrap().bvh.clone(), app.scene.mesh.clone(), app.shown.as_ref().unwrap());
+    let (camera, style) = (shown.camera, shown.style);
+    assert_ne!(camera.width % 8, 0, "a partly covered last column is part of the test");
+    let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
+    let mut coarse = None;
+    render_passes(&*bvh, &mesh, &camera, &settings, &Default::default(), |f, _| {
+        if f.stride == 8 {
+            coarse = Some(f);
+        }
+    })
+    .unwrap();
+    let coarse = coarse.unwrap();
+    let (img, _) = view_image(&coarse, style.view, style.colormap, style.range, style.cost);
+    assert_eq!(img.width(), camera.width.div_ceil(8));
+    let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
+    let shown = h.state_mut().shown.as_mut().unwrap();
+    shown.texture.set(image, egui::TextureOptions::NEAREST);
+    shown.frame = Arc::new(coarse);
+    h.step();
+    h.step();
+    assert!(h.query_by_label_contains("1/8 resolution").is_some(), "the status line names the pass");
+    let options = egui_kittest::SnapshotOptions::default()
+        .max_failed_pixels(4000)
+        .output_path(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/snapshots"));
+    h.snapshot_options("coarse_pass", &options);
+}
