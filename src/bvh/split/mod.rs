@@ -157,24 +157,21 @@ pub(crate) fn leaf_is_cheaper(n: usize, weighted: f32, node: &NodeInfo, params: 
 }
 
 /// Move the elements satisfying `left` to the front; returns how many there are. Unstable.
+///
+/// Branch-free Lomuto: every element is swapped with the first non-left one (a no-op while there
+/// is none) and the boundary advances by the predicate's 0 or 1. In the top levels `left` is a coin
+/// toss the branch predictor loses half the time; two extra moves per element cost less.
 #[inline]
-pub(crate) fn partition<T>(items: &mut [T], mut left: impl FnMut(&T) -> bool) -> usize {
-    let mut i = 0;
-    let mut j = items.len();
-    loop {
-        while i < j && left(&items[i]) {
-            i += 1;
-        }
-        while i < j && !left(&items[j - 1]) {
-            j -= 1;
-        }
-        if i >= j {
-            return i;
-        }
-        items.swap(i, j - 1);
-        i += 1;
-        j -= 1;
+pub(crate) fn partition<T: Copy>(items: &mut [T], mut left: impl FnMut(&T) -> bool) -> usize {
+    let mut boundary = 0;
+    for i in 0..items.len() {
+        let x = items[i];
+        let goes_left = left(&x);
+        items[i] = items[boundary];
+        items[boundary] = x;
+        boundary += goes_left as usize;
     }
+    boundary
 }
 
 #[cfg(test)]

@@ -49,6 +49,11 @@ impl Acc {
         let e = (self.max - self.min).max(Vec3A::ZERO);
         2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
     }
+
+    #[inline(always)]
+    fn of(p: &BuildPrim) -> Acc {
+        Acc { min: p.min(), max: p.max() }
+    }
 }
 
 pub fn split_sah_binned(
@@ -58,11 +63,14 @@ pub fn split_sah_binned(
     scratch: &mut SplitScratch,
 ) -> SplitDecision {
     let n = prims.len();
+    let cb = node.centroid_bounds;
+    let extent = cb.max - cb.min;
+    if n == 2 {
+        return split_two(prims, extent, node, params);
+    }
     // A node of n triangles can use at most n non-empty bins per axis; sweeping more only costs
     // time in the many small nodes near the leaves (the same planes are found).
     let bins = (params.sah_bins as usize).min(n.max(4)).clamp(2, MAX_BINS);
-    let cb = node.centroid_bounds;
-    let extent = cb.max - cb.min;
     // Axes with no extent cannot be split by a plane; their scale 0 puts everything in bin 0.
     let scale: [f32; 3] = std::array::from_fn(|a| if extent[a] > 0.0 { bins as f32 / extent[a] } else { 0.0 });
     let (lo, sc, top) = (Vec3A::from(cb.min), Vec3A::from(Vec3::from(scale)), Vec3A::splat((bins - 1) as f32));
@@ -105,32 +113,38 @@ pub fn split_sah_binned(
     } else {
         bin_into(all, prims);
     }
+    // The three axes are swept together, plane by plane: three independent chains of box unions
+    // instead of one, which the CPU overlaps.
     let right_area = &mut scratch.areas;
     right_area.clear();
-    right_area.resize(bins, 0.0);
-    let mut best: Option<(f32, usize, usize)> = None; // (weighted cost, axis, plane)
-    for axis in (0..3).filter(|&a| extent[a] > 0.0) {
-        let b = &all[axis * bins..(axis + 1) * bins];
-        // right_area[i]: area of bins i..; plane i separates bins ..i from i..
-        let mut acc = Acc::EMPTY;
-        for i in (1..bins).rev() {
-            acc.add(&b[i]);
-            right_area[i] = acc.area();
-        }
-        let (mut acc, mut left) = (Acc::EMPTY, 0u32);
-        for i in 1..bins {
-            acc.add(&b[i - 1]);
-            left += b[i - 1].count;
-            let right = n as u32 - left;
-            if left == 0 || right == 0 {
-                continue;
-            }
-            let cost = acc.area() * left as f32 + right_area[i] * right as f32;
-            if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, axis, i));
-            }
+    right_area.resize(3 * bins, 0.0);
+    let bin = |axis: usize, i: usize| &all[axis * bins + i];
+    // right_area[3i + axis]: area of the bins i.. of that axis; plane i separates bins ..i from i..
+    let mut acc = [Acc::EMPTY; 3];
+    for i in (1..bins).rev() {
+        for axis in 0..3 {
+            acc[axis].add(bin(axis, i));
+            right_area[3 * i + axis] = acc[axis].area();
         }
     }
+    let splittable = extent.to_array().map(|e| e > 0.0);
+    let (mut acc, mut left) = ([Acc::EMPTY; 3], [0u32; 3]);
+    let (mut best_cost, mut best_axis, mut best_plane) = (f32::INFINITY, 0, 0);
+    for i in 1..bins {
+        for axis in 0..3 {
+            let b = bin(axis, i - 1);
+            acc[axis].add(b);
+            left[axis] += b.count;
+            let right = n as u32 - left[axis];
+            let cost = acc[axis].area() * left[axis] as f32 + right_area[3 * i + axis] * right as f32;
+            // Written to compile to selects, not branches: most planes lose.
+            let better = cost < best_cost && left[axis] != 0 && right != 0 && splittable[axis];
+            best_cost = if better { cost } else { best_cost };
+            best_axis = if better { axis } else { best_axis };
+            best_plane = if better { i } else { best_plane };
+        }
+    }
+    let best = (best_plane != 0).then_some((best_cost, best_axis, best_plane));
     let Some((weighted, axis, plane)) = best else {
         return SplitDecision::Fallback; // all centroids coincide
     };
@@ -148,4 +162,21 @@ pub fn split_sah_binned(
         "the partition sends left exactly the triangles binned left of the plane"
     );
     SplitDecision::Split { axis: axis as u8, mid }
+}
+
+/// Two triangles: every plane between their centroids makes the same two one-triangle children, so
+/// their cost is computed directly (what the bins would give, without them); the axis is the first
+/// with extent, as the sweep would pick, and the triangle of the lower centroid goes left.
+fn split_two(prims: &mut [BuildPrim], extent: Vec3, node: &NodeInfo, params: &BuildParams) -> SplitDecision {
+    let Some(axis) = (0..3).find(|&a| extent[a] > 0.0) else {
+        return SplitDecision::Fallback; // both centroids coincide
+    };
+    let weighted = Acc::of(&prims[0]).area() + Acc::of(&prims[1]).area();
+    if leaf_is_cheaper(2, weighted, node, params) {
+        return SplitDecision::Leaf;
+    }
+    if prims[0].centroid()[axis] > prims[1].centroid()[axis] {
+        prims.swap(0, 1);
+    }
+    SplitDecision::Split { axis: axis as u8, mid: 1 }
 }
