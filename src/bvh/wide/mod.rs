@@ -19,6 +19,7 @@ use super::tree::{NodeKind, NodeView, TreeView};
 use super::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use glam::Vec3;
+use rayon::prelude::*;
 use std::time::Instant;
 
 pub const WIDTH: usize = 4;
@@ -93,7 +94,10 @@ impl WideBvh {
         // tree of k nodes has (k - 1) / 2); reserving that third up front avoids regrowing a vector
         // of 128-byte nodes several times on big meshes.
         let mut nodes = Vec::with_capacity(b.len() / 6 + 1);
-        nodes.push(WideNode::EMPTY);
+        // Touched in parallel first: faulting in the fresh pages of a big array is a good part of
+        // the collapse's time, and it splits over threads.
+        nodes.par_extend(rayon::iter::repeat_n(WideNode::EMPTY, b.len() / 6 + 1));
+        nodes.truncate(1);
         if b[0].is_leaf() || bvh.prim_ids.is_empty() {
             if b[0].count > 0 {
                 nodes[0].set(0, b[0].bounds, b[0].index, b[0].count as u8);
