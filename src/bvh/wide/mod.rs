@@ -14,7 +14,7 @@
 
 mod traverse;
 
-use super::node::Bvh;
+use super::node::{Bvh, BvhNode};
 use super::tree::{NodeKind, NodeView, TreeView};
 use super::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
@@ -90,53 +90,151 @@ impl WideBvh {
         let start = Instant::now();
         let root_bounds = bvh.root_bounds();
         let b = &bvh.nodes;
-        // Each wide node takes the place of up to three binary interior nodes (of which a binary
-        // tree of k nodes has (k - 1) / 2); reserving that third up front avoids regrowing a vector
-        // of 128-byte nodes several times on big meshes.
-        let mut nodes = Vec::with_capacity(b.len() / 6 + 1);
-        // Touched in parallel first: faulting in the fresh pages of a big array is a good part of
-        // the collapse's time, and it splits over threads.
-        nodes.par_extend(rayon::iter::repeat_n(WideNode::EMPTY, b.len() / 6 + 1));
-        nodes.truncate(1);
-        if b[0].is_leaf() || bvh.prim_ids.is_empty() {
+        let nodes = if b[0].is_leaf() || bvh.prim_ids.is_empty() {
+            let mut root = WideNode::EMPTY;
             if b[0].count > 0 {
-                nodes[0].set(0, b[0].bounds, b[0].index, b[0].count as u8);
+                root.set(0, b[0].bounds, b[0].index, b[0].count as u8);
             }
+            vec![root]
+        } else if b.len() < PARALLEL_MIN_NODES {
+            collapse_sequential(b, 0, b.len())
         } else {
-            let mut stack = vec![(0usize, 0usize)]; // (binary node, wide node to fill)
-            while let Some((bin, wide)) = stack.pop() {
-                let mut kids = [0usize; WIDTH];
-                let (l, r) = (b[bin].index as usize, b[bin].index as usize + 1);
-                kids[0] = l;
-                kids[1] = r;
-                let mut n = 2;
-                while n < WIDTH {
-                    let open = (0..n)
-                        .filter(|&k| !b[kids[k]].is_leaf())
-                        .max_by(|&x, &y| b[kids[x]].bounds.area().total_cmp(&b[kids[y]].bounds.area()));
-                    let Some(k) = open else { break };
-                    let first = b[kids[k]].index as usize;
-                    kids[k] = first;
-                    kids[n] = first + 1;
-                    n += 1;
-                }
-                for (slot, &k) in kids[..n].iter().enumerate() {
-                    let node = &b[k];
-                    if node.is_leaf() {
-                        nodes[wide].set(slot, node.bounds, node.index, node.count as u8);
-                    } else {
-                        let child = nodes.len();
-                        nodes.push(WideNode::EMPTY);
-                        nodes[wide].set(slot, node.bounds, child as u32, 0);
-                        stack.push((k, child));
-                    }
-                }
-            }
-        }
+            collapse_parallel(b, 0, 0).into_nodes()
+        };
         let mut report = bvh.report;
         report.collapse_time = start.elapsed();
         let params = BuildParams { layout: super::Layout::Wide4, ..bvh.params };
         WideBvh { nodes, prim_ids: bvh.prim_ids, tris: bvh.tris, root_bounds, params, report }
+    }
+}
+
+/// The binary nodes a wide node over interior binary node `bin` takes as its children: its two
+/// children, then, while fewer than four, the interior one of largest surface area replaced by
+/// its own two.
+fn wide_children(b: &[BvhNode], bin: usize) -> ([usize; WIDTH], usize) {
+    let mut kids = [0usize; WIDTH];
+    kids[0] = b[bin].index as usize;
+    kids[1] = kids[0] + 1;
+    let mut n = 2;
+    while n < WIDTH {
+        let open = (0..n)
+            .filter(|&k| !b[kids[k]].is_leaf())
+            .max_by(|&x, &y| b[kids[x]].bounds.area().total_cmp(&b[kids[y]].bounds.area()));
+        let Some(k) = open else { break };
+        let first = b[kids[k]].index as usize;
+        kids[k] = first;
+        kids[n] = first + 1;
+        n += 1;
+    }
+    (kids, n)
+}
+
+/// Collapse the subtree under interior binary node `root` with an explicit stack; node 0 of the
+/// result is its wide root, child indices are local. `expected` binary nodes are under the root.
+fn collapse_sequential(b: &[BvhNode], root: usize, expected: usize) -> Vec<WideNode> {
+    // Each wide node takes the place of up to three binary interior nodes (half the nodes are
+    // interior); reserving that up front avoids regrowing a vector of 128-byte nodes.
+    let mut nodes = Vec::with_capacity(expected / 6 + 1);
+    nodes.push(WideNode::EMPTY);
+    let mut stack = vec![(root, 0usize)]; // (binary node, wide node to fill)
+    while let Some((bin, wide)) = stack.pop() {
+        let (kids, n) = wide_children(b, bin);
+        for (slot, &k) in kids[..n].iter().enumerate() {
+            let node = &b[k];
+            if node.is_leaf() {
+                nodes[wide].set(slot, node.bounds, node.index, node.count as u8);
+            } else {
+                let child = nodes.len();
+                nodes.push(WideNode::EMPTY);
+                nodes[wide].set(slot, node.bounds, child as u32, 0);
+                stack.push((k, child));
+            }
+        }
+    }
+    nodes
+}
+
+/// Binary trees at least this big are collapsed in parallel ...
+const PARALLEL_MIN_NODES: usize = 1 << 15;
+/// ... their top wide levels one by one, the subtrees below (up to 4³) on rayon.
+const PARALLEL_DEPTH: u32 = 3;
+
+/// A collapsed subtree as the parallel collapse returns it, written into one array at the end.
+enum WideTree {
+    /// Node 0 is the root; child indices are local to the vector.
+    Flat(Vec<WideNode>),
+    /// A wide node whose interior slots are filled in by `into_nodes`, and its interior children.
+    Node { node: WideNode, kids: Vec<(usize, WideTree)>, len: usize },
+}
+
+fn collapse_parallel(b: &[BvhNode], bin: usize, depth: u32) -> WideTree {
+    if depth >= PARALLEL_DEPTH {
+        // A guess (the tree is near balanced); the vector grows if it is short.
+        return WideTree::Flat(collapse_sequential(b, bin, b.len() >> (2 * depth)));
+    }
+    let (kids, n) = wide_children(b, bin);
+    let mut node = WideNode::EMPTY;
+    let mut interior = Vec::new();
+    for (slot, &k) in kids[..n].iter().enumerate() {
+        let c = &b[k];
+        // Interior slots get their child index when the tree is written out.
+        node.set(slot, c.bounds, if c.is_leaf() { c.index } else { u32::MAX }, c.count as u8);
+        if !c.is_leaf() {
+            interior.push((slot, k));
+        }
+    }
+    let kids: Vec<(usize, WideTree)> =
+        interior.into_par_iter().map(|(slot, k)| (slot, collapse_parallel(b, k, depth + 1))).collect();
+    let len = 1 + kids.iter().map(|(_, t)| t.len()).sum::<usize>();
+    WideTree::Node { node, kids, len }
+}
+
+impl WideTree {
+    fn len(&self) -> usize {
+        match self {
+            WideTree::Flat(nodes) => nodes.len(),
+            WideTree::Node { len, .. } => *len,
+        }
+    }
+
+    /// One array, each subtree contiguous after its parent (child subtrees in slot order).
+    fn into_nodes(self) -> Vec<WideNode> {
+        let mut nodes = Vec::with_capacity(self.len());
+        // Filled in parallel: first touch of fresh pages is much of the cost of a big array.
+        nodes.par_extend(rayon::iter::repeat_n(WideNode::EMPTY, self.len()));
+        self.write(&mut nodes, 0);
+        nodes
+    }
+
+    /// Write into `out`, whose first node has global index `base`.
+    fn write(self, out: &mut [WideNode], base: u32) {
+        match self {
+            WideTree::Flat(nodes) => {
+                for (to, from) in out.iter_mut().zip(nodes) {
+                    *to = from;
+                    for slot in 0..WIDTH {
+                        if to.valid & (1 << slot) != 0 && to.count[slot] == 0 {
+                            to.child[slot] += base;
+                        }
+                    }
+                }
+            }
+            WideTree::Node { mut node, kids, .. } => {
+                let (root, mut rest) = out.split_first_mut().expect("room for the node");
+                let mut jobs = Vec::with_capacity(kids.len());
+                let mut next = base + 1;
+                for (slot, tree) in kids {
+                    node.child[slot] = next;
+                    let len = tree.len();
+                    let (mine, others) = rest.split_at_mut(len);
+                    jobs.push((tree, mine, next));
+                    next += len as u32;
+                    rest = others;
+                }
+                *root = node;
+                jobs.into_par_iter().for_each(|(tree, out, base)| tree.write(out, base));
+            }
+        }
     }
 }
 
@@ -181,5 +279,42 @@ impl TreeView for WideBvh {
 
     fn report(&self) -> &BuildReport {
         &self.report
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::BuildParams;
+
+    /// The tree as (depth, bounds, kind) in walk order, which follows slots, not node indices.
+    fn shape(w: &WideBvh) -> Vec<(u32, Aabb, NodeKind)> {
+        let mut out = Vec::new();
+        w.walk(&mut |v| {
+            out.push((v.depth, v.bounds, v.kind));
+            true
+        });
+        out
+    }
+
+    #[test]
+    fn the_parallel_collapse_makes_the_same_tree_as_the_sequential_one() {
+        let mesh = crate::mesh::generate::torus(2.0, 0.5, 256, 160);
+        let binary = Bvh::build(&mesh, &BuildParams { layout: crate::bvh::Layout::Binary, ..Default::default() });
+        assert!(binary.nodes.len() >= PARALLEL_MIN_NODES, "big enough to collapse in parallel");
+        let parallel = WideBvh::from_binary(binary.clone());
+        let sequential =
+            WideBvh { nodes: collapse_sequential(&binary.nodes, 0, binary.nodes.len()), ..parallel.clone() };
+        assert_eq!(parallel.nodes.len(), sequential.nodes.len());
+        assert!(shape(&parallel) == shape(&sequential), "the same nodes under the same parents");
+        // Every interior slot points at a distinct node, and every node but the root is pointed at once.
+        let mut seen = vec![0u32; parallel.nodes.len()];
+        for n in &parallel.nodes {
+            for slot in n.slots().filter(|&s| n.count[s] == 0) {
+                seen[n.child[slot] as usize] += 1;
+            }
+        }
+        assert_eq!(seen[0], 0);
+        assert!(seen[1..].iter().all(|&c| c == 1));
     }
 }
