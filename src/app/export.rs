@@ -2,7 +2,7 @@
 //! or JSON (current strategy and the one before).
 
 use super::{BvhscopeApp, StrategyFigures};
-use crate::render::{draw_legend, view_image};
+use crate::render::{draw_legend, full_size, view_image};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -26,6 +26,8 @@ pub fn save_png(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
     let shown = app.shown.as_ref().ok_or("nothing rendered yet")?;
     let s = shown.style;
     let (img, legend) = view_image(&shown.frame, s.view, s.colormap, s.range, s.cost);
+    // A coarse pass's image has a pixel per traced pixel; the file has the frame's size.
+    let img = full_size(&img, &shown.frame);
     let img = match &legend {
         Some(l) => draw_legend(&img, l),
         None => img,

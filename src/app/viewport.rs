@@ -47,10 +47,10 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         // A coarse pass's image has a texel per traced pixel; its last row and column may cover
         // pixels past the frame's edge, which the uv range leaves out.
         let f = &shown.frame;
-        let ((cols, rows), s) = (f.grid_size(), f.stride.max(1) as f32);
+        let ((cols, rows), s) = (f.grid_size(), f.stride().max(1) as f32);
         let uv = Rect::from_min_max(
             Pos2::ZERO,
-            Pos2::new(f.width as f32 / (cols as f32 * s), f.height as f32 / (rows as f32 * s)),
+            Pos2::new(f.width() as f32 / (cols as f32 * s), f.height() as f32 / (rows as f32 * s)),
         );
         painter.image(shown.texture.id(), rect, uv, Color32::WHITE);
     } else {
@@ -117,7 +117,7 @@ fn pixel_at(frame: &Frame, rect: Rect, pos: Pos2) -> Option<(u32, u32)> {
     if !(0.0..1.0).contains(&u) || !(0.0..1.0).contains(&v) {
         return None;
     }
-    Some(((u * frame.width as f32) as u32, (v * frame.height as f32) as u32))
+    Some(((u * frame.width() as f32) as u32, (v * frame.height() as f32) as u32))
 }
 
 fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
@@ -147,9 +147,9 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
                 ui.end_row();
             }
         }
-        if frame.stride > 1 {
+        if frame.stride() > 1 {
             ui.label("");
-            ui.weak(format!("coarse pass: traced pixel of a {0}×{0} block", frame.stride));
+            ui.weak(format!("coarse pass: traced pixel of a {0}×{0} block", frame.stride()));
             ui.end_row();
         }
     });

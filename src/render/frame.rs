@@ -2,10 +2,11 @@
 //! beside it when the render counted.
 //!
 //! Samples and counters live in two arrays, and the counters only when asked for: the plain
-//! view's frame stays small (20 bytes a pixel, 18 MB at 1280×720), and a counted frame is two
-//! allocations under glibc's 32 MiB mmap limit rather than one above it. One array of 48-byte
-//! samples was freshly mapped, faulted in and unmapped on every frame, which cost the app's
-//! frame about 20 ms (BENCHMARKS.md, "The frame regression").
+//! view's frame stays small (20 bytes a pixel, 18 MB at 1280×720). One array of 48-byte samples
+//! (44 MB at 1280×720, past the 32 MiB up to which glibc's malloc reuses freed memory) was freshly
+//! mapped, faulted in and unmapped on every frame, which cost the app's frame about 20 ms
+//! (BENCHMARKS.md, "The frame regression"); larger views pass that limit whatever the layout, so
+//! dropped frames' storage is kept for the next (`Spare`).
 
 use crate::bvh::RayCounters;
 use glam::Vec3;
@@ -37,12 +38,15 @@ impl PixelSample {
 /// The renderer's working frame stores a slot for every pixel (later passes fill the gaps); a
 /// `snapshot` of a coarse pass stores only the traced pixels, so handing it on costs 1/stride² of
 /// the full frame.
+///
+/// The fields are private: the indexing depends on them together (`step` divides `stride`).
 #[derive(Clone, Debug)]
 pub struct Frame {
-    pub width: u32,
-    pub height: u32,
-    /// 1 when every pixel was traced; 8, 4 or 2 after a coarse pass; 0 before any pass.
-    pub stride: u32,
+    width: u32,
+    height: u32,
+    /// 1 when every pixel was traced; 8, 4 or 2 after a coarse pass; 0 before any pass. Set by
+    /// the renderer after each pass.
+    pub(super) stride: u32,
     /// Pixel spacing of the stored samples: 1, or `stride` in a snapshot.
     step: u32,
     /// Row by row over the stored grid.
@@ -65,6 +69,19 @@ impl Frame {
         Self { width, height, stride: 0, step: 1, samples, counters }
     }
 
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// 1 when every pixel was traced; 8, 4 or 2 after a coarse pass; 0 before any pass.
+    pub fn stride(&self) -> u32 {
+        self.stride
+    }
+
     pub fn is_complete(&self) -> bool {
         self.stride == 1
     }
@@ -80,10 +97,17 @@ impl Frame {
         (self.width.div_ceil(s), self.height.div_ceil(s))
     }
 
+    /// Stored slots from one traced pixel to the next in a row (1 in a snapshot).
+    #[inline]
+    fn slots_per_grid_step(&self) -> usize {
+        debug_assert!(self.stride.max(1).is_multiple_of(self.step), "step divides stride");
+        (self.stride.max(1) / self.step) as usize
+    }
+
     /// Index of the stored slot of traced grid point (gx, gy).
     #[inline]
     fn grid_index(&self, gx: u32, gy: u32) -> usize {
-        let per_step = (self.stride.max(1) / self.step) as usize;
+        let per_step = self.slots_per_grid_step();
         let cols = self.width.div_ceil(self.step) as usize;
         gy as usize * per_step * cols + gx as usize * per_step
     }
@@ -116,7 +140,7 @@ impl Frame {
     /// Row `gy` of the traced grid: each traced sample with its counters (zero when uncounted).
     pub fn grid_row(&self, gy: u32) -> impl Iterator<Item = (&PixelSample, RayCounters)> + '_ {
         let (cols, _) = self.grid_size();
-        let per = (self.stride.max(1) / self.step) as usize;
+        let per = self.slots_per_grid_step();
         let start = self.grid_index(0, gy);
         let counters = self.counters.get(start..).unwrap_or_default().iter().step_by(per).copied();
         let samples = self.samples[start..].iter().step_by(per).take(cols as usize);
@@ -142,22 +166,31 @@ impl Frame {
         let (cols, rows) = self.grid_size();
         let n = cols as usize * rows as usize;
         let (mut samples, mut counters) = Spare::take(n, self.counted());
-        // Rows in parallel: the gather is memory-bound.
-        samples.resize(n, PixelSample::MISS);
-        samples.par_chunks_mut(cols as usize).enumerate().for_each(|(gy, row)| {
-            for (to, (from, _)) in row.iter_mut().zip(self.grid_row(gy as u32)) {
-                *to = *from;
-            }
-        });
+        self.gather(&mut samples, PixelSample::MISS, |(s, _)| *s);
         if self.counted() {
-            counters.resize(n, RayCounters::ZERO);
-            counters.par_chunks_mut(cols as usize).enumerate().for_each(|(gy, row)| {
-                for (to, (_, from)) in row.iter_mut().zip(self.grid_row(gy as u32)) {
-                    *to = from;
-                }
-            });
+            self.gather(&mut counters, RayCounters::ZERO, |(_, c)| c);
         }
         Frame { width: self.width, height: self.height, stride: self.stride, step: self.stride, samples, counters }
+    }
+
+    /// Fill the empty `out` with `pick` of each traced pixel, row by row of the grid; rows in
+    /// parallel, as the gather is memory-bound (`fill` only sizes the vector first).
+    fn gather<T: Copy + Send + Sync>(
+        &self,
+        out: &mut Vec<T>,
+        fill: T,
+        pick: impl Fn((&PixelSample, RayCounters)) -> T + Sync,
+    ) {
+        let (cols, rows) = self.grid_size();
+        out.par_extend(rayon::iter::repeat_n(fill, cols as usize * rows as usize));
+        if cols == 0 {
+            return;
+        }
+        out.par_chunks_mut(cols as usize).enumerate().for_each(|(gy, row)| {
+            for (to, from) in row.iter_mut().zip(self.grid_row(gy as u32)) {
+                *to = pick(from);
+            }
+        });
     }
 
     /// The full-resolution frame's storage, for the renderer to fill: samples and counters
@@ -186,8 +219,9 @@ impl Drop for Frame {
 /// of a frame's size is mapped anew by the system allocator, its pages faulted in on first touch
 /// and unmapped again when freed; on this machine that cost more than tracing the bunny's frame
 /// (BENCHMARKS.md, "The frame regression"). The app drops a frame and its three coarse snapshots
-/// per render, so the last `Spare::KEPT` vectors of each kind are kept (first in, first out);
-/// vectors under `Spare::MIN_BYTES` are left to the allocator.
+/// per render, so the last `Spare::KEPT` vectors of each kind are kept (first in, first out), at
+/// most `Spare::MAX_BYTES` of each: at the app's largest view (2560×1440) a counted frame and its
+/// snapshots fit, about 230 MB in all. Vectors under `Spare::MIN_BYTES` are left to the allocator.
 struct Spare {
     samples: Vec<Vec<PixelSample>>,
     counters: Vec<Vec<RayCounters>>,
@@ -198,6 +232,7 @@ static SPARE: std::sync::Mutex<Spare> = std::sync::Mutex::new(Spare { samples: V
 impl Spare {
     const KEPT: usize = 4;
     const MIN_BYTES: usize = 1 << 20;
+    const MAX_BYTES: usize = 192 << 20;
 
     /// Empty vectors able to hold `n` samples, and `n` counters if `counted`: the smallest kept
     /// ones large enough, else fresh.
@@ -226,9 +261,10 @@ impl Spare {
     /// Keep a dropped frame's vectors; the oldest kept ones beyond `KEPT` are freed, outside the lock.
     fn keep(samples: Vec<PixelSample>, counters: Vec<RayCounters>) {
         fn push<T>(kept: &mut Vec<Vec<T>>, v: Vec<T>, evicted: &mut Vec<Vec<T>>) {
-            if v.capacity() * size_of::<T>() >= Spare::MIN_BYTES {
+            let bytes = |v: &Vec<T>| v.capacity() * size_of::<T>();
+            if bytes(&v) >= Spare::MIN_BYTES {
                 kept.push(v);
-                if kept.len() > Spare::KEPT {
+                while kept.len() > Spare::KEPT || kept.iter().map(bytes).sum::<usize>() > Spare::MAX_BYTES {
                     evicted.push(kept.remove(0));
                 }
             }
@@ -348,6 +384,25 @@ mod tests {
             assert!(samples.iter().all(|s| *s == PixelSample::MISS));
             assert!(counters.iter().all(|c| *c == RayCounters::ZERO));
             samples.fill(PixelSample { t: 2.0, normal: Vec3::Y, prim: 4 });
+        }
+    }
+
+    #[test]
+    fn frames_without_pixels_give_empty_snapshots_and_images() {
+        for (w, h) in [(0, 5), (5, 0), (0, 0)] {
+            for stride in [2, 1] {
+                let f = traced_frame(w, h, stride, true);
+                let snap = f.snapshot();
+                assert_eq!(snap.traced().count(), 0);
+                let (img, _) = crate::render::view_image(
+                    &snap,
+                    crate::render::View::Visits,
+                    Default::default(),
+                    Default::default(),
+                    Default::default(),
+                );
+                assert_eq!(img.width() * img.height(), 0);
+            }
         }
     }
 

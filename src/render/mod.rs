@@ -14,4 +14,4 @@ pub use colormap::ColorMap;
 pub use frame::{Frame, PixelSample, RaySummary};
 pub use legend::draw_legend;
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
-pub use views::{view_image, HeatRange, Legend, View};
+pub use views::{full_size, view_image, HeatRange, Legend, View};

@@ -117,7 +117,7 @@ fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
     control: &WorkControl,
 ) -> u64 {
     let gen = camera.ray_gen();
-    let w = frame.width;
+    let w = frame.width();
     for_each_band(frame, control, |y0, rows, samples, counters| {
         let mut traced = 0u64;
         for x0 in (0..w).step_by(TILE as usize) {
@@ -152,8 +152,8 @@ fn for_each_band(
     control: &WorkControl,
     trace_band: impl Fn(u32, u32, &mut [PixelSample], &mut [RayCounters]) -> u64 + Sync,
 ) -> u64 {
-    let band = (frame.width * TILE) as usize;
-    let w = frame.width as usize;
+    let band = (frame.width() * TILE) as usize;
+    let w = frame.width() as usize;
     let (samples, counters) = frame.slots_mut();
     let counter_bands: Vec<&mut [RayCounters]> = if counters.is_empty() {
         samples.chunks(band).map(|_| Default::default()).collect()
@@ -202,7 +202,7 @@ fn trace_pass_packets<A: Accelerator>(
 ) -> u64 {
     const _: () = assert!(TILE.is_multiple_of(2 * PASS_STRIDES[0]));
     let gen = camera.ray_gen();
-    let w = frame.width;
+    let w = frame.width();
     for_each_band(frame, control, |y0, rows, samples, _| {
         let mut traced = 0u64;
         for x0 in (0..w).step_by(TILE as usize) {
@@ -283,7 +283,7 @@ mod tests {
         let mut total = 0;
         let control = WorkControl::new();
         let frame = render_progressive(&bvh, &mesh, &cam, &settings, &control, |f, p| {
-            strides.push(f.stride);
+            strides.push(f.stride());
             total += p.rays;
         })
         .unwrap();

@@ -180,10 +180,23 @@ pub fn view_image(
     }
 }
 
+/// `view_image`'s image at the frame's full size: a coarse pass's pixels repeated over the blocks
+/// they stand for (what the app shows stretched, as a file of the frame's size).
+pub fn full_size(img: &RgbImage, frame: &Frame) -> RgbImage {
+    let s = frame.stride().max(1);
+    if img.dimensions() == (frame.width(), frame.height()) {
+        return img.clone();
+    }
+    RgbImage::from_fn(frame.width(), frame.height(), |x, y| *img.get_pixel(x / s, y / s))
+}
+
 /// An image of the frame's traced grid, `pixel(sample, counters)` per grid point, rows in parallel.
 fn grid_image(frame: &Frame, pixel: impl Fn(&super::PixelSample, RayCounters) -> [u8; 3] + Sync) -> RgbImage {
     let (w, h) = frame.grid_size();
     let mut buf = vec![0u8; w as usize * h as usize * 3];
+    if w == 0 {
+        return RgbImage::new(0, h);
+    }
     buf.par_chunks_mut(w as usize * 3).enumerate().for_each(|(gy, row)| {
         for (rgb, (s, c)) in row.chunks_exact_mut(3).zip(frame.grid_row(gy as u32)) {
             rgb.copy_from_slice(&pixel(s, c));
@@ -207,7 +220,7 @@ mod tests {
         let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
         let mut passes = Vec::new();
         render_passes(&bvh, &mesh, &cam, &settings, &WorkControl::new(), |f, _| passes.push(f)).unwrap();
-        assert_eq!(passes.iter().map(|f| f.stride).collect::<Vec<_>>(), [8, 4, 2, 1]);
+        assert_eq!(passes.iter().map(|f| f.stride()).collect::<Vec<_>>(), [8, 4, 2, 1]);
         let full = passes.last().unwrap();
         assert_eq!(full.full_samples(), render(&bvh, &mesh, &cam, &settings).full_samples());
         let cost = SahCost::default();
@@ -217,10 +230,15 @@ mod tests {
             assert_eq!(reference.dimensions(), (45, 29));
             for f in &passes {
                 let (img, _) = view_image(f, view, ColorMap::Viridis, range, cost);
-                let s = f.stride;
+                let s = f.stride();
                 assert_eq!(img.dimensions(), (45u32.div_ceil(s), 29u32.div_ceil(s)), "{view:?} 1/{s}");
                 for (gx, gy, p) in img.enumerate_pixels() {
                     assert_eq!(p, reference.get_pixel(gx * s, gy * s), "{view:?} 1/{s}: pixel ({gx}, {gy})");
+                }
+                let big = full_size(&img, f);
+                assert_eq!(big.dimensions(), (45, 29));
+                for (x, y, p) in big.enumerate_pixels() {
+                    assert_eq!(p, reference.get_pixel(x - x % s, y - y % s), "{view:?} 1/{s} at full size: ({x}, {y})");
                 }
             }
         }

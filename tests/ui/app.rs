@@ -195,8 +195,8 @@ fn the_view_and_the_statistics_can_be_exported() {
     h.run_steps(3); // a new egui Area is measured, unseen, in its first frame
     let frame = h.state().shown.as_ref().unwrap().frame.clone();
     let img = image::open(&png).expect("PNG written").to_rgb8();
-    assert_eq!(img.width(), frame.width.max(176));
-    assert!(img.height() > frame.height, "the heatmap PNG carries its legend below the image");
+    assert_eq!(img.width(), frame.width().max(176));
+    assert!(img.height() > frame.height(), "the heatmap PNG carries its legend below the image");
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(text.starts_with("which,strategy,triangles"), "{text}");
     assert!(text.lines().nth(1).unwrap().starts_with("current,SAH binned,"), "{text}");
@@ -348,7 +348,7 @@ fn a_coarse_pass_is_shown_in_place_at_its_resolution_snapshot() {
     let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
     let mut coarse = None;
     render_passes(&*bvh, &mesh, &camera, &settings, &Default::default(), |f, _| {
-        if f.stride == 8 {
+        if f.stride() == 8 {
             coarse = Some(f);
         }
     })

@@ -7,15 +7,11 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         match &app.shown {
             Some(s) => {
                 let f = &s.frame;
-                let res = if f.stride <= 1 {
-                    format!("full resolution {}×{}", f.width, f.height)
+                let (cols, rows) = f.grid_size();
+                let res = if f.stride() <= 1 {
+                    format!("full resolution {cols}×{rows}")
                 } else {
-                    format!(
-                        "1/{} resolution ({}×{} traced)",
-                        f.stride,
-                        f.width.div_ceil(f.stride),
-                        f.height.div_ceil(f.stride)
-                    )
+                    format!("1/{} resolution ({cols}×{rows} traced)", f.stride())
                 };
                 ui.label(res);
                 ui.separator();

@@ -193,10 +193,15 @@ mod tests {
 
     #[test]
     fn partition_moves_matching_items_first() {
-        let mut v = vec![5, 1, 8, 2, 9, 3, 7];
+        let original = vec![5, 1, 8, 2, 9, 3, 7, 4, 4, 6];
+        let mut v = original.clone();
         let k = partition(&mut v, |&x| x < 5);
-        assert_eq!(k, 3);
+        assert_eq!(k, 5);
         assert!(v[..k].iter().all(|&x| x < 5) && v[k..].iter().all(|&x| x >= 5));
+        let (mut sorted, mut expected) = (v.clone(), original);
+        sorted.sort();
+        expected.sort();
+        assert_eq!(sorted, expected, "a permutation: nothing lost or duplicated");
         let mut e: Vec<i32> = vec![];
         assert_eq!(partition(&mut e, |_| true), 0);
         let mut all = vec![1, 2];

@@ -169,7 +169,9 @@ enum WideTree {
 
 fn collapse_parallel(b: &[BvhNode], bin: usize, depth: u32) -> WideTree {
     if depth >= PARALLEL_DEPTH {
-        // A guess (the tree is near balanced); the vector grows if it is short.
+        // Binary nodes under this one, guessed: a near-balanced tree splits them about four ways
+        // per wide level. `collapse_sequential` reserves a wide node per six of them; if the guess
+        // is short, its vector grows.
         return WideTree::Flat(collapse_sequential(b, bin, b.len() >> (2 * depth)));
     }
     let (kids, n) = wide_children(b, bin);
