@@ -66,12 +66,13 @@ pub fn render_progressive<A: Accelerator>(
     let mut previous = 0u32;
     for &stride in strides {
         let t = Instant::now();
+        let pass = Pass { accel, mesh, camera, trace: settings.trace, stride, previous, control };
         let rays = if settings.count {
-            trace_pass::<A, RayCounters>(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
+            pass.trace::<RayCounters>(&mut frame)
         } else if accel.traces_packets() {
-            trace_pass_packets(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
+            pass.trace_packets(&mut frame)
         } else {
-            trace_pass::<A, NoStats>(accel, mesh, camera, settings.trace, &mut frame, stride, previous, control)
+            pass.trace::<NoStats>(&mut frame)
         };
         control.check()?;
         frame.stride = stride;
@@ -104,43 +105,47 @@ pub fn render_passes<A: Accelerator>(
     Ok(())
 }
 
-/// Trace the pixels on the `stride` grid that the `previous` grid (0: none) did not cover.
-#[allow(clippy::too_many_arguments)]
-fn trace_pass<A: Accelerator, S: TraversalStats + Default + Into<RayCounters>>(
-    accel: &A,
-    mesh: &Mesh,
-    camera: &Camera,
+/// One pass: the pixels on the `stride` grid that the `previous` grid (0: none) did not cover.
+struct Pass<'a, A> {
+    accel: &'a A,
+    mesh: &'a Mesh,
+    camera: &'a Camera,
     trace: TraceOptions,
-    frame: &mut Frame,
     stride: u32,
     previous: u32,
-    control: &WorkControl,
-) -> u64 {
-    let gen = camera.ray_gen();
-    let w = frame.width();
-    for_each_band(frame, control, |y0, rows, samples, counters| {
-        let mut traced = 0u64;
-        for x0 in (0..w).step_by(TILE as usize) {
-            for dy in (0..rows).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
-                let y = y0 + dy;
-                for x in (x0..(x0 + TILE).min(w)).step_by(stride as usize) {
-                    if previous != 0 && x.is_multiple_of(previous) && y.is_multiple_of(previous) {
-                        continue;
+    control: &'a WorkControl,
+}
+
+impl<A: Accelerator> Pass<'_, A> {
+    /// Trace the pass ray by ray, counting into `S`; returns the rays traced.
+    fn trace<S: TraversalStats + Default + Into<RayCounters>>(&self, frame: &mut Frame) -> u64 {
+        let Pass { accel, mesh, camera, trace, stride, previous, control } = *self;
+        let gen = camera.ray_gen();
+        let w = frame.width();
+        for_each_band(frame, control, |y0, rows, samples, counters| {
+            let mut traced = 0u64;
+            for x0 in (0..w).step_by(TILE as usize) {
+                for dy in (0..rows).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
+                    let y = y0 + dy;
+                    for x in (x0..(x0 + TILE).min(w)).step_by(stride as usize) {
+                        if previous != 0 && x.is_multiple_of(previous) && y.is_multiple_of(previous) {
+                            continue;
+                        }
+                        let mut ray = gen.pixel_ray(x, y);
+                        let mut stats = S::default();
+                        let hit = accel.closest_hit(&mut ray, trace, &mut stats);
+                        let i = (dy * w + x) as usize;
+                        samples[i] = sample(mesh, &ray, hit);
+                        if let Some(c) = counters.get_mut(i) {
+                            *c = stats.into();
+                        }
+                        traced += 1;
                     }
-                    let mut ray = gen.pixel_ray(x, y);
-                    let mut stats = S::default();
-                    let hit = accel.closest_hit(&mut ray, trace, &mut stats);
-                    let i = (dy * w + x) as usize;
-                    samples[i] = sample(mesh, &ray, hit);
-                    if let Some(c) = counters.get_mut(i) {
-                        *c = stats.into();
-                    }
-                    traced += 1;
                 }
             }
-        }
-        traced
-    })
+            traced
+        })
+    }
 }
 
 /// Run `trace_band(y0, rows, samples, counters)` on each band of `TILE` rows in parallel (rayon),
@@ -187,57 +192,50 @@ fn sample(mesh: &Mesh, ray: &Ray, hit: Option<Hit>) -> PixelSample {
     }
 }
 
-/// `trace_pass` without counters, in packets: the pass's pixels grouped in 2×2 blocks of its grid
-/// (every block lies inside one tile, since 2·stride divides the tile size).
-#[allow(clippy::too_many_arguments)]
-fn trace_pass_packets<A: Accelerator>(
-    accel: &A,
-    mesh: &Mesh,
-    camera: &Camera,
-    trace: TraceOptions,
-    frame: &mut Frame,
-    stride: u32,
-    previous: u32,
-    control: &WorkControl,
-) -> u64 {
-    const _: () = assert!(TILE.is_multiple_of(2 * PASS_STRIDES[0]));
-    let gen = camera.ray_gen();
-    let w = frame.width();
-    for_each_band(frame, control, |y0, rows, samples, _| {
-        let mut traced = 0u64;
-        for x0 in (0..w).step_by(TILE as usize) {
-            let x_end = (x0 + TILE).min(w);
-            for dy in (0..rows).step_by(2 * stride as usize) {
-                for x in (x0..x_end).step_by(2 * stride as usize) {
-                    // Lanes: (x, dy), (x + s, dy), (x, dy + s), (x + s, dy + s).
-                    let pixel = |k: usize| (x + stride * (k as u32 & 1), dy + stride * (k as u32 >> 1));
-                    let mut active = 0u8;
-                    for k in 0..PACKET {
-                        let (px, pdy) = pixel(k);
-                        let done_before =
-                            previous != 0 && px.is_multiple_of(previous) && (y0 + pdy).is_multiple_of(previous);
-                        if px < x_end && pdy < rows && !done_before {
-                            active |= 1 << k;
+impl<A: Accelerator> Pass<'_, A> {
+    /// `trace` without counters, in packets: the pass's pixels grouped in 2×2 blocks of its grid
+    /// (every block lies inside one tile, since 2·stride divides the tile size).
+    fn trace_packets(&self, frame: &mut Frame) -> u64 {
+        const _: () = assert!(TILE.is_multiple_of(2 * PASS_STRIDES[0]));
+        let Pass { accel, mesh, camera, trace, stride, previous, control } = *self;
+        let gen = camera.ray_gen();
+        let w = frame.width();
+        for_each_band(frame, control, |y0, rows, samples, _| {
+            let mut traced = 0u64;
+            for x0 in (0..w).step_by(TILE as usize) {
+                let x_end = (x0 + TILE).min(w);
+                for dy in (0..rows).step_by(2 * stride as usize) {
+                    for x in (x0..x_end).step_by(2 * stride as usize) {
+                        // Lanes: (x, dy), (x + s, dy), (x, dy + s), (x + s, dy + s).
+                        let pixel = |k: usize| (x + stride * (k as u32 & 1), dy + stride * (k as u32 >> 1));
+                        let mut active = 0u8;
+                        for k in 0..PACKET {
+                            let (px, pdy) = pixel(k);
+                            let done_before =
+                                previous != 0 && px.is_multiple_of(previous) && (y0 + pdy).is_multiple_of(previous);
+                            if px < x_end && pdy < rows && !done_before {
+                                active |= 1 << k;
+                            }
                         }
-                    }
-                    if active == 0 {
-                        continue;
-                    }
-                    let mut rays = std::array::from_fn(|k| {
-                        let (px, pdy) = pixel(k);
-                        gen.pixel_ray(px.min(w - 1), y0 + pdy.min(rows - 1))
-                    });
-                    let hits = accel.closest_hit4(&mut rays, active, trace);
-                    for k in (0..PACKET).filter(|k| active & (1 << k) != 0) {
-                        let (px, pdy) = pixel(k);
-                        samples[(pdy * w + px) as usize] = sample(mesh, &rays[k], hits[k]);
-                        traced += 1;
+                        if active == 0 {
+                            continue;
+                        }
+                        let mut rays = std::array::from_fn(|k| {
+                            let (px, pdy) = pixel(k);
+                            gen.pixel_ray(px.min(w - 1), y0 + pdy.min(rows - 1))
+                        });
+                        let hits = accel.closest_hit4(&mut rays, active, trace);
+                        for k in (0..PACKET).filter(|k| active & (1 << k) != 0) {
+                            let (px, pdy) = pixel(k);
+                            samples[(pdy * w + px) as usize] = sample(mesh, &rays[k], hits[k]);
+                            traced += 1;
+                        }
                     }
                 }
             }
-        }
-        traced
-    })
+            traced
+        })
+    }
 }
 
 impl From<NoStats> for RayCounters {
