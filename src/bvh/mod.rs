@@ -14,6 +14,7 @@ mod simd;
 pub mod split;
 mod stack;
 mod stats;
+mod subtree;
 mod traverse;
 pub mod tree;
 pub mod two_level;
