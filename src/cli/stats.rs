@@ -120,6 +120,7 @@ fn format_two_level(
 pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildParams, s: &TreeStats) -> String {
     let mut o = String::new();
     let _ = writeln!(o, "mesh            {}", report.path.display());
+    let _ = writeln!(o, "load            {:.2} ms", report.load_time.as_secs_f64() * 1e3);
     let _ = writeln!(
         o,
         "triangles       {} ({} degenerate skipped), {} vertices, {} groups",

@@ -5,6 +5,7 @@ pub mod generate;
 mod mesh;
 mod obj;
 mod obj_lines;
+mod obj_parallel;
 
 pub use mesh::{Mesh, MeshGroup, SurfaceInteraction};
 pub use obj::{load_obj, parse_obj, write_obj, LoadReport, MeshError, MAX_COORDINATE};

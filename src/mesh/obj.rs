@@ -1,14 +1,16 @@
-//! OBJ loading through `tobj`, with errors that name the file and, where known, the line.
+//! OBJ loading, with errors that name the file and, where known, the line.
 //!
-//! We read the file ourselves (to tell a missing file from a directory from binary data) and hand
-//! it to tobj. tobj reports *what* failed but not *where*; on failure we scan the text once
-//! for the first line showing that fault (`obj_lines.rs`), so the user can open the file at the
-//! right place.
+//! We read the file ourselves (to tell a missing file from a directory from binary data). Plain
+//! files are parsed in parallel (`obj_parallel.rs`, the same models tobj would give); all others go
+//! to tobj. tobj reports *what* failed but not *where*; on failure we scan the text once for the
+//! first line showing that fault (`obj_lines.rs`), so the user can open the file at the right place.
 
 use super::obj_lines::{diagnose, first_bad_face, first_bad_line, line_at, statements, Corner};
+use super::obj_parallel;
 use super::{Mesh, MeshGroup};
 use crate::geometry::triangle::double_area;
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 use std::fmt;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
@@ -84,9 +86,8 @@ pub struct LoadReport {
 
 /// Load an OBJ file: polygons are triangulated, groups kept, zero-area triangles skipped.
 ///
-/// The file is streamed into tobj (a 2M-triangle OBJ is a quarter of a gigabyte; holding it as
-/// one string would only cost time). Only when something is wrong is it read again as text, to
-/// tell binary data from text and to find the offending line.
+/// The file is read whole (a 2M-triangle OBJ is a quarter of a gigabyte) and parsed in parallel
+/// when it is a plain one (`obj_parallel.rs`); otherwise, and to explain any error, by tobj.
 pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
     let start = Instant::now();
@@ -97,39 +98,55 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
     if std::fs::metadata(path).map_err(io)?.is_dir() {
         return Err(MeshError::IsDirectory { path: path.into() });
     }
-    let file = std::fs::File::open(path).map_err(io)?;
-    let mut reader = SlashWatch { inner: std::io::BufReader::with_capacity(1 << 20, file), slash: false };
-    let streamed = load_models(&mut reader).map_err(Problem::Tobj);
-    match streamed.and_then(|models| build_mesh(path, models)) {
-        Ok((mesh, mut report)) => {
-            // tobj ignores texture and normal indices when the file declares none. They can only
-            // be there if a '/' passed by, so only then is the file read again to look.
-            if reader.slash && (!report.has_uvs || !report.has_normals) {
-                let text = std::fs::read_to_string(path).map_err(io)?;
-                check_unchecked_indices(path, &text, &report)?;
-            }
-            report.load_time = start.elapsed();
-            Ok((mesh, report))
-        }
-        Err(problem) => {
-            let bytes = std::fs::read(path).map_err(io)?;
-            let text = match std::str::from_utf8(&bytes) {
-                Ok(t) => t,
-                Err(e) => return Err(MeshError::NotText { path: path.into(), line: line_at(&bytes, e.valid_up_to()) }),
-            };
-            Err(explain(path, text, problem))
-        }
+    let bytes = read_file(path).map_err(io)?;
+    let text = match std::str::from_utf8(&bytes) {
+        Ok(t) => t,
+        Err(e) => return Err(MeshError::NotText { path: path.into(), line: line_at(&bytes, e.valid_up_to()) }),
+    };
+    let (mesh, mut report) = parse_obj(path, text)?;
+    report.load_time = start.elapsed();
+    Ok((mesh, report))
+}
+
+/// The whole file. Big files are read in parallel pieces: on this machine faulting in the pages
+/// of a fresh buffer costs about as much as the copy, and the threads share that.
+fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::{Read, Seek, SeekFrom};
+    const PIECE: usize = 16 << 20;
+    let len = std::fs::metadata(path)?.len() as usize;
+    let pieces = (len / PIECE).clamp(1, rayon::current_num_threads());
+    if pieces == 1 {
+        return std::fs::read(path);
     }
+    let mut bytes = vec![0u8; len];
+    let size = len.div_ceil(pieces);
+    bytes.par_chunks_mut(size).enumerate().try_for_each(|(k, piece)| {
+        let mut file = std::fs::File::open(path)?;
+        file.seek(SeekFrom::Start((k * size) as u64))?;
+        file.read_exact(piece)
+    })?;
+    // The file may have grown since its length was taken; the rest would be missing.
+    let mut file = std::fs::File::open(path)?;
+    file.seek(SeekFrom::Start(len as u64))?;
+    file.read_to_end(&mut bytes)?;
+    Ok(bytes)
 }
 
 /// Parse OBJ text; `path` is used for the mesh name and in error messages.
 pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
-    let (mesh, report) = load_models(&mut Cursor::new(text.as_bytes()))
-        .map_err(Problem::Tobj)
-        .and_then(|models| build_mesh(path, models))
-        .map_err(|problem| explain(path, text, problem))?;
-    check_unchecked_indices(path, text, &report)?;
+    let (models, by_tobj) = match obj_parallel::models(text) {
+        Some(models) => (Ok(models), false),
+        None => (load_models(&mut Cursor::new(text.as_bytes())).map_err(Problem::Tobj), true),
+    };
+
+    let (mesh, report) =
+        models.and_then(|models| build_mesh(path, models)).map_err(|problem| explain(path, text, problem))?;
+    // tobj ignores texture and normal indices when the file declares none (the parallel reader
+    // declines such files). They can only be there if the text has a '/'.
+    if by_tobj && text.contains('/') {
+        check_unchecked_indices(path, text, &report)?;
+    }
     Ok((mesh, report))
 }
 
@@ -143,36 +160,6 @@ fn check_unchecked_indices(path: &Path, text: &str, report: &LoadReport) -> Resu
         }
     }
     Ok(())
-}
-
-/// A reader that notes whether a '/' went past: only then can a face refer to texture
-/// coordinates or normals.
-struct SlashWatch<R> {
-    inner: R,
-    slash: bool,
-}
-
-impl<R: std::io::BufRead> std::io::Read for SlashWatch<R> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        self.slash |= buf[..n].contains(&b'/');
-        Ok(n)
-    }
-}
-
-impl<R: std::io::BufRead> std::io::BufRead for SlashWatch<R> {
-    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
-        self.inner.fill_buf()
-    }
-
-    fn consume(&mut self, amt: usize) {
-        if !self.slash {
-            if let Ok(buf) = self.inner.fill_buf() {
-                self.slash = buf[..amt.min(buf.len())].contains(&b'/');
-            }
-        }
-        self.inner.consume(amt)
-    }
 }
 
 /// What went wrong before the text was looked at for line numbers.
@@ -207,7 +194,8 @@ fn explain(path: &Path, text: &str, problem: Problem) -> MeshError {
     }
 }
 
-fn load_models(reader: &mut impl std::io::BufRead) -> Result<Vec<tobj::Model>, tobj::LoadError> {
+/// tobj with our options: the reference the parallel reader is tested against.
+pub(super) fn load_models(reader: &mut impl std::io::BufRead) -> Result<Vec<tobj::Model>, tobj::LoadError> {
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     // Materials are not needed to show a BVH; a missing .mtl must not fail the load.
     tobj::load_obj_buf(reader, &options, |_| Err(tobj::LoadError::OpenFileFailed)).map(|(models, _)| models)
@@ -240,31 +228,35 @@ fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport
             }
         }
         let first = mesh.triangles.len() as u32;
-        for f in m.indices.chunks_exact(3) {
-            let tri = [f[0] + base, f[1] + base, f[2] + base];
-            let verts = tri.map(|i| mesh.positions[i as usize]);
-            if verts.iter().all(|v| v.is_finite()) && double_area(&verts) == 0.0 {
-                degenerate += 1;
-            } else {
-                mesh.triangles.push(tri);
-            }
-        }
+        // In parallel, in order: a 2M-triangle mesh spends a tenth of its load here otherwise.
+        let positions = &mesh.positions;
+        let kept: Vec<[u32; 3]> = m
+            .indices
+            .par_chunks_exact(3)
+            .map(|f| [f[0] + base, f[1] + base, f[2] + base])
+            .filter(|tri| {
+                let verts = tri.map(|i| positions[i as usize]);
+                !(verts.iter().all(|v| v.is_finite()) && double_area(&verts) == 0.0)
+            })
+            .collect();
+        degenerate += m.indices.len() / 3 - kept.len();
+        mesh.triangles.extend_from_slice(&kept);
         let last = mesh.triangles.len() as u32;
         if last > first {
             mesh.groups.push(MeshGroup { name: model.name.clone(), triangles: first..last });
         }
     }
 
-    if mesh.positions.iter().any(|p| !p.is_finite()) {
+    if mesh.positions.par_iter().any(|p| !p.is_finite()) {
         return Err(Problem::NonFinite("a vertex position", "v", 3));
     }
-    if mesh.positions.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+    if mesh.positions.par_iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
         return Err(Problem::TooLarge);
     }
-    if mesh.normals.iter().any(|n| !n.is_finite()) {
+    if mesh.normals.par_iter().any(|n| !n.is_finite()) {
         return Err(Problem::NonFinite("a vertex normal", "vn", 3));
     }
-    if mesh.uvs.iter().any(|t| !t.is_finite()) {
+    if mesh.uvs.par_iter().any(|t| !t.is_finite()) {
         return Err(Problem::NonFinite("a texture coordinate", "vt", 1));
     }
     if mesh.triangles.is_empty() {
