@@ -98,6 +98,13 @@ fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(bv
     }
 }
 
+/// The plain and the counting traversal of one SAH tree (built twice: the build is deterministic),
+/// for the alternated overhead measurement in `main.rs`.
+pub fn plain_and_counting(mesh: &Mesh, layout: Layout) -> [Box<dyn Tracer>; 2] {
+    let params = BuildParams { layout, ..BuildParams::with_strategy(SplitStrategy::SahBinned) };
+    [tracer::<NoStats>(AnyBvh::build(mesh, &params)), tracer::<RayCounters>(AnyBvh::build(mesh, &params))]
+}
+
 /// How our rows trace: plain single rays, single rays with the heatmap counters on, or packets of four.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Tracing {

@@ -9,6 +9,7 @@ mod contenders;
 mod rays;
 mod scenes;
 
+use bvhscope::bvh::Layout;
 use bvhscope::mesh::Mesh;
 use contenders::{Contender, Family, Tracer, Tracing};
 use rayon::prelude::*;
@@ -215,20 +216,49 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
             b.sah.unwrap_or(f64::NAN)
         );
     }
-    let plain = rows.iter().find(|r| r.name == "bvhscope sah (BVH2)");
-    let counting = rows.iter().find(|r| r.name == "bvhscope sah (BVH2), counting");
-    if let (Some(p), Some(c)) = (plain, counting) {
-        let _ = writeln!(
-            o,
-            "counting overhead {name}: primary 1T {:+.1}%, incoherent 1T {:+.1}%",
-            (p.p1 / c.p1 - 1.0) * 100.0,
-            (p.i1 / c.i1 - 1.0) * 100.0
-        );
-    }
     for r in rows.iter().filter(|r| ours(r) && !r.name.contains("packets")) {
         if let Some(b) = r.bytes {
             let _ = writeln!(o, "memory {name}: {} {:.1} bytes per triangle (nodes + indices)", r.name, b);
         }
+    }
+    o
+}
+
+/// The heatmap counters' cost, measured in alternation: on one thread, the plain and the counting
+/// traversal of the same tree take turns `pairs` times (which goes first alternates too), and the
+/// median of the per-pair ratios is kept. Rows of the table are timed minutes apart, and this
+/// machine drifts by ±15% over minutes; a pair is timed within seconds.
+fn counting_overhead(mesh: &Mesh, s: &Settings, one: &ThreadPool) -> String {
+    let primary = rays::primary(mesh, s.primary_size);
+    let incoherent = rays::incoherent(mesh, s.incoherent, 0x5EED);
+    let pairs = if s.quick || mesh.triangle_count() > 1_000_000 { 3 } else { 5 };
+    let mut o = String::new();
+    for (layout, label) in [(Layout::Binary, "BVH2"), (Layout::Wide4, "BVH4")] {
+        let [plain, counting] = contenders::plain_and_counting(mesh, layout);
+        let overhead = |rays: &[RaySpec]| {
+            let ratios = (0..pairs)
+                .map(|k| {
+                    let time = |t: &dyn Tracer| trace(one, rays, t);
+                    let ((p, hp), (c, hc)) = if k % 2 == 0 {
+                        let p = time(plain.as_ref());
+                        (p, time(counting.as_ref()))
+                    } else {
+                        let c = time(counting.as_ref());
+                        (time(plain.as_ref()), c)
+                    };
+                    assert_eq!(hp, hc, "the counting traversal must find the same hits");
+                    c.as_secs_f64() / p.as_secs_f64()
+                })
+                .collect();
+            (median(ratios) - 1.0) * 100.0
+        };
+        let _ = writeln!(
+            o,
+            "counting overhead {} SAH {label} (alternated, median of {pairs} pairs): primary 1T {:+.1}%, incoherent 1T {:+.1}%",
+            mesh.name,
+            overhead(&primary),
+            overhead(&incoherent)
+        );
     }
     o
 }
@@ -407,6 +437,7 @@ fn main() {
         print!("{t}");
         out += &t;
         closing += &ratios(mesh, &rows);
+        closing += &counting_overhead(mesh, &s, &one);
     }
     println!("\n{closing}");
     if !quick {
