@@ -13,9 +13,11 @@ fn assert_same(ours: &[tobj::Model], theirs: &[tobj::Model], what: &str) {
         assert_eq!(a.name, b.name, "{what}: model {k} name");
         let (a, b) = (&a.mesh, &b.mesh);
         assert_eq!(a.indices, b.indices, "{what}: model {k} indices");
-        assert_eq!(a.positions, b.positions, "{what}: model {k} positions");
-        assert_eq!(a.normals, b.normals, "{what}: model {k} normals");
-        assert_eq!(a.texcoords, b.texcoords, "{what}: model {k} texcoords");
+        // Bit for bit: NaN coordinates are read (our checks reject them later) and must match too.
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a.positions), bits(&b.positions), "{what}: model {k} positions");
+        assert_eq!(bits(&a.normals), bits(&b.normals), "{what}: model {k} normals");
+        assert_eq!(bits(&a.texcoords), bits(&b.texcoords), "{what}: model {k} texcoords");
         assert!(a.vertex_color.is_empty() && b.vertex_color.is_empty(), "{what}: model {k} colours");
         assert_eq!(a.face_arities, b.face_arities, "{what}: model {k} arities");
     }
@@ -77,7 +79,9 @@ fn what_tobj_must_read_is_declined() {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n",               // four parts
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl\nf 1 2 3\n",             // a material without a name
     ] {
-        assert!(models_in_chunks(text, 1).is_none(), "accepted:\n{text}");
+        for chunks in [1, 3, 64] {
+            assert!(models_in_chunks(text, chunks).is_none(), "accepted in {chunks} chunks:\n{text}");
+        }
     }
 }
 
@@ -134,24 +138,33 @@ fn shared_meshes_match_tobj() {
 use proptest::prelude::*;
 
 /// A random plain OBJ file: vertices, texture coordinates and normals interleaved with faces
-/// of 3–6 corners of one form, absolute or relative indices, objects, comments, materials,
-/// blank lines and CRLF line ends.
+/// of 3–6 corners of one form, absolute (sometimes `+n`) or relative indices, objects (sometimes
+/// after leading whitespace), comments, materials, blank lines and CRLF line ends; numbers in
+/// plain or exponent form, now and then NaN or infinite; words separated by spaces, tabs,
+/// vertical tabs or no-break spaces; extra words after `vt` and `vn`; corners like `1/` and `1//`.
 fn obj_text() -> impl Strategy<Value = String> {
     let line = prop_oneof![
-        4 => (0u8..3, any::<[i16; 3]>()).prop_map(|(a, x)| (a, x.to_vec())),
+        4 => (0u8..3, any::<[i16; 4]>()).prop_map(|(a, x)| (a, x.to_vec())),
         3 => (3u8..4, proptest::collection::vec(any::<i16>(), 3..7)),
-        1 => (4u8..8, any::<[i16; 3]>()).prop_map(|(a, x)| (a, x.to_vec())),
+        1 => (4u8..8, any::<[i16; 4]>()).prop_map(|(a, x)| (a, x.to_vec())),
     ];
     (any::<(bool, bool)>(), any::<bool>(), proptest::collection::vec(line, 1..60)).prop_map(
         |((uv, normal), crlf, lines)| {
             let mut counts = [0i64; 3];
             let mut out = String::new();
             for (kind, x) in lines {
-                let f = |k: usize| x[k] as f32 / 64.0;
+                let sep = ["\t", "\u{b}", "\u{a0}", "  "].get(x[0].rem_euclid(16) as usize).unwrap_or(&" ");
+                let num = |k: usize| match x[k].rem_euclid(61) {
+                    0 => "nan".to_owned(),
+                    1 => "-inf".to_owned(),
+                    2..=9 => format!("{:e}", x[k] as f32 / 8.0),
+                    _ => format!("{}", x[k] as f32 / 64.0),
+                };
+                let extra = if x.len() == 4 && x[3] % 5 == 0 { format!("{sep}{}", num(3)) } else { String::new() };
                 match kind {
-                    0 => out += &format!("v {} {} {}", f(0), f(1), f(2)),
-                    1 => out += &format!("vt {} {}", f(0), f(1)),
-                    2 => out += &format!("vn {} {} {}", f(0), f(1), f(2)),
+                    0 => out += &format!("v{sep}{}{sep}{}{sep}{}", num(0), num(1), num(2)),
+                    1 => out += &format!("vt{sep}{}{sep}{}{extra}", num(0), num(1)),
+                    2 => out += &format!("vn{sep}{}{sep}{}{sep}{}{extra}", num(0), num(1), num(2)),
                     3 => {
                         let needed = [true, uv, normal];
                         if (0..3).any(|a| needed[a] && counts[a] == 0) {
@@ -162,21 +175,22 @@ fn obj_text() -> impl Strategy<Value = String> {
                             let index = |a: usize| {
                                 let i = (r as i64 + 7 * a as i64).rem_euclid(counts[a]);
                                 // Every third corner counts back from the last declared.
-                                if (c + a) % 3 == 2 {
-                                    i - counts[a]
-                                } else {
-                                    i + 1
+                                match (c + a) % 3 {
+                                    2 => format!("{}", i - counts[a]),
+                                    1 if r % 2 == 0 => format!("+{}", i + 1),
+                                    _ => format!("{}", i + 1),
                                 }
                             };
+                            let tail = ["", "/", "//"][r.rem_euclid(3) as usize];
                             out += &match (uv, normal) {
-                                (false, false) => format!(" {}", index(0)),
+                                (false, false) => format!(" {}{tail}", index(0)),
                                 (true, false) => format!(" {}/{}", index(0), index(1)),
                                 (false, true) => format!(" {}//{}", index(0), index(2)),
                                 (true, true) => format!(" {}/{}/{}", index(0), index(1), index(2)),
                             };
                         }
                     }
-                    4 => out += &format!("o part{}", x[0] % 4),
+                    4 => out += &format!("{}o part{}", if x[1] % 4 == 0 { " " } else { "" }, x[0] % 4),
                     5 => out += &format!("g  group {} ", x[0] % 3),
                     6 => out += &format!("usemtl m{}\n# note {}", x[0], x[1]),
                     _ => out += "",
