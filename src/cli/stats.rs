@@ -98,14 +98,7 @@ fn format_two_level(
         top.nodes, top.leaves, top.max_depth, top.sah_cost
     );
     let b = &t.bottom_params;
-    let _ = writeln!(
-        o,
-        "bottom level    {}, {} layout (max leaf size {}, {} SAH bins)",
-        b.strategy.label(),
-        b.layout.label(),
-        b.max_leaf_size,
-        b.sah_bins
-    );
+    let _ = writeln!(o, "bottom level    {}", params_text(b));
     for (name, s) in bottom {
         let _ = writeln!(
             o,
@@ -114,6 +107,17 @@ fn format_two_level(
         );
     }
     o
+}
+
+/// Strategy, layout, leaf size and bins, as the text blocks print them.
+fn params_text(p: &crate::bvh::BuildParams) -> String {
+    format!(
+        "{}, {} layout (max leaf size {}, {} SAH bins)",
+        p.strategy.label(),
+        p.layout.label(),
+        p.max_leaf_size,
+        p.sah_bins
+    )
 }
 
 /// The statistics as a human-readable block.
@@ -126,14 +130,7 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         "triangles       {} ({} degenerate skipped), {} vertices, {} groups",
         report.triangles, report.degenerate_skipped, report.vertices, report.groups
     );
-    let _ = writeln!(
-        o,
-        "strategy        {}, {} layout (max leaf size {}, {} SAH bins)",
-        params.strategy.label(),
-        params.layout.label(),
-        params.max_leaf_size,
-        params.sah_bins
-    );
+    let _ = writeln!(o, "strategy        {}", params_text(params));
     let _ = writeln!(
         o,
         "build           {:.2} ms (setup {:.2}, split {:.2}, reorder {:.2})",

@@ -95,10 +95,11 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
         std::io::ErrorKind::NotFound => MeshError::NotFound { path: path.into() },
         _ => MeshError::Io { path: path.into(), source: e },
     };
-    if std::fs::metadata(path).map_err(io)?.is_dir() {
+    let metadata = std::fs::metadata(path).map_err(io)?;
+    if metadata.is_dir() {
         return Err(MeshError::IsDirectory { path: path.into() });
     }
-    let bytes = read_file(path).map_err(io)?;
+    let bytes = read_file(path, metadata.len() as usize).map_err(io)?;
     let text = match std::str::from_utf8(&bytes) {
         Ok(t) => t,
         Err(e) => return Err(MeshError::NotText { path: path.into(), line: line_at(&bytes, e.valid_up_to()) }),
@@ -110,10 +111,10 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
 
 /// The whole file. Big files are read in parallel pieces: on this machine faulting in the pages
 /// of a fresh buffer costs about as much as the copy, and the threads share that.
-fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
+/// `len` is the size the file had when looked at; whatever it has grown by since is read too.
+fn read_file(path: &Path, len: usize) -> std::io::Result<Vec<u8>> {
     use std::io::{Read, Seek, SeekFrom};
     const PIECE: usize = 16 << 20;
-    let len = std::fs::metadata(path)?.len() as usize;
     let pieces = (len / PIECE).clamp(1, rayon::current_num_threads());
     if pieces == 1 {
         return std::fs::read(path);
