@@ -30,11 +30,23 @@ fn main() {
         params.max_leaf_size = l.parse().expect("LEAF is a number");
     }
     if what == "build" {
-        let t = Instant::now();
-        for _ in 0..20 {
-            std::hint::black_box(AnyBvh::build(&mesh, &params));
-        }
-        println!("build: {:.2} ms each", t.elapsed().as_secs_f64() * 1e3 / 20.0);
+        // Median of 31 builds, and of each phase (the machine is noisy).
+        let mut runs: Vec<[f64; 4]> = (0..31)
+            .map(|_| {
+                let t = Instant::now();
+                let bvh = std::hint::black_box(bvhscope::bvh::Bvh::build(&mesh, &params));
+                let total = t.elapsed().as_secs_f64() * 1e3;
+                let r = &bvh.report;
+                let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+                [total, ms(r.setup_time), ms(r.split_time), ms(r.reorder_time)]
+            })
+            .collect();
+        let mut median = |k: usize| {
+            runs.sort_by(|a, b| a[k].total_cmp(&b[k]));
+            runs[runs.len() / 2][k]
+        };
+        let (total, setup, split, reorder) = (median(0), median(1), median(2), median(3));
+        println!("binary build: median {total:.2} ms (setup {setup:.2}, split {split:.2}, reorder {reorder:.2})");
         return;
     }
     let bvh = AnyBvh::build(&mesh, &params);

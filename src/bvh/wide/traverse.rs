@@ -5,7 +5,9 @@
 //! same path as nodes, as tagged references (the loop layout of Embree's BVH4 traversal, Wald et
 //! al., "Embree: A Kernel Framework for Efficient CPU Ray Tracing", SIGGRAPH 2014). Counters: a
 //! node visit counts once, its box tests count per valid child (so wide and binary heatmaps
-//! measure the same work).
+//! measure the same work). A child pushed on the stack is prefetched into the cache: incoherent
+//! rays wait on memory, and by the time it is popped its node has arrived (bunny, 1M incoherent
+//! rays, one thread: +9..20%; the 2M knot: +7..9%; primary rays unchanged).
 
 use super::{WideBvh, WideNode, WIDTH};
 use crate::bvh::stack::TraversalStack;
@@ -13,7 +15,7 @@ use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
 use crate::geometry::{MollerTrumbore, Ray, TriangleHit, TriangleIntersector, TriangleTest, Watertight};
 
 const _: () = assert!(WIDTH == 4, "child references pack the slot into two bits");
-use crate::bvh::simd::{max_keep, min_keep};
+use crate::bvh::simd::{max_keep, min_keep, prefetch};
 use wide::f32x4;
 
 /// Deepest stack a traversal can need: at most three pushes per level (the build bounds the depth
@@ -68,6 +70,19 @@ impl WideBvh {
         }
     }
 
+    /// Start loading a child that goes on the stack: the node, or a leaf's first triangle.
+    #[inline(always)]
+    fn prefetch_child(&self, node: &WideNode, slot: usize) {
+        let i = node.child[slot] as usize;
+        if node.count[slot] > 0 {
+            if let Some(t) = self.tris.get(i) {
+                prefetch(t);
+            }
+        } else if let Some(n) = self.nodes.get(i) {
+            prefetch(n);
+        }
+    }
+
     fn closest<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
         &self,
         ray: &mut Ray,
@@ -112,9 +127,11 @@ impl WideBvh {
                 if rest2 == 0 {
                     let (r0, r1) = (Self::child_ref(node, cur, s0), Self::child_ref(node, cur, s1));
                     if enter[s0] <= enter[s1] {
+                        self.prefetch_child(node, s1);
                         stack.push((r1, enter[s1]));
                         cur = r0;
                     } else {
+                        self.prefetch_child(node, s0);
                         stack.push((r0, enter[s0]));
                         cur = r1;
                     }
@@ -127,6 +144,7 @@ impl WideBvh {
                     let slot = m.trailing_zeros() as usize;
                     m &= m - 1;
                     let r = Self::child_ref(node, cur, slot);
+                    self.prefetch_child(node, slot);
                     stack.push((r, enter[slot]));
                     k += 1;
                 }
