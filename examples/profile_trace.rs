@@ -132,23 +132,40 @@ fn main() {
         c.triangle_tests as f64 / n
     );
     if std::env::var("PACKET").is_ok() && what == "primary" {
-        // 2×2 pixel blocks of the 1024² frame.
-        let newray = std::env::var_os("NEWRAY").is_some();
-        let t = Instant::now();
-        let mut hits = 0;
-        for _ in 0..5 {
-            for by in (0..1024).step_by(2) {
-                for bx in (0..1024).step_by(2) {
-                    let idx = [by * 1024 + bx, by * 1024 + bx + 1, (by + 1) * 1024 + bx, (by + 1) * 1024 + bx + 1];
-                    let mut four =
-                        idx.map(|i| if newray { Ray::new(rays[i].origin(), rays[i].dir()) } else { rays[i] });
-                    let h = bvh.closest_hit4(&mut four, 0b1111, TraceOptions::default());
-                    hits += h.iter().filter(|h| h.is_some()).count();
+        // 8×8 pixel blocks of the 1024² frame, each in packet order; results checked against
+        // single rays on a first, untimed round.
+        use bvhscope::bvh::packet::{packet_position, PACKET};
+        let mut t = Instant::now();
+        let (mut hits, mut differ) = (0, 0);
+        let mut out = [None; PACKET];
+        let mut packet = Vec::with_capacity(PACKET);
+        for round in 0..6 {
+            if round == 1 {
+                (t, hits) = (Instant::now(), 0);
+            }
+            for by in (0..1024).step_by(8) {
+                for bx in (0..1024).step_by(8) {
+                    let index = |k: u32| {
+                        let (x, y) = packet_position(k);
+                        (by + y as usize) * 1024 + bx + x as usize
+                    };
+                    packet.clear();
+                    packet.extend((0..PACKET as u32).map(|k| rays[index(k)]));
+                    bvh.closest_hits(&mut packet, &mut out, TraceOptions::default());
+                    hits += out.iter().filter(|h| h.is_some()).count();
+                    if round == 0 {
+                        for (k, h) in out.iter().enumerate() {
+                            let mut r = rays[index(k as u32)];
+                            let want = bvh.closest_hit(&mut r, TraceOptions::default(), &mut NoStats);
+                            differ += (want.map(|h| h.t) != h.map(|h| h.t)) as usize;
+                        }
+                    }
                 }
             }
         }
         let secs = t.elapsed().as_secs_f64();
-        println!("{what} {layout:?} packets: {:.2} MRays/s, {hits} hits", 5.0 * rays.len() as f64 / secs / 1e6);
+        let rate = 5.0 * rays.len() as f64 / secs / 1e6;
+        println!("{what} {layout:?} packets: {rate:.2} MRays/s, {hits} hits, {differ} differ from single rays");
     }
     let t = Instant::now();
     let mut hits = 0;

@@ -1,6 +1,7 @@
 //! Every implementation under test, behind one trait: build (timed) and trace one ray.
 
 use crate::rays::RaySpec;
+use bvhscope::bvh::packet::PACKET;
 use bvhscope::bvh::{
     Accelerator, AnyBvh, BuildParams, Layout, NoStats, RayCounters, SplitStrategy, TraceOptions, TreeStats,
 };
@@ -67,8 +68,8 @@ impl<A: Accelerator + Send, S: bvhscope::bvh::TraversalStats + Default + Sync + 
     }
 }
 
-/// Our BVH traced in packets of four consecutive rays (`Accelerator::closest_hit4`): a 2×2 pixel
-/// block of the primary frame; four unrelated rays of the incoherent set.
+/// Our BVH traced in packets of up to 64 consecutive rays (`Accelerator::closest_hits`): an 8×8
+/// pixel tile of the primary frame; 64 unrelated rays of the incoherent set.
 struct OursPackets {
     bvh: AnyBvh,
 }
@@ -81,12 +82,16 @@ impl Tracer for OursPackets {
 
     fn trace_chunk(&self, rays: &[RaySpec]) -> usize {
         let mut hits = 0;
-        let mut four = rays.chunks_exact(4);
-        for c in &mut four {
-            let mut r = [0, 1, 2, 3].map(|k| Ray::new(c[k].origin, c[k].dir));
-            hits += self.bvh.closest_hit4(&mut r, 0b1111, TraceOptions::default()).iter().flatten().count();
+        let mut packet = Vec::with_capacity(PACKET);
+        let mut out = [None; PACKET];
+        for c in rays.chunks(PACKET) {
+            packet.clear();
+            packet.extend(c.iter().map(|r| Ray::new(r.origin, r.dir)));
+            let out = &mut out[..c.len()];
+            self.bvh.closest_hits(&mut packet, out, TraceOptions::default());
+            hits += out.iter().flatten().count();
         }
-        hits + four.remainder().iter().filter(|r| self.trace(r)).count()
+        hits
     }
 }
 
@@ -105,7 +110,7 @@ pub fn plain_and_counting(mesh: &Mesh, layout: Layout) -> [Box<dyn Tracer>; 2] {
     [tracer::<NoStats>(AnyBvh::build(mesh, &params)), tracer::<RayCounters>(AnyBvh::build(mesh, &params))]
 }
 
-/// How our rows trace: plain single rays, single rays with the heatmap counters on, or packets of four.
+/// How our rows trace: plain single rays, single rays with the heatmap counters on, or packets of 64.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Tracing {
     Plain,
@@ -122,7 +127,7 @@ pub fn ours(strategy: SplitStrategy, layout: Layout, tracing: Tracing) -> Conten
     let name = match tracing {
         Tracing::Plain => format!("bvhscope {} ({layout_name})", strategy.short_name()),
         Tracing::Counting => format!("bvhscope {} ({layout_name}), counting", strategy.short_name()),
-        Tracing::Packets => format!("bvhscope {} ({layout_name}, 2×2 packets)", strategy.short_name()),
+        Tracing::Packets => format!("bvhscope {} ({layout_name}, 8×8 packets)", strategy.short_name()),
     };
     Contender {
         name,

@@ -195,7 +195,7 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
             line(&format!("{label} {what}/obvhs-best-BVH2"), a, best(rows, is(Family::ObvhsBvh2), key), key);
             line(&format!("{label} {what}/obvhs-best-CWBVH"), a, best(rows, is(Family::ObvhsCwbvh), key), key);
         }
-        for our in ["bvhscope sah (BVH2)", "bvhscope sah (BVH2, 2×2 packets)"] {
+        for our in ["bvhscope sah (BVH2)", "bvhscope sah (BVH2, 8×8 packets)"] {
             let a = rows.iter().find(|r| r.name == our);
             let label = format!("{label} sah-BVH2{}/bvh-crate", if our.contains("packets") { "-packets" } else { "" });
             line(&label, a, best(rows, is(Family::BvhCrate), key), key);
@@ -286,7 +286,7 @@ fn app_figures(meshes: &[Mesh], all: &ThreadPool) -> String {
     if let Some(bunny) = meshes.iter().find(|m| m.name.contains("bunny")) {
         for (layout, what) in [
             (bvhscope::bvh::Layout::Wide4, "wide SAH, the app's default"),
-            (bvhscope::bvh::Layout::Binary, "binary SAH, 2×2 packets"),
+            (bvhscope::bvh::Layout::Binary, "binary SAH, 8×8 packets"),
         ] {
             let bvh = all.install(|| AnyBvh::build(bunny, &BuildParams { layout, ..BuildParams::default() }));
             let cam = Camera::framing(&bunny.bounds(), 1280, 720);

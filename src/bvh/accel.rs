@@ -54,22 +54,20 @@ pub trait Accelerator: Sync {
     /// Whether anything is hit within the ray's interval (stops at the first hit found).
     fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool;
 
-    /// Whether `closest_hit4` traces a real packet (faster for coherent rays than four single
-    /// rays); when false, callers should trace single rays.
+    /// Whether `closest_hits` traces a real packet (faster for coherent rays than single rays);
+    /// when false, callers should trace single rays.
     fn traces_packets(&self) -> bool {
         false
     }
 
-    /// Closest hits of up to four coherent rays (those whose bit is set in `active`), with the same
-    /// results as `closest_hit` on each. BVHs trace them as one packet (`bvh::packet`); the default
-    /// traces them one by one. Uncounted: heatmaps trace single rays.
-    fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
-        std::array::from_fn(|k| {
-            if active & (1 << k) != 0 {
-                self.closest_hit(&mut rays[k], opts, &mut super::NoStats)
-            } else {
-                None
-            }
-        })
+    /// Closest hits of up to `PACKET` (64) coherent rays, an 8×8 pixel block best listed in the
+    /// order of `packet::packet_position`, with the same results as `closest_hit` on each:
+    /// `hits[k]` for `rays[k]` (the slices are equally long). BVHs trace them as one packet
+    /// (`bvh::packet`); the default traces them one by one. Uncounted: heatmaps trace single rays.
+    fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
+        assert!(rays.len() <= PACKET && hits.len() == rays.len(), "a packet holds at most {PACKET} rays");
+        for (ray, hit) in rays.iter_mut().zip(hits) {
+            *hit = self.closest_hit(ray, opts, &mut super::NoStats);
+        }
     }
 }

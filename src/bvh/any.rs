@@ -1,6 +1,5 @@
 //! A built BVH in either layout behind one type: what the app, the CLI and the tests hold.
 
-use super::packet::PACKET;
 use super::tree::{NodeView, TreeView};
 use super::wide::WideBvh;
 use super::{Accelerator, BuildParams, BuildReport, Bvh, Hit, Layout, TraceOptions, TraversalStats};
@@ -65,15 +64,10 @@ impl Accelerator for AnyBvh {
     }
 
     #[inline]
-    fn closest_hit4(
-        &self,
-        rays: &mut [crate::geometry::Ray; PACKET],
-        active: u8,
-        opts: TraceOptions,
-    ) -> [Option<Hit>; PACKET] {
+    fn closest_hits(&self, rays: &mut [crate::geometry::Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
         match self {
-            AnyBvh::Binary(b) => Accelerator::closest_hit4(b, rays, active, opts),
-            AnyBvh::Wide(w) => Accelerator::closest_hit4(w, rays, active, opts),
+            AnyBvh::Binary(b) => b.closest_hits(rays, hits, opts),
+            AnyBvh::Wide(w) => w.closest_hits(rays, hits, opts),
         }
     }
 }

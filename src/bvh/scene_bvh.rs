@@ -2,7 +2,6 @@
 //! over the scene's mesh placements. Both give the same triangle ids, so the flattened mesh shades
 //! either.
 
-use super::packet::PACKET;
 use super::tree::TreeView;
 use super::{Accelerator, AnyBvh, BuildParams, Hit, TraceOptions, TraversalStats, TwoLevelBvh};
 use crate::geometry::Ray;
@@ -107,10 +106,10 @@ impl Accelerator for SceneBvh {
     }
 
     #[inline]
-    fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
+    fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
         match self {
-            SceneBvh::Single(b) => b.closest_hit4(rays, active, opts),
-            SceneBvh::TwoLevel(t) => t.closest_hit4(rays, active, opts),
+            SceneBvh::Single(b) => b.closest_hits(rays, hits, opts),
+            SceneBvh::TwoLevel(t) => t.closest_hits(rays, hits, opts),
         }
     }
 }

@@ -9,7 +9,6 @@
 //! per node. Layout and loop follow pbrt-v4 §7.3.5 ("BVHAggregate::Intersect").
 
 use super::node::{Bvh, TRAVERSAL_STACK_SIZE};
-use super::packet::PACKET;
 use super::stack::TraversalStack;
 use super::{Accelerator, Hit, TraceOptions, TraversalOrder, TraversalStats};
 use crate::geometry::{MollerTrumbore, Ray, TriangleIntersector, TriangleTest, Watertight};
@@ -114,7 +113,7 @@ impl Accelerator for Bvh {
         true
     }
 
-    fn closest_hit4(&self, rays: &mut [Ray; PACKET], active: u8, opts: TraceOptions) -> [Option<Hit>; PACKET] {
-        Bvh::closest_hit4(self, rays, active, opts)
+    fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
+        self.closest_hits_packet(rays, hits, opts)
     }
 }

@@ -3,11 +3,11 @@
 //! one ray per pixel in total. Work is split into bands of 16-pixel-square tiles run on rayon; the
 //! cancel flag is read before each band, and the caller sees the frame after each pass. The plain
 //! normal view of an accelerator that traces packets (the binary BVH, `bvh::packet`) hands it each
-//! pass in fours (2×2 pixels of the pass's grid); with counters on, or for the wide BVH, every ray
-//! is traced alone.
+//! pass in packets of up to 8×8 pixels of the pass's grid; with counters on, or for the wide BVH,
+//! every ray is traced alone.
 
 use super::{Camera, Frame, PixelSample};
-use crate::bvh::packet::PACKET;
+use crate::bvh::packet::{packet_position, PACKET, PACKET_SIDE};
 use crate::bvh::{Accelerator, Hit, NoStats, RayCounters, TraceOptions, TraversalStats};
 use crate::geometry::Ray;
 use crate::mesh::Mesh;
@@ -193,44 +193,40 @@ fn sample(mesh: &Mesh, ray: &Ray, hit: Option<Hit>) -> PixelSample {
 }
 
 impl<A: Accelerator> Pass<'_, A> {
-    /// `trace` without counters, in packets: the pass's pixels grouped in 2×2 blocks of its grid
-    /// (every block lies inside one tile, since 2·stride divides the tile size).
+    /// `trace` without counters, in packets: the pass's pixels grouped in blocks of 8×8 pixels of
+    /// its grid (fewer rows where the band is shorter), listed in `packet_position` order, leaving
+    /// out the pixels an earlier pass traced.
     fn trace_packets(&self, frame: &mut Frame) -> u64 {
-        const _: () = assert!(TILE.is_multiple_of(2 * PASS_STRIDES[0]));
         let Pass { accel, mesh, camera, trace, stride, previous, control } = *self;
         let gen = camera.ray_gen();
         let w = frame.width();
+        let span = PACKET_SIDE * stride;
         for_each_band(frame, control, |y0, rows, samples, _| {
             let mut traced = 0u64;
-            for x0 in (0..w).step_by(TILE as usize) {
-                let x_end = (x0 + TILE).min(w);
-                for dy in (0..rows).step_by(2 * stride as usize) {
-                    for x in (x0..x_end).step_by(2 * stride as usize) {
-                        // Lanes: (x, dy), (x + s, dy), (x, dy + s), (x + s, dy + s).
-                        let pixel = |k: usize| (x + stride * (k as u32 & 1), dy + stride * (k as u32 >> 1));
-                        let mut active = 0u8;
-                        for k in 0..PACKET {
-                            let (px, pdy) = pixel(k);
-                            let done_before =
-                                previous != 0 && px.is_multiple_of(previous) && (y0 + pdy).is_multiple_of(previous);
-                            if px < x_end && pdy < rows && !done_before {
-                                active |= 1 << k;
-                            }
-                        }
-                        if active == 0 {
-                            continue;
-                        }
-                        let mut rays = std::array::from_fn(|k| {
-                            let (px, pdy) = pixel(k);
-                            gen.pixel_ray(px.min(w - 1), y0 + pdy.min(rows - 1))
-                        });
-                        let hits = accel.closest_hit4(&mut rays, active, trace);
-                        for k in (0..PACKET).filter(|k| active & (1 << k) != 0) {
-                            let (px, pdy) = pixel(k);
-                            samples[(pdy * w + px) as usize] = sample(mesh, &rays[k], hits[k]);
-                            traced += 1;
+            let mut rays = Vec::with_capacity(PACKET);
+            let mut pixels = Vec::with_capacity(PACKET);
+            let mut hits = [None; PACKET];
+            // Bands start on a multiple of TILE, which every stride divides: row 0 is on the grid.
+            for by in (0..rows).step_by(span as usize) {
+                for bx in (0..w).step_by(span as usize) {
+                    rays.clear();
+                    pixels.clear();
+                    for k in 0..PACKET as u32 {
+                        let (gx, gy) = packet_position(k);
+                        let (x, dy) = (bx + gx * stride, by + gy * stride);
+                        let done_before =
+                            previous != 0 && x.is_multiple_of(previous) && (y0 + dy).is_multiple_of(previous);
+                        if x < w && dy < rows && !done_before {
+                            rays.push(gen.pixel_ray(x, y0 + dy));
+                            pixels.push((dy * w + x) as usize);
                         }
                     }
+                    let hits = &mut hits[..rays.len()];
+                    accel.closest_hits(&mut rays, hits, trace);
+                    for ((ray, hit), &i) in rays.iter().zip(hits.iter()).zip(&pixels) {
+                        samples[i] = sample(mesh, ray, *hit);
+                    }
+                    traced += rays.len() as u64;
                 }
             }
             traced
