@@ -1,0 +1,196 @@
+//! Tests of `packet.rs`: packets against single rays, and the frustum test against the slab test.
+
+use super::*;
+use crate::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, SplitStrategy};
+use crate::mesh::generate::{builtin_scene, torus_knot};
+use crate::mesh::Mesh;
+use crate::render::Camera;
+use glam::Vec3;
+
+/// `rays` traced in packets of `size` against single rays: the same hit or miss at the same
+/// distance, and the same `t_max` left on each ray. Returns the hits.
+fn agree(bvh: &AnyBvh, rays: &[Ray], size: usize, what: &str) -> usize {
+    let mut hits = 0;
+    let opts = TraceOptions::default();
+    for (c, chunk) in rays.chunks(size).enumerate() {
+        let mut packet = chunk.to_vec();
+        let mut got = vec![Some(Hit { t: -1.0, u: 0.0, v: 0.0, prim: 0 }); chunk.len()];
+        bvh.closest_hits(&mut packet, &mut got, opts);
+        for (k, (&before, got)) in chunk.iter().zip(&got).enumerate() {
+            let mut single = before;
+            let want = bvh.closest_hit(&mut single, opts, &mut NoStats);
+            assert_eq!(got.map(|h| h.t), want.map(|h| h.t), "{what}: ray {k} of packet {c}");
+            assert_eq!(packet[k].t_max, single.t_max, "{what}: ray {k} of packet {c}: t_max");
+            if let (Some(g), Some(w)) = (got, want) {
+                // Two triangles at exactly the same distance may swap; barycentrics then
+                // belong to the triangle reported.
+                if g.prim == w.prim {
+                    assert_eq!((g.u, g.v), (w.u, w.v), "{what}: ray {k} of packet {c}");
+                }
+            }
+            hits += got.is_some() as usize;
+        }
+    }
+    hits
+}
+
+/// A `size`×`size` frame's rays in 8×8 blocks, each in `packet_position` order.
+fn primary_blocks(mesh: &Mesh, size: u32) -> Vec<Ray> {
+    let cam = Camera::framing_from(&mesh.bounds(), size, size, Vec3::new(0.45, 0.35, 1.0), 45.0);
+    let g = cam.ray_gen();
+    let mut rays = Vec::new();
+    for by in (0..size).step_by(8) {
+        for bx in (0..size).step_by(8) {
+            rays.extend(
+                (0..PACKET as u32)
+                    .map(packet_position)
+                    .filter(|&(x, y)| bx + x < size && by + y < size)
+                    .map(|(x, y)| g.pixel_ray(bx + x, by + y)),
+            );
+        }
+    }
+    rays
+}
+
+/// Rays in every direction from points around the mesh: packets whose rays diverge at once
+/// (and whose directions differ in sign, which turns the packet's frustum test off).
+fn scattered(mesh: &Mesh, count: usize) -> Vec<Ray> {
+    let (c, r) = (mesh.bounds().center(), mesh.bounds().extent().length());
+    let mut s = 0x2545_F491_4F6C_DD1Du64;
+    let mut rnd = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+    };
+    (0..count)
+        .map(|_| {
+            let o = c + Vec3::new(rnd(), rnd(), rnd()) * r;
+            let d = Vec3::new(rnd(), rnd(), rnd()).normalize_or(Vec3::X);
+            Ray::new(o, d)
+        })
+        .collect()
+}
+
+/// Axis-aligned rays, some with zero direction components and origins on box planes: the slab
+/// test's NaN and infinity cases, lane by lane.
+fn axis_aligned(mesh: &Mesh) -> Vec<Ray> {
+    let b = mesh.bounds();
+    let mut rays = Vec::new();
+    for i in 0..64 {
+        let f = i as f32 / 63.0;
+        let p = b.min + (b.max - b.min) * f;
+        rays.push(Ray::new(Vec3::new(p.x, p.y, b.max.z + 1.0), Vec3::NEG_Z));
+        rays.push(Ray::new(Vec3::new(b.min.x - 1.0, p.y, p.z), Vec3::X));
+        rays.push(Ray::new(Vec3::new(b.min.x, b.min.y - 1.0, p.z), Vec3::Y));
+        rays.push(Ray::new(Vec3::new(p.x, b.max.y, b.min.z - 1.0), Vec3::Z));
+    }
+    rays
+}
+
+#[test]
+fn packets_find_what_single_rays_find() {
+    for mesh in [builtin_scene(), torus_knot(2, 3, 0.3, 256, 16)] {
+        for layout in Layout::ALL {
+            for strategy in SplitStrategy::ALL {
+                let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
+                let what = format!("{} {strategy:?} {layout:?}", mesh.name);
+                let hits = agree(&bvh, &primary_blocks(&mesh, 64), PACKET, &what);
+                assert!(hits > 200 && hits < 64 * 64, "{what}: the frame both hits and misses ({hits})");
+                // Partial packets: the last group has padding lanes, or the packet is one ray.
+                for size in [1, 3, 5, 33, 63] {
+                    agree(&bvh, &primary_blocks(&mesh, 40), size, &what);
+                }
+                assert!(agree(&bvh, &scattered(&mesh, 2048), PACKET, &what) > 0);
+                assert!(agree(&bvh, &axis_aligned(&mesh), PACKET, &what) > 0);
+            }
+        }
+    }
+}
+
+#[test]
+fn packets_keep_the_rays_intervals() {
+    let mesh = builtin_scene();
+    let bvh = AnyBvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..BuildParams::default() });
+    // Segments that stop short of the surface, or start beyond it, must miss as single rays do.
+    let rays: Vec<Ray> = primary_blocks(&mesh, 32)
+        .into_iter()
+        .enumerate()
+        .map(|(i, r)| match i % 3 {
+            0 => Ray::segment(r.origin(), r.dir(), 0.0, 1e-3),
+            1 => Ray::segment(r.origin(), r.dir(), 1e6, f32::INFINITY),
+            _ => r,
+        })
+        .collect();
+    let hits = agree(&bvh, &rays, PACKET, "segments");
+    assert!(hits > 0);
+}
+
+#[test]
+fn an_empty_bvh_misses_every_ray() {
+    let empty = Mesh::from_triangles("empty", vec![], vec![]);
+    for layout in Layout::ALL {
+        let bvh = AnyBvh::build(&empty, &BuildParams { layout, ..BuildParams::default() });
+        let mut rays = [Ray::new(Vec3::ZERO, Vec3::X); PACKET];
+        let mut hits = [Some(Hit { t: 1.0, u: 0.0, v: 0.0, prim: 0 }); PACKET];
+        bvh.closest_hits(&mut rays, &mut hits, TraceOptions::default());
+        assert_eq!(hits, [None; PACKET]);
+        bvh.closest_hits(&mut [], &mut [], TraceOptions::default());
+    }
+}
+
+#[test]
+fn positions_cover_the_block_once_in_two_by_two_groups() {
+    let mut seen = [[false; 8]; 8];
+    for k in 0..PACKET as u32 {
+        let (x, y) = packet_position(k);
+        assert!(!seen[y as usize][x as usize], "({x}, {y}) twice");
+        seen[y as usize][x as usize] = true;
+        let (x0, y0) = packet_position(k & !3);
+        assert_eq!((x / 2, y / 2), (x0 / 2, y0 / 2), "ray {k} is in its group's 2×2 block");
+    }
+}
+
+/// The frustum test may only reject a box that every ray of the packet misses: checked on
+/// random packets (a common origin or scattered origins, narrow or wide cones) against random
+/// boxes, with the single-ray slab test as the judge.
+#[test]
+fn the_frustum_rejects_only_boxes_every_ray_misses() {
+    let mut s = 0x9E37_79B9_7F4A_7C15u64;
+    let mut rnd = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let (mut rejected, mut valid) = (0, 0);
+    for case in 0..4000 {
+        let spread = [0.01, 0.1, 0.5][case % 3];
+        let centre = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(Vec3::Z);
+        let eye = Vec3::new(rnd(), rnd(), rnd()) * 4.0 - 2.0;
+        let rays: Vec<Ray> = (0..1 + case % PACKET)
+            .map(|_| {
+                let o = if case % 2 == 0 { eye } else { eye + Vec3::new(rnd(), rnd(), rnd()) * spread };
+                let d = centre + (Vec3::new(rnd(), rnd(), rnd()) - 0.5) * spread;
+                let mut r = Ray::new(o, d);
+                r.t_max = if case % 5 == 0 { rnd() * 4.0 } else { f32::INFINITY };
+                r
+            })
+            .collect();
+        let frustum = Frustum::new(&rays);
+        valid += frustum.valid as usize;
+        let t_far = rays.iter().fold(f32::NEG_INFINITY, |m, r| m.max(r.t_max));
+        for _ in 0..8 {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 6.0 - 3.0;
+            let h = Vec3::new(rnd(), rnd(), rnd()) * 0.5;
+            let b = Aabb::new(c - h, c + h);
+            if frustum.misses(&b, t_far) {
+                rejected += 1;
+                for r in &rays {
+                    assert!(b.intersect(r).is_none(), "case {case}: a rejected box is hit by {r:?}");
+                }
+            }
+        }
+    }
+    assert!(valid > 2000 && rejected > 1000, "the test exercised the frustum: {valid} valid, {rejected} rejected");
+}
