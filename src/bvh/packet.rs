@@ -177,15 +177,9 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
     fn new(rays: &'r mut [Ray]) -> Self {
         let n = rays.len();
         let n_groups = n.div_ceil(4);
-        let groups = std::array::from_fn(|g| {
-            // Padding lanes repeat a real ray; their t_max of -inf makes them miss every box.
-            let four: [Ray; 4] = std::array::from_fn(|k| rays[(4 * g + k).min(n.saturating_sub(1))]);
-            if n == 0 {
-                Group::new(&[Ray::new(glam::Vec3::ZERO, glam::Vec3::X); 4])
-            } else {
-                Group::new(&four)
-            }
-        });
+        // Padding lanes repeat the last ray; their t_max of -inf makes them miss every box. (The
+        // caller returns before this for an empty packet.)
+        let groups = std::array::from_fn(|g| Group::new(&std::array::from_fn(|k| rays[(4 * g + k).min(n - 1)])));
         let mut packet = Packet {
             rays,
             groups,
