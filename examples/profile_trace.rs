@@ -1,7 +1,8 @@
 //! A profiling driver: traces the bunny's primary and incoherent rays with the wide SAH BVH on
 //! one thread, many times over, for `perf record` / `valgrind --tool=callgrind`.
 //! `cargo run --release --example profile_trace -- [binary|wide4] [primary|incoherent|build|frame]`
-//! (`frame` with `PARTS=1` also splits the app's frame into counting, passes and snapshots).
+//! (`frame` with `PARTS=1` also splits the app's frame into counting, passes and snapshots;
+//! `primary` with `PACKET=1` also times 8×8 packets, with `PACKET=only` nothing else).
 
 use bvhscope::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, TraceOptions};
 use bvhscope::geometry::Ray;
@@ -95,7 +96,10 @@ fn main() {
     let rays: Vec<Ray> = if what == "primary" {
         let cam = Camera::framing_from(&mesh.bounds(), 1024, 1024, Vec3::new(0.45, 0.35, 1.0), 45.0);
         let g = cam.ray_gen();
-        (0..1024 * 1024).map(|i| g.pixel_ray(i % 1024, i / 1024)).collect()
+        (0..1024 * 1024)
+            .map(|i| g.pixel_ray(i % 1024, i / 1024))
+            .map(|r| if std::env::var("AWAY").is_ok() { Ray::new(r.origin(), -r.dir()) } else { r })
+            .collect()
     } else {
         let mut s = 12345u64;
         let mut rnd = move || {
@@ -135,11 +139,12 @@ fn main() {
         // 8×8 pixel blocks of the 1024² frame, each in packet order; results checked against
         // single rays on a first, untimed round.
         use bvhscope::bvh::packet::{packet_position, PACKET};
+        const ROUNDS: usize = 20;
         let mut t = Instant::now();
         let (mut hits, mut differ) = (0, 0);
         let mut out = [None; PACKET];
         let mut packet = Vec::with_capacity(PACKET);
-        for round in 0..6 {
+        for round in 0..ROUNDS + 1 {
             if round == 1 {
                 (t, hits) = (Instant::now(), 0);
             }
@@ -164,8 +169,11 @@ fn main() {
             }
         }
         let secs = t.elapsed().as_secs_f64();
-        let rate = 5.0 * rays.len() as f64 / secs / 1e6;
+        let rate = ROUNDS as f64 * rays.len() as f64 / secs / 1e6;
         println!("{what} {layout:?} packets: {rate:.2} MRays/s, {hits} hits, {differ} differ from single rays");
+        if std::env::var("PACKET").is_ok_and(|p| p == "only") {
+            return;
+        }
     }
     let t = Instant::now();
     let mut hits = 0;

@@ -397,6 +397,7 @@ fn main() {
         }
     }
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Packets));
+    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Packets));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Counting));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Counting));
     contenders.extend(contenders::obvhs_all());

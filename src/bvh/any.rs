@@ -60,7 +60,7 @@ impl Accelerator for AnyBvh {
     }
 
     fn traces_packets(&self) -> bool {
-        matches!(self, AnyBvh::Binary(_))
+        true
     }
 
     #[inline]

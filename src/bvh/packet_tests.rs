@@ -111,7 +111,6 @@ fn packets_find_what_single_rays_find() {
 #[test]
 fn packets_keep_the_rays_intervals() {
     let mesh = builtin_scene();
-    let bvh = AnyBvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..BuildParams::default() });
     // Segments that stop short of the surface, or start beyond it, must miss as single rays do.
     let rays: Vec<Ray> = primary_blocks(&mesh, 32)
         .into_iter()
@@ -122,8 +121,10 @@ fn packets_keep_the_rays_intervals() {
             _ => r,
         })
         .collect();
-    let hits = agree(&bvh, &rays, PACKET, "segments");
-    assert!(hits > 0);
+    for layout in Layout::ALL {
+        let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::default() });
+        assert!(agree(&bvh, &rays, PACKET, &format!("segments, {layout:?}")) > 0);
+    }
 }
 
 #[test]
@@ -177,17 +178,28 @@ fn the_frustum_rejects_only_boxes_every_ray_misses() {
                 r
             })
             .collect();
-        let frustum = Frustum::new(&rays);
+        let mut traced = rays.clone();
+        let mut slot = MaybeUninit::uninit();
+        let frustum = &Packet::<Watertight>::new_in(&mut slot, &mut traced).frustum;
         valid += frustum.valid as usize;
         let t_far = rays.iter().fold(f32::NEG_INFINITY, |m, r| m.max(r.t_max));
-        for _ in 0..8 {
-            let c = Vec3::new(rnd(), rnd(), rnd()) * 6.0 - 3.0;
-            let h = Vec3::new(rnd(), rnd(), rnd()) * 0.5;
-            let b = Aabb::new(c - h, c + h);
-            if frustum.misses(&b, t_far) {
-                rejected += 1;
-                for r in &rays {
-                    assert!(b.intersect(r).is_none(), "case {case}: a rejected box is hit by {r:?}");
+        for _ in 0..2 {
+            // Four boxes, as a wide node holds them: the four-box test must agree with `misses`.
+            let boxes: [Aabb; 4] = std::array::from_fn(|_| {
+                let c = Vec3::new(rnd(), rnd(), rnd()) * 6.0 - 3.0;
+                let h = Vec3::new(rnd(), rnd(), rnd()) * 0.5;
+                Aabb::new(c - h, c + h)
+            });
+            let min = std::array::from_fn(|axis| std::array::from_fn(|k| boxes[k].min[axis]));
+            let max = std::array::from_fn(|axis| std::array::from_fn(|k| boxes[k].max[axis]));
+            let may_hit = frustum.may_hit4(&min, &max, t_far);
+            for (k, b) in boxes.iter().enumerate() {
+                assert_eq!(may_hit >> k & 1 == 0, frustum.misses(b, t_far), "case {case}: box {k}, two forms");
+                if frustum.misses(b, t_far) {
+                    rejected += 1;
+                    for r in &rays {
+                        assert!(b.intersect(r).is_none(), "case {case}: a rejected box is hit by {r:?}");
+                    }
                 }
             }
         }

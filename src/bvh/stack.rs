@@ -7,12 +7,14 @@ use std::mem::MaybeUninit;
 /// A node to visit and the distance at which the ray enters its box.
 pub type StackEntry = (u32, f32);
 
-pub struct TraversalStack<const N: usize> {
-    items: [MaybeUninit<StackEntry>; N],
+/// A stack of up to `N` entries of `E`: by default a node and its entry distance; packets keep a
+/// node and the first group of rays that may hit it.
+pub struct TraversalStack<const N: usize, E: Copy = StackEntry> {
+    items: [MaybeUninit<E>; N],
     len: usize,
 }
 
-impl<const N: usize> TraversalStack<N> {
+impl<const N: usize, E: Copy> TraversalStack<N, E> {
     #[inline(always)]
     pub fn new() -> Self {
         Self { items: [const { MaybeUninit::uninit() }; N], len: 0 }
@@ -21,11 +23,23 @@ impl<const N: usize> TraversalStack<N> {
     /// Push an entry. Indexing stays bounds-checked: overflowing is impossible by the depth bound,
     /// and if that bound were ever broken this stops with a message instead of corrupting memory.
     #[inline(always)]
-    pub fn push(&mut self, e: StackEntry) {
+    pub fn push(&mut self, e: E) {
         self.items[self.len] = MaybeUninit::new(e);
         self.len += 1;
     }
 
+    #[inline(always)]
+    pub fn pop(&mut self) -> Option<E> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: every slot below `len` was written by `push` before `len` passed it.
+        Some(unsafe { self.items[self.len].assume_init() })
+    }
+}
+
+impl<const N: usize> TraversalStack<N> {
     /// Sort the top `k` entries so the nearest (smallest distance) is popped first.
     #[inline(always)]
     pub fn sort_top(&mut self, k: usize) {
@@ -42,18 +56,6 @@ impl<const N: usize> TraversalStack<N> {
         }
     }
 
-    #[inline(always)]
-    pub fn pop(&mut self) -> Option<StackEntry> {
-        if self.len == 0 {
-            return None;
-        }
-        self.len -= 1;
-        // SAFETY: every slot below `len` was written by `push` before `len` passed it.
-        Some(unsafe { self.items[self.len].assume_init() })
-    }
-}
-
-impl<const N: usize> TraversalStack<N> {
     /// Pop entries until one the ray enters no later than `t_max` (the closest hit so far): the
     /// next node worth visiting. Entries beyond it are dropped: nothing in them can be nearer.
     #[inline(always)]
@@ -67,7 +69,7 @@ impl<const N: usize> TraversalStack<N> {
     }
 }
 
-impl<const N: usize> Default for TraversalStack<N> {
+impl<const N: usize, E: Copy> Default for TraversalStack<N, E> {
     fn default() -> Self {
         Self::new()
     }

@@ -12,6 +12,7 @@
 //! the vertices themselves, and rebuilding them from stored edges would change its rounding and so
 //! lose the guarantee that rays through shared edges hit.
 
+mod packet;
 mod traverse;
 
 use super::node::{Bvh, BvhNode};

@@ -200,4 +200,12 @@ impl Accelerator for WideBvh {
         let mut r = *ray;
         self.dispatch::<true, S>(&mut r, opts, stats).is_some()
     }
+
+    fn traces_packets(&self) -> bool {
+        true
+    }
+
+    fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
+        self.closest_hits_packet(rays, hits, opts)
+    }
 }
