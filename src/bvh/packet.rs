@@ -247,8 +247,8 @@ pub(super) struct Packet<'r, T: TriangleIntersector> {
     one_sign: bool,
     neg: [bool; 3],
     pub(super) frustum: Frustum,
-    /// Each ray's triangle-test setup, made at its first leaf (bit k of `prepared_mask` set).
-    prepared: [MaybeUninit<T::Prepared>; PACKET],
+    /// Each group's triangle-test setup, made at its first leaf (bit g of `prepared_mask` set).
+    prepared: [MaybeUninit<T::Prepared4>; GROUPS],
     prepared_mask: u64,
     /// Each ray's nearest hit so far (bit k of `hit_mask` set): leaf-order triangle and barycentrics.
     best: [MaybeUninit<(u32, TriangleHit)>; PACKET],
@@ -324,29 +324,33 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
     /// one of them found a nearer hit.
     #[inline(always)]
     pub(super) fn leaf(&mut self, g: usize, mask: u32, tris: &[[glam::Vec3; 3]], first: usize, count: usize) -> bool {
+        if self.prepared_mask & (1 << g) == 0 {
+            self.prepared[g].write(T::prepare4(self.rays, 4 * g));
+            self.prepared_mask |= 1 << g;
+        }
+        // SAFETY: bit g of `prepared_mask` is set only after slot g was written.
+        let prepared = unsafe { self.prepared[g].assume_init_ref() };
+        let (t_min, mut t_max) = (self.groups()[g].t_min, self.groups()[g].t_max);
         let mut found = false;
         for (i, tri) in tris[first..first + count].iter().enumerate() {
-            let mut m = mask;
-            while m != 0 {
-                let k = 4 * g + m.trailing_zeros() as usize;
-                m &= m - 1;
-                let ray = &mut self.rays[k];
-                if self.prepared_mask & (1 << k) == 0 {
-                    self.prepared[k].write(T::prepare(ray));
-                    self.prepared_mask |= 1 << k;
-                }
-                // SAFETY: bit k of `prepared_mask` is set only after slot k was written.
-                let prepared = unsafe { self.prepared[k].assume_init_ref() };
-                if let Some(h) = T::intersect(prepared, ray, tri) {
-                    ray.t_max = h.t;
-                    self.best[k].write(((first + i) as u32, h));
-                    self.hit_mask |= 1 << k;
-                    found = true;
-                }
+            let hits = T::intersect4(prepared, t_min, t_max, mask, tri);
+            if hits.mask == 0 {
+                continue;
             }
+            let mut m = hits.mask;
+            while m != 0 {
+                let lane = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let k = 4 * g + lane;
+                let h = TriangleHit { t: hits.t[lane], u: hits.u[lane], v: hits.v[lane] };
+                self.rays[k].t_max = h.t;
+                self.best[k].write(((first + i) as u32, h));
+                self.hit_mask |= 1 << k;
+            }
+            t_max = Group::t_max_of(self.rays, 4 * g);
+            found = true;
         }
         if found {
-            let t_max = Group::t_max_of(self.rays, 4 * g);
             self.groups_mut()[g].t_max = t_max;
         }
         found

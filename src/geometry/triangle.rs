@@ -8,6 +8,7 @@
 
 use super::Ray;
 use glam::{DVec3, Vec3};
+use wide::f32x4;
 
 /// Distance and barycentrics of a ray–triangle hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,6 +46,24 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
     type Prepared: Copy;
     fn prepare(ray: &Ray) -> Self::Prepared;
     fn intersect(p: &Self::Prepared, ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit>;
+
+    /// Data computed once per group of four rays of a packet, for `intersect4`.
+    type Prepared4: Copy;
+    /// The setup of rays `base..base + 4` of `rays` (lanes past the end repeat the last ray).
+    fn prepare4(rays: &[Ray], base: usize) -> Self::Prepared4;
+    /// One triangle against the four rays, each within `[t_min, t_max)` of its lane: the mask
+    /// of the lanes in `lanes` that hit, and their hits. Lane by lane the same result as
+    /// `intersect` (packets must find exactly what single rays find).
+    fn intersect4(p: &Self::Prepared4, t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4;
+}
+
+/// The hits of `intersect4`: lane k of each array is ray k's hit when bit k of `mask` is set.
+#[derive(Clone, Copy, Debug)]
+pub struct Hits4 {
+    pub mask: u32,
+    pub t: [f32; 4],
+    pub u: [f32; 4],
+    pub v: [f32; 4],
 }
 
 /// Watertight ray–triangle intersection. Woop, Benthin & Wald, "Watertight Ray/Triangle
@@ -68,7 +87,7 @@ pub struct WatertightRay {
 impl TriangleIntersector for Watertight {
     type Prepared = WatertightRay;
 
-    #[inline]
+    #[inline(always)]
     fn prepare(ray: &Ray) -> WatertightRay {
         let d = ray.dir();
         let a = d.abs();
@@ -126,6 +145,76 @@ impl TriangleIntersector for Watertight {
         // u, v, w weight v0, v1, v2: in our convention u ↔ v1 and v ↔ v2.
         Some(TriangleHit { t, u: v * inv_det, v: w * inv_det })
     }
+
+    type Prepared4 = WatertightRay4;
+
+    #[inline(always)]
+    fn prepare4(rays: &[Ray], base: usize) -> WatertightRay4 {
+        let last = rays.len() - 1;
+        let mut rows = [[[0f32; 4]; 3]; 4]; // [origin, rx, ry, rz][axis][lane]
+        for k in 0..4 {
+            let r = &rays[(base + k).min(last)];
+            let w = Self::prepare(r);
+            for (row, v) in rows.iter_mut().zip([r.origin(), w.rx, w.ry, w.rz]) {
+                for axis in 0..3 {
+                    row[axis][k] = v[axis];
+                }
+            }
+        }
+        let [org, rx, ry, rz] = rows.map(|row| row.map(f32x4::from));
+        WatertightRay4 { org, rx, ry, rz }
+    }
+
+    /// `intersect`'s arithmetic in the same order, one lane per ray (SSE and NEON round each
+    /// operation as scalar code does, and nothing is fused), so each lane's result is the scalar
+    /// one bit for bit; a lane with an exactly-zero edge function takes the same double-precision
+    /// fallback, lane by lane.
+    #[inline(always)]
+    fn intersect4(p: &WatertightRay4, t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
+        let rel = |v: Vec3| [f32x4::splat(v.x) - p.org[0], f32x4::splat(v.y) - p.org[1], f32x4::splat(v.z) - p.org[2]];
+        // glam's dot: (x·x' + y·y') + z·z'.
+        let dot = |a: &[f32x4; 3], r: &[f32x4; 3]| a[0] * r[0] + a[1] * r[1] + a[2] * r[2];
+        let (a, b, c) = (rel(tri[0]), rel(tri[1]), rel(tri[2]));
+        let (ax, ay) = (dot(&a, &p.rx), dot(&a, &p.ry));
+        let (bx, by) = (dot(&b, &p.rx), dot(&b, &p.ry));
+        let (cx, cy) = (dot(&c, &p.rx), dot(&c, &p.ry));
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        let zero = (u.simd_eq(f32x4::ZERO) | v.simd_eq(f32x4::ZERO) | w.simd_eq(f32x4::ZERO)).to_bitmask() & lanes;
+        if zero != 0 {
+            let (mut uu, mut vv, mut ww) = (u.to_array(), v.to_array(), w.to_array());
+            let f = |x: f32x4, k: usize| x.to_array()[k] as f64;
+            let mut m = zero;
+            while m != 0 {
+                let k = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let (ax, ay, bx, by, cx, cy) = (f(ax, k), f(ay, k), f(bx, k), f(by, k), f(cx, k), f(cy, k));
+                uu[k] = (cx * by - cy * bx) as f32;
+                vv[k] = (ax * cy - ay * cx) as f32;
+                ww[k] = (bx * ay - by * ax) as f32;
+            }
+            (u, v, w) = (f32x4::from(uu), f32x4::from(vv), f32x4::from(ww));
+        }
+        let z = f32x4::ZERO;
+        let outside = (u.simd_lt(z) | v.simd_lt(z) | w.simd_lt(z)) & (u.simd_gt(z) | v.simd_gt(z) | w.simd_gt(z));
+        let det = u + v + w;
+        let t_scaled = u * dot(&a, &p.rz) + v * dot(&b, &p.rz) + w * dot(&c, &p.rz);
+        let inv_det = f32x4::ONE / det;
+        let t = t_scaled * inv_det;
+        let inside = det.simd_ne(z) & t.simd_ge(t_min) & t.simd_lt(t_max);
+        let mask = inside.to_bitmask() & !outside.to_bitmask() & lanes;
+        Hits4 { mask, t: t.to_array(), u: (v * inv_det).to_array(), v: (w * inv_det).to_array() }
+    }
+}
+
+/// Four rays' `WatertightRay` rows and origins, lane k for ray k.
+#[derive(Clone, Copy, Debug)]
+pub struct WatertightRay4 {
+    org: [f32x4; 3],
+    rx: [f32x4; 3],
+    ry: [f32x4; 3],
+    rz: [f32x4; 3],
 }
 
 /// Möller–Trumbore ray–triangle intersection. Möller & Trumbore, "Fast, Minimum Storage
@@ -168,6 +257,31 @@ impl TriangleIntersector for MollerTrumbore {
             return None;
         }
         Some(TriangleHit { t, u, v })
+    }
+
+    /// The four rays themselves: this test is not vectorised (it is the one students write first,
+    /// kept for comparison), so `intersect4` runs it lane by lane.
+    type Prepared4 = [Ray; 4];
+
+    fn prepare4(rays: &[Ray], base: usize) -> [Ray; 4] {
+        std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
+    }
+
+    fn intersect4(rays: &[Ray; 4], t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
+        let mut hits = Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+        let (t_min, t_max) = (t_min.to_array(), t_max.to_array());
+        let mut m = lanes;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let mut ray = rays[k];
+            (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
+            if let Some(h) = Self::intersect(&(), &ray, tri) {
+                hits.mask |= 1 << k;
+                (hits.t[k], hits.u[k], hits.v[k]) = (h.t, h.u, h.v);
+            }
+        }
+        hits
     }
 }
 
@@ -315,5 +429,60 @@ mod tests {
     fn empty_ray_is_never_hit() {
         let r = Ray::new(Vec3::new(0.25, f32::NAN, 1.0), -Vec3::Z);
         assert_eq!(both(&r, &TRI), [None, None]);
+    }
+
+    /// Four rays aimed at points of a triangle (on its edges and vertices too, where the
+    /// watertight test's edge functions are exactly zero), with random intervals.
+    fn four_rays() -> impl proptest::strategy::Strategy<Value = ([Vec3; 3], [Ray; 4], u32)> {
+        use proptest::prelude::*;
+        let grid = || (-4i32..=4).prop_map(|v| v as f32 * 0.5);
+        let point = || [grid(), grid(), grid()].prop_map(Vec3::from_array);
+        let ray = (0u32..4, 0u32..4, 0u32..4, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..6);
+        (point(), point(), point(), [ray.clone(), ray.clone(), ray.clone(), ray], 0u32..16).prop_map(
+            |(a, b, c, rays, lanes)| {
+                let tri = [a, b, c];
+                let rays = rays.map(|(i, j, k, d, s, interval)| {
+                    let w = (i + j + k).max(1) as f32;
+                    let target = (a * i as f32 + b * j as f32 + c * k as f32) / w;
+                    let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32 + 0.25);
+                    let mut r = Ray::new(target - dir * s as f32, dir);
+                    match interval {
+                        0 => r.t_max = s as f32, // the hit lies exactly at t_max: excluded
+                        1 => r.t_min = s as f32 + 0.5,
+                        2 => r.t_max = s as f32 * 0.5,
+                        _ => {}
+                    }
+                    r
+                });
+                (tri, rays, lanes)
+            },
+        )
+    }
+
+    fn agree4<T: TriangleIntersector>(tri: &[Vec3; 3], rays: &[Ray; 4], lanes: u32) {
+        let p = T::prepare4(rays, 0);
+        let lane = |f: &dyn Fn(&Ray) -> f32| f32x4::from(rays.each_ref().map(f));
+        let got = T::intersect4(&p, lane(&|r| r.t_min), lane(&|r| r.t_max), lanes, tri);
+        for (k, ray) in rays.iter().enumerate() {
+            let want = if lanes & (1 << k) != 0 { T::intersect(&T::prepare(ray), ray, tri) } else { None };
+            assert_eq!(got.mask & (1 << k) != 0, want.is_some(), "lane {k}: hit or miss");
+            if let Some(h) = want {
+                let bits = |x: f32| x.to_bits();
+                assert_eq!(
+                    (bits(got.t[k]), bits(got.u[k]), bits(got.v[k])),
+                    (bits(h.t), bits(h.u), bits(h.v)),
+                    "lane {k}: bit for bit"
+                );
+            }
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+        #[test]
+        fn four_rays_at_once_find_what_each_ray_finds((tri, rays, lanes) in four_rays()) {
+            agree4::<Watertight>(&tri, &rays, lanes);
+            agree4::<MollerTrumbore>(&tri, &rays, lanes);
+        }
     }
 }
