@@ -19,15 +19,18 @@ pub struct Ray {
 
 impl Ray {
     /// A ray over `[0, +inf]`.
+    #[inline]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
         Self::segment(origin, dir, 0.0, f32::INFINITY)
     }
 
     /// A ray over `[t_min, t_max]`. Non-finite input gives an empty ray (see the module docs).
+    #[inline]
     pub fn segment(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
         // 1/±0 = ±inf keeps the sign of a -0 component, which the slab test relies on.
         let inv_dir = Vec3::ONE / dir;
-        let valid = origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO && !t_min.is_nan() && !t_max.is_nan();
+        // Without short-circuits: one branch-free test (rays are made by the million).
+        let valid = origin.is_finite() & dir.is_finite() & (dir != Vec3::ZERO) & !t_min.is_nan() & !t_max.is_nan();
         Self {
             origin,
             dir,
