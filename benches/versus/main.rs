@@ -3,7 +3,7 @@
 //! median of several runs; hit counts are printed so nobody wins by missing.
 //! `BENCH_QUICK=1` runs a reduced set (under two minutes on 2 cores). For iterating on one thing:
 //! `BENCH_ONLY=sah,medium` keeps contenders whose names contain a word, `BENCH_MESH=bunny` one mesh,
-//! `BENCH_APP=1` prints only the app figures.
+//! `BENCH_APP=1` prints only the app figures, `BENCH_OVERHEAD=1` only the counting overhead.
 
 mod contenders;
 mod rays;
@@ -225,10 +225,12 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
 }
 
 /// The heatmap counters' cost, measured in alternation: on one thread, the plain and the counting
-/// traversal of the same tree take turns `pairs` times (which goes first alternates too), and the
-/// median of the per-pair ratios is kept. Rows of the table are timed minutes apart, and this
-/// machine drifts by ±15% over minutes; a pair is timed within seconds.
+/// traversal of the same tree take turns on every slice of 16384 rays (which goes first alternates
+/// from slice to slice), their times are summed over the whole ray set, and the median of `pairs`
+/// such passes is kept. Rows of the table are timed minutes apart, and this machine drifts by ±15%
+/// over minutes and by several percent over seconds; two turns on a slice are milliseconds apart.
 fn counting_overhead(mesh: &Mesh, s: &Settings, one: &ThreadPool) -> String {
+    const SLICE: usize = 16384;
     let primary = rays::primary(mesh, s.primary_size);
     let incoherent = rays::incoherent(mesh, s.incoherent, 0x5EED);
     let pairs = if s.quick || mesh.triangle_count() > 1_000_000 { 3 } else { 5 };
@@ -238,23 +240,28 @@ fn counting_overhead(mesh: &Mesh, s: &Settings, one: &ThreadPool) -> String {
         let overhead = |rays: &[RaySpec]| {
             let ratios = (0..pairs)
                 .map(|k| {
-                    let time = |t: &dyn Tracer| trace(one, rays, t);
-                    let ((p, hp), (c, hc)) = if k % 2 == 0 {
-                        let p = time(plain.as_ref());
-                        (p, time(counting.as_ref()))
-                    } else {
-                        let c = time(counting.as_ref());
-                        (time(plain.as_ref()), c)
-                    };
-                    assert_eq!(hp, hc, "the counting traversal must find the same hits");
-                    c.as_secs_f64() / p.as_secs_f64()
+                    let (mut plain_s, mut counting_s) = (0.0, 0.0);
+                    for (j, slice) in rays.chunks(SLICE).enumerate() {
+                        let time = |t: &dyn Tracer| trace(one, slice, t);
+                        let ((p, hp), (c, hc)) = if (j + k) % 2 == 0 {
+                            let p = time(plain.as_ref());
+                            (p, time(counting.as_ref()))
+                        } else {
+                            let c = time(counting.as_ref());
+                            (time(plain.as_ref()), c)
+                        };
+                        assert_eq!(hp, hc, "the counting traversal must find the same hits");
+                        plain_s += p.as_secs_f64();
+                        counting_s += c.as_secs_f64();
+                    }
+                    counting_s / plain_s
                 })
                 .collect();
             (median(ratios) - 1.0) * 100.0
         };
         let _ = writeln!(
             o,
-            "counting overhead {} SAH {label} (alternated, median of {pairs} pairs): primary 1T {:+.1}%, incoherent 1T {:+.1}%",
+            "counting overhead {} SAH {label} (alternated per {SLICE} rays, median of {pairs} passes): primary 1T {:+.1}%, incoherent 1T {:+.1}%",
             mesh.name,
             overhead(&primary),
             overhead(&incoherent)
@@ -285,7 +292,7 @@ fn app_figures(meshes: &[Mesh], all: &ThreadPool) -> String {
     let mut o = String::from("\n### App figures (all threads)\n\n");
     if let Some(bunny) = meshes.iter().find(|m| m.name.contains("bunny")) {
         for (layout, what) in [
-            (bvhscope::bvh::Layout::Wide4, "wide SAH, the app's default"),
+            (bvhscope::bvh::Layout::Wide4, "wide SAH, the app's default layout, 8×8 packets"),
             (bvhscope::bvh::Layout::Binary, "binary SAH, 8×8 packets"),
         ] {
             let bvh = all.install(|| AnyBvh::build(bunny, &BuildParams { layout, ..BuildParams::default() }));
@@ -425,6 +432,13 @@ fn main() {
     // BENCH_MESH=word keeps meshes whose name contains it.
     if let Ok(m) = std::env::var("BENCH_MESH") {
         meshes.retain(|mesh| mesh.name.to_lowercase().contains(&m.to_lowercase()));
+    }
+    // BENCH_OVERHEAD=1: only the counting overhead.
+    if std::env::var("BENCH_OVERHEAD").is_ok_and(|v| v == "1") {
+        for mesh in &meshes {
+            print!("{}", counting_overhead(mesh, &s, &one));
+        }
+        return;
     }
     let started = Instant::now();
     let mut out = String::new();
