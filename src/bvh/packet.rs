@@ -8,9 +8,10 @@
 //! group misses, a conservative test of the whole packet (interval arithmetic over the rays'
 //! origins and inverse directions, the paper's §4.2) rejects most boxes no ray reaches before the
 //! other groups are tried one by one. At a leaf every group from the first active one is
-//! box-tested and its hitting rays test the leaf's triangles with the single-ray test, so every ray
-//! gets the hit it would get alone (the same distance; between triangles hit at exactly the same
-//! distance either may be reported).
+//! box-tested and its hitting rays test the leaf's triangles four at a time
+//! (`TriangleIntersector::intersect4`, bit for bit the single-ray test), so every ray gets the hit
+//! it would get alone (the same distance; between triangles hit at exactly the same distance either
+//! may be reported).
 //!
 //! Packets are for the renderer's uncounted views of primary rays (`bvhscope render` of normals or
 //! depth): heatmaps, and the app, which always counts for its hover read-out, trace single rays.
@@ -29,7 +30,9 @@ use std::mem::MaybeUninit;
 use wide::f32x4;
 
 /// Four rays of a packet in SIMD form (lane k = ray k), for one slab test of a box against all
-/// four. Padding lanes (past the packet's end) get `t_max = -inf`, so every box misses them.
+/// four. Padding lanes (past the packet's end) repeat the last ray with `t_max = -inf`, so boxes
+/// nearly always miss them (a box can still pass one whose ray starts inside it with
+/// `t_min = -inf`); `Packet::leaf` masks them out.
 pub(super) struct Group {
     org: [f32x4; 3],
     inv: [f32x4; 3],
@@ -261,7 +264,24 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
     /// that misses everything. The caller returns before this for an empty packet.
     #[inline(always)]
     pub(super) fn new_in<'s>(slot: &'s mut MaybeUninit<Self>, rays: &'r mut [Ray]) -> &'s mut Self {
+        debug_assert!(rays.len() <= PACKET, "a packet holds at most {PACKET} rays");
         let n_groups = rays.len().div_ceil(4);
+        // Every field, by name: a field added to `Packet` and not written below fails to compile
+        // here instead of being left uninitialised.
+        let _every_field = |p: &Self| {
+            let Packet {
+                rays: _,
+                groups: _,
+                n_groups: _,
+                one_sign: _,
+                neg: _,
+                frustum: _,
+                prepared: _,
+                prepared_mask: _,
+                best: _,
+                hit_mask: _,
+            } = p;
+        };
         let p = slot.as_mut_ptr();
         // SAFETY: every field that is not a MaybeUninit array is written here through raw
         // pointers (no reference to uninitialised data is made) before the slot is taken as set.
@@ -292,7 +312,7 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
     /// The set groups.
     #[inline(always)]
     fn groups(&self) -> &[Group] {
-        // SAFETY: `new` wrote the first `n_groups` slots; MaybeUninit<Group> has Group's layout.
+        // SAFETY: `new_in` wrote the first `n_groups` slots; MaybeUninit<Group> has Group's layout.
         unsafe { std::slice::from_raw_parts(self.groups.as_ptr().cast::<Group>(), self.n_groups) }
     }
 
@@ -324,6 +344,8 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
     /// one of them found a nearer hit.
     #[inline(always)]
     pub(super) fn leaf(&mut self, g: usize, mask: u32, tris: &[[glam::Vec3; 3]], first: usize, count: usize) -> bool {
+        // Only the lanes of real rays (the last group may have padding lanes).
+        let mask = mask & ((1u32 << (self.rays.len() - 4 * g).min(4)) - 1);
         if self.prepared_mask & (1 << g) == 0 {
             self.prepared[g].write(T::prepare4(self.rays, 4 * g));
             self.prepared_mask |= 1 << g;

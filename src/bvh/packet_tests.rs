@@ -108,6 +108,40 @@ fn packets_find_what_single_rays_find() {
     }
 }
 
+/// Rays at the edges of what a ray can be: subnormal and negative-zero direction components,
+/// NaN, intervals starting at -inf or ending at -inf, origins inside the mesh; in packets of every
+/// size, so the padding lanes of the last group repeat such a ray.
+#[test]
+fn odd_rays_in_packets_of_every_size_agree_with_single_rays() {
+    let mesh = builtin_scene();
+    let c = mesh.bounds().center();
+    let tiny = f32::MIN_POSITIVE / 4.0; // subnormal: its inverse is infinite
+    let dirs = [
+        Vec3::new(tiny, -tiny, 1.0),
+        Vec3::new(-0.0, 0.0, -1.0),
+        Vec3::new(tiny, tiny, tiny),
+        Vec3::new(0.3, -0.0, 0.7),
+        Vec3::new(f32::NAN, 0.0, 1.0),
+        Vec3::new(-0.5, 0.25, -0.0),
+    ];
+    let mut rays = Vec::new();
+    for (i, d) in dirs.iter().cycle().take(96).enumerate() {
+        let o = c + Vec3::new((i % 5) as f32 * 0.1, (i % 3) as f32 * -0.1, 0.05);
+        rays.push(match i % 4 {
+            0 => Ray::segment(o, *d, f32::NEG_INFINITY, f32::INFINITY),
+            1 => Ray::segment(o, *d, 0.0, f32::NEG_INFINITY),
+            _ => Ray::new(o, *d),
+        });
+    }
+    for layout in Layout::ALL {
+        let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::default() });
+        for size in [1, 2, 3, 5, 17, 63, 64] {
+            let hits = agree(&bvh, &rays, size, &format!("odd rays, {layout:?}, packets of {size}"));
+            assert!(hits > 10 && hits < rays.len(), "{layout:?}: some rays hit, some miss ({hits})");
+        }
+    }
+}
+
 #[test]
 fn packets_keep_the_rays_intervals() {
     let mesh = builtin_scene();

@@ -4,10 +4,11 @@
 //! are dropped, the others are visited nearest first along the packet's leading direction.
 //!
 //! Why it beats binary packets for primary rays: the wide tree has half the levels, so a packet
-//! pops, pushes and sorts half as often, and the packet's frustum rejects all four children with
-//! one SIMD test before any group is tried. Leaves are the binary BVH's, tested the same way: every
-//! group from the leaf's first one, and its hitting rays with the single-ray triangle test, so
-//! each ray gets the hit it would get alone.
+//! pops, pushes and sorts half as often. Each child is first tested against the node's first
+//! group; the children it misses are put to the packet's frustum, one SIMD test for the four boxes,
+//! before the following groups are tried. Leaves are the binary BVH's, tested the same way: every
+//! group from the leaf's first one, its hitting rays with the four-ray triangle test (bit for bit
+//! the single-ray test), so each ray gets the hit it would get alone.
 
 use super::{WideBvh, WIDTH};
 use crate::bvh::packet::{Packet, PACKET};
