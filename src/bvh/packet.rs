@@ -343,7 +343,27 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
     /// Test triangles `first..first + count` against the rays of group `g` in `mask`; true when
     /// one of them found a nearer hit.
     #[inline(always)]
-    pub(super) fn leaf(&mut self, g: usize, mask: u32, tris: &[[glam::Vec3; 3]], first: usize, count: usize) -> bool {
+    /// A leaf over `tris` (`first` is the index of `tris[0]` in leaf order) for every group from
+    /// `from` whose rays hit its box `[lo, hi]`; true when one of them found a nearer hit.
+    pub(super) fn leaf_groups(
+        &mut self,
+        from: usize,
+        lo: [f32; 3],
+        hi: [f32; 3],
+        tris: &[[glam::Vec3; 3]],
+        first: usize,
+    ) -> bool {
+        let mut found = false;
+        for g in from..self.n_groups {
+            let mask = self.group_hits(g, lo, hi);
+            if mask != 0 {
+                found |= self.leaf(g, mask, tris, first);
+            }
+        }
+        found
+    }
+
+    fn leaf(&mut self, g: usize, mask: u32, tris: &[[glam::Vec3; 3]], first: usize) -> bool {
         // Only the lanes of real rays (the last group may have padding lanes).
         let mask = mask & ((1u32 << (self.rays.len() - 4 * g).min(4)) - 1);
         if self.prepared_mask & (1 << g) == 0 {
@@ -354,7 +374,7 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
         let prepared = unsafe { self.prepared[g].assume_init_ref() };
         let (t_min, mut t_max) = (self.groups()[g].t_min, self.groups()[g].t_max);
         let mut found = false;
-        for (i, tri) in tris[first..first + count].iter().enumerate() {
+        for (i, tri) in tris.iter().enumerate() {
             let hits = T::intersect4(prepared, t_min, t_max, mask, tri);
             if hits.mask == 0 {
                 continue;
@@ -391,13 +411,12 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
     }
 }
 
-impl Bvh {
-    fn closest_packet<T: TriangleIntersector>(&self, rays: &mut [Ray], hits: &mut [Option<Hit>]) {
-        assert!(rays.len() <= PACKET && hits.len() == rays.len(), "a packet holds at most {PACKET} rays");
-        hits.fill(None);
-        if rays.is_empty() || self.prim_ids.is_empty() {
-            return;
-        }
+impl PacketWalk for Bvh {
+    fn has_no_triangles(&self) -> bool {
+        self.prim_ids.is_empty()
+    }
+
+    fn walk<T: TriangleIntersector>(&self, rays: &mut [Ray], hits: &mut [Option<Hit>]) {
         // Near child by the first ray's direction on the split axis (the rays are coherent; the
         // order only affects speed, not the result).
         let lead = rays[0].inv_dir();
@@ -431,14 +450,7 @@ impl Bvh {
                     continue;
                 }
                 let (start, count) = (node.index as usize, node.count as usize);
-                let mut found = packet.leaf(g, mask, &self.tris, start, count);
-                for h in g + 1..packet.n_groups {
-                    let m = packet.group_hits(h, lo, hi);
-                    if m != 0 {
-                        found |= packet.leaf(h, m, &self.tris, start, count);
-                    }
-                }
-                if found {
+                if packet.leaf_groups(g, lo, hi, &self.tris[start..start + count], start) {
                     t_far = packet.t_far();
                 }
             }
@@ -447,14 +459,33 @@ impl Bvh {
         }
         packet.finish(&self.prim_ids, hits);
     }
+}
 
-    /// Closest hits of up to `PACKET` coherent rays (an 8×8 pixel block, best in the order of
-    /// `packet_position`), the same as `closest_hit` on each.
-    pub(crate) fn closest_hits_packet(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
-        match opts.test {
-            TriangleTest::Watertight => self.closest_packet::<Watertight>(rays, hits),
-            TriangleTest::MollerTrumbore => self.closest_packet::<MollerTrumbore>(rays, hits),
-        }
+/// A BVH layout that traces packets: its ranged walk over one packet. `closest_hits_packet` does
+/// the rest for every layout.
+pub(super) trait PacketWalk {
+    /// True when there is nothing to hit.
+    fn has_no_triangles(&self) -> bool;
+    /// Trace `rays` (1 to `PACKET` of them) as one packet; `hits` are cleared.
+    fn walk<T: TriangleIntersector>(&self, rays: &mut [Ray], hits: &mut [Option<Hit>]);
+}
+
+/// Closest hits of up to `PACKET` coherent rays (an 8×8 pixel block, best in the order of
+/// `packet_position`), the same as `closest_hit` on each.
+pub(super) fn closest_hits_packet<B: PacketWalk>(
+    bvh: &B,
+    rays: &mut [Ray],
+    hits: &mut [Option<Hit>],
+    opts: TraceOptions,
+) {
+    assert!(rays.len() <= PACKET && hits.len() == rays.len(), "a packet holds at most {PACKET} rays");
+    hits.fill(None);
+    if rays.is_empty() || bvh.has_no_triangles() {
+        return;
+    }
+    match opts.test {
+        TriangleTest::Watertight => bvh.walk::<Watertight>(rays, hits),
+        TriangleTest::MollerTrumbore => bvh.walk::<MollerTrumbore>(rays, hits),
     }
 }
 

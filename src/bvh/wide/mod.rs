@@ -69,6 +69,12 @@ impl WideNode {
         )
     }
 
+    /// Slot `slot`'s box as its `(min, max)` planes per axis.
+    pub fn slot_planes(&self, slot: usize) -> ([f32; 3], [f32; 3]) {
+        let (lo, hi) = (&self.min, &self.max);
+        ([lo[0][slot], lo[1][slot], lo[2][slot]], [hi[0][slot], hi[1][slot], hi[2][slot]])
+    }
+
     pub fn slots(&self) -> impl Iterator<Item = usize> + '_ {
         (0..WIDTH).filter(|k| self.valid & (1 << k) != 0)
     }

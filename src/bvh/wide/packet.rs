@@ -11,10 +11,10 @@
 //! the single-ray test), so each ray gets the hit it would get alone.
 
 use super::{WideBvh, WIDTH};
-use crate::bvh::packet::{Packet, PACKET};
+use crate::bvh::packet::{Packet, PacketWalk};
 use crate::bvh::stack::TraversalStack;
-use crate::bvh::{Hit, TraceOptions, TRAVERSAL_STACK_SIZE};
-use crate::geometry::{MollerTrumbore, Ray, TriangleIntersector, TriangleTest, Watertight};
+use crate::bvh::{Hit, TRAVERSAL_STACK_SIZE};
+use crate::geometry::{Ray, TriangleIntersector};
 use std::mem::MaybeUninit;
 use wide::f32x4;
 
@@ -24,13 +24,12 @@ const STACK: usize = 3 * TRAVERSAL_STACK_SIZE + 4;
 /// A child reference as in `traverse.rs`: a node index, or `LEAF | (node·4 + slot)`.
 const LEAF: u32 = 1 << 31;
 
-impl WideBvh {
-    fn closest_packet<T: TriangleIntersector>(&self, rays: &mut [Ray], hits: &mut [Option<Hit>]) {
-        assert!(rays.len() <= PACKET && hits.len() == rays.len(), "a packet holds at most {PACKET} rays");
-        hits.fill(None);
-        if rays.is_empty() || self.prim_ids.is_empty() {
-            return;
-        }
+impl PacketWalk for WideBvh {
+    fn has_no_triangles(&self) -> bool {
+        self.prim_ids.is_empty()
+    }
+
+    fn walk<T: TriangleIntersector>(&self, rays: &mut [Ray], hits: &mut [Option<Hit>]) {
         // Children are ordered by their centres along the first ray's direction: for coherent rays
         // that is front to back (the order only affects speed, never the result).
         let lead = rays[0].dir();
@@ -59,11 +58,6 @@ impl WideBvh {
                     hit[j] = (key[s], r, g as u8);
                     n += 1;
                 };
-                let bounds = |s: usize| {
-                    let lo = [node.min[0][s], node.min[1][s], node.min[2][s]];
-                    let hi = [node.max[0][s], node.max[1][s], node.max[2][s]];
-                    (lo, hi)
-                };
                 // Most children are hit by the node's first group; the others are first put to
                 // the frustum, then to the following groups one by one.
                 let mut missed = 0u32;
@@ -71,7 +65,7 @@ impl WideBvh {
                 while todo != 0 {
                     let s = todo.trailing_zeros() as usize;
                     todo &= todo - 1;
-                    let (lo, hi) = bounds(s);
+                    let (lo, hi) = node.slot_planes(s);
                     if packet.group_hits(first, lo, hi) != 0 {
                         add(s, first);
                     } else {
@@ -83,7 +77,7 @@ impl WideBvh {
                     while missed != 0 {
                         let s = missed.trailing_zeros() as usize;
                         missed &= missed - 1;
-                        let (lo, hi) = bounds(s);
+                        let (lo, hi) = node.slot_planes(s);
                         let mut g = first + 1;
                         while g < packet.n_groups && packet.group_hits(g, lo, hi) == 0 {
                             g += 1;
@@ -103,17 +97,9 @@ impl WideBvh {
             } else {
                 let (index, s) = ((cur & !LEAF) >> 2, (cur & 3) as usize);
                 let node = &self.nodes[index as usize];
-                let lo = [node.min[0][s], node.min[1][s], node.min[2][s]];
-                let hi = [node.max[0][s], node.max[1][s], node.max[2][s]];
+                let (lo, hi) = node.slot_planes(s);
                 let (start, count) = (node.child[s] as usize, node.count[s] as usize);
-                let mut found = false;
-                for g in first..packet.n_groups {
-                    let m = packet.group_hits(g, lo, hi);
-                    if m != 0 {
-                        found |= packet.leaf(g, m, &self.tris, start, count);
-                    }
-                }
-                if found {
+                if packet.leaf_groups(first, lo, hi, &self.tris[start..start + count], start) {
                     t_far = packet.t_far();
                 }
             }
@@ -121,13 +107,5 @@ impl WideBvh {
             (cur, first) = (r, g as usize);
         }
         packet.finish(&self.prim_ids, hits);
-    }
-
-    /// Closest hits of up to `PACKET` coherent rays, the same as `closest_hit` on each.
-    pub(crate) fn closest_hits_packet(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
-        match opts.test {
-            TriangleTest::Watertight => self.closest_packet::<Watertight>(rays, hits),
-            TriangleTest::MollerTrumbore => self.closest_packet::<MollerTrumbore>(rays, hits),
-        }
     }
 }

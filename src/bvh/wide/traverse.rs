@@ -206,6 +206,6 @@ impl Accelerator for WideBvh {
     }
 
     fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
-        self.closest_hits_packet(rays, hits, opts)
+        crate::bvh::packet::closest_hits_packet(self, rays, hits, opts)
     }
 }
