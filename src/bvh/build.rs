@@ -76,7 +76,8 @@ pub struct BuildParams {
     /// Most triangles in a leaf (default 4). The SAH strategies may stop earlier when a leaf is
     /// cheaper than a split; no strategy makes a larger leaf.
     pub max_leaf_size: u32,
-    /// Bins per axis for `SahBinned` (default 16).
+    /// Bins per axis for `SahBinned` (default 16); nodes of fewer than three triangles per bin
+    /// use n/3 bins (at least 4).
     pub sah_bins: u32,
     pub cost: SahCost,
     pub layout: Layout,
