@@ -143,6 +143,8 @@ pub enum SplitDecision {
 #[derive(Default)]
 pub struct SplitScratch {
     pub areas: Vec<f32>,
+    /// Per plane of the binned SAH, the right side's area on each axis (lanes 0..3).
+    pub plane_areas: Vec<Vec4>,
     pub bins: Vec<sah_binned::Bin>,
 }
 

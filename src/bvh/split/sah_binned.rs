@@ -7,7 +7,7 @@
 
 use super::{leaf_is_cheaper, partition, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
 use crate::bvh::BuildParams;
-use glam::{Vec3, Vec3A};
+use glam::{BVec4A, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 /// Upper bound on the bin count.
@@ -117,35 +117,44 @@ pub fn split_sah_binned(
     } else {
         bin_into(all, prims);
     }
-    // The three axes are swept together, plane by plane: three independent chains of box unions
-    // instead of one, which the CPU overlaps.
-    let right_area = &mut scratch.areas;
+    // The three axes are swept together, plane by plane, with lane k of each vector for axis k:
+    // three independent chains of box unions, and the three areas and costs of a plane computed
+    // with one set of SIMD operations.
+    let right_area = &mut scratch.plane_areas;
     right_area.clear();
-    right_area.resize(3 * bins, 0.0);
+    right_area.resize(bins, Vec4::ZERO);
     let bin = |axis: usize, i: usize| &all[axis * bins + i];
-    // right_area[3i + axis]: area of the bins i.. of that axis; plane i separates bins ..i from i..
+    // right_area[i]: per axis, the area of bins i..; plane i separates bins ..i from i..
     let mut acc = [Acc::EMPTY; 3];
     for i in (1..bins).rev() {
-        for axis in 0..3 {
-            acc[axis].add(bin(axis, i));
-            right_area[3 * i + axis] = acc[axis].area();
+        for (axis, a) in acc.iter_mut().enumerate() {
+            a.add(bin(axis, i));
         }
+        right_area[i] = areas3(&acc);
     }
     let splittable = extent.to_array().map(|e| e > 0.0);
     let (mut acc, mut left) = ([Acc::EMPTY; 3], [0u32; 3]);
-    let (mut best_cost, mut best_axis, mut best_plane) = (f32::INFINITY, 0, 0);
+    // Per axis, the cheapest plane so far (the first of equal ones).
+    let (mut lane_cost, mut lane_plane) = (Vec4::INFINITY, Vec4::ZERO);
     for i in 1..bins {
         for axis in 0..3 {
             let b = bin(axis, i - 1);
             acc[axis].add(b);
             left[axis] += b.count;
-            let right = n as u32 - left[axis];
-            let cost = acc[axis].area() * left[axis] as f32 + right_area[3 * i + axis] * right as f32;
-            // Written to compile to selects, not branches: most planes lose.
-            let better = cost < best_cost && left[axis] != 0 && right != 0 && splittable[axis];
-            best_cost = if better { cost } else { best_cost };
-            best_axis = if better { axis } else { best_axis };
-            best_plane = if better { i } else { best_plane };
+        }
+        let right = left.map(|l| n as u32 - l);
+        let counts = |c: [u32; 3]| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, 0.0);
+        let cost = areas3(&acc) * counts(left) + right_area[i] * counts(right);
+        let usable = |a: usize| left[a] != 0 && right[a] != 0 && splittable[a];
+        let better = cost.cmplt(lane_cost) & BVec4A::new(usable(0), usable(1), usable(2), false);
+        lane_cost = Vec4::select(better, cost, lane_cost);
+        lane_plane = Vec4::select(better, Vec4::splat(i as f32), lane_plane);
+    }
+    // The cheapest axis; on a tie the lower axis.
+    let (mut best_cost, mut best_axis, mut best_plane) = (f32::INFINITY, 0, 0);
+    for axis in 0..3 {
+        if lane_cost[axis] < best_cost {
+            (best_cost, best_axis, best_plane) = (lane_cost[axis], axis, lane_plane[axis] as usize);
         }
     }
     let best = (best_plane != 0).then_some((best_cost, best_axis, best_plane));
@@ -166,6 +175,19 @@ pub fn split_sah_binned(
         "the partition sends left exactly the triangles binned left of the plane"
     );
     SplitDecision::Split { axis: axis as u8, mid }
+}
+
+/// Surface areas of three boxes at once: lane k is `boxes[k].area()`, computed with the same
+/// operations in the same order (lane 3 is 0).
+#[inline(always)]
+fn areas3(boxes: &[Acc; 3]) -> Vec4 {
+    let e = boxes.map(|b| (b.max - b.min).max(Vec3A::ZERO));
+    let (x, y, z) = (
+        Vec4::new(e[0].x, e[1].x, e[2].x, 0.0),
+        Vec4::new(e[0].y, e[1].y, e[2].y, 0.0),
+        Vec4::new(e[0].z, e[1].z, e[2].z, 0.0),
+    );
+    2.0 * (x * y + y * z + z * x)
 }
 
 /// Two triangles: every plane between their centroids makes the same two one-triangle children, so
