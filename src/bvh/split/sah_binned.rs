@@ -126,11 +126,11 @@ pub fn split_sah_binned(
     let bin = |axis: usize, i: usize| &all[axis * bins + i];
     // right_area[i]: per axis, the area of bins i..; plane i separates bins ..i from i..
     let mut acc = [Acc::EMPTY; 3];
-    for i in (1..bins).rev() {
+    for (i, area) in right_area.iter_mut().enumerate().skip(1).rev() {
         for (axis, a) in acc.iter_mut().enumerate() {
             a.add(bin(axis, i));
         }
-        right_area[i] = areas3(&acc);
+        *area = areas3(&acc);
     }
     let splittable = extent.to_array().map(|e| e > 0.0);
     let (mut acc, mut left) = ([Acc::EMPTY; 3], [0u32; 3]);
