@@ -136,7 +136,7 @@ pub fn split_sah_binned(
     let (mut acc, mut left) = ([Acc::EMPTY; 3], [0u32; 3]);
     // Per axis, the cheapest plane so far (the first of equal ones).
     let (mut lane_cost, mut lane_plane) = (Vec4::INFINITY, Vec4::ZERO);
-    for i in 1..bins {
+    for (i, &right_area) in right_area.iter().enumerate().skip(1) {
         for axis in 0..3 {
             let b = bin(axis, i - 1);
             acc[axis].add(b);
@@ -144,7 +144,7 @@ pub fn split_sah_binned(
         }
         let right = left.map(|l| n as u32 - l);
         let counts = |c: [u32; 3]| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, 0.0);
-        let cost = areas3(&acc) * counts(left) + right_area[i] * counts(right);
+        let cost = areas3(&acc) * counts(left) + right_area * counts(right);
         let usable = |a: usize| left[a] != 0 && right[a] != 0 && splittable[a];
         let better = cost.cmplt(lane_cost) & BVec4A::new(usable(0), usable(1), usable(2), false);
         lane_cost = Vec4::select(better, cost, lane_cost);
