@@ -2,7 +2,9 @@
 //! primary rays, next to a linear scan of all triangles.
 //!
 //! Frame times are the median of several full frames of the plain (non-counting) traversal on all
-//! threads; the per-ray means come from one extra counting frame. The linear scan is timed on the
+//! threads; the per-ray means come from one extra counting frame. Build times are the median of as
+//! many builds, or of fewer when they pass a second in all: one build of a small mesh takes a few
+//! milliseconds, and a single one can be twice the next on a busy machine. The linear scan is timed on the
 //! full frame when that is projected to take at most ~10 s, else on an evenly spread sample of
 //! its rays, and the table says so.
 
@@ -34,7 +36,8 @@ pub struct CompareArgs {
     pub view_args: ViewArgs,
     #[arg(long, value_enum, default_value = "markdown")]
     pub format: CompareFormat,
-    /// Frames timed per strategy (the median is reported).
+    /// Frames timed per strategy, and builds (the medians are reported; builds stop early once
+    /// they have taken a second).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100))]
     pub runs: u32,
 }
@@ -95,6 +98,9 @@ fn time_linear(mesh: &Mesh, camera: &Camera, trace: TraceOptions, budget: Durati
     (ms(t) * total as f64 / n as f64, Some(n))
 }
 
+/// Builds of one strategy stop once they have taken this long in all (at least one is made).
+const BUILD_BUDGET_MS: f64 = 1000.0;
+
 /// Build and measure every strategy and the linear scan.
 pub fn compare_rows(
     mesh: &Mesh,
@@ -114,7 +120,15 @@ pub fn compare_rows(
     for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))) {
         let params = build.params_with(strategy, layout);
         let name = format!("{} ({})", strategy.label(), layout.short_name());
-        let bvh = progress::with_spinner(&format!("building {name}"), || AnyBvh::build(mesh, &params));
+        let (bvh, build_ms) = progress::with_spinner(&format!("building {name}"), || {
+            let mut bvh = AnyBvh::build(mesh, &params);
+            let mut times = vec![TreeStats::of(&bvh).build_total_ms];
+            while times.len() < runs as usize && times.iter().sum::<f64>() < BUILD_BUDGET_MS {
+                bvh = AnyBvh::build(mesh, &params);
+                times.push(TreeStats::of(&bvh).build_total_ms);
+            }
+            (bvh, median(times))
+        });
         let (stats, summary, times) = progress::with_spinner(&format!("tracing {name}"), || {
             let stats = TreeStats::of(&bvh);
             let summary = render(&bvh, mesh, camera, &counting).ray_summary();
@@ -130,7 +144,7 @@ pub fn compare_rows(
         let frame_ms = median(times);
         rows.push(CompareRow {
             name,
-            build_ms: Some(stats.build_total_ms),
+            build_ms: Some(build_ms),
             nodes: stats.nodes,
             max_depth: stats.max_depth,
             mean_leaf_depth: stats.mean_leaf_depth,
@@ -237,9 +251,9 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
             let _ = writeln!(o);
             let _ = writeln!(
                 o,
-                "{}: {} triangles; {}x{} primary rays ({} rays), {} threads; traversal {}, {} test; frame ms = median of {} frames.",
+                "{}: {} triangles; {}x{} primary rays ({} rays), {} threads; traversal {}, {} test; frame ms = median of {} frames; build ms = median of up to {} builds.",
                 a.mesh.display(), mesh.triangle_count(), camera.width, camera.height, rays, threads,
-                a.build.order.label(), a.build.test.label(), a.runs
+                a.build.order.label(), a.build.test.label(), a.runs, a.runs
             );
             if let Some(n) = rows.last().and_then(|r| r.sampled_rays) {
                 let _ = writeln!(o, "* linear scan timed on {n} of {rays} rays (a full frame would take over 10 s) and scaled to the full frame.");
