@@ -13,9 +13,11 @@ fn tmp(name: &str) -> PathBuf {
     dir.join(name)
 }
 
-/// A small mesh of our own: two triangles forming a tent.
+/// A small mesh of our own: four triangles forming a tent. Each call writes its own file: tests
+/// run in parallel, and rewriting one shared file let a test read it half written.
 fn tent() -> PathBuf {
-    let p = tmp("tent.obj");
+    static CALLS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let p = tmp(&format!("tent-{}.obj", CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed)));
     std::fs::write(&p, "o tent\nv -1 0 -1\nv 1 0 -1\nv 0 1 0\nv -1 0 1\nv 1 0 1\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n")
         .unwrap();
     p
