@@ -77,7 +77,7 @@ pub struct BuildParams {
     /// cheaper than a split; no strategy makes a larger leaf.
     pub max_leaf_size: u32,
     /// Bins per axis for `SahBinned` (default 16); nodes of fewer than three triangles per bin
-    /// use n/3 bins (at least 4).
+    /// use n/3 bins (at least 4, never more than asked for).
     pub sah_bins: u32,
     pub cost: SahCost,
     pub layout: Layout,

@@ -80,7 +80,7 @@ pub struct BuildArgs {
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=255))]
     pub max_leaf_size: u32,
     /// Bins per axis for the binned SAH (2..=256); nodes of fewer than 3·bins triangles use a
-    /// third of their count (at least 4).
+    /// third of their count (at least 4, never more than asked for).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(2..=256))]
     pub bins: u32,
     /// SAH cost of one traversal step (relative to one triangle test), a positive number.

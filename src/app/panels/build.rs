@@ -48,7 +48,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         .on_hover_text("Most triangles in a leaf. The SAH strategies may stop earlier when a leaf is cheaper.");
     let sah = s.build.strategy == SplitStrategy::SahBinned;
     ui.add_enabled(sah, egui::Slider::new(&mut s.build.sah_bins, 2..=64).text("SAH bins"))
-        .on_hover_text("Bins per axis of the binned SAH: more bins, closer to the exact sweep, slower build. Small nodes use fewer: a third of their triangle count, at least 4.");
+        .on_hover_text("Bins per axis of the binned SAH: more bins, closer to the exact sweep, slower build. Small nodes use fewer: a third of their triangle count, at least 4 (never more than asked for).");
     ui.add(egui::Slider::new(&mut s.build.cost.traversal, 0.1..=4.0).text("SAH traversal cost"))
         .on_hover_text("Cost of one traversal step relative to one triangle test (1 = equal).");
 

@@ -213,7 +213,7 @@ mod tests {
     use crate::mesh::generate;
 
     /// The binned SAH's trees against the exact sweep's, on meshes where the planes matter: a
-    /// wrong cost, a wrong side count or an empty side let through would cost far more than 3%.
+    /// wrong cost, a wrong side count or a plane off by one costs far more than 3%.
     #[test]
     fn binned_sah_trees_come_close_to_the_exact_sweep() {
         for mesh in [generate::torus_knot(3, 5, 0.3, 256, 12), generate::stadium(), generate::builtin_scene()] {
