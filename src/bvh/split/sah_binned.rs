@@ -246,7 +246,11 @@ mod tests {
         assert_eq!(at(0.0, 0.99, 1.0)[..3], [0, 0, 1]);
         assert_eq!(at(14.999, 15.0, 15.5)[..3], [14, 15, 15], "the last bin takes the far edge");
         assert_eq!(at(-0.5, -1e30, 1e30)[..3], [0, 0, 15], "outside the bounds: the nearest end bin");
-        assert_eq!(at(f32::NAN, 3.5, f32::INFINITY)[..3], [0, 3, 15], "NaN goes to bin 0, as the partition sends it left");
+        assert_eq!(
+            at(f32::NAN, 3.5, f32::INFINITY)[..3],
+            [0, 3, 15],
+            "NaN goes to bin 0, as the partition sends it left"
+        );
     }
 
     /// The binned SAH's trees against the exact sweep's, on meshes where the planes matter: a
