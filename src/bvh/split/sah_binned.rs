@@ -45,7 +45,8 @@ fn bin_indices(scaled: Vec3A, top: Vec3A) -> [u32; 4] {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{__m128, __m128i, _mm_cvttps_epi32};
-        // SAFETY: SSE2 is part of the x86-64 baseline; the lanes are in 0..=top, well inside i32.
+        // SAFETY: SSE2 is part of the x86-64 baseline. (The clamp above keeps every lane in 0..=top,
+        // so the conversion is exact; `__m128::from` needs glam's SSE2 backend, its default there.)
         let i: __m128i = unsafe { _mm_cvttps_epi32(__m128::from(clamped)) };
         // SAFETY: __m128i and [u32; 4] have the same size, and any bits are a valid u32.
         unsafe { std::mem::transmute::<__m128i, [u32; 4]>(i) }
@@ -194,13 +195,20 @@ pub fn split_sah_binned(
     // Same arithmetic as the binning above (SIMD there, scalar here: IEEE gives equal results).
     // For an integer plane in 1..bins, floor(clamp(x, 0, bins - 1)) < plane ⟺ x < plane, so the
     // clamp and the cast can be skipped; `!(x >= plane)` sends NaN left, as its bin 0 would.
-    let mid = partition(prims, |p| !((p.centroid()[axis] - lo) * s >= plane));
+    let mid = partition(prims, |p| goes_left((p.centroid()[axis] - lo) * s, plane));
     debug_assert_eq!(
         mid,
         all[axis * bins..axis * bins + plane as usize].iter().map(|b| b.count as usize).sum::<usize>(),
         "the partition sends left exactly the triangles binned left of the plane"
     );
     SplitDecision::Split { axis: axis as u8, mid }
+}
+
+/// The partition's side for a scaled centroid offset and an integer plane in 1..bins: left exactly
+/// when `bin_indices` puts it in a bin below the plane (NaN included, in bin 0).
+#[inline(always)]
+fn goes_left(scaled: f32, plane: f32) -> bool {
+    !(scaled >= plane)
 }
 
 /// Surface areas of three boxes at once: lane k is `boxes[k].area()`, computed with the same
@@ -235,7 +243,7 @@ fn split_two(prims: &mut [BuildPrim], extent: Vec3, node: &NodeInfo, params: &Bu
 
 #[cfg(test)]
 mod tests {
-    use super::bin_indices;
+    use super::{bin_indices, goes_left};
     use crate::bvh::{BuildParams, Bvh, Layout, SplitStrategy, TreeStats};
     use crate::mesh::generate;
 
@@ -251,6 +259,14 @@ mod tests {
             [0, 3, 15],
             "NaN goes to bin 0, as the partition sends it left"
         );
+        // The partition's test agrees with the bins for every plane, at, between and beyond bin edges.
+        let values = [f32::NAN, f32::NEG_INFINITY, -1.0, -0.0, 0.0, 0.5, 0.999, 1.0, 7.0, 7.5, 14.999, 15.0, 15.5, 1e9];
+        for x in values {
+            for plane in 1..=15 {
+                let bin = bin_indices(glam::Vec3A::splat(x), top)[0];
+                assert_eq!(bin < plane, goes_left(x, plane as f32), "x = {x}, plane {plane}");
+            }
+        }
     }
 
     /// The binned SAH's trees against the exact sweep's, on meshes where the planes matter: a
