@@ -52,17 +52,22 @@ fn primary_blocks(mesh: &Mesh, size: u32) -> Vec<Ray> {
     rays
 }
 
+/// A fixed-seed xorshift64 stream of floats in [0, 1): the same random cases on every run.
+fn uniform(mut s: u64) -> impl FnMut() -> f32 {
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
 /// Rays in every direction from points around the mesh: packets whose rays diverge at once
 /// (and whose directions differ in sign, which turns the packet's frustum test off).
 fn scattered(mesh: &Mesh, count: usize) -> Vec<Ray> {
     let (c, r) = (mesh.bounds().center(), mesh.bounds().extent().length());
-    let mut s = 0x2545_F491_4F6C_DD1Du64;
-    let mut rnd = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 40) as f32 / (1u64 << 24) as f32 - 0.5
-    };
+    let mut rnd = uniform(0x2545_F491_4F6C_DD1D);
+    let mut rnd = move || rnd() - 0.5;
     (0..count)
         .map(|_| {
             let o = c + Vec3::new(rnd(), rnd(), rnd()) * r;
@@ -191,13 +196,7 @@ fn positions_cover_the_block_once_in_two_by_two_groups() {
 /// boxes, with the single-ray slab test as the judge.
 #[test]
 fn the_frustum_rejects_only_boxes_every_ray_misses() {
-    let mut s = 0x9E37_79B9_7F4A_7C15u64;
-    let mut rnd = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rnd = uniform(0x9E37_79B9_7F4A_7C15);
     let (mut rejected, mut valid) = (0, 0);
     for case in 0..4000 {
         let spread = [0.01, 0.1, 0.5][case % 3];
