@@ -21,8 +21,15 @@ impl AnyBvh {
         }
     }
 
+    /// Build with a control whose total is set to this build's work (see `Bvh::build_controlled`).
     pub fn build_controlled(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<AnyBvh, Cancelled> {
-        let bvh = Bvh::build_controlled(mesh, params, control)?;
+        control.set_total(super::build::build_work(mesh.triangle_count(), params));
+        Self::build_counted(mesh, params, control)
+    }
+
+    /// Build, advancing `control` without setting its total (`Bvh::build_counted`).
+    pub(crate) fn build_counted(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<AnyBvh, Cancelled> {
+        let bvh = Bvh::build_counted(mesh, params, control)?;
         Ok(match params.layout {
             Layout::Binary => AnyBvh::Binary(bvh),
             Layout::Wide4 => AnyBvh::Wide(WideBvh::from_binary(bvh)),

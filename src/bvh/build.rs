@@ -141,13 +141,20 @@ impl Bvh {
         }
     }
 
-    /// Build with a control: progress counts triangles placed in leaves (out of all triangles),
-    /// and a cancel request stops the build within a few hundred nodes.
+    /// Build with a control: its total is set to the build's work (`build_work`), its progress
+    /// advances at every split and leaf, and a cancel request stops the build within a few
+    /// hundred nodes.
     pub fn build_controlled(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<Bvh, Cancelled> {
+        control.set_total(build_work(mesh.triangle_count(), params));
+        Self::build_counted(mesh, params, control)
+    }
+
+    /// Build, advancing `control`'s progress by `build_work` without setting its total: for
+    /// callers that build several BVHs under one control (the two-level BVH).
+    pub(crate) fn build_counted(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<Bvh, Cancelled> {
         let t0 = Instant::now();
         let params = params.clamped();
         let n = mesh.triangle_count();
-        control.set_total(n as u64);
         let make = |i: usize| {
             let tri = mesh.triangle(i as u32);
             let bounds = Aabb::from_points(&tri);
@@ -180,9 +187,53 @@ impl BuildParams {
     }
 }
 
+/// The work units of building over `n` primitives, the total a build's progress reaches.
+///
+/// Progress counts primitives partitioned at every level, not only primitives placed in leaves:
+/// counting leaves alone left the progress at 0 % while the top levels were split, half of an
+/// exact-sweep build of 2M triangles. A build over n primitives is taken to have
+/// L = ⌈log2(n / max leaf size)⌉ + 1 levels, and each primitive is worth L units: one for each of
+/// the first L levels it is partitioned at, and the levels it skips when it reaches a leaf
+/// earlier. So the progress is exact at the end (n·L), moves with every split, and a tree deeper
+/// than L (midpoint on uneven meshes) only spends its last levels at the full count.
+pub fn build_work(n: usize, params: &BuildParams) -> u64 {
+    n as u64 * progress_levels(n, params) as u64
+}
+
+fn progress_levels(n: usize, params: &BuildParams) -> u32 {
+    let leaf = params.clamped().max_leaf_size as usize;
+    let leaves = n.div_ceil(leaf).max(1);
+    leaves.next_power_of_two().trailing_zeros() + 1
+}
+
+/// The build's progress: a control and the levels its primitives are counted over.
+struct Progress<'a> {
+    control: &'a WorkControl,
+    levels: u32,
+}
+
+impl Progress<'_> {
+    fn check(&self) -> Result<(), Cancelled> {
+        self.control.check()
+    }
+
+    /// A node of `n` primitives at `depth` was partitioned.
+    fn split(&self, n: usize, depth: u32) {
+        if depth < self.levels {
+            self.control.add_done(n as u64);
+        }
+    }
+
+    /// A leaf of `n` primitives was made at `depth`: the levels its primitives will not pass.
+    fn leaf(&self, n: usize, depth: u32) {
+        self.control.add_done(n as u64 * self.levels.saturating_sub(depth) as u64);
+    }
+}
+
 /// A binary BVH over arbitrary boxes (the top level of a two-level BVH, whose "primitives" are
 /// instances): the nodes, and for each leaf slot the index of its box in `boxes`. Leaf `index`
-/// fields point into that order, as they point into `Bvh::prim_ids` for triangles.
+/// fields point into that order, as they point into `Bvh::prim_ids` for triangles. Progress
+/// advances by `build_work(boxes.len(), params)`; the total is the caller's to set.
 pub fn build_over_boxes(
     boxes: &[Aabb],
     params: &BuildParams,
@@ -191,7 +242,6 @@ pub fn build_over_boxes(
     let t0 = Instant::now();
     let params = params.clamped();
     let mut prims: Vec<BuildPrim> = boxes.iter().enumerate().map(|(i, b)| BuildPrim::new(*b, i as u32)).collect();
-    control.set_total(boxes.len() as u64);
     let setup_time = t0.elapsed();
     let (nodes, mut report) = build_nodes(&mut prims, &params, control)?;
     report.setup_time = setup_time;
@@ -205,7 +255,8 @@ fn build_nodes(
     control: &WorkControl,
 ) -> Result<(Vec<BvhNode>, BuildReport), Cancelled> {
     let t1 = Instant::now();
-    let (tree, over) = build_subtree(prims, 0, 0, params, control)?;
+    let progress = Progress { control, levels: progress_levels(prims.len(), params) };
+    let (tree, over) = build_subtree(prims, 0, 0, params, &progress)?;
     let nodes = tree.into_nodes();
     Ok((
         nodes,
@@ -335,25 +386,26 @@ fn build_subtree(
     offset: u32,
     depth: u32,
     params: &BuildParams,
-    control: &WorkControl,
+    progress: &Progress,
 ) -> Result<(Subtree, Overrides), Cancelled> {
     let sequential = |prims: &mut [BuildPrim]| {
-        build_sequential(prims, offset, depth, params, control).map(|(nodes, over)| (Subtree::Flat(nodes), over))
+        build_sequential(prims, offset, depth, params, progress).map(|(nodes, over)| (Subtree::Flat(nodes), over))
     };
     if prims.len() < PARALLEL_MIN_PRIMS || depth >= PARALLEL_MAX_DEPTH {
         return sequential(prims);
     }
-    control.check()?;
+    progress.check()?;
     let info = node_info(prims);
     let mut over = Overrides::default();
     let decision = decide(prims, &info, depth, params, &mut SplitScratch::default(), &mut over);
     let SplitDecision::Split { axis, mid } = decision else {
         return sequential(prims);
     };
+    progress.split(prims.len(), depth);
     let (l, r) = prims.split_at_mut(mid);
     let (left, right) = rayon::join(
-        || build_subtree(l, offset, depth + 1, params, control),
-        || build_subtree(r, offset + mid as u32, depth + 1, params, control),
+        || build_subtree(l, offset, depth + 1, params, progress),
+        || build_subtree(r, offset + mid as u32, depth + 1, params, progress),
     );
     let ((left, lo), (right, ro)) = (left?, right?);
     over += lo;
@@ -368,7 +420,7 @@ fn build_sequential(
     offset: u32,
     depth0: u32,
     params: &BuildParams,
-    control: &WorkControl,
+    progress: &Progress,
 ) -> Result<(Vec<BvhNode>, Overrides), Cancelled> {
     let mut nodes = Vec::with_capacity((2 * prims.len() / params.max_leaf_size.max(1) as usize).max(1));
     nodes.push(BvhNode::leaf(Aabb::EMPTY, offset, 0));
@@ -382,7 +434,7 @@ fn build_sequential(
     while let Some(task) = stack.pop() {
         steps += 1;
         if steps.is_multiple_of(256) {
-            control.check()?;
+            progress.check()?;
         }
         let range = &mut prims[task.start as usize..task.end as usize];
         let info = node_info(range);
@@ -393,6 +445,7 @@ fn build_sequential(
                 nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
                 nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
                 nodes[task.node as usize] = BvhNode::interior(info.bounds, left, axis);
+                progress.split(n, task.depth);
                 let mid = task.start + mid as u32;
                 let depth = task.depth + 1;
                 // Right pushed first so the left subtree is laid out right after its parent pair.
@@ -401,7 +454,7 @@ fn build_sequential(
             }
             _ => {
                 nodes[task.node as usize] = BvhNode::leaf(info.bounds, offset + task.start, n as u16);
-                control.add_done(n as u64);
+                progress.leaf(n, task.depth);
             }
         }
     }
@@ -424,7 +477,8 @@ mod tests {
             let mut prims: Vec<BuildPrim> = (0..mesh.triangle_count())
                 .map(|i| BuildPrim::new(Aabb::from_points(&mesh.triangle(i as u32)), i as u32))
                 .collect();
-            let (nodes, _) = build_sequential(&mut prims, 0, 0, &params, &WorkControl::new()).unwrap();
+            let progress = Progress { control: &WorkControl::new(), levels: 1 };
+            let (nodes, _) = build_sequential(&mut prims, 0, 0, &params, &progress).unwrap();
             assert_eq!(bvh.nodes.len(), nodes.len(), "{strategy:?}");
             assert!(bvh.nodes == nodes, "{strategy:?}: the same nodes in the same places");
             assert!(bvh.prim_ids.iter().copied().eq(prims.iter().map(|p| p.index())), "{strategy:?}");
@@ -434,15 +488,46 @@ mod tests {
     #[test]
     fn build_reports_progress_and_can_be_cancelled() {
         let mesh = torus(2.0, 0.5, 64, 32);
-        let control = WorkControl::new();
-        let bvh = Bvh::build_controlled(&mesh, &BuildParams::default(), &control).unwrap();
-        assert_eq!(control.total(), mesh.triangle_count() as u64);
-        assert_eq!(control.done(), control.total(), "every triangle ends in a leaf");
-        assert_eq!(bvh.prim_ids.len(), mesh.triangle_count());
+        for strategy in SplitStrategy::ALL {
+            for max_leaf_size in [1, 4, 16] {
+                let control = WorkControl::new();
+                let params = BuildParams { max_leaf_size, ..BuildParams::with_strategy(strategy) };
+                let bvh = Bvh::build_controlled(&mesh, &params, &control).unwrap();
+                let n = mesh.triangle_count() as u64;
+                assert!(control.total() >= n * 8, "4096 triangles pass at least 8 levels");
+                assert_eq!(control.done(), control.total(), "{strategy:?}/{max_leaf_size}: the work adds up");
+                assert_eq!(bvh.prim_ids.len(), mesh.triangle_count());
+            }
+        }
 
         let cancelled = WorkControl::new();
         cancelled.cancel();
         assert_eq!(Bvh::build_controlled(&mesh, &BuildParams::default(), &cancelled).unwrap_err(), Cancelled);
+    }
+
+    #[test]
+    fn progress_moves_at_the_first_split_not_only_at_the_first_leaf() {
+        // The exact sweep's first splits of a million triangles are the slow part of its build;
+        // progress that counted only triangles placed in leaves stayed at 0 through them.
+        let mesh = torus(2.0, 0.5, 1024, 512);
+        let n = mesh.triangle_count() as u64;
+        let control = WorkControl::new();
+        let first_seen = std::thread::scope(|s| {
+            let build = s
+                .spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(SplitStrategy::SahSweep), &control));
+            let mut seen = 0;
+            while seen == 0 && !build.is_finished() {
+                seen = control.done();
+            }
+            control.cancel();
+            let _ = build.join().expect("the build thread does not panic");
+            seen
+        });
+        assert!(
+            first_seen >= n,
+            "the root's split counts its {n} triangles at once (first progress seen: {first_seen})"
+        );
+        assert!(first_seen < control.total(), "and is only part of the work");
     }
 
     #[test]
@@ -459,7 +544,7 @@ mod tests {
             control.cancel();
             build.join().expect("the build thread does not panic")
         });
-        assert_eq!(result.unwrap_err(), Cancelled, "cancelled part-way, after {} triangles", control.done());
-        assert!(control.done() < mesh.triangle_count() as u64);
+        assert_eq!(result.unwrap_err(), Cancelled, "cancelled part-way, after {} units", control.done());
+        assert!(control.done() < control.total());
     }
 }

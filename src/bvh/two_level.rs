@@ -12,7 +12,7 @@
 //! The top level is always a binary tree (a scene has few instances next to its triangles); its
 //! strategy and leaf size are chosen separately from the bottom level's, which may be wide.
 
-use super::build::build_over_boxes;
+use super::build::{build_over_boxes, build_work};
 use super::node::{walk_nodes, BvhNode, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;
 use super::tree::{NodeKind, NodeView, TreeView};
@@ -100,8 +100,12 @@ impl TwoLevelBvh {
         control: &WorkControl,
     ) -> Result<TwoLevelBvh, Cancelled> {
         let t0 = Instant::now();
+        // One progress over all of it: every mesh's build, then the top level's.
+        let work = meshes.iter().map(|m| build_work(m.triangle_count(), bottom)).sum::<u64>()
+            + build_work(placements.len(), top);
+        control.set_total(work);
         let bottom_bvhs =
-            meshes.iter().map(|m| AnyBvh::build_controlled(m, bottom, control)).collect::<Result<Vec<_>, _>>()?;
+            meshes.iter().map(|m| AnyBvh::build_counted(m, bottom, control)).collect::<Result<Vec<_>, _>>()?;
         let bottom_time = t0.elapsed();
         let t1 = Instant::now();
         let mut first_prim = 0u32;
