@@ -3,7 +3,6 @@
 
 use super::{BvhscopeApp, StrategyFigures};
 use crate::render::{draw_legend, full_size, view_image};
-use std::fmt::Write;
 use std::path::Path;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,7 +24,10 @@ pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
 pub fn save_png(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
     let shown = app.shown.as_ref().ok_or("nothing rendered yet")?;
     let s = shown.style;
-    let (img, legend) = view_image(&shown.frame, s.view, s.colormap, s.range, s.cost);
+    let (img, mut legend) = view_image(&shown.frame, s.view, s.colormap, s.range, s.cost);
+    if let Some(l) = &mut legend {
+        l.subject = format!("{}, {}", app.scene.title(), shown.build_label);
+    }
     // A coarse pass's image has a pixel per traced pixel; the file has the frame's size.
     let img = full_size(&img, &shown.frame);
     let img = match &legend {
@@ -46,6 +48,67 @@ fn rows(app: &BvhscopeApp) -> Vec<(&'static str, StrategyFigures)> {
     v
 }
 
+/// The statistics rows as CSV (RFC 4180, written by the `csv` crate, so a label with a comma is
+/// quoted): one record per strategy; per-ray fields are empty while not yet measured.
+pub fn stats_csv(rows: &[(&str, StrategyFigures)]) -> String {
+    const HEADER: [&str; 20] = [
+        "which",
+        "strategy",
+        "triangles",
+        "build_ms",
+        "nodes",
+        "leaves",
+        "max_depth",
+        "mean_leaf_depth",
+        "sah_cost",
+        "bytes",
+        "rays",
+        "rays_in_root_box",
+        "mean_nodes_visited",
+        "max_nodes_visited",
+        "mean_box_tests",
+        "mean_triangle_tests",
+        "max_triangle_tests",
+        "root_box_mean_nodes_visited",
+        "root_box_mean_box_tests",
+        "root_box_mean_triangle_tests",
+    ];
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(HEADER).expect("writing CSV to memory");
+    for (which, f) in rows {
+        let s = &f.stats;
+        let mut rec = vec![
+            which.to_string(),
+            f.label.clone(),
+            s.triangles.to_string(),
+            format!("{:.3}", f.build_ms),
+            s.nodes.to_string(),
+            s.leaves.to_string(),
+            s.max_depth.to_string(),
+            format!("{:.3}", s.mean_leaf_depth),
+            format!("{:.4}", s.sah_cost),
+            s.memory_bytes.to_string(),
+        ];
+        match f.rays.map(|r| r.summary) {
+            Some(r) => rec.extend([
+                r.rays.to_string(),
+                r.root_rays.to_string(),
+                format!("{:.3}", r.mean_nodes_visited),
+                r.max_nodes_visited.to_string(),
+                format!("{:.3}", r.mean_box_tests),
+                format!("{:.3}", r.mean_triangle_tests),
+                r.max_triangle_tests.to_string(),
+                format!("{:.3}", r.root_mean_nodes_visited),
+                format!("{:.3}", r.root_mean_box_tests),
+                format!("{:.3}", r.root_mean_triangle_tests),
+            ]),
+            None => rec.resize(HEADER.len(), String::new()),
+        }
+        w.write_record(&rec).expect("writing CSV to memory");
+    }
+    String::from_utf8(w.into_inner().expect("writing CSV to memory")).expect("CSV of UTF-8 fields")
+}
+
 pub fn stats_text(app: &BvhscopeApp, format: StatsFormat) -> Result<String, String> {
     let rows = rows(app);
     if rows.is_empty() {
@@ -55,41 +118,76 @@ pub fn stats_text(app: &BvhscopeApp, format: StatsFormat) -> Result<String, Stri
         StatsFormat::Json => {
             let items: Vec<_> = rows
                 .iter()
-                .map(|(which, f)| serde_json::json!({ "which": which, "strategy": f.label, "tree": f.stats, "rays": f.rays }))
+                .map(|(which, f)| {
+                    let rays = f.rays.map(|r| serde_json::json!({ "summary": r.summary, "camera": r.camera, "trace": r.trace }));
+                    serde_json::json!({ "which": which, "strategy": f.label, "build_ms": f.build_ms, "tree": f.stats, "rays": rays })
+                })
                 .collect();
             let v = serde_json::json!({ "scene": app.scene.title(), "triangles": app.scene.report.triangles, "strategies": items });
             serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
         }
-        StatsFormat::Csv => {
-            let mut o = String::from("which,strategy,triangles,build_ms,nodes,leaves,max_depth,mean_leaf_depth,sah_cost,bytes,mean_nodes_visited,max_nodes_visited,mean_box_tests,mean_triangle_tests,max_triangle_tests\n");
-            for (which, f) in rows {
-                let s = &f.stats;
-                let r = f.rays.unwrap_or_default();
-                let _ = writeln!(
-                    o,
-                    "{which},{},{},{:.3},{},{},{},{:.3},{:.4},{},{:.3},{},{:.3},{:.3},{}",
-                    f.label,
-                    s.triangles,
-                    s.build_total_ms,
-                    s.nodes,
-                    s.leaves,
-                    s.max_depth,
-                    s.mean_leaf_depth,
-                    s.sah_cost,
-                    s.memory_bytes,
-                    r.mean_nodes_visited,
-                    r.max_nodes_visited,
-                    r.mean_box_tests,
-                    r.mean_triangle_tests,
-                    r.max_triangle_tests
-                );
-            }
-            o
-        }
+        StatsFormat::Csv => stats_csv(&rows),
     })
 }
 
 pub fn save_stats(app: &BvhscopeApp, path: &Path, format: StatsFormat) -> Result<(), String> {
     let text = stats_text(app, format)?;
     std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::MeasuredRays;
+    use crate::bvh::TreeStats;
+    use crate::render::{Camera, RaySummary};
+
+    #[test]
+    fn the_csv_parses_with_a_real_reader_and_leaves_unmeasured_rays_empty() {
+        let stats = TreeStats { triangles: 10, nodes: 7, leaves: 4, ..Default::default() };
+        let camera = Camera::framing(&crate::geometry::Aabb::new(glam::Vec3::ZERO, glam::Vec3::ONE), 64, 48);
+        let summary = RaySummary {
+            rays: 3072,
+            root_rays: 1000,
+            mean_nodes_visited: 1.5,
+            root_mean_nodes_visited: 4.5,
+            ..Default::default()
+        };
+        let measured = MeasuredRays { summary, camera, trace: Default::default() };
+        let rows = [
+            (
+                "current",
+                StrategyFigures {
+                    label: "Equal count, binary".into(),
+                    stats: stats.clone(),
+                    build_ms: 1.25,
+                    rays: Some(measured),
+                },
+            ),
+            (
+                "previous",
+                StrategyFigures {
+                    label: "top SAH binned / Midpoint, \"wide4\"".into(),
+                    stats,
+                    build_ms: 0.5,
+                    rays: None,
+                },
+            ),
+        ];
+        let text = stats_csv(&rows);
+        let mut reader = csv::Reader::from_reader(text.as_bytes());
+        let header = reader.headers().unwrap().clone();
+        let records: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+        assert_eq!(records.len(), 2);
+        for r in &records {
+            assert_eq!(r.len(), header.len(), "every record has the header's fields:\n{text}");
+        }
+        let field = |r: &csv::StringRecord, name: &str| r[header.iter().position(|h| h == name).unwrap()].to_string();
+        assert_eq!(field(&records[0], "strategy"), "Equal count, binary");
+        assert_eq!(field(&records[1], "strategy"), "top SAH binned / Midpoint, \"wide4\"");
+        assert_eq!(field(&records[0], "root_box_mean_nodes_visited"), "4.500");
+        assert_eq!(field(&records[0], "rays_in_root_box"), "1000");
+        assert_eq!(field(&records[1], "mean_nodes_visited"), "", "not measured is empty, not 0");
+        assert_eq!(field(&records[1], "build_ms"), "0.500");
+    }
 }

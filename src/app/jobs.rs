@@ -57,6 +57,7 @@ pub struct PassOutput {
     pub legend: Option<Legend>,
     pub info: PassInfo,
     pub camera: Camera,
+    pub trace: TraceOptions,
     pub style: ViewStyle,
 }
 
@@ -193,8 +194,9 @@ impl Jobs {
             let _ = render_passes(&*r.bvh, &r.mesh, &r.camera, &settings, &control, |frame, info| {
                 let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
-                let (bvh, camera, style) = (r.bvh.clone(), r.camera, r.style);
-                send(JobEvent::Pass(PassOutput { bvh, frame: Arc::new(frame), image, legend, info, camera, style }));
+                let (bvh, camera, style, trace) = (r.bvh.clone(), r.camera, r.style, r.trace);
+                let frame = Arc::new(frame);
+                send(JobEvent::Pass(PassOutput { bvh, frame, image, legend, info, camera, trace, style }));
             });
         });
         self.render = Some(job);

@@ -15,24 +15,17 @@ mod viewport;
 pub use jobs::Pick;
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
+pub use panels::stats::fmt_ms;
 pub use scene::{BuiltBvh, Scene, SceneSource};
 pub use settings::{BoxLevel, Settings};
+pub use shortcuts::Action;
 
-use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TreeStats};
-use crate::render::{Camera, ColorMap, Frame, Legend, RaySummary, View};
+use crate::bvh::{Preset, SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
+use crate::render::{Camera, ColorMap, Frame, Legend, RaySummary, UpAxis, View};
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// "SAH binned, 4-wide SIMD": the strategy and layout of a build, for the statistics columns.
-fn figures_label(p: &SceneBuild) -> String {
-    let one = format!("{}, {}", p.bvh.strategy.label(), p.bvh.layout.short_name());
-    match p.top {
-        Some(top) => format!("top {} / {one}", top.strategy.label()),
-        None => one,
-    }
-}
 
 /// How the app starts.
 #[derive(Clone, Debug, Default)]
@@ -65,14 +58,35 @@ pub struct Shown {
     pub style: ViewStyle,
     /// Rays per second of the last pass.
     pub rays_per_s: f64,
+    /// The build that traced it ("SAH binned, wide4"), for captions.
+    pub build_label: String,
+}
+
+/// Per-ray figures of a full frame, with what they depend on besides the BVH: the camera (and
+/// image size) and the traversal options. Figures measured under other ones are not comparable.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeasuredRays {
+    pub summary: RaySummary,
+    pub camera: Camera,
+    pub trace: TraceOptions,
+}
+
+impl MeasuredRays {
+    /// Whether these figures and `other` come from the same rays (camera, image size, traversal).
+    pub fn comparable(&self, camera: &Camera, trace: &TraceOptions) -> bool {
+        self.camera == *camera && self.trace == *trace
+    }
 }
 
 /// One strategy's figures for the statistics panel (the current one and the one before).
 #[derive(Clone, Debug)]
 pub struct StrategyFigures {
     pub label: String,
+    /// Of the tree the statistics rows describe (`BuiltBvh::stats`).
     pub stats: TreeStats,
-    pub rays: Option<RaySummary>,
+    /// The whole build, every level.
+    pub build_ms: f64,
+    pub rays: Option<MeasuredRays>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,6 +108,14 @@ pub struct PathWindow {
     pub pick: Pick,
     pub text: String,
     pub note: Option<String>,
+    /// Its text field takes the keyboard when it first shows (then single-key shortcuts stop).
+    pub focus: bool,
+}
+
+impl PathWindow {
+    pub fn new(pick: Pick, text: String, note: Option<String>) -> Self {
+        Self { pick, text, note, focus: true }
+    }
 }
 
 pub struct BvhscopeApp {
@@ -103,7 +125,7 @@ pub struct BvhscopeApp {
     pub scene_id: u64,
     pub built: Option<BuiltBvh>,
     /// Work per ray in the latest full frame of the current BVH.
-    pub rays: Option<RaySummary>,
+    pub rays: Option<MeasuredRays>,
     /// The figures of the strategy shown before the current one.
     pub previous: Option<StrategyFigures>,
     pub orbit: OrbitCamera,
@@ -119,13 +141,17 @@ pub struct BvhscopeApp {
     overlay_cache: Option<OverlayCache>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
+    /// Where the viewport was drawn in the last frame (its size is the rendered image's).
+    pub viewport_rect: egui::Rect,
 }
 
-/// The overlay's triangles for one camera and viewport rectangle (redrawn only when they change).
+/// The overlay's triangles for one camera and viewport rectangle, and for the frame they were
+/// depth-tested against if they were (redrawn only when these change).
 struct OverlayCache {
     boxes: Arc<Vec<OverlayBox>>,
     camera: Camera,
     rect: egui::Rect,
+    depth: Option<Arc<Frame>>,
     mesh: Arc<egui::Mesh>,
 }
 
@@ -136,14 +162,23 @@ struct BoxCache {
     boxes: Arc<Vec<OverlayBox>>,
 }
 
+/// How a scene file's camera orbits: about the axis its up vector is nearest to (Y or Z).
+fn up_axis_of(c: &Camera) -> UpAxis {
+    if c.up.z.abs() > c.up.y.abs() && c.up.z.abs() >= c.up.x.abs() {
+        UpAxis::Z
+    } else {
+        UpAxis::Y
+    }
+}
+
 impl BvhscopeApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
         let settings: Settings = cc.storage.and_then(|s| eframe::get_value(s, eframe::APP_KEY)).unwrap_or_default();
         let scene = Scene::builtin();
         let aspect = 1.6;
         let mut app = Self {
+            orbit: OrbitCamera::home(&scene.mesh.bounds(), aspect, settings.up_axis),
             settings,
-            orbit: OrbitCamera::home(&scene.mesh.bounds(), aspect),
             scene,
             scene_id: 1,
             built: None,
@@ -159,6 +194,7 @@ impl BvhscopeApp {
             box_cache: None,
             overlay_cache: None,
             viewport_aspect: aspect,
+            viewport_rect: egui::Rect::NOTHING,
         };
         if let Some(file) = options.file {
             app.open(file);
@@ -187,14 +223,24 @@ impl BvhscopeApp {
         for w in &scene.warnings {
             self.message(MessageKind::Warning, format!("{}: {w}", scene.title()));
         }
-        // A scene file brings its camera and the BVH settings to start with.
+        // A scene file brings its camera (and with it the up axis) and the BVH settings to start
+        // with; two levels are the start only where a mesh is placed more than once (the
+        // Moer-lite lab scene places its monkey once: one level, as the handout builds it).
+        if let Some(c) = &scene.camera {
+            self.settings.up_axis = up_axis_of(c);
+        }
         self.orbit = match &scene.camera {
-            Some(c) => OrbitCamera::from_camera(c),
-            None => OrbitCamera::home(&scene.mesh.bounds(), self.viewport_aspect),
+            Some(c) => OrbitCamera::from_camera(c, self.settings.up_axis),
+            None => OrbitCamera::home(&scene.mesh.bounds(), self.viewport_aspect, self.settings.up_axis),
         };
         if let Some(b) = scene.build {
             self.settings.build = b;
         }
+        if let Some(inst) = &scene.instances {
+            self.settings.two_level = inst.placements.len() > inst.meshes.len();
+        }
+        // A new mesh has its own heatmap scale.
+        self.settings.fixed_ranges.clear();
         if let Some(note) = scene.desc.as_ref().and_then(|d| d.note.as_ref()) {
             self.message(MessageKind::Info, format!("{}: {note}", scene.title()));
         }
@@ -280,25 +326,49 @@ impl BvhscopeApp {
         self.box_cache.as_ref().map(|c| c.boxes.clone())
     }
 
-    /// The overlay mesh of `boxes` seen by `camera` in `rect` (cached).
-    pub fn overlay_mesh(&mut self, boxes: Arc<Vec<OverlayBox>>, camera: Camera, rect: egui::Rect) -> Arc<egui::Mesh> {
+    /// The overlay mesh of `boxes` seen by `camera` in `rect` (cached), depth-tested against
+    /// `depth` (the frame on screen) when given.
+    pub fn overlay_mesh(
+        &mut self,
+        boxes: Arc<Vec<OverlayBox>>,
+        camera: Camera,
+        rect: egui::Rect,
+        depth: Option<Arc<Frame>>,
+    ) -> Arc<egui::Mesh> {
         if let Some(c) = &self.overlay_cache {
-            if Arc::ptr_eq(&c.boxes, &boxes) && c.camera == camera && c.rect == rect {
+            let same_depth = match (&c.depth, &depth) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (None, None) => true,
+                _ => false,
+            };
+            if Arc::ptr_eq(&c.boxes, &boxes) && c.camera == camera && c.rect == rect && same_depth {
                 return c.mesh.clone();
             }
         }
-        let mesh = Arc::new(overlay::boxes_mesh(&boxes, &camera, rect, 1.2));
-        self.overlay_cache = Some(OverlayCache { boxes, camera, rect, mesh: mesh.clone() });
+        let test = depth.as_deref().map(|frame| overlay::DepthTest { frame, rect });
+        let mesh = Arc::new(overlay::boxes_mesh(&boxes, &camera, rect, 1.2, test));
+        self.overlay_cache = Some(OverlayCache { boxes, camera, rect, depth, mesh: mesh.clone() });
         mesh
     }
 
     /// Figures of the current strategy for the statistics panel.
     pub fn current_figures(&self) -> Option<StrategyFigures> {
         self.current_bvh().map(|b| StrategyFigures {
-            label: figures_label(&b.bvh.build_params()),
+            label: b.bvh.build_params().label(),
             stats: b.stats.clone(),
+            build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
             rays: self.rays,
         })
+    }
+
+    /// The camera and traversal the current per-ray figures come from (or, before the first
+    /// full frame, the ones the image on screen was made with).
+    pub fn rays_key(&self) -> Option<(Camera, TraceOptions)> {
+        match (&self.rays, &self.shown) {
+            (Some(r), _) => Some((r.camera, r.trace)),
+            (None, Some(s)) => Some((s.camera, self.settings.trace)),
+            (None, None) => None,
+        }
     }
 
     pub fn frame_mesh(&mut self) {
@@ -306,7 +376,21 @@ impl BvhscopeApp {
     }
 
     pub fn reset_view(&mut self) {
-        self.orbit = OrbitCamera::home(&self.scene.mesh.bounds(), self.viewport_aspect);
+        self.orbit = OrbitCamera::home(&self.scene.mesh.bounds(), self.viewport_aspect, self.settings.up_axis);
+    }
+
+    /// Orbit about another axis: the camera goes back to that axis's default view.
+    pub fn set_up_axis(&mut self, up: UpAxis) {
+        if self.settings.up_axis != up {
+            self.settings.up_axis = up;
+            self.reset_view();
+        }
+    }
+
+    /// Switch to a preset's settings (the build and the render follow).
+    pub fn apply_preset(&mut self, preset: Preset) {
+        self.settings.apply_preset(preset);
+        self.message(MessageKind::Info, format!("{}: {}", preset.label(), preset.description()));
     }
 
     fn apply(&mut self, ctx: &egui::Context, event: JobEvent) {
@@ -330,14 +414,9 @@ impl BvhscopeApp {
                         self.previous = Some(old);
                     }
                 }
-                let stats = TreeStats::of(bvh.tree());
-                let bottom = match (bvh.two_level(), &self.scene.instances) {
-                    (Some(t), Some(inst)) => {
-                        t.bottom.iter().zip(&inst.meshes).map(|(b, m)| (m.name.clone(), TreeStats::of(b))).collect()
-                    }
-                    _ => Vec::new(),
-                };
-                self.built = Some(BuiltBvh { bvh, stats, bottom, scene_id });
+                let names: Vec<String> =
+                    self.scene.instances.iter().flat_map(|i| &i.meshes).map(|m| m.name.clone()).collect();
+                self.built = Some(BuiltBvh::new(bvh, &names, scene_id));
                 self.rays = None;
             }
             JobEvent::Built { .. } => {}
@@ -347,11 +426,8 @@ impl BvhscopeApp {
                 // rfd answers None at once when it has no portal or zenity to ask; a person who
                 // cancels a real dialog takes longer than that.
                 if took < Duration::from_millis(300) {
-                    self.path_window = Some(PathWindow {
-                        pick,
-                        text: String::new(),
-                        note: Some("No file dialog is available on this system (no desktop portal or zenity). Type the path instead.".into()),
-                    });
+                    let note = "No file dialog is available on this system (no desktop portal or zenity). Type the path instead.";
+                    self.path_window = Some(PathWindow::new(pick, String::new(), Some(note.into())));
                 }
             }
         }
@@ -385,7 +461,7 @@ impl BvhscopeApp {
             // Per-ray figures belong to the BVH that traced them; a pass of an older BVH that
             // arrives after a rebuild must not be shown (or remembered) under the new strategy.
             if self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
-                self.rays = Some(p.frame.ray_summary());
+                self.rays = Some(MeasuredRays { summary: p.frame.ray_summary(), camera: p.camera, trace: p.trace });
             }
         }
         let texture = match self.shown.take() {
@@ -395,8 +471,16 @@ impl BvhscopeApp {
             }
             None => ctx.load_texture("bvhscope-view", p.image, options),
         };
-        self.shown =
-            Some(Shown { texture, frame: p.frame, camera: p.camera, legend: p.legend, style: p.style, rays_per_s });
+        let build_label = p.bvh.build_params().label();
+        self.shown = Some(Shown {
+            texture,
+            frame: p.frame,
+            camera: p.camera,
+            legend: p.legend,
+            style: p.style,
+            rays_per_s,
+            build_label,
+        });
     }
 
     /// Everything that happens before the panels are drawn: job results, dropped files, keys.
@@ -421,7 +505,7 @@ impl BvhscopeApp {
         use shortcuts::Action as A;
         match action {
             A::Open => self.jobs.pick_file(Pick::Open, ""),
-            A::OpenPath => self.path_window = Some(PathWindow { pick: Pick::Open, text: String::new(), note: None }),
+            A::OpenPath => self.path_window = Some(PathWindow::new(Pick::Open, String::new(), None)),
             A::SavePng => self.jobs.pick_file(Pick::SavePng, &export::default_name(self, "png")),
             A::ExportStats => self.jobs.pick_file(Pick::SaveStatsCsv, &export::default_name(self, "csv")),
             A::FrameMesh => self.frame_mesh(),
@@ -456,18 +540,24 @@ impl eframe::App for BvhscopeApp {
         self.handle_input(&ctx);
         egui::Panel::top("menu").show(ui, |ui| panels::menu::show(self, ui));
         egui::Panel::bottom("status").show(ui, |ui| panels::status::show(self, ui));
-        egui::Panel::left("controls").resizable(true).default_size(290.0).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| {
+        // The side panels keep the width they have (the user's, remembered by egui's memory):
+        // their contents wrap, scroll or clip inside it and never widen them, so the viewport,
+        // and with it the camera's aspect, stays as it is when the figures change.
+        egui::Panel::left("controls").resizable(true).default_size(290.0).size_range(200.0..=640.0).show(ui, |ui| {
+            panels::fixed_width(ui, |ui| {
                 panels::build::show(self, ui);
                 ui.separator();
                 panels::view::show(self, ui);
-            });
+            })
         });
-        egui::Panel::right("statistics").resizable(true).default_size(330.0).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| panels::stats::show(self, ui));
-        });
+        egui::Panel::right("statistics")
+            .resizable(true)
+            .default_size(340.0)
+            .size_range(220.0..=720.0)
+            .show(ui, |ui| panels::fixed_width(ui, |ui| panels::stats::show(self, ui)));
         egui::CentralPanel::default().frame(egui::Frame::NONE.fill(egui::Color32::from_gray(12))).show(ui, |ui| {
             self.viewport_aspect = ui.available_width() / ui.available_height().max(1.0);
+            self.viewport_rect = ui.available_rect_before_wrap();
             viewport::show(self, ui);
         });
         panels::windows::show(self, &ctx);

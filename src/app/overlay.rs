@@ -1,12 +1,16 @@
 //! The node-box overlay: BVH boxes as wireframes over the ray-cast image, in the same pinhole
 //! projection as the renderer. Edges are clipped against the near plane in camera space before
 //! projection, so a box around or behind the camera draws correctly instead of wrapping around.
+//! Optionally only what lies in front of the surface is drawn: each edge is cut into pieces a few
+//! pixels long, and a piece is kept when its distance from the eye is no more than the distance
+//! the ray of the pixel under it travelled to its hit (the depth test of a rasteriser, against
+//! the ray-cast image).
 
 use super::settings::BoxLevel;
 use crate::bvh::two_level::placed_corners;
 use crate::bvh::{SceneBvh, TreeView};
 use crate::geometry::Aabb;
-use crate::render::Camera;
+use crate::render::{Camera, Frame};
 use egui::{Color32, Mesh, Pos2, Rect};
 use glam::Vec3;
 
@@ -56,10 +60,11 @@ impl Projector {
     /// The screen segment of a world segment, clipped to the near plane; None if wholly behind it.
     #[cfg(test)]
     pub fn segment(&self, a: Vec3, b: Vec3) -> Option<(Pos2, Pos2)> {
-        self.clip_segment(self.to_camera(a), self.to_camera(b))
+        self.clip_segment(self.to_camera(a), self.to_camera(b)).map(|(a, b)| (self.to_screen(a), self.to_screen(b)))
     }
 
-    fn clip_segment(&self, mut a: Vec3, mut b: Vec3) -> Option<(Pos2, Pos2)> {
+    /// A camera-space segment clipped to the near plane (camera space); None if wholly behind it.
+    fn clip_segment(&self, mut a: Vec3, mut b: Vec3) -> Option<(Vec3, Vec3)> {
         if a.z < self.near && b.z < self.near {
             return None;
         }
@@ -68,13 +73,41 @@ impl Projector {
         } else if b.z < self.near {
             b = b + (a - b) * ((self.near - b.z) / (a.z - b.z));
         }
-        Some((self.to_screen(a), self.to_screen(b)))
+        Some((a, b))
     }
 
-    /// The 12 edges of a box given by its corners (`Aabb::corners` order), clipped and projected.
-    pub fn box_edges(&self, corners: &[Vec3; 8]) -> impl Iterator<Item = (Pos2, Pos2)> + '_ {
+    /// The 12 edges of a box given by its corners (`Aabb::corners` order), clipped, in camera
+    /// space (the eye at the origin, so a point's length is its distance from the eye).
+    pub fn box_edges(&self, corners: &[Vec3; 8]) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
         let corners = corners.map(|c| self.to_camera(c));
         EDGES.iter().filter_map(move |&(i, j)| self.clip_segment(corners[i], corners[j]))
+    }
+}
+
+/// The depth test of "only in front of the surface": the frame the overlay is drawn over, and
+/// where it is on screen.
+#[derive(Clone, Copy)]
+pub struct DepthTest<'a> {
+    pub frame: &'a Frame,
+    pub rect: Rect,
+}
+
+impl DepthTest<'_> {
+    /// Screen length of the pieces an edge is cut into for the test.
+    const PIECE: f32 = 3.0;
+
+    /// Whether a camera-space point drawn at `screen` lies in front of the surface there: no
+    /// farther from the eye than the pixel's ray went (a miss is infinitely far; a point off the
+    /// image is kept). The 0.1% allowance keeps box faces that lie on the surface.
+    fn in_front(&self, point: Vec3, screen: Pos2) -> bool {
+        let (f, r) = (self.frame, self.rect);
+        let u = (screen.x - r.min.x) / r.width();
+        let v = (screen.y - r.min.y) / r.height();
+        if !(0.0..1.0).contains(&u) || !(0.0..1.0).contains(&v) {
+            return true;
+        }
+        let (x, y) = ((u * f.width() as f32) as u32, (v * f.height() as f32) as u32);
+        point.length() <= f.sample(x, y).t * 1.001
     }
 }
 
@@ -122,9 +155,25 @@ pub fn node_color(node: usize) -> Color32 {
     egui::ecolor::Hsva::new(hue, 0.85, 1.0, 1.0).into()
 }
 
+/// Add the quad of a screen segment to the mesh.
+fn add_segment(mesh: &mut Mesh, p: Pos2, q: Pos2, width: f32, color: Color32) {
+    let d = q - p;
+    let len = d.length();
+    if !(len.is_finite()) || len < 1e-3 {
+        return;
+    }
+    let n = egui::vec2(-d.y, d.x) / len * (width * 0.5);
+    let base = mesh.vertices.len() as u32;
+    for v in [p + n, p - n, q - n, q + n] {
+        mesh.colored_vertex(v, color);
+    }
+    mesh.add_triangle(base, base + 1, base + 2);
+    mesh.add_triangle(base, base + 2, base + 3);
+}
+
 /// All boxes as one mesh of thin quads: far cheaper for egui than 12 line shapes per box, which
-/// keeps 10,000 boxes smooth.
-pub fn boxes_mesh(boxes: &[OverlayBox], camera: &Camera, rect: Rect, width: f32) -> Mesh {
+/// keeps 10,000 boxes smooth. With `depth`, only the parts in front of the surface.
+pub fn boxes_mesh(boxes: &[OverlayBox], camera: &Camera, rect: Rect, width: f32, depth: Option<DepthTest>) -> Mesh {
     let extent =
         boxes.iter().flat_map(|b| b.corners).fold(Aabb::EMPTY, |acc, c| acc.grow(c)).extent().length().max(1e-6);
     let near = (extent * 1e-4).max((camera.position - camera.look_at).length() * 1e-4);
@@ -133,23 +182,36 @@ pub fn boxes_mesh(boxes: &[OverlayBox], camera: &Camera, rect: Rect, width: f32)
     let mut mesh = Mesh::default();
     for b in boxes {
         let (color, width) = if b.top { (Color32::WHITE, width * 2.0) } else { (node_color(b.id), width) };
-        for (p, q) in projector.box_edges(&b.corners) {
+        for (a, c) in projector.box_edges(&b.corners) {
+            let (p, q) = (projector.to_screen(a), projector.to_screen(c));
             // Segments far outside the view are dropped; egui clips the rest to the viewport.
             if !clip.contains(p) && !clip.contains(q) && !Rect::from_two_pos(p, q).intersects(rect) {
                 continue;
             }
-            let d = q - p;
-            let len = d.length();
-            if !(len.is_finite()) || len < 1e-3 {
+            let Some(test) = depth else {
+                add_segment(&mut mesh, p, q, width, color);
                 continue;
+            };
+            // Pieces along the edge, interpolated in camera space (a screen-space step is not a
+            // fixed step in depth); each kept or dropped by its middle, runs merged into a quad.
+            let pieces = ((q - p).length() / DepthTest::PIECE).ceil().clamp(1.0, 512.0) as usize;
+            let at = |k: f32| a + (c - a) * (k / pieces as f32);
+            let mut run: Option<Pos2> = None;
+            for k in 0..pieces {
+                let mid = at(k as f32 + 0.5);
+                let visible = test.in_front(mid, projector.to_screen(mid));
+                match (visible, run) {
+                    (true, None) => run = Some(projector.to_screen(at(k as f32))),
+                    (false, Some(start)) => {
+                        add_segment(&mut mesh, start, projector.to_screen(at(k as f32)), width, color);
+                        run = None;
+                    }
+                    _ => {}
+                }
             }
-            let n = egui::vec2(-d.y, d.x) / len * (width * 0.5);
-            let base = mesh.vertices.len() as u32;
-            for v in [p + n, p - n, q - n, q + n] {
-                mesh.colored_vertex(v, color);
+            if let Some(start) = run {
+                add_segment(&mut mesh, start, q, width, color);
             }
-            mesh.add_triangle(base, base + 1, base + 2);
-            mesh.add_triangle(base, base + 2, base + 3);
         }
     }
     mesh
@@ -211,14 +273,50 @@ mod tests {
             OverlayBox::world(1, &Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))),
             OverlayBox::world(2, &Aabb::new(Vec3::splat(-0.5), Vec3::splat(0.5))),
         ];
-        let m = boxes_mesh(&boxes, &camera(), rect(), 1.0);
+        let m = boxes_mesh(&boxes, &camera(), rect(), 1.0, None);
         // Both boxes lie wholly in front of the camera and inside the view; the edges along the
         // view axis are off-centre, so they project to real segments too: 2 × 12 quads.
         assert_eq!(m.vertices.len(), 24 * 4);
         assert_eq!(m.indices.len(), 24 * 6);
         // A box behind the camera adds nothing.
         let behind = vec![OverlayBox::world(3, &Aabb::new(Vec3::new(-1.0, -1.0, 6.0), Vec3::new(1.0, 1.0, 8.0)))];
-        assert_eq!(boxes_mesh(&behind, &camera(), rect(), 1.0).vertices.len(), 0);
+        assert_eq!(boxes_mesh(&behind, &camera(), rect(), 1.0, None).vertices.len(), 0);
         assert_ne!(node_color(1), node_color(2));
+    }
+
+    /// The total screen length of the quads of a mesh (each quad's long side).
+    fn drawn_length(m: &Mesh) -> f32 {
+        m.vertices.chunks(4).map(|q| (q[2].pos - q[1].pos).length()).sum()
+    }
+
+    #[test]
+    fn only_the_parts_in_front_of_the_surface_are_drawn_when_asked() {
+        use crate::bvh::{AnyBvh, BuildParams};
+        use crate::render::{render, RenderSettings};
+        // A wall at z = 0 facing the camera (at z = 5), and two boxes: one in front of the wall,
+        // one behind it, both within the view.
+        let wall = crate::mesh::Mesh {
+            positions: vec![
+                Vec3::new(-9.0, -9.0, 0.0),
+                Vec3::new(9.0, -9.0, 0.0),
+                Vec3::new(9.0, 9.0, 0.0),
+                Vec3::new(-9.0, 9.0, 0.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            ..Default::default()
+        };
+        let cam = camera();
+        let frame = render(&AnyBvh::build(&wall, &BuildParams::default()), &wall, &cam, &RenderSettings::default());
+        let test = DepthTest { frame: &frame, rect: rect() };
+        let front = vec![OverlayBox::world(1, &Aabb::new(Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.0, 1.0, 2.0)))];
+        let behind = vec![OverlayBox::world(2, &Aabb::new(Vec3::new(-1.0, -1.0, -3.0), Vec3::new(1.0, 1.0, -2.0)))];
+        let across = vec![OverlayBox::world(3, &Aabb::new(Vec3::new(-1.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0)))];
+        let all = |b: &[OverlayBox]| drawn_length(&boxes_mesh(b, &cam, rect(), 1.0, None));
+        let shown = |b: &[OverlayBox]| drawn_length(&boxes_mesh(b, &cam, rect(), 1.0, Some(test)));
+        assert!((shown(&front) - all(&front)).abs() < 0.01 * all(&front), "a box in front is drawn whole");
+        assert_eq!(shown(&behind), 0.0, "a box behind the wall is hidden");
+        // A box through the wall: its front face and the front halves of its side edges.
+        let (a, s) = (all(&across), shown(&across));
+        assert!(s > 0.3 * a && s < 0.8 * a, "part of a box through the wall: {s} of {a}");
     }
 }

@@ -74,14 +74,45 @@ impl Scene {
 /// The BVH of the current scene.
 pub struct BuiltBvh {
     pub bvh: Arc<SceneBvh>,
-    /// Of the single BVH, or of the top level of two.
+    /// What the statistics rows describe: the single BVH; for two levels the top level, or the
+    /// mesh's BVH when the scene places one mesh once (its top level is one node, nothing to
+    /// describe).
     pub stats: TreeStats,
+    /// Two levels: the top level's statistics.
+    pub top_stats: Option<TreeStats>,
     /// Two levels: each mesh's name and its BVH's statistics.
     pub bottom: Vec<(String, TreeStats)>,
     pub scene_id: u64,
 }
 
 impl BuiltBvh {
+    /// Statistics of a finished build; `names` are the scene's mesh names (two levels).
+    pub fn new(bvh: Arc<SceneBvh>, names: &[String], scene_id: u64) -> Self {
+        let (stats, top_stats, bottom) = match bvh.two_level() {
+            Some(t) => {
+                let top = TreeStats::of(&t.top);
+                let bottom: Vec<(String, TreeStats)> = t
+                    .bottom
+                    .iter()
+                    .enumerate()
+                    .map(|(k, b)| (names.get(k).cloned().unwrap_or_else(|| format!("mesh {k}")), TreeStats::of(b)))
+                    .collect();
+                let rows = match (&t.instances[..], &bottom[..]) {
+                    ([_], [(_, mesh)]) => mesh.clone(),
+                    _ => top.clone(),
+                };
+                (rows, Some(top), bottom)
+            }
+            None => (TreeStats::of(bvh.tree()), None, Vec::new()),
+        };
+        Self { bvh, stats, top_stats, bottom, scene_id }
+    }
+
+    /// Whether the statistics rows describe the mesh's BVH of a two-level build of one placement.
+    pub fn rows_are_the_mesh(&self) -> bool {
+        self.bvh.two_level().is_some_and(|t| t.instances.len() == 1 && t.bottom.len() == 1)
+    }
+
     /// Deepest level of the bottom BVHs (or of the single BVH): the box depth slider's end.
     pub fn bottom_max_depth(&self) -> u32 {
         match self.bvh.two_level() {

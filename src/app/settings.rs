@@ -1,7 +1,8 @@
 //! What the user chose, remembered across runs (eframe persistence).
 
-use crate::bvh::{BuildParams, Layout, TraceOptions};
-use crate::render::{ColorMap, HeatRange, View};
+use crate::bvh::{BuildParams, Layout, Preset, TraceOptions};
+use crate::render::{ColorMap, HeatRange, UpAxis, View};
+use std::collections::HashMap;
 use std::path::PathBuf;
 
 /// How many recent files the File menu remembers.
@@ -23,13 +24,20 @@ pub struct Settings {
     pub trace: TraceOptions,
     pub view: View,
     pub colormap: ColorMap,
-    /// Heatmap range: the frame's own min..max, or `fixed_range`.
-    pub auto_range: bool,
-    pub fixed_range: (f32, f32),
+    /// Fixed heatmap ranges, per view (a view without one uses its frame's own min..max). Each
+    /// view has its own because their scales differ (nodes visited 0..60, combined cost 0..250);
+    /// cleared when a scene is opened, whose scale is its own too, so not saved either.
+    #[serde(skip)]
+    pub fixed_ranges: HashMap<View, (f32, f32)>,
+    /// Which axis of the mesh points up (the orbit and the default camera follow it).
+    pub up_axis: UpAxis,
     pub show_boxes: bool,
     pub box_depth: u32,
     /// Also draw leaves shallower than `box_depth`.
     pub boxes_leaves_above: bool,
+    /// Draw only the parts of the boxes in front of the surface (depth-tested against the
+    /// ray-cast image), so deep levels do not hide the mesh.
+    pub boxes_in_front: bool,
     /// Coarse passes first (off: each frame at full resolution at once).
     pub progressive: bool,
     pub recent_files: Vec<PathBuf>,
@@ -46,11 +54,12 @@ impl Default for Settings {
             trace: TraceOptions::default(),
             view: View::Normals,
             colormap: ColorMap::Viridis,
-            auto_range: true,
-            fixed_range: (0.0, 100.0),
+            fixed_ranges: HashMap::new(),
+            up_axis: UpAxis::Y,
             show_boxes: false,
             box_depth: 3,
             boxes_leaves_above: false,
+            boxes_in_front: false,
             progressive: true,
             recent_files: Vec::new(),
         }
@@ -87,12 +96,26 @@ impl BoxLevel {
 }
 
 impl Settings {
+    /// The heatmap range of the current view.
     pub fn heat_range(&self) -> HeatRange {
-        if self.auto_range {
-            HeatRange::Auto
-        } else {
-            HeatRange::Fixed { min: self.fixed_range.0, max: self.fixed_range.1 }
+        match self.fixed_ranges.get(&self.view) {
+            Some(&(min, max)) => HeatRange::Fixed { min, max },
+            None => HeatRange::Auto,
         }
+    }
+
+    /// Set what `preset` sets (the rest stays).
+    pub fn apply_preset(&mut self, preset: Preset) {
+        let p = preset.build();
+        self.build =
+            BuildParams { strategy: p.strategy, layout: p.layout, max_leaf_size: p.max_leaf_size, ..self.build };
+        self.trace = preset.trace();
+        self.two_level = preset.two_level();
+    }
+
+    /// Whether the settings are `preset`'s.
+    pub fn is_preset(&self, preset: Preset) -> bool {
+        preset.is_applied(&self.build, &self.trace, self.two_level)
     }
 
     /// Put `path` at the top of the recent files.
@@ -132,8 +155,8 @@ mod tests {
         s.build.strategy = crate::bvh::SplitStrategy::Midpoint;
         s.view = View::TriTests;
         s.colormap = ColorMap::Turbo;
-        s.auto_range = false;
-        s.fixed_range = (2.0, 40.0);
+        s.up_axis = UpAxis::Z;
+        s.boxes_in_front = true;
         for i in 0..12 {
             s.remember(PathBuf::from(format!("/nonexistent/mesh{i}.obj")));
         }
@@ -146,6 +169,28 @@ mod tests {
         eframe::set_value(&mut storage, eframe::APP_KEY, &s);
         let back: Settings = eframe::get_value(&storage, eframe::APP_KEY).expect("saved settings load");
         assert_eq!(back, s);
+    }
+
+    #[test]
+    fn a_fixed_range_belongs_to_its_view() {
+        let mut s = Settings { view: View::Visits, ..Settings::default() };
+        s.fixed_ranges.insert(View::Visits, (0.0, 56.0));
+        assert_eq!(s.heat_range(), HeatRange::Fixed { min: 0.0, max: 56.0 });
+        s.view = View::Cost;
+        assert_eq!(s.heat_range(), HeatRange::Auto, "nodes visited's scale is not combined cost's");
+    }
+
+    #[test]
+    fn the_handout_preset_is_applied_and_recognised() {
+        let mut s = Settings::default();
+        assert!(!s.is_preset(Preset::Handout));
+        s.apply_preset(Preset::Handout);
+        assert!(s.is_preset(Preset::Handout));
+        assert_eq!(s.build.strategy, crate::bvh::SplitStrategy::Midpoint);
+        assert_eq!(s.build.max_leaf_size, Preset::HANDOUT_MAX_LEAF_SIZE);
+        assert!(!s.two_level);
+        s.build.max_leaf_size = 8;
+        assert!(!s.is_preset(Preset::Handout), "a changed leaf size is no longer the handout's");
     }
 
     #[test]

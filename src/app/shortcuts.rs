@@ -48,6 +48,18 @@ pub const MOUSE: &[(&str, &str)] = &[
     ("Drop an .obj", "Open it"),
 ];
 
+/// A shortcut as the Help window and the menus show it: modifiers by name, keys by their symbol
+/// (`]`, not egui's `CloseBracket`).
+pub fn shortcut_text(ctx: &egui::Context, s: &KeyboardShortcut) -> String {
+    let is_mac = ctx.os().is_mac();
+    let names = if is_mac { egui::ModifierNames::SYMBOLS } else { egui::ModifierNames::NAMES };
+    let mut text = names.format(&s.modifiers, is_mac);
+    if !text.is_empty() {
+        text += names.concat;
+    }
+    text + s.logical_key.symbol_or_name()
+}
+
 /// The actions whose keys were pressed this frame. Single-key shortcuts are ignored while a text
 /// field has the keyboard.
 pub fn pressed(ctx: &egui::Context) -> Vec<Action> {

@@ -63,7 +63,8 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     if app.settings.show_boxes {
         if let (Some(boxes), Some(camera)) = (app.overlay_boxes(), app.shown.as_ref().map(|s| s.camera)) {
             app.boxes_drawn = boxes.len();
-            let mesh = app.overlay_mesh(boxes, camera, rect);
+            let depth = app.settings.boxes_in_front.then(|| app.shown.as_ref().map(|s| s.frame.clone())).flatten();
+            let mesh = app.overlay_mesh(boxes, camera, rect, depth);
             painter.add(egui::Shape::Mesh(mesh));
         }
     }
@@ -192,30 +193,35 @@ fn legend_area(ui: &egui::Ui, rect: Rect, legend: &Legend) {
         });
 }
 
-/// Errors (until dismissed) and notes (for a few seconds) across the top of the viewport.
+/// Errors (until dismissed) and notes (for a few seconds) across the top of the viewport. Each
+/// wraps inside the viewport, however long (a scene's note can be a paragraph), with its Dismiss
+/// button below the text, so the button stays on screen.
 fn messages(app: &mut BvhscopeApp, ui: &egui::Ui, rect: Rect) {
     if app.messages.is_empty() {
         return;
     }
     let mut dismiss = None;
+    let margin = 8.0;
+    let width = (rect.width() - 24.0 - 2.0 * margin).max(60.0);
     egui::Area::new(ui.scope_id().with("messages"))
         .fixed_pos(rect.left_top() + Vec2::new(12.0, 12.0))
         .order(egui::Order::Foreground)
+        .constrain_to(rect)
         .show(ui.ctx(), |ui| {
-            ui.set_max_width(rect.width() - 24.0);
+            ui.set_max_width(width + 2.0 * margin);
             for (i, m) in app.messages.iter().enumerate() {
                 let (fill, title) = match m.kind {
                     MessageKind::Error => (Color32::from_rgb(110, 24, 24), "Error"),
                     MessageKind::Warning => (Color32::from_rgb(110, 80, 10), "Warning"),
                     MessageKind::Info => (Color32::from_rgb(24, 60, 100), "Note"),
                 };
-                egui::Frame::new().fill(fill).inner_margin(8.0).corner_radius(4.0).show(ui, |ui| {
-                    ui.horizontal(|ui| {
-                        ui.label(egui::RichText::new(format!("{title}: {}", m.text)).color(Color32::WHITE));
-                        if ui.small_button("Dismiss").clicked() {
-                            dismiss = Some(i);
-                        }
-                    });
+                egui::Frame::new().fill(fill).inner_margin(margin).corner_radius(4.0).show(ui, |ui| {
+                    ui.set_max_width(width);
+                    let text = egui::RichText::new(format!("{title}: {}", m.text)).color(Color32::WHITE);
+                    ui.add(egui::Label::new(text).wrap());
+                    if ui.small_button("Dismiss").clicked() {
+                        dismiss = Some(i);
+                    }
                 });
             }
         });

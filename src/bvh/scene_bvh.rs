@@ -18,6 +18,18 @@ pub struct SceneBuild {
     pub top: Option<BuildParams>,
 }
 
+impl SceneBuild {
+    /// "SAH binned, wide4", or "top SAH binned / Midpoint, binary" for two levels: the strategy and
+    /// layout, as the statistics columns and exported images name a build.
+    pub fn label(&self) -> String {
+        let one = format!("{}, {}", self.bvh.strategy.label(), self.bvh.layout.short_name());
+        match self.top {
+            Some(top) => format!("top {} / {one}", top.strategy.label()),
+            None => one,
+        }
+    }
+}
+
 /// A scene's meshes and their placements (mesh index, object-to-world transform).
 pub type Placements<'a> = (&'a [&'a Mesh], &'a [(u32, Affine3A)]);
 

@@ -1,9 +1,9 @@
 //! Arguments shared by the subcommands, and clap's value lists for the core's enums (so `--help`
 //! lists every strategy, view, order, test and colour map under its kebab-case name).
 
-use crate::bvh::{BuildParams, Layout, SahCost, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder};
+use crate::bvh::{BuildParams, Layout, Preset, SahCost, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder};
 use crate::geometry::{Aabb, TriangleTest};
-use crate::render::{Camera, ColorMap, View};
+use crate::render::{Camera, ColorMap, UpAxis, View};
 use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
 use glam::Vec3;
@@ -61,6 +61,19 @@ impl ValueEnum for TriangleTest {
     }
 }
 
+impl ValueEnum for UpAxis {
+    fn value_variants<'a>() -> &'a [Self] {
+        &UpAxis::ALL
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        let help = match self {
+            UpAxis::Y => "+y is up (most formats, the handout)",
+            UpAxis::Z => "+z is up (CAD, Blender coordinates, many scans); the default camera looks along +y",
+        };
+        Some(PossibleValue::new(self.short_name()).help(help))
+    }
+}
+
 impl ValueEnum for ColorMap {
     fn value_variants<'a>() -> &'a [Self] {
         &ColorMap::ALL
@@ -70,32 +83,37 @@ impl ValueEnum for ColorMap {
     }
 }
 
-/// How to build and traverse the BVH.
-#[derive(Args, Debug, Clone)]
+/// How to build and traverse the BVH. Each option left out comes from `--preset` if given, else
+/// from the scene file's `bvh` settings (as the app starts from them), else the default.
+#[derive(Args, Debug, Clone, Default)]
 pub struct BuildArgs {
-    /// Split strategy.
-    #[arg(long, short, value_enum, default_value = "sah")]
-    pub strategy: SplitStrategy,
-    /// Most triangles in a leaf (1..=255).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=255))]
-    pub max_leaf_size: u32,
-    /// Bins per axis for the binned SAH (2..=256); nodes of fewer than 3·bins triangles use a
-    /// third of their count (at least 4, never more than asked for).
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(2..=256))]
-    pub bins: u32,
-    /// SAH cost of one traversal step (relative to one triangle test), a positive number.
-    #[arg(long, default_value_t = 1.0, value_parser = parse_positive)]
-    pub traversal_cost: f32,
+    /// Start from a named set of options (the ones given here still win).
+    #[arg(long, value_enum)]
+    pub preset: Option<Preset>,
+    /// Split strategy [default: sah].
+    #[arg(long, short, value_enum)]
+    pub strategy: Option<SplitStrategy>,
+    /// Most triangles in a leaf, 1..=255 [default: 4].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
+    pub max_leaf_size: Option<u32>,
+    /// Bins per axis for the binned SAH, 2..=256; nodes of fewer than 3·bins triangles use a
+    /// third of their count (at least 4, never more than asked for) [default: 16].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=256))]
+    pub bins: Option<u32>,
+    /// SAH cost of one traversal step (relative to one triangle test), a positive number
+    /// [default: 1].
+    #[arg(long, value_parser = parse_positive)]
+    pub traversal_cost: Option<f32>,
     /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
     #[arg(long, value_enum)]
     pub layout: Option<Layout>,
     /// Child visited first at interior nodes of the binary layout (the wide one always takes the
-    /// nearest first).
-    #[arg(long, value_enum, default_value = "entry-distance")]
-    pub order: TraversalOrder,
-    /// Ray–triangle test.
-    #[arg(long = "triangle-test", value_enum, default_value = "watertight")]
-    pub test: TriangleTest,
+    /// nearest first) [default: entry-distance].
+    #[arg(long, value_enum)]
+    pub order: Option<TraversalOrder>,
+    /// Ray–triangle test [default: watertight].
+    #[arg(long = "triangle-test", value_enum)]
+    pub test: Option<TriangleTest>,
     /// Build two levels: a top-level BVH over the scene's mesh placements and one BVH per mesh
     /// (the options above then apply to the meshes' BVHs). An OBJ is one placement of itself.
     #[arg(long)]
@@ -108,18 +126,51 @@ pub struct BuildArgs {
     pub top_max_leaf_size: u32,
 }
 
+impl ValueEnum for Preset {
+    fn value_variants<'a>() -> &'a [Self] {
+        &Preset::ALL
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(self.short_name()).help(self.description()))
+    }
+}
+
 impl BuildArgs {
-    pub fn params(&self, strategy: SplitStrategy) -> BuildParams {
-        self.params_with(strategy, self.layout.unwrap_or_default())
+    /// The parameters before the options given on the command line: the preset's, the scene's,
+    /// or the defaults.
+    fn base(&self, scene: Option<&BuildParams>) -> BuildParams {
+        match (self.preset, scene) {
+            (Some(p), _) => p.build(),
+            (None, Some(s)) => *s,
+            (None, None) => BuildParams::default(),
+        }
     }
 
-    pub fn params_with(&self, strategy: SplitStrategy, layout: Layout) -> BuildParams {
+    /// The build parameters: the options given, else the preset's, the scene's (`scene`, from a
+    /// scene file), the defaults.
+    pub fn params(&self, scene: Option<&BuildParams>) -> BuildParams {
+        let base = self.base(scene);
+        self.params_with(scene, self.strategy.unwrap_or(base.strategy), self.layout.unwrap_or(base.layout))
+    }
+
+    /// `params` with the strategy and layout given (`compare` goes through them all).
+    pub fn params_with(&self, scene: Option<&BuildParams>, strategy: SplitStrategy, layout: Layout) -> BuildParams {
+        let base = self.base(scene);
         BuildParams {
             strategy,
             layout,
-            max_leaf_size: self.max_leaf_size,
-            sah_bins: self.bins,
-            cost: SahCost { traversal: self.traversal_cost, ..SahCost::default() },
+            max_leaf_size: self.max_leaf_size.unwrap_or(base.max_leaf_size),
+            sah_bins: self.bins.unwrap_or(base.sah_bins),
+            cost: SahCost { traversal: self.traversal_cost.unwrap_or(base.cost.traversal), ..base.cost },
+        }
+    }
+
+    /// The layouts `compare` shows: the one given or the preset's, else both.
+    pub fn compare_layouts(&self) -> Vec<Layout> {
+        match (self.layout, self.preset) {
+            (Some(l), _) => vec![l],
+            (None, Some(p)) => vec![p.build().layout],
+            (None, None) => Layout::ALL.to_vec(),
         }
     }
 
@@ -136,7 +187,8 @@ impl BuildArgs {
     }
 
     pub fn trace(&self) -> TraceOptions {
-        TraceOptions { order: self.order, test: self.test }
+        let base = self.preset.map_or(TraceOptions::default(), Preset::trace);
+        TraceOptions { order: self.order.unwrap_or(base.order), test: self.test.unwrap_or(base.test) }
     }
 }
 
@@ -146,12 +198,17 @@ pub struct ViewArgs {
     /// Image size, WIDTHxHEIGHT [default: the scene's, else 1280x720].
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Camera as EYE:TARGET[:UP], each X,Y,Z (e.g. 0,1,5:0,0,0). Default: frames the mesh.
+    /// Camera as EYE:TARGET[:UP], each X,Y,Z (e.g. 0,1,5:0,0,0); UP defaults to the --up axis.
+    /// Default: frames the mesh from the front.
     #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
-    pub camera: Option<(Vec3, Vec3, Vec3)>,
+    pub camera: Option<(Vec3, Vec3, Option<Vec3>)>,
     /// Vertical field of view in degrees (between 0 and 180).
     #[arg(long, default_value_t = 45.0, value_parser = parse_fov)]
     pub fov: f32,
+    /// Which axis of the mesh points up: the default camera frames it from the front with this
+    /// axis up (and `--camera` takes it as the up vector unless it gives one).
+    #[arg(long, value_enum, default_value = "y")]
+    pub up: UpAxis,
 }
 
 impl ViewArgs {
@@ -161,10 +218,11 @@ impl ViewArgs {
         let (w, h) = self.size.or(scene.map(|c| (c.width, c.height))).unwrap_or((1280, 720));
         let cam = match (self.camera, scene) {
             (Some((position, look_at, up)), _) => {
+                let up = up.unwrap_or(self.up.vector());
                 Camera { position, look_at, up, vfov_deg: self.fov, width: w, height: h }
             }
             (None, Some(c)) => Camera { width: w, height: h, ..*c },
-            (None, None) => Camera::framing_from(bounds, w, h, Camera::DEFAULT_VIEW_FROM, self.fov),
+            (None, None) => Camera::framing_up(bounds, w, h, self.up, self.fov),
         };
         cam.validate().map_err(|e| super::CliError::Usage(format!("--camera: {e}")))?;
         Ok(cam)
@@ -210,12 +268,12 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
     }
 }
 
-/// `0,1,5:0,0,0[:0,1,0]` → (eye, target, up).
-pub fn parse_camera(s: &str) -> Result<(Vec3, Vec3, Vec3), String> {
+/// `0,1,5:0,0,0[:0,1,0]` → (eye, target, up if given).
+pub fn parse_camera(s: &str) -> Result<(Vec3, Vec3, Option<Vec3>), String> {
     let parts: Vec<&str> = s.split(':').collect();
     match parts[..] {
-        [eye, target] => Ok((parse_vec3(eye)?, parse_vec3(target)?, Vec3::Y)),
-        [eye, target, up] => Ok((parse_vec3(eye)?, parse_vec3(target)?, parse_vec3(up)?)),
+        [eye, target] => Ok((parse_vec3(eye)?, parse_vec3(target)?, None)),
+        [eye, target, up] => Ok((parse_vec3(eye)?, parse_vec3(target)?, Some(parse_vec3(up)?))),
         _ => Err(format!("'{s}' is not EYE:TARGET[:UP]")),
     }
 }
@@ -229,11 +287,37 @@ mod tests {
         assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
         assert!(parse_size("0x10").is_err() && parse_size("12").is_err() && parse_size("axb").is_err());
         let (e, t, u) = parse_camera("0,1,5:0,0,0").unwrap();
-        assert_eq!((e, t, u), (Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y));
-        assert_eq!(parse_camera("1,2,3:4,5,6:0,0,1").unwrap().2, Vec3::Z);
+        assert_eq!((e, t, u), (Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, None));
+        assert_eq!(parse_camera("1,2,3:4,5,6:0,0,1").unwrap().2, Some(Vec3::Z));
         assert!(parse_camera("1,2:0,0,0").is_err() && parse_camera("nan,0,0:0,0,0").is_err());
         assert_eq!(parse_positive("2.5"), Ok(2.5));
         assert!(parse_positive("nan").is_err() && parse_positive("inf").is_err() && parse_positive("-1").is_err());
         assert!(parse_positive("0").is_err());
+    }
+
+    #[test]
+    fn options_given_win_over_the_preset_which_wins_over_the_scene() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct T {
+            #[command(flatten)]
+            b: BuildArgs,
+        }
+        let scene = BuildParams { strategy: SplitStrategy::EqualCount, max_leaf_size: 2, ..BuildParams::default() };
+        let parse = |args: &[&str]| T::parse_from([&["t"], args].concat()).b;
+        let plain = parse(&[]);
+        assert_eq!(plain.params(None), BuildParams::default());
+        assert_eq!(plain.params(Some(&scene)), scene, "a scene file's settings, as the app starts from them");
+        assert_eq!(plain.trace(), TraceOptions::default());
+        let handout = parse(&["--preset", "handout"]);
+        assert_eq!(handout.params(Some(&scene)), Preset::Handout.build());
+        assert_eq!(handout.trace(), Preset::Handout.trace());
+        assert_eq!(handout.compare_layouts(), vec![Layout::Binary]);
+        let mine = parse(&["--preset", "handout", "--max-leaf-size", "8", "--triangle-test", "watertight"]);
+        let p = mine.params(None);
+        assert_eq!((p.strategy, p.layout, p.max_leaf_size), (SplitStrategy::Midpoint, Layout::Binary, 8));
+        assert_eq!(mine.trace(), TraceOptions { test: TriangleTest::Watertight, ..Preset::Handout.trace() });
+        assert_eq!(parse(&["-s", "sah-sweep"]).params(Some(&scene)).strategy, SplitStrategy::SahSweep);
+        assert_eq!(parse(&[]).compare_layouts(), Layout::ALL.to_vec());
     }
 }

@@ -1,17 +1,23 @@
 //! `bvhscope compare`: the lab-report table. Every strategy is built and measured on the same
 //! primary rays, next to a linear scan of all triangles.
 //!
-//! Frame times are the median of several full frames of the plain (non-counting) traversal on all
-//! threads; the per-ray means come from one extra counting frame. Build times are the median of as
-//! many builds, or of fewer when they pass a second in all: one build of a small mesh takes a few
-//! milliseconds, and a single one can be twice the next on a busy machine. The linear scan is timed on the
-//! full frame when that is projected to take at most ~10 s, else on an evenly spread sample of
-//! its rays, and the table says so.
+//! Three timings per strategy. "trace ms" is what a student's renderer would see: one thread (or
+//! `--threads`), one ray at a time, closest hit only, no shading; it follows the work per ray, and
+//! the speedup over the linear scan compares it with the scan timed the same way. "frame ms" is
+//! the app's frame: the renderer on all threads (or `--threads`), 8×8 ray packets, shading
+//! included; there, making rays and shading cost as much as tracing, so strategies differ little.
+//! Both are medians of `--runs` frames of the plain (non-counting) traversal; the per-ray means
+//! come from one extra counting frame, over all rays and over the rays that enter the root box.
+//! Build times are the median of as many builds, or of fewer when they pass a second in all: one
+//! build of a small mesh takes a few milliseconds, and a single one can be twice the next on a
+//! busy machine. The linear scan is timed on the full frame when that is projected to take at most
+//! ~10 s, else on an evenly spread sample of its rays, and the table says so.
 
 use super::args::{BuildArgs, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{Accelerator, AnyBvh, Layout, LinearScan, NoStats, SplitStrategy, TraceOptions, TreeStats, TreeView};
-use crate::mesh::Mesh;
+use crate::bvh::{
+    Accelerator, AnyBvh, BuildParams, LinearScan, NoStats, SplitStrategy, TraceOptions, TreeStats, TreeView,
+};
 use crate::render::{render, Camera, RenderSettings};
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
@@ -40,6 +46,10 @@ pub struct CompareArgs {
     /// they have taken a second).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100))]
     pub runs: u32,
+    /// Threads for all the work: builds, frames and the single-ray trace timing [default: all
+    /// cores for builds and frames, one for the trace timing].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
 }
 
 /// One row of the table.
@@ -51,15 +61,35 @@ pub struct CompareRow {
     pub max_depth: u32,
     pub mean_leaf_depth: f64,
     pub sah_cost: Option<f64>,
+    /// Means over all primary rays.
     pub nodes_per_ray: f64,
     pub tri_tests_per_ray: f64,
-    /// Full-frame time (median of the timed frames; projected from a sample for a sampled row).
+    /// Means over the rays that enter the root box.
+    pub root_nodes_per_ray: f64,
+    pub root_tri_tests_per_ray: f64,
+    /// Single rays, closest hit, no shading, on `trace_threads` (median; projected from a sample
+    /// for a sampled row).
+    pub trace_ms: f64,
+    /// The renderer's full frame with shading (median of the timed frames; the linear scan's is
+    /// its single-ray trace on the frame's threads, as it has no packets).
     pub frame_ms: f64,
+    /// Rays per second of the frame.
     pub mrays_per_s: f64,
+    /// The linear scan's trace time over this row's.
     pub speedup_over_linear: f64,
     /// Rays actually timed, when fewer than the frame's.
     pub sampled_rays: Option<usize>,
     pub fallback_splits: u32,
+}
+
+/// How the rows were measured (for the table's footer and the JSON).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct CompareSetup {
+    pub trace_threads: usize,
+    pub frame_threads: usize,
+    /// Rays that enter the root box (the same for every strategy: they share the root box).
+    pub root_rays: u64,
+    pub rays: u64,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -71,82 +101,109 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-/// Time the linear scan: on the whole frame if that is cheap enough, else on a spread sample.
-fn time_linear(mesh: &Mesh, camera: &Camera, trace: TraceOptions, budget: Duration) -> (f64, Option<usize>) {
-    let linear = LinearScan::new(mesh);
+/// Trace `n` of the camera's pixels (evenly spread; all of them when `n` is the pixel count) one
+/// ray at a time, closest hit only, on the current thread pool: the work of a renderer's
+/// intersection loop and nothing else.
+fn trace_rays<A: Accelerator>(accel: &A, camera: &Camera, trace: TraceOptions, n: usize) -> Duration {
     let gen = camera.ray_gen();
     let total = camera.width as usize * camera.height as usize;
-    let time_sample = |n: usize| {
-        let start = Instant::now();
-        (0..n).into_par_iter().for_each(|i| {
-            let p = (i * total / n) as u32;
-            let mut ray = gen.pixel_ray(p % camera.width, p / camera.width);
-            std::hint::black_box(linear.closest_hit(&mut ray, trace, &mut NoStats));
-        });
-        start.elapsed()
-    };
+    let start = Instant::now();
+    (0..n).into_par_iter().with_min_len(256).for_each(|i| {
+        let p = (i * total / n) as u32;
+        let mut ray = gen.pixel_ray(p % camera.width, p / camera.width);
+        std::hint::black_box(accel.closest_hit(&mut ray, trace, &mut NoStats));
+    });
+    start.elapsed()
+}
+
+/// Time the linear scan's trace: on the whole frame if that is cheap enough, else on a spread
+/// sample, scaled to the frame. Returns (ms, rays timed if sampled).
+fn time_linear(linear: &LinearScan, camera: &Camera, trace: TraceOptions, budget: Duration) -> (f64, Option<usize>) {
+    let total = camera.width as usize * camera.height as usize;
     let probe = 256.min(total);
-    let t = time_sample(probe);
+    let t = trace_rays(linear, camera, trace, probe);
     let projected = t.as_secs_f64() * total as f64 / probe as f64;
     if projected <= budget.as_secs_f64() {
-        return (ms(time_sample(total)), None);
+        return (ms(trace_rays(linear, camera, trace, total)), None);
     }
     // About a fifth of the budget on the sample.
     let n = ((budget.as_secs_f64() / 5.0 / t.as_secs_f64().max(1e-9)) * probe as f64) as usize;
     let n = n.clamp(probe, total);
-    let t = time_sample(n);
+    let t = trace_rays(linear, camera, trace, n);
     (ms(t) * total as f64 / n as f64, Some(n))
 }
 
 /// Builds of one strategy stop once they have taken this long in all (at least one is made).
 const BUILD_BUDGET_MS: f64 = 1000.0;
 
-/// Build and measure every strategy and the linear scan.
+/// A thread pool of `n` threads (`None`: rayon's default, one per core).
+fn pool(n: Option<u32>) -> rayon::ThreadPool {
+    let b = rayon::ThreadPoolBuilder::new();
+    let b = match n {
+        Some(n) => b.num_threads(n as usize),
+        None => b,
+    };
+    b.build().expect("a thread pool can be started")
+}
+
+/// Build and measure every strategy and the linear scan. Builds and frames run on `threads` (all
+/// cores when `None`), the single-ray trace timing on `threads` (one when `None`).
 pub fn compare_rows(
-    mesh: &Mesh,
+    mesh: &crate::mesh::Mesh,
     camera: &Camera,
     build: &BuildArgs,
+    scene: Option<&BuildParams>,
     runs: u32,
+    threads: Option<u32>,
     linear_budget: Duration,
-) -> Vec<CompareRow> {
+) -> (Vec<CompareRow>, CompareSetup) {
+    let (frames, traces) = (pool(threads), pool(Some(threads.unwrap_or(1))));
     let rays = camera.width as f64 * camera.height as f64;
-    let plain = RenderSettings { trace: build.trace(), count: false, progressive: false };
+    let trace = build.trace();
+    let plain = RenderSettings { trace, count: false, progressive: false };
     let counting = RenderSettings { count: true, ..plain };
     let mut rows = Vec::new();
-    let layouts: Vec<Layout> = match build.layout {
-        Some(l) => vec![l],
-        None => Layout::ALL.to_vec(),
-    };
+    let mut root_rays = 0;
+    let layouts = build.compare_layouts();
     for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))) {
-        let params = build.params_with(strategy, layout);
+        let params = build.params_with(scene, strategy, layout);
         let name = format!("{} ({})", strategy.label(), layout.short_name());
         let (bvh, build_ms) = progress::with_spinner(&format!("building {name}"), || {
-            let build_ms = |bvh: &AnyBvh| ms(bvh.report().total_time());
-            let mut bvh = AnyBvh::build(mesh, &params);
-            let mut times = vec![build_ms(&bvh)];
-            // Past the budget, one more build when the count is even: the median of two would be
-            // the slower, often the first, cold one.
-            while times.len() < runs as usize
-                && (times.iter().sum::<f64>() < BUILD_BUDGET_MS || times.len().is_multiple_of(2))
-            {
-                bvh = AnyBvh::build(mesh, &params);
-                times.push(build_ms(&bvh));
-            }
-            (bvh, median(times))
+            frames.install(|| {
+                let build_ms = |bvh: &AnyBvh| ms(bvh.report().total_time());
+                let mut bvh = AnyBvh::build(mesh, &params);
+                let mut times = vec![build_ms(&bvh)];
+                // Past the budget, one more build when the count is even: the median of two would be
+                // the slower, often the first, cold one.
+                while times.len() < runs as usize
+                    && (times.iter().sum::<f64>() < BUILD_BUDGET_MS || times.len().is_multiple_of(2))
+                {
+                    bvh = AnyBvh::build(mesh, &params);
+                    times.push(build_ms(&bvh));
+                }
+                (bvh, median(times))
+            })
         });
-        let (stats, summary, times) = progress::with_spinner(&format!("tracing {name}"), || {
+        let (stats, summary, frame_times, trace_times) = progress::with_spinner(&format!("tracing {name}"), || {
             let stats = TreeStats::of(&bvh);
-            let summary = render(&bvh, mesh, camera, &counting).ray_summary();
-            let times: Vec<f64> = (0..runs)
-                .map(|_| {
-                    let t = Instant::now();
-                    std::hint::black_box(render(&bvh, mesh, camera, &plain));
-                    ms(t.elapsed())
-                })
-                .collect();
-            (stats, summary, times)
+            let (summary, frame_times) = frames.install(|| {
+                let summary = render(&bvh, mesh, camera, &counting).ray_summary();
+                let times: Vec<f64> = (0..runs)
+                    .map(|_| {
+                        let t = Instant::now();
+                        std::hint::black_box(render(&bvh, mesh, camera, &plain));
+                        ms(t.elapsed())
+                    })
+                    .collect();
+                (summary, times)
+            });
+            let total = rays as usize;
+            let trace_times: Vec<f64> =
+                traces.install(|| (0..runs).map(|_| ms(trace_rays(&bvh, camera, trace, total))).collect());
+            (stats, summary, frame_times, trace_times)
         });
-        let frame_ms = median(times);
+        root_rays = summary.root_rays;
+        let frame_ms = median(frame_times);
         rows.push(CompareRow {
             name,
             build_ms: Some(build_ms),
@@ -156,6 +213,9 @@ pub fn compare_rows(
             sah_cost: Some(stats.sah_cost),
             nodes_per_ray: summary.mean_nodes_visited,
             tri_tests_per_ray: summary.mean_triangle_tests,
+            root_nodes_per_ray: summary.root_mean_nodes_visited,
+            root_tri_tests_per_ray: summary.root_mean_triangle_tests,
+            trace_ms: median(trace_times),
             frame_ms,
             mrays_per_s: rays / frame_ms / 1e3,
             speedup_over_linear: 0.0,
@@ -163,8 +223,13 @@ pub fn compare_rows(
             fallback_splits: stats.fallback_splits,
         });
     }
-    let (linear_ms, sampled) =
-        progress::with_spinner("timing the linear scan", || time_linear(mesh, camera, build.trace(), linear_budget));
+    let linear = LinearScan::new(mesh);
+    let ((linear_ms, sampled), (frame_ms, _)) = progress::with_spinner("timing the linear scan", || {
+        // The scan has no packets: its "frame" is its trace on the frame's threads.
+        let trace_ms = traces.install(|| time_linear(&linear, camera, trace, linear_budget));
+        (trace_ms, frames.install(|| time_linear(&linear, camera, trace, linear_budget)))
+    });
+    let n = mesh.triangle_count() as f64;
     rows.push(CompareRow {
         name: "Linear scan".to_string(),
         build_ms: None,
@@ -173,92 +238,134 @@ pub fn compare_rows(
         mean_leaf_depth: 0.0,
         sah_cost: None,
         nodes_per_ray: 0.0,
-        tri_tests_per_ray: mesh.triangle_count() as f64,
-        frame_ms: linear_ms,
-        mrays_per_s: rays / linear_ms / 1e3,
+        tri_tests_per_ray: n,
+        root_nodes_per_ray: 0.0,
+        root_tri_tests_per_ray: n,
+        trace_ms: linear_ms,
+        frame_ms,
+        mrays_per_s: rays / frame_ms / 1e3,
         speedup_over_linear: 1.0,
         sampled_rays: sampled,
         fallback_splits: 0,
     });
     for r in &mut rows {
-        r.speedup_over_linear = linear_ms / r.frame_ms;
+        r.speedup_over_linear = linear_ms / r.trace_ms;
     }
-    rows
+    let setup = CompareSetup {
+        trace_threads: traces.current_num_threads(),
+        frame_threads: frames.current_num_threads(),
+        root_rays,
+        rays: rays as u64,
+    };
+    (rows, setup)
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {
-    v.map_or("—".to_string(), |v| format!("{v:.digits$}"))
+    v.map_or(String::new(), |v| format!("{v:.digits$}"))
+}
+
+/// The rows as CSV (RFC 4180, by the `csv` crate): one header, one record per row; values not
+/// measured (a linear scan's build time) are empty fields.
+pub fn rows_csv(rows: &[CompareRow]) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let header = [
+        "strategy",
+        "build_ms",
+        "nodes",
+        "max_depth",
+        "mean_leaf_depth",
+        "sah_cost",
+        "nodes_per_ray",
+        "tri_tests_per_ray",
+        "root_box_nodes_per_ray",
+        "root_box_tri_tests_per_ray",
+        "trace_ms",
+        "frame_ms",
+        "mrays_per_s",
+        "speedup_over_linear",
+        "sampled_rays",
+    ];
+    let mut records = vec![header.map(String::from).to_vec()];
+    for r in rows {
+        records.push(vec![
+            r.name.clone(),
+            opt(r.build_ms, 2),
+            r.nodes.to_string(),
+            r.max_depth.to_string(),
+            format!("{:.2}", r.mean_leaf_depth),
+            opt(r.sah_cost, 3),
+            format!("{:.3}", r.nodes_per_ray),
+            format!("{:.3}", r.tri_tests_per_ray),
+            format!("{:.3}", r.root_nodes_per_ray),
+            format!("{:.3}", r.root_tri_tests_per_ray),
+            format!("{:.2}", r.trace_ms),
+            format!("{:.2}", r.frame_ms),
+            format!("{:.3}", r.mrays_per_s),
+            format!("{:.1}", r.speedup_over_linear),
+            r.sampled_rays.map_or(String::new(), |n| n.to_string()),
+        ]);
+    }
+    for rec in records {
+        w.write_record(&rec).expect("writing CSV to memory");
+    }
+    String::from_utf8(w.into_inner().expect("writing CSV to memory")).expect("CSV of UTF-8 fields")
 }
 
 pub fn run(a: &CompareArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
-    let mesh = loaded.mesh;
+    let mesh = &loaded.mesh;
     let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
-    let rows = compare_rows(&mesh, &camera, &a.build, a.runs, Duration::from_secs(10));
-    let rays = camera.width as usize * camera.height as usize;
-    let threads = rayon::current_num_threads();
+    let scene = loaded.build.as_ref();
+    let (rows, setup) = compare_rows(mesh, &camera, &a.build, scene, a.runs, a.threads, Duration::from_secs(10));
+    let rays = setup.rays;
+    let trace = a.build.trace();
     let mut o = String::new();
     match a.format {
         CompareFormat::Json => {
             let v = serde_json::json!({
                 "mesh": a.mesh, "triangles": mesh.triangle_count(), "width": camera.width, "height": camera.height,
-                "threads": threads, "trace": a.build.trace(), "rows": rows,
+                "setup": setup, "trace": trace, "preset": a.build.preset, "rows": rows,
             });
             let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
-        CompareFormat::Csv => {
-            let _ = writeln!(o, "strategy,build_ms,nodes,max_depth,mean_leaf_depth,sah_cost,nodes_per_ray,tri_tests_per_ray,frame_ms,mrays_per_s,speedup_over_linear,sampled_rays");
-            for r in &rows {
-                let _ = writeln!(
-                    o,
-                    "{},{},{},{},{:.2},{},{:.2},{:.2},{:.2},{:.3},{:.1},{}",
-                    r.name,
-                    opt(r.build_ms, 2),
-                    r.nodes,
-                    r.max_depth,
-                    r.mean_leaf_depth,
-                    opt(r.sah_cost, 3),
-                    r.nodes_per_ray,
-                    r.tri_tests_per_ray,
-                    r.frame_ms,
-                    r.mrays_per_s,
-                    r.speedup_over_linear,
-                    r.sampled_rays.map_or(String::new(), |n| n.to_string())
-                );
-            }
-        }
+        CompareFormat::Csv => o = rows_csv(&rows),
         CompareFormat::Markdown => {
-            let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | nodes / ray | tri tests / ray | frame ms | MRays/s | speedup vs linear |");
+            let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | nodes / ray: all / in root box | tri tests / ray: all / in root box | trace ms | frame ms | speedup vs linear |");
             let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
             for r in &rows {
                 let depth =
                     if r.nodes > 0 { format!("{} / {:.1}", r.max_depth, r.mean_leaf_depth) } else { "—".into() };
-                let frame = if r.sampled_rays.is_some() {
-                    format!("{:.0} *", r.frame_ms)
-                } else {
-                    format!("{:.1}", r.frame_ms)
-                };
+                let sampled = if r.sampled_rays.is_some() { " *" } else { "" };
+                let dash = |v: Option<f64>, d: usize| v.map_or("—".to_string(), |v| format!("{v:.d$}"));
                 let _ = writeln!(
                     o,
-                    "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {} | {:.2} | {:.0}× |",
+                    "| {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1}{sampled} | {:.1}{sampled} | {:.0}× |",
                     r.name,
-                    opt(r.build_ms, 1),
+                    dash(r.build_ms, 1),
                     r.nodes,
                     depth,
-                    opt(r.sah_cost, 2),
+                    dash(r.sah_cost, 2),
                     r.nodes_per_ray,
+                    r.root_nodes_per_ray,
                     r.tri_tests_per_ray,
-                    frame,
-                    r.mrays_per_s,
+                    r.root_tri_tests_per_ray,
+                    r.trace_ms,
+                    r.frame_ms,
                     r.speedup_over_linear
                 );
             }
             let _ = writeln!(o);
+            let preset = a.build.preset.map_or(String::new(), |p| format!("preset {}; ", p.short_name()));
             let _ = writeln!(
                 o,
-                "{}: {} triangles; {}x{} primary rays ({} rays), {} threads; traversal {}, {} test; frame ms = median of {} frames; build ms = median of up to {} builds.",
-                a.mesh.display(), mesh.triangle_count(), camera.width, camera.height, rays, threads,
-                a.build.order.label(), a.build.test.label(), a.runs, a.runs
+                "{}: {} triangles; {}x{} primary rays ({} rays, {} = {:.0}% enter the root box); {preset}traversal {}, {} test.",
+                a.mesh.display(), mesh.triangle_count(), camera.width, camera.height, rays, setup.root_rays,
+                100.0 * setup.root_rays as f64 / rays.max(1) as f64, trace.order.label(), trace.test.label()
+            );
+            let _ = writeln!(
+                o,
+                "trace ms: single rays, closest hit, no shading, {} thread(s); frame ms: the renderer (8×8 packets, shading) on {} thread(s); medians of {} frames; build ms: median of up to {} builds on {} thread(s); speedup: the linear scan's trace ms over the row's.",
+                setup.trace_threads, setup.frame_threads, a.runs, a.runs, setup.frame_threads
             );
             if let Some(n) = rows.last().and_then(|r| r.sampled_rays) {
                 let _ = writeln!(o, "* linear scan timed on {n} of {rays} rays (a full frame would take over 10 s) and scaled to the full frame.");
@@ -275,4 +382,46 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
     }
     print!("{o}");
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(name: &str, build_ms: Option<f64>) -> CompareRow {
+        CompareRow {
+            name: name.into(),
+            build_ms,
+            nodes: 7,
+            max_depth: 2,
+            mean_leaf_depth: 1.5,
+            sah_cost: build_ms.map(|_| 3.25),
+            nodes_per_ray: 1.0,
+            tri_tests_per_ray: 2.0,
+            root_nodes_per_ray: 4.0,
+            root_tri_tests_per_ray: 8.0,
+            trace_ms: 1.0,
+            frame_ms: 2.0,
+            mrays_per_s: 3.0,
+            speedup_over_linear: 4.0,
+            sampled_rays: None,
+            fallback_splits: 0,
+        }
+    }
+
+    #[test]
+    fn the_csv_has_as_many_fields_in_every_record_and_empty_ones_for_what_was_not_measured() {
+        let text = rows_csv(&[row("Equal count, binary \"quoted\"", Some(1.0)), row("Linear scan", None)]);
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let header = r.headers().unwrap().clone();
+        let records: Vec<csv::StringRecord> = r.records().map(|r| r.unwrap()).collect();
+        assert_eq!(records.len(), 2);
+        for rec in &records {
+            assert_eq!(rec.len(), header.len(), "{text}");
+        }
+        assert_eq!(&records[0][0], "Equal count, binary \"quoted\"");
+        let build = header.iter().position(|h| h == "build_ms").unwrap();
+        assert_eq!(&records[1][build], "", "the linear scan has no build");
+        assert_eq!(&records[0][header.iter().position(|h| h == "root_box_nodes_per_ray").unwrap()], "4.000");
+    }
 }

@@ -38,11 +38,16 @@ fn parse_range(s: &str) -> Result<(f32, f32), String> {
     }
 }
 
+/// The file name of a path, for captions.
+pub(crate) fn file_name(p: &std::path::Path) -> String {
+    p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
     let mesh = &loaded.mesh;
     let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
-    let params = a.build.params(a.build.strategy);
+    let params = a.build.params(loaded.build.as_ref());
     let bvh = build_scene(&loaded, &a.build.scene_build(params));
     let settings = RenderSettings { trace: a.build.trace(), count: a.view.is_heatmap(), progressive: false };
     let total = camera.width as u64 * camera.height as u64;
@@ -52,7 +57,10 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     })
     .map_err(|_| CliError::Usage("render cancelled".into()))?;
     let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
-    let (img, legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
+    let (img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
+    if let Some(l) = &mut legend {
+        l.subject = format!("{}, {}", file_name(&a.mesh), bvh.build_params().label());
+    }
     let img = match &legend {
         Some(l) => draw_legend(&img, l),
         None => img,

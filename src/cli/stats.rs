@@ -25,7 +25,7 @@ pub struct StatsArgs {
 
 pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
-    let params = a.build.params(a.build.strategy);
+    let params = a.build.params(loaded.build.as_ref());
     let bvh = build_scene(&loaded, &a.build.scene_build(params));
     let report = &loaded.report;
     match (&bvh, a.format) {

@@ -29,6 +29,58 @@ pub enum CameraError {
     BadSize(u32, u32),
 }
 
+/// Which world axis points up. Most formats (and the handout) are Y-up; CAD tools, Blender's own
+/// coordinates and many scans are Z-up, and a Z-up mesh framed as Y-up is seen from below.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum UpAxis {
+    #[default]
+    Y,
+    Z,
+}
+
+impl UpAxis {
+    pub const ALL: [UpAxis; 2] = [UpAxis::Y, UpAxis::Z];
+
+    pub fn vector(self) -> Vec3 {
+        match self {
+            UpAxis::Y => Vec3::Y,
+            UpAxis::Z => Vec3::Z,
+        }
+    }
+
+    pub fn short_name(self) -> &'static str {
+        match self {
+            UpAxis::Y => "y",
+            UpAxis::Z => "z",
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            UpAxis::Y => "Y up",
+            UpAxis::Z => "Z up",
+        }
+    }
+
+    /// A direction written in the Y-up convention (x right, y up, +z towards a viewer in front),
+    /// in world coordinates of this convention. Z-up: y up becomes z up, and the front (+z) is
+    /// -y, so a front view looks along +y, as in Blender's front view.
+    pub fn from_y_up(self, v: Vec3) -> Vec3 {
+        match self {
+            UpAxis::Y => v,
+            UpAxis::Z => Vec3::new(v.x, -v.z, v.y),
+        }
+    }
+
+    /// The inverse of `from_y_up`.
+    pub fn to_y_up(self, v: Vec3) -> Vec3 {
+        match self {
+            UpAxis::Y => v,
+            UpAxis::Z => Vec3::new(v.x, v.z, -v.y),
+        }
+    }
+}
+
 /// The camera's ray generator: a basis computed once per frame.
 #[derive(Clone, Copy, Debug)]
 pub struct RayGen {
@@ -115,21 +167,39 @@ impl Camera {
     /// A camera that shows all of `bounds` from a fixed oblique direction (front, right, above),
     /// with +y up and a 45° vertical field of view: the default view of the CLI and the app.
     pub fn framing(bounds: &Aabb, width: u32, height: u32) -> Camera {
-        Self::framing_from(bounds, width, height, Self::DEFAULT_VIEW_FROM, Self::DEFAULT_VFOV_DEG)
+        Self::framing_up(bounds, width, height, UpAxis::Y, Self::DEFAULT_VFOV_DEG)
+    }
+
+    /// The default view (front, right, above) of a mesh whose up axis is `up`.
+    pub fn framing_up(bounds: &Aabb, width: u32, height: u32, up: UpAxis, vfov_deg: f32) -> Camera {
+        Self::framing_from_up(bounds, width, height, up.from_y_up(Self::DEFAULT_VIEW_FROM), vfov_deg, up)
     }
 
     /// Like `framing`, looking along `-from` with the given vertical field of view: the closest
     /// camera distance at which all eight corners of the box lie inside 95% of the image (found by
     /// bisection).
     pub fn framing_from(bounds: &Aabb, width: u32, height: u32, from: Vec3, vfov_deg: f32) -> Camera {
+        Self::framing_from_up(bounds, width, height, from, vfov_deg, UpAxis::Y)
+    }
+
+    /// `framing_from` with `up` pointing up in the image.
+    pub fn framing_from_up(
+        bounds: &Aabb,
+        width: u32,
+        height: u32,
+        from: Vec3,
+        vfov_deg: f32,
+        up_axis: UpAxis,
+    ) -> Camera {
         let vfov_deg = if vfov_deg > 0.0 && vfov_deg < 180.0 { vfov_deg } else { Self::DEFAULT_VFOV_DEG };
         let (width, height) = (width.max(1), height.max(1));
         let b = if bounds.is_empty() { Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)) } else { *bounds };
         let center = b.center();
         let radius = (b.extent().length() * 0.5).max(1e-6);
-        let dir = from.try_normalize().unwrap_or(Vec3::Z);
+        let world_up = up_axis.vector();
+        let dir = from.try_normalize().unwrap_or(up_axis.from_y_up(Vec3::Z));
         let forward = -dir;
-        let right = forward.cross(Vec3::Y).try_normalize().unwrap_or(Vec3::X);
+        let right = forward.cross(world_up).try_normalize().unwrap_or(Vec3::X);
         let up = right.cross(forward);
         let tan_v = (vfov_deg.to_radians() * 0.5).tan() * 0.95;
         let tan_h = tan_v * width as f32 / height as f32;
@@ -156,7 +226,7 @@ impl Camera {
                 lo = mid;
             }
         }
-        Camera { position: center + dir * hi, look_at: center, up: Vec3::Y, vfov_deg, width, height }
+        Camera { position: center + dir * hi, look_at: center, up: world_up, vfov_deg, width, height }
     }
 }
 
@@ -213,6 +283,28 @@ mod tests {
                 widest = widest.max(sx).max(sy);
             }
             assert!(widest > 0.9, "the box fills the view at {fov}° ({widest})");
+        }
+    }
+
+    #[test]
+    fn a_z_up_box_is_framed_from_the_front_as_the_same_box_y_up() {
+        // The same box written Y-up and Z-up (y ↔ z, front flipped): the default cameras of the
+        // two see the same picture, each with its own axis up.
+        let y_up = Aabb::new(Vec3::new(-1.0, 0.0, -0.5), Vec3::new(3.0, 2.0, 0.5));
+        let z_up = Aabb::new(UpAxis::Z.from_y_up(y_up.min), UpAxis::Z.from_y_up(y_up.max));
+        let z_up = Aabb::new(z_up.min.min(z_up.max), z_up.min.max(z_up.max));
+        let a = Camera::framing_up(&y_up, 640, 480, UpAxis::Y, 45.0);
+        let b = Camera::framing_up(&z_up, 640, 480, UpAxis::Z, 45.0);
+        assert_eq!(a, Camera::framing(&y_up, 640, 480));
+        assert_eq!(b.up, Vec3::Z);
+        b.validate().unwrap();
+        let map = |v: Vec3| UpAxis::Z.to_y_up(v);
+        assert!((map(b.position) - a.position).length() < 1e-4, "{} vs {}", map(b.position), a.position);
+        assert!((map(b.look_at) - a.look_at).length() < 1e-5);
+        assert!(b.position.z > b.look_at.z, "seen from above, not from underneath");
+        assert!(b.position.y < b.look_at.y, "from the front (-y)");
+        for v in [Vec3::X, Vec3::new(0.3, -2.0, 5.0)] {
+            assert_eq!(UpAxis::Z.to_y_up(UpAxis::Z.from_y_up(v)), v);
         }
     }
 

@@ -9,11 +9,12 @@ const PAD: u32 = 8;
 const TEXT_SCALE: u32 = 2;
 const LINE: u32 = 8 * TEXT_SCALE;
 
-fn text_width(s: &str) -> u32 {
-    s.chars().count() as u32 * LINE
+/// Width of `s` drawn at `scale` (8 pixels per character per unit of scale).
+fn text_width(s: &str, scale: u32) -> u32 {
+    s.chars().count() as u32 * 8 * scale
 }
 
-fn draw_text(img: &mut RgbImage, x: u32, y: u32, s: &str, color: Rgb<u8>) {
+fn draw_text(img: &mut RgbImage, x: u32, y: u32, s: &str, color: Rgb<u8>, scale: u32) {
     for (i, ch) in s.chars().enumerate() {
         let glyph = font8x8::BASIC_FONTS.get(ch).or_else(|| font8x8::LATIN_FONTS.get(ch)).unwrap_or([0; 8]);
         for (row, bits) in glyph.iter().enumerate() {
@@ -21,10 +22,10 @@ fn draw_text(img: &mut RgbImage, x: u32, y: u32, s: &str, color: Rgb<u8>) {
                 if bits & (1 << col) == 0 {
                     continue;
                 }
-                for dy in 0..TEXT_SCALE {
-                    for dx in 0..TEXT_SCALE {
-                        let px = x + i as u32 * LINE + col * TEXT_SCALE + dx;
-                        let py = y + row as u32 * TEXT_SCALE + dy;
+                for dy in 0..scale {
+                    for dx in 0..scale {
+                        let px = x + (i as u32 * 8 + col) * scale + dx;
+                        let py = y + row as u32 * scale + dy;
                         if px < img.width() && py < img.height() {
                             img.put_pixel(px, py, color);
                         }
@@ -33,6 +34,13 @@ fn draw_text(img: &mut RgbImage, x: u32, y: u32, s: &str, color: Rgb<u8>) {
             }
         }
     }
+}
+
+/// A line of text in a `LINE`-high row: at the legend's scale when it fits in `width`, else at
+/// half that (an 8-pixel font), so a long mesh name in a small image stays whole.
+fn draw_line(img: &mut RgbImage, x: u32, y: u32, s: &str, color: Rgb<u8>, width: u32) {
+    let scale = if text_width(s, TEXT_SCALE) <= width { TEXT_SCALE } else { 1 };
+    draw_text(img, x, y + (LINE - 8 * scale) / 2, s, color, scale);
 }
 
 /// Format a legend number compactly: integers as integers, others with one decimal.
@@ -44,23 +52,35 @@ pub fn fmt_value(v: f64) -> String {
     }
 }
 
-/// The image with a legend strip appended below it.
+/// Height of the strip `draw_legend` appends for `legend`.
+pub fn legend_height(legend: &Legend) -> u32 {
+    let lines = if legend.subject.is_empty() { 3 } else { 4 };
+    PAD * (lines + 1) + LINE * lines
+}
+
+/// The image with a legend strip appended below it: the title, what the image is of (mesh,
+/// strategy, layout), the colour bar with its range, and the frame's min / mean / max.
 pub fn draw_legend(img: &RgbImage, legend: &Legend) -> RgbImage {
-    let strip = PAD * 4 + LINE * 3;
+    let strip = legend_height(legend);
     let (w, h) = (img.width().max(2 * PAD + 10 * LINE), img.height());
     let mut out = RgbImage::from_pixel(w, h + strip, Rgb([24, 24, 24]));
     image::imageops::replace(&mut out, img, 0, 0);
     let white = Rgb([235, 235, 235]);
-    let y0 = h + PAD;
-    draw_text(&mut out, PAD, y0, &legend.title, white);
+    let grey = Rgb([170, 170, 170]);
+    let mut y = h + PAD;
+    draw_line(&mut out, PAD, y, &legend.title, white, w - 2 * PAD);
+    if !legend.subject.is_empty() {
+        y += LINE + PAD;
+        draw_line(&mut out, PAD, y, &legend.subject, grey, w - 2 * PAD);
+    }
     // Colour bar between the two range labels.
     let lo = fmt_value(legend.range_min as f64);
     let hi = fmt_value(legend.range_max as f64);
-    let bar_y = y0 + LINE + PAD;
-    let bar_x0 = PAD + text_width(&lo) + PAD;
-    let bar_x1 = w.saturating_sub(PAD + text_width(&hi) + PAD).max(bar_x0 + 1);
-    draw_text(&mut out, PAD, bar_y, &lo, white);
-    draw_text(&mut out, bar_x1 + PAD, bar_y, &hi, white);
+    let bar_y = y + LINE + PAD;
+    let bar_x0 = PAD + text_width(&lo, TEXT_SCALE) + PAD;
+    let bar_x1 = w.saturating_sub(PAD + text_width(&hi, TEXT_SCALE) + PAD).max(bar_x0 + 1);
+    draw_text(&mut out, PAD, bar_y, &lo, white, TEXT_SCALE);
+    draw_text(&mut out, bar_x1 + PAD, bar_y, &hi, white, TEXT_SCALE);
     for x in bar_x0..bar_x1 {
         let c = legend.colormap.map((x - bar_x0) as f32 / (bar_x1 - bar_x0 - 1).max(1) as f32);
         for y in bar_y..bar_y + LINE {
@@ -73,6 +93,51 @@ pub fn draw_legend(img: &RgbImage, legend: &Legend) -> RgbImage {
         fmt_value(legend.mean),
         fmt_value(legend.max as f64)
     );
-    draw_text(&mut out, PAD, bar_y + LINE + PAD, &summary, white);
+    draw_line(&mut out, PAD, bar_y + LINE + PAD, &summary, white, w - 2 * PAD);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn legend(subject: &str) -> Legend {
+        Legend {
+            title: "nodes visited per ray".into(),
+            subject: subject.into(),
+            colormap: super::super::ColorMap::Viridis,
+            range_min: 0.0,
+            range_max: 60.0,
+            min: 1.0,
+            max: 59.0,
+            mean: 12.5,
+        }
+    }
+
+    /// Rows of the strip that have any light pixel (text or bar).
+    fn inked_rows(img: &RgbImage, from: u32) -> Vec<u32> {
+        (from..img.height()).filter(|&y| (0..img.width()).any(|x| img.get_pixel(x, y).0[0] > 100)).collect()
+    }
+
+    #[test]
+    fn the_strip_names_what_the_image_shows_on_a_line_of_its_own() {
+        let img = RgbImage::new(320, 40);
+        let plain = draw_legend(&img, &legend(""));
+        let named = draw_legend(&img, &legend("bunny.obj, SAH binned, binary"));
+        assert_eq!(named.height() - plain.height(), LINE + PAD, "one more line");
+        assert_eq!(named.height(), 40 + legend_height(&legend("x")));
+        // The subject line has ink between the title and the bar.
+        let title_end = 40 + PAD + LINE;
+        let subject_rows: Vec<u32> =
+            inked_rows(&named, title_end).into_iter().filter(|&y| y < title_end + PAD + LINE).collect();
+        assert!(!subject_rows.is_empty(), "the subject is drawn");
+        // A subject too long for the strip at the legend's scale is drawn at half size, whole.
+        let long = "a-very-long-mesh-name-from-a-scanning-lab.obj, SAH sweep, 4-wide SIMD";
+        assert!(text_width(long, TEXT_SCALE) > 600 - 2 * PAD && text_width(long, 1) <= 600 - 2 * PAD);
+        let small = draw_legend(&RgbImage::new(600, 10), &legend(long));
+        let last_col = (0..small.width())
+            .rev()
+            .find(|&x| (10 + PAD + LINE..10 + 2 * (PAD + LINE)).any(|y| small.get_pixel(x, y).0[0] > 100));
+        assert!(last_col.is_some_and(|x| x < 600 - PAD), "the long subject ends inside the strip: {last_col:?}");
+    }
 }

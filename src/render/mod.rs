@@ -9,9 +9,9 @@ pub mod legend;
 mod raycast;
 mod views;
 
-pub use camera::{Camera, CameraError};
+pub use camera::{Camera, CameraError, UpAxis};
 pub use colormap::ColorMap;
 pub use frame::{Frame, PixelSample, RaySummary};
-pub use legend::draw_legend;
+pub use legend::{draw_legend, legend_height};
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
 pub use views::{full_size, view_image, HeatRange, Legend, View};

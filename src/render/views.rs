@@ -101,6 +101,9 @@ pub enum HeatRange {
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Legend {
     pub title: String,
+    /// What the image is of: mesh, strategy, layout (set by whoever knows them; drawn into an
+    /// exported PNG's legend strip, so a file says what it shows). Empty when unknown.
+    pub subject: String,
     pub colormap: ColorMap,
     pub range_min: f32,
     pub range_max: f32,
@@ -175,7 +178,10 @@ pub fn view_image(
             let scale = if hi > lo { 1.0 / (hi - lo) } else { 0.0 };
             let img = grid_image(frame, |_, c| colormap.map((view.metric(&c, cost) - lo) * scale));
             let title = format!("{} per ray", view.label().to_lowercase());
-            (img, Some(Legend { title, colormap, range_min: lo, range_max: hi, min, max, mean }))
+            (
+                img,
+                Some(Legend { title, subject: String::new(), colormap, range_min: lo, range_max: hi, min, max, mean }),
+            )
         }
     }
 }

@@ -161,6 +161,60 @@ fn opening_a_broken_obj_shows_an_error_and_keeps_the_old_scene() {
     h.get_by_label(&nodes.to_string());
 }
 
+/// Type `text` as a keyboard does: per character a key press (when the character has a key),
+/// its text, and the key release, one frame each, with nothing focused by the test.
+fn type_keys(h: &mut Harness<'_, BvhscopeApp>, text: &str) {
+    for c in text.chars() {
+        let key = egui::Key::from_name(&c.to_uppercase().to_string());
+        if let Some(key) = key {
+            h.key_down(key);
+        }
+        h.event(egui::Event::Text(c.to_string()));
+        if let Some(key) = key {
+            h.key_up(key);
+        }
+        h.step();
+    }
+}
+
+#[test]
+fn a_typed_path_goes_into_the_field_and_fires_no_shortcut() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let settings = h.state().settings.clone();
+    let orbit = h.state().orbit;
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::L);
+    h.run_steps(2);
+    assert!(h.get_by_label("Path").is_focused(), "the field takes the keyboard when it opens");
+    // s: next strategy, r: reset camera, b: boxes, c: colour map, f: frame, 1..5: views, ]: depth.
+    let typed = "meshes/scrubbed-fbc-12345].obj";
+    type_keys(&mut h, typed);
+    assert_eq!(h.state().path_window.as_ref().map(|w| w.text.as_str()), Some(typed));
+    assert_eq!(h.state().settings, settings, "no setting changed while typing");
+    assert_eq!(h.state().orbit, orbit, "the camera did not move");
+    assert!(h.state().jobs.build.is_none(), "no build started");
+    h.key_press(egui::Key::Enter);
+    run_until(&mut h, "the error", |a| a.messages.iter().any(|m| m.kind == MessageKind::Error));
+    assert!(h.state().path_window.is_none(), "Enter opens the path");
+    h.get_by_label_contains("scrubbed-fbc-12345].obj");
+    // With the field gone, the same keys are shortcuts again.
+    h.key_press(egui::Key::B);
+    h.step();
+    assert!(h.state().settings.show_boxes);
+}
+
+#[test]
+fn escape_closes_the_path_window() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.state_mut().act(bvhscope::app::Action::OpenPath);
+    h.run_steps(2);
+    type_keys(&mut h, "x");
+    h.key_press(egui::Key::Escape);
+    h.run_steps(2);
+    assert!(h.state().path_window.is_none());
+}
+
 #[test]
 fn a_mesh_opened_by_typing_its_path_replaces_the_scene() {
     let mut h = harness();
@@ -169,8 +223,6 @@ fn a_mesh_opened_by_typing_its_path_replaces_the_scene() {
         temp_file("tent.obj", "v -1 0 -1\nv 1 0 -1\nv 0 1 0\nv -1 0 1\nv 1 0 1\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n");
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::L);
     h.run_steps(2);
-    h.get_by_label("Path").focus();
-    h.step();
     h.get_by_label("Path").type_text(tent.to_str().unwrap());
     h.run_steps(2);
     h.get_by_label("Open").click();
@@ -198,8 +250,12 @@ fn the_view_and_the_statistics_can_be_exported() {
     assert_eq!(img.width(), frame.width().max(176));
     assert!(img.height() > frame.height(), "the heatmap PNG carries its legend below the image");
     let text = std::fs::read_to_string(&csv).unwrap();
-    assert!(text.starts_with("which,strategy,triangles"), "{text}");
-    assert!(text.lines().nth(1).unwrap().starts_with("current,SAH binned,"), "{text}");
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let header = reader.headers().unwrap().clone();
+    assert_eq!(header.iter().take(3).collect::<Vec<_>>(), ["which", "strategy", "triangles"]);
+    let rec = reader.records().next().unwrap().unwrap();
+    assert_eq!(rec.len(), header.len());
+    assert_eq!((&rec[0], &rec[1]), ("current", "SAH binned, wide4"), "{text}");
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["strategies"][0]["tree"]["nodes"], h.state().current_bvh().unwrap().stats.nodes);
     assert_eq!(h.query_all_by_label_contains("Note: Saved").count(), 3, "each save is confirmed on screen");
@@ -280,7 +336,7 @@ fn a_scene_with_placements_builds_two_levels_shown_level_by_level() {
     h.get_by_label("Top-level nodes visited").click_accesskit();
     run_until(&mut h, "the top-level heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
     h.get_by_label_contains("Legend: top-level nodes visited per ray");
-    let rays = h.state().rays.expect("per-ray figures");
+    let rays = h.state().rays.expect("per-ray figures").summary;
     assert!(rays.mean_top_nodes_visited > 0.0 && rays.mean_instances_entered > 0.0);
 
     // Boxes (their controls are below the fold of the left panel, so accessibility actions click
@@ -367,4 +423,203 @@ fn a_coarse_pass_is_shown_in_place_at_its_resolution_snapshot() {
         .max_failed_pixels(4000)
         .output_path(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/snapshots"));
     h.snapshot_options("coarse_pass", &options);
+}
+
+#[test]
+fn the_viewport_keeps_its_width_when_the_figures_change() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let before = h.state().viewport_rect;
+    assert!(before.width() > 500.0, "{before:?}");
+    // A second strategy adds the "before" column and its figures to the statistics.
+    h.get_by_role_and_label(Role::ComboBox, "Split strategy").click();
+    h.run_steps(3);
+    h.get_by_label("Equal count").click();
+    run_until(&mut h, "the equal-count build", |a| a.previous.is_some() && idle(a));
+    h.get_by_label("before: SAH binned, wide4");
+    assert_eq!(h.state().viewport_rect, before, "the side panels did not widen");
+    // Two levels and back.
+    let scene = temp_file(
+        "width.json",
+        &format!(
+            r#"{{"note": "{}", "meshes": [{{"file": "{t}"}}, {{"file": "{t}", "transform": {{"translate": [3, 0, 0]}}}}]}}"#,
+            "a long note that goes on and on to be wider than any panel ".repeat(4),
+            t = temp_file("width-tent.obj", "v -1 0 -1\nv 1 0 -1\nv 0 1 0\nf 1 2 3\n").display()
+        ),
+    );
+    h.input_mut().dropped_files.push(Arc::new(Dropped(scene)));
+    let two = |a: &BvhscopeApp| a.current_bvh().is_some_and(|b| b.bvh.two_level().is_some());
+    run_until(&mut h, "the two-level build", |a| a.scene.report.triangles == 2 && two(a) && idle(a));
+    assert_eq!(h.state().viewport_rect, before);
+    h.get_by_label("Two levels: 2 placements of 1 meshes").click();
+    run_until(&mut h, "one level", |a| a.current_bvh().is_some_and(|b| b.bvh.two_level().is_none()) && idle(a));
+    assert_eq!(h.state().viewport_rect, before);
+}
+
+#[test]
+fn before_figures_from_another_camera_are_marked_stale() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.state_mut().settings.build.strategy = SplitStrategy::Midpoint;
+    run_until(&mut h, "the midpoint build", |a| a.previous.is_some() && a.rays.is_some() && idle(a));
+    assert!(h.query_by_label("stale").is_none(), "same camera: the figures compare");
+    // Orbit: the next frame's rays are others; the figures from before are not comparable.
+    h.state_mut().orbit.orbit(120.0, 0.0);
+    run_until(&mut h, "the new frame", |a| {
+        idle(a) && a.rays.is_some_and(|r| r.camera != a.previous.as_ref().unwrap().rays.unwrap().camera)
+    });
+    assert_eq!(h.query_all_by_label("stale").count(), 4, "every per-ray row of the before column");
+}
+
+#[test]
+fn a_long_scene_note_wraps_inside_the_viewport_and_can_be_dismissed() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/many-instances.json");
+    h.input_mut().dropped_files.push(Arc::new(Dropped(scene)));
+    run_until(&mut h, "the scene", |a| a.scene.instances.is_some() && idle(a));
+    let viewport = h.state().viewport_rect;
+    let note = h.get_by_label_contains("Note: many-instances.json: 144 placements").rect();
+    assert!(viewport.contains_rect(note), "the note {note:?} inside the viewport {viewport:?}");
+    assert!(note.height() > 30.0, "it wraps over several lines");
+    // "Opened …" and the note, each with its own button, all on screen; the note's is the last.
+    let buttons: Vec<_> = h.query_all_by_label("Dismiss").collect();
+    assert_eq!(buttons.len(), 2);
+    for b in &buttons {
+        assert!(viewport.contains_rect(b.rect()), "Dismiss {:?} on screen", b.rect());
+    }
+    assert!(buttons[1].rect().min.y > note.max.y - 1.0, "below its note");
+    buttons[1].click();
+    h.run_steps(2);
+    assert!(h.query_by_label_contains("Note: many-instances.json").is_none());
+}
+
+#[test]
+fn two_level_figures_show_the_whole_build_time_and_one_placement_shows_the_mesh() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/many-instances.json");
+    h.input_mut().dropped_files.push(Arc::new(Dropped(scene)));
+    let two = |a: &BvhscopeApp| a.current_bvh().is_some_and(|b| b.bvh.two_level().is_some());
+    run_until(&mut h, "the two-level build", |a| two(a) && idle(a));
+    assert!(h.state().settings.two_level, "a mesh placed 144 times starts as two levels");
+    let (total, meshes, top) = {
+        let b = h.state().current_bvh().unwrap();
+        let t = b.bvh.two_level().unwrap();
+        (b.bvh.build_time(), t.bottom_time, t.top_time)
+    };
+    assert_eq!(total, meshes + top);
+    let figures = h.state().current_figures().unwrap();
+    assert_eq!(figures.build_ms, total.as_secs_f64() * 1e3);
+    assert!(figures.build_ms > 0.0);
+    h.get_by_label(&bvhscope::app::fmt_ms(figures.build_ms));
+
+    // A scene that places its one mesh once opens in one level; two levels describe the mesh.
+    let one = temp_file(
+        "one-placement.json",
+        &format!(
+            r#"{{"meshes": [{{"file": "{}"}}]}}"#,
+            temp_file("one-tent.obj", "v -1 0 -1\nv 1 0 -1\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n").display()
+        ),
+    );
+    h.input_mut().dropped_files.push(Arc::new(Dropped(one)));
+    run_until(&mut h, "the one-placement scene", |a| {
+        a.scene.report.triangles == 2 && a.current_bvh().is_some() && idle(a)
+    });
+    assert!(!h.state().settings.two_level, "one placement: one level, as the handout builds it");
+    h.get_by_label("Two levels: 1 placements of 1 meshes").click();
+    run_until(&mut h, "two levels", |a| two(a) && idle(a));
+    let b = h.state().current_bvh().unwrap();
+    assert!(b.rows_are_the_mesh());
+    assert_eq!(b.stats.triangles, 2, "the rows count the mesh's triangles, not one placement");
+    h.get_by_label_contains("the rows above describe the mesh's BVH");
+}
+
+#[test]
+fn the_help_window_names_keys_by_their_symbols() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.key_press(egui::Key::F1);
+    h.run_steps(2);
+    h.get_by_label("]");
+    h.get_by_label("[");
+    assert!(h.query_by_label_contains("Bracket").is_none());
+}
+
+#[test]
+fn a_fixed_range_stays_with_its_view_and_a_new_mesh_clears_it() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.get_by_label("Nodes visited").click();
+    run_until(&mut h, "the heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+    h.get_by_label("Fix the current range").click();
+    h.run_steps(2);
+    let view = bvhscope::render::View::Visits;
+    let fixed = *h.state().settings.fixed_ranges.get(&view).expect("fixed for nodes visited");
+    h.get_by_label("Combined cost").click();
+    run_until(&mut h, "the cost heatmap", |a| {
+        idle(a) && a.shown.as_ref().is_some_and(|s| s.style.view == bvhscope::render::View::Cost)
+    });
+    assert_eq!(h.state().settings.heat_range(), bvhscope::render::HeatRange::Auto, "another view, its own range");
+    let legend = h.state().shown.as_ref().unwrap().legend.clone().unwrap();
+    assert_eq!(
+        (legend.range_min, legend.range_max),
+        (legend.min, legend.max),
+        "not saturated by the other view's scale"
+    );
+    h.get_by_label("Nodes visited").click();
+    h.run_steps(2);
+    assert_eq!(h.state().settings.heat_range(), bvhscope::render::HeatRange::Fixed { min: fixed.0, max: fixed.1 });
+    let tent = temp_file("range-tent.obj", "v -1 0 -1\nv 1 0 -1\nv 0 1 0\nf 1 2 3\n");
+    h.input_mut().dropped_files.push(Arc::new(Dropped(tent)));
+    run_until(&mut h, "the tent", |a| a.scene.report.triangles == 1 && idle(a));
+    assert!(h.state().settings.fixed_ranges.is_empty(), "a new mesh starts on its own scale");
+}
+
+#[test]
+fn the_exported_png_names_the_mesh_the_strategy_and_the_view() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.get_by_label("Nodes visited").click();
+    run_until(&mut h, "the heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+    let png = temp_file("named.png", "");
+    h.state_mut().picked(bvhscope::app::Pick::SavePng, png.clone());
+    let img = image::open(&png).unwrap().to_rgb8();
+    let frame = h.state().shown.as_ref().unwrap().frame.clone();
+    let mut legend = h.state().shown.as_ref().unwrap().legend.clone().unwrap();
+    legend.subject = format!("{}, SAH binned, wide4", h.state().scene.title());
+    assert_eq!(img.height(), frame.height() + bvhscope::render::legend_height(&legend), "a line for the subject");
+    // The same strip drawn here from the expected words matches the file's, pixel for pixel.
+    let base = image::RgbImage::from_fn(frame.width(), frame.height(), |x, y| *img.get_pixel(x, y));
+    assert!(bvhscope::render::draw_legend(&base, &legend) == img, "the strip says what the image shows");
+}
+
+#[test]
+fn handout_mode_is_one_click() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.get_by_label("Handout mode").click();
+    run_until(&mut h, "the handout build", |a| {
+        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint) && idle(a)
+    });
+    let s = &h.state().settings;
+    assert!(s.is_preset(bvhscope::bvh::Preset::Handout));
+    assert_eq!(s.build.layout, bvhscope::bvh::Layout::Binary);
+    assert_eq!(s.trace, bvhscope::bvh::Preset::Handout.trace());
+    h.get_by_label("Handout mode (on)");
+    h.get_by_label("Midpoint, binary");
+}
+
+#[test]
+fn a_z_up_mesh_is_seen_from_the_front() {
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.get_by_label("Z up").click();
+    h.run_steps(2);
+    let cam = h.state().orbit.camera(800, 600);
+    assert_eq!(cam.up, glam::Vec3::Z);
+    assert!(cam.position.z > cam.look_at.z && cam.position.y < cam.look_at.y, "front (-y), above (+z): {cam:?}");
+    run_until(&mut h, "a frame from the new camera", |a| {
+        idle(a) && a.shown.as_ref().is_some_and(|s| s.camera.up == glam::Vec3::Z)
+    });
 }

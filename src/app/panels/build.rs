@@ -2,11 +2,26 @@
 //! rebuilds (or re-renders) in the background.
 
 use crate::app::BvhscopeApp;
-use crate::bvh::{Layout, SplitStrategy, TraversalOrder};
+use crate::bvh::{Layout, Preset, SplitStrategy, TraversalOrder};
 use crate::geometry::TriangleTest;
 
 pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("Build");
+    for preset in Preset::ALL {
+        let on = app.settings.is_preset(preset);
+        let text = if on { format!("{} (on)", preset.label()) } else { preset.label().to_string() };
+        if ui
+            .add_enabled(!on, egui::Button::new(text))
+            .on_hover_text(format!(
+                "One click to {}: the BVH a student writes in the lab, so the figures compare with yours",
+                preset.description()
+            ))
+            .on_disabled_hover_text(format!("These are the settings of {}", preset.description()))
+            .clicked()
+        {
+            app.apply_preset(preset);
+        }
+    }
     let has_instances = app.has_instances();
     let placements = app.scene.instances.as_ref().map_or(0, |i| i.placements.len());
     let meshes = app.scene.instances.as_ref().map_or(0, |i| i.meshes.len());
@@ -27,7 +42,8 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
                     .response
                     .labelled_by(label.id);
             });
-            ui.add(egui::Slider::new(&mut s.top_build.max_leaf_size, 1..=16).text("Placements per leaf"));
+            ui.add(egui::Slider::new(&mut s.top_build.max_leaf_size, 1..=16).text("Placements per leaf"))
+                .on_hover_text("Most placements in a leaf of the top level");
             ui.label("Bottom level (each mesh's BVH)");
         }
     }

@@ -1,11 +1,11 @@
 //! The menu bar: File (open, recent, built-in scene, export), View, Help.
 
-use crate::app::shortcuts::{Action, SHORTCUTS};
+use crate::app::shortcuts::{shortcut_text as format_shortcut, Action, SHORTCUTS};
 use crate::app::{BvhscopeApp, PathWindow, Pick};
 use crate::render::View;
 
 fn shortcut_text(ctx: &egui::Context, action: Action) -> String {
-    SHORTCUTS.iter().find(|(_, a, _)| *a == action).map_or(String::new(), |(s, _, _)| ctx.format_shortcut(s))
+    SHORTCUTS.iter().find(|(_, a, _)| *a == action).map_or(String::new(), |(s, _, _)| format_shortcut(ctx, s))
 }
 
 fn item(ui: &mut egui::Ui, text: &str, action: Action) -> bool {
@@ -55,11 +55,8 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
                 app.jobs.pick_file(Pick::SaveScene, &name);
             }
             if ui.button("Save to a typed path…").clicked() {
-                app.path_window = Some(PathWindow {
-                    pick: Pick::SavePng,
-                    text: crate::app::export::default_name(app, "png"),
-                    note: None,
-                });
+                let name = crate::app::export::default_name(app, "png");
+                app.path_window = Some(PathWindow::new(Pick::SavePng, name, None));
             }
             ui.separator();
             if ui.button("Quit").clicked() {

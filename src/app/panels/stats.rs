@@ -1,38 +1,117 @@
 //! The statistics panel: the current strategy's tree and per-ray figures, next to the strategy
-//! shown before it, and the leaf-size histogram.
+//! shown before it, and the leaf-size histogram. Every row says what it counts in its tooltip.
 
 use crate::app::{BuiltBvh, BvhscopeApp, StrategyFigures};
-use crate::bvh::TreeView;
+use crate::bvh::{SahCost, TreeView};
 use crate::render::RaySummary;
 use egui_plot::{Bar, BarChart, Plot};
 
-type Row = (&'static str, fn(&StrategyFigures) -> String);
+/// A row: its name, what it means (tooltip), and its value for a strategy (`None`: not measured
+/// yet). Per-ray rows are marked, because they depend on the camera as well as on the tree.
+struct Row {
+    name: &'static str,
+    tip: &'static str,
+    per_ray: bool,
+    value: fn(&StrategyFigures) -> Option<String>,
+}
+
+/// Build times under 10 ms with two decimals, so a fast build does not read as 0.0.
+pub fn fmt_ms(ms: f64) -> String {
+    if ms < 10.0 {
+        format!("{ms:.2}")
+    } else {
+        format!("{ms:.1}")
+    }
+}
+
+fn rays(f: &StrategyFigures) -> Option<&RaySummary> {
+    f.rays.as_ref().map(|r| &r.summary)
+}
 
 const ROWS: &[Row] = &[
-    ("Build ms", |f| format!("{:.1}", f.stats.build_total_ms)),
-    ("Nodes", |f| f.stats.nodes.to_string()),
-    ("Leaves", |f| f.stats.leaves.to_string()),
-    ("Depth max / mean", |f| format!("{} / {:.1}", f.stats.max_depth, f.stats.mean_leaf_depth)),
-    ("SAH cost", |f| format!("{:.2}", f.stats.sah_cost)),
-    ("Bytes / triangle", |f| format!("{:.1}", f.stats.memory_bytes as f64 / f.stats.triangles.max(1) as f64)),
-    ("Fallback splits", |f| f.stats.fallback_splits.to_string()),
-    ("Nodes visited / ray", |f| {
-        f.rays.map_or("…".into(), |r| format!("{:.2} (max {})", r.mean_nodes_visited, r.max_nodes_visited))
-    }),
-    ("Box tests / ray", |f| f.rays.map_or("…".into(), |r| format!("{:.2}", r.mean_box_tests))),
-    ("Triangle tests / ray", |f| {
-        f.rays.map_or("…".into(), |r| format!("{:.2} (max {})", r.mean_triangle_tests, r.max_triangle_tests))
-    }),
+    Row {
+        name: "Build ms",
+        tip: "Time to build the BVH: every level (for two levels, the meshes' BVHs and the top level), with the tree laid out for traversal",
+        per_ray: false,
+        value: |f| Some(fmt_ms(f.build_ms)),
+    },
+    Row {
+        name: "Nodes",
+        tip: "Interior nodes and leaves (for the 4-wide layout: wide nodes and leaf slots)",
+        per_ray: false,
+        value: |f| Some(f.stats.nodes.to_string()),
+    },
+    Row { name: "Leaves", tip: "Nodes that hold triangles", per_ray: false, value: |f| Some(f.stats.leaves.to_string()) },
+    Row {
+        name: "Depth max / mean",
+        tip: "Levels from the root (depth 0) to the deepest leaf, and the mean over leaves, in levels of this layout",
+        per_ray: false,
+        value: |f| Some(format!("{} / {:.1}", f.stats.max_depth, f.stats.mean_leaf_depth)),
+    },
+    Row {
+        name: "SAH cost",
+        tip: "Surface area heuristic of the whole tree: Σ interior C_trav·A(node)/A(root) + Σ leaves C_isect·N·A(leaf)/A(root). The expected traversal steps plus triangle tests of a random ray through the root box (constants below)",
+        per_ray: false,
+        value: |f| Some(format!("{:.2}", f.stats.sah_cost)),
+    },
+    Row {
+        name: "Bytes / triangle",
+        tip: "Memory of the nodes and the triangle index array, per triangle",
+        per_ray: false,
+        value: |f| Some(format!("{:.1}", f.stats.memory_bytes as f64 / f.stats.triangles.max(1) as f64)),
+    },
+    Row {
+        name: "Fallback splits",
+        tip: "Nodes where the strategy found no useful split (midpoint with an empty side, SAH with coincident centroids) and an equal-count split was used",
+        per_ray: false,
+        value: |f| Some(f.stats.fallback_splits.to_string()),
+    },
+    Row {
+        name: "Rays in root box",
+        tip: "Share of the frame's primary rays that enter the root box; the others cost one box test and visit nothing",
+        per_ray: true,
+        value: |f| rays(f).map(|r| format!("{:.1} % of {}", 100.0 * r.root_fraction(), r.rays)),
+    },
+    Row {
+        name: "Nodes visited / ray",
+        tip: "Nodes taken from the stack and processed (interior and leaf), per ray that enters the root box; in brackets the mean over all rays and the most of any ray",
+        per_ray: true,
+        value: |f| {
+            rays(f).map(|r| {
+                format!("{:.2} (all {:.2}, max {})", r.root_mean_nodes_visited, r.mean_nodes_visited, r.max_nodes_visited)
+            })
+        },
+    },
+    Row {
+        name: "Box tests / ray",
+        tip: "Ray–box slab tests per ray that enters the root box (the root's own test included; a wide node tests each valid child); in brackets over all rays",
+        per_ray: true,
+        value: |f| rays(f).map(|r| format!("{:.2} (all {:.2})", r.root_mean_box_tests, r.mean_box_tests)),
+    },
+    Row {
+        name: "Triangle tests / ray",
+        tip: "Ray–triangle tests per ray that enters the root box; in brackets the mean over all rays and the most of any ray",
+        per_ray: true,
+        value: |f| {
+            rays(f).map(|r| {
+                format!("{:.2} (all {:.2}, max {})", r.root_mean_triangle_tests, r.mean_triangle_tests, r.max_triangle_tests)
+            })
+        },
+    },
 ];
 
-/// The two levels: the tree rows above are the top level's; here each mesh's BVH, and the
-/// per-ray work split by level.
-fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<RaySummary>) {
+/// The two levels: each mesh's BVH, and the per-ray work split by level.
+fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<&RaySummary>) {
     let Some(t) = built.bvh.two_level() else { return };
     ui.add_space(6.0);
     ui.strong("Two levels");
-    ui.weak("The tree rows above describe the top level, whose leaves hold placements.");
-    egui::Grid::new("two-level").num_columns(2).striped(true).show(ui, |ui| {
+    if built.rows_are_the_mesh() {
+        ui.weak("One placement of one mesh: the rows above describe the mesh's BVH (the top level is a single node).");
+    } else {
+        ui.weak("The tree rows above describe the top level, whose leaves hold placements.");
+    }
+    let width = super::grid_column_width(ui, 2);
+    egui::Grid::new("two-level").num_columns(2).striped(true).max_col_width(width).show(ui, |ui| {
         ui.label("Placements / meshes");
         ui.label(format!("{} / {}", t.instances.len(), t.bottom.len()));
         ui.end_row();
@@ -43,26 +122,30 @@ fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<RaySummary>) {
             t.bottom.iter().map(|b| b.triangle_count()).sum::<usize>()
         ));
         ui.end_row();
-        ui.label("Build ms (meshes + top)");
-        ui.label(format!("{:.1} + {:.2}", t.bottom_time.as_secs_f64() * 1e3, t.top_time.as_secs_f64() * 1e3));
+        ui.label("Build ms (meshes + top)").on_hover_text(
+            "The meshes' BVHs (each built once) and the top level over the placements; their sum is the Build ms row",
+        );
+        ui.label(format!("{} + {}", fmt_ms(t.bottom_time.as_secs_f64() * 1e3), fmt_ms(t.top_time.as_secs_f64() * 1e3)));
         ui.end_row();
         ui.label("Memory, all levels");
         ui.label(format!("{:.1} KiB", t.memory_bytes() as f64 / 1024.0));
         ui.end_row();
         if let Some(r) = rays {
-            ui.label("Top-level nodes / ray");
+            ui.label("Top-level nodes / ray").on_hover_text("Nodes of the top level visited per ray (all rays)");
             ui.label(format!("{:.2}", r.mean_top_nodes_visited));
             ui.end_row();
-            ui.label("Bottom-level nodes / ray");
+            ui.label("Bottom-level nodes / ray").on_hover_text("Nodes of the meshes' BVHs visited per ray (all rays)");
             ui.label(format!("{:.2}", r.mean_nodes_visited - r.mean_top_nodes_visited));
             ui.end_row();
-            ui.label("Placements entered / ray");
+            ui.label("Placements entered / ray")
+                .on_hover_text("Placements whose mesh BVH the ray entered, moved into object space (all rays)");
             ui.label(format!("{:.2}", r.mean_instances_entered));
             ui.end_row();
         }
     });
     ui.label("Each mesh's BVH (built once)");
-    egui::Grid::new("bottom-level").num_columns(5).striped(true).show(ui, |ui| {
+    let width = super::grid_column_width(ui, 5);
+    egui::Grid::new("bottom-level").num_columns(5).striped(true).max_col_width(width).show(ui, |ui| {
         for h in ["Mesh", "Triangles", "Nodes", "Depth", "SAH cost"] {
             ui.strong(h);
         }
@@ -78,6 +161,15 @@ fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<RaySummary>) {
     });
 }
 
+/// What "combined cost" means with the constants in use (tooltips of the statistics and the
+/// heatmap views).
+pub fn combined_cost_text(c: SahCost) -> String {
+    format!(
+        "Combined cost = C_trav × nodes visited + C_isect × triangle tests, with C_trav = {} and C_isect = {} (the SAH constants of the build)",
+        c.traversal, c.intersection
+    )
+}
+
 pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("Statistics");
     if let Some(note) = app.scene.desc.as_ref().and_then(|d| d.note.as_ref()) {
@@ -90,14 +182,14 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         ui.label(r.triangles.to_string());
         ui.end_row();
         if r.degenerate_skipped > 0 {
-            ui.label("Degenerate skipped");
+            ui.label("Degenerate skipped").on_hover_text("Triangles of zero area, left out of the BVH");
             ui.label(r.degenerate_skipped.to_string());
             ui.end_row();
         }
         ui.label("Vertices");
         ui.label(r.vertices.to_string());
         ui.end_row();
-        ui.label("Groups");
+        ui.label("Groups").on_hover_text("Objects and groups (o / g lines) of the file");
         ui.label(r.groups.to_string());
         ui.end_row();
     });
@@ -110,31 +202,54 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         return;
     };
     let previous = app.previous.clone();
-    egui::Grid::new("bvh-stats").num_columns(3).striped(true).show(ui, |ui| {
+    let key = app.rays_key();
+    // "Before" per-ray figures count only when they come from the same rays as the current ones.
+    let comparable = |f: &StrategyFigures| match (&f.rays, &key) {
+        (Some(r), Some((camera, trace))) => r.comparable(camera, trace),
+        _ => false,
+    };
+    let width = super::grid_column_width(ui, 3);
+    egui::Grid::new("bvh-stats").num_columns(3).striped(true).max_col_width(width).show(ui, |ui| {
         ui.label("");
         ui.strong(&current.label);
         match &previous {
             Some(p) => ui.weak(format!("before: {}", p.label)),
             None => ui.weak("before: —"),
-        };
+        }
+        .on_hover_text("The strategy shown before this one, for comparison");
         ui.end_row();
-        for (name, value) in ROWS {
-            ui.label(*name);
-            ui.label(value(&current));
-            ui.weak(previous.as_ref().map_or(String::new(), value));
+        for row in ROWS {
+            ui.label(row.name).on_hover_text(row.tip);
+            ui.label((row.value)(&current).unwrap_or_else(|| "…".into()));
+            match &previous {
+                Some(p) if row.per_ray && !comparable(p) => {
+                    let was = (row.value)(p).unwrap_or_else(|| "not measured".into());
+                    ui.weak(egui::RichText::new("stale").italics()).on_hover_text(format!(
+                        "Measured with another camera, image size or traversal order (was {was}); not comparable with this frame"
+                    ));
+                }
+                Some(p) => {
+                    ui.weak((row.value)(p).unwrap_or_default());
+                }
+                None => {
+                    ui.label("");
+                }
+            }
             ui.end_row();
         }
     });
+    let c = current.stats.sah_constants;
     ui.weak(format!(
-        "Per-ray figures: all primary rays of the last full frame. SAH cost with C_trav = {}, C_isect = {}.",
-        current.stats.sah_constants.traversal, current.stats.sah_constants.intersection
-    ));
+        "Per-ray figures: the primary rays of the last full frame that enter the root box (all rays in brackets). SAH cost with C_trav = {}, C_isect = {}.",
+        c.traversal, c.intersection
+    ))
+    .on_hover_text(combined_cost_text(c));
     if let Some(built) = app.current_bvh().filter(|b| b.bvh.two_level().is_some()) {
-        two_level(ui, built, current.rays);
+        two_level(ui, built, rays(&current));
     }
 
     ui.add_space(6.0);
-    ui.label("Leaf sizes (triangles per leaf)");
+    ui.label("Leaf sizes (triangles per leaf)").on_hover_text("How many leaves hold each number of triangles");
     let bars: Vec<Bar> = current
         .stats
         .leaf_size_histogram

@@ -1,26 +1,44 @@
-//! The view panel: what the image shows, heatmap colours and range, and the node-box overlay.
+//! The view panel: what the image shows, heatmap colours and range, the up axis, and the node-box
+//! overlay.
 
 use crate::app::{BoxLevel, BvhscopeApp};
-use crate::render::{ColorMap, View};
+use crate::render::{ColorMap, UpAxis, View};
+
+/// What a view shows, for its tooltip; `cost` is the combined-cost text with the constants in use.
+fn view_tip(v: View, cost: &str) -> String {
+    match v {
+        View::Normals => {
+            "The surface normal as colour (n·0.5 + 0.5), as the handout's normal integrator draws it".into()
+        }
+        View::Depth => "Distance from the camera to the hit, near bright, far dim; misses black".into(),
+        View::Visits => {
+            "Heatmap of the nodes each primary ray visited (taken from the stack and processed, interior and leaf)"
+                .into()
+        }
+        View::TriTests => "Heatmap of the ray–triangle tests each primary ray made".into(),
+        View::Cost => format!("Heatmap of each ray's combined cost. {cost}"),
+        View::TopVisits => "Nodes of the top level (over the placements) visited per ray".into(),
+        View::BottomVisits => "Nodes of the meshes' own BVHs visited per ray".into(),
+        View::Instances => "Placements whose mesh BVH the ray entered (moved into object space)".into(),
+    }
+}
 
 pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("View");
     let max_depth = app.current_bvh().map_or(0, |b| b.bottom_max_depth());
     // The top level's depth, when two levels are built.
-    let top_depth = app.current_bvh().filter(|b| b.bvh.two_level().is_some()).map(|b| b.stats.max_depth);
+    let top_depth = app.current_bvh().and_then(|b| b.top_stats.as_ref()).map(|s| s.max_depth);
     let legend_range = app.shown.as_ref().and_then(|s| s.legend.as_ref()).map(|l| (l.range_min, l.range_max));
+    let cost = super::stats::combined_cost_text(app.settings.build.cost);
+    let mut up = app.settings.up_axis;
     let s = &mut app.settings;
     for v in View::ALL.into_iter().filter(|v| !v.is_per_level()) {
-        ui.radio_value(&mut s.view, v, v.label());
+        ui.radio_value(&mut s.view, v, v.label()).on_hover_text(view_tip(v, &cost));
     }
     if top_depth.is_some() {
         ui.label("Two-level work (Nodes visited counts both levels)");
         for v in View::ALL.into_iter().filter(|v| v.is_per_level()) {
-            ui.radio_value(&mut s.view, v, v.label()).on_hover_text(match v {
-                View::TopVisits => "Nodes of the top level (over the placements) visited per ray",
-                View::BottomVisits => "Nodes of the meshes' own BVHs visited per ray",
-                _ => "Placements whose mesh BVH the ray entered (moved into object space)",
-            });
+            ui.radio_value(&mut s.view, v, v.label()).on_hover_text(view_tip(v, &cost));
         }
     } else if s.view.is_per_level() {
         s.view = View::Visits; // a single BVH has no levels to tell apart
@@ -36,36 +54,58 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
                     }
                 })
                 .response
-                .labelled_by(label.id);
+                .labelled_by(label.id)
+                .on_hover_text("Perceptual colour maps: equal steps in value look like equal steps in colour");
         });
-        ui.checkbox(&mut s.auto_range, "Auto range (this frame's min..max)");
-        if !s.auto_range {
+        let view = s.view;
+        let mut auto = !s.fixed_ranges.contains_key(&view);
+        if ui
+            .checkbox(&mut auto, "Auto range (this frame's min..max)")
+            .on_hover_text("Off: a fixed range for this view, kept when the strategy changes so two strategies show in the same colours. Each view has its own; opening a scene clears them.")
+            .changed()
+        {
+            if auto {
+                s.fixed_ranges.remove(&view);
+            } else {
+                let (lo, hi) = legend_range.unwrap_or((0.0, 100.0));
+                s.fixed_ranges.insert(view, (lo, hi.max(lo + 1.0)));
+            }
+        }
+        if let Some(range) = s.fixed_ranges.get_mut(&view) {
             ui.horizontal(|ui| {
                 ui.label("Range");
-                ui.add(egui::DragValue::new(&mut s.fixed_range.0).speed(0.5).prefix("min "));
-                ui.add(egui::DragValue::new(&mut s.fixed_range.1).speed(0.5).prefix("max "));
+                ui.add(egui::DragValue::new(&mut range.0).speed(0.5).prefix("min "));
+                ui.add(egui::DragValue::new(&mut range.1).speed(0.5).prefix("max "));
             });
-            if s.fixed_range.1 <= s.fixed_range.0 {
-                s.fixed_range.1 = s.fixed_range.0 + 1.0;
+            if range.1 <= range.0 {
+                range.1 = range.0 + 1.0;
             }
         }
         if let Some((lo, hi)) = legend_range {
             if ui
                 .button("Fix the current range")
-                .on_hover_text("Keep this scale, to compare strategies on the same colours")
+                .on_hover_text("Keep this scale for this view, to compare strategies on the same colours")
                 .clicked()
             {
-                s.auto_range = false;
-                s.fixed_range = (lo, hi.max(lo + 1.0));
+                s.fixed_ranges.insert(view, (lo, hi.max(lo + 1.0)));
             }
         }
     });
     ui.checkbox(&mut s.progressive, "Progressive refinement")
         .on_hover_text("Coarse passes first (1/8, 1/4, 1/2, full)");
+    ui.horizontal(|ui| {
+        ui.label("Up axis").on_hover_text(
+            "Which axis of the mesh points up. Meshes exported Z-up (CAD, scans) look as if seen from underneath with Y up. Changing it resets the camera to the front view.",
+        );
+        for a in UpAxis::ALL {
+            ui.radio_value(&mut up, a, a.label());
+        }
+    });
 
     ui.separator();
     ui.heading("Node boxes");
-    ui.checkbox(&mut s.show_boxes, "Show node boxes");
+    ui.checkbox(&mut s.show_boxes, "Show node boxes")
+        .on_hover_text("The boxes of every node at the chosen depth, as wireframes over the image (B)");
     s.box_depth = s.box_depth.min(max_depth);
     if let Some(top_max) = top_depth {
         ui.add_enabled_ui(s.show_boxes, |ui| {
@@ -87,10 +127,15 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             .on_hover_text("Boxes of each mesh's own BVH, placed by each of its instances");
         });
     } else {
-        ui.add_enabled(s.show_boxes, egui::Slider::new(&mut s.box_depth, 0..=max_depth).text("Box depth"));
+        ui.add_enabled(s.show_boxes, egui::Slider::new(&mut s.box_depth, 0..=max_depth).text("Box depth"))
+            .on_hover_text("Depth of the nodes whose boxes are drawn (0: the root); [ and ] step it");
     }
-    ui.add_enabled(s.show_boxes, egui::Checkbox::new(&mut s.boxes_leaves_above, "Also leaves above this depth"));
+    ui.add_enabled(s.show_boxes, egui::Checkbox::new(&mut s.boxes_leaves_above, "Also leaves above this depth"))
+        .on_hover_text("Leaves shallower than the depth, which have no nodes at it");
+    ui.add_enabled(s.show_boxes, egui::Checkbox::new(&mut s.boxes_in_front, "Only in front of the surface"))
+        .on_hover_text("Hide the parts of the boxes behind the surface the rays hit (depth-tested against the ray-cast image), so deep levels do not hide the mesh");
     if s.show_boxes {
         ui.label(format!("{} boxes drawn", app.boxes_drawn));
     }
+    app.set_up_axis(up);
 }

@@ -1,6 +1,6 @@
 //! Floating windows: Help (shortcuts), and the path field used when no file dialog is available.
 
-use crate::app::shortcuts::{MOUSE, SHORTCUTS};
+use crate::app::shortcuts::{shortcut_text, MOUSE, SHORTCUTS};
 use crate::app::{BvhscopeApp, Pick};
 use std::path::PathBuf;
 
@@ -10,7 +10,7 @@ pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
         ui.heading("Keyboard");
         egui::Grid::new("keys").num_columns(2).striped(true).show(ui, |ui| {
             for (shortcut, _, what) in SHORTCUTS {
-                ui.monospace(ctx.format_shortcut(shortcut));
+                ui.monospace(shortcut_text(ctx, shortcut));
                 ui.label(*what);
                 ui.end_row();
             }
@@ -42,7 +42,15 @@ pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
         }
         let label = ui.label("Path");
         let edit = ui.add(egui::TextEdit::singleline(&mut window.text).desired_width(420.0)).labelled_by(label.id);
+        // The field takes the keyboard when the window opens: what is typed goes into it, and
+        // while it has focus no single-key shortcut fires (`shortcuts::pressed`).
+        if std::mem::take(&mut window.focus) {
+            edit.request_focus();
+        }
         let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        if (edit.has_focus() || edit.lost_focus()) && ui.input(|i| i.key_pressed(egui::Key::Escape)) {
+            keep = false;
+        }
         ui.horizontal(|ui| {
             let verb = if window.pick == Pick::Open { "Open" } else { "Save" };
             if (ui.button(verb).clicked() || enter) && !window.text.trim().is_empty() {
