@@ -49,6 +49,15 @@ fn check_ray(mesh: &Mesh, bvhs: &[AnyBvh], linear: &LinearScan, ray: Ray) {
             let any = bvh.any_hit(&ray, opts, &mut NoStats);
             assert_eq!(any, expected.is_some(), "any-hit disagrees with closest hit: {what}");
             assert!(counters.nodes_visited >= 1 || expected.is_none(), "counters ran: {what}");
+            // "Rays in the root box" are the rays that visit a node: every layout tests the root
+            // box first and visits nothing when it misses.
+            let mut root = None;
+            bvh.walk(&mut |n| {
+                root.get_or_insert(n.bounds);
+                false
+            });
+            let enters_root = root.is_some_and(|b| b.intersect(&ray).is_some()) && bvh.triangle_count() > 0;
+            assert_eq!(counters.nodes_visited > 0, enters_root, "nodes visited iff the root box is entered: {what}");
         }
     }
 }

@@ -166,3 +166,159 @@ fn a_scene_renders_and_reports_two_levels() {
     let out = bvhscope(&["render", s, "--top-strategy", "sah", "-o", png.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "top-level options need --two-level");
 }
+
+#[test]
+fn the_handout_preset_sets_the_labs_bvh_and_the_options_given_still_win() {
+    let t = tent();
+    let out = bvhscope(&["stats", t.to_str().unwrap(), "--preset", "handout", "--size", "40x30"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let leaf = bvhscope::bvh::Preset::HANDOUT_MAX_LEAF_SIZE;
+    assert!(text.contains(&format!("Midpoint, binary layout (max leaf size {leaf},")), "{text}");
+    assert!(text.contains("split-axis sign order, Möller–Trumbore test"), "{text}");
+    let out = bvhscope(&["stats", t.to_str().unwrap(), "--preset", "handout", "--max-leaf-size", "1", "--no-rays"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Midpoint, binary layout (max leaf size 1,"), "{text}");
+    assert!(!text.contains("rays "), "no frame traced: {text}");
+}
+
+#[test]
+fn stats_counts_the_rays_in_the_root_box_as_the_app_does() {
+    use bvhscope::bvh::{AnyBvh, BuildParams};
+    use bvhscope::render::{render, Camera, RenderSettings};
+    let t = tent();
+    let out = bvhscope(&["stats", t.to_str().unwrap(), "--size", "64x48", "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = &v["rays"]["summary"];
+    // The same frame traced here through the library, as the app traces it.
+    let mesh = bvhscope::mesh::load_obj(&t).unwrap().0;
+    let bvh = AnyBvh::build(&mesh, &BuildParams::default());
+    let cam = Camera::framing(&mesh.bounds(), 64, 48);
+    let s = render(&bvh, &mesh, &cam, &RenderSettings { count: true, ..Default::default() }).ray_summary();
+    assert_eq!(r["rays"], 64 * 48);
+    assert_eq!(r["root_rays"], s.root_rays);
+    assert!(s.root_rays > 0 && s.root_rays < s.rays);
+    assert_eq!(r["root_mean_nodes_visited"].as_f64().unwrap(), s.root_mean_nodes_visited);
+    assert_eq!(r["mean_triangle_tests"].as_f64().unwrap(), s.mean_triangle_tests);
+    assert!(s.root_mean_nodes_visited > s.mean_nodes_visited, "the root-box mean is not diluted by misses");
+}
+
+#[test]
+fn compare_times_single_rays_and_writes_csv_a_reader_parses() {
+    let out = bvhscope(&[
+        "compare",
+        tent().to_str().unwrap(),
+        "--size",
+        "40x30",
+        "--runs",
+        "1",
+        "--format",
+        "csv",
+        "--preset",
+        "handout",
+        "--threads",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut r = csv::Reader::from_reader(&out.stdout[..]);
+    let header = r.headers().unwrap().clone();
+    let records: Vec<csv::StringRecord> = r.records().map(|r| r.unwrap()).collect();
+    assert_eq!(records.len(), 5, "four strategies in the preset's binary layout, and the linear scan");
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name} in {header:?}"));
+    for rec in &records {
+        assert_eq!(rec.len(), header.len());
+        assert!(rec[col("trace_ms")].parse::<f64>().unwrap() > 0.0);
+        let (all, root) = (&rec[col("tri_tests_per_ray")], &rec[col("root_box_tri_tests_per_ray")]);
+        assert!(root.parse::<f64>().unwrap() >= all.parse::<f64>().unwrap());
+    }
+    assert_eq!(&records[0][0], "Midpoint (binary)");
+    assert_eq!(&records[4][col("build_ms")], "", "the linear scan has no build");
+
+    let out = bvhscope(&["compare", tent().to_str().unwrap(), "--size", "40x30", "--runs", "1", "--layout", "binary"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("| trace ms | frame ms |") && text.contains("enter the root box"), "{text}");
+    assert!(text.contains("single rays, closest hit, no shading, 1 thread(s)"), "{text}");
+}
+
+#[test]
+fn a_heatmap_png_names_its_mesh_strategy_and_layout() {
+    use bvhscope::render::{draw_legend, legend_height};
+    let t = tent();
+    let png = tmp("named-visits.png");
+    let out = bvhscope(&[
+        "render",
+        t.to_str().unwrap(),
+        "--size",
+        "320x48",
+        "--view",
+        "visits",
+        "--strategy",
+        "midpoint",
+        "--layout",
+        "binary",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&png).unwrap().to_rgb8();
+    let base = image::RgbImage::from_fn(320, 48, |x, y| *img.get_pixel(x, y));
+    // Redraw the strip with the caption the file should carry; it must match the file's.
+    let mut legend = bvhscope::render::view_image(
+        &{
+            let mesh = bvhscope::mesh::load_obj(&t).unwrap().0;
+            let p = bvhscope::bvh::BuildParams {
+                strategy: bvhscope::bvh::SplitStrategy::Midpoint,
+                layout: bvhscope::bvh::Layout::Binary,
+                ..Default::default()
+            };
+            let bvh = bvhscope::bvh::AnyBvh::build(&mesh, &p);
+            let cam = bvhscope::render::Camera::framing(&mesh.bounds(), 320, 48);
+            bvhscope::render::render(
+                &bvh,
+                &mesh,
+                &cam,
+                &bvhscope::render::RenderSettings { count: true, ..Default::default() },
+            )
+        },
+        bvhscope::render::View::Visits,
+        bvhscope::render::ColorMap::Viridis,
+        bvhscope::render::HeatRange::Auto,
+        Default::default(),
+    )
+    .1
+    .unwrap();
+    legend.subject = format!("{}, Midpoint, binary", t.file_name().unwrap().to_string_lossy());
+    assert_eq!(img.height(), 48 + legend_height(&legend));
+    assert!(draw_legend(&base, &legend) == img, "the strip names mesh, strategy, layout and view");
+}
+
+#[test]
+fn a_z_up_copy_of_a_mesh_renders_as_the_y_up_original() {
+    // The tent written Z-up: (x, y, z) -> (x, -z, y).
+    let zup = tmp("tent-zup.obj");
+    std::fs::write(&zup, "v -1 1 0\nv 1 1 0\nv 0 0 1\nv -1 -1 0\nv 1 -1 0\nf 1 2 3\nf 3 4 5\nf 1 3 4\nf 2 5 3\n")
+        .unwrap();
+    let (a, b) = (tmp("yup-depth.png"), tmp("zup-depth.png"));
+    let run = |mesh: &std::path::Path, up: &str, out: &std::path::Path| {
+        let o = bvhscope(&[
+            "render",
+            mesh.to_str().unwrap(),
+            "--up",
+            up,
+            "--view",
+            "depth",
+            "--size",
+            "64x48",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        image::open(out).unwrap().to_rgb8()
+    };
+    let (y, z) = (run(&tent(), "y", &a), run(&zup, "z", &b));
+    let differ =
+        y.pixels().zip(z.pixels()).filter(|(p, q)| p.0.iter().zip(q.0).any(|(a, b)| a.abs_diff(b) > 2)).count();
+    assert!(differ <= 3, "{differ} of {} pixels differ", 64 * 48);
+    assert!(y.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 200, "the tent is in view");
+}

@@ -15,7 +15,6 @@ mod viewport;
 pub use jobs::Pick;
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
-pub use panels::stats::fmt_ms;
 pub use scene::{BuiltBvh, Scene, SceneSource};
 pub use settings::{BoxLevel, Settings};
 pub use shortcuts::Action;

@@ -30,7 +30,7 @@ pub use node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 pub use preset::Preset;
 pub use scene_bvh::{SceneBuild, SceneBvh};
 pub use split::SplitStrategy;
-pub use stats::TreeStats;
+pub use stats::{fmt_ms, TreeStats};
 pub use tree::{NodeKind, NodeView, TreeView};
 pub use two_level::TwoLevelBvh;
 pub use wide::WideBvh;

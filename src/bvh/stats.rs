@@ -32,6 +32,16 @@ pub struct TreeStats {
     pub depth_limited_splits: u32,
 }
 
+/// A time in milliseconds as the statistics print it: two decimals under 10 ms, so a fast build
+/// does not read as 0.0, one above.
+pub fn fmt_ms(ms: f64) -> String {
+    if ms < 10.0 {
+        format!("{ms:.2}")
+    } else {
+        format!("{ms:.1}")
+    }
+}
+
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }

@@ -339,9 +339,9 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
                 let dash = |v: Option<f64>, d: usize| v.map_or("—".to_string(), |v| format!("{v:.d$}"));
                 let _ = writeln!(
                     o,
-                    "| {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1}{sampled} | {:.1}{sampled} | {:.0}× |",
+                    "| {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} / {:.1} | {}{sampled} | {}{sampled} | {:.0}× |",
                     r.name,
-                    dash(r.build_ms, 1),
+                    r.build_ms.map_or("—".to_string(), crate::bvh::fmt_ms),
                     r.nodes,
                     depth,
                     dash(r.sah_cost, 2),
@@ -349,8 +349,8 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
                     r.root_nodes_per_ray,
                     r.tri_tests_per_ray,
                     r.root_tri_tests_per_ray,
-                    r.trace_ms,
-                    r.frame_ms,
+                    crate::bvh::fmt_ms(r.trace_ms),
+                    crate::bvh::fmt_ms(r.frame_ms),
                     r.speedup_over_linear
                 );
             }

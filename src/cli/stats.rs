@@ -1,8 +1,10 @@
-//! `bvhscope stats`: the statistics of one BVH.
+//! `bvhscope stats`: the statistics of one BVH, and the work per primary ray of one frame (the
+//! figures of the app's statistics panel, from the same camera and size when given the same).
 
-use super::args::BuildArgs;
-use super::{build_scene, load_mesh, CliError};
+use super::args::{BuildArgs, ViewArgs};
+use super::{build_scene, load_mesh, progress, CliError};
 use crate::bvh::{SceneBvh, TreeStats, TreeView};
+use crate::render::{render, Camera, RaySummary, RenderSettings};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -19,8 +21,40 @@ pub struct StatsArgs {
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
+    /// The frame whose primary rays are counted (camera and size as `render` takes them).
+    #[command(flatten)]
+    pub view_args: ViewArgs,
+    /// Only the tree's statistics: trace no rays.
+    #[arg(long)]
+    pub no_rays: bool,
     #[arg(long, value_enum, default_value = "text")]
     pub format: StatsFormat,
+}
+
+/// The per-ray block of the text output.
+fn format_rays(camera: &Camera, trace: &crate::bvh::TraceOptions, r: &RaySummary) -> String {
+    let mut o = String::new();
+    let _ = writeln!(o, "traversal       {} order, {} test", trace.order.label(), trace.test.label());
+    let _ = writeln!(
+        o,
+        "rays            {}x{} primary rays: {} ({:.1}%) enter the root box, {} hit",
+        camera.width,
+        camera.height,
+        r.root_rays,
+        100.0 * r.root_fraction(),
+        r.hits
+    );
+    let _ = writeln!(
+        o,
+        "  in root box   per ray: nodes visited {:.2}, box tests {:.2}, triangle tests {:.2}",
+        r.root_mean_nodes_visited, r.root_mean_box_tests, r.root_mean_triangle_tests
+    );
+    let _ = writeln!(
+        o,
+        "  all rays      per ray: nodes visited {:.2} (max {}), box tests {:.2}, triangle tests {:.2} (max {})",
+        r.mean_nodes_visited, r.max_nodes_visited, r.mean_box_tests, r.mean_triangle_tests, r.max_triangle_tests
+    );
+    o
 }
 
 pub fn run(a: &StatsArgs) -> Result<(), CliError> {
@@ -28,12 +62,27 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     let params = a.build.params(loaded.build.as_ref());
     let bvh = build_scene(&loaded, &a.build.scene_build(params));
     let report = &loaded.report;
+    let rays = if a.no_rays {
+        None
+    } else {
+        let camera = a.view_args.camera(&loaded.mesh.bounds(), loaded.camera.as_ref())?;
+        let settings = RenderSettings { trace: a.build.trace(), count: true, progressive: false };
+        let summary = progress::with_spinner("tracing the frame", || render(&bvh, &loaded.mesh, &camera, &settings))
+            .ray_summary();
+        Some((camera, summary))
+    };
+    let rays_json = rays
+        .map(|(camera, summary)| serde_json::json!({ "camera": camera, "trace": a.build.trace(), "summary": summary }));
+    let rays_text = rays.map_or(String::new(), |(camera, r)| format_rays(&camera, &a.build.trace(), &r));
     match (&bvh, a.format) {
         (SceneBvh::Single(b), StatsFormat::Json) => {
-            let v = serde_json::json!({ "mesh": report, "params": params, "stats": TreeStats::of(b) });
+            let v =
+                serde_json::json!({ "mesh": report, "params": params, "stats": TreeStats::of(b), "rays": rays_json });
             println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
-        (SceneBvh::Single(b), StatsFormat::Text) => print!("{}", format_text(report, &params, &TreeStats::of(b))),
+        (SceneBvh::Single(b), StatsFormat::Text) => {
+            print!("{}{rays_text}", format_text(report, &params, &TreeStats::of(b)))
+        }
         (SceneBvh::TwoLevel(t), format) => {
             let top = TreeStats::of(&t.top);
             let names = loaded.instances.as_ref().map(|i| i.meshes.iter().map(|m| m.name.clone()).collect::<Vec<_>>());
@@ -54,11 +103,13 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
                     bottom.iter().map(|(name, s)| serde_json::json!({ "mesh": name, "stats": s })).collect();
                 let v = serde_json::json!({
                     "scene": report, "instances": t.instances.len(), "memory_bytes": t.memory_bytes(),
+                    "build_ms": (t.bottom_time + t.top_time).as_secs_f64() * 1e3,
                     "top": { "params": t.top.params, "stats": top }, "bottom": { "params": params, "meshes": bottom_json },
+                    "rays": rays_json,
                 });
                 println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
             } else {
-                print!("{}", format_two_level(report, t, &top, &bottom));
+                print!("{}{rays_text}", format_two_level(report, t, &top, &bottom));
             }
         }
     }

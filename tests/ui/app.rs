@@ -512,7 +512,7 @@ fn two_level_figures_show_the_whole_build_time_and_one_placement_shows_the_mesh(
     let figures = h.state().current_figures().unwrap();
     assert_eq!(figures.build_ms, total.as_secs_f64() * 1e3);
     assert!(figures.build_ms > 0.0);
-    h.get_by_label(&bvhscope::app::fmt_ms(figures.build_ms));
+    h.get_by_label(&bvhscope::bvh::fmt_ms(figures.build_ms));
 
     // A scene that places its one mesh once opens in one level; two levels describe the mesh.
     let one = temp_file(

@@ -2,7 +2,7 @@
 //! shown before it, and the leaf-size histogram. Every row says what it counts in its tooltip.
 
 use crate::app::{BuiltBvh, BvhscopeApp, StrategyFigures};
-use crate::bvh::{SahCost, TreeView};
+use crate::bvh::{fmt_ms, SahCost, TreeView};
 use crate::render::RaySummary;
 use egui_plot::{Bar, BarChart, Plot};
 
@@ -13,15 +13,6 @@ struct Row {
     tip: &'static str,
     per_ray: bool,
     value: fn(&StrategyFigures) -> Option<String>,
-}
-
-/// Build times under 10 ms with two decimals, so a fast build does not read as 0.0.
-pub fn fmt_ms(ms: f64) -> String {
-    if ms < 10.0 {
-        format!("{ms:.2}")
-    } else {
-        format!("{ms:.1}")
-    }
 }
 
 fn rays(f: &StrategyFigures) -> Option<&RaySummary> {
