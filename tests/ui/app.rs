@@ -113,7 +113,9 @@ fn switching_back_before_a_build_finishes_cancels_it() {
 fn moving_the_depth_slider_changes_the_number_of_boxes_drawn() {
     let mut h = harness();
     run_until(&mut h, "the first build", idle);
+    assert_eq!(h.state().settings.box_depth, 3, "the default depth survives the first frames, built or not");
     h.get_by_label("Show node boxes").click();
+    h.get_by_role_and_label(Role::Slider, "Box depth").set_value_accesskit(0.0);
     h.step();
     h.step();
     h.get_by_label("1 boxes drawn"); // depth 0: the root
@@ -468,7 +470,7 @@ fn before_figures_from_another_camera_are_marked_stale() {
     run_until(&mut h, "the new frame", |a| {
         idle(a) && a.rays.is_some_and(|r| r.camera != a.previous.as_ref().unwrap().rays.unwrap().camera)
     });
-    assert_eq!(h.query_all_by_label("stale").count(), 4, "every per-ray row of the before column");
+    assert_eq!(h.query_all_by_label("stale").count(), 7, "every per-ray row of the before column");
 }
 
 #[test]
@@ -622,4 +624,23 @@ fn a_z_up_mesh_is_seen_from_the_front() {
     run_until(&mut h, "a frame from the new camera", |a| {
         idle(a) && a.shown.as_ref().is_some_and(|s| s.camera.up == glam::Vec3::Z)
     });
+}
+
+#[test]
+fn the_moer_lite_lab_scene_opens_in_one_level() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/models/moer-lite-lab1-bvh");
+    if !dir.is_dir() {
+        assert!(std::env::var("CI").map_or(true, |v| v != "true"), "CI=true but {} is missing", dir.display());
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), "notice: {} not found; skipping the Moer-lite scene test", dir.display());
+        return;
+    }
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.state_mut().settings.two_level = true;
+    h.input_mut().dropped_files.push(Arc::new(Dropped(dir.join("scene.json"))));
+    run_until(&mut h, "the lab's monkey", |a| a.scene.report.triangles == 968 && a.current_bvh().is_some() && idle(a));
+    assert!(!h.state().settings.two_level, "one placement of one mesh: one level");
+    assert!(h.state().current_bvh().unwrap().bvh.two_level().is_none());
+    h.get_by_label("Two levels: 1 placements of 1 meshes");
 }

@@ -59,35 +59,45 @@ const ROWS: &[Row] = &[
     },
     Row {
         name: "Rays in root box",
-        tip: "Share of the frame's primary rays that enter the root box; the others cost one box test and visit nothing",
+        tip: "Share of the frame's primary rays that enter the root box; the others cost one box test and visit nothing. The per-ray rows below are means over these rays, unless they say all rays",
         per_ray: true,
-        value: |f| rays(f).map(|r| format!("{:.1} % of {}", 100.0 * r.root_fraction(), r.rays)),
+        value: |f| rays(f).map(|r| format!("{:.1} %", 100.0 * r.root_fraction())),
     },
     Row {
         name: "Nodes visited / ray",
-        tip: "Nodes taken from the stack and processed (interior and leaf), per ray that enters the root box; in brackets the mean over all rays and the most of any ray",
+        tip: "Nodes taken from the stack and processed (interior and leaf), per ray that enters the root box",
         per_ray: true,
-        value: |f| {
-            rays(f).map(|r| {
-                format!("{:.2} (all {:.2}, max {})", r.root_mean_nodes_visited, r.mean_nodes_visited, r.max_nodes_visited)
-            })
-        },
+        value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_nodes_visited)),
     },
     Row {
         name: "Box tests / ray",
-        tip: "Ray–box slab tests per ray that enters the root box (the root's own test included; a wide node tests each valid child); in brackets over all rays",
+        tip: "Ray–box slab tests per ray that enters the root box (the root's own test included; a wide node tests each valid child)",
         per_ray: true,
-        value: |f| rays(f).map(|r| format!("{:.2} (all {:.2})", r.root_mean_box_tests, r.mean_box_tests)),
+        value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_box_tests)),
     },
     Row {
         name: "Triangle tests / ray",
-        tip: "Ray–triangle tests per ray that enters the root box; in brackets the mean over all rays and the most of any ray",
+        tip: "Ray–triangle tests per ray that enters the root box",
         per_ray: true,
-        value: |f| {
-            rays(f).map(|r| {
-                format!("{:.2} (all {:.2}, max {})", r.root_mean_triangle_tests, r.mean_triangle_tests, r.max_triangle_tests)
-            })
-        },
+        value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_triangle_tests)),
+    },
+    Row {
+        name: "Nodes / ray, all rays",
+        tip: "Nodes visited per ray over all primary rays of the frame, those that miss the root box (0 nodes) included",
+        per_ray: true,
+        value: |f| rays(f).map(|r| format!("{:.2}", r.mean_nodes_visited)),
+    },
+    Row {
+        name: "Tri tests / ray, all rays",
+        tip: "Triangle tests per ray over all primary rays of the frame",
+        per_ray: true,
+        value: |f| rays(f).map(|r| format!("{:.2}", r.mean_triangle_tests)),
+    },
+    Row {
+        name: "Most in one ray",
+        tip: "The most nodes visited, and the most triangle tests, of any one ray of the frame",
+        per_ray: true,
+        value: |f| rays(f).map(|r| format!("{} / {}", r.max_nodes_visited, r.max_triangle_tests)),
     },
 ];
 
@@ -199,7 +209,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         (Some(r), Some((camera, trace))) => r.comparable(camera, trace),
         _ => false,
     };
-    let width = super::grid_column_width(ui, 3);
+    let width = 0.4 * ui.available_width();
     egui::Grid::new("bvh-stats").num_columns(3).striped(true).max_col_width(width).show(ui, |ui| {
         ui.label("");
         ui.strong(&current.label);
@@ -231,7 +241,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     });
     let c = current.stats.sah_constants;
     ui.weak(format!(
-        "Per-ray figures: the primary rays of the last full frame that enter the root box (all rays in brackets). SAH cost with C_trav = {}, C_isect = {}.",
+        "Per-ray figures: the primary rays of the last full frame that enter the root box, unless a row says all rays. SAH cost with C_trav = {}, C_isect = {}.",
         c.traversal, c.intersection
     ))
     .on_hover_text(combined_cost_text(c));

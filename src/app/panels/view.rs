@@ -26,6 +26,7 @@ fn view_tip(v: View, cost: &str) -> String {
 pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("View");
     let max_depth = app.current_bvh().map_or(0, |b| b.bottom_max_depth());
+    let app_has_bvh = app.current_bvh().is_some();
     // The top level's depth, when two levels are built.
     let top_depth = app.current_bvh().and_then(|b| b.top_stats.as_ref()).map(|s| s.max_depth);
     let legend_range = app.shown.as_ref().and_then(|s| s.legend.as_ref()).map(|l| (l.range_min, l.range_max));
@@ -106,7 +107,10 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("Node boxes");
     ui.checkbox(&mut s.show_boxes, "Show node boxes")
         .on_hover_text("The boxes of every node at the chosen depth, as wireframes over the image (B)");
-    s.box_depth = s.box_depth.min(max_depth);
+    // Until a BVH is built its depth is unknown: keep the chosen depth rather than clamp it to 0.
+    if app_has_bvh {
+        s.box_depth = s.box_depth.min(max_depth);
+    }
     if let Some(top_max) = top_depth {
         ui.add_enabled_ui(s.show_boxes, |ui| {
             ui.horizontal(|ui| {
@@ -122,13 +126,18 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             .on_hover_text("Boxes of the top level (over the placements), drawn white");
             ui.add_enabled(
                 s.box_level.shows_bottom(),
-                egui::Slider::new(&mut s.box_depth, 0..=max_depth).text("Bottom-level depth"),
+                egui::Slider::new(&mut s.box_depth, 0..=max_depth)
+                    .clamping(egui::SliderClamping::Edits)
+                    .text("Bottom-level depth"),
             )
             .on_hover_text("Boxes of each mesh's own BVH, placed by each of its instances");
         });
     } else {
-        ui.add_enabled(s.show_boxes, egui::Slider::new(&mut s.box_depth, 0..=max_depth).text("Box depth"))
-            .on_hover_text("Depth of the nodes whose boxes are drawn (0: the root); [ and ] step it");
+        ui.add_enabled(
+            s.show_boxes,
+            egui::Slider::new(&mut s.box_depth, 0..=max_depth).clamping(egui::SliderClamping::Edits).text("Box depth"),
+        )
+        .on_hover_text("Depth of the nodes whose boxes are drawn (0: the root); [ and ] step it");
     }
     ui.add_enabled(s.show_boxes, egui::Checkbox::new(&mut s.boxes_leaves_above, "Also leaves above this depth"))
         .on_hover_text("Leaves shallower than the depth, which have no nodes at it");
