@@ -187,13 +187,27 @@ pub fn diagonal_rods(rings: u32, sides: u32, length: f32, radius: f32, spacing: 
     m
 }
 
+/// A square floor of two triangles in the y = 0 plane, `size` on a side, facing up: the two huge
+/// triangles of `scenes/knot-on-floor.json`.
+pub fn floor(size: f32) -> Mesh {
+    let mut m = Mesh { name: "floor".into(), ..Default::default() };
+    let h = size * 0.5;
+    push_quad(&mut m, [Vec3::new(-h, 0.0, -h), Vec3::new(-h, 0.0, h), Vec3::new(h, 0.0, h), Vec3::new(h, 0.0, -h)]);
+    end_group(&mut m, "floor");
+    m
+}
+
 /// The meshes in `assets/` (file name, mesh) for the scenes; `cargo run --example make_assets` writes them.
 pub fn assets() -> Vec<(&'static str, Mesh)> {
+    let mut knot = torus_knot(2, 3, 0.3, 128, 16);
+    knot.name = "knot".into();
     vec![
         ("torus.obj", torus(1.0, 0.35, 48, 24)),
         ("cornell-box.obj", cornell_box()),
         ("stadium.obj", stadium()),
         ("diagonal-rods.obj", diagonal_rods(8, 6, 10.0, 0.03, 0.2)),
+        ("floor.obj", floor(40.0)),
+        ("knot.obj", knot),
     ]
 }
 
