@@ -113,10 +113,13 @@ fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<&RaySummary>) {
     }
     let width = super::grid_column_width(ui, 2);
     egui::Grid::new("two-level").num_columns(2).striped(true).max_col_width(width).show(ui, |ui| {
-        ui.label("Placements / meshes");
+        ui.label("Placements / meshes")
+            .on_hover_text("Placements in the scene file, and the distinct meshes they place");
         ui.label(format!("{} / {}", t.instances.len(), t.bottom.len()));
         ui.end_row();
-        ui.label("Triangles placed / stored");
+        ui.label("Triangles placed / stored").on_hover_text(
+            "Triangles as the rays meet them (each placement counts its mesh's), and as stored (each mesh once)",
+        );
         ui.label(format!(
             "{} / {}",
             t.instanced_triangle_count(),
@@ -128,7 +131,8 @@ fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<&RaySummary>) {
         );
         ui.label(format!("{} + {}", fmt_ms(t.bottom_time.as_secs_f64() * 1e3), fmt_ms(t.top_time.as_secs_f64() * 1e3)));
         ui.end_row();
-        ui.label("Memory, all levels");
+        ui.label("Memory, all levels")
+            .on_hover_text("Nodes and index arrays of the top level and of each mesh's BVH (once), and the placements");
         ui.label(format!("{:.1} KiB", t.memory_bytes() as f64 / 1024.0));
         ui.end_row();
         if let Some(r) = rays {
@@ -179,7 +183,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     }
     let r = &app.scene.report;
     egui::Grid::new("scene-stats").num_columns(2).striped(true).show(ui, |ui| {
-        ui.label("Triangles");
+        ui.label("Triangles").on_hover_text("Triangles in the scene as the rays see it (polygons fan-triangulated, placements counted), zero-area ones left out");
         ui.label(r.triangles.to_string());
         ui.end_row();
         if r.degenerate_skipped > 0 {
@@ -187,7 +191,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             ui.label(r.degenerate_skipped.to_string());
             ui.end_row();
         }
-        ui.label("Vertices");
+        ui.label("Vertices").on_hover_text("Vertex positions of the loaded meshes");
         ui.label(r.vertices.to_string());
         ui.end_row();
         ui.label("Groups").on_hover_text("Objects and groups (o / g lines) of the file");
