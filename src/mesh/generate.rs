@@ -359,13 +359,19 @@ mod tests {
     fn assets_are_named_and_sound() {
         let assets = assets();
         let names: Vec<&str> = assets.iter().map(|(n, _)| *n).collect();
-        assert_eq!(names, ["torus.obj", "cornell-box.obj", "stadium.obj", "diagonal-rods.obj"]);
+        assert_eq!(names, ["torus.obj", "cornell-box.obj", "stadium.obj", "diagonal-rods.obj", "floor.obj", "knot.obj"]);
         for (name, m) in &assets {
             assert!(m.triangle_count() > 0, "{name}");
             assert_no_degenerate(m);
         }
         let torus = &assets[0].1;
         assert_eq!(torus.normals.len(), torus.positions.len(), "the torus has normals");
+        let floor = &assets[4].1;
+        assert_eq!(floor.triangle_count(), 2, "the floor is two huge triangles");
+        for t in 0..2 {
+            let [a, b, c] = floor.triangle(t);
+            assert!((b - a).cross(c - a).y > 0.0, "facing up");
+        }
     }
 
     #[test]

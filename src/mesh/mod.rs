@@ -1,5 +1,6 @@
 //! The triangle mesh we render, and loading it from OBJ files.
 
+mod error;
 pub mod generate;
 #[allow(clippy::module_inception)]
 mod mesh;
@@ -7,5 +8,7 @@ mod obj;
 mod obj_lines;
 mod obj_parallel;
 
+pub use error::{MeshError, MAX_COORDINATE};
 pub use mesh::{Mesh, MeshGroup, SurfaceInteraction};
-pub use obj::{load_obj, parse_obj, write_obj, LoadReport, MeshError, MAX_COORDINATE};
+pub(crate) use obj::decode_text;
+pub use obj::{load_obj, parse_obj, read_user_file, write_obj, LoadReport};

@@ -5,69 +5,17 @@
 //! to tobj. tobj reports *what* failed but not *where*; on failure we scan the text once for the
 //! first line showing that fault (`obj_lines.rs`), so the user can open the file at the right place.
 
+use super::error::{MeshError, MAX_COORDINATE};
 use super::obj_lines::{diagnose, first_bad_face, first_bad_line, line_at, statements, Corner};
 use super::obj_parallel;
 use super::{Mesh, MeshGroup};
 use crate::geometry::triangle::double_area;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use std::fmt;
+use std::borrow::Cow;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-
-/// Why a mesh could not be loaded. Every message starts with the file name.
-#[derive(Debug, thiserror::Error)]
-pub enum MeshError {
-    #[error("{}: no such file", .path.display())]
-    NotFound { path: PathBuf },
-    #[error("{}: is a directory, not an OBJ file", .path.display())]
-    IsDirectory { path: PathBuf },
-    #[error("{}: cannot read: {source}", .path.display())]
-    Io { path: PathBuf, source: std::io::Error },
-    #[error("{}: line {line}: not a text file (binary data or invalid UTF-8)", .path.display())]
-    NotText { path: PathBuf, line: usize },
-    #[error("{}{}: {message}", .path.display(), LineSuffix(*.line))]
-    Parse { path: PathBuf, line: Option<usize>, message: String },
-    #[error("{}{}: {message}", .path.display(), LineSuffix(*.line))]
-    IndexOutOfRange { path: PathBuf, line: Option<usize>, message: String },
-    #[error("{}{}: {what} has a NaN or infinite coordinate", .path.display(), LineSuffix(*.line))]
-    NonFinite { path: PathBuf, line: Option<usize>, what: &'static str },
-    #[error("{}{}: a vertex coordinate exceeds ±{MAX_COORDINATE:e}, too large to trace in single precision (scale the mesh down)", .path.display(), LineSuffix(*.line))]
-    TooLarge { path: PathBuf, line: Option<usize> },
-    #[error("{}: no triangles{}", .path.display(), if *.degenerate > 0 { format!(" (all {} faces are degenerate)", .degenerate) } else { String::new() })]
-    NoTriangles { path: PathBuf, degenerate: usize },
-}
-
-impl MeshError {
-    /// The line the error points at, when known.
-    pub fn line(&self) -> Option<usize> {
-        match self {
-            MeshError::NotText { line, .. } => Some(*line),
-            MeshError::Parse { line, .. }
-            | MeshError::IndexOutOfRange { line, .. }
-            | MeshError::NonFinite { line, .. }
-            | MeshError::TooLarge { line, .. } => *line,
-            _ => None,
-        }
-    }
-}
-
-struct LineSuffix(Option<usize>);
-
-impl fmt::Display for LineSuffix {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.0 {
-            Some(n) => write!(f, ": line {n}"),
-            None => Ok(()),
-        }
-    }
-}
-
-/// Largest coordinate magnitude accepted. The triangle tests multiply three coordinates
-/// together (edge functions times depth), so beyond about 1e12 single precision overflows and
-/// rays silently miss; 1e10 leaves a wide margin.
-pub const MAX_COORDINATE: f32 = 1e10;
 
 /// What loading found, for the UI's status line and the CLI's report.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -91,22 +39,64 @@ pub struct LoadReport {
 pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
     let start = Instant::now();
+    let bytes = read_user_file(path)?;
+    let text = decode_text(path, &bytes)?;
+    let (mesh, mut report) = parse_obj(path, &text)?;
+    report.load_time = start.elapsed();
+    Ok((mesh, report))
+}
+
+/// The bytes of a file the user named, refusing what is not a regular file: a FIFO, a device
+/// (`/dev/zero`, `/dev/urandom`) or a socket would be read forever, or block until another
+/// program writes.
+pub fn read_user_file(path: &Path) -> Result<Vec<u8>, MeshError> {
     let io = |e: std::io::Error| match e.kind() {
         std::io::ErrorKind::NotFound => MeshError::NotFound { path: path.into() },
         _ => MeshError::Io { path: path.into(), source: e },
     };
     let metadata = std::fs::metadata(path).map_err(io)?;
-    if metadata.is_dir() {
+    let kind = metadata.file_type();
+    if kind.is_dir() {
         return Err(MeshError::IsDirectory { path: path.into() });
     }
-    let bytes = read_file(path, metadata.len() as usize).map_err(io)?;
-    let text = match std::str::from_utf8(&bytes) {
-        Ok(t) => t,
-        Err(e) => return Err(MeshError::NotText { path: path.into(), line: line_at(&bytes, e.valid_up_to()) }),
-    };
-    let (mesh, mut report) = parse_obj(path, text)?;
-    report.load_time = start.elapsed();
-    Ok((mesh, report))
+    if !kind.is_file() {
+        return Err(MeshError::NotRegular { path: path.into(), what: special_file_kind(&kind) });
+    }
+    read_file(path, metadata.len() as usize).map_err(io)
+}
+
+/// What a file that is neither a regular file nor a directory is, in words.
+fn special_file_kind(kind: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if kind.is_char_device() {
+            return "a character device";
+        }
+        if kind.is_block_device() {
+            return "a block device";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = kind;
+    "a special file"
+}
+
+/// The file's bytes as text. A UTF-8 byte-order mark (Windows exporters write one) is dropped.
+/// Bytes that are not UTF-8 (Latin-1 from older exporters, in comments and object names) are
+/// decoded lossily: the names get a replacement character, the geometry, which is ASCII, loads.
+/// A NUL byte means binary data, not OBJ text.
+pub(crate) fn decode_text<'a>(path: &Path, bytes: &'a [u8]) -> Result<Cow<'a, str>, MeshError> {
+    let bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
+    if let Some(pos) = bytes.iter().position(|&b| b == 0) {
+        return Err(MeshError::NotText { path: path.into(), line: line_at(bytes, pos) });
+    }
+    Ok(String::from_utf8_lossy(bytes))
 }
 
 /// The whole file. Big files are read in parallel pieces: on this machine faulting in the pages
@@ -136,9 +126,15 @@ fn read_file(path: &Path, len: usize) -> std::io::Result<Vec<u8>> {
 /// Parse OBJ text; `path` is used for the mesh name and in error messages.
 pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
+    let text = &*join_continued_lines(text.strip_prefix('\u{feff}').unwrap_or(text));
     let (models, by_tobj) = match obj_parallel::models(text) {
         Some(models) => (Ok(models), false),
-        None => (load_models(&mut Cursor::new(text.as_bytes())).map_err(Problem::Tobj), true),
+        None => {
+            // Vertex colours (`v x y z r g b`) and weights (`v x y z w`) are not needed to show a
+            // BVH, and tobj refuses a file that gives colours to some vertices only.
+            let plain = positions_only(text);
+            (load_models(&mut Cursor::new(plain.as_bytes())).map_err(Problem::Tobj), true)
+        }
     };
 
     let (mesh, report) =
@@ -149,6 +145,59 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
         check_unchecked_indices(path, text, &report)?;
     }
     Ok((mesh, report))
+}
+
+/// The text with each statement continued by a trailing backslash joined into one line (the OBJ
+/// format allows it). The line breaks removed are put back after the joined statement, so every
+/// line keeps its number in error messages (a joined statement is reported at its first line).
+fn join_continued_lines(text: &str) -> Cow<'_, str> {
+    if !text.contains("\\\n") && !text.contains("\\\r\n") {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut pending = 0;
+    for line in text.split_inclusive('\n') {
+        let body = line.trim_end_matches(['\n', '\r']);
+        match body.strip_suffix('\\') {
+            Some(head) if line.ends_with('\n') => {
+                out.push_str(head);
+                out.push(' ');
+                pending += 1;
+            }
+            _ => {
+                out.push_str(line);
+                for _ in 0..pending {
+                    out.push('\n');
+                }
+                pending = 0;
+            }
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// The text with every `v` statement cut to its three coordinates (dropping a weight or a
+/// colour), line for line.
+fn positions_only(text: &str) -> Cow<'_, str> {
+    let long = |line: &str| {
+        let mut t = line.split('#').next().unwrap_or("").split_whitespace();
+        t.next() == Some("v") && t.count() > 3
+    };
+    if !text.lines().any(long) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len());
+    for line in text.split_inclusive('\n') {
+        if long(line) {
+            let coords: Vec<&str> = line.split_whitespace().skip(1).take(3).collect();
+            out.push_str("v ");
+            out.push_str(&coords.join(" "));
+            out.push('\n');
+        } else {
+            out.push_str(line);
+        }
+    }
+    Cow::Owned(out)
 }
 
 /// Texture and normal indices tobj did not check (it ignores them when none are declared).
@@ -184,7 +233,12 @@ fn explain(path: &Path, text: &str, problem: Problem) -> MeshError {
         Problem::NonFinite(what, keyword, min) => {
             MeshError::NonFinite { path: path.into(), line: first_bad_line(text, keyword, min), what }
         }
-        Problem::NoTriangles { degenerate } => MeshError::NoTriangles { path: path.into(), degenerate },
+        // Faces of one or two corners (lines and points written as `f`) make no triangle: when
+        // they are all there is, say which line instead of just "no triangles".
+        Problem::NoTriangles { degenerate } => match first_bad_face(text, None).filter(|_| degenerate == 0) {
+            Some((line, message)) => MeshError::Parse { path: path.into(), line: Some(line), message },
+            None => MeshError::NoTriangles { path: path.into(), degenerate },
+        },
         Problem::TooLarge => {
             let line = statements(text).find_map(|(n, k, args)| {
                 let big = args.iter().take(3).any(|a| a.parse::<f32>().is_ok_and(|x| x.abs() > MAX_COORDINATE));

@@ -1,7 +1,7 @@
 //! Finding the line behind an OBJ loading failure: tobj says *what* is wrong, these scans of the
 //! text say *where*, so the user can open the file at the right place.
 
-use super::obj::MeshError;
+use super::error::MeshError;
 use std::path::{Path, PathBuf};
 
 /// 1-based line number of byte offset `pos`.

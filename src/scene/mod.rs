@@ -69,10 +69,12 @@ pub fn trs(translate: Vec3, axis: Vec3, radians: f32, scale: Vec3) -> Affine3A {
 
 /// Read a JSON file, with errors that name the file and the line.
 fn read_json(path: &Path) -> Result<serde_json::Value, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => SceneError::NotFound { path: path.into() },
-        _ => SceneError::Io { path: path.into(), source: e },
+    let bytes = crate::mesh::read_user_file(path).map_err(|e| match e {
+        MeshError::NotFound { path } => SceneError::NotFound { path },
+        MeshError::Io { path, source } => SceneError::Io { path, source },
+        other => SceneError::Mesh(other),
     })?;
+    let text = crate::mesh::decode_text(path, &bytes)?;
     serde_json::from_str(&text).map_err(|e| SceneError::Json {
         path: path.into(),
         line: e.line(),
