@@ -139,10 +139,8 @@ fn a_fifo_or_a_device_is_refused_at_once() {
     // Nobody writes to it: reading it would block for ever. The check must not open it.
     let e = load_err(&fifo);
     assert!(e.to_string().contains("a FIFO (named pipe), not a regular file"), "{e}");
-    let scene = bvhscope::scene::load_any(&fifo.with_extension("json"));
-    assert!(scene.is_err());
     std::fs::rename(&fifo, fifo.with_extension("json")).unwrap();
-    let e = bvhscope::scene::load_any(&fifo.with_extension("json")).expect_err("a FIFO scene file");
+    let e = bvhscope::scene::load_any(fifo.with_extension("json")).expect_err("a FIFO scene file");
     assert!(e.to_string().contains("FIFO"), "{e}");
     let _ = std::fs::remove_file(fifo.with_extension("json"));
 }
