@@ -1,16 +1,8 @@
-//! bvhscope's core: geometry, mesh loading, BVH construction and traversal, statistics and the
-//! ray-cast renderer. Nothing here knows about the GUI; the app and the CLI are thin layers on top.
+//! bvhscope: the desktop app and the command line over the core (`bvhscope-core`, re-exported here
+//! so `bvhscope::bvh`, `bvhscope::render` … name the same things everywhere).
 
-// `!(a <= b)` on floats is deliberate throughout: it is true when either side is NaN, which is how
-// NaN input is made to fall on the safe side (a miss, an empty interval, a rejected value).
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+pub use bvhscope_core::{bvh, geometry, mesh, options, render, scene, work};
 
 #[cfg(feature = "gui")]
 pub mod app;
-pub mod bvh;
 pub mod cli;
-pub mod geometry;
-pub mod mesh;
-pub mod render;
-pub mod scene;
-pub mod work;

@@ -125,9 +125,9 @@ pub fn ours(strategy: SplitStrategy, layout: Layout, tracing: Tracing) -> Conten
         Layout::Wide4 => "BVH4",
     };
     let name = match tracing {
-        Tracing::Plain => format!("bvhscope {} ({layout_name})", strategy.short_name()),
-        Tracing::Counting => format!("bvhscope {} ({layout_name}), counting", strategy.short_name()),
-        Tracing::Packets => format!("bvhscope {} ({layout_name}, 8×8 packets)", strategy.short_name()),
+        Tracing::Plain => format!("bvhscope {} ({layout_name})", strategy.name()),
+        Tracing::Counting => format!("bvhscope {} ({layout_name}), counting", strategy.name()),
+        Tracing::Packets => format!("bvhscope {} ({layout_name}, 8×8 packets)", strategy.name()),
     };
     Contender {
         name,

@@ -14,9 +14,9 @@ pub enum StatsFormat {
 /// A file name describing the current scene, strategy and view.
 pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
     let scene: String = app.scene.title().chars().map(|c| if c.is_alphanumeric() { c } else { '-' }).collect();
-    let strategy = app.settings.build.strategy.short_name();
+    let strategy = app.settings.build.strategy.name();
     match ext {
-        "png" => format!("bvhscope-{scene}-{strategy}-{}.png", app.settings.view.short_name()),
+        "png" => format!("bvhscope-{scene}-{strategy}-{}.png", app.settings.view.name()),
         _ => format!("bvhscope-{scene}-stats.{ext}"),
     }
 }

@@ -389,7 +389,7 @@ impl BvhscopeApp {
     /// Switch to a preset's settings (the build and the render follow).
     pub fn apply_preset(&mut self, preset: Preset) {
         self.settings.apply_preset(preset);
-        self.message(MessageKind::Info, format!("{}: {}", preset.label(), preset.description()));
+        self.message(MessageKind::Info, format!("{}: {}", preset.label(), preset.help()));
     }
 
     fn apply(&mut self, ctx: &egui::Context, event: JobEvent) {

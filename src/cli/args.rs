@@ -1,86 +1,28 @@
-//! Arguments shared by the subcommands, and clap's value lists for the core's enums (so `--help`
-//! lists every strategy, view, order, test and colour map under its kebab-case name).
+//! Arguments shared by the subcommands. Every value list, help line, limit and default comes from
+//! the core's option tables (`crate::options`), which the app's panels and scene files read too.
 
 use crate::bvh::{BuildParams, Layout, Preset, SahCost, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder};
 use crate::geometry::{Aabb, TriangleTest};
-use crate::render::{Camera, ColorMap, UpAxis, View};
-use clap::builder::PossibleValue;
-use clap::{Args, ValueEnum};
+use crate::options::{Choice, Number, MAX_LEAF_SIZE, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
+use crate::render::{Camera, UpAxis};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use clap::Args;
 use glam::Vec3;
 
-impl ValueEnum for SplitStrategy {
-    fn value_variants<'a>() -> &'a [Self] {
-        &SplitStrategy::ALL
-    }
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(self.short_name()).help(self.description()))
-    }
+/// clap's parser for a choice: the names of its table, each with its help in `--help`.
+pub fn choice<T: Choice + Clone>() -> impl TypedValueParser<Value = T> {
+    PossibleValuesParser::new(T::TABLE.iter().map(|n| PossibleValue::new(n.name).help(n.help)))
+        .map(|s| T::from_name(&s).expect("clap passes only the listed names"))
 }
 
-impl ValueEnum for Layout {
-    fn value_variants<'a>() -> &'a [Self] {
-        &Layout::ALL
-    }
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(self.short_name()).help(self.label()))
-    }
+/// A whole number within a table's limits.
+fn whole(n: &'static Number<u32>) -> impl TypedValueParser<Value = u32> {
+    clap::value_parser!(u32).range(n.min as i64..=n.max as i64)
 }
 
-impl ValueEnum for View {
-    fn value_variants<'a>() -> &'a [Self] {
-        &View::ALL
-    }
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(self.short_name()).help(self.label()))
-    }
-}
-
-impl ValueEnum for TraversalOrder {
-    fn value_variants<'a>() -> &'a [Self] {
-        &TraversalOrder::ALL
-    }
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        let name = match self {
-            TraversalOrder::SplitAxisSign => "split-axis",
-            TraversalOrder::EntryDistance => "entry-distance",
-        };
-        Some(PossibleValue::new(name).help(self.label()))
-    }
-}
-
-impl ValueEnum for TriangleTest {
-    fn value_variants<'a>() -> &'a [Self] {
-        &TriangleTest::ALL
-    }
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        let name = match self {
-            TriangleTest::Watertight => "watertight",
-            TriangleTest::MollerTrumbore => "moller-trumbore",
-        };
-        Some(PossibleValue::new(name).help(self.label()))
-    }
-}
-
-impl ValueEnum for UpAxis {
-    fn value_variants<'a>() -> &'a [Self] {
-        &UpAxis::ALL
-    }
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        let help = match self {
-            UpAxis::Y => "+y is up (most formats, the handout)",
-            UpAxis::Z => "+z is up (CAD, Blender coordinates, many scans); the default camera looks along +y",
-        };
-        Some(PossibleValue::new(self.short_name()).help(help))
-    }
-}
-
-impl ValueEnum for ColorMap {
-    fn value_variants<'a>() -> &'a [Self] {
-        &ColorMap::ALL
-    }
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(self.label()))
-    }
+/// A number's help line with its limits and default, for `--help`.
+fn number_help<T: std::fmt::Display + PartialOrd + Copy>(n: &Number<T>) -> String {
+    format!("{} ({}) [default: {}]", n.help, n.range_text(), n.default)
 }
 
 /// How to build and traverse the BVH. Each option left out comes from `--preset` if given, else
@@ -88,51 +30,36 @@ impl ValueEnum for ColorMap {
 #[derive(Args, Debug, Clone, Default)]
 pub struct BuildArgs {
     /// Start from a named set of options (the ones given here still win).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Preset>())]
     pub preset: Option<Preset>,
     /// Split strategy [default: sah].
-    #[arg(long, short, value_enum)]
+    #[arg(long, short, value_parser = choice::<SplitStrategy>())]
     pub strategy: Option<SplitStrategy>,
-    /// Most triangles in a leaf, 1..=255 [default: 4].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
+    #[arg(long, value_parser = whole(&MAX_LEAF_SIZE), help = number_help(&MAX_LEAF_SIZE))]
     pub max_leaf_size: Option<u32>,
-    /// Bins per axis for the binned SAH, 2..=256; nodes of fewer than 3·bins triangles use a
-    /// third of their count (at least 4, never more than asked for) [default: 16].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=256))]
+    #[arg(long, value_parser = whole(&SAH_BINS), help = number_help(&SAH_BINS))]
     pub bins: Option<u32>,
-    /// SAH cost of one traversal step (relative to one triangle test), a positive number
-    /// [default: 1].
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_traversal_cost, help = number_help(&TRAVERSAL_COST))]
     pub traversal_cost: Option<f32>,
     /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Layout>())]
     pub layout: Option<Layout>,
     /// Child visited first at interior nodes of the binary layout (the wide one always takes the
     /// nearest first) [default: entry-distance].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<TraversalOrder>())]
     pub order: Option<TraversalOrder>,
     /// Ray–triangle test [default: watertight].
-    #[arg(long = "triangle-test", value_enum)]
+    #[arg(long = "triangle-test", value_parser = choice::<TriangleTest>())]
     pub test: Option<TriangleTest>,
     /// Build two levels: a top-level BVH over the scene's mesh placements and one BVH per mesh
     /// (the options above then apply to the meshes' BVHs). An OBJ is one placement of itself.
     #[arg(long)]
     pub two_level: bool,
     /// Split strategy of the top level [default: --strategy].
-    #[arg(long, value_enum, requires = "two_level")]
+    #[arg(long, value_parser = choice::<SplitStrategy>(), requires = "two_level")]
     pub top_strategy: Option<SplitStrategy>,
-    /// Most placements in a top-level leaf (1..=255).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=255), requires = "two_level")]
+    #[arg(long, default_value_t = TOP_MAX_LEAF_SIZE.default, value_parser = whole(&TOP_MAX_LEAF_SIZE), help = number_help(&TOP_MAX_LEAF_SIZE), requires = "two_level")]
     pub top_max_leaf_size: u32,
-}
-
-impl ValueEnum for Preset {
-    fn value_variants<'a>() -> &'a [Self] {
-        &Preset::ALL
-    }
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(self.short_name()).help(self.description()))
-    }
 }
 
 impl BuildArgs {
@@ -207,7 +134,7 @@ pub struct ViewArgs {
     pub fov: f32,
     /// Which axis of the mesh points up: the default camera frames it from the front with this
     /// axis up (and `--camera` takes it as the up vector unless it gives one).
-    #[arg(long, value_enum, default_value = "y")]
+    #[arg(long, value_parser = choice::<UpAxis>(), default_value = "y")]
     pub up: UpAxis,
 }
 
@@ -237,11 +164,11 @@ pub fn parse_fov(s: &str) -> Result<f32, String> {
     }
 }
 
-/// A finite number greater than zero.
-pub fn parse_positive(s: &str) -> Result<f32, String> {
+/// A traversal cost within its limits.
+pub fn parse_traversal_cost(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("'{s}' is not a positive number")),
+        Ok(v) if TRAVERSAL_COST.contains(v) => Ok(v),
+        _ => Err(format!("'{s}' is not a number {}", TRAVERSAL_COST.range_text())),
     }
 }
 
@@ -290,9 +217,9 @@ mod tests {
         assert_eq!((e, t, u), (Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, None));
         assert_eq!(parse_camera("1,2,3:4,5,6:0,0,1").unwrap().2, Some(Vec3::Z));
         assert!(parse_camera("1,2:0,0,0").is_err() && parse_camera("nan,0,0:0,0,0").is_err());
-        assert_eq!(parse_positive("2.5"), Ok(2.5));
-        assert!(parse_positive("nan").is_err() && parse_positive("inf").is_err() && parse_positive("-1").is_err());
-        assert!(parse_positive("0").is_err());
+        assert_eq!(parse_traversal_cost("2.5"), Ok(2.5));
+        assert!(parse_traversal_cost("nan").is_err() && parse_traversal_cost("inf").is_err());
+        assert!(parse_traversal_cost("-1").is_err() && parse_traversal_cost("0").is_err());
     }
 
     #[test]

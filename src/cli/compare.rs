@@ -167,7 +167,7 @@ pub fn compare_rows(
     let layouts = build.compare_layouts();
     for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))) {
         let params = build.params_with(scene, strategy, layout);
-        let name = format!("{} ({})", strategy.label(), layout.short_name());
+        let name = format!("{} ({})", strategy.label(), layout.name());
         let (bvh, build_ms) = progress::with_spinner(&format!("building {name}"), || {
             frames.install(|| {
                 let build_ms = |bvh: &AnyBvh| ms(bvh.report().total_time());
@@ -355,7 +355,7 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
                 );
             }
             let _ = writeln!(o);
-            let preset = a.build.preset.map_or(String::new(), |p| format!("preset {}; ", p.short_name()));
+            let preset = a.build.preset.map_or(String::new(), |p| format!("preset {}; ", p.name()));
             let _ = writeln!(
                 o,
                 "{}: {} triangles; {}x{} primary rays ({} rays, {} = {:.0}% enter the root box); {preset}traversal {}, {} test.",

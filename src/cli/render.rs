@@ -14,7 +14,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub build: BuildArgs,
     /// What to show.
-    #[arg(long, value_enum, default_value = "normals")]
+    #[arg(long, value_parser = super::args::choice::<View>(), default_value = "normals")]
     pub view: View,
     /// Output PNG.
     #[arg(long, short, default_value = "out.png")]
@@ -22,7 +22,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub view_args: ViewArgs,
     /// Colour map of heatmaps.
-    #[arg(long, value_enum, default_value = "viridis")]
+    #[arg(long, value_parser = super::args::choice::<ColorMap>(), default_value = "viridis")]
     pub colormap: ColorMap,
     /// Fixed heatmap range MIN:MAX (default: the frame's own min and max).
     #[arg(long, value_parser = parse_range)]

@@ -2,8 +2,21 @@
 //! rebuilds (or re-renders) in the background.
 
 use crate::app::BvhscopeApp;
-use crate::bvh::{Layout, Preset, SplitStrategy, TraversalOrder};
-use crate::geometry::TriangleTest;
+use crate::bvh::{Preset, SplitStrategy};
+use crate::options::{Choice, Number, MAX_LEAF_SIZE, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
+
+/// A slider over a number's whole range (logarithmic: leaf sizes of 1..255 and costs of 0.01..100
+/// are chosen near their small ends), labelled and explained by the option table.
+fn number<T: egui::emath::Numeric>(ui: &mut egui::Ui, value: &mut T, n: &Number<T>, log: bool) {
+    ui.add(egui::Slider::new(value, n.min..=n.max).logarithmic(log).text(n.label)).on_hover_text(n.help);
+}
+
+/// One radio button per value of a choice, with its help.
+fn radios<T: Choice>(ui: &mut egui::Ui, value: &mut T) {
+    for n in T::TABLE {
+        ui.radio_value(value, n.value, n.label).on_hover_text(n.help);
+    }
+}
 
 pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("Build");
@@ -14,9 +27,9 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             .add_enabled(!on, egui::Button::new(text))
             .on_hover_text(format!(
                 "One click to {}: the BVH a student writes in the lab, so the figures compare with yours",
-                preset.description()
+                preset.help()
             ))
-            .on_disabled_hover_text(format!("These are the settings of {}", preset.description()))
+            .on_disabled_hover_text(format!("These are the settings of {}", preset.help()))
             .clicked()
         {
             app.apply_preset(preset);
@@ -36,14 +49,13 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
                     .selected_text(s.top_build.strategy.label())
                     .show_ui(ui, |ui| {
                         for k in SplitStrategy::ALL {
-                            ui.selectable_value(&mut s.top_build.strategy, k, k.label()).on_hover_text(k.description());
+                            ui.selectable_value(&mut s.top_build.strategy, k, k.label()).on_hover_text(k.help());
                         }
                     })
                     .response
                     .labelled_by(label.id);
             });
-            ui.add(egui::Slider::new(&mut s.top_build.max_leaf_size, 1..=16).text("Placements per leaf"))
-                .on_hover_text("Most placements in a leaf of the top level");
+            number(ui, &mut s.top_build.max_leaf_size, &TOP_MAX_LEAF_SIZE, true);
             ui.label("Bottom level (each mesh's BVH)");
         }
     }
@@ -53,48 +65,25 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         .width(200.0)
         .show_ui(ui, |ui| {
             for k in SplitStrategy::ALL {
-                ui.selectable_value(&mut s.build.strategy, k, k.label()).on_hover_text(k.description());
+                ui.selectable_value(&mut s.build.strategy, k, k.label()).on_hover_text(k.help());
             }
         })
         .response
         .labelled_by(label.id)
-        .on_hover_text(s.build.strategy.description());
+        .on_hover_text(s.build.strategy.help());
 
-    ui.add(egui::Slider::new(&mut s.build.max_leaf_size, 1..=32).text("Max leaf size"))
-        .on_hover_text("Most triangles in a leaf. The SAH strategies may stop earlier when a leaf is cheaper.");
+    number(ui, &mut s.build.max_leaf_size, &MAX_LEAF_SIZE, true);
     let sah = s.build.strategy == SplitStrategy::SahBinned;
-    ui.add_enabled(sah, egui::Slider::new(&mut s.build.sah_bins, 2..=64).text("SAH bins"))
-        .on_hover_text("Bins per axis of the binned SAH: more bins, closer to the exact sweep, slower build. Small nodes use fewer: a third of their triangle count, at least 4 (never more than asked for).");
-    ui.add(egui::Slider::new(&mut s.build.cost.traversal, 0.1..=4.0).text("SAH traversal cost"))
-        .on_hover_text("Cost of one traversal step relative to one triangle test (1 = equal).");
+    ui.add_enabled_ui(sah, |ui| number(ui, &mut s.build.sah_bins, &SAH_BINS, true));
+    number(ui, &mut s.build.cost.traversal, &TRAVERSAL_COST, true);
 
     ui.add_space(4.0);
     ui.label("Layout");
-    for l in Layout::ALL {
-        let tip = match l {
-            Layout::Binary => "The binary BVH as built (two children per node), as in the handout",
-            Layout::Wide4 => "Collapsed into 4-wide nodes whose boxes are tested together with SIMD: faster",
-        };
-        ui.radio_value(&mut s.build.layout, l, l.label()).on_hover_text(tip);
-    }
+    radios(ui, &mut s.build.layout);
     ui.label("Traversal order (binary layout)");
-    for o in TraversalOrder::ALL {
-        let tip = match o {
-            TraversalOrder::SplitAxisSign => {
-                "The handout's rule: the ray's sign on the node's split axis picks the near child"
-            }
-            TraversalOrder::EntryDistance => "Visit the child whose box the ray enters first",
-        };
-        ui.radio_value(&mut s.trace.order, o, o.label()).on_hover_text(tip);
-    }
+    radios(ui, &mut s.trace.order);
     ui.label("Triangle test");
-    for t in TriangleTest::ALL {
-        let tip = match t {
-            TriangleTest::Watertight => "Woop, Benthin & Wald 2013: no cracks along shared edges",
-            TriangleTest::MollerTrumbore => "Möller & Trumbore 1997: the classic; may miss rays exactly through edges",
-        };
-        ui.radio_value(&mut s.trace.test, t, t.label()).on_hover_text(tip);
-    }
+    radios(ui, &mut s.trace.test);
     if let Some(job) = &app.jobs.build {
         ui.horizontal(|ui| {
             ui.spinner();

@@ -4,22 +4,11 @@
 use crate::app::{BoxLevel, BvhscopeApp};
 use crate::render::{ColorMap, UpAxis, View};
 
-/// What a view shows, for its tooltip; `cost` is the combined-cost text with the constants in use.
+/// What a view shows, for its tooltip: its help, and for combined cost the constants in use.
 fn view_tip(v: View, cost: &str) -> String {
     match v {
-        View::Normals => {
-            "The surface normal as colour (n·0.5 + 0.5), as the handout's normal integrator draws it".into()
-        }
-        View::Depth => "Distance from the camera to the hit, near bright, far dim; misses black".into(),
-        View::Visits => {
-            "Heatmap of the nodes each primary ray visited (taken from the stack and processed, interior and leaf)"
-                .into()
-        }
-        View::TriTests => "Heatmap of the ray–triangle tests each primary ray made".into(),
         View::Cost => format!("Heatmap of each ray's combined cost. {cost}"),
-        View::TopVisits => "Nodes of the top level (over the placements) visited per ray".into(),
-        View::BottomVisits => "Nodes of the meshes' own BVHs visited per ray".into(),
-        View::Instances => "Placements whose mesh BVH the ray entered (moved into object space)".into(),
+        _ => v.help().to_string(),
     }
 }
 
@@ -99,7 +88,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             "Which axis of the mesh points up. Meshes exported Z-up (CAD, scans) look as if seen from underneath with Y up. Changing it resets the camera to the front view.",
         );
         for a in UpAxis::ALL {
-            ui.radio_value(&mut up, a, a.label());
+            ui.radio_value(&mut up, a, a.label()).on_hover_text(a.help());
         }
     });
 

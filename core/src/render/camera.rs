@@ -39,26 +39,10 @@ pub enum UpAxis {
 }
 
 impl UpAxis {
-    pub const ALL: [UpAxis; 2] = [UpAxis::Y, UpAxis::Z];
-
     pub fn vector(self) -> Vec3 {
         match self {
             UpAxis::Y => Vec3::Y,
             UpAxis::Z => Vec3::Z,
-        }
-    }
-
-    pub fn short_name(self) -> &'static str {
-        match self {
-            UpAxis::Y => "y",
-            UpAxis::Z => "z",
-        }
-    }
-
-    pub fn label(self) -> &'static str {
-        match self {
-            UpAxis::Y => "Y up",
-            UpAxis::Z => "Z up",
         }
     }
 

@@ -5,7 +5,7 @@
 //! binned in one pass over the triangles, so a node costs O(n + bins), with no per-node allocation
 //! below the top levels; big nodes are binned in parallel chunks.
 
-use super::{leaf_is_cheaper, partition, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
+use super::{partition, BuildPrim, NodeInfo, Proposal, Splitter};
 use crate::bvh::BuildParams;
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
@@ -86,17 +86,42 @@ impl Acc {
     }
 }
 
-pub fn split_sah_binned(
+/// The binned SAH with its scratch: the bins of the three axes, and per plane the right side's
+/// area on each axis (lanes 0..3).
+pub struct SahBinned {
+    max_bins: usize,
+    bins: Vec<Bin>,
+    plane_areas: Vec<Vec4>,
+}
+
+impl SahBinned {
+    pub fn new(params: &BuildParams) -> Self {
+        Self { max_bins: params.sah_bins as usize, bins: Vec::new(), plane_areas: Vec::new() }
+    }
+}
+
+impl Splitter for SahBinned {
+    fn prices_splits(&self) -> bool {
+        true
+    }
+
+    fn split(&mut self, prims: &mut [BuildPrim], node: &NodeInfo) -> Proposal {
+        binned(prims, node, self.max_bins, &mut self.bins, &mut self.plane_areas)
+    }
+}
+
+fn binned(
     prims: &mut [BuildPrim],
     node: &NodeInfo,
-    params: &BuildParams,
-    scratch: &mut SplitScratch,
-) -> SplitDecision {
+    max_bins: usize,
+    all: &mut Vec<Bin>,
+    right_area: &mut Vec<Vec4>,
+) -> Proposal {
     let n = prims.len();
     let cb = node.centroid_bounds;
     let extent = cb.max - cb.min;
     if n == 2 {
-        return split_two(prims, extent, node, params);
+        return split_two(prims, extent);
     }
     // A node of n triangles fills at most n bins per axis, and planes between bins of one or two
     // centroids seldom beat their neighbours; the sweeps, not the binning, are the cost of the
@@ -104,7 +129,7 @@ pub fn split_sah_binned(
     // one-thread build of the bunny 20.4 -> 19.2 ms (medians of seven alternated runs of 31
     // builds), SAH cost +0.1% (bunny 31.435 -> 31.459, beast 20.502 -> 20.516, 2M knot
     // 53.18 -> 53.23).
-    let bins = (params.sah_bins as usize).min((n / 3).max(4)).clamp(2, MAX_BINS);
+    let bins = max_bins.min((n / 3).max(4)).clamp(2, MAX_BINS);
     // Axes with no extent cannot be split by a plane; their scale 0 puts everything in bin 0.
     let scale: [f32; 3] = std::array::from_fn(|a| if extent[a] > 0.0 { bins as f32 / extent[a] } else { 0.0 });
     let (lo, sc, top) = (Vec3A::from(cb.min), Vec3A::from(Vec3::from(scale)), Vec3A::splat((bins - 1) as f32));
@@ -119,7 +144,6 @@ pub fn split_sah_binned(
             }
         }
     };
-    let all = &mut scratch.bins;
     all.clear();
     all.resize(3 * bins, Bin::EMPTY);
     if n >= PARALLEL_BINNING_MIN {
@@ -147,7 +171,6 @@ pub fn split_sah_binned(
     // The three axes are swept together, plane by plane, with lane k of each vector for axis k:
     // three independent chains of box unions, and the three areas and costs of a plane computed
     // with one set of SIMD operations.
-    let right_area = &mut scratch.plane_areas;
     right_area.clear();
     right_area.resize(bins, Vec4::ZERO);
     let bin = |axis: usize, i: usize| &all[axis * bins + i];
@@ -186,11 +209,8 @@ pub fn split_sah_binned(
     }
     let best = (best_plane != 0).then_some((best_cost, best_axis, best_plane));
     let Some((weighted, axis, plane)) = best else {
-        return SplitDecision::Fallback; // all centroids coincide
+        return Proposal::None; // all centroids coincide
     };
-    if leaf_is_cheaper(n, weighted, node, params) {
-        return SplitDecision::Leaf;
-    }
     let (lo, s, plane) = (cb.min[axis], scale[axis], plane as f32);
     // Same arithmetic as the binning above (SIMD there, scalar here: IEEE gives equal results).
     // For an integer plane in 1..bins, floor(clamp(x, 0, bins - 1)) < plane ⟺ x < plane, so the
@@ -201,7 +221,7 @@ pub fn split_sah_binned(
         all[axis * bins..axis * bins + plane as usize].iter().map(|b| b.count as usize).sum::<usize>(),
         "the partition sends left exactly the triangles binned left of the plane"
     );
-    SplitDecision::Split { axis: axis as u8, mid }
+    Proposal::Split { axis: axis as u8, mid, weighted: Some(weighted) }
 }
 
 /// The partition's side for a scaled centroid offset and an integer plane in 1..bins: left exactly
@@ -227,18 +247,15 @@ fn areas3(boxes: &[Acc; 3]) -> Vec4 {
 /// Two triangles: every plane between their centroids makes the same two one-triangle children, so
 /// their cost is computed directly (what the bins would give, without them); the axis is the first
 /// with extent, as the sweep would pick, and the triangle of the lower centroid goes left.
-fn split_two(prims: &mut [BuildPrim], extent: Vec3, node: &NodeInfo, params: &BuildParams) -> SplitDecision {
+fn split_two(prims: &mut [BuildPrim], extent: Vec3) -> Proposal {
     let Some(axis) = (0..3).find(|&a| extent[a] > 0.0) else {
-        return SplitDecision::Fallback; // both centroids coincide
+        return Proposal::None; // both centroids coincide
     };
     let weighted = Acc::of(&prims[0]).area() + Acc::of(&prims[1]).area();
-    if leaf_is_cheaper(2, weighted, node, params) {
-        return SplitDecision::Leaf;
-    }
     if prims[0].centroid()[axis] > prims[1].centroid()[axis] {
         prims.swap(0, 1);
     }
-    SplitDecision::Split { axis: axis as u8, mid: 1 }
+    Proposal::Split { axis: axis as u8, mid: 1, weighted: Some(weighted) }
 }
 
 #[cfg(test)]

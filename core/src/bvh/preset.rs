@@ -16,32 +16,8 @@ pub enum Preset {
 }
 
 impl Preset {
-    pub const ALL: [Preset; 1] = [Preset::Handout];
-
     /// The handout preset's leaf size: small, as a first BVH's leaves usually are.
     pub const HANDOUT_MAX_LEAF_SIZE: u32 = 4;
-
-    pub fn short_name(self) -> &'static str {
-        match self {
-            Preset::Handout => "handout",
-        }
-    }
-
-    pub fn label(self) -> &'static str {
-        match self {
-            Preset::Handout => "Handout mode",
-        }
-    }
-
-    /// What the preset sets, in one sentence (tooltip and `--help`).
-    pub fn description(self) -> String {
-        match self {
-            Preset::Handout => format!(
-                "the lab's BVH: midpoint split, binary layout, split-axis-sign order, Möller–Trumbore test, max leaf size {} (the handout leaves it to you), one level",
-                Self::HANDOUT_MAX_LEAF_SIZE
-            ),
-        }
-    }
 
     /// The build parameters the preset sets (the SAH constants and bins stay at their defaults).
     pub fn build(self) -> BuildParams {

@@ -1,6 +1,7 @@
-//! Split strategies: given the primitives of one node, decide whether to make a leaf or where to
-//! split, and partition the primitives accordingly. One file per strategy; the driver that calls
-//! them is `bvh::build`.
+//! Split strategies: given the primitives of one node, propose where to split and partition the
+//! primitives accordingly. One file per strategy, each a `Splitter` that keeps the scratch memory it
+//! reuses from node to node; the driver that calls them, and decides leaf or split, is
+//! `bvh::build`.
 
 mod equal_count;
 mod midpoint;
@@ -10,15 +11,41 @@ mod sah_sweep;
 use crate::geometry::Aabb;
 use glam::{Vec3A, Vec4};
 
-pub use equal_count::split_equal_count;
-pub use midpoint::split_midpoint;
-pub use sah_binned::split_sah_binned;
+pub use equal_count::EqualCount;
+pub use midpoint::Midpoint;
+pub use sah_binned::SahBinned;
+pub use sah_sweep::SahSweep;
 
 /// The largest bin count the binned SAH accepts.
 pub const fn sah_binned_max_bins() -> usize {
     sah_binned::MAX_BINS
 }
-pub use sah_sweep::split_sah_sweep;
+
+/// A split strategy at work on one tree: it proposes a split of a node's primitives, partitioning
+/// them, and owns the scratch memory it reuses from node to node (no allocation per node).
+pub trait Splitter: Send {
+    /// Whether the strategy prices its splits with the SAH (`Proposal::weighted`). Those are asked
+    /// even about nodes small enough for a leaf; the others are asked only about nodes that must
+    /// be split.
+    fn prices_splits(&self) -> bool {
+        false
+    }
+
+    /// Propose a split of `prims`, partitioned so the first `mid` go left.
+    fn split(&mut self, prims: &mut [BuildPrim], node: &NodeInfo) -> Proposal;
+}
+
+impl SplitStrategy {
+    /// A splitter of this strategy for a build with `params`.
+    pub fn splitter(self, params: &crate::bvh::BuildParams) -> Box<dyn Splitter> {
+        match self {
+            SplitStrategy::Midpoint => Box::new(Midpoint),
+            SplitStrategy::EqualCount => Box::new(EqualCount),
+            SplitStrategy::SahBinned => Box::new(SahBinned::new(params)),
+            SplitStrategy::SahSweep => Box::new(SahSweep::new(params)),
+        }
+    }
+}
 
 /// How the builder chooses splits.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -32,46 +59,6 @@ pub enum SplitStrategy {
     SahBinned,
     /// Surface area heuristic, evaluated between every pair of neighbouring centroids.
     SahSweep,
-}
-
-impl SplitStrategy {
-    pub const ALL: [SplitStrategy; 4] =
-        [SplitStrategy::Midpoint, SplitStrategy::EqualCount, SplitStrategy::SahBinned, SplitStrategy::SahSweep];
-
-    /// Kebab-case name used on the command line.
-    pub fn short_name(self) -> &'static str {
-        match self {
-            SplitStrategy::Midpoint => "midpoint",
-            SplitStrategy::EqualCount => "equal-count",
-            SplitStrategy::SahBinned => "sah",
-            SplitStrategy::SahSweep => "sah-sweep",
-        }
-    }
-
-    pub fn label(self) -> &'static str {
-        match self {
-            SplitStrategy::Midpoint => "Midpoint",
-            SplitStrategy::EqualCount => "Equal count",
-            SplitStrategy::SahBinned => "SAH binned",
-            SplitStrategy::SahSweep => "SAH sweep",
-        }
-    }
-
-    /// One line for a tooltip or `--help`.
-    pub fn description(self) -> &'static str {
-        match self {
-            SplitStrategy::Midpoint => {
-                "split the widest axis of the centroid bounds in the middle; fast, poor on uneven meshes"
-            }
-            SplitStrategy::EqualCount => {
-                "split at the median centroid of the widest axis; balanced tree, ignores box sizes"
-            }
-            SplitStrategy::SahBinned => "surface area heuristic over bins on all axes; near-best trees, fast to build",
-            SplitStrategy::SahSweep => {
-                "surface area heuristic tried between every pair of centroids; exact, slowest to build"
-            }
-        }
-    }
 }
 
 /// A triangle as the builder sees it: its bounds in SIMD registers' layout (a box union is two
@@ -126,36 +113,15 @@ pub struct NodeInfo {
     pub centroid_bounds: Aabb,
 }
 
-/// A strategy's answer. `Split::mid` is the partition point: `prims[..mid]` go left.
+/// A strategy's answer.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum SplitDecision {
-    Leaf,
-    Split {
-        axis: u8,
-        mid: usize,
-    },
-    /// The strategy found no useful split (e.g. midpoint with one side empty). The driver makes a
+pub enum Proposal {
+    /// `prims[..mid]` go left. `weighted`: for a strategy that prices its split with the SAH, the
+    /// sum A_L·n_L + A_R·n_R of the two sides (the driver compares it with a leaf's cost).
+    Split { axis: u8, mid: usize, weighted: Option<f32> },
+    /// No useful split (midpoint with one side empty, coincident centroids). The driver makes a
     /// leaf if the triangles fit in one, else splits by equal count and counts it in the statistics.
-    Fallback,
-}
-
-/// Scratch memory a strategy may reuse from node to node (no allocation per node).
-#[derive(Default)]
-pub struct SplitScratch {
-    pub areas: Vec<f32>,
-    /// Per plane of the binned SAH, the right side's area on each axis (lanes 0..3).
-    pub plane_areas: Vec<Vec4>,
-    pub bins: Vec<sah_binned::Bin>,
-}
-
-/// The SAH's leaf-or-split decision: a leaf (allowed only up to the maximum leaf size) costs
-/// C_isect·n; the best split costs C_trav + C_isect·(A_L·n_L + A_R·n_R)/A, where `weighted` is the
-/// sum in parentheses.
-#[inline]
-pub(crate) fn leaf_is_cheaper(n: usize, weighted: f32, node: &NodeInfo, params: &crate::bvh::BuildParams) -> bool {
-    let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
-    let leaf_cost = params.cost.intersection * n as f32;
-    n <= params.max_leaf_size as usize && leaf_cost <= split_cost
+    None,
 }
 
 /// Move the elements satisfying `left` to the front; returns how many there are. Unstable.

@@ -3,7 +3,7 @@
 //! ray tracing using space subdivision" (The Visual Computer, 1990); Wald 2007 §3 for the sweep.
 //! O(n log n) per node; use the binned version for big meshes in interactive work.
 
-use super::{leaf_is_cheaper, BuildPrim, NodeInfo, SplitDecision, SplitScratch};
+use super::{BuildPrim, NodeInfo, Proposal, Splitter};
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 
@@ -11,14 +11,29 @@ fn sort_on(prims: &mut [BuildPrim], axis: usize) {
     prims.sort_unstable_by(|a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]).then(a.index().cmp(&b.index())));
 }
 
-pub fn split_sah_sweep(
-    prims: &mut [BuildPrim],
-    node: &NodeInfo,
-    params: &BuildParams,
-    scratch: &mut SplitScratch,
-) -> SplitDecision {
+/// The exact sweep, with its scratch: the area of every suffix of the sorted primitives.
+pub struct SahSweep {
+    right_area: Vec<f32>,
+}
+
+impl SahSweep {
+    pub fn new(_params: &BuildParams) -> Self {
+        Self { right_area: Vec::new() }
+    }
+}
+
+impl Splitter for SahSweep {
+    fn prices_splits(&self) -> bool {
+        true
+    }
+
+    fn split(&mut self, prims: &mut [BuildPrim], node: &NodeInfo) -> Proposal {
+        sweep(prims, node, &mut self.right_area)
+    }
+}
+
+fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>) -> Proposal {
     let n = prims.len();
-    let right_area = &mut scratch.areas;
     right_area.clear();
     right_area.resize(n, 0.0);
     let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, mid)
@@ -49,13 +64,10 @@ pub fn split_sah_sweep(
         }
     }
     let Some((weighted, axis, mid)) = best else {
-        return SplitDecision::Fallback;
+        return Proposal::None;
     };
-    if leaf_is_cheaper(n, weighted, node, params) {
-        return SplitDecision::Leaf;
-    }
     if sorted_on != Some(axis) {
         sort_on(prims, axis);
     }
-    SplitDecision::Split { axis: axis as u8, mid }
+    Proposal::Split { axis: axis as u8, mid, weighted: Some(weighted) }
 }

@@ -11,17 +11,6 @@ pub enum ColorMap {
 }
 
 impl ColorMap {
-    pub const ALL: [ColorMap; 4] = [ColorMap::Viridis, ColorMap::Inferno, ColorMap::Magma, ColorMap::Turbo];
-
-    pub fn label(self) -> &'static str {
-        match self {
-            ColorMap::Viridis => "viridis",
-            ColorMap::Inferno => "inferno",
-            ColorMap::Magma => "magma",
-            ColorMap::Turbo => "turbo",
-        }
-    }
-
     fn gradient(self) -> colorous::Gradient {
         match self {
             ColorMap::Viridis => colorous::VIRIDIS,

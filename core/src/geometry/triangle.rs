@@ -28,17 +28,6 @@ pub enum TriangleTest {
     MollerTrumbore,
 }
 
-impl TriangleTest {
-    pub const ALL: [TriangleTest; 2] = [TriangleTest::Watertight, TriangleTest::MollerTrumbore];
-
-    pub fn label(self) -> &'static str {
-        match self {
-            TriangleTest::Watertight => "watertight",
-            TriangleTest::MollerTrumbore => "Möller–Trumbore",
-        }
-    }
-}
-
 /// A ray–triangle test with per-ray precomputation, used as a type parameter of the traversal so
 /// the choice costs nothing per triangle.
 pub trait TriangleIntersector: Copy + Send + Sync + 'static {

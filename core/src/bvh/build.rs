@@ -5,17 +5,15 @@
 //! split, so the two children of a node are adjacent and an interior node needs only one index.
 
 use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
-use super::split::{self, BuildPrim, NodeInfo, SplitDecision, SplitScratch, SplitStrategy};
+use super::split::{BuildPrim, EqualCount, NodeInfo, Proposal, SplitStrategy, Splitter};
 use super::subtree::Subtree;
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
+use crate::options::{MAX_LEAF_SIZE, SAH_BINS, TRAVERSAL_COST};
 use crate::work::{Cancelled, WorkControl};
 use glam::Vec3A;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
-
-/// Largest leaf the node format can hold (its count field is 16 bits); we cap far lower.
-pub const MAX_LEAF_SIZE_LIMIT: u32 = 255;
 
 /// Below this depth a node is always split by equal count, whatever the strategy says. Equal
 /// count halves the range, so the tree depth stays under `HEURISTIC_DEPTH_LIMIT + 32`, inside the
@@ -37,7 +35,7 @@ pub struct SahCost {
 
 impl Default for SahCost {
     fn default() -> Self {
-        Self { traversal: 1.0, intersection: 1.0 }
+        Self { traversal: TRAVERSAL_COST.default, intersection: 1.0 }
     }
 }
 
@@ -49,24 +47,6 @@ pub enum Layout {
     /// The binary BVH collapsed into 4-wide nodes traversed with SIMD box tests (`bvh::wide`).
     #[default]
     Wide4,
-}
-
-impl Layout {
-    pub const ALL: [Layout; 2] = [Layout::Binary, Layout::Wide4];
-
-    pub fn label(self) -> &'static str {
-        match self {
-            Layout::Binary => "binary",
-            Layout::Wide4 => "4-wide SIMD",
-        }
-    }
-
-    pub fn short_name(self) -> &'static str {
-        match self {
-            Layout::Binary => "binary",
-            Layout::Wide4 => "wide4",
-        }
-    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -87,8 +67,8 @@ impl Default for BuildParams {
     fn default() -> Self {
         Self {
             strategy: SplitStrategy::SahBinned,
-            max_leaf_size: 4,
-            sah_bins: 16,
+            max_leaf_size: MAX_LEAF_SIZE.default,
+            sah_bins: SAH_BINS.default,
             cost: SahCost::default(),
             layout: Layout::default(),
         }
@@ -180,8 +160,9 @@ impl BuildParams {
     /// The parameters with every field in the range the builder accepts.
     fn clamped(&self) -> BuildParams {
         BuildParams {
-            max_leaf_size: self.max_leaf_size.clamp(1, MAX_LEAF_SIZE_LIMIT),
-            sah_bins: self.sah_bins.clamp(2, split::sah_binned_max_bins() as u32),
+            max_leaf_size: MAX_LEAF_SIZE.clamp(self.max_leaf_size),
+            sah_bins: SAH_BINS.clamp(self.sah_bins),
+            cost: SahCost { traversal: TRAVERSAL_COST.clamp(self.cost.traversal), ..self.cost },
             ..*self
         }
     }
@@ -329,48 +310,70 @@ impl std::ops::AddAssign for Overrides {
     }
 }
 
-/// The split of one node: the strategy's answer, checked and, where needed, replaced.
+/// What becomes of a node.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Decision {
+    Leaf,
+    /// `prims[..mid]` go to the left child.
+    Split {
+        axis: u8,
+        mid: usize,
+    },
+}
+
+/// The SAH's comparison of a leaf with the best split (Goldsmith & Salmon 1987; pbrt-v4 §7.3.2): a
+/// leaf costs C_isect·n; the split costs C_trav + C_isect·(A_L·n_L + A_R·n_R)/A, where `weighted`
+/// is the sum in parentheses.
+fn leaf_is_cheaper(n: usize, weighted: f32, node: &NodeInfo, params: &BuildParams) -> bool {
+    let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
+    let leaf_cost = params.cost.intersection * n as f32;
+    leaf_cost <= split_cost
+}
+
+/// Leaf or split, for every strategy, decided here and nowhere else: a single triangle is a leaf;
+/// below the depth limit every node is split by equal count; a node that fits in a leaf is one,
+/// unless the strategy prices splits (the SAH) and its best split is cheaper; a node that does not
+/// fit is split as the strategy proposes, or by equal count when it finds no useful split.
 fn decide(
     range: &mut [BuildPrim],
     info: &NodeInfo,
     depth: u32,
     params: &BuildParams,
-    scratch: &mut SplitScratch,
+    splitter: &mut dyn Splitter,
     over: &mut Overrides,
-) -> SplitDecision {
+) -> Decision {
     let n = range.len();
     if n == 1 {
-        return SplitDecision::Leaf;
+        return Decision::Leaf;
     }
+    let equal_count = |range: &mut [BuildPrim]| {
+        let (axis, mid) = EqualCount::median(range, info);
+        Decision::Split { axis, mid }
+    };
     if depth >= HEURISTIC_DEPTH_LIMIT {
         over.depth_limited += 1;
-        return split::split_equal_count(range, info);
+        return equal_count(range);
     }
-    let d = match params.strategy {
-        SplitStrategy::Midpoint | SplitStrategy::EqualCount if n <= params.max_leaf_size as usize => {
-            SplitDecision::Leaf
+    let fits = n <= params.max_leaf_size as usize;
+    if fits && !splitter.prices_splits() {
+        return Decision::Leaf;
+    }
+    match splitter.split(range, info) {
+        // A split must leave both sides non-empty.
+        Proposal::Split { axis, mid, weighted } if mid > 0 && mid < n => {
+            if fits && weighted.is_none_or(|w| leaf_is_cheaper(n, w, info, params)) {
+                Decision::Leaf
+            } else {
+                Decision::Split { axis, mid }
+            }
         }
-        SplitStrategy::Midpoint => split::split_midpoint(range, info),
-        SplitStrategy::EqualCount => split::split_equal_count(range, info),
-        SplitStrategy::SahBinned => split::split_sah_binned(range, info, params, scratch),
-        SplitStrategy::SahSweep => split::split_sah_sweep(range, info, params, scratch),
-    };
-    match d {
-        // No useful split, but the triangles fit in a leaf: that is the best we can do
-        // (e.g. the two halves of a quad whose diagonal spans its box share a centroid).
-        SplitDecision::Fallback if n <= params.max_leaf_size as usize => SplitDecision::Leaf,
-        // A strategy may only ask for a leaf that fits; otherwise split it anyway.
-        SplitDecision::Leaf if n > params.max_leaf_size as usize => {
+        // No useful split, but the triangles fit in a leaf: that is the best we can do (e.g. the
+        // two halves of a quad whose diagonal spans its box share a centroid).
+        _ if fits => Decision::Leaf,
+        _ => {
             over.fallback += 1;
-            split::split_equal_count(range, info)
+            equal_count(range)
         }
-        // A split must leave both sides non-empty; treat anything else like a fallback.
-        SplitDecision::Fallback | SplitDecision::Split { .. } if !matches!(d, SplitDecision::Split { mid, .. } if mid > 0 && mid < n) =>
-        {
-            over.fallback += 1;
-            split::split_equal_count(range, info)
-        }
-        d => d,
     }
 }
 
@@ -397,8 +400,8 @@ fn build_subtree(
     progress.check()?;
     let info = node_info(prims);
     let mut over = Overrides::default();
-    let decision = decide(prims, &info, depth, params, &mut SplitScratch::default(), &mut over);
-    let SplitDecision::Split { axis, mid } = decision else {
+    let decision = decide(prims, &info, depth, params, &mut *params.strategy.splitter(params), &mut over);
+    let Decision::Split { axis, mid } = decision else {
         return sequential(prims);
     };
     progress.split(prims.len(), depth);
@@ -428,7 +431,7 @@ fn build_sequential(
     if prims.is_empty() {
         return Ok((nodes, over)); // one empty leaf: every ray misses its empty box
     }
-    let mut scratch = SplitScratch::default();
+    let mut splitter = params.strategy.splitter(params);
     let mut stack = vec![Task { node: 0, start: 0, end: prims.len() as u32, depth: depth0 }];
     let mut steps = 0u32;
     while let Some(task) = stack.pop() {
@@ -439,8 +442,8 @@ fn build_sequential(
         let range = &mut prims[task.start as usize..task.end as usize];
         let info = node_info(range);
         let n = range.len();
-        match decide(range, &info, task.depth, params, &mut scratch, &mut over) {
-            SplitDecision::Split { axis, mid } => {
+        match decide(range, &info, task.depth, params, &mut *splitter, &mut over) {
+            Decision::Split { axis, mid } => {
                 let left = nodes.len() as u32;
                 nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
                 nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
@@ -452,7 +455,7 @@ fn build_sequential(
                 stack.push(Task { node: left + 1, start: mid, end: task.end, depth });
                 stack.push(Task { node: left, start: task.start, end: mid, depth });
             }
-            _ => {
+            Decision::Leaf => {
                 nodes[task.node as usize] = BvhNode::leaf(info.bounds, offset + task.start, n as u16);
                 progress.leaf(n, task.depth);
             }

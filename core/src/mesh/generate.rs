@@ -359,7 +359,10 @@ mod tests {
     fn assets_are_named_and_sound() {
         let assets = assets();
         let names: Vec<&str> = assets.iter().map(|(n, _)| *n).collect();
-        assert_eq!(names, ["torus.obj", "cornell-box.obj", "stadium.obj", "diagonal-rods.obj", "floor.obj", "knot.obj"]);
+        assert_eq!(
+            names,
+            ["torus.obj", "cornell-box.obj", "stadium.obj", "diagonal-rods.obj", "floor.obj", "knot.obj"]
+        );
         for (name, m) in &assets {
             assert!(m.triangle_count() > 0, "{name}");
             assert_no_degenerate(m);

@@ -23,7 +23,7 @@ pub mod wide;
 
 pub use accel::{Accelerator, Hit, TraceOptions, TraversalOrder};
 pub use any::AnyBvh;
-pub use build::{BuildParams, BuildReport, Layout, SahCost, MAX_LEAF_SIZE_LIMIT};
+pub use build::{BuildParams, BuildReport, Layout, SahCost};
 pub use counters::{NoStats, RayCounters, TraversalStats};
 pub use linear::LinearScan;
 pub use node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};

@@ -26,46 +26,9 @@ pub enum View {
 }
 
 impl View {
-    pub const ALL: [View; 8] = [
-        View::Normals,
-        View::Depth,
-        View::Visits,
-        View::TriTests,
-        View::Cost,
-        View::TopVisits,
-        View::BottomVisits,
-        View::Instances,
-    ];
-
     /// Whether the view is about the levels of a two-level BVH (all zero for a single BVH).
     pub fn is_per_level(self) -> bool {
         matches!(self, View::TopVisits | View::BottomVisits | View::Instances)
-    }
-
-    pub fn short_name(self) -> &'static str {
-        match self {
-            View::Normals => "normals",
-            View::Depth => "depth",
-            View::Visits => "visits",
-            View::TriTests => "tri-tests",
-            View::Cost => "cost",
-            View::TopVisits => "top-visits",
-            View::BottomVisits => "bottom-visits",
-            View::Instances => "instances",
-        }
-    }
-
-    pub fn label(self) -> &'static str {
-        match self {
-            View::Normals => "Normals",
-            View::Depth => "Depth",
-            View::Visits => "Nodes visited",
-            View::TriTests => "Triangle tests",
-            View::Cost => "Combined cost",
-            View::TopVisits => "Top-level nodes visited",
-            View::BottomVisits => "Bottom-level nodes visited",
-            View::Instances => "Instances entered",
-        }
     }
 
     pub fn is_heatmap(self) -> bool {

@@ -22,7 +22,7 @@ impl SceneBuild {
     /// "SAH binned, wide4", or "top SAH binned / Midpoint, binary" for two levels: the strategy and
     /// layout, as the statistics columns and exported images name a build.
     pub fn label(&self) -> String {
-        let one = format!("{}, {}", self.bvh.strategy.label(), self.bvh.layout.short_name());
+        let one = format!("{}, {}", self.bvh.strategy.label(), self.bvh.layout.name());
         match self.top {
             Some(top) => format!("top {} / {one}", top.strategy.label()),
             None => one,

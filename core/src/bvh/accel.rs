@@ -30,17 +30,6 @@ pub enum TraversalOrder {
     EntryDistance,
 }
 
-impl TraversalOrder {
-    pub const ALL: [TraversalOrder; 2] = [TraversalOrder::SplitAxisSign, TraversalOrder::EntryDistance];
-
-    pub fn label(self) -> &'static str {
-        match self {
-            TraversalOrder::SplitAxisSign => "split-axis sign",
-            TraversalOrder::EntryDistance => "entry distance",
-        }
-    }
-}
-
 /// Run-time choices of a query; each combination is its own compiled loop.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct TraceOptions {

@@ -3,7 +3,7 @@
 //! names it (`meshes[1].transform.rotate.degrees: expected a number, found a string`).
 
 use super::{join, kind, resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
-use crate::bvh::{BuildParams, Layout, SplitStrategy};
+use crate::bvh::BuildParams;
 use crate::render::Camera;
 use glam::{Affine3A, Mat4, Vec3};
 use std::path::Path;
@@ -126,35 +126,35 @@ fn transform(t: &serde_json::Value, field: &str, f: &Fields) -> Result<Affine3A,
     Ok(trs(translate, axis, degrees.to_radians(), scale))
 }
 
+/// The scene's `bvh` object: the names and limits of `crate::options`, as the CLI takes them.
 fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
+    use crate::options::{Choice, Number, MAX_LEAF_SIZE, SAH_BINS, TRAVERSAL_COST};
+    fn choice<T: Choice>(v: &serde_json::Value, field: &str, f: &Fields) -> Result<T, SceneError> {
+        v.as_str().and_then(T::from_name).ok_or_else(|| f.err(field, format!("expected one of {}", T::names())))
+    }
+    fn whole(v: &serde_json::Value, n: &Number<u32>, field: &str, f: &Fields) -> Result<u32, SceneError> {
+        match v.as_u64() {
+            Some(x) if x <= u32::MAX as u64 && n.contains(x as u32) => Ok(x as u32),
+            _ => Err(f.err(field, format!("expected a whole number {}", n.range_text()))),
+        }
+    }
     let o = b.as_object().ok_or_else(|| f.err("bvh", format!("expected an object, found {}", kind(b))))?;
     let mut p = BuildParams::default();
     for (key, v) in o {
         let field = join("bvh", key);
         match key.as_str() {
-            "strategy" => {
-                let s = v.as_str().unwrap_or_default();
-                p.strategy = SplitStrategy::ALL.into_iter().find(|k| k.short_name() == s).ok_or_else(|| {
-                    let names: Vec<&str> = SplitStrategy::ALL.iter().map(|k| k.short_name()).collect();
-                    f.err(&field, format!("expected one of {}", names.join(", ")))
-                })?;
-            }
-            "layout" => {
-                let s = v.as_str().unwrap_or_default();
-                p.layout = Layout::ALL
-                    .into_iter()
-                    .find(|l| l.short_name() == s)
-                    .ok_or_else(|| f.err(&field, "expected binary or wide4"))?;
-            }
-            "max_leaf_size" => match v.as_u64() {
-                Some(n @ 1..=255) => p.max_leaf_size = n as u32,
-                _ => return Err(f.err(&field, "expected a whole number 1..=255")),
+            "strategy" => p.strategy = choice(v, &field, f)?,
+            "layout" => p.layout = choice(v, &field, f)?,
+            k if k == MAX_LEAF_SIZE.key => p.max_leaf_size = whole(v, &MAX_LEAF_SIZE, &field, f)?,
+            k if k == SAH_BINS.key => p.sah_bins = whole(v, &SAH_BINS, &field, f)?,
+            k if k == TRAVERSAL_COST.key => match v.as_f64() {
+                Some(x) if TRAVERSAL_COST.contains(x as f32) => p.cost.traversal = x as f32,
+                _ => return Err(f.err(&field, format!("expected a number {}", TRAVERSAL_COST.range_text()))),
             },
-            "bins" => match v.as_u64() {
-                Some(n @ 2..=256) => p.sah_bins = n as u32,
-                _ => return Err(f.err(&field, "expected a whole number 2..=256")),
-            },
-            _ => return Err(f.err(&field, "unknown field (expected strategy, layout, max_leaf_size, bins)")),
+            _ => {
+                let keys = ["strategy", "layout", MAX_LEAF_SIZE.key, SAH_BINS.key, TRAVERSAL_COST.key].join(", ");
+                return Err(f.err(&field, format!("unknown field (expected {keys})")));
+            }
         }
     }
     Ok(p)
@@ -187,8 +187,8 @@ pub fn write_scene_file(camera: &Camera, meshes: &[super::SceneMesh], build: &Bu
         },
         "meshes": meshes,
         "bvh": {
-            "strategy": build.strategy.short_name(), "layout": build.layout.short_name(),
-            "max_leaf_size": build.max_leaf_size, "bins": build.sah_bins,
+            "strategy": build.strategy.name(), "layout": build.layout.name(),
+            "max_leaf_size": build.max_leaf_size, "bins": build.sah_bins, "traversal_cost": build.cost.traversal,
         },
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()

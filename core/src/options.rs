@@ -1,0 +1,359 @@
+//! Every option a user sets, described once: its name on the command line and in scene files, its
+//! label in the app, its help (the CLI's `--help` and the app's tooltips), and for numbers the
+//! limits and the default. The CLI, the build panel and the scene-file reader all read these
+//! tables, so none of them can accept a value the others refuse.
+
+use crate::bvh::{Layout, Preset, SplitStrategy, TraversalOrder};
+use crate::geometry::TriangleTest;
+use crate::render::{ColorMap, UpAxis, View};
+
+/// One value of a choice: what it is called where.
+#[derive(Clone, Copy, Debug)]
+pub struct Named<T> {
+    pub value: T,
+    /// Kebab-case: the command line and scene files.
+    pub name: &'static str,
+    /// The app.
+    pub label: &'static str,
+    /// One line for `--help` and tooltips.
+    pub help: &'static str,
+}
+
+/// A choice among named values (strategy, layout, view…), with its table.
+pub trait Choice: Copy + PartialEq + Send + Sync + 'static {
+    const TABLE: &'static [Named<Self>];
+
+    fn named(self) -> &'static Named<Self> {
+        Self::TABLE.iter().find(|n| n.value == self).expect("every value is in its table")
+    }
+    fn from_name(name: &str) -> Option<Self> {
+        Self::TABLE.iter().find(|n| n.name == name).map(|n| n.value)
+    }
+    /// The names, for messages that list what is accepted.
+    fn names() -> String {
+        Self::TABLE.iter().map(|n| n.name).collect::<Vec<_>>().join(", ")
+    }
+}
+
+/// The values of a table in its order (the choices' `ALL` constants).
+const fn values<T: Copy, const N: usize>(table: &[Named<T>; N]) -> [T; N] {
+    let mut out = [table[0].value; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = table[i].value;
+        i += 1;
+    }
+    out
+}
+
+/// `ALL`, `name`, `label`, `help` and `from_name` of a choice, read from its table.
+macro_rules! choice {
+    ($ty:ty, $table:ident, $n:literal) => {
+        impl Choice for $ty {
+            const TABLE: &'static [Named<Self>] = &$table;
+        }
+        impl $ty {
+            pub const ALL: [$ty; $n] = values(&$table);
+
+            pub fn name(self) -> &'static str {
+                Choice::named(self).name
+            }
+            pub fn label(self) -> &'static str {
+                Choice::named(self).label
+            }
+            pub fn help(self) -> &'static str {
+                Choice::named(self).help
+            }
+            pub fn from_name(name: &str) -> Option<Self> {
+                <Self as Choice>::from_name(name)
+            }
+        }
+    };
+}
+
+const STRATEGIES: [Named<SplitStrategy>; 4] = [
+    Named {
+        value: SplitStrategy::Midpoint,
+        name: "midpoint",
+        label: "Midpoint",
+        help: "split the widest axis of the centroid bounds in the middle; fast, poor on uneven meshes",
+    },
+    Named {
+        value: SplitStrategy::EqualCount,
+        name: "equal-count",
+        label: "Equal count",
+        help: "split at the median centroid of the widest axis; balanced tree, ignores box sizes",
+    },
+    Named {
+        value: SplitStrategy::SahBinned,
+        name: "sah",
+        label: "SAH binned",
+        help: "surface area heuristic over bins on all axes; near-best trees, fast to build",
+    },
+    Named {
+        value: SplitStrategy::SahSweep,
+        name: "sah-sweep",
+        label: "SAH sweep",
+        help: "surface area heuristic tried between every pair of centroids; exact, slowest to build",
+    },
+];
+choice!(SplitStrategy, STRATEGIES, 4);
+
+const LAYOUTS: [Named<Layout>; 2] = [
+    Named {
+        value: Layout::Binary,
+        name: "binary",
+        label: "binary",
+        help: "the binary BVH as built (two children per node), as in the handout",
+    },
+    Named {
+        value: Layout::Wide4,
+        name: "wide4",
+        label: "4-wide SIMD",
+        help: "collapsed into 4-wide nodes whose boxes are tested together with SIMD: faster",
+    },
+];
+choice!(Layout, LAYOUTS, 2);
+
+const ORDERS: [Named<TraversalOrder>; 2] = [
+    Named {
+        value: TraversalOrder::SplitAxisSign,
+        name: "split-axis",
+        label: "split-axis sign",
+        help: "the handout's rule: the ray's sign on the node's split axis picks the near child",
+    },
+    Named {
+        value: TraversalOrder::EntryDistance,
+        name: "entry-distance",
+        label: "entry distance",
+        help: "visit the child whose box the ray enters first",
+    },
+];
+choice!(TraversalOrder, ORDERS, 2);
+
+const TESTS: [Named<TriangleTest>; 2] = [
+    Named {
+        value: TriangleTest::Watertight,
+        name: "watertight",
+        label: "watertight",
+        help: "Woop, Benthin & Wald 2013: no cracks along shared edges",
+    },
+    Named {
+        value: TriangleTest::MollerTrumbore,
+        name: "moller-trumbore",
+        label: "Möller–Trumbore",
+        help: "Möller & Trumbore 1997: the classic; may miss rays exactly through edges",
+    },
+];
+choice!(TriangleTest, TESTS, 2);
+
+const VIEWS: [Named<View>; 8] = [
+    Named {
+        value: View::Normals,
+        name: "normals",
+        label: "Normals",
+        help: "the surface normal as colour (n·0.5 + 0.5), as the handout's normal integrator draws it",
+    },
+    Named {
+        value: View::Depth,
+        name: "depth",
+        label: "Depth",
+        help: "distance from the camera to the hit, near bright, far dim; misses black",
+    },
+    Named {
+        value: View::Visits,
+        name: "visits",
+        label: "Nodes visited",
+        help: "heatmap of the nodes each primary ray visited (taken from the stack and processed, interior and leaf)",
+    },
+    Named {
+        value: View::TriTests,
+        name: "tri-tests",
+        label: "Triangle tests",
+        help: "heatmap of the ray–triangle tests each primary ray made",
+    },
+    Named {
+        value: View::Cost,
+        name: "cost",
+        label: "Combined cost",
+        help: "heatmap of C_trav × nodes visited + C_isect × triangle tests, with the build's SAH constants",
+    },
+    Named {
+        value: View::TopVisits,
+        name: "top-visits",
+        label: "Top-level nodes visited",
+        help: "nodes of the top level (over the placements) visited per ray",
+    },
+    Named {
+        value: View::BottomVisits,
+        name: "bottom-visits",
+        label: "Bottom-level nodes visited",
+        help: "nodes of the meshes' own BVHs visited per ray",
+    },
+    Named {
+        value: View::Instances,
+        name: "instances",
+        label: "Instances entered",
+        help: "placements whose mesh BVH the ray entered (moved into object space)",
+    },
+];
+choice!(View, VIEWS, 8);
+
+const COLOR_MAPS: [Named<ColorMap>; 4] = [
+    Named { value: ColorMap::Viridis, name: "viridis", label: "viridis", help: "perceptually uniform, blue to yellow" },
+    Named {
+        value: ColorMap::Inferno,
+        name: "inferno",
+        label: "inferno",
+        help: "perceptually uniform, black to yellow",
+    },
+    Named { value: ColorMap::Magma, name: "magma", label: "magma", help: "perceptually uniform, black to white" },
+    Named { value: ColorMap::Turbo, name: "turbo", label: "turbo", help: "rainbow-like, more contrast, not uniform" },
+];
+choice!(ColorMap, COLOR_MAPS, 4);
+
+const UP_AXES: [Named<UpAxis>; 2] = [
+    Named { value: UpAxis::Y, name: "y", label: "Y up", help: "+y is up (most formats, the handout)" },
+    Named {
+        value: UpAxis::Z,
+        name: "z",
+        label: "Z up",
+        help: "+z is up (CAD, Blender coordinates, many scans); the default camera looks along +y",
+    },
+];
+choice!(UpAxis, UP_AXES, 2);
+
+const PRESETS: [Named<Preset>; 1] = [Named {
+    value: Preset::Handout,
+    name: "handout",
+    label: "Handout mode",
+    help: "the lab's BVH: midpoint split, binary layout, split-axis-sign order, Möller–Trumbore test, max leaf size 4 (the handout leaves it to you), one level",
+}];
+choice!(Preset, PRESETS, 1);
+
+/// A number a user sets: its names, help, limits (inclusive) and default.
+#[derive(Clone, Copy, Debug)]
+pub struct Number<T> {
+    /// Kebab-case: the command line (`--max-leaf-size`).
+    pub name: &'static str,
+    /// Snake-case: the scene file's `bvh` object.
+    pub key: &'static str,
+    pub label: &'static str,
+    pub help: &'static str,
+    pub min: T,
+    pub max: T,
+    pub default: T,
+}
+
+impl<T: PartialOrd + Copy> Number<T> {
+    pub fn contains(&self, v: T) -> bool {
+        self.min <= v && v <= self.max
+    }
+
+    /// `v` within the limits (a NaN, which is in no order with them, gives the default).
+    pub fn clamp(&self, v: T) -> T {
+        if v.partial_cmp(&self.min).is_none() {
+            self.default
+        } else if v < self.min {
+            self.min
+        } else if v > self.max {
+            self.max
+        } else {
+            v
+        }
+    }
+
+    /// The limits, for messages: "1..=255".
+    pub fn range_text(&self) -> String
+    where
+        T: std::fmt::Display,
+    {
+        format!("{}..={}", self.min, self.max)
+    }
+}
+
+/// Most triangles in a leaf (the node format's count field would take 65535; trees with leaves
+/// that big are not worth building).
+pub const MAX_LEAF_SIZE: Number<u32> = Number {
+    name: "max-leaf-size",
+    key: "max_leaf_size",
+    label: "Max leaf size",
+    help: "Most triangles in a leaf. The SAH strategies may stop earlier when a leaf is cheaper than a split.",
+    min: 1,
+    max: 255,
+    default: 4,
+};
+
+pub const SAH_BINS: Number<u32> = Number {
+    name: "bins",
+    key: "bins",
+    label: "SAH bins",
+    help: "Bins per axis of the binned SAH: more bins, closer to the exact sweep, slower build. Nodes of fewer than three triangles per bin use a third of their count, at least 4 (never more than asked for).",
+    min: 2,
+    max: crate::bvh::split::sah_binned_max_bins() as u32,
+    default: 16,
+};
+
+pub const TRAVERSAL_COST: Number<f32> = Number {
+    name: "traversal-cost",
+    key: "traversal_cost",
+    label: "SAH traversal cost",
+    help: "SAH cost of one traversal step relative to one triangle test (1 = equal).",
+    min: 0.01,
+    max: 100.0,
+    default: 1.0,
+};
+
+pub const TOP_MAX_LEAF_SIZE: Number<u32> = Number {
+    name: "top-max-leaf-size",
+    key: "top_max_leaf_size",
+    label: "Placements per leaf",
+    help: "Most placements in a leaf of the top level (two levels).",
+    min: 1,
+    max: 255,
+    default: 1,
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check<T: Choice + std::fmt::Debug>() {
+        for (i, n) in T::TABLE.iter().enumerate() {
+            assert_eq!(T::from_name(n.name), Some(n.value));
+            assert!(T::TABLE[..i].iter().all(|m| m.name != n.name && m.value != n.value), "{:?} twice", n.value);
+            assert!(!n.help.is_empty() && !n.label.is_empty());
+            assert!(n.name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-'), "{}", n.name);
+        }
+        assert_eq!(T::from_name("no such thing"), None);
+    }
+
+    #[test]
+    fn every_choice_is_named_once_and_found_by_its_name() {
+        check::<SplitStrategy>();
+        check::<Layout>();
+        check::<TraversalOrder>();
+        check::<TriangleTest>();
+        check::<View>();
+        check::<ColorMap>();
+        check::<UpAxis>();
+        check::<Preset>();
+        assert_eq!(SplitStrategy::ALL.len(), STRATEGIES.len());
+        assert_eq!(View::ALL[2], View::Visits);
+    }
+
+    #[test]
+    fn the_handout_help_states_the_leaf_size_the_preset_uses() {
+        let leaf = format!("max leaf size {}", Preset::HANDOUT_MAX_LEAF_SIZE);
+        assert!(Preset::Handout.help().contains(&leaf));
+    }
+
+    #[test]
+    fn numbers_clamp_into_their_limits() {
+        assert_eq!(MAX_LEAF_SIZE.clamp(0), 1);
+        assert_eq!(MAX_LEAF_SIZE.clamp(1000), 255);
+        assert_eq!(TRAVERSAL_COST.clamp(f32::NAN), 1.0);
+        assert!(SAH_BINS.contains(SAH_BINS.default) && MAX_LEAF_SIZE.contains(MAX_LEAF_SIZE.default));
+        assert_eq!(MAX_LEAF_SIZE.range_text(), "1..=255");
+    }
+}
