@@ -286,9 +286,9 @@ fn shared_cases() -> &'static [SharedCase] {
 /// in its box; all parameters in [0, 1].
 fn mesh_ray(mesh: &Mesh, from: Vec3, to: Vec3, inside: bool) -> Ray {
     let b = mesh.bounds();
-    let target = b.min + b.extent() * to;
+    let target = Vec3::from(b.min) + b.extent() * to;
     let origin = if inside {
-        b.min + b.extent() * from
+        Vec3::from(b.min) + b.extent() * from
     } else {
         let d = (from - 0.5).normalize_or(Vec3::X);
         b.center() + d * b.extent().length()

@@ -109,21 +109,21 @@ pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
         reached += 1;
         let node: &BvhNode = &bvh.nodes[i];
         if let Some(pb) = parent {
-            assert!(pb.contains_box(&node.bounds), "node {i} box sticks out of its parent");
+            assert!(pb.contains_box(&node.bounds()), "node {i} box sticks out of its parent");
         }
         if node.is_leaf() {
             assert!(node.count as u32 <= bvh.params.max_leaf_size, "leaf {i} has {} > max", node.count);
             for k in node.prims() {
                 for v in bvh.tris[k] {
-                    assert!(node.bounds.contains_box(&Aabb::new(v, v)), "leaf {i} does not contain its triangle");
+                    assert!(node.bounds().contains_box(&Aabb::new(v, v)), "leaf {i} does not contain its triangle");
                 }
             }
             leaf_ranges.push(node.prims());
         } else {
             let l = node.index as usize;
             assert!(l > i && l + 1 < bvh.nodes.len(), "child index of node {i}");
-            stack.push((l, Some(node.bounds)));
-            stack.push((l + 1, Some(node.bounds)));
+            stack.push((l, Some(node.bounds())));
+            stack.push((l + 1, Some(node.bounds())));
         }
     }
     assert_eq!(reached, bvh.nodes.len(), "every node is reachable exactly once");

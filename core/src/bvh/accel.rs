@@ -3,7 +3,7 @@
 
 use super::packet::PACKET;
 use super::TraversalStats;
-use crate::geometry::{Ray, TriangleTest};
+use crate::geometry::{Ray, TriangleIntersector, TriangleTest};
 
 /// A closest hit: distance, barycentrics and the mesh's triangle index.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,11 +37,65 @@ pub struct TraceOptions {
     pub test: TriangleTest,
 }
 
+/// Runs `$body` with the triangle test as type `$t` and the near-child rule as const `$bd` (true:
+/// entry distance) that `$opts` ask for: the one place where run-time options become compiled
+/// loops. Every combination is its own loop, so no choice costs a branch per node or triangle.
+macro_rules! dispatch {
+    ($opts:expr, |$t:ident, $bd:ident| $body:expr) => {{
+        use $crate::bvh::TraversalOrder as O;
+        use $crate::geometry::{MollerTrumbore, TriangleTest as Test, Watertight};
+        match ($opts.test, $opts.order) {
+            (Test::Watertight, O::EntryDistance) => {
+                type $t = Watertight;
+                const $bd: bool = true;
+                $body
+            }
+            (Test::Watertight, O::SplitAxisSign) => {
+                type $t = Watertight;
+                const $bd: bool = false;
+                $body
+            }
+            (Test::MollerTrumbore, O::EntryDistance) => {
+                type $t = MollerTrumbore;
+                const $bd: bool = true;
+                $body
+            }
+            (Test::MollerTrumbore, O::SplitAxisSign) => {
+                type $t = MollerTrumbore;
+                const $bd: bool = false;
+                $body
+            }
+        }
+    }};
+}
+pub(crate) use dispatch;
+
+/// What can be traced: every BVH layout, the two-level BVH and the linear scan. An implementation
+/// writes `trace`, its traversal compiled for one combination of options; `closest_hit` and
+/// `any_hit`, written here once, pick the combination the run-time options ask for.
 pub trait Accelerator: Sync {
+    /// The traversal for triangle test `T`, near-child rule `BY_DISTANCE` (entry distance; else
+    /// the sign of the ray on the node's split axis; structures without the choice ignore it),
+    /// query `ANY` (stop at the first hit found) and statistics sink `S`. On a hit, `ray.t_max`
+    /// is the hit distance.
+    fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit>;
+
     /// Closest hit within the ray's interval; on a hit, `ray.t_max` is the hit distance.
-    fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit>;
+    #[inline]
+    fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
+        dispatch!(opts, |T, BY_DISTANCE| self.trace::<T, BY_DISTANCE, false, S>(ray, stats))
+    }
+
     /// Whether anything is hit within the ray's interval (stops at the first hit found).
-    fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool;
+    #[inline]
+    fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool {
+        let mut r = *ray;
+        dispatch!(opts, |T, BY_DISTANCE| self.trace::<T, BY_DISTANCE, true, S>(&mut r, stats)).is_some()
+    }
 
     /// Whether `closest_hits` traces a real packet (faster for coherent rays than single rays);
     /// when false, callers should trace single rays.

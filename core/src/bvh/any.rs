@@ -3,6 +3,7 @@
 use super::tree::{NodeView, TreeView};
 use super::wide::WideBvh;
 use super::{Accelerator, BuildParams, BuildReport, Bvh, Hit, Layout, TraceOptions, TraversalStats};
+use crate::geometry::TriangleIntersector;
 use crate::mesh::Mesh;
 use crate::work::{Cancelled, WorkControl};
 
@@ -46,23 +47,14 @@ impl AnyBvh {
 
 impl Accelerator for AnyBvh {
     #[inline]
-    fn closest_hit<S: TraversalStats>(
+    fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
         &self,
         ray: &mut crate::geometry::Ray,
-        opts: TraceOptions,
         stats: &mut S,
     ) -> Option<Hit> {
         match self {
-            AnyBvh::Binary(b) => b.closest_hit(ray, opts, stats),
-            AnyBvh::Wide(w) => w.closest_hit(ray, opts, stats),
-        }
-    }
-
-    #[inline]
-    fn any_hit<S: TraversalStats>(&self, ray: &crate::geometry::Ray, opts: TraceOptions, stats: &mut S) -> bool {
-        match self {
-            AnyBvh::Binary(b) => b.any_hit(ray, opts, stats),
-            AnyBvh::Wide(w) => w.any_hit(ray, opts, stats),
+            AnyBvh::Binary(b) => b.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
+            AnyBvh::Wide(w) => w.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
         }
     }
 

@@ -11,7 +11,6 @@ use crate::geometry::Aabb;
 use crate::mesh::Mesh;
 use crate::options::{MAX_LEAF_SIZE, SAH_BINS, TRAVERSAL_COST};
 use crate::work::{Cancelled, WorkControl};
-use glam::Vec3A;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -250,50 +249,22 @@ fn build_nodes(
     ))
 }
 
-/// Bounds and centroid bounds of a range (in parallel for big ranges), in SIMD form.
-#[derive(Clone, Copy)]
-struct Extents {
-    min: Vec3A,
-    max: Vec3A,
-    cmin: Vec3A,
-    cmax: Vec3A,
-}
-
-impl Extents {
-    const EMPTY: Extents =
-        Extents { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY, cmin: Vec3A::INFINITY, cmax: Vec3A::NEG_INFINITY };
-
-    #[inline(always)]
-    fn add(self, p: &BuildPrim) -> Extents {
-        let c = p.centroid();
-        Extents {
-            min: self.min.min(p.min()),
-            max: self.max.max(p.max()),
-            cmin: self.cmin.min(c),
-            cmax: self.cmax.max(c),
-        }
-    }
-
-    fn merge(self, o: Extents) -> Extents {
-        Extents {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-            cmin: self.cmin.min(o.cmin),
-            cmax: self.cmax.max(o.cmax),
-        }
-    }
-}
-
+/// The node's bounds and centroid bounds (in parallel for big ranges).
 fn node_info(prims: &[BuildPrim]) -> NodeInfo {
-    let e = if prims.len() >= PARALLEL_MIN_PRIMS {
-        prims
-            .par_chunks(4096)
-            .map(|c| c.iter().fold(Extents::EMPTY, Extents::add))
-            .reduce(|| Extents::EMPTY, Extents::merge)
-    } else {
-        prims.iter().fold(Extents::EMPTY, Extents::add)
+    const EMPTY: NodeInfo = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY };
+    let add = |i: NodeInfo, p: &BuildPrim| NodeInfo {
+        bounds: i.bounds.union(p.bounds()),
+        centroid_bounds: i.centroid_bounds.grow(p.centroid()),
     };
-    NodeInfo { bounds: Aabb::new(e.min.into(), e.max.into()), centroid_bounds: Aabb::new(e.cmin.into(), e.cmax.into()) }
+    let merge = |a: NodeInfo, b: NodeInfo| NodeInfo {
+        bounds: a.bounds.union(b.bounds),
+        centroid_bounds: a.centroid_bounds.union(b.centroid_bounds),
+    };
+    if prims.len() >= PARALLEL_MIN_PRIMS {
+        prims.par_chunks(4096).map(|c| c.iter().fold(EMPTY, add)).reduce(|| EMPTY, merge)
+    } else {
+        prims.iter().fold(EMPTY, add)
+    }
 }
 
 /// Nodes where the driver overrode or replaced the strategy's answer.

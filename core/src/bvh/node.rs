@@ -9,12 +9,13 @@ use glam::Vec3;
 /// (see `build::HEURISTIC_DEPTH_LIMIT`), so the fixed-size stack cannot overflow.
 pub const TRAVERSAL_STACK_SIZE: usize = 128;
 
-/// One node: 24 bytes of bounds, then either the first of two adjacent children (interior,
-/// `count == 0`) or the first of `count` triangles (leaf).
+/// One node: 24 bytes of bounds (the box's lower and upper planes), then either the first of two
+/// adjacent children (interior, `count == 0`) or the first of `count` triangles (leaf).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BvhNode {
-    pub bounds: Aabb,
+    pub lo: [f32; 3],
+    pub hi: [f32; 3],
     /// Interior: index of the left child (the right one follows it). Leaf: first triangle.
     pub index: u32,
     /// Number of triangles; 0 marks an interior node.
@@ -33,11 +34,25 @@ impl BvhNode {
     }
 
     pub fn leaf(bounds: Aabb, first: u32, count: u16) -> Self {
-        Self { bounds, index: first, count, axis: 0, _pad: 0 }
+        let (lo, hi) = bounds.planes();
+        Self { lo, hi, index: first, count, axis: 0, _pad: 0 }
     }
 
     pub fn interior(bounds: Aabb, left: u32, axis: u8) -> Self {
-        Self { bounds, index: left, count: 0, axis, _pad: 0 }
+        let (lo, hi) = bounds.planes();
+        Self { lo, hi, index: left, count: 0, axis, _pad: 0 }
+    }
+
+    /// The node's box.
+    #[inline(always)]
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(Vec3::from_array(self.lo), Vec3::from_array(self.hi))
+    }
+
+    /// The slab test of the node's box (`geometry::slab::one_box`).
+    #[inline(always)]
+    pub fn slab(&self, origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> (f32, f32) {
+        crate::geometry::slab::one_box(&self.lo, &self.hi, origin, inv_dir, t_min, t_max)
     }
 
     /// The triangle range of a leaf.
@@ -61,7 +76,7 @@ pub struct Bvh {
 
 impl Bvh {
     pub fn root_bounds(&self) -> Aabb {
-        self.nodes[0].bounds
+        self.nodes[0].bounds()
     }
 
     /// Bytes used by the nodes and the primitive index array.
@@ -78,7 +93,7 @@ pub(crate) fn walk_nodes(nodes: &[BvhNode], empty: bool, f: &mut dyn FnMut(&supe
     while let Some((i, depth)) = stack.pop() {
         let n = &nodes[i];
         let kind = if n.is_leaf() || empty { NodeKind::Leaf { count: n.count as u32 } } else { NodeKind::Interior };
-        let descend = f(&NodeView { id: i, bounds: n.bounds, depth, kind });
+        let descend = f(&NodeView { id: i, bounds: n.bounds(), depth, kind });
         if descend && kind == NodeKind::Interior {
             stack.push((n.index as usize + 1, depth + 1));
             stack.push((n.index as usize, depth + 1));

@@ -213,8 +213,8 @@ fn the_frustum_rejects_only_boxes_every_ray_misses() {
             .collect();
         let mut traced = rays.clone();
         let mut slot = MaybeUninit::uninit();
-        let frustum = &Packet::<Watertight>::new_in(&mut slot, &mut traced).frustum;
-        valid += frustum.valid as usize;
+        let frustum = &Packet::<crate::geometry::Watertight>::new_in(&mut slot, &mut traced).frustum;
+        valid += frustum.is_valid() as usize;
         let t_far = rays.iter().fold(f32::NEG_INFINITY, |m, r| m.max(r.t_max));
         for _ in 0..2 {
             // Four boxes, as a wide node holds them: the four-box test must agree with `misses`.
@@ -223,9 +223,12 @@ fn the_frustum_rejects_only_boxes_every_ray_misses() {
                 let h = Vec3::new(rnd(), rnd(), rnd()) * 0.5;
                 Aabb::new(c - h, c + h)
             });
-            let min = std::array::from_fn(|axis| std::array::from_fn(|k| boxes[k].min[axis]));
-            let max = std::array::from_fn(|axis| std::array::from_fn(|k| boxes[k].max[axis]));
-            let may_hit = frustum.may_hit4(&min, &max, t_far);
+            let mut four = crate::geometry::slab::Boxes4::EMPTY;
+            for (k, b) in boxes.iter().enumerate() {
+                let (lo, hi) = b.planes();
+                four.set(k, lo, hi);
+            }
+            let may_hit = frustum.may_hit4(&four, t_far);
             for (k, b) in boxes.iter().enumerate() {
                 assert_eq!(may_hit >> k & 1 == 0, frustum.misses(b, t_far), "case {case}: box {k}, two forms");
                 if frustum.misses(b, t_far) {

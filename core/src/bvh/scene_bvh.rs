@@ -4,7 +4,7 @@
 
 use super::tree::TreeView;
 use super::{Accelerator, AnyBvh, BuildParams, Hit, TraceOptions, TraversalStats, TwoLevelBvh};
-use crate::geometry::Ray;
+use crate::geometry::{Ray, TriangleIntersector};
 use crate::mesh::Mesh;
 use crate::work::{Cancelled, WorkControl};
 use glam::Affine3A;
@@ -98,18 +98,14 @@ impl SceneBvh {
 
 impl Accelerator for SceneBvh {
     #[inline]
-    fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
+    fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
         match self {
-            SceneBvh::Single(b) => b.closest_hit(ray, opts, stats),
-            SceneBvh::TwoLevel(t) => t.closest_hit(ray, opts, stats),
-        }
-    }
-
-    #[inline]
-    fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool {
-        match self {
-            SceneBvh::Single(b) => b.any_hit(ray, opts, stats),
-            SceneBvh::TwoLevel(t) => t.any_hit(ray, opts, stats),
+            SceneBvh::Single(b) => b.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
+            SceneBvh::TwoLevel(t) => t.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
         }
     }
 

@@ -1,112 +1,163 @@
-//! BVH traversal: closest hit and any hit, with a fixed-size stack, near child first.
+//! The binary BVH's walk, written once: ordered stack traversal with a fixed-size stack, near
+//! child first (pbrt-v4 §7.3.5, "BVHAggregate::Intersect"). The mesh BVH (triangles at its leaves)
+//! and the two-level BVH's top level (placements at its leaves) both walk with it; what happens at
+//! a leaf is the caller's closure, and what is counted is the statistics sink's.
 //!
 //! At an interior node both children's boxes are tested; a child the ray misses, or enters beyond
 //! the closest hit so far, is never visited. Of two hit children the near one is visited next and
 //! the far one pushed with its entry distance, which is checked again when it is popped (the hit
 //! found meanwhile may make it useless). Near is chosen by the handout's rule (direction sign on the
-//! split axis) or by the entry distance; both are compiled as separate loops (`BY_DISTANCE`), as are
-//! the triangle test (`T`) and the statistics sink (`S`), so none of the choices costs a branch
-//! per node. Layout and loop follow pbrt-v4 §7.3.5 ("BVHAggregate::Intersect").
+//! split axis) or by the entry distance, compiled as separate loops (`BY_DISTANCE`).
 
-use super::node::{Bvh, TRAVERSAL_STACK_SIZE};
+use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;
-use super::{Accelerator, Hit, TraceOptions, TraversalOrder, TraversalStats};
-use crate::geometry::{MollerTrumbore, Ray, TriangleIntersector, TriangleTest, Watertight};
+use super::{Accelerator, Hit, TraceOptions, TraversalStats};
+use crate::geometry::{Ray, TriangleIntersector};
+use std::ops::Range;
 
-impl Bvh {
-    fn closest<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
-        &self,
-        ray: &mut Ray,
-        stats: &mut S,
-    ) -> Option<Hit> {
-        let nodes = &self.nodes[..];
-        let (origin, inv_dir) = (ray.origin(), ray.inv_dir());
-        // Which child is near under the handout's rule, per axis: a negative direction component
-        // (including -0) means the right child (larger coordinates) is met first.
-        let dir_neg = [inv_dir.x.is_sign_negative(), inv_dir.y.is_sign_negative(), inv_dir.z.is_sign_negative()];
-        stats.box_tests(1);
-        let (t0, t1) = nodes[0].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
-        if !(t0 <= t1) {
-            return None;
-        }
-        // The triangle test's per-ray setup waits for the first leaf: most rays that miss never
-        // reach one.
-        let mut prepared: Option<T::Prepared> = None;
-        let mut best: Option<(usize, crate::geometry::TriangleHit)> = None;
-        let mut stack = TraversalStack::<TRAVERSAL_STACK_SIZE>::new();
-        let mut current = 0usize;
-        loop {
-            let node = &nodes[current];
-            stats.node_visited();
-            if node.is_leaf() {
-                stats.leaf_visited();
-                stats.triangle_tests(node.count as u32);
-                for i in node.prims() {
-                    if let Some(h) = T::intersect(prepared.get_or_insert_with(|| T::prepare(ray)), ray, &self.tris[i]) {
-                        ray.t_max = h.t;
-                        best = Some((i, h));
-                        if ANY {
-                            break;
-                        }
-                    }
-                }
-                if ANY && best.is_some() {
-                    break;
-                }
-            } else {
-                let left = node.index as usize;
-                stats.box_tests(2);
-                let (l0, l1) = nodes[left].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
-                let (r0, r1) = nodes[left + 1].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
-                let hit_l = l0 <= l1;
-                let hit_r = r0 <= r1;
-                if hit_l && hit_r {
+/// Which level of a hierarchy a walk is on, for the counters: a mesh's BVH, or the top level of a
+/// two-level BVH, whose visits a sink may also count apart (`top_node_visited`).
+pub(crate) trait Level {
+    fn node_visited<S: TraversalStats>(stats: &mut S);
+    fn box_tests<S: TraversalStats>(stats: &mut S, n: u32);
+    fn leaf_visited<S: TraversalStats>(stats: &mut S);
+}
+
+/// A mesh's BVH: leaves hold triangles.
+pub(crate) enum MeshLevel {}
+
+impl Level for MeshLevel {
+    #[inline(always)]
+    fn node_visited<S: TraversalStats>(stats: &mut S) {
+        stats.node_visited();
+    }
+    #[inline(always)]
+    fn box_tests<S: TraversalStats>(stats: &mut S, n: u32) {
+        stats.box_tests(n);
+    }
+    #[inline(always)]
+    fn leaf_visited<S: TraversalStats>(stats: &mut S) {
+        stats.leaf_visited();
+    }
+}
+
+/// The top level of a two-level BVH: leaves hold placements (counted as instances entered).
+pub(crate) enum TopLevelWalk {}
+
+impl Level for TopLevelWalk {
+    #[inline(always)]
+    fn node_visited<S: TraversalStats>(stats: &mut S) {
+        stats.top_node_visited();
+    }
+    #[inline(always)]
+    fn box_tests<S: TraversalStats>(stats: &mut S, n: u32) {
+        stats.top_box_tests(n);
+    }
+    #[inline(always)]
+    fn leaf_visited<S: TraversalStats>(_: &mut S) {}
+}
+
+/// Walk `nodes` (node 0 the root) nearest first. `leaf(range, ray, stats)` is called for every
+/// leaf reached, with the leaf's range of primitive slots; it may shrink `ray.t_max` (a nearer hit
+/// prunes what is left) and returns true to stop the walk (an any-hit query that found one).
+#[inline(always)]
+pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
+    nodes: &[BvhNode],
+    ray: &mut Ray,
+    stats: &mut S,
+    mut leaf: impl FnMut(Range<usize>, &mut Ray, &mut S) -> bool,
+) {
+    let (origin, inv_dir) = (ray.origin(), ray.inv_dir());
+    // Which child is near under the handout's rule, per axis: a negative direction component
+    // (including -0) means the right child (larger coordinates) is met first.
+    let dir_neg = [inv_dir.x.is_sign_negative(), inv_dir.y.is_sign_negative(), inv_dir.z.is_sign_negative()];
+    L::box_tests(stats, 1);
+    let (t0, t1) = nodes[0].slab(origin, inv_dir, ray.t_min, ray.t_max);
+    if !(t0 <= t1) {
+        return;
+    }
+    let mut stack = TraversalStack::<TRAVERSAL_STACK_SIZE>::new();
+    let mut current = 0usize;
+    loop {
+        let node = &nodes[current];
+        L::node_visited(stats);
+        if node.is_leaf() {
+            L::leaf_visited(stats);
+            if leaf(node.prims(), ray, stats) {
+                return;
+            }
+        } else {
+            let left = node.index as usize;
+            L::box_tests(stats, 2);
+            let (l0, l1) = nodes[left].slab(origin, inv_dir, ray.t_min, ray.t_max);
+            let (r0, r1) = nodes[left + 1].slab(origin, inv_dir, ray.t_min, ray.t_max);
+            match (l0 <= l1, r0 <= r1) {
+                (true, true) => {
                     let right_first = if BY_DISTANCE { r0 < l0 } else { dir_neg[node.axis as usize] };
                     let (near, far, far_t) = if right_first { (left + 1, left, l0) } else { (left, left + 1, r0) };
                     stack.push((far as u32, far_t));
                     current = near;
                     continue;
-                } else if hit_l {
+                }
+                (true, false) => {
                     current = left;
                     continue;
-                } else if hit_r {
+                }
+                (false, true) => {
                     current = left + 1;
                     continue;
                 }
-            }
-            // The next node that can still hold a hit nearer than the best so far.
-            match stack.pop_nearer(ray.t_max) {
-                Some(n) => current = n as usize,
-                None => break,
+                (false, false) => {}
             }
         }
-        best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
-    }
-
-    fn dispatch<const ANY: bool, S: TraversalStats>(
-        &self,
-        ray: &mut Ray,
-        opts: TraceOptions,
-        stats: &mut S,
-    ) -> Option<Hit> {
-        use TraversalOrder::*;
-        match (opts.test, opts.order) {
-            (TriangleTest::Watertight, EntryDistance) => self.closest::<Watertight, true, ANY, S>(ray, stats),
-            (TriangleTest::Watertight, SplitAxisSign) => self.closest::<Watertight, false, ANY, S>(ray, stats),
-            (TriangleTest::MollerTrumbore, EntryDistance) => self.closest::<MollerTrumbore, true, ANY, S>(ray, stats),
-            (TriangleTest::MollerTrumbore, SplitAxisSign) => self.closest::<MollerTrumbore, false, ANY, S>(ray, stats),
+        // The next node that can still hold a hit nearer than the best so far.
+        match stack.pop_nearer(ray.t_max) {
+            Some(n) => current = n as usize,
+            None => return,
         }
     }
 }
 
-impl Accelerator for Bvh {
-    fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
-        self.dispatch::<false, S>(ray, opts, stats)
+/// Test a leaf's triangles `tris` (slot `first` onwards in leaf order) against the ray: each
+/// nearer hit shrinks `ray.t_max` and is kept in `best`; an any-hit query stops at the first. The
+/// triangle tests actually made are counted (an any-hit that stops early counts no more). The
+/// triangle test's per-ray setup waits in `prepared` for the first leaf: most rays that miss never
+/// reach one. Shared by the binary and the wide walk.
+#[inline(always)]
+pub(crate) fn test_triangles<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
+    tris: &[[glam::Vec3; 3]],
+    first: usize,
+    ray: &mut Ray,
+    stats: &mut S,
+    prepared: &mut Option<T::Prepared>,
+    best: &mut Option<(usize, crate::geometry::TriangleHit)>,
+) -> bool {
+    for (k, tri) in tris.iter().enumerate() {
+        if let Some(h) = T::intersect(prepared.get_or_insert_with(|| T::prepare(ray)), ray, tri) {
+            ray.t_max = h.t;
+            *best = Some((first + k, h));
+            if ANY {
+                stats.triangle_tests(k as u32 + 1);
+                return true;
+            }
+        }
     }
+    stats.triangle_tests(tris.len() as u32);
+    false
+}
 
-    fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool {
-        let mut r = *ray;
-        self.dispatch::<true, S>(&mut r, opts, stats).is_some()
+impl Accelerator for Bvh {
+    fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
+        let (mut prepared, mut best) = (None, None);
+        walk::<MeshLevel, BY_DISTANCE, S>(&self.nodes, ray, stats, |range, ray, stats| {
+            let first = range.start;
+            test_triangles::<T, ANY, S>(&self.tris[range], first, ray, stats, &mut prepared, &mut best)
+        });
+        best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
     }
 
     fn traces_packets(&self) -> bool {

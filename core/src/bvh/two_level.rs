@@ -13,11 +13,11 @@
 //! strategy and leaf size are chosen separately from the bottom level's, which may be wide.
 
 use super::build::{build_over_boxes, build_work};
-use super::node::{walk_nodes, BvhNode, TRAVERSAL_STACK_SIZE};
-use super::stack::TraversalStack;
+use super::node::{walk_nodes, BvhNode};
+use super::traverse::{walk, TopLevelWalk};
 use super::tree::{NodeKind, NodeView, TreeView};
-use super::{Accelerator, AnyBvh, BuildParams, BuildReport, Hit, TraceOptions, TraversalStats};
-use crate::geometry::{Aabb, Ray};
+use super::{Accelerator, AnyBvh, BuildParams, BuildReport, Hit, TraversalStats};
+use crate::geometry::{Aabb, Ray, TriangleIntersector};
 use crate::mesh::Mesh;
 use crate::work::{Cancelled, WorkControl};
 use glam::{Affine3A, Vec3};
@@ -157,8 +157,9 @@ impl TwoLevelBvh {
         out
     }
 
-    /// Walk the top level nearest box first. At each leaf, `enter` is called for its instances
-    /// with the world ray (whose `t_max` it may shrink) and returns true to stop the traversal.
+    /// Walk the top level nearest box first (`traverse::walk`, entry-distance order: the top level
+    /// has no split-axis rule of its own). At each leaf, `enter` is called for its instances with
+    /// the world ray (whose `t_max` it may shrink) and returns true to stop the traversal.
     #[inline(always)]
     fn traverse<S: TraversalStats>(
         &self,
@@ -166,56 +167,12 @@ impl TwoLevelBvh {
         stats: &mut S,
         mut enter: impl FnMut(&Instance, &mut Ray, &mut S) -> bool,
     ) {
-        let nodes = &self.top.nodes[..];
         if self.instances.is_empty() {
             return;
         }
-        let (origin, inv_dir) = (ray.origin(), ray.inv_dir());
-        stats.top_box_tests(1);
-        let (t0, t1) = nodes[0].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
-        if !(t0 <= t1) {
-            return;
-        }
-        let mut stack = TraversalStack::<TRAVERSAL_STACK_SIZE>::new();
-        let mut current = 0usize;
-        loop {
-            let node = &nodes[current];
-            stats.top_node_visited();
-            if node.is_leaf() {
-                for slot in node.prims() {
-                    let inst = &self.instances[self.top.order[slot] as usize];
-                    if enter(inst, ray, stats) {
-                        return;
-                    }
-                }
-            } else {
-                let left = node.index as usize;
-                stats.top_box_tests(2);
-                let (l0, l1) = nodes[left].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
-                let (r0, r1) = nodes[left + 1].bounds.slab(origin, inv_dir, ray.t_min, ray.t_max);
-                match (l0 <= l1, r0 <= r1) {
-                    (true, true) => {
-                        let (near, far, far_t) = if r0 < l0 { (left + 1, left, l0) } else { (left, left + 1, r0) };
-                        stack.push((far as u32, far_t));
-                        current = near;
-                        continue;
-                    }
-                    (true, false) => {
-                        current = left;
-                        continue;
-                    }
-                    (false, true) => {
-                        current = left + 1;
-                        continue;
-                    }
-                    (false, false) => {}
-                }
-            }
-            match stack.pop_nearer(ray.t_max) {
-                Some(n) => current = n as usize,
-                None => return,
-            }
-        }
+        walk::<TopLevelWalk, true, S>(&self.top.nodes, ray, stats, |slots, ray, stats| {
+            slots.into_iter().any(|slot| enter(&self.instances[self.top.order[slot] as usize], ray, stats))
+        });
     }
 
     /// The world ray in an instance's object space, over the same interval.
@@ -231,29 +188,25 @@ impl TwoLevelBvh {
 }
 
 impl Accelerator for TwoLevelBvh {
-    fn closest_hit<S: TraversalStats>(&self, ray: &mut Ray, opts: TraceOptions, stats: &mut S) -> Option<Hit> {
+    fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
         let mut best = None;
         self.traverse(ray, stats, |inst, ray, stats| {
             stats.instance_entered();
             let mut local = Self::object_ray(inst, ray);
-            if let Some(h) = self.bottom[inst.mesh as usize].closest_hit(&mut local, opts, stats) {
-                ray.t_max = h.t;
-                best = Some(Hit { prim: inst.first_prim + h.prim, ..h });
+            match self.bottom[inst.mesh as usize].trace::<T, BY_DISTANCE, ANY, S>(&mut local, stats) {
+                Some(h) => {
+                    ray.t_max = h.t;
+                    best = Some(Hit { prim: inst.first_prim + h.prim, ..h });
+                    ANY
+                }
+                None => false,
             }
-            false
         });
         best
-    }
-
-    fn any_hit<S: TraversalStats>(&self, ray: &Ray, opts: TraceOptions, stats: &mut S) -> bool {
-        let mut found = false;
-        let mut r = *ray;
-        self.traverse(&mut r, stats, |inst, ray, stats| {
-            stats.instance_entered();
-            found = self.bottom[inst.mesh as usize].any_hit(&Self::object_ray(inst, ray), opts, stats);
-            found
-        });
-        found
     }
 }
 
@@ -278,7 +231,7 @@ pub fn top_leaf_sizes(top: &TopLevel) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{LinearScan, NoStats, RayCounters, SplitStrategy};
+    use crate::bvh::{LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions};
     use crate::mesh::generate::torus;
 
     /// A torus placed four times (one of them rotated and scaled), and the same scene flattened.

@@ -2,6 +2,7 @@
 
 mod aabb;
 mod ray;
+pub mod slab;
 pub(crate) mod triangle;
 
 pub use aabb::Aabb;

@@ -279,8 +279,8 @@ mod tests {
         assert_eq!(m.triangle_count(), 3 * 128);
         assert_no_degenerate(&m);
         let b = m.bounds();
-        assert!((b.min - Vec3::new(-120.0, 0.0, -120.0)).abs().max_element() < 0.1, "{b:?}");
-        assert!((b.max - Vec3::new(120.0, 30.0, 120.0)).abs().max_element() < 0.1, "{b:?}");
+        assert!((Vec3::from(b.min) - Vec3::new(-120.0, 0.0, -120.0)).abs().max_element() < 0.1, "{b:?}");
+        assert!((Vec3::from(b.max) - Vec3::new(120.0, 30.0, 120.0)).abs().max_element() < 0.1, "{b:?}");
         // The floor faces up, the stands face the middle.
         for (i, t) in m.triangles.iter().enumerate() {
             let n = normal(&m, t);
@@ -302,7 +302,7 @@ mod tests {
         assert_eq!(m.groups.last().unwrap().triangles.end as usize, m.triangle_count());
         assert_no_degenerate(&m);
         let b = m.bounds();
-        assert_eq!((b.min, b.max), (Vec3::new(-2.75, 0.0, -2.75), Vec3::new(2.75, 5.5, 2.75)));
+        assert_eq!((Vec3::from(b.min), Vec3::from(b.max)), (Vec3::new(-2.75, 0.0, -2.75), Vec3::new(2.75, 5.5, 2.75)));
         // Walls face into the room.
         let middle = Vec3::new(0.0, 2.75, 0.0);
         for wall in ["floor", "ceiling", "back_wall", "left_wall", "right_wall"] {

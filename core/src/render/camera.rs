@@ -275,7 +275,7 @@ mod tests {
         // The same box written Y-up and Z-up (y ↔ z, front flipped): the default cameras of the
         // two see the same picture, each with its own axis up.
         let y_up = Aabb::new(Vec3::new(-1.0, 0.0, -0.5), Vec3::new(3.0, 2.0, 0.5));
-        let z_up = Aabb::new(UpAxis::Z.from_y_up(y_up.min), UpAxis::Z.from_y_up(y_up.max));
+        let z_up = Aabb::new(UpAxis::Z.from_y_up(y_up.min.into()), UpAxis::Z.from_y_up(y_up.max.into()));
         let z_up = Aabb::new(z_up.min.min(z_up.max), z_up.min.max(z_up.max));
         let a = Camera::framing_up(&y_up, 640, 480, UpAxis::Y, 45.0);
         let b = Camera::framing_up(&z_up, 640, 480, UpAxis::Z, 45.0);

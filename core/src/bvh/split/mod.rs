@@ -74,7 +74,7 @@ pub struct BuildPrim {
 
 impl BuildPrim {
     pub fn new(bounds: Aabb, index: u32) -> Self {
-        Self { min_index: bounds.min.extend(f32::from_bits(index)), max: bounds.max.into() }
+        Self { min_index: bounds.min.extend(f32::from_bits(index)), max: bounds.max }
     }
 
     /// The lower corner. glam leaves a `Vec3A`'s fourth lane unspecified, so this is free.
@@ -100,9 +100,9 @@ impl BuildPrim {
         (self.min() + self.max) * 0.5
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn bounds(&self) -> Aabb {
-        Aabb::new(self.min().into(), self.max.into())
+        Aabb { min: self.min(), max: self.max }
     }
 }
 

@@ -7,6 +7,7 @@
 
 use super::{partition, BuildPrim, NodeInfo, Proposal, Splitter};
 use crate::bvh::BuildParams;
+use crate::geometry::Aabb;
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
@@ -16,22 +17,20 @@ pub const MAX_BINS: usize = 256;
 /// Nodes with at least this many triangles are binned in parallel.
 const PARALLEL_BINNING_MIN: usize = 1 << 15;
 
-/// One bin: the triangles' bounds (SIMD layout) and count.
+/// One bin: the triangles' bounds and count.
 #[derive(Clone, Copy, Debug)]
 pub struct Bin {
-    min: Vec3A,
-    max: Vec3A,
+    bounds: Aabb,
     count: u32,
 }
 
 impl Bin {
-    const EMPTY: Bin = Bin { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY, count: 0 };
+    const EMPTY: Bin = Bin { bounds: Aabb::EMPTY, count: 0 };
 
     #[inline(always)]
     fn merge(&mut self, o: &Bin) {
         self.count += o.count;
-        self.min = self.min.min(o.min);
-        self.max = self.max.max(o.max);
+        self.bounds = self.bounds.union(o.bounds);
     }
 }
 
@@ -55,34 +54,6 @@ fn bin_indices(scaled: Vec3A, top: Vec3A) -> [u32; 4] {
     {
         let u = clamped.as_uvec3();
         [u.x, u.y, u.z, 0]
-    }
-}
-
-/// A running union of boxes in SIMD layout, with the surface area of the SAH.
-#[derive(Clone, Copy)]
-struct Acc {
-    min: Vec3A,
-    max: Vec3A,
-}
-
-impl Acc {
-    const EMPTY: Acc = Acc { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
-
-    #[inline(always)]
-    fn add(&mut self, b: &Bin) {
-        self.min = self.min.min(b.min);
-        self.max = self.max.max(b.max);
-    }
-
-    #[inline(always)]
-    fn area(&self) -> f32 {
-        let e = (self.max - self.min).max(Vec3A::ZERO);
-        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
-    }
-
-    #[inline(always)]
-    fn of(p: &BuildPrim) -> Acc {
-        Acc { min: p.min(), max: p.max() }
     }
 }
 
@@ -132,15 +103,14 @@ fn binned(
     let bins = max_bins.min((n / 3).max(4)).clamp(2, MAX_BINS);
     // Axes with no extent cannot be split by a plane; their scale 0 puts everything in bin 0.
     let scale: [f32; 3] = std::array::from_fn(|a| if extent[a] > 0.0 { bins as f32 / extent[a] } else { 0.0 });
-    let (lo, sc, top) = (Vec3A::from(cb.min), Vec3A::from(Vec3::from(scale)), Vec3A::splat((bins - 1) as f32));
+    let (lo, sc, top) = (cb.min, Vec3A::from(Vec3::from(scale)), Vec3A::splat((bins - 1) as f32));
     let bin_into = |all: &mut [Bin], chunk: &[BuildPrim]| {
         for p in chunk {
             let idx = bin_indices((p.centroid() - lo) * sc, top);
             for (axis, &i) in idx.iter().take(3).enumerate() {
                 let bin = &mut all[axis * bins + i as usize];
                 bin.count += 1;
-                bin.min = bin.min.min(p.min());
-                bin.max = bin.max.max(p.max());
+                bin.bounds = bin.bounds.union(p.bounds());
             }
         }
     };
@@ -175,21 +145,21 @@ fn binned(
     right_area.resize(bins, Vec4::ZERO);
     let bin = |axis: usize, i: usize| &all[axis * bins + i];
     // right_area[i]: per axis, the area of bins i..; plane i separates bins ..i from i..
-    let mut acc = [Acc::EMPTY; 3];
+    let mut acc = [Aabb::EMPTY; 3];
     for (i, area) in right_area.iter_mut().enumerate().skip(1).rev() {
         for (axis, a) in acc.iter_mut().enumerate() {
-            a.add(bin(axis, i));
+            *a = a.union(bin(axis, i).bounds);
         }
         *area = areas3(&acc);
     }
     let splittable = extent.to_array().map(|e| e > 0.0);
-    let (mut acc, mut left) = ([Acc::EMPTY; 3], [0u32; 3]);
+    let (mut acc, mut left) = ([Aabb::EMPTY; 3], [0u32; 3]);
     // Per axis, the cheapest plane so far (the first of equal ones).
     let (mut lane_cost, mut lane_plane) = (Vec4::INFINITY, Vec4::ZERO);
     for (i, &right_area) in right_area.iter().enumerate().skip(1) {
         for axis in 0..3 {
             let b = bin(axis, i - 1);
-            acc[axis].add(b);
+            acc[axis] = acc[axis].union(b.bounds);
             left[axis] += b.count;
         }
         let right = left.map(|l| n as u32 - l);
@@ -234,7 +204,7 @@ fn goes_left(scaled: f32, plane: f32) -> bool {
 /// Surface areas of three boxes at once: lane k is `boxes[k].area()`, computed with the same
 /// operations in the same order (lane 3 is 0).
 #[inline(always)]
-fn areas3(boxes: &[Acc; 3]) -> Vec4 {
+fn areas3(boxes: &[Aabb; 3]) -> Vec4 {
     let e = boxes.map(|b| (b.max - b.min).max(Vec3A::ZERO));
     let (x, y, z) = (
         Vec4::new(e[0].x, e[1].x, e[2].x, 0.0),
@@ -247,11 +217,11 @@ fn areas3(boxes: &[Acc; 3]) -> Vec4 {
 /// Two triangles: every plane between their centroids makes the same two one-triangle children, so
 /// their cost is computed directly (what the bins would give, without them); the axis is the first
 /// with extent, as the sweep would pick, and the triangle of the lower centroid goes left.
-fn split_two(prims: &mut [BuildPrim], extent: Vec3) -> Proposal {
+fn split_two(prims: &mut [BuildPrim], extent: Vec3A) -> Proposal {
     let Some(axis) = (0..3).find(|&a| extent[a] > 0.0) else {
         return Proposal::None; // both centroids coincide
     };
-    let weighted = Acc::of(&prims[0]).area() + Acc::of(&prims[1]).area();
+    let weighted = prims[0].bounds().area() + prims[1].bounds().area();
     if prims[0].centroid()[axis] > prims[1].centroid()[axis] {
         prims.swap(0, 1);
     }

@@ -18,6 +18,7 @@ mod traverse;
 use super::node::{Bvh, BvhNode};
 use super::tree::{NodeKind, NodeView, TreeView};
 use super::{BuildParams, BuildReport};
+use crate::geometry::slab::Boxes4;
 use crate::geometry::Aabb;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -25,14 +26,13 @@ use std::time::Instant;
 
 pub const WIDTH: usize = 4;
 
-/// Children boxes in SoA order (`min[axis][slot]`), then per slot: a child node index (interior,
+/// Children boxes in SoA order (`boxes`), then per slot: a child node index (interior,
 /// `count == 0`) or the first triangle of a leaf (`count > 0`). Empty slots have an inverted box
 /// (+inf..-inf), which every slab test misses, and are clear in `valid`.
 #[repr(C, align(64))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WideNode {
-    pub min: [[f32; WIDTH]; 3],
-    pub max: [[f32; WIDTH]; 3],
+    pub boxes: Boxes4,
     pub child: [u32; WIDTH],
     pub count: [u8; WIDTH],
     /// Bit k set when slot k holds a child.
@@ -43,40 +43,82 @@ pub struct WideNode {
 const _: () = assert!(std::mem::size_of::<WideNode>() == 128);
 
 impl WideNode {
-    pub const EMPTY: WideNode = WideNode {
-        min: [[f32::INFINITY; WIDTH]; 3],
-        max: [[f32::NEG_INFINITY; WIDTH]; 3],
-        child: [u32::MAX; WIDTH],
-        count: [0; WIDTH],
-        valid: 0,
-        _pad: [0; 11],
-    };
+    pub const EMPTY: WideNode =
+        WideNode { boxes: Boxes4::EMPTY, child: [u32::MAX; WIDTH], count: [0; WIDTH], valid: 0, _pad: [0; 11] };
 
     fn set(&mut self, slot: usize, b: Aabb, child: u32, count: u8) {
-        for axis in 0..3 {
-            self.min[axis][slot] = b.min[axis];
-            self.max[axis][slot] = b.max[axis];
-        }
+        let (lo, hi) = b.planes();
+        self.boxes.set(slot, lo, hi);
         self.child[slot] = child;
         self.count[slot] = count;
         self.valid |= 1 << slot;
     }
 
     pub fn slot_bounds(&self, slot: usize) -> Aabb {
-        Aabb::new(
-            Vec3::new(self.min[0][slot], self.min[1][slot], self.min[2][slot]),
-            Vec3::new(self.max[0][slot], self.max[1][slot], self.max[2][slot]),
-        )
+        self.boxes.bounds(slot)
     }
 
     /// Slot `slot`'s box as its `(min, max)` planes per axis.
     pub fn slot_planes(&self, slot: usize) -> ([f32; 3], [f32; 3]) {
-        let (lo, hi) = (&self.min, &self.max);
-        ([lo[0][slot], lo[1][slot], lo[2][slot]], [hi[0][slot], hi[1][slot], hi[2][slot]])
+        self.boxes.planes(slot)
     }
 
     pub fn slots(&self) -> impl Iterator<Item = usize> + '_ {
         (0..WIDTH).filter(|k| self.valid & (1 << k) != 0)
+    }
+}
+
+/// A reference to a wide node's child, as the single-ray and the packet walks carry it on their
+/// stacks, encoded here once: an interior child is its node index; a leaf is `LEAF | node·4 +
+/// slot`, the node and slot that hold it (its first triangle and count are read from that node,
+/// which is still in cache when the leaf is reached). The top bit is free: a tree of 2³¹ wide
+/// nodes would need 256 GB.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct ChildRef(u32);
+
+const _: () = assert!(WIDTH == 4, "child references pack the slot into two bits");
+
+impl ChildRef {
+    const LEAF: u32 = 1 << 31;
+    /// The root node.
+    pub(crate) const ROOT: ChildRef = ChildRef(0);
+
+    /// Slot `slot` of node `index` (`node`).
+    #[inline(always)]
+    pub(crate) fn of(node: &WideNode, index: u32, slot: usize) -> Self {
+        if node.count[slot] > 0 {
+            ChildRef(Self::LEAF | index << 2 | slot as u32)
+        } else {
+            ChildRef(node.child[slot])
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn is_leaf(self) -> bool {
+        self.0 & Self::LEAF != 0
+    }
+
+    /// The index of an interior child.
+    #[inline(always)]
+    pub(crate) fn node(self) -> u32 {
+        self.0
+    }
+
+    /// The node and slot of a leaf.
+    #[inline(always)]
+    pub(crate) fn leaf(self) -> (usize, usize) {
+        (((self.0 & !Self::LEAF) >> 2) as usize, (self.0 & 3) as usize)
+    }
+
+    /// The bits, for a stack entry.
+    #[inline(always)]
+    pub(crate) fn raw(self) -> u32 {
+        self.0
+    }
+
+    #[inline(always)]
+    pub(crate) fn from_raw(bits: u32) -> Self {
+        ChildRef(bits)
     }
 }
 
@@ -100,7 +142,7 @@ impl WideBvh {
         let nodes = if b[0].is_leaf() || bvh.prim_ids.is_empty() {
             let mut root = WideNode::EMPTY;
             if b[0].count > 0 {
-                root.set(0, b[0].bounds, b[0].index, b[0].count as u8);
+                root.set(0, b[0].bounds(), b[0].index, b[0].count as u8);
             }
             vec![root]
         } else if b.len() < PARALLEL_MIN_NODES {
@@ -126,7 +168,7 @@ fn wide_children(b: &[BvhNode], bin: usize) -> ([usize; WIDTH], usize) {
     while n < WIDTH {
         let open = (0..n)
             .filter(|&k| !b[kids[k]].is_leaf())
-            .max_by(|&x, &y| b[kids[x]].bounds.area().total_cmp(&b[kids[y]].bounds.area()));
+            .max_by(|&x, &y| b[kids[x]].bounds().area().total_cmp(&b[kids[y]].bounds().area()));
         let Some(k) = open else { break };
         let first = b[kids[k]].index as usize;
         kids[k] = first;
@@ -149,11 +191,11 @@ fn collapse_sequential(b: &[BvhNode], root: usize, expected: usize) -> Vec<WideN
         for (slot, &k) in kids[..n].iter().enumerate() {
             let node = &b[k];
             if node.is_leaf() {
-                nodes[wide].set(slot, node.bounds, node.index, node.count as u8);
+                nodes[wide].set(slot, node.bounds(), node.index, node.count as u8);
             } else {
                 let child = nodes.len();
                 nodes.push(WideNode::EMPTY);
-                nodes[wide].set(slot, node.bounds, child as u32, 0);
+                nodes[wide].set(slot, node.bounds(), child as u32, 0);
                 stack.push((k, child));
             }
         }
@@ -187,7 +229,7 @@ fn collapse_parallel(b: &[BvhNode], bin: usize, depth: u32) -> WideTree {
     for (slot, &k) in kids[..n].iter().enumerate() {
         let c = &b[k];
         // Interior slots get their child index when the tree is written out.
-        node.set(slot, c.bounds, if c.is_leaf() { c.index } else { u32::MAX }, c.count as u8);
+        node.set(slot, c.bounds(), if c.is_leaf() { c.index } else { u32::MAX }, c.count as u8);
         if !c.is_leaf() {
             interior.push((slot, k));
         }

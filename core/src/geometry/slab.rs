@@ -1,0 +1,381 @@
+//! The ray–box slab tests, every variant in one place: one ray against one box (binary nodes and
+//! root boxes), one ray against four boxes (a wide node's children, one SIMD pass), four rays
+//! against one box (a packet's group, one SIMD pass), and an interval of rays against one or four
+//! boxes (a packet's frustum). They share two rules, stated here once.
+//!
+//! **Planes and NaN** (Williams, Barrus, Morley & Shirley, "An Efficient and Robust Ray–Box
+//! Intersection Algorithm", JGT 2005): the near and far plane of each axis are chosen by the sign
+//! of the reciprocal direction, not by min/max of the two distances. A direction component of +0
+//! or -0 has a reciprocal of +inf or -inf, so an origin strictly inside the slab gives
+//! (-inf, +inf) and one outside an empty interval. An origin exactly on a plane with a zero
+//! component gives 0·inf = NaN: the ray lies in the plane, which must not constrain it, and the
+//! running minimum and maximum skip a NaN (`f32::min`/`max`, and `max_keep`/`min_keep` in SIMD),
+//! which leaves the interval unchanged. A malformed ray cannot hit: it is born empty (`Ray`).
+//!
+//! **Robustness** (Ize, "Robust BVH Ray Traversal", JCGT 2013; pbrt-v4 §6.1.2): each slab distance
+//! (plane − origin)·(1/d) is rounded three times (the subtraction, the reciprocal, the product), so
+//! it may be off by a relative γ(3) = 3ε/(1 − 3ε). A box the ray only touches, at a vertex shared
+//! with the triangle the ray is aimed at, has equal entry and exit; rounded, the entry can come
+//! out above the exit and the box is culled although the watertight triangle test would hit. So
+//! the exit over the three axes is widened by 2γ(3) of its magnitude before it is compared.
+//! Second, a box is also culled when its entry lies beyond the closest hit so far (`t_max`); but
+//! the triangle tests round too, so two triangles meeting at the vertex the ray is aimed at give
+//! distances a few units in the last place apart, and the box of the nearer one can start just
+//! beyond the farther one's rounded distance. So the entry is lowered by `ENTRY_SLACK` of its
+//! magnitude (a bound on both roundings with room to spare) before it is compared with `t_max`,
+//! and the lowered entry is what the traversals keep on their stacks. Every box the exact ray
+//! meets, and every box holding a triangle whose rounded distance beats `t_max`, passes; a few
+//! the ray only grazes are visited as well, which costs a little work and never a result (the
+//! triangle test decides).
+
+use super::{Aabb, Ray};
+use glam::Vec3;
+use wide::f32x4;
+
+/// γ(n) of floating-point error analysis: the relative error bound of n rounded operations.
+const fn gamma(n: u32) -> f32 {
+    let e = f32::EPSILON * 0.5;
+    (n as f32 * e) / (1.0 - n as f32 * e)
+}
+
+/// The relative widening of a box's exit distance (see the module docs).
+pub const EXIT_SLACK: f32 = 2.0 * gamma(3);
+
+/// The relative lowering of a box's entry distance (see the module docs): 2⁻¹⁶, about 128 units
+/// in the last place, covering the slab test's γ(3) and the triangle tests' rounding of `t`.
+pub const ENTRY_SLACK: f32 = 1.0 / 65536.0;
+
+/// An entry distance lowered by `ENTRY_SLACK` of its magnitude; ±inf stay as they are.
+#[inline(always)]
+fn lower(t: f32) -> f32 {
+    (t - t.abs() * ENTRY_SLACK).min(t)
+}
+
+#[inline(always)]
+fn lower4(t: f32x4) -> f32x4 {
+    min_keep(t - t.abs() * f32x4::splat(ENTRY_SLACK), t)
+}
+
+/// An exit distance widened by `EXIT_SLACK` of its magnitude, towards +inf. ±inf stay as they
+/// are: -inf + inf·slack would be NaN, which the running minimum with `t_max` would skip, turning
+/// a miss into a hit, so the larger of the widened value and the original is kept (a NaN sum
+/// leaves the original).
+#[inline(always)]
+fn widen(t: f32) -> f32 {
+    (t + t.abs() * EXIT_SLACK).max(t)
+}
+
+#[inline(always)]
+fn widen4(t: f32x4) -> f32x4 {
+    max_keep(t + t.abs() * f32x4::splat(EXIT_SLACK), t)
+}
+
+/// `max(t, acc)` where a NaN `t` (0·inf: the ray lies in a slab plane) leaves `acc` unchanged, the
+/// scalar `f32::max` rule in SIMD. SSE's maxps returns its second operand on NaN; elsewhere the
+/// NaN-aware `max` is used.
+#[inline(always)]
+pub fn max_keep(t: f32x4, acc: f32x4) -> f32x4 {
+    if cfg!(any(target_arch = "x86", target_arch = "x86_64")) {
+        t.fast_max(acc)
+    } else {
+        t.max(acc)
+    }
+}
+
+/// `min(t, acc)` with the same NaN rule as `max_keep`.
+#[inline(always)]
+pub fn min_keep(t: f32x4, acc: f32x4) -> f32x4 {
+    if cfg!(any(target_arch = "x86", target_arch = "x86_64")) {
+        t.fast_min(acc)
+    } else {
+        t.min(acc)
+    }
+}
+
+/// One ray against one box given by its planes: the clipped interval `(t_enter, t_exit)`, a hit
+/// when `t_enter <= t_exit`.
+#[inline(always)]
+pub fn one_box(lo: &[f32; 3], hi: &[f32; 3], origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> (f32, f32) {
+    // Sign-selected planes; `is_sign_negative` distinguishes -inf (from -0) from +inf.
+    let pick = |axis: usize, inv: f32| if inv.is_sign_negative() { (hi[axis], lo[axis]) } else { (lo[axis], hi[axis]) };
+    let (nx, fx) = pick(0, inv_dir.x);
+    let (ny, fy) = pick(1, inv_dir.y);
+    let (nz, fz) = pick(2, inv_dir.z);
+    let t_enter =
+        t_min.max((nx - origin.x) * inv_dir.x).max((ny - origin.y) * inv_dir.y).max((nz - origin.z) * inv_dir.z);
+    let far = ((fx - origin.x) * inv_dir.x).min((fy - origin.y) * inv_dir.y).min((fz - origin.z) * inv_dir.z);
+    (lower(t_enter), t_max.min(widen(far)))
+}
+
+/// Four boxes' planes in SoA order (`min[axis][box]`), for one SIMD slab test of all four: a
+/// wide node's children, or a binary node's two with two empty slots.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Boxes4 {
+    pub min: [[f32; 4]; 3],
+    pub max: [[f32; 4]; 3],
+}
+
+impl Boxes4 {
+    /// Four empty boxes (+inf..-inf), which every slab test misses.
+    pub const EMPTY: Boxes4 = Boxes4 { min: [[f32::INFINITY; 4]; 3], max: [[f32::NEG_INFINITY; 4]; 3] };
+
+    /// Put box `b`'s planes in slot `k`.
+    #[inline(always)]
+    pub fn set(&mut self, k: usize, lo: [f32; 3], hi: [f32; 3]) {
+        for axis in 0..3 {
+            self.min[axis][k] = lo[axis];
+            self.max[axis][k] = hi[axis];
+        }
+    }
+
+    /// Slot `k`'s planes.
+    #[inline(always)]
+    pub fn planes(&self, k: usize) -> ([f32; 3], [f32; 3]) {
+        let (lo, hi) = (&self.min, &self.max);
+        ([lo[0][k], lo[1][k], lo[2][k]], [hi[0][k], hi[1][k], hi[2][k]])
+    }
+
+    /// Slot `k`'s box.
+    pub fn bounds(&self, k: usize) -> Aabb {
+        let (lo, hi) = self.planes(k);
+        Aabb::new(Vec3::from_array(lo), Vec3::from_array(hi))
+    }
+}
+
+/// One ray in SIMD form for testing the four child boxes of a wide node at once.
+pub struct RayX4 {
+    org: [f32x4; 3],
+    inv: [f32x4; 3],
+    neg: [bool; 3],
+}
+
+impl RayX4 {
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let (o, i) = (ray.origin(), ray.inv_dir());
+        Self {
+            org: [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)],
+            inv: [f32x4::splat(i.x), f32x4::splat(i.y), f32x4::splat(i.z)],
+            neg: [i.x.is_sign_negative(), i.y.is_sign_negative(), i.z.is_sign_negative()],
+        }
+    }
+
+    /// Entry distances of the four boxes and the mask of those hit within `[t_min, t_max]`;
+    /// `valid` masks out empty slots.
+    #[inline(always)]
+    pub fn four_boxes(&self, boxes: &Boxes4, valid: u32, t_min: f32, t_max: f32) -> ([f32; 4], u32) {
+        let (min, max) = (&boxes.min, &boxes.max);
+        let mut enter = f32x4::splat(t_min);
+        let mut far = f32x4::splat(f32::INFINITY);
+        for axis in 0..3 {
+            let (near, far_plane) = if self.neg[axis] { (&max[axis], &min[axis]) } else { (&min[axis], &max[axis]) };
+            let t0 = (f32x4::from(*near) - self.org[axis]) * self.inv[axis];
+            let t1 = (f32x4::from(*far_plane) - self.org[axis]) * self.inv[axis];
+            enter = max_keep(t0, enter);
+            far = min_keep(t1, far);
+        }
+        let (enter, exit) = (lower4(enter), widen4(far).min(f32x4::splat(t_max)));
+        let mask = enter.simd_le(exit).to_bitmask() & valid;
+        (enter.to_array(), mask)
+    }
+}
+
+/// Four rays of a packet in SIMD form (lane k = ray k), for one slab test of a box against all
+/// four. Padding lanes (past the packet's end) repeat the last ray with `t_max = -inf`, so boxes
+/// nearly always miss them (a box can still pass one whose ray starts inside it with
+/// `t_min = -inf`); the packet masks them out at leaves.
+pub struct RayGroup {
+    org: [f32x4; 3],
+    inv: [f32x4; 3],
+    /// Per axis, all-ones lanes where the direction is negative (the far plane is `min`).
+    pub(crate) neg: [f32x4; 3],
+    pub t_min: f32x4,
+    /// The rays' current `t_max` (the nearest hit so far).
+    pub t_max: f32x4,
+}
+
+impl RayGroup {
+    /// Rays `base..base + 4` of `rays`; lanes past the end repeat the last ray (its padding).
+    #[inline(always)]
+    pub fn new(rays: &[Ray], base: usize) -> Self {
+        let last = rays.len() - 1;
+        let ray = |k: usize| &rays[(base + k).min(last)];
+        let lanes = |f: &dyn Fn(&Ray) -> f32| f32x4::from([f(ray(0)), f(ray(1)), f(ray(2)), f(ray(3))]);
+        let inv = [lanes(&|r| r.inv_dir().x), lanes(&|r| r.inv_dir().y), lanes(&|r| r.inv_dir().z)];
+        // The scalar test picks planes by `is_sign_negative`; `< 0` agrees for every valid ray (a
+        // -0 component gives -inf; an invalid ray has t_max = -inf and misses anyway).
+        let sign = |v: f32x4| v.simd_lt(f32x4::ZERO);
+        RayGroup {
+            org: [lanes(&|r| r.origin().x), lanes(&|r| r.origin().y), lanes(&|r| r.origin().z)],
+            neg: [sign(inv[0]), sign(inv[1]), sign(inv[2])],
+            inv,
+            t_min: lanes(&|r| r.t_min),
+            t_max: Self::t_max_of(rays, base),
+        }
+    }
+
+    /// The `t_max` of rays `base..base + 4` (`-inf` past the end).
+    #[inline(always)]
+    pub fn t_max_of(rays: &[Ray], base: usize) -> f32x4 {
+        let lane = |k: usize| rays.get(base + k).map_or(f32::NEG_INFINITY, |r| r.t_max);
+        f32x4::from([lane(0), lane(1), lane(2), lane(3)])
+    }
+
+    /// Lanes whose ray hits the box `[lo, hi]` within [t_min, t_max]: the scalar test's
+    /// arithmetic, lane by lane.
+    #[inline(always)]
+    pub fn hit(&self, lo: [f32; 3], hi: [f32; 3]) -> u32 {
+        let mut enter = self.t_min;
+        let mut far = f32x4::splat(f32::INFINITY);
+        for axis in 0..3 {
+            let ta = (f32x4::splat(lo[axis]) - self.org[axis]) * self.inv[axis];
+            let tb = (f32x4::splat(hi[axis]) - self.org[axis]) * self.inv[axis];
+            enter = max_keep(self.neg[axis].bitselect(tb, ta), enter);
+            far = min_keep(self.neg[axis].bitselect(ta, tb), far);
+        }
+        lower4(enter).simd_le(widen4(far).min(self.t_max)).to_bitmask()
+    }
+
+    /// `hit` for a packet whose rays all share the direction's sign on every axis: the near and
+    /// far planes per axis are chosen once for all lanes (the same values `hit` selects, so the
+    /// same result), which saves the per-lane selects, a third of the test.
+    #[inline(always)]
+    pub fn hit_planes(&self, near: [f32; 3], far_planes: [f32; 3]) -> u32 {
+        let mut enter = self.t_min;
+        let mut far = f32x4::splat(f32::INFINITY);
+        for axis in 0..3 {
+            let t_near = (f32x4::splat(near[axis]) - self.org[axis]) * self.inv[axis];
+            let t_far = (f32x4::splat(far_planes[axis]) - self.org[axis]) * self.inv[axis];
+            enter = max_keep(t_near, enter);
+            far = min_keep(t_far, far);
+        }
+        lower4(enter).simd_le(widen4(far).min(self.t_max)).to_bitmask()
+    }
+}
+
+/// A conservative bound of a packet's rays: where they start and the range of their inverse
+/// directions per axis. Valid only when every ray's direction has the same sign on each axis and
+/// no component is zero (then each ray's near plane of a box is the same one, and the bounds on
+/// its slab distances follow from the corners of the ranges).
+pub struct RayInterval {
+    valid: bool,
+    org_lo: [f32; 3],
+    org_hi: [f32; 3],
+    inv_lo: [f32; 3],
+    inv_hi: [f32; 3],
+    neg: [bool; 3],
+    t_min: f32,
+}
+
+impl RayInterval {
+    /// Whether the bounds hold (one direction sign per axis, finite values); when not, the
+    /// interval rejects nothing.
+    pub fn is_valid(&self) -> bool {
+        self.valid
+    }
+
+    /// An interval that rejects nothing.
+    pub const OFF: RayInterval = RayInterval {
+        valid: false,
+        org_lo: [0.0; 3],
+        org_hi: [0.0; 3],
+        inv_lo: [0.0; 3],
+        inv_hi: [0.0; 3],
+        neg: [false; 3],
+        t_min: 0.0,
+    };
+
+    /// The bounds of the rays in `groups` (padding lanes repeat a ray, so they change nothing).
+    #[inline(always)]
+    pub fn new(groups: &[RayGroup]) -> Self {
+        let inf = f32x4::splat(f32::INFINITY);
+        let (mut org_lo, mut org_hi) = ([inf; 3], [-inf; 3]);
+        let (mut inv_lo, mut inv_hi) = ([inf; 3], [-inf; 3]);
+        let mut t_min = inf;
+        // |x| < inf is false for infinities and NaNs; min and max skip NaNs, so a ray with one
+        // must switch the test off here.
+        let is_finite = |v: f32x4| v.abs().simd_lt(inf);
+        let mut finite = f32x4::ZERO.simd_eq(f32x4::ZERO);
+        for g in groups {
+            for axis in 0..3 {
+                let (o, i) = (g.org[axis], g.inv[axis]);
+                finite &= is_finite(o) & is_finite(i);
+                (org_lo[axis], org_hi[axis]) = (org_lo[axis].min(o), org_hi[axis].max(o));
+                (inv_lo[axis], inv_hi[axis]) = (inv_lo[axis].min(i), inv_hi[axis].max(i));
+            }
+            t_min = t_min.min(g.t_min);
+        }
+        let low = |v: f32x4| v.to_array().into_iter().fold(f32::INFINITY, f32::min);
+        let high = |v: f32x4| v.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max);
+        let inv_lo = inv_lo.map(low);
+        let inv_hi = inv_hi.map(high);
+        // One sign per axis, no zero or infinite component, finite origins.
+        let one_sign = (0..3).all(|a| inv_lo[a] > 0.0 || inv_hi[a] < 0.0);
+        RayInterval {
+            valid: !groups.is_empty() && one_sign && finite.all(),
+            org_lo: org_lo.map(low),
+            org_hi: org_hi.map(high),
+            neg: std::array::from_fn(|a| inv_hi[a] < 0.0),
+            inv_lo,
+            inv_hi,
+            t_min: low(t_min),
+        }
+    }
+
+    /// True when no ray of the packet can hit `b` before `t_far` (the farthest `t_max` of the
+    /// packet). Each ray's slab distance `(plane - o) · inv` is a rounded expression monotonic in
+    /// `o` and in `inv`, so its extremes over the ranges are at their corners: the bounds below
+    /// contain every ray's own rounded value, and the exit is widened as the rays' own is.
+    #[inline(always)]
+    pub fn misses(&self, b: &Aabb, t_far: f32) -> bool {
+        if !self.valid {
+            return false;
+        }
+        let mut enter = self.t_min;
+        let mut far = f32::INFINITY;
+        for axis in 0..3 {
+            let (near, far_plane) =
+                if self.neg[axis] { (b.max[axis], b.min[axis]) } else { (b.min[axis], b.max[axis]) };
+            let corners = |plane: f32| {
+                let (d0, d1) = (plane - self.org_hi[axis], plane - self.org_lo[axis]);
+                let (i0, i1) = (self.inv_lo[axis], self.inv_hi[axis]);
+                [d0 * i0, d0 * i1, d1 * i0, d1 * i1]
+            };
+            let n = corners(near);
+            let f = corners(far_plane);
+            enter = enter.max(n[0].min(n[1]).min(n[2]).min(n[3]));
+            far = far.min(f[0].max(f[1]).max(f[2]).max(f[3]));
+        }
+        lower(enter) > t_far.min(widen(far))
+    }
+
+    /// The four-box form of `misses`: the mask of the boxes some ray of the packet may hit
+    /// before `t_far`, all four when the test does not apply. The same bounds, one SIMD lane per
+    /// box.
+    #[inline(always)]
+    pub fn may_hit4(&self, boxes: &Boxes4, t_far: f32) -> u32 {
+        let (min, max) = (&boxes.min, &boxes.max);
+        if !self.valid {
+            return 0b1111;
+        }
+        let mut enter = f32x4::splat(self.t_min);
+        let mut far = f32x4::splat(f32::INFINITY);
+        for axis in 0..3 {
+            let (near, far_plane) = if self.neg[axis] { (max[axis], min[axis]) } else { (min[axis], max[axis]) };
+            let (o_lo, o_hi) = (f32x4::splat(self.org_lo[axis]), f32x4::splat(self.org_hi[axis]));
+            let (i0, i1) = (f32x4::splat(self.inv_lo[axis]), f32x4::splat(self.inv_hi[axis]));
+            let corners = |plane: [f32; 4]| {
+                let p = f32x4::from(plane);
+                let (d0, d1) = (p - o_hi, p - o_lo);
+                (d0 * i0, d0 * i1, d1 * i0, d1 * i1)
+            };
+            let n = corners(near);
+            let f = corners(far_plane);
+            enter = enter.max(n.0.min(n.1).min(n.2.min(n.3)));
+            far = far.min(f.0.max(f.1).max(f.2.max(f.3)));
+        }
+        // Rejected only when surely empty, as in `misses` (a NaN keeps the box).
+        let exit = widen4(far).min(f32x4::splat(t_far));
+        !lower4(enter).simd_gt(exit).to_bitmask() & 0b1111
+    }
+}
