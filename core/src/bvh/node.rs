@@ -49,10 +49,10 @@ impl BvhNode {
         Aabb::new(Vec3::from_array(self.lo), Vec3::from_array(self.hi))
     }
 
-    /// The slab test of the node's box (`geometry::slab::one_box`).
+    /// The slab test of the node's box (`geometry::slab::OneRay`).
     #[inline(always)]
-    pub fn slab(&self, origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> (f32, f32) {
-        crate::geometry::slab::one_box(&self.lo, &self.hi, origin, inv_dir, t_min, t_max)
+    pub fn slab(&self, ray: &crate::geometry::slab::OneRay, t_min: f32, t_max: f32) -> (f32, f32) {
+        ray.one_box(&self.lo, &self.hi, t_min, t_max)
     }
 
     /// The triangle range of a leaf.

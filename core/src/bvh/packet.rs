@@ -24,8 +24,9 @@
 use super::node::{Bvh, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;
 use super::{Hit, TraceOptions};
-use crate::geometry::slab::{Boxes4, RayGroup, RayInterval};
+use crate::geometry::slab::{RayGroup, RayInterval};
 use crate::geometry::{Aabb, Ray, TriangleHit, TriangleIntersector};
+use glam::Vec3;
 use std::mem::MaybeUninit;
 use wide::f32x4;
 
@@ -110,7 +111,7 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
             }
         }
         packet.one_sign = (0..3).all(|a| all_neg[a].all() || !any_neg[a].any());
-        packet.neg = all_neg.map(|m| m.all());
+        packet.neg = [all_neg[0].all(), all_neg[1].all(), all_neg[2].all()];
         packet.frustum = RayInterval::new(packet.groups());
         packet
     }
@@ -148,6 +149,7 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
 
     /// A leaf over `tris` (`first` is the index of `tris[0]` in leaf order) for every group from
     /// `from` whose rays hit its box `[lo, hi]`; true when one of them found a nearer hit.
+    #[inline(always)]
     pub(super) fn leaf_groups(
         &mut self,
         from: usize,
@@ -166,6 +168,8 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
         found
     }
 
+    /// Test triangles `tris` (the first at `first` in leaf order) against the rays of group `g`
+    /// in `mask`; true when one of them found a nearer hit.
     fn leaf(&mut self, g: usize, mask: u32, tris: &[[glam::Vec3; 3]], first: usize) -> bool {
         // Only the lanes of real rays (the last group may have padding lanes).
         let mask = mask & ((1u32 << (self.rays.len() - 4 * g).min(4)) - 1);
@@ -196,7 +200,7 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
             found = true;
         }
         if found {
-            self.groups_mut()[g].t_max = t_max;
+            self.groups_mut()[g].set_t_max(t_max);
         }
         found
     }
@@ -224,9 +228,18 @@ pub(super) trait PacketTree {
     fn root_bounds(&self) -> Aabb;
     fn root(&self) -> u32;
     fn is_leaf(&self, r: u32) -> bool;
-    /// An interior node's children: their planes (written to `scratch` when the layout does not
-    /// store them so), the mask of valid slots, and each slot's reference.
-    fn children<'a>(&'a self, r: u32, scratch: &'a mut Boxes4) -> (&'a Boxes4, u32, [u32; 4]);
+    /// The valid child slots of interior node `r`.
+    fn slots(&self, r: u32) -> u32;
+    /// Slot `slot`'s box, as its planes.
+    fn slot_planes(&self, r: u32, slot: usize) -> ([f32; 3], [f32; 3]);
+    /// Per slot, where its box's centre lies along `lead` (twice that, in fact: the order is all
+    /// that counts).
+    fn keys(&self, r: u32, lead: Vec3) -> [f32; 4];
+    /// The slots of `missed` whose boxes some ray of the packet may still hit before `t_far`
+    /// (the packet's interval test, `RayInterval`).
+    fn may_hit(&self, r: u32, missed: u32, frustum: &RayInterval, t_far: f32) -> u32;
+    /// The reference of slot `slot` of interior node `r`.
+    fn child(&self, r: u32, slot: usize) -> u32;
     /// A leaf's box, and its triangles `first..first + count` in leaf order.
     fn leaf(&self, r: u32) -> ([f32; 3], [f32; 3], usize, usize);
 }
@@ -249,13 +262,36 @@ impl PacketTree for Bvh {
         self.nodes[r as usize].is_leaf()
     }
     #[inline(always)]
-    fn children<'a>(&'a self, r: u32, scratch: &'a mut Boxes4) -> (&'a Boxes4, u32, [u32; 4]) {
-        let left = self.nodes[r as usize].index;
-        for (slot, child) in [left, left + 1].into_iter().enumerate() {
-            let n = &self.nodes[child as usize];
-            scratch.set(slot, n.lo, n.hi);
+    fn slots(&self, _: u32) -> u32 {
+        0b11
+    }
+    #[inline(always)]
+    fn slot_planes(&self, r: u32, slot: usize) -> ([f32; 3], [f32; 3]) {
+        let n = &self.nodes[(self.nodes[r as usize].index as usize) + slot];
+        (n.lo, n.hi)
+    }
+    #[inline(always)]
+    fn keys(&self, r: u32, lead: Vec3) -> [f32; 4] {
+        let key = |s: usize| {
+            let (lo, hi) = self.slot_planes(r, s);
+            (Vec3::from_array(lo) + Vec3::from_array(hi)).dot(lead)
+        };
+        [key(0), key(1), 0.0, 0.0]
+    }
+    #[inline(always)]
+    fn may_hit(&self, r: u32, missed: u32, frustum: &RayInterval, t_far: f32) -> u32 {
+        let mut m = 0;
+        for s in 0..2 {
+            if missed & (1 << s) != 0 {
+                let (lo, hi) = self.slot_planes(r, s);
+                m |= (!frustum.misses(&Aabb::new(Vec3::from_array(lo), Vec3::from_array(hi)), t_far) as u32) << s;
+            }
         }
-        (scratch, 0b11, [left, left + 1, 0, 0])
+        m
+    }
+    #[inline(always)]
+    fn child(&self, r: u32, slot: usize) -> u32 {
+        self.nodes[r as usize].index + slot as u32
     }
     #[inline(always)]
     fn leaf(&self, r: u32) -> ([f32; 3], [f32; 3], usize, usize) {
@@ -279,7 +315,6 @@ const STACK: usize = 3 * TRAVERSAL_STACK_SIZE + 4;
 /// each ray gets the hit it would get alone.
 fn walk<B: PacketTree, T: TriangleIntersector>(bvh: &B, rays: &mut [Ray], hits: &mut [Option<Hit>]) {
     let lead = rays[0].dir();
-    let lead = [f32x4::splat(lead.x), f32x4::splat(lead.y), f32x4::splat(lead.z)];
     let mut slot = MaybeUninit::uninit();
     let packet = Packet::<T>::new_in(&mut slot, rays);
     let mut t_far = packet.t_far();
@@ -291,12 +326,9 @@ fn walk<B: PacketTree, T: TriangleIntersector>(bvh: &B, rays: &mut [Ray], hits: 
     // (child reference, first group that may hit it).
     let mut stack = TraversalStack::<STACK, (u32, u8)>::new();
     let (mut cur, mut first) = (bvh.root(), root_group);
-    let mut scratch = Boxes4::EMPTY;
     loop {
         if !bvh.is_leaf(cur) {
-            let (planes, valid, refs) = bvh.children(cur, &mut scratch);
-            let centre = |axis: usize| f32x4::from(planes.min[axis]) + f32x4::from(planes.max[axis]);
-            let key = (centre(0) * lead[0] + centre(1) * lead[1] + centre(2) * lead[2]).to_array();
+            let key = bvh.keys(cur, lead);
             // The hit children as (key, reference, first group), kept sorted far to near.
             let mut hit = [(0f32, 0u32, 0u8); 4];
             let mut n = 0;
@@ -306,15 +338,15 @@ fn walk<B: PacketTree, T: TriangleIntersector>(bvh: &B, rays: &mut [Ray], hits: 
                     hit[j] = hit[j - 1];
                     j -= 1;
                 }
-                hit[j] = (key[s], refs[s], g as u8);
+                hit[j] = (key[s], bvh.child(cur, s), g as u8);
                 n += 1;
             };
             let mut missed = 0u32;
-            let mut todo = valid;
+            let mut todo = bvh.slots(cur);
             while todo != 0 {
                 let s = todo.trailing_zeros() as usize;
                 todo &= todo - 1;
-                let (lo, hi) = planes.planes(s);
+                let (lo, hi) = bvh.slot_planes(cur, s);
                 if packet.group_hits(first, lo, hi) != 0 {
                     add(s, first);
                 } else {
@@ -322,11 +354,11 @@ fn walk<B: PacketTree, T: TriangleIntersector>(bvh: &B, rays: &mut [Ray], hits: 
                 }
             }
             if missed != 0 && first + 1 < packet.n_groups {
-                missed &= packet.frustum.may_hit4(planes, t_far);
+                missed &= bvh.may_hit(cur, missed, &packet.frustum, t_far);
                 while missed != 0 {
                     let s = missed.trailing_zeros() as usize;
                     missed &= missed - 1;
-                    let (lo, hi) = planes.planes(s);
+                    let (lo, hi) = bvh.slot_planes(cur, s);
                     let mut g = first + 1;
                     while g < packet.n_groups && packet.group_hits(g, lo, hi) == 0 {
                         g += 1;

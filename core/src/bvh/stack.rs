@@ -56,12 +56,14 @@ impl<const N: usize> TraversalStack<N> {
         }
     }
 
-    /// Pop entries until one the ray enters no later than `t_max` (the closest hit so far): the
-    /// next node worth visiting. Entries beyond it are dropped: nothing in them can be nearer.
+    /// Pop entries until one the ray enters no later than `limit` (the closest hit so far,
+    /// widened as `geometry::slab` explains: a box starting a rounding error beyond the closest
+    /// hit may still hold a hit that rounds nearer): the next node worth visiting. Entries beyond
+    /// it are dropped: nothing in them can be nearer.
     #[inline(always)]
-    pub fn pop_nearer(&mut self, t_max: f32) -> Option<u32> {
+    pub fn pop_nearer(&mut self, limit: f32) -> Option<u32> {
         while let Some((node, t_enter)) = self.pop() {
-            if t_enter <= t_max {
+            if t_enter <= limit {
                 return Some(node);
             }
         }

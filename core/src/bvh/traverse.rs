@@ -12,6 +12,7 @@
 use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;
 use super::{Accelerator, Hit, TraceOptions, TraversalStats};
+use crate::geometry::slab::{widen, OneRay};
 use crate::geometry::{Ray, TriangleIntersector};
 use std::ops::Range;
 
@@ -67,12 +68,15 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
     stats: &mut S,
     mut leaf: impl FnMut(Range<usize>, &mut Ray, &mut S) -> bool,
 ) {
-    let (origin, inv_dir) = (ray.origin(), ray.inv_dir());
+    let inv_dir = ray.inv_dir();
+    let slab_ray = OneRay::new(ray);
+    // The closest hit so far, widened: what boxes and stack entries are compared with.
+    let mut limit = widen(ray.t_max);
     // Which child is near under the handout's rule, per axis: a negative direction component
     // (including -0) means the right child (larger coordinates) is met first.
     let dir_neg = [inv_dir.x.is_sign_negative(), inv_dir.y.is_sign_negative(), inv_dir.z.is_sign_negative()];
     L::box_tests(stats, 1);
-    let (t0, t1) = nodes[0].slab(origin, inv_dir, ray.t_min, ray.t_max);
+    let (t0, t1) = nodes[0].slab(&slab_ray, ray.t_min, limit);
     if !(t0 <= t1) {
         return;
     }
@@ -86,11 +90,12 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
             if leaf(node.prims(), ray, stats) {
                 return;
             }
+            limit = widen(ray.t_max);
         } else {
             let left = node.index as usize;
             L::box_tests(stats, 2);
-            let (l0, l1) = nodes[left].slab(origin, inv_dir, ray.t_min, ray.t_max);
-            let (r0, r1) = nodes[left + 1].slab(origin, inv_dir, ray.t_min, ray.t_max);
+            let (l0, l1) = nodes[left].slab(&slab_ray, ray.t_min, limit);
+            let (r0, r1) = nodes[left + 1].slab(&slab_ray, ray.t_min, limit);
             match (l0 <= l1, r0 <= r1) {
                 (true, true) => {
                     let right_first = if BY_DISTANCE { r0 < l0 } else { dir_neg[node.axis as usize] };
@@ -111,7 +116,7 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
             }
         }
         // The next node that can still hold a hit nearer than the best so far.
-        match stack.pop_nearer(ray.t_max) {
+        match stack.pop_nearer(limit) {
             Some(n) => current = n as usize,
             None => return,
         }

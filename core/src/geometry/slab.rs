@@ -15,18 +15,19 @@
 //! **Robustness** (Ize, "Robust BVH Ray Traversal", JCGT 2013; pbrt-v4 §6.1.2): each slab distance
 //! (plane − origin)·(1/d) is rounded three times (the subtraction, the reciprocal, the product), so
 //! it may be off by a relative γ(3) = 3ε/(1 − 3ε). A box the ray only touches, at a vertex shared
-//! with the triangle the ray is aimed at, has equal entry and exit; rounded, the entry can come
-//! out above the exit and the box is culled although the watertight triangle test would hit. So
-//! the exit over the three axes is widened by 2γ(3) of its magnitude before it is compared.
-//! Second, a box is also culled when its entry lies beyond the closest hit so far (`t_max`); but
-//! the triangle tests round too, so two triangles meeting at the vertex the ray is aimed at give
-//! distances a few units in the last place apart, and the box of the nearer one can start just
-//! beyond the farther one's rounded distance. So the entry is lowered by `ENTRY_SLACK` of its
-//! magnitude (a bound on both roundings with room to spare) before it is compared with `t_max`,
-//! and the lowered entry is what the traversals keep on their stacks. Every box the exact ray
-//! meets, and every box holding a triangle whose rounded distance beats `t_max`, passes; a few
-//! the ray only grazes are visited as well, which costs a little work and never a result (the
-//! triangle test decides).
+//! with the triangle the ray is aimed at, has equal entry and exit; rounded, the entry can come out
+//! above the exit and the box is culled although the watertight triangle test would hit. So, as
+//! Ize does, the far planes' distances are computed with a reciprocal direction enlarged by
+//! `SLACK` (`inv_far`): every exit comes out a little late, never early. And a box is culled when
+//! its entry lies beyond the closest hit so far (`t_max`); but the triangle tests round too, so two
+//! triangles meeting at the vertex the ray is aimed at give distances a few units in the last place
+//! apart, and the box of the nearer one can start just beyond the farther one's rounded distance.
+//! So boxes and stack entries are compared with `t_max` widened by `SLACK` (`widen`), which the
+//! traversals compute once per hit rather than per box. Every box the exact ray meets, and every
+//! box holding a triangle whose rounded distance beats `t_max`, passes; a few the ray only grazes
+//! are visited as well, which costs a little work and never a result (the triangle test decides,
+//! against the exact `t_max`). Both widenings stay off the per-node dependency chain: a widening
+//! of each exit there cost a fifth of the wide traversal's speed.
 
 use super::{Aabb, Ray};
 use glam::Vec3;
@@ -38,36 +39,25 @@ const fn gamma(n: u32) -> f32 {
     (n as f32 * e) / (1.0 - n as f32 * e)
 }
 
-/// The relative widening of a box's exit distance (see the module docs).
-pub const EXIT_SLACK: f32 = 2.0 * gamma(3);
+/// The relative widening of exits (see the module docs): 2⁻¹⁶, about 128 units in the last place,
+/// covering the slab test's 2γ(3) and the triangle tests' rounding of `t` with room to spare.
+pub const SLACK: f32 = 1.0 / 65536.0;
 
-/// The relative lowering of a box's entry distance (see the module docs): 2⁻¹⁶, about 128 units
-/// in the last place, covering the slab test's γ(3) and the triangle tests' rounding of `t`.
-pub const ENTRY_SLACK: f32 = 1.0 / 65536.0;
+const _: () = assert!(SLACK > 2.0 * gamma(3));
 
-/// An entry distance lowered by `ENTRY_SLACK` of its magnitude; ±inf stay as they are.
+/// A distance widened by `SLACK` of its magnitude, towards +inf: the `t_max` boxes and stack
+/// entries are compared with. ±inf stay as they are (-inf + inf·slack would be NaN, so the larger
+/// of the widened value and the original is kept).
 #[inline(always)]
-fn lower(t: f32) -> f32 {
-    (t - t.abs() * ENTRY_SLACK).min(t)
+pub fn widen(t: f32) -> f32 {
+    (t + t.abs() * SLACK).max(t)
 }
 
+/// The reciprocal direction enlarged by `SLACK`, for the far planes: the same sign, a larger
+/// magnitude, so every exit distance (positive for a box ahead) comes out late, never early.
 #[inline(always)]
-fn lower4(t: f32x4) -> f32x4 {
-    min_keep(t - t.abs() * f32x4::splat(ENTRY_SLACK), t)
-}
-
-/// An exit distance widened by `EXIT_SLACK` of its magnitude, towards +inf. ±inf stay as they
-/// are: -inf + inf·slack would be NaN, which the running minimum with `t_max` would skip, turning
-/// a miss into a hit, so the larger of the widened value and the original is kept (a NaN sum
-/// leaves the original).
-#[inline(always)]
-fn widen(t: f32) -> f32 {
-    (t + t.abs() * EXIT_SLACK).max(t)
-}
-
-#[inline(always)]
-fn widen4(t: f32x4) -> f32x4 {
-    max_keep(t + t.abs() * f32x4::splat(EXIT_SLACK), t)
+fn far_inv(inv: Vec3) -> Vec3 {
+    inv * (1.0 + SLACK)
 }
 
 /// `max(t, acc)` where a NaN `t` (0·inf: the ray lies in a slab plane) leaves `acc` unchanged, the
@@ -92,19 +82,55 @@ pub fn min_keep(t: f32x4, acc: f32x4) -> f32x4 {
     }
 }
 
-/// One ray against one box given by its planes: the clipped interval `(t_enter, t_exit)`, a hit
-/// when `t_enter <= t_exit`.
+/// `widen` in SIMD.
 #[inline(always)]
-pub fn one_box(lo: &[f32; 3], hi: &[f32; 3], origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> (f32, f32) {
+fn widen4(t: f32x4) -> f32x4 {
+    max_keep(t + t.abs() * f32x4::splat(SLACK), t)
+}
+
+/// One ray prepared for slab tests against single boxes: origin, reciprocal direction, and the
+/// enlarged reciprocal for the far planes.
+#[derive(Clone, Copy, Debug)]
+pub struct OneRay {
+    origin: Vec3,
+    inv: Vec3,
+    inv_far: Vec3,
+}
+
+impl OneRay {
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        Self { origin: ray.origin(), inv: ray.inv_dir(), inv_far: far_inv(ray.inv_dir()) }
+    }
+
+    /// The box given by its planes: the clipped interval `(t_enter, t_exit)`, a hit when
+    /// `t_enter <= t_exit`. `t_max` is the caller's limit (the closest hit so far, widened).
+    #[inline(always)]
+    pub fn one_box(&self, lo: &[f32; 3], hi: &[f32; 3], t_min: f32, t_max: f32) -> (f32, f32) {
+        interval(lo, hi, self.origin, self.inv, self.inv_far, t_min, t_max)
+    }
+}
+
+/// The slab test of one box, with `inv_far` the reciprocal for the far planes.
+#[inline(always)]
+fn interval(lo: &[f32; 3], hi: &[f32; 3], o: Vec3, inv: Vec3, invf: Vec3, t_min: f32, t_max: f32) -> (f32, f32) {
     // Sign-selected planes; `is_sign_negative` distinguishes -inf (from -0) from +inf.
     let pick = |axis: usize, inv: f32| if inv.is_sign_negative() { (hi[axis], lo[axis]) } else { (lo[axis], hi[axis]) };
-    let (nx, fx) = pick(0, inv_dir.x);
-    let (ny, fy) = pick(1, inv_dir.y);
-    let (nz, fz) = pick(2, inv_dir.z);
-    let t_enter =
-        t_min.max((nx - origin.x) * inv_dir.x).max((ny - origin.y) * inv_dir.y).max((nz - origin.z) * inv_dir.z);
-    let far = ((fx - origin.x) * inv_dir.x).min((fy - origin.y) * inv_dir.y).min((fz - origin.z) * inv_dir.z);
-    (lower(t_enter), t_max.min(widen(far)))
+    let (nx, fx) = pick(0, inv.x);
+    let (ny, fy) = pick(1, inv.y);
+    let (nz, fz) = pick(2, inv.z);
+    let t_enter = t_min.max((nx - o.x) * inv.x).max((ny - o.y) * inv.y).max((nz - o.z) * inv.z);
+    let t_exit = t_max.min((fx - o.x) * invf.x).min((fy - o.y) * invf.y).min((fz - o.z) * invf.z);
+    (t_enter, t_exit)
+}
+
+/// One ray against one box, with nothing prepared (a root box, once per ray): the exit is
+/// widened after the fact, which costs a few operations but no setup.
+#[inline(always)]
+pub fn box_once(lo: &[f32; 3], hi: &[f32; 3], ray: &Ray) -> (f32, f32) {
+    let inv = ray.inv_dir();
+    let (t_enter, t_exit) = interval(lo, hi, ray.origin(), inv, inv, ray.t_min, ray.t_max);
+    (t_enter, widen(t_exit))
 }
 
 /// Four boxes' planes in SoA order (`min[axis][box]`), for one SIMD slab test of all four: a
@@ -146,35 +172,36 @@ impl Boxes4 {
 pub struct RayX4 {
     org: [f32x4; 3],
     inv: [f32x4; 3],
+    inv_far: [f32x4; 3],
     neg: [bool; 3],
 }
 
 impl RayX4 {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
-        let (o, i) = (ray.origin(), ray.inv_dir());
+        let (o, i, f) = (ray.origin(), ray.inv_dir(), far_inv(ray.inv_dir()));
         Self {
             org: [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)],
             inv: [f32x4::splat(i.x), f32x4::splat(i.y), f32x4::splat(i.z)],
+            inv_far: [f32x4::splat(f.x), f32x4::splat(f.y), f32x4::splat(f.z)],
             neg: [i.x.is_sign_negative(), i.y.is_sign_negative(), i.z.is_sign_negative()],
         }
     }
 
-    /// Entry distances of the four boxes and the mask of those hit within `[t_min, t_max]`;
-    /// `valid` masks out empty slots.
+    /// Entry distances of the four boxes and the mask of those hit within `[t_min, t_max]`
+    /// (`t_max` the caller's limit, the closest hit widened); `valid` masks out empty slots.
     #[inline(always)]
     pub fn four_boxes(&self, boxes: &Boxes4, valid: u32, t_min: f32, t_max: f32) -> ([f32; 4], u32) {
         let (min, max) = (&boxes.min, &boxes.max);
         let mut enter = f32x4::splat(t_min);
-        let mut far = f32x4::splat(f32::INFINITY);
+        let mut exit = f32x4::splat(t_max);
         for axis in 0..3 {
-            let (near, far_plane) = if self.neg[axis] { (&max[axis], &min[axis]) } else { (&min[axis], &max[axis]) };
+            let (near, far) = if self.neg[axis] { (&max[axis], &min[axis]) } else { (&min[axis], &max[axis]) };
             let t0 = (f32x4::from(*near) - self.org[axis]) * self.inv[axis];
-            let t1 = (f32x4::from(*far_plane) - self.org[axis]) * self.inv[axis];
+            let t1 = (f32x4::from(*far) - self.org[axis]) * self.inv_far[axis];
             enter = max_keep(t0, enter);
-            far = min_keep(t1, far);
+            exit = min_keep(t1, exit);
         }
-        let (enter, exit) = (lower4(enter), widen4(far).min(f32x4::splat(t_max)));
         let mask = enter.simd_le(exit).to_bitmask() & valid;
         (enter.to_array(), mask)
     }
@@ -187,11 +214,14 @@ impl RayX4 {
 pub struct RayGroup {
     org: [f32x4; 3],
     inv: [f32x4; 3],
+    inv_far: [f32x4; 3],
     /// Per axis, all-ones lanes where the direction is negative (the far plane is `min`).
     pub(crate) neg: [f32x4; 3],
     pub t_min: f32x4,
     /// The rays' current `t_max` (the nearest hit so far).
     pub t_max: f32x4,
+    /// `t_max` widened, what boxes are compared with.
+    t_limit: f32x4,
 }
 
 impl RayGroup {
@@ -202,16 +232,27 @@ impl RayGroup {
         let ray = |k: usize| &rays[(base + k).min(last)];
         let lanes = |f: &dyn Fn(&Ray) -> f32| f32x4::from([f(ray(0)), f(ray(1)), f(ray(2)), f(ray(3))]);
         let inv = [lanes(&|r| r.inv_dir().x), lanes(&|r| r.inv_dir().y), lanes(&|r| r.inv_dir().z)];
+        let far = |i: f32x4| i * f32x4::splat(1.0 + SLACK);
+        let t_max = Self::t_max_of(rays, base);
         // The scalar test picks planes by `is_sign_negative`; `< 0` agrees for every valid ray (a
         // -0 component gives -inf; an invalid ray has t_max = -inf and misses anyway).
         let sign = |v: f32x4| v.simd_lt(f32x4::ZERO);
         RayGroup {
             org: [lanes(&|r| r.origin().x), lanes(&|r| r.origin().y), lanes(&|r| r.origin().z)],
             neg: [sign(inv[0]), sign(inv[1]), sign(inv[2])],
+            inv_far: [far(inv[0]), far(inv[1]), far(inv[2])],
             inv,
             t_min: lanes(&|r| r.t_min),
-            t_max: Self::t_max_of(rays, base),
+            t_limit: widen4(t_max),
+            t_max,
         }
+    }
+
+    /// Set the rays' `t_max` (after hits).
+    #[inline(always)]
+    pub fn set_t_max(&mut self, t_max: f32x4) {
+        self.t_max = t_max;
+        self.t_limit = widen4(t_max);
     }
 
     /// The `t_max` of rays `base..base + 4` (`-inf` past the end).
@@ -226,14 +267,15 @@ impl RayGroup {
     #[inline(always)]
     pub fn hit(&self, lo: [f32; 3], hi: [f32; 3]) -> u32 {
         let mut enter = self.t_min;
-        let mut far = f32x4::splat(f32::INFINITY);
+        let mut exit = self.t_limit;
         for axis in 0..3 {
-            let ta = (f32x4::splat(lo[axis]) - self.org[axis]) * self.inv[axis];
-            let tb = (f32x4::splat(hi[axis]) - self.org[axis]) * self.inv[axis];
-            enter = max_keep(self.neg[axis].bitselect(tb, ta), enter);
-            far = min_keep(self.neg[axis].bitselect(ta, tb), far);
+            let (lo, hi) = (f32x4::splat(lo[axis]), f32x4::splat(hi[axis]));
+            let near = self.neg[axis].bitselect(hi, lo);
+            let far = self.neg[axis].bitselect(lo, hi);
+            enter = max_keep((near - self.org[axis]) * self.inv[axis], enter);
+            exit = min_keep((far - self.org[axis]) * self.inv_far[axis], exit);
         }
-        lower4(enter).simd_le(widen4(far).min(self.t_max)).to_bitmask()
+        enter.simd_le(exit).to_bitmask()
     }
 
     /// `hit` for a packet whose rays all share the direction's sign on every axis: the near and
@@ -242,14 +284,14 @@ impl RayGroup {
     #[inline(always)]
     pub fn hit_planes(&self, near: [f32; 3], far_planes: [f32; 3]) -> u32 {
         let mut enter = self.t_min;
-        let mut far = f32x4::splat(f32::INFINITY);
+        let mut exit = self.t_limit;
         for axis in 0..3 {
             let t_near = (f32x4::splat(near[axis]) - self.org[axis]) * self.inv[axis];
-            let t_far = (f32x4::splat(far_planes[axis]) - self.org[axis]) * self.inv[axis];
+            let t_far = (f32x4::splat(far_planes[axis]) - self.org[axis]) * self.inv_far[axis];
             enter = max_keep(t_near, enter);
-            far = min_keep(t_far, far);
+            exit = min_keep(t_far, exit);
         }
-        lower4(enter).simd_le(widen4(far).min(self.t_max)).to_bitmask()
+        enter.simd_le(exit).to_bitmask()
     }
 }
 
@@ -307,15 +349,17 @@ impl RayInterval {
         }
         let low = |v: f32x4| v.to_array().into_iter().fold(f32::INFINITY, f32::min);
         let high = |v: f32x4| v.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max);
-        let inv_lo = inv_lo.map(low);
-        let inv_hi = inv_hi.map(high);
+        // Written out per axis: `array::map` was left out of line here, a twentieth of a packet.
+        let lows = |v: &[f32x4; 3]| [low(v[0]), low(v[1]), low(v[2])];
+        let highs = |v: &[f32x4; 3]| [high(v[0]), high(v[1]), high(v[2])];
+        let (inv_lo, inv_hi) = (lows(&inv_lo), highs(&inv_hi));
         // One sign per axis, no zero or infinite component, finite origins.
         let one_sign = (0..3).all(|a| inv_lo[a] > 0.0 || inv_hi[a] < 0.0);
         RayInterval {
             valid: !groups.is_empty() && one_sign && finite.all(),
-            org_lo: org_lo.map(low),
-            org_hi: org_hi.map(high),
-            neg: std::array::from_fn(|a| inv_hi[a] < 0.0),
+            org_lo: lows(&org_lo),
+            org_hi: highs(&org_hi),
+            neg: [inv_hi[0] < 0.0, inv_hi[1] < 0.0, inv_hi[2] < 0.0],
             inv_lo,
             inv_hi,
             t_min: low(t_min),
@@ -332,7 +376,7 @@ impl RayInterval {
             return false;
         }
         let mut enter = self.t_min;
-        let mut far = f32::INFINITY;
+        let mut exit = t_far;
         for axis in 0..3 {
             let (near, far_plane) =
                 if self.neg[axis] { (b.max[axis], b.min[axis]) } else { (b.min[axis], b.max[axis]) };
@@ -344,9 +388,9 @@ impl RayInterval {
             let n = corners(near);
             let f = corners(far_plane);
             enter = enter.max(n[0].min(n[1]).min(n[2]).min(n[3]));
-            far = far.min(f[0].max(f[1]).max(f[2]).max(f[3]));
+            exit = exit.min(f[0].max(f[1]).max(f[2]).max(f[3]));
         }
-        lower(enter) > t_far.min(widen(far))
+        enter > widen(exit)
     }
 
     /// The four-box form of `misses`: the mask of the boxes some ray of the packet may hit
@@ -359,7 +403,7 @@ impl RayInterval {
             return 0b1111;
         }
         let mut enter = f32x4::splat(self.t_min);
-        let mut far = f32x4::splat(f32::INFINITY);
+        let mut exit = f32x4::splat(t_far);
         for axis in 0..3 {
             let (near, far_plane) = if self.neg[axis] { (max[axis], min[axis]) } else { (min[axis], max[axis]) };
             let (o_lo, o_hi) = (f32x4::splat(self.org_lo[axis]), f32x4::splat(self.org_hi[axis]));
@@ -372,10 +416,9 @@ impl RayInterval {
             let n = corners(near);
             let f = corners(far_plane);
             enter = enter.max(n.0.min(n.1).min(n.2.min(n.3)));
-            far = far.min(f.0.max(f.1).max(f.2.max(f.3)));
+            exit = exit.min(f.0.max(f.1).max(f.2.max(f.3)));
         }
         // Rejected only when surely empty, as in `misses` (a NaN keeps the box).
-        let exit = widen4(far).min(f32x4::splat(t_far));
-        !lower4(enter).simd_gt(exit).to_bitmask() & 0b1111
+        !enter.simd_gt(widen4(exit)).to_bitmask() & 0b1111
     }
 }

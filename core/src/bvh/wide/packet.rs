@@ -5,8 +5,10 @@
 
 use super::{ChildRef, WideBvh};
 use crate::bvh::packet::PacketTree;
-use crate::geometry::slab::Boxes4;
+use crate::geometry::slab::RayInterval;
 use crate::geometry::Aabb;
+use glam::Vec3;
+use wide::f32x4;
 
 impl PacketTree for WideBvh {
     fn prim_ids(&self) -> &[u32] {
@@ -26,11 +28,28 @@ impl PacketTree for WideBvh {
         ChildRef::from_raw(r).is_leaf()
     }
     #[inline(always)]
-    fn children<'a>(&'a self, r: u32, _: &'a mut Boxes4) -> (&'a Boxes4, u32, [u32; 4]) {
+    fn slots(&self, r: u32) -> u32 {
+        self.nodes[ChildRef::from_raw(r).node() as usize].valid as u32
+    }
+    #[inline(always)]
+    fn slot_planes(&self, r: u32, slot: usize) -> ([f32; 3], [f32; 3]) {
+        self.nodes[ChildRef::from_raw(r).node() as usize].boxes.planes(slot)
+    }
+    #[inline(always)]
+    fn keys(&self, r: u32, lead: Vec3) -> [f32; 4] {
+        let b = &self.nodes[ChildRef::from_raw(r).node() as usize].boxes;
+        let centre = |axis: usize| f32x4::from(b.min[axis]) + f32x4::from(b.max[axis]);
+        (centre(0) * f32x4::splat(lead.x) + centre(1) * f32x4::splat(lead.y) + centre(2) * f32x4::splat(lead.z))
+            .to_array()
+    }
+    #[inline(always)]
+    fn may_hit(&self, r: u32, missed: u32, frustum: &RayInterval, t_far: f32) -> u32 {
+        missed & frustum.may_hit4(&self.nodes[ChildRef::from_raw(r).node() as usize].boxes, t_far)
+    }
+    #[inline(always)]
+    fn child(&self, r: u32, slot: usize) -> u32 {
         let index = ChildRef::from_raw(r).node();
-        let node = &self.nodes[index as usize];
-        let refs = std::array::from_fn(|s| ChildRef::of(node, index, s).raw());
-        (&node.boxes, node.valid as u32, refs)
+        ChildRef::of(&self.nodes[index as usize], index, slot).raw()
     }
     #[inline(always)]
     fn leaf(&self, r: u32) -> ([f32; 3], [f32; 3], usize, usize) {

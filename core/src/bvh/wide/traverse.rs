@@ -14,7 +14,7 @@ use crate::bvh::simd::prefetch;
 use crate::bvh::stack::TraversalStack;
 use crate::bvh::traverse::test_triangles;
 use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
-use crate::geometry::slab::RayX4;
+use crate::geometry::slab::{widen, RayX4};
 use crate::geometry::{Ray, TriangleIntersector};
 
 /// Deepest stack a traversal can need: at most three pushes per level (the build bounds the depth
@@ -50,6 +50,9 @@ impl WideBvh {
             return;
         }
         let sray = RayX4::new(ray);
+        // The closest hit so far, widened: what boxes and stack entries are compared with.
+        let mut limit = widen(ray.t_max);
+        let t_min = ray.t_min;
         let mut stack = TraversalStack::<STACK>::new();
         let mut cur = ChildRef::ROOT;
         'traversal: loop {
@@ -59,10 +62,10 @@ impl WideBvh {
                 let node = &self.nodes[index as usize];
                 stats.node_visited();
                 stats.box_tests(node.valid.count_ones());
-                let (enter, mask) = sray.four_boxes(&node.boxes, node.valid as u32, ray.t_min, ray.t_max);
+                let (enter, mask) = sray.four_boxes(&node.boxes, node.valid as u32, t_min, limit);
                 if mask == 0 {
                     // Nothing hit here: continue with the nearest useful entry of the stack.
-                    match stack.pop_nearer(ray.t_max) {
+                    match stack.pop_nearer(limit) {
                         Some(r) => {
                             cur = ChildRef::from_raw(r);
                             continue 'traversal;
@@ -79,10 +82,17 @@ impl WideBvh {
                 let s1 = rest.trailing_zeros() as usize;
                 let rest2 = rest & (rest - 1);
                 if rest2 == 0 {
-                    let (near, far) = if enter[s0] <= enter[s1] { (s0, s1) } else { (s1, s0) };
-                    self.prefetch_child(node, far);
-                    stack.push((ChildRef::of(node, index, far).raw(), enter[far]));
-                    cur = ChildRef::of(node, index, near);
+                    // Both references first: they do not wait for the comparison.
+                    let (r0, r1) = (ChildRef::of(node, index, s0), ChildRef::of(node, index, s1));
+                    if enter[s0] <= enter[s1] {
+                        self.prefetch_child(node, s1);
+                        stack.push((r1.raw(), enter[s1]));
+                        cur = r0;
+                    } else {
+                        self.prefetch_child(node, s0);
+                        stack.push((r0.raw(), enter[s0]));
+                        cur = r1;
+                    }
                     continue;
                 }
                 // Three or four children hit: push them all, nearest on top, and take it.
@@ -107,7 +117,8 @@ impl WideBvh {
             if leaf(node.child[slot] as usize, node.count[slot] as usize, ray, stats) {
                 break 'traversal;
             }
-            match stack.pop_nearer(ray.t_max) {
+            limit = widen(ray.t_max);
+            match stack.pop_nearer(limit) {
                 Some(r) => cur = ChildRef::from_raw(r),
                 None => break 'traversal,
             }
