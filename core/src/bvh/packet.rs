@@ -15,11 +15,11 @@
 //!
 //! Packets are for the renderer's uncounted views of primary rays (`bvhscope render` of normals or
 //! depth): heatmaps, and the app, which always counts for its hover read-out, trace single rays.
-//! Incoherent rays defeat both shortcuts (bunny, 1M rays: 0.5 against 0.9 MRays/s), so they are
-//! traced one by one. Both layouts trace packets with the one walk of this file (`walk`), over the
-//! children of their nodes as `PacketTree` presents them: the binary BVH's two children, the wide
-//! BVH's four. Earlier, packets were 2×2 blocks traced with all four lanes tested at every node;
-//! 8×8 ranged packets are 1.3× faster on the bunny's primary frame.
+//! Incoherent rays defeat both shortcuts (they are slower in packets than alone, BENCHMARKS.md,
+//! "Seventh round"), so they are traced one by one. Both layouts trace packets with the one walk
+//! of this file (`walk`), over the children of their nodes as `PacketTree` presents them: the
+//! binary BVH's two children, the wide BVH's four. Earlier, packets were 2×2 blocks traced with all four lanes tested at every node;
+//! 8×8 ranged packets replaced them (BENCHMARKS.md, "Seventh round").
 
 use super::node::{Bvh, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;

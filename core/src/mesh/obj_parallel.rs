@@ -2,9 +2,9 @@
 //! gives for them; anything it does not know, and every error, goes to tobj, which stays the
 //! reference (`obj.rs`).
 //!
-//! Why it exists: tobj parses on one thread at about 140 MB/s here. For the 234 MB file of a
-//! 2M-triangle mesh with normals and uvs that is 1.5–1.9 s, which alone breaks the 2 s load + build
-//! budget of issue 4. OBJ lines are independent except for the face indices, which count the
+//! Why it exists: tobj parses on one thread, and for the files of multi-million-triangle meshes that
+//! alone takes most of the time we allow for loading and building them (figures: BENCHMARKS.md,
+//! "Fifth round", Loading). OBJ lines are independent except for the face indices, which count the
 //! vertices declared so far, and the object each face falls in. So the text is cut at line ends
 //! into chunks, the chunks are parsed in parallel, and their counts are stitched with prefix sums.
 //!

@@ -97,9 +97,7 @@ fn binned(
     // A node of n triangles fills at most n bins per axis, and planes between bins of one or two
     // centroids seldom beat their neighbours; the sweeps, not the binning, are the cost of the
     // many small nodes near the leaves. So a node gets n/3 bins (at least 4) up to the maximum:
-    // one-thread build of the bunny 20.4 -> 19.2 ms (medians of seven alternated runs of 31
-    // builds), SAH cost +0.1% (bunny 31.435 -> 31.459, beast 20.502 -> 20.516, 2M knot
-    // 53.18 -> 53.23).
+    // a faster build for a tenth of a percent of SAH cost (BENCHMARKS.md, "Ninth round").
     let bins = max_bins.min((n / 3).max(4)).clamp(2, MAX_BINS);
     // Axes with no extent cannot be split by a plane; their scale 0 puts everything in bin 0.
     let scale: [f32; 3] = std::array::from_fn(|a| if extent[a] > 0.0 { bins as f32 / extent[a] } else { 0.0 });
