@@ -71,9 +71,10 @@ fn main() {
         let plain_ms = median(&|| drop(std::hint::black_box(render(&bvh, &mesh, &cam, &plain))));
         println!("frame {layout:?}, plain: median {plain_ms:.1} ms of 20");
         let app = RenderSettings { count: true, progressive: true, ..RenderSettings::default() };
+        let frames = bvhscope::render::FramePool::default();
         let app_ms = median(&|| {
             let control = bvhscope::work::WorkControl::new();
-            let _ = render_passes(&bvh, &mesh, &cam, &app, &control, |f, _| {
+            let _ = render_passes(&bvh, &mesh, &cam, &app, &frames, &control, |f, _| {
                 let style = (View::Normals, Default::default(), Default::default(), Default::default());
                 std::hint::black_box(view_image(&f, style.0, style.1, style.2, style.3));
             });
@@ -84,10 +85,11 @@ fn main() {
             let counted = RenderSettings { count: true, ..RenderSettings::default() };
             let c_ms = median(&|| drop(std::hint::black_box(render(&bvh, &mesh, &cam, &counted))));
             let control = bvhscope::work::WorkControl::new();
-            let p_ms =
-                median(&|| drop(bvhscope::render::render_progressive(&bvh, &mesh, &cam, &app, &control, |_, _| {})));
+            let p_ms = median(&|| {
+                drop(bvhscope::render::render_progressive(&bvh, &mesh, &cam, &app, &frames, &control, |_, _| {}))
+            });
             let s_ms = median(&|| {
-                let _ = render_passes(&bvh, &mesh, &cam, &app, &control, |f, _| drop(std::hint::black_box(f)));
+                let _ = render_passes(&bvh, &mesh, &cam, &app, &frames, &control, |f, _| drop(std::hint::black_box(f)));
             });
             println!("counted {c_ms:.1}, progressive {p_ms:.1}, with snapshots {s_ms:.1}");
         }

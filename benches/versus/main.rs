@@ -308,10 +308,10 @@ fn app_figures(meshes: &[Mesh], all: &ThreadPool) -> String {
                 // What the app does per frame: count (for the hover read-out and the statistics),
                 // refine in four passes, and build each pass's image.
                 let app = RenderSettings { count: true, progressive: true, ..settings };
-                let control = bvhscope::work::WorkControl::new();
+                let (control, frames) = (bvhscope::work::WorkControl::new(), Default::default());
                 let app_ms = median_ms(9, || {
                     all.install(|| {
-                        let _ = render_passes(&bvh, bunny, &cam, &app, &control, |f, _| {
+                        let _ = render_passes(&bvh, bunny, &cam, &app, &frames, &control, |f, _| {
                             let (v, c, r) = (View::Normals, ColorMap::default(), HeatRange::Auto);
                             std::hint::black_box(view_image(&f, v, c, r, Default::default()));
                         });

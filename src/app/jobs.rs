@@ -7,7 +7,7 @@ use crate::bvh::{SahCost, TraceOptions};
 use crate::bvh::{SceneBuild, SceneBvh};
 use crate::mesh::Mesh;
 use crate::render::{
-    render_passes, view_image, Camera, ColorMap, Frame, HeatRange, Legend, PassInfo, RenderSettings, View,
+    render_passes, view_image, Camera, ColorMap, Frame, FramePool, HeatRange, Legend, PassInfo, RenderSettings, View,
 };
 use crate::scene::{load_any, SceneInstances};
 use crate::work::{Cancelled, WorkControl};
@@ -99,6 +99,8 @@ pub struct Jobs {
     pub last_render: Option<RenderRequest>,
     /// The last build started: its parameters and scene.
     pub last_build: Option<(SceneBuild, u64)>,
+    /// The render jobs' frame storage, reused from one render to the next (`FramePool`).
+    frames: FramePool,
 }
 
 impl Jobs {
@@ -115,6 +117,7 @@ impl Jobs {
             picking: None,
             last_render: None,
             last_build: None,
+            frames: FramePool::default(),
         }
     }
 
@@ -186,12 +189,12 @@ impl Jobs {
         }
         let job = self.start("Rendering".to_string());
         let (send, control) = (self.sender(job.id), job.control.clone());
-        let r = req.clone();
+        let (r, frames) = (req.clone(), self.frames.clone());
         std::thread::spawn(move || {
             // Always count: the heatmaps and the hover read-out need the counters, and counting
             // costs little next to shading.
             let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive };
-            let _ = render_passes(&*r.bvh, &r.mesh, &r.camera, &settings, &control, |frame, info| {
+            let _ = render_passes(&*r.bvh, &r.mesh, &r.camera, &settings, &frames, &control, |frame, info| {
                 let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
                 let (bvh, camera, style, trace) = (r.bvh.clone(), r.camera, r.style, r.trace);

@@ -1,7 +1,9 @@
 //! The desktop app (eframe/egui): a thin layer of state and panels over the core. The state is
-//! here; the panels only read and change it; long work runs in `jobs` and comes back as events.
+//! here; the panels only read it and emit `Action`s, which `act` applies; `reconcile` then
+//! decides what to rebuild and re-render. Long work runs in `jobs` and comes back as events.
 //! Data flows one way: mesh → BVH → renderer → image → screen.
 
+mod action;
 mod export;
 mod jobs;
 mod orbit;
@@ -12,14 +14,14 @@ mod settings;
 mod shortcuts;
 mod viewport;
 
+pub use action::{Action, Actions};
 pub use jobs::Pick;
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
 pub use scene::{BuiltBvh, Scene, SceneSource};
 pub use settings::{BoxLevel, Settings};
-pub use shortcuts::Action;
 
-use crate::bvh::{Preset, SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
+use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
 use crate::render::{Camera, ColorMap, Frame, Legend, RaySummary, UpAxis, View};
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
 use std::path::PathBuf;
@@ -134,14 +136,15 @@ pub struct BvhscopeApp {
     pub messages: Vec<Message>,
     pub show_help: bool,
     pub path_window: Option<PathWindow>,
-    /// Boxes drawn by the overlay in the last frame.
-    pub boxes_drawn: usize,
-    box_cache: Option<BoxCache>,
-    overlay_cache: Option<OverlayCache>,
+    /// Derived from the state, kept while it is unchanged (the viewport reads them).
+    box_cache: std::cell::RefCell<Option<BoxCache>>,
+    overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
     /// Where the viewport was drawn in the last frame (its size is the rendered image's).
     pub viewport_rect: egui::Rect,
+    /// The image size the viewport asks for (0 × 0 before it is first laid out).
+    viewport_pixels: (u32, u32),
 }
 
 /// The overlay's triangles for one camera and viewport rectangle, and for the frame they were
@@ -189,26 +192,17 @@ impl BvhscopeApp {
             messages: Vec::new(),
             show_help: false,
             path_window: None,
-            boxes_drawn: 0,
-            box_cache: None,
-            overlay_cache: None,
+            box_cache: Default::default(),
+            overlay_cache: Default::default(),
             viewport_aspect: aspect,
             viewport_rect: egui::Rect::NOTHING,
+            viewport_pixels: (0, 0),
         };
         if let Some(file) = options.file {
-            app.open(file);
+            app.act(Action::OpenFile(file));
         }
-        app.ensure_build();
+        app.reconcile();
         app
-    }
-
-    /// Load a mesh in the background; the current scene stays until it has loaded.
-    pub fn open(&mut self, path: PathBuf) {
-        self.jobs.load(path);
-    }
-
-    pub fn show_builtin(&mut self) {
-        self.set_scene(Scene::builtin());
     }
 
     pub fn message(&mut self, kind: MessageKind, text: impl Into<String>) {
@@ -247,7 +241,6 @@ impl BvhscopeApp {
         self.scene_id += 1;
         self.previous = None;
         self.rays = None;
-        self.ensure_build();
     }
 
     /// The current camera, meshes and BVH settings as a scene file (not for the built-in scene,
@@ -295,8 +288,32 @@ impl BvhscopeApp {
         SceneBuild { bvh: self.settings.build, top }
     }
 
+    /// Bring the background work in line with the state: settings that depend on the BVH are
+    /// kept within it, a build starts when the settings or the scene differ from what was built
+    /// or is building, and a render when what the viewport would show differs from the last
+    /// render asked for. The one place that decides what to rebuild and re-render.
+    pub fn reconcile(&mut self) {
+        self.fit_settings_to_bvh();
+        self.ensure_build();
+        self.ensure_render();
+    }
+
+    /// Box depths within the tree's depth (once it is known: until a BVH is built the chosen
+    /// depth is kept), and no per-level view for a single BVH, which has no levels to tell apart.
+    fn fit_settings_to_bvh(&mut self) {
+        let Some(built) = self.current_bvh() else { return };
+        let (max, top) = (built.bottom_max_depth(), built.top_stats.as_ref().map(|s| s.max_depth));
+        let s = &mut self.settings;
+        s.box_depth = s.box_depth.min(max);
+        match top {
+            Some(top) => s.top_box_depth = s.top_box_depth.min(top),
+            None if s.view.is_per_level() => s.view = View::Visits,
+            None => {}
+        }
+    }
+
     /// Start a build when the settings or the scene differ from what was built or is building.
-    pub fn ensure_build(&mut self) {
+    fn ensure_build(&mut self) {
         let build = self.wanted_build();
         let wanted = (build, self.scene_id);
         let have = self.current_bvh().is_some_and(|b| b.bvh.build_params() == build);
@@ -309,32 +326,58 @@ impl BvhscopeApp {
         }
     }
 
+    /// Start a render when what the viewport would show (camera, image size, BVH, view)
+    /// differs from the last render asked for.
+    fn ensure_render(&mut self) {
+        let (w, h) = self.viewport_pixels;
+        let Some(built) = self.current_bvh().filter(|_| w > 0 && h > 0) else { return };
+        let req = jobs::RenderRequest {
+            bvh: built.bvh.clone(),
+            mesh: self.scene.mesh.clone(),
+            camera: self.orbit.camera(w, h),
+            trace: self.settings.trace,
+            style: self.view_style(),
+            progressive: self.settings.progressive,
+        };
+        if req.camera.validate().is_ok() && !self.jobs.last_render.as_ref().is_some_and(|last| last.same_as(&req)) {
+            self.jobs.render(req);
+        }
+    }
+
     /// The boxes of the overlay for the current BVH and settings (cached): the single BVH's at
     /// the box depth, or for two levels the top level's and/or the bottom level's, each at its
     /// own depth.
-    pub fn overlay_boxes(&mut self) -> Option<Arc<Vec<OverlayBox>>> {
+    pub fn overlay_boxes(&self) -> Option<Arc<Vec<OverlayBox>>> {
         let bvh = self.current_bvh()?.bvh.clone();
         let s = &self.settings;
         let key = (s.box_level, s.top_box_depth, s.box_depth, s.boxes_leaves_above);
-        let fresh = self.box_cache.as_ref().is_some_and(|c| Arc::ptr_eq(&c.bvh, &bvh) && c.key == key);
+        let mut cache = self.box_cache.borrow_mut();
+        let fresh = cache.as_ref().is_some_and(|c| Arc::ptr_eq(&c.bvh, &bvh) && c.key == key);
         if !fresh {
             let (level, top_depth, depth, leaves_above) = key;
             let boxes = overlay::boxes_of(&bvh, level, top_depth, depth, leaves_above);
-            self.box_cache = Some(BoxCache { bvh, key, boxes: Arc::new(boxes) });
+            *cache = Some(BoxCache { bvh, key, boxes: Arc::new(boxes) });
         }
-        self.box_cache.as_ref().map(|c| c.boxes.clone())
+        cache.as_ref().map(|c| c.boxes.clone())
+    }
+
+    /// How many boxes the overlay draws (0 when it is off).
+    pub fn boxes_drawn(&self) -> usize {
+        let boxes = self.settings.show_boxes.then(|| self.overlay_boxes()).flatten();
+        boxes.map_or(0, |b| b.len())
     }
 
     /// The overlay mesh of `boxes` seen by `camera` in `rect` (cached), depth-tested against
     /// `depth` (the frame on screen) when given.
     pub fn overlay_mesh(
-        &mut self,
+        &self,
         boxes: Arc<Vec<OverlayBox>>,
         camera: Camera,
         rect: egui::Rect,
         depth: Option<Arc<Frame>>,
     ) -> Arc<egui::Mesh> {
-        if let Some(c) = &self.overlay_cache {
+        let mut cache = self.overlay_cache.borrow_mut();
+        if let Some(c) = &*cache {
             let same_depth = match (&c.depth, &depth) {
                 (Some(a), Some(b)) => Arc::ptr_eq(a, b),
                 (None, None) => true,
@@ -346,7 +389,7 @@ impl BvhscopeApp {
         }
         let test = depth.as_deref().map(|frame| overlay::DepthTest { frame, rect });
         let mesh = Arc::new(overlay::boxes_mesh(&boxes, &camera, rect, 1.2, test));
-        self.overlay_cache = Some(OverlayCache { boxes, camera, rect, depth, mesh: mesh.clone() });
+        *cache = Some(OverlayCache { boxes, camera, rect, depth, mesh: mesh.clone() });
         mesh
     }
 
@@ -370,26 +413,13 @@ impl BvhscopeApp {
         }
     }
 
-    pub fn frame_mesh(&mut self) {
-        self.orbit.frame(&self.scene.mesh.bounds(), self.viewport_aspect);
+    /// The image size the viewport renders at.
+    pub fn viewport_pixels(&self) -> (u32, u32) {
+        self.viewport_pixels
     }
 
-    pub fn reset_view(&mut self) {
+    fn reset_view(&mut self) {
         self.orbit = OrbitCamera::home(&self.scene.mesh.bounds(), self.viewport_aspect, self.settings.up_axis);
-    }
-
-    /// Orbit about another axis: the camera goes back to that axis's default view.
-    pub fn set_up_axis(&mut self, up: UpAxis) {
-        if self.settings.up_axis != up {
-            self.settings.up_axis = up;
-            self.reset_view();
-        }
-    }
-
-    /// Switch to a preset's settings (the build and the render follow).
-    pub fn apply_preset(&mut self, preset: Preset) {
-        self.settings.apply_preset(preset);
-        self.message(MessageKind::Info, format!("{}: {}", preset.label(), preset.help()));
     }
 
     fn apply(&mut self, ctx: &egui::Context, event: JobEvent) {
@@ -420,7 +450,7 @@ impl BvhscopeApp {
             }
             JobEvent::Built { .. } => {}
             JobEvent::Pass(pass) => self.show_pass(ctx, pass),
-            JobEvent::Picked { pick, path: Some(path), .. } => self.picked(pick, path),
+            JobEvent::Picked { pick, path: Some(path), .. } => self.act(Action::Picked(pick, path)),
             JobEvent::Picked { pick, path: None, took } => {
                 // rfd answers None at once when it has no portal or zenity to ask; a person who
                 // cancels a real dialog takes longer than that.
@@ -433,10 +463,10 @@ impl BvhscopeApp {
     }
 
     /// Act on a chosen file.
-    pub fn picked(&mut self, pick: Pick, path: PathBuf) {
+    fn picked(&mut self, pick: Pick, path: PathBuf) {
         let result = match pick {
             Pick::Open => {
-                self.open(path);
+                self.jobs.load(path);
                 return;
             }
             Pick::SavePng => export::save_png(self, &path),
@@ -482,33 +512,65 @@ impl BvhscopeApp {
         });
     }
 
-    /// Everything that happens before the panels are drawn: job results, dropped files, keys.
-    fn handle_input(&mut self, ctx: &egui::Context) {
+    /// Job results, and the actions of input outside the panels: dropped files and keys.
+    fn handle_input(&mut self, ctx: &egui::Context, actions: &mut Actions) {
         for event in self.jobs.poll() {
             self.apply(ctx, event);
         }
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
         });
-        if let Some(path) = dropped.into_iter().next() {
-            self.open(path);
-        }
-        for action in shortcuts::pressed(ctx) {
-            self.act(action);
-        }
+        actions.extend(dropped.into_iter().take(1).map(Action::OpenFile));
+        actions.extend(shortcuts::pressed(ctx));
         // Info messages fade out; errors stay until dismissed.
         self.messages.retain(|m| m.kind != MessageKind::Info || m.at.elapsed() < Duration::from_secs(6));
     }
 
-    pub fn act(&mut self, action: shortcuts::Action) {
-        use shortcuts::Action as A;
+    /// Apply one action: the only place the state changes in answer to the user.
+    pub fn act(&mut self, action: Action) {
+        use Action as A;
         match action {
             A::Open => self.jobs.pick_file(Pick::Open, ""),
             A::OpenPath => self.path_window = Some(PathWindow::new(Pick::Open, String::new(), None)),
+            // Loads in the background; the current scene stays until it has loaded.
+            A::OpenFile(path) => self.jobs.load(path),
+            A::ShowBuiltin => self.set_scene(Scene::builtin()),
             A::SavePng => self.jobs.pick_file(Pick::SavePng, &export::default_name(self, "png")),
+            A::SavePngTyped => {
+                let name = export::default_name(self, "png");
+                self.path_window = Some(PathWindow::new(Pick::SavePng, name, None));
+            }
             A::ExportStats => self.jobs.pick_file(Pick::SaveStatsCsv, &export::default_name(self, "csv")),
-            A::FrameMesh => self.frame_mesh(),
+            A::ExportStatsJson => self.jobs.pick_file(Pick::SaveStatsJson, &export::default_name(self, "json")),
+            A::SaveScene => {
+                let name = format!("{}.json", self.scene.title().trim_end_matches(".obj").trim_end_matches(".json"));
+                self.jobs.pick_file(Pick::SaveScene, &name);
+            }
+            A::Picked(pick, path) => {
+                self.path_window = None;
+                self.picked(pick, path);
+            }
+            A::PathText(text) => {
+                if let Some(w) = &mut self.path_window {
+                    w.text = text;
+                }
+            }
+            A::PathFocused => {
+                if let Some(w) = &mut self.path_window {
+                    w.focus = false;
+                }
+            }
+            A::ClosePathWindow => self.path_window = None,
+            A::Orbit(dx, dy) => self.orbit.orbit(dx, dy),
+            A::Pan { dx, dy, height } => self.orbit.pan(dx, dy, height),
+            A::Zoom(amount) => self.orbit.zoom(amount),
+            A::FrameMesh => self.orbit.frame(&self.scene.mesh.bounds(), self.viewport_aspect),
             A::ResetView => self.reset_view(),
+            A::Viewport { rect, pixels } => {
+                self.viewport_rect = rect;
+                self.viewport_aspect = rect.width() / rect.height().max(1.0);
+                self.viewport_pixels = pixels;
+            }
             A::View(i) => self.settings.view = View::ALL[i.min(View::ALL.len() - 1)],
             A::ToggleBoxes => self.settings.show_boxes = !self.settings.show_boxes,
             A::DepthUp => {
@@ -528,7 +590,28 @@ impl BvhscopeApp {
                 let i = ColorMap::ALL.iter().position(|c| *c == self.settings.colormap).unwrap_or(0);
                 self.settings.colormap = ColorMap::ALL[(i + 1) % ColorMap::ALL.len()];
             }
+            A::ApplyPreset(preset) => {
+                self.settings.apply_preset(preset);
+                self.message(MessageKind::Info, format!("{}: {}", preset.label(), preset.help()));
+            }
+            A::SetUpAxis(up) => {
+                if self.settings.up_axis != up {
+                    self.settings.up_axis = up;
+                    self.reset_view();
+                }
+            }
+            A::Edit(settings) => {
+                let up = settings.up_axis;
+                self.settings = Settings { up_axis: self.settings.up_axis, ..*settings };
+                self.act(A::SetUpAxis(up));
+            }
             A::Help => self.show_help = !self.show_help,
+            A::SetHelp(on) => self.show_help = on,
+            A::Dismiss(i) => {
+                if i < self.messages.len() {
+                    self.messages.remove(i);
+                }
+            }
         }
     }
 }
@@ -536,17 +619,24 @@ impl BvhscopeApp {
 impl eframe::App for BvhscopeApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
-        self.handle_input(&ctx);
-        egui::Panel::top("menu").show(ui, |ui| panels::menu::show(self, ui));
+        let mut actions = Actions::new();
+        self.handle_input(&ctx, &mut actions);
+        // The panels see the state as it is after the input's actions.
+        for action in actions.drain(..) {
+            self.act(action);
+        }
+        self.reconcile();
+        let out = &mut actions;
+        egui::Panel::top("menu").show(ui, |ui| panels::menu::show(self, ui, out));
         egui::Panel::bottom("status").show(ui, |ui| panels::status::show(self, ui));
         // The side panels keep the width they have (the user's, remembered by egui's memory):
         // their contents wrap, scroll or clip inside it and never widen them, so the viewport,
         // and with it the camera's aspect, stays as it is when the figures change.
         egui::Panel::left("controls").resizable(true).default_size(290.0).size_range(200.0..=640.0).show(ui, |ui| {
             panels::fixed_width(ui, |ui| {
-                panels::build::show(self, ui);
+                panels::build::show(self, ui, out);
                 ui.separator();
-                panels::view::show(self, ui);
+                panels::view::show(self, ui, out);
             })
         });
         egui::Panel::right("statistics")
@@ -554,13 +644,18 @@ impl eframe::App for BvhscopeApp {
             .default_size(340.0)
             .size_range(220.0..=720.0)
             .show(ui, |ui| panels::fixed_width(ui, |ui| panels::stats::show(self, ui)));
-        egui::CentralPanel::default().frame(egui::Frame::NONE.fill(egui::Color32::from_gray(12))).show(ui, |ui| {
-            self.viewport_aspect = ui.available_width() / ui.available_height().max(1.0);
-            self.viewport_rect = ui.available_rect_before_wrap();
-            viewport::show(self, ui);
-        });
-        panels::windows::show(self, &ctx);
-        self.ensure_build();
+        egui::CentralPanel::default()
+            .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(12)))
+            .show(ui, |ui| viewport::show(self, ui, out));
+        panels::windows::show(self, &ctx, out);
+        // What the panels asked for takes effect now, and shows in the next frame.
+        if !actions.is_empty() {
+            for action in actions {
+                self.act(action);
+            }
+            self.reconcile();
+            ctx.request_repaint();
+        }
         if self.jobs.is_busy() {
             // Keep progress indicators moving; results also wake the UI themselves.
             ctx.request_repaint_after(Duration::from_millis(100));

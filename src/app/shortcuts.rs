@@ -1,23 +1,7 @@
 //! Keyboard shortcuts: one table, used both to handle keys and to list them in the Help window.
 
+use super::Action;
 use egui::{Key, KeyboardShortcut, Modifiers};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Action {
-    Open,
-    OpenPath,
-    SavePng,
-    ExportStats,
-    FrameMesh,
-    ResetView,
-    View(usize),
-    ToggleBoxes,
-    DepthUp,
-    DepthDown,
-    NextStrategy,
-    NextColormap,
-    Help,
-}
 
 pub const SHORTCUTS: &[(KeyboardShortcut, Action, &str)] = &[
     (KeyboardShortcut::new(Modifiers::COMMAND, Key::O), Action::Open, "Open a mesh (file dialog)"),
@@ -69,7 +53,7 @@ pub fn pressed(ctx: &egui::Context) -> Vec<Action> {
             .iter()
             .filter(|(s, _, _)| !(typing && s.modifiers == Modifiers::NONE))
             .filter(|(s, _, _)| i.consume_shortcut(s))
-            .map(|(_, a, _)| *a)
+            .map(|(_, a, _)| a.clone())
             .collect()
     })
 }

@@ -1,9 +1,8 @@
 //! The central view: the ray-cast image, mouse camera control, the node-box overlay, the heatmap
-//! legend and the per-pixel read-out on hover. It asks for a new render whenever what it would
-//! show (camera, BVH, view, size) differs from the last request.
+//! legend and the per-pixel read-out on hover. It reports its size and the mouse's camera moves
+//! as actions; the app's reconciler renders what it would show.
 
-use super::jobs::RenderRequest;
-use super::{BvhscopeApp, MessageKind};
+use super::{Action, Actions, BvhscopeApp, MessageKind};
 use crate::render::legend::fmt_value;
 use crate::render::{Frame, Legend};
 use egui::{Color32, PointerButton, Pos2, Rect, Sense, Stroke, Vec2};
@@ -12,22 +11,22 @@ use std::sync::Arc;
 /// Largest image the viewport renders (pixels), so huge windows stay interactive.
 const MAX_PIXELS: f32 = 2560.0 * 1440.0;
 
-pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
+pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let rect = ui.available_rect_before_wrap();
     let response = ui.allocate_rect(rect, Sense::click_and_drag());
 
     // Camera input.
     if response.dragged_by(PointerButton::Primary) {
         let d = response.drag_delta();
-        app.orbit.orbit(d.x, d.y);
+        out.push(Action::Orbit(d.x, d.y));
     } else if response.dragged_by(PointerButton::Secondary) || response.dragged_by(PointerButton::Middle) {
         let d = response.drag_delta();
-        app.orbit.pan(d.x, d.y, rect.height());
+        out.push(Action::Pan { dx: d.x, dy: d.y, height: rect.height() });
     }
     if response.hovered() {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
-            app.orbit.zoom(scroll);
+            out.push(Action::Zoom(scroll));
         }
     }
 
@@ -38,8 +37,10 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     if area > MAX_PIXELS {
         size *= (MAX_PIXELS / area).sqrt();
     }
-    let (w, h) = (size.x.round().max(1.0) as u32, size.y.round().max(1.0) as u32);
-    request_render(app, w, h);
+    let pixels = (size.x.round().max(1.0) as u32, size.y.round().max(1.0) as u32);
+    if rect != app.viewport_rect || pixels != app.viewport_pixels() {
+        out.push(Action::Viewport { rect, pixels });
+    }
 
     // The image, stretched to the viewport while a new size is on its way.
     let painter = ui.painter_at(rect);
@@ -59,10 +60,8 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     }
 
     // Node boxes, in the camera of the image they are drawn over.
-    app.boxes_drawn = 0;
     if app.settings.show_boxes {
         if let (Some(boxes), Some(camera)) = (app.overlay_boxes(), app.shown.as_ref().map(|s| s.camera)) {
-            app.boxes_drawn = boxes.len();
             let depth = app.settings.boxes_in_front.then(|| app.shown.as_ref().map(|s| s.frame.clone())).flatten();
             let mesh = app.overlay_mesh(boxes, camera, rect, depth);
             painter.add(egui::Shape::Mesh(mesh));
@@ -81,7 +80,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         );
     }
 
-    messages(app, ui, rect);
+    messages(app, ui, rect, out);
     if let Some(shown) = &app.shown {
         if let Some(legend) = &shown.legend {
             legend_area(ui, rect, legend);
@@ -90,24 +89,6 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             let frame = shown.frame.clone();
             response.on_hover_ui_at_pointer(|ui| pixel_readout(ui, &frame, rect, pos));
         }
-    }
-}
-
-fn request_render(app: &mut BvhscopeApp, w: u32, h: u32) {
-    let Some(built) = app.current_bvh() else { return };
-    let req = RenderRequest {
-        bvh: built.bvh.clone(),
-        mesh: app.scene.mesh.clone(),
-        camera: app.orbit.camera(w, h),
-        trace: app.settings.trace,
-        style: app.view_style(),
-        progressive: app.settings.progressive,
-    };
-    if req.camera.validate().is_err() {
-        return;
-    }
-    if !app.jobs.last_render.as_ref().is_some_and(|last| last.same_as(&req)) {
-        app.jobs.render(req);
     }
 }
 
@@ -196,7 +177,7 @@ fn legend_area(ui: &egui::Ui, rect: Rect, legend: &Legend) {
 /// Errors (until dismissed) and notes (for a few seconds) across the top of the viewport. Each
 /// wraps inside the viewport, however long (a scene's note can be a paragraph), with its Dismiss
 /// button below the text, so the button stays on screen.
-fn messages(app: &mut BvhscopeApp, ui: &egui::Ui, rect: Rect) {
+fn messages(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, out: &mut Actions) {
     if app.messages.is_empty() {
         return;
     }
@@ -225,7 +206,5 @@ fn messages(app: &mut BvhscopeApp, ui: &egui::Ui, rect: Rect) {
                 });
             }
         });
-    if let Some(i) = dismiss {
-        app.messages.remove(i);
-    }
+    out.extend(dismiss.map(Action::Dismiss));
 }

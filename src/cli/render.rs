@@ -53,7 +53,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let total = camera.width as u64 * camera.height as u64;
     let control = WorkControl::new();
     let frame = progress::with_bar("rendering", &control, || {
-        render_progressive(&bvh, mesh, &camera, &settings, &control, |_, _| {})
+        render_progressive(&bvh, mesh, &camera, &settings, &Default::default(), &control, |_, _| {})
     })
     .map_err(|_| CliError::Usage("render cancelled".into()))?;
     let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });

@@ -1,7 +1,7 @@
 //! The desktop app driven through egui_kittest, without a display: what a user sees and does.
 //! Built by the `ui-tests` package (see its Cargo.toml); snapshots live in `tests/snapshots/`.
 
-use bvhscope::app::{AppOptions, BvhscopeApp, MessageKind, SceneSource};
+use bvhscope::app::{Action, AppOptions, BvhscopeApp, MessageKind, SceneSource};
 use bvhscope::bvh::SplitStrategy;
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
@@ -92,11 +92,15 @@ fn switching_back_before_a_build_finishes_cancels_it() {
     let sah_nodes = h.state().current_bvh().unwrap().stats.nodes;
     // Choose midpoint, then SAH again before the midpoint build can finish (it takes
     // milliseconds; these two requests are microseconds apart).
-    h.state_mut().settings.build.strategy = SplitStrategy::Midpoint;
-    h.state_mut().ensure_build();
+    let choose = |h: &mut Harness<'_, BvhscopeApp>, strategy| {
+        let mut s = h.state().settings.clone();
+        s.build.strategy = strategy;
+        h.state_mut().act(Action::Edit(Box::new(s)));
+        h.state_mut().reconcile();
+    };
+    choose(&mut h, SplitStrategy::Midpoint);
     assert!(h.state().jobs.build.is_some(), "the midpoint build runs");
-    h.state_mut().settings.build.strategy = SplitStrategy::SahBinned;
-    h.state_mut().ensure_build();
+    choose(&mut h, SplitStrategy::SahBinned);
     assert!(h.state().jobs.build.is_none(), "the midpoint build is cancelled");
     run_until(&mut h, "quiet", idle);
     for _ in 0..20 {
@@ -107,6 +111,27 @@ fn switching_back_before_a_build_finishes_cancels_it() {
     assert_eq!(b.bvh.build_params().bvh.strategy, SplitStrategy::SahBinned);
     assert_eq!(b.stats.nodes, sah_nodes);
     assert!(h.state().previous.is_none(), "no strategy the user did not keep appears as 'before'");
+}
+
+/// Panels only emit actions; the reconciler alone decides from the state what work follows: a
+/// new view re-renders the BVH there is, a new strategy rebuilds, the same settings do nothing.
+#[test]
+fn the_reconciler_re_renders_for_a_view_and_rebuilds_for_a_strategy() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    let edit = |h: &mut Harness<'_, BvhscopeApp>, change: &dyn Fn(&mut bvhscope::app::Settings)| {
+        let mut s = h.state().settings.clone();
+        change(&mut s);
+        h.state_mut().act(Action::Edit(Box::new(s)));
+        h.state_mut().reconcile();
+    };
+    edit(&mut h, &|_| {});
+    assert!(!h.state().jobs.is_busy(), "unchanged settings start nothing");
+    edit(&mut h, &|s| s.view = bvhscope::render::View::Visits);
+    assert!(h.state().jobs.build.is_none() && h.state().jobs.render.is_some(), "a view re-renders only");
+    run_until(&mut h, "the heatmap", idle);
+    edit(&mut h, &|s| s.build.strategy = SplitStrategy::Midpoint);
+    assert!(h.state().jobs.build.is_some(), "a strategy rebuilds");
 }
 
 #[test]
@@ -123,7 +148,7 @@ fn moving_the_depth_slider_changes_the_number_of_boxes_drawn() {
     h.step();
     h.step();
     assert_eq!(h.state().settings.box_depth, 6);
-    let drawn = h.state().boxes_drawn;
+    let drawn = h.state().boxes_drawn();
     // The default layout is 4-wide: depth 6 holds at most 4^6 nodes.
     assert!(drawn > 64 && drawn <= 4096, "depth 6 of a 4-wide tree, drew {drawn}");
     h.get_by_label(&format!("{drawn} boxes drawn"));
@@ -132,7 +157,7 @@ fn moving_the_depth_slider_changes_the_number_of_boxes_drawn() {
     h.step();
     h.step();
     assert_eq!(h.state().settings.box_depth, 7);
-    assert!(h.state().boxes_drawn > drawn);
+    assert!(h.state().boxes_drawn() > drawn);
 }
 
 #[test]
@@ -209,7 +234,7 @@ fn a_typed_path_goes_into_the_field_and_fires_no_shortcut() {
 fn escape_closes_the_path_window() {
     let mut h = harness();
     run_until(&mut h, "the first build", idle);
-    h.state_mut().act(bvhscope::app::Action::OpenPath);
+    h.state_mut().act(Action::OpenPath);
     h.run_steps(2);
     type_keys(&mut h, "x");
     h.key_press(egui::Key::Escape);
@@ -243,9 +268,9 @@ fn the_view_and_the_statistics_can_be_exported() {
     let png = dir.join("view.png");
     let csv = dir.join("stats.csv");
     let json = dir.join("stats.json");
-    h.state_mut().picked(bvhscope::app::Pick::SavePng, png.clone());
-    h.state_mut().picked(bvhscope::app::Pick::SaveStatsCsv, csv.clone());
-    h.state_mut().picked(bvhscope::app::Pick::SaveStatsJson, json.clone());
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SavePng, png.clone()));
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveStatsCsv, csv.clone()));
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveStatsJson, json.clone()));
     h.run_steps(3); // a new egui Area is measured, unseen, in its first frame
     let frame = h.state().shown.as_ref().unwrap().frame.clone();
     let img = image::open(&png).expect("PNG written").to_rgb8();
@@ -290,7 +315,7 @@ fn a_scene_file_brings_its_camera_and_settings_and_can_be_saved_back() {
     assert_eq!(cam.vfov_deg, 40.0);
 
     let saved = scene.with_file_name("saved.json");
-    h.state_mut().picked(bvhscope::app::Pick::SaveScene, saved.clone());
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveScene, saved.clone()));
     let back = bvhscope::scene::load_any(&saved).expect("the saved scene loads");
     assert_eq!(back.mesh.triangle_count(), 8);
     assert_eq!(back.build.unwrap().strategy, SplitStrategy::Midpoint);
@@ -352,11 +377,11 @@ fn a_scene_with_placements_builds_two_levels_shown_level_by_level() {
     h.step();
     h.step();
     assert_eq!(h.state().settings.box_level, bvhscope::app::BoxLevel::Top);
-    assert_eq!(h.state().boxes_drawn, 1);
+    assert_eq!(h.state().boxes_drawn(), 1);
     h.get_by_label("Both").click_accesskit();
     h.step();
     h.step();
-    assert_eq!(h.state().boxes_drawn, 1 + 6, "the top root and each placement's mesh root");
+    assert_eq!(h.state().boxes_drawn(), 1 + 6, "the top root and each placement's mesh root");
 
     // One level again: the scene flattened into one BVH, and no per-level views.
     h.get_by_label("Two levels: 6 placements of 1 meshes").click();
@@ -370,7 +395,7 @@ fn the_builtin_scene_cannot_be_saved_as_a_scene_file() {
     let mut h = harness();
     run_until(&mut h, "the first build", idle);
     let path = std::env::temp_dir().join(format!("bvhscope-ui-builtin-{}.json", std::process::id()));
-    h.state_mut().picked(bvhscope::app::Pick::SaveScene, path.clone());
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveScene, path.clone()));
     assert!(!path.exists());
     assert!(h.state().messages.iter().any(|m| m.kind == MessageKind::Error && m.text.contains("built-in")));
 }
@@ -405,7 +430,7 @@ fn a_coarse_pass_is_shown_in_place_at_its_resolution_snapshot() {
     assert_ne!(camera.width % 8, 0, "a partly covered last column is part of the test");
     let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
     let mut coarse = None;
-    render_passes(&*bvh, &mesh, &camera, &settings, &Default::default(), |f, _| {
+    render_passes(&*bvh, &mesh, &camera, &settings, &Default::default(), &Default::default(), |f, _| {
         if f.stride() == 8 {
             coarse = Some(f);
         }
@@ -585,7 +610,7 @@ fn the_exported_png_names_the_mesh_the_strategy_and_the_view() {
     h.get_by_label("Nodes visited").click();
     run_until(&mut h, "the heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
     let png = temp_file("named.png", "");
-    h.state_mut().picked(bvhscope::app::Pick::SavePng, png.clone());
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SavePng, png.clone()));
     let img = image::open(&png).unwrap().to_rgb8();
     let frame = h.state().shown.as_ref().unwrap().frame.clone();
     let mut legend = h.state().shown.as_ref().unwrap().legend.clone().unwrap();

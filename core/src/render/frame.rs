@@ -4,9 +4,9 @@
 //! Samples and counters live in two arrays, and the counters only when asked for: the plain
 //! view's frame stays small (20 bytes a pixel, 18 MB at 1280×720). One array of 48-byte samples
 //! (44 MB at 1280×720, past the 32 MiB up to which glibc's malloc reuses freed memory) was freshly
-//! mapped, faulted in and unmapped on every frame, which cost the app's frame about 20 ms
-//! (BENCHMARKS.md, "The frame regression"); larger views pass that limit whatever the layout, so
-//! dropped frames' storage is kept for the next (`Spare`).
+//! mapped, faulted in and unmapped on every frame, a cost the app's frame rate showed
+//! (BENCHMARKS.md, "The frame regression, located"); larger views pass that limit whatever the
+//! layout, so the render job keeps dropped frames' storage for its next frame.
 
 use crate::bvh::RayCounters;
 use glam::Vec3;
@@ -53,20 +53,28 @@ pub struct Frame {
     samples: Vec<PixelSample>,
     /// One per stored sample when the render counted, else empty.
     counters: Vec<RayCounters>,
+    /// Where the storage goes when the frame is dropped.
+    pool: FramePool,
 }
 
 impl Frame {
-    /// An untraced full-resolution frame, with counters if `counted`. Its storage is a dropped
-    /// frame's when one large enough was kept (see `Spare`), else fresh; it is filled in parallel
-    /// either way.
+    /// An untraced full-resolution frame, with counters if `counted`, on fresh storage that is
+    /// freed when it is dropped.
     pub fn new(width: u32, height: u32, counted: bool) -> Self {
+        Self::new_in(&FramePool::default(), width, height, counted)
+    }
+
+    /// `new`, on a dropped frame's storage from `pool` when one large enough was kept, else fresh;
+    /// filled in parallel either way. The frame, and its snapshots, return their storage to
+    /// `pool` when dropped.
+    pub fn new_in(pool: &FramePool, width: u32, height: u32, counted: bool) -> Self {
         let n = width as usize * height as usize;
-        let (mut samples, mut counters) = Spare::take(n, counted);
+        let (mut samples, mut counters) = pool.take(n, counted);
         samples.par_extend(rayon::iter::repeat_n(PixelSample::MISS, n));
         if counted {
             counters.par_extend(rayon::iter::repeat_n(RayCounters::ZERO, n));
         }
-        Self { width, height, stride: 0, step: 1, samples, counters }
+        Self { width, height, stride: 0, step: 1, samples, counters, pool: pool.clone() }
     }
 
     pub fn width(&self) -> u32 {
@@ -165,12 +173,21 @@ impl Frame {
         }
         let (cols, rows) = self.grid_size();
         let n = cols as usize * rows as usize;
-        let (mut samples, mut counters) = Spare::take(n, self.counted());
+        let (mut samples, mut counters) = self.pool.take(n, self.counted());
         self.gather(&mut samples, PixelSample::MISS, |(s, _)| *s);
         if self.counted() {
             self.gather(&mut counters, RayCounters::ZERO, |(_, c)| c);
         }
-        Frame { width: self.width, height: self.height, stride: self.stride, step: self.stride, samples, counters }
+        let pool = self.pool.clone();
+        Frame {
+            width: self.width,
+            height: self.height,
+            stride: self.stride,
+            step: self.stride,
+            samples,
+            counters,
+            pool,
+        }
     }
 
     /// Fill the empty `out` with `pick` of each traced pixel, row by row of the grid; rows in
@@ -211,32 +228,45 @@ impl Frame {
 
 impl Drop for Frame {
     fn drop(&mut self) {
-        Spare::keep(std::mem::take(&mut self.samples), std::mem::take(&mut self.counters));
+        self.pool.keep(std::mem::take(&mut self.samples), std::mem::take(&mut self.counters));
     }
 }
 
-/// Storage of recently dropped frames, for new frames and snapshots to reuse. A fresh allocation
-/// of a frame's size is mapped anew by the system allocator, its pages faulted in on first touch
-/// and unmapped again when freed; on this machine that cost more than tracing the bunny's frame
-/// (BENCHMARKS.md, "The frame regression"). The app drops a frame and its three coarse snapshots
-/// per render, so the last `Spare::KEPT` vectors of each kind are kept (first in, first out), at
-/// most `Spare::MAX_BYTES` of each: at the app's largest view (2560×1440) a counted frame and its
-/// snapshots fit, about 230 MB in all. Vectors under `Spare::MIN_BYTES` are left to the allocator.
-struct Spare {
+/// Storage of a render job's dropped frames, for its new frames and snapshots to reuse. A fresh
+/// allocation of a frame's size is mapped anew by the system allocator, its pages faulted in on
+/// first touch and unmapped again when freed; on this machine that cost more than tracing the
+/// bunny's frame (BENCHMARKS.md, "The frame regression, located"). The app's render job drops a
+/// frame and its three coarse snapshots per render, so the last `KEPT` vectors of each kind are
+/// kept (first in, first out), at most `MAX_BYTES` of each: at the app's largest view (2560×1440)
+/// a counted frame and its snapshots fit, about 230 MB in all. Vectors under `MIN_BYTES` are left
+/// to the allocator.
+///
+/// A frame made in a pool returns its storage to that pool when dropped, wherever it is dropped
+/// (the app drops frames on the UI thread); the storage is freed with the pool's last frame or
+/// handle. Clones share one pool.
+#[derive(Clone, Default)]
+pub struct FramePool(std::sync::Arc<std::sync::Mutex<Kept>>);
+
+#[derive(Default)]
+struct Kept {
     samples: Vec<Vec<PixelSample>>,
     counters: Vec<Vec<RayCounters>>,
 }
 
-static SPARE: std::sync::Mutex<Spare> = std::sync::Mutex::new(Spare { samples: Vec::new(), counters: Vec::new() });
+impl std::fmt::Debug for FramePool {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("FramePool")
+    }
+}
 
-impl Spare {
+impl FramePool {
     const KEPT: usize = 4;
     const MIN_BYTES: usize = 1 << 20;
     const MAX_BYTES: usize = 192 << 20;
 
     /// Empty vectors able to hold `n` samples, and `n` counters if `counted`: the smallest kept
     /// ones large enough, else fresh.
-    fn take(n: usize, counted: bool) -> (Vec<PixelSample>, Vec<RayCounters>) {
+    fn take(&self, n: usize, counted: bool) -> (Vec<PixelSample>, Vec<RayCounters>) {
         fn smallest_fitting<T>(kept: &mut Vec<Vec<T>>, n: usize) -> Vec<T> {
             let fitting = kept.iter().enumerate().filter(|(_, v)| v.capacity() >= n);
             match fitting.min_by_key(|(_, v)| v.capacity()) {
@@ -245,10 +275,10 @@ impl Spare {
             }
         }
         let (mut samples, mut counters) = (Vec::new(), Vec::new());
-        if let Ok(mut spare) = SPARE.lock() {
-            samples = smallest_fitting(&mut spare.samples, n);
+        if let Ok(mut kept) = self.0.lock() {
+            samples = smallest_fitting(&mut kept.samples, n);
             if counted {
-                counters = smallest_fitting(&mut spare.counters, n);
+                counters = smallest_fitting(&mut kept.counters, n);
             }
         }
         samples.clear();
@@ -259,20 +289,20 @@ impl Spare {
     }
 
     /// Keep a dropped frame's vectors; the oldest kept ones beyond `KEPT` are freed, outside the lock.
-    fn keep(samples: Vec<PixelSample>, counters: Vec<RayCounters>) {
+    fn keep(&self, samples: Vec<PixelSample>, counters: Vec<RayCounters>) {
         fn push<T>(kept: &mut Vec<Vec<T>>, v: Vec<T>, evicted: &mut Vec<Vec<T>>) {
             let bytes = |v: &Vec<T>| v.capacity() * size_of::<T>();
-            if bytes(&v) >= Spare::MIN_BYTES {
+            if bytes(&v) >= FramePool::MIN_BYTES {
                 kept.push(v);
-                while kept.len() > Spare::KEPT || kept.iter().map(bytes).sum::<usize>() > Spare::MAX_BYTES {
+                while kept.len() > FramePool::KEPT || kept.iter().map(bytes).sum::<usize>() > FramePool::MAX_BYTES {
                     evicted.push(kept.remove(0));
                 }
             }
         }
         let (mut old_samples, mut old_counters) = (Vec::new(), Vec::new());
-        if let Ok(mut spare) = SPARE.lock() {
-            push(&mut spare.samples, samples, &mut old_samples);
-            push(&mut spare.counters, counters, &mut old_counters);
+        if let Ok(mut kept) = self.0.lock() {
+            push(&mut kept.samples, samples, &mut old_samples);
+            push(&mut kept.counters, counters, &mut old_counters);
         }
     }
 }
@@ -397,18 +427,24 @@ mod tests {
     }
 
     #[test]
-    fn a_frame_on_a_dropped_frames_storage_starts_empty() {
-        // Large enough to be kept as a spare (over `Spare::MIN_BYTES` of samples).
+    fn a_frame_on_a_dropped_frames_storage_starts_empty_and_only_its_pool_reuses_it() {
+        // Large enough to be kept (over `FramePool::MIN_BYTES` of samples).
         let (w, h) = (701, 499);
-        let mut f = traced_frame(w, h, 1, true);
+        let pool = FramePool::default();
+        let mut f = Frame::new_in(&pool, w, h, true);
         let (samples, counters) = f.slots_mut();
         samples.fill(PixelSample { t: 1.0, normal: Vec3::X, prim: 3 });
         counters.fill(RayCounters { nodes_visited: 9, ..RayCounters::ZERO });
+        let storage = samples.as_ptr();
         drop(f);
+        // Another pool (or none) gets fresh storage: pools are not shared through a global.
+        let mut other = Frame::new_in(&FramePool::default(), w, h, true);
+        assert_ne!(other.slots_mut().0.as_ptr(), storage);
         for (w, h) in [(w, h), (w - 1, h - 2)] {
-            let mut f = Frame::new(w, h, true);
+            let mut f = Frame::new_in(&pool, w, h, true);
             let n = (w * h) as usize;
             let (samples, counters) = f.slots_mut();
+            assert_eq!(samples.as_ptr(), storage, "the pool's kept storage is reused");
             assert_eq!((samples.len(), counters.len()), (n, n));
             assert!(samples.iter().all(|s| *s == PixelSample::MISS));
             assert!(counters.iter().all(|c| *c == RayCounters::ZERO));

@@ -11,7 +11,7 @@ mod views;
 
 pub use camera::{Camera, CameraError, UpAxis};
 pub use colormap::ColorMap;
-pub use frame::{Frame, PixelSample, RaySummary};
+pub use frame::{Frame, FramePool, PixelSample, RaySummary};
 pub use legend::{draw_legend, legend_height};
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
 pub use views::{full_size, view_image, HeatRange, Legend, View};

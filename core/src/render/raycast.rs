@@ -1,12 +1,12 @@
 //! Progressive ray casting: pass 1 traces every 8th pixel in x and y, then every 4th, 2nd, and
 //! finally the rest, each pass tracing only pixels no earlier pass traced, so the full frame costs
 //! one ray per pixel in total. Work is split into bands of 16-pixel-square tiles run on rayon; the
-//! cancel flag is read before each band, and the caller sees the frame after each pass. The plain
-//! normal view of an accelerator that traces packets (the binary BVH, `bvh::packet`) hands it each
-//! pass in packets of up to 8×8 pixels of the pass's grid; with counters on, or for the wide BVH,
-//! every ray is traced alone.
+//! cancel flag is read before each band, and the caller sees the frame after each pass. Without
+//! counters, an accelerator that traces packets (both BVH layouts, `bvh::packet`; not the linear
+//! scan) gets each pass in packets of up to 8×8 pixels of the pass's grid; with counters on (the
+//! heatmaps, and the app, which counts for its hover read-out) every ray is traced alone.
 
-use super::{Camera, Frame, PixelSample};
+use super::{Camera, Frame, FramePool, PixelSample};
 use crate::bvh::packet::{packet_position, PACKET, PACKET_SIDE};
 use crate::bvh::{Accelerator, Hit, NoStats, RayCounters, TraceOptions, TraversalStats};
 use crate::geometry::Ray;
@@ -42,26 +42,28 @@ pub struct PassInfo {
 /// Render a full frame in one pass (no cancellation, no progress).
 pub fn render<A: Accelerator>(accel: &A, mesh: &Mesh, camera: &Camera, settings: &RenderSettings) -> Frame {
     let settings = RenderSettings { progressive: false, ..*settings };
-    match render_progressive(accel, mesh, camera, &settings, &WorkControl::new(), |_, _| {}) {
+    match render_progressive(accel, mesh, camera, &settings, &FramePool::default(), &WorkControl::new(), |_, _| {}) {
         Ok(frame) => frame,
         Err(Cancelled) => unreachable!("nobody else holds this control"),
     }
 }
 
-/// Render pass by pass. The control's total is set to the pixel count and its done counter
-/// advanced as bands finish; `on_pass` sees the frame after each pass. Returns the finished frame,
-/// or `Cancelled` once the control is cancelled (checked before each band).
+/// Render pass by pass, into a frame from `frames` (a job that renders again and again keeps one
+/// pool). The control's total is set to the pixel count and its done counter advanced as bands
+/// finish; `on_pass` sees the frame after each pass. Returns the finished frame, or `Cancelled`
+/// once the control is cancelled (checked before each band).
 pub fn render_progressive<A: Accelerator>(
     accel: &A,
     mesh: &Mesh,
     camera: &Camera,
     settings: &RenderSettings,
+    frames: &FramePool,
     control: &WorkControl,
     mut on_pass: impl FnMut(&Frame, &PassInfo),
 ) -> Result<Frame, Cancelled> {
     let start = Instant::now();
     control.set_total(camera.width as u64 * camera.height as u64);
-    let mut frame = Frame::new(camera.width, camera.height, settings.count);
+    let mut frame = Frame::new_in(frames, camera.width, camera.height, settings.count);
     let strides: &[u32] = if settings.progressive { &PASS_STRIDES } else { &[1] };
     let mut previous = 0u32;
     for &stride in strides {
@@ -90,11 +92,12 @@ pub fn render_passes<A: Accelerator>(
     mesh: &Mesh,
     camera: &Camera,
     settings: &RenderSettings,
+    frames: &FramePool,
     control: &WorkControl,
     mut on_pass: impl FnMut(Frame, PassInfo),
 ) -> Result<(), Cancelled> {
     let mut last = None;
-    let frame = render_progressive(accel, mesh, camera, settings, control, |frame, info| {
+    let frame = render_progressive(accel, mesh, camera, settings, frames, control, |frame, info| {
         if frame.is_complete() {
             last = Some(*info);
         } else {
@@ -276,7 +279,7 @@ mod tests {
         let mut strides = Vec::new();
         let mut total = 0;
         let control = WorkControl::new();
-        let frame = render_progressive(&bvh, &mesh, &cam, &settings, &control, |f, p| {
+        let frame = render_progressive(&bvh, &mesh, &cam, &settings, &FramePool::default(), &control, |f, p| {
             strides.push(f.stride());
             total += p.rays;
         })
@@ -304,7 +307,9 @@ mod tests {
             let mut total = 0;
             let control = WorkControl::new();
             let plain = RenderSettings { progressive: true, ..Default::default() };
-            let frame = render_progressive(&bvh, &mesh, &cam, &plain, &control, |_, p| total += p.rays).unwrap();
+            let frame =
+                render_progressive(&bvh, &mesh, &cam, &plain, &FramePool::default(), &control, |_, p| total += p.rays)
+                    .unwrap();
             assert_eq!(total, 45 * 29, "{layout:?}: every pixel traced once");
             assert_eq!(control.done(), 45 * 29);
             let one_pass = render(&bvh, &mesh, &cam, &plain);
@@ -328,7 +333,7 @@ mod tests {
         let control = WorkControl::new();
         let settings = RenderSettings { progressive: true, ..Default::default() };
         let mut passes = 0;
-        let r = render_progressive(&bvh, &mesh, &cam, &settings, &control, |_, _| {
+        let r = render_progressive(&bvh, &mesh, &cam, &settings, &FramePool::default(), &control, |_, _| {
             passes += 1;
             control.cancel();
         });

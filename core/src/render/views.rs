@@ -188,7 +188,8 @@ mod tests {
         let bvh = AnyBvh::build(&mesh, &BuildParams::default());
         let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
         let mut passes = Vec::new();
-        render_passes(&bvh, &mesh, &cam, &settings, &WorkControl::new(), |f, _| passes.push(f)).unwrap();
+        render_passes(&bvh, &mesh, &cam, &settings, &Default::default(), &WorkControl::new(), |f, _| passes.push(f))
+            .unwrap();
         assert_eq!(passes.iter().map(|f| f.stride()).collect::<Vec<_>>(), [8, 4, 2, 1]);
         let full = passes.last().unwrap();
         assert_eq!(full.full_samples(), render(&bvh, &mesh, &cam, &settings).full_samples());

@@ -1,7 +1,7 @@
 //! The build panel: strategy and its parameters, traversal order and triangle test. Any change
 //! rebuilds (or re-renders) in the background.
 
-use crate::app::BvhscopeApp;
+use crate::app::{Action, Actions, BvhscopeApp};
 use crate::bvh::{Preset, SplitStrategy};
 use crate::options::{Choice, Number, MAX_LEAF_SIZE, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
 
@@ -18,7 +18,7 @@ fn radios<T: Choice>(ui: &mut egui::Ui, value: &mut T) {
     }
 }
 
-pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
+pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.heading("Build");
     for preset in Preset::ALL {
         let on = app.settings.is_preset(preset);
@@ -32,13 +32,14 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             .on_disabled_hover_text(format!("These are the settings of {}", preset.help()))
             .clicked()
         {
-            app.apply_preset(preset);
+            out.push(Action::ApplyPreset(preset));
         }
     }
     let has_instances = app.has_instances();
     let placements = app.scene.instances.as_ref().map_or(0, |i| i.placements.len());
     let meshes = app.scene.instances.as_ref().map_or(0, |i| i.meshes.len());
-    let s = &mut app.settings;
+    let mut edited = app.settings.clone();
+    let s = &mut edited;
     if has_instances {
         ui.checkbox(&mut s.two_level, format!("Two levels: {placements} placements of {meshes} meshes"))
             .on_hover_text("A top-level BVH over the scene's mesh placements, and one BVH per mesh built once however often it is placed. Off: one BVH over the whole scene flattened.");
@@ -84,6 +85,9 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     radios(ui, &mut s.trace.order);
     ui.label("Triangle test");
     radios(ui, &mut s.trace.test);
+    if edited != app.settings {
+        out.push(Action::Edit(Box::new(edited)));
+    }
     if let Some(job) = &app.jobs.build {
         ui.horizontal(|ui| {
             ui.spinner();

@@ -1,62 +1,54 @@
 //! The menu bar: File (open, recent, built-in scene, export), View, Help.
 
-use crate::app::shortcuts::{shortcut_text as format_shortcut, Action, SHORTCUTS};
-use crate::app::{BvhscopeApp, PathWindow, Pick};
+use crate::app::shortcuts::{shortcut_text as format_shortcut, SHORTCUTS};
+use crate::app::{Action, Actions, BvhscopeApp};
 use crate::render::View;
 
-fn shortcut_text(ctx: &egui::Context, action: Action) -> String {
-    SHORTCUTS.iter().find(|(_, a, _)| *a == action).map_or(String::new(), |(s, _, _)| format_shortcut(ctx, s))
+fn shortcut_text(ctx: &egui::Context, action: &Action) -> String {
+    SHORTCUTS.iter().find(|(_, a, _)| a == action).map_or(String::new(), |(s, _, _)| format_shortcut(ctx, s))
 }
 
-fn item(ui: &mut egui::Ui, text: &str, action: Action) -> bool {
-    let shortcut = shortcut_text(ui.ctx(), action);
-    ui.add(egui::Button::new(text).shortcut_text(shortcut)).clicked()
+/// A menu item that emits `action`, with the action's shortcut beside it.
+fn item(ui: &mut egui::Ui, out: &mut Actions, text: &str, action: Action) {
+    let shortcut = shortcut_text(ui.ctx(), &action);
+    if ui.add(egui::Button::new(text).shortcut_text(shortcut)).clicked() {
+        out.push(action);
+    }
 }
 
-pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
+pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| {
-            if item(ui, "Open…", Action::Open) {
-                app.act(Action::Open);
-            }
-            if item(ui, "Open path…", Action::OpenPath) {
-                app.act(Action::OpenPath);
-            }
+            item(ui, out, "Open…", Action::Open);
+            item(ui, out, "Open path…", Action::OpenPath);
             ui.menu_button("Open recent", |ui| {
                 if app.settings.recent_files.is_empty() {
                     ui.weak("No recent files");
                 }
                 for path in app.settings.recent_files.clone() {
                     if ui.button(path.display().to_string()).clicked() {
-                        app.open(path);
+                        out.push(Action::OpenFile(path));
                     }
                 }
             });
             if ui.button("Built-in scene").clicked() {
-                app.show_builtin();
+                out.push(Action::ShowBuiltin);
             }
             ui.separator();
-            if item(ui, "Save view as PNG…", Action::SavePng) {
-                app.act(Action::SavePng);
-            }
-            if item(ui, "Export statistics as CSV…", Action::ExportStats) {
-                app.act(Action::ExportStats);
-            }
+            item(ui, out, "Save view as PNG…", Action::SavePng);
+            item(ui, out, "Export statistics as CSV…", Action::ExportStats);
             if ui.button("Export statistics as JSON…").clicked() {
-                let name = crate::app::export::default_name(app, "json");
-                app.jobs.pick_file(Pick::SaveStatsJson, &name);
+                out.push(Action::ExportStatsJson);
             }
             if ui
                 .button("Save scene as…")
                 .on_hover_text("The camera, the meshes and the BVH settings, as a scene file")
                 .clicked()
             {
-                let name = format!("{}.json", app.scene.title().trim_end_matches(".obj").trim_end_matches(".json"));
-                app.jobs.pick_file(Pick::SaveScene, &name);
+                out.push(Action::SaveScene);
             }
             if ui.button("Save to a typed path…").clicked() {
-                let name = crate::app::export::default_name(app, "png");
-                app.path_window = Some(PathWindow::new(Pick::SavePng, name, None));
+                out.push(Action::SavePngTyped);
             }
             ui.separator();
             if ui.button("Quit").clicked() {
@@ -65,28 +57,23 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         });
         ui.menu_button("View", |ui| {
             for (i, v) in View::ALL.iter().enumerate() {
-                let shortcut = shortcut_text(ui.ctx(), Action::View(i));
+                let shortcut = shortcut_text(ui.ctx(), &Action::View(i));
                 if ui
                     .add(egui::Button::selectable(app.settings.view == *v, v.label()).shortcut_text(shortcut))
                     .clicked()
                 {
-                    app.settings.view = *v;
+                    out.push(Action::View(i));
                 }
             }
             ui.separator();
-            if item(ui, "Frame the mesh", Action::FrameMesh) {
-                app.frame_mesh();
-            }
-            if item(ui, "Reset camera", Action::ResetView) {
-                app.reset_view();
-            }
-            if item(ui, "Node boxes", Action::ToggleBoxes) {
-                app.act(Action::ToggleBoxes);
-            }
+            item(ui, out, "Frame the mesh", Action::FrameMesh);
+            item(ui, out, "Reset camera", Action::ResetView);
+            item(ui, out, "Node boxes", Action::ToggleBoxes);
         });
         ui.menu_button("Help", |ui| {
-            if item(ui, "Keyboard and mouse", Action::Help) {
-                app.show_help = true;
+            let shortcut = shortcut_text(ui.ctx(), &Action::Help);
+            if ui.add(egui::Button::new("Keyboard and mouse").shortcut_text(shortcut)).clicked() {
+                out.push(Action::SetHelp(true));
             }
         });
         ui.separator();

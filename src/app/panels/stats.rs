@@ -175,7 +175,7 @@ pub fn combined_cost_text(c: SahCost) -> String {
     )
 }
 
-pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
+pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("Statistics");
     if let Some(note) = app.scene.desc.as_ref().and_then(|d| d.note.as_ref()) {
         ui.label(egui::RichText::new(note).italics());

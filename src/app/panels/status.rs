@@ -2,7 +2,7 @@
 
 use crate::app::BvhscopeApp;
 
-pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
+pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {
         match &app.shown {
             Some(s) => {

@@ -1,7 +1,7 @@
 //! The view panel: what the image shows, heatmap colours and range, the up axis, and the node-box
 //! overlay.
 
-use crate::app::{BoxLevel, BvhscopeApp};
+use crate::app::{Action, Actions, BoxLevel, BvhscopeApp};
 use crate::render::{ColorMap, UpAxis, View};
 
 /// What a view shows, for its tooltip: its help, and for combined cost the constants in use.
@@ -12,16 +12,15 @@ fn view_tip(v: View, cost: &str) -> String {
     }
 }
 
-pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
+pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.heading("View");
     let max_depth = app.current_bvh().map_or(0, |b| b.bottom_max_depth());
-    let app_has_bvh = app.current_bvh().is_some();
     // The top level's depth, when two levels are built.
     let top_depth = app.current_bvh().and_then(|b| b.top_stats.as_ref()).map(|s| s.max_depth);
     let legend_range = app.shown.as_ref().and_then(|s| s.legend.as_ref()).map(|l| (l.range_min, l.range_max));
     let cost = super::stats::combined_cost_text(app.settings.build.cost);
-    let mut up = app.settings.up_axis;
-    let s = &mut app.settings;
+    let mut edited = app.settings.clone();
+    let s = &mut edited;
     for v in View::ALL.into_iter().filter(|v| !v.is_per_level()) {
         ui.radio_value(&mut s.view, v, v.label()).on_hover_text(view_tip(v, &cost));
     }
@@ -30,8 +29,6 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
         for v in View::ALL.into_iter().filter(|v| v.is_per_level()) {
             ui.radio_value(&mut s.view, v, v.label()).on_hover_text(view_tip(v, &cost));
         }
-    } else if s.view.is_per_level() {
-        s.view = View::Visits; // a single BVH has no levels to tell apart
     }
     ui.add_enabled_ui(s.view.is_heatmap(), |ui| {
         ui.horizontal(|ui| {
@@ -88,7 +85,7 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
             "Which axis of the mesh points up. Meshes exported Z-up (CAD, scans) look as if seen from underneath with Y up. Changing it resets the camera to the front view.",
         );
         for a in UpAxis::ALL {
-            ui.radio_value(&mut up, a, a.label()).on_hover_text(a.help());
+            ui.radio_value(&mut s.up_axis, a, a.label()).on_hover_text(a.help());
         }
     });
 
@@ -96,10 +93,6 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.heading("Node boxes");
     ui.checkbox(&mut s.show_boxes, "Show node boxes")
         .on_hover_text("The boxes of every node at the chosen depth, as wireframes over the image (B)");
-    // Until a BVH is built its depth is unknown: keep the chosen depth rather than clamp it to 0.
-    if app_has_bvh {
-        s.box_depth = s.box_depth.min(max_depth);
-    }
     if let Some(top_max) = top_depth {
         ui.add_enabled_ui(s.show_boxes, |ui| {
             ui.horizontal(|ui| {
@@ -107,7 +100,6 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
                     ui.radio_value(&mut s.box_level, l, l.label());
                 }
             });
-            s.top_box_depth = s.top_box_depth.min(top_max);
             ui.add_enabled(
                 s.box_level.shows_top(),
                 egui::Slider::new(&mut s.top_box_depth, 0..=top_max).text("Top-level depth"),
@@ -133,7 +125,9 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui) {
     ui.add_enabled(s.show_boxes, egui::Checkbox::new(&mut s.boxes_in_front, "Only in front of the surface"))
         .on_hover_text("Hide the parts of the boxes behind the surface the rays hit (depth-tested against the ray-cast image), so deep levels do not hide the mesh");
     if s.show_boxes {
-        ui.label(format!("{} boxes drawn", app.boxes_drawn));
+        ui.label(format!("{} boxes drawn", app.boxes_drawn()));
     }
-    app.set_up_axis(up);
+    if edited != app.settings {
+        out.push(Action::Edit(Box::new(edited)));
+    }
 }

@@ -1,10 +1,10 @@
 //! Floating windows: Help (shortcuts), and the path field used when no file dialog is available.
 
 use crate::app::shortcuts::{shortcut_text, MOUSE, SHORTCUTS};
-use crate::app::{BvhscopeApp, Pick};
+use crate::app::{Action, Actions, BvhscopeApp, Pick};
 use std::path::PathBuf;
 
-pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
+pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
     let mut open = app.show_help;
     egui::Window::new("Help").open(&mut open).resizable(false).show(ctx, |ui| {
         ui.heading("Keyboard");
@@ -24,9 +24,12 @@ pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
             }
         });
     });
-    app.show_help = open;
+    if open != app.show_help {
+        out.push(Action::SetHelp(open));
+    }
 
-    let Some(window) = &mut app.path_window else { return };
+    let Some(window) = &app.path_window else { return };
+    let mut text = window.text.clone();
     let title = match window.pick {
         Pick::Open => "Open a mesh",
         Pick::SavePng => "Save the view as PNG",
@@ -41,11 +44,12 @@ pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
             ui.label(note);
         }
         let label = ui.label("Path");
-        let edit = ui.add(egui::TextEdit::singleline(&mut window.text).desired_width(420.0)).labelled_by(label.id);
+        let edit = ui.add(egui::TextEdit::singleline(&mut text).desired_width(420.0)).labelled_by(label.id);
         // The field takes the keyboard when the window opens: what is typed goes into it, and
         // while it has focus no single-key shortcut fires (`shortcuts::pressed`).
-        if std::mem::take(&mut window.focus) {
+        if window.focus {
             edit.request_focus();
+            out.push(Action::PathFocused);
         }
         let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
         if (edit.has_focus() || edit.lost_focus()) && ui.input(|i| i.key_pressed(egui::Key::Escape)) {
@@ -53,8 +57,8 @@ pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
         }
         ui.horizontal(|ui| {
             let verb = if window.pick == Pick::Open { "Open" } else { "Save" };
-            if (ui.button(verb).clicked() || enter) && !window.text.trim().is_empty() {
-                chosen = Some((window.pick, PathBuf::from(window.text.trim())));
+            if (ui.button(verb).clicked() || enter) && !text.trim().is_empty() {
+                chosen = Some((window.pick, PathBuf::from(text.trim())));
             }
             if ui.button("Cancel").clicked() {
                 keep = false;
@@ -62,9 +66,10 @@ pub fn show(app: &mut BvhscopeApp, ctx: &egui::Context) {
         });
     });
     if let Some((pick, path)) = chosen {
-        app.path_window = None;
-        app.picked(pick, path);
+        out.push(Action::Picked(pick, path));
     } else if !keep {
-        app.path_window = None;
+        out.push(Action::ClosePathWindow);
+    } else if text != window.text {
+        out.push(Action::PathText(text));
     }
 }

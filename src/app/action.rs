@@ -1,0 +1,73 @@
+//! Everything that changes the app's state, as values. Panels, windows, the viewport and the
+//! keyboard only read the state and emit actions; `BvhscopeApp::act` is the one place that
+//! changes it, and `BvhscopeApp::reconcile` the one place that decides, from the state alone,
+//! what to rebuild and what to re-render (the egui demo app's split of state and UI).
+
+use super::{Pick, Settings};
+use crate::bvh::Preset;
+use crate::render::UpAxis;
+use std::path::PathBuf;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    /// Ask for a mesh or scene with the file dialog.
+    Open,
+    /// Open the typed-path window to open a file.
+    OpenPath,
+    OpenFile(PathBuf),
+    ShowBuiltin,
+    /// Save the view as PNG through the file dialog.
+    SavePng,
+    /// Save the view as PNG to a typed path.
+    SavePngTyped,
+    /// Export the statistics as CSV through the file dialog.
+    ExportStats,
+    ExportStatsJson,
+    SaveScene,
+    /// A file was chosen (dialog or typed path) for `Pick`.
+    Picked(Pick, PathBuf),
+    /// The typed-path window's text changed.
+    PathText(String),
+    /// The typed-path window's field has taken the keyboard.
+    PathFocused,
+    ClosePathWindow,
+
+    /// Camera: orbit by a mouse drag in points, pan by a drag over a viewport of that height,
+    /// zoom by a scroll amount.
+    Orbit(f32, f32),
+    Pan {
+        dx: f32,
+        dy: f32,
+        height: f32,
+    },
+    Zoom(f32),
+    FrameMesh,
+    ResetView,
+    /// The viewport's rectangle this frame and the image size it renders at.
+    Viewport {
+        rect: egui::Rect,
+        pixels: (u32, u32),
+    },
+
+    /// Show view number `i` of `View::ALL` (shortcuts 1..5, the View menu).
+    View(usize),
+    ToggleBoxes,
+    DepthUp,
+    DepthDown,
+    NextStrategy,
+    NextColormap,
+    ApplyPreset(Preset),
+    /// Orbit about another axis (the camera goes back to that axis's default view).
+    SetUpAxis(UpAxis),
+    /// The build or view panel's form, edited: the settings as they now are.
+    Edit(Box<Settings>),
+
+    /// Toggle the Help window.
+    Help,
+    SetHelp(bool),
+    /// Dismiss message `i` of the viewport's messages.
+    Dismiss(usize),
+}
+
+/// Where panels put the actions they emit during one frame.
+pub type Actions = Vec<Action>;
