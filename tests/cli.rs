@@ -1,5 +1,7 @@
 //! The command line as a user runs it: outputs, formats, and one-line errors with exit code 2.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -321,4 +323,25 @@ fn a_z_up_copy_of_a_mesh_renders_as_the_y_up_original() {
         y.pixels().zip(z.pixels()).filter(|(p, q)| p.0.iter().zip(q.0).any(|(a, b)| a.abs_diff(b) > 2)).count();
     assert!(differ <= 3, "{differ} of {} pixels differ", 64 * 48);
     assert!(y.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 200, "the tent is in view");
+}
+
+/// One level over a scene past the flattening budget is refused in one line that says to use two
+/// levels, before anything is allocated; two levels of the same scene work.
+#[test]
+fn one_level_over_too_many_placements_is_refused_and_two_levels_build() {
+    let dir = tmp("many");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = common::many_placements(&dir, 21_000);
+    let out = bvhscope(&["stats", scene.to_str().unwrap(), "--no-rays"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(
+        err.contains("many-21000.json") && err.contains("21000000 triangles") && err.contains("--two-level"),
+        "{err}"
+    );
+    let out = bvhscope(&["stats", scene.to_str().unwrap(), "--no-rays", "--two-level", "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["instances"], 21_000, "{v}");
 }

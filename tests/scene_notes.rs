@@ -9,7 +9,7 @@ use bvhscope::render::{render, Camera, RenderSettings};
 use bvhscope::scene::load_any;
 use std::path::Path;
 
-fn scene(name: &str) -> Option<bvhscope::scene::Loaded> {
+fn scene(name: &str) -> Option<bvhscope::scene::Scene> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name);
     match load_any(&path) {
         Ok(l) => Some(l),
@@ -23,10 +23,11 @@ fn scene(name: &str) -> Option<bvhscope::scene::Loaded> {
 }
 
 /// Nodes visited per ray in the root box, and triangle tests, for `strategy` from `camera`.
-fn work(l: &bvhscope::scene::Loaded, strategy: SplitStrategy, camera: &Camera) -> (f64, f64) {
+fn work(l: &bvhscope::scene::Scene, strategy: SplitStrategy, camera: &Camera) -> (f64, f64) {
     let p = BuildParams { strategy, layout: Layout::Binary, ..BuildParams::default() };
-    let bvh = AnyBvh::build(&l.mesh, &p);
-    let s = render(&bvh, &l.mesh, camera, &RenderSettings { count: true, ..Default::default() }).ray_summary();
+    let mesh = l.flat_mesh().unwrap();
+    let bvh = AnyBvh::build(&mesh, &p);
+    let s = render(&bvh, &*mesh, camera, &RenderSettings { count: true, ..Default::default() }).ray_summary();
     (s.root_mean_nodes_visited, s.root_mean_triangle_tests)
 }
 
@@ -56,8 +57,9 @@ fn on_the_floor_sah_visits_half_the_nodes_of_midpoint_in_both_layouts() {
     for layout in [Layout::Binary, Layout::Wide4] {
         let visits = |strategy| {
             let p = BuildParams { strategy, layout, ..BuildParams::default() };
-            let bvh = AnyBvh::build(&l.mesh, &p);
-            render(&bvh, &l.mesh, &camera, &RenderSettings { count: true, ..Default::default() })
+            let mesh = l.flat_mesh().unwrap();
+            let bvh = AnyBvh::build(&mesh, &p);
+            render(&bvh, &*mesh, &camera, &RenderSettings { count: true, ..Default::default() })
                 .ray_summary()
                 .root_mean_nodes_visited
         };

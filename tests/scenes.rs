@@ -2,9 +2,10 @@
 
 mod common;
 
-use bvhscope::bvh::{AnyBvh, BuildParams, LinearScan, SplitStrategy};
+use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy};
 use bvhscope::render::{render, RenderSettings};
 use bvhscope::scene::{load_any, parse_scene_file, write_scene_file, SceneError};
+use bvhscope::work::WorkControl;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -60,11 +61,12 @@ fn moer_lite_scene_hit_mask_equals_linear_search() {
     assert!(loaded.warnings.is_empty());
     let cam = loaded.camera.unwrap();
     let settings = RenderSettings::default();
-    let reference = render(&LinearScan::new(&loaded.mesh), &loaded.mesh, &cam, &settings).hit_mask();
+    let mesh = loaded.flat_mesh().unwrap();
+    let reference = render(&LinearScan::new(&mesh), &*mesh, &cam, &settings).hit_mask();
     assert!(reference.iter().filter(|&&h| h).count() > 50_000);
     for s in SplitStrategy::ALL {
-        let bvh = AnyBvh::build(&loaded.mesh, &BuildParams::with_strategy(s));
-        assert_eq!(render(&bvh, &loaded.mesh, &cam, &settings).hit_mask(), reference, "{s:?}");
+        let bvh = AnyBvh::build(&mesh, &BuildParams::with_strategy(s));
+        assert_eq!(render(&bvh, &*mesh, &cam, &settings).hit_mask(), reference, "{s:?}");
     }
 }
 
@@ -82,10 +84,11 @@ fn our_scene_file_round_trips_and_places_meshes() {
     }"#;
     let path = write(&dir, "two.json", text);
     let loaded = load_any(&path).unwrap();
-    assert_eq!(loaded.mesh.triangle_count(), 2, "one OBJ placed twice");
-    assert_eq!(loaded.mesh.groups.len(), 2);
+    assert_eq!(loaded.placed_triangles(), 2, "one OBJ placed twice");
+    let flat = loaded.flat_mesh().unwrap();
+    assert_eq!(flat.groups.len(), 2);
     // Second placement: scale 2, rotate 90° about z, then translate: (1,0,0) → (0,2,0) → (10,2,0).
-    let moved = loaded.mesh.triangle(1);
+    let moved = flat.triangle(1);
     assert!((moved[1] - Vec3::new(10.0, 2.0, 0.0)).length() < 1e-5, "{moved:?}");
     let build = loaded.build.unwrap();
     assert_eq!((build.strategy, build.max_leaf_size), (SplitStrategy::Midpoint, 2));
@@ -93,7 +96,7 @@ fn our_scene_file_round_trips_and_places_meshes() {
     assert_eq!((cam.width, cam.height, cam.vfov_deg), (64, 48, 30.0));
 
     // Written back, it reads the same.
-    let meshes = loaded.scene.as_ref().unwrap().meshes.clone();
+    let meshes = loaded.desc.as_ref().unwrap().meshes.clone();
     let again = parse_scene_file(&path, &write_scene_file(&cam, &meshes, &build)).unwrap();
     assert_eq!(again.camera, Some(cam));
     assert_eq!(again.build, Some(build));
@@ -166,7 +169,55 @@ fn analytic_shapes_are_listed_in_a_warning_and_the_rest_loads() {
     let text = r#"{"camera": {"transform": {"position": [0,0,5], "lookAt": [0,0,0], "up": [0,1,0]}, "verticalFov": 45, "film": {"size": [8, 8]}},
         "scene": {"shapes": [{"type": "sphere", "center": [0,0,0], "radius": 1}, {"type": "triangle", "file": "tri.obj"}]}}"#;
     let loaded = load_any(write(&dir, "mixed.json", text)).unwrap();
-    assert_eq!(loaded.mesh.triangle_count(), 1);
+    assert_eq!(loaded.placed_triangles(), 1);
     assert_eq!(loaded.warnings.len(), 1);
     assert!(loaded.warnings[0].contains("scene.shapes[0] (sphere)"), "{:?}", loaded.warnings);
+}
+
+#[test]
+fn a_scene_of_many_placements_costs_memory_per_placement_and_flattens_only_within_the_budget() {
+    use bvhscope::bvh::SceneBuild;
+    use bvhscope::scene::{SceneError, MAX_FLAT_TRIANGLES};
+    let dir = temp_dir();
+    // 21,000 placements of 1,000 triangles: 21M placed triangles, past the one-level budget.
+    let n = 21_000;
+    let scene = load_any(common::many_placements(&dir, n)).unwrap();
+    assert_eq!(scene.placed_triangles(), 21_000_000);
+    assert!(scene.placed_triangles() > MAX_FLAT_TRIANGLES);
+    assert_eq!(scene.report.triangles, 21_000_000, "the report counts placed triangles");
+    // The box of every placed vertex, without flattening: 145 × 145 grid, 3 apart, torus radius 1.3.
+    let b = scene.bounds();
+    assert!((b.min.x + 1.3).abs() < 0.02 && (b.max.x - (144.0 * 3.0 + 1.3)).abs() < 0.02, "{b:?}");
+    assert!((b.max.z - (144.0 * 3.0 + 1.3)).abs() < 0.02 && (b.max.y - 0.3).abs() < 0.02, "{b:?}");
+
+    // One level is refused before anything is allocated, in one sentence naming the file.
+    let e = scene.flat_mesh().expect_err("past the budget");
+    assert!(matches!(e, SceneError::TooLargeToFlatten { triangles: 21_000_000, .. }), "{e}");
+    let text = e.to_string();
+    assert!(text.contains("many-21000.json") && text.contains("two levels"), "{text}");
+    let one = SceneBuild { bvh: BuildParams::default(), top: None };
+    assert!(scene.build(&one, &WorkControl::new()).is_err());
+
+    // Two levels: one torus BVH, and per placement a transform pair, a box and an id.
+    let top = BuildParams { max_leaf_size: 1, layout: Layout::Binary, ..BuildParams::default() };
+    let two = scene.build(&SceneBuild { bvh: BuildParams::default(), top: Some(top) }, &WorkControl::new()).unwrap();
+    let t = two.two_level().unwrap();
+    let mesh_bvh = bvhscope::bvh::TreeView::memory_bytes(&t.bottom[0]);
+    let per_placement = (two.memory_bytes() - mesh_bvh) as f64 / n as f64;
+    assert!(per_placement < 400.0, "{per_placement:.0} bytes per placement");
+    // The scene holds its one mesh and no flattened copy.
+    match &scene.geometry {
+        bvhscope::scene::Geometry::Placed { instances, flat, .. } => {
+            assert_eq!(instances.meshes.len(), 1);
+            assert!(flat.get().is_none(), "nothing was flattened");
+        }
+        other => panic!("a scene file's geometry is its placements: {other:?}"),
+    }
+    // It traces and shades: the ray down onto the first torus's ring hits it.
+    let mut ray = bvhscope::geometry::Ray::new(Vec3::new(1.0, 5.0, 0.0), -Vec3::Y);
+    let hit = bvhscope::bvh::Accelerator::closest_hit(&two, &mut ray, Default::default(), &mut bvhscope::bvh::NoStats)
+        .expect("hits the torus");
+    assert!((hit.t - 4.7).abs() < 0.01, "t = {}", hit.t);
+    let n = bvhscope::mesh::Surface::shading_normal(&two, &ray, hit.prim, hit.triangle_hit());
+    assert!(n.y > 0.9, "the top of the ring faces up: {n}");
 }

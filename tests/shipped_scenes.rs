@@ -6,7 +6,7 @@
 
 mod common;
 
-use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy, TwoLevelBvh};
+use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SceneBuild, SplitStrategy};
 use bvhscope::mesh::{generate, write_obj};
 use bvhscope::render::{render, Camera, RenderSettings};
 use bvhscope::scene::{describe, load_any, SceneError};
@@ -95,9 +95,10 @@ fn every_scene_builds_everywhere_and_hits_what_the_linear_scan_hits() {
             continue;
         }
         let loaded = load_any(&path).unwrap_or_else(|e| panic!("{e}"));
-        let mesh = &loaded.mesh;
+        let flat = loaded.flat_mesh().unwrap_or_else(|e| panic!("{e}"));
+        let mesh = &*flat;
         assert!(loaded.warnings.is_empty(), "{n}: {:?}", loaded.warnings);
-        assert_eq!(loaded.scene.as_ref().and_then(|s| s.note.as_ref()), desc.note.as_ref(), "{n}: the note");
+        assert_eq!(loaded.desc.as_ref().and_then(|s| s.note.as_ref()), desc.note.as_ref(), "{n}: the note");
         let camera = small_camera(&loaded.camera.expect("a camera"), mesh.triangle_count());
         let settings = RenderSettings::default();
         let reference = render(&LinearScan::new(mesh), mesh, &camera, &settings).hit_mask();
@@ -112,18 +113,23 @@ fn every_scene_builds_everywhere_and_hits_what_the_linear_scan_hits() {
                 let differ = mask.iter().zip(&reference).filter(|(a, b)| a != b).count();
                 assert_eq!(differ, 0, "{n}, {strategy:?} {layout:?}: {differ} pixels differ from the linear scan");
             }
-            // Two levels (this strategy on both) against the flattened scene's single BVH.
-            let inst = loaded.instances.as_ref().expect("a scene gives its placements");
+            // Two levels (this strategy on both), shading through the placements without the
+            // flattened mesh, against the flattened scene's single BVH.
+            assert!(loaded.instances().is_some(), "a scene gives its placements");
             let p = BuildParams { strategy, ..base };
-            let two = TwoLevelBvh::build(&inst.mesh_refs(), &inst.placements, &p, &p, &WorkControl::new()).unwrap();
+            let two = loaded.build(&SceneBuild { bvh: p, top: Some(p) }, &WorkControl::new()).unwrap();
             let (a, b) =
-                (render(&two, mesh, &camera, &settings), render(&AnyBvh::build(mesh, &p), mesh, &camera, &settings));
+                (render(&two, &two, &camera, &settings), render(&AnyBvh::build(mesh, &p), mesh, &camera, &settings));
             let mut differ = 0;
             for (x, y) in a.full_samples().unwrap().iter().zip(b.full_samples().unwrap()) {
                 if x.is_hit() != y.is_hit() {
                     differ += 1;
                 } else if x.is_hit() {
                     assert!((x.t - y.t).abs() <= 1e-4 * y.t, "{n}, {strategy:?}: two levels t {} vs one {}", x.t, y.t);
+                    if x.prim == y.prim {
+                        let (nx, ny) = (x.normal, y.normal);
+                        assert!(nx.dot(ny) > 0.999, "{n}, {strategy:?}: triangle {} shaded {nx} vs {ny}", x.prim);
+                    }
                 }
             }
             // Rotated placements round differently in object space: allow a grazing ray in 1000.

@@ -126,10 +126,10 @@ fn rotated_and_scaled_instances_agree_with_the_flattened_scene() {
 fn the_moer_lite_scene_two_level_equals_flattened() {
     let Some(dir) = common::shared_models() else { return };
     let loaded = load_any(dir.join("moer-lite-lab1-bvh/scene.json")).expect("the Moer-lite scene loads");
-    let scene = loaded.instances.expect("a scene file gives instances");
+    let scene = loaded.instances().expect("a scene file gives instances");
     let camera = Camera { width: 300, height: 200, ..loaded.camera.expect("the scene has a camera") };
     let p = BuildParams::default();
-    let (two, single) = frames(&scene, &camera, &p, &p);
+    let (two, single) = frames(scene, &camera, &p, &p);
     assert!(single.full_samples().unwrap().iter().any(|s| s.is_hit()));
     for (a, b) in two.full_samples().unwrap().iter().zip(single.full_samples().unwrap()) {
         assert_eq!((a.prim, a.t.to_bits()), (b.prim, b.t.to_bits()));

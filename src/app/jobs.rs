@@ -2,15 +2,13 @@
 //! and report over one channel; the UI thread only polls. Starting a job of a kind cancels the
 //! running one of that kind, and results of superseded jobs are dropped by id.
 
-use super::scene::Scene;
 use crate::bvh::{SahCost, TraceOptions};
 use crate::bvh::{SceneBuild, SceneBvh};
-use crate::mesh::Mesh;
 use crate::render::{
     render_passes, view_image, Camera, ColorMap, Frame, FramePool, HeatRange, Legend, PassInfo, RenderSettings, View,
 };
-use crate::scene::{load_any, SceneInstances};
-use crate::work::{Cancelled, WorkControl};
+use crate::scene::{Scene, SceneBuildError};
+use crate::work::WorkControl;
 use std::path::PathBuf;
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::Arc;
@@ -28,8 +26,8 @@ pub struct ViewStyle {
 
 #[derive(Clone)]
 pub struct RenderRequest {
+    /// What is traced, and what shades its hits.
     pub bvh: Arc<SceneBvh>,
-    pub mesh: Arc<Mesh>,
     pub camera: Camera,
     pub trace: TraceOptions,
     pub style: ViewStyle,
@@ -40,7 +38,6 @@ impl RenderRequest {
     /// Whether two requests would produce the same image.
     pub fn same_as(&self, o: &RenderRequest) -> bool {
         Arc::ptr_eq(&self.bvh, &o.bvh)
-            && Arc::ptr_eq(&self.mesh, &o.mesh)
             && self.camera == o.camera
             && self.trace == o.trace
             && self.style == o.style
@@ -72,8 +69,8 @@ pub enum Pick {
 }
 
 pub enum JobEvent {
-    Loaded(Result<Scene, String>),
-    Built { scene_id: u64, params: SceneBuild, result: Result<Arc<SceneBvh>, Cancelled> },
+    Loaded(Result<Arc<Scene>, String>),
+    Built { scene_id: u64, params: SceneBuild, result: Result<Arc<SceneBvh>, SceneBuildError> },
     Pass(PassOutput),
     Picked { pick: Pick, path: Option<PathBuf>, took: Duration },
 }
@@ -146,15 +143,14 @@ impl Jobs {
         let job = self.start(format!("Loading {}", path.display()));
         let send = self.sender(job.id);
         std::thread::spawn(move || {
-            let result = load_any(&path).map(|l| Scene::from_loaded(l, path)).map_err(|e| e.to_string());
+            let result = Scene::open(&path).map(Arc::new).map_err(|e| e.to_string());
             send(JobEvent::Loaded(result));
         });
         self.load = Some(job);
     }
 
-    /// Build a BVH (or two levels, over `instances`) in the background; a running build is
-    /// cancelled.
-    pub fn build(&mut self, mesh: Arc<Mesh>, instances: Option<SceneInstances>, params: SceneBuild, scene_id: u64) {
+    /// Build a BVH (or two levels) over `scene` in the background; a running build is cancelled.
+    pub fn build(&mut self, scene: Arc<Scene>, params: SceneBuild, scene_id: u64) {
         if let Some(old) = self.build.take() {
             old.control.cancel();
         }
@@ -165,9 +161,7 @@ impl Jobs {
         let job = self.start(label);
         let (send, control) = (self.sender(job.id), job.control.clone());
         std::thread::spawn(move || {
-            let meshes = instances.as_ref().map(|i| i.mesh_refs());
-            let placed = instances.as_ref().zip(meshes.as_ref()).map(|(i, m)| (&m[..], &i.placements[..]));
-            let result = SceneBvh::build(&mesh, placed, &params, &control).map(Arc::new);
+            let result = scene.build(&params, &control).map(Arc::new);
             send(JobEvent::Built { scene_id, params, result });
         });
         self.build = Some(job);
@@ -194,7 +188,7 @@ impl Jobs {
             // Always count: the heatmaps and the hover read-out need the counters, and counting
             // costs little next to shading.
             let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive };
-            let _ = render_passes(&*r.bvh, &r.mesh, &r.camera, &settings, &frames, &control, |frame, info| {
+            let _ = render_passes(&*r.bvh, &*r.bvh, &r.camera, &settings, &frames, &control, |frame, info| {
                 let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
                 let (bvh, camera, style, trace) = (r.bvh.clone(), r.camera, r.style, r.trace);

@@ -14,15 +14,17 @@ mod settings;
 mod shortcuts;
 mod viewport;
 
+pub use crate::scene::{Scene, SceneSource};
 pub use action::{Action, Actions};
 pub use jobs::Pick;
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
-pub use scene::{BuiltBvh, Scene, SceneSource};
+pub use scene::BuiltBvh;
 pub use settings::{BoxLevel, Settings};
 
 use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
 use crate::render::{Camera, ColorMap, Frame, Legend, RaySummary, UpAxis, View};
+use crate::scene::SceneBuildError;
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -121,7 +123,7 @@ impl PathWindow {
 
 pub struct BvhscopeApp {
     pub settings: Settings,
-    pub scene: Scene,
+    pub scene: Arc<Scene>,
     /// Increases with every scene loaded; a BVH belongs to the scene it was built for.
     pub scene_id: u64,
     pub built: Option<BuiltBvh>,
@@ -176,10 +178,10 @@ fn up_axis_of(c: &Camera) -> UpAxis {
 impl BvhscopeApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
         let settings: Settings = cc.storage.and_then(|s| eframe::get_value(s, eframe::APP_KEY)).unwrap_or_default();
-        let scene = Scene::builtin();
+        let scene = Arc::new(Scene::builtin());
         let aspect = 1.6;
         let mut app = Self {
-            orbit: OrbitCamera::home(&scene.mesh.bounds(), aspect, settings.up_axis),
+            orbit: OrbitCamera::home(&scene.bounds(), aspect, settings.up_axis),
             settings,
             scene,
             scene_id: 1,
@@ -212,7 +214,7 @@ impl BvhscopeApp {
         }
     }
 
-    fn set_scene(&mut self, scene: Scene) {
+    fn set_scene(&mut self, scene: Arc<Scene>) {
         for w in &scene.warnings {
             self.message(MessageKind::Warning, format!("{}: {w}", scene.title()));
         }
@@ -224,12 +226,12 @@ impl BvhscopeApp {
         }
         self.orbit = match &scene.camera {
             Some(c) => OrbitCamera::from_camera(c, self.settings.up_axis),
-            None => OrbitCamera::home(&scene.mesh.bounds(), self.viewport_aspect, self.settings.up_axis),
+            None => OrbitCamera::home(&scene.bounds(), self.viewport_aspect, self.settings.up_axis),
         };
         if let Some(b) = scene.build {
             self.settings.build = b;
         }
-        if let Some(inst) = &scene.instances {
+        if let Some(inst) = scene.instances() {
             self.settings.two_level = inst.placements.len() > inst.meshes.len();
         }
         // A new mesh has its own heatmap scale.
@@ -278,7 +280,7 @@ impl BvhscopeApp {
 
     /// Whether the scene can be built as two levels (it came from a scene file).
     pub fn has_instances(&self) -> bool {
-        self.scene.instances.is_some()
+        self.scene.instances().is_some()
     }
 
     /// What the settings ask to build for the current scene.
@@ -294,6 +296,7 @@ impl BvhscopeApp {
     /// render asked for. The one place that decides what to rebuild and re-render.
     pub fn reconcile(&mut self) {
         self.fit_settings_to_bvh();
+        self.fit_levels_to_scene();
         self.ensure_build();
         self.ensure_render();
     }
@@ -312,6 +315,18 @@ impl BvhscopeApp {
         }
     }
 
+    /// One level over a scene too large to flatten is not built: the app switches to two levels
+    /// and says why (the CLI refuses with the same sentence).
+    fn fit_levels_to_scene(&mut self) {
+        if self.settings.two_level || !self.has_instances() {
+            return;
+        }
+        if let Err(e) = self.scene.check_one_level() {
+            self.settings.two_level = true;
+            self.message(MessageKind::Warning, format!("{e}. Switched to two levels."));
+        }
+    }
+
     /// Start a build when the settings or the scene differ from what was built or is building.
     fn ensure_build(&mut self) {
         let build = self.wanted_build();
@@ -321,8 +336,7 @@ impl BvhscopeApp {
             // Switched back to what is built while another build ran: that build is not wanted.
             self.jobs.cancel_build();
         } else if self.jobs.last_build != Some(wanted) {
-            let instances = if build.top.is_some() { self.scene.instances.clone() } else { None };
-            self.jobs.build(self.scene.mesh.clone(), instances, build, self.scene_id);
+            self.jobs.build(self.scene.clone(), build, self.scene_id);
         }
     }
 
@@ -333,7 +347,6 @@ impl BvhscopeApp {
         let Some(built) = self.current_bvh().filter(|_| w > 0 && h > 0) else { return };
         let req = jobs::RenderRequest {
             bvh: built.bvh.clone(),
-            mesh: self.scene.mesh.clone(),
             camera: self.orbit.camera(w, h),
             trace: self.settings.trace,
             style: self.view_style(),
@@ -419,7 +432,7 @@ impl BvhscopeApp {
     }
 
     fn reset_view(&mut self) {
-        self.orbit = OrbitCamera::home(&self.scene.mesh.bounds(), self.viewport_aspect, self.settings.up_axis);
+        self.orbit = OrbitCamera::home(&self.scene.bounds(), self.viewport_aspect, self.settings.up_axis);
     }
 
     fn apply(&mut self, ctx: &egui::Context, event: JobEvent) {
@@ -444,9 +457,12 @@ impl BvhscopeApp {
                     }
                 }
                 let names: Vec<String> =
-                    self.scene.instances.iter().flat_map(|i| &i.meshes).map(|m| m.name.clone()).collect();
+                    self.scene.instances().iter().flat_map(|i| &i.meshes).map(|m| m.name.clone()).collect();
                 self.built = Some(BuiltBvh::new(bvh, &names, scene_id));
                 self.rays = None;
+            }
+            JobEvent::Built { scene_id, result: Err(SceneBuildError::Scene(e)), .. } if scene_id == self.scene_id => {
+                self.message(MessageKind::Error, e.to_string());
             }
             JobEvent::Built { .. } => {}
             JobEvent::Pass(pass) => self.show_pass(ctx, pass),
@@ -534,7 +550,7 @@ impl BvhscopeApp {
             A::OpenPath => self.path_window = Some(PathWindow::new(Pick::Open, String::new(), None)),
             // Loads in the background; the current scene stays until it has loaded.
             A::OpenFile(path) => self.jobs.load(path),
-            A::ShowBuiltin => self.set_scene(Scene::builtin()),
+            A::ShowBuiltin => self.set_scene(Arc::new(Scene::builtin())),
             A::SavePng => self.jobs.pick_file(Pick::SavePng, &export::default_name(self, "png")),
             A::SavePngTyped => {
                 let name = export::default_name(self, "png");
@@ -564,7 +580,7 @@ impl BvhscopeApp {
             A::Orbit(dx, dy) => self.orbit.orbit(dx, dy),
             A::Pan { dx, dy, height } => self.orbit.pan(dx, dy, height),
             A::Zoom(amount) => self.orbit.zoom(amount),
-            A::FrameMesh => self.orbit.frame(&self.scene.mesh.bounds(), self.viewport_aspect),
+            A::FrameMesh => self.orbit.frame(&self.scene.bounds(), self.viewport_aspect),
             A::ResetView => self.reset_view(),
             A::Viewport { rect, pixels } => {
                 self.viewport_rect = rect;

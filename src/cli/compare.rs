@@ -313,7 +313,7 @@ pub fn rows_csv(rows: &[CompareRow]) -> String {
 
 pub fn run(a: &CompareArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
-    let mesh = &loaded.mesh;
+    let mesh = &*loaded.flat_mesh()?;
     let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
     let scene = loaded.build.as_ref();
     let (rows, setup) = compare_rows(mesh, &camera, &a.build, scene, a.runs, a.threads, Duration::from_secs(10));

@@ -11,7 +11,7 @@ pub use args::{parse_camera, parse_size, BuildArgs};
 pub use compare::{compare_rows, CompareRow};
 
 use crate::mesh::MeshError;
-use crate::scene::{load_any, Loaded, SceneError};
+use crate::scene::{Scene, SceneBuildError, SceneError};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 
@@ -52,9 +52,9 @@ pub enum CliError {
 }
 
 /// Load a mesh or a scene with a spinner when it takes over a second, and print what was skipped.
-pub(crate) fn load_mesh(path: &Path) -> Result<Loaded, CliError> {
+pub(crate) fn load_mesh(path: &Path) -> Result<Scene, CliError> {
     let label = format!("loading {}", path.display());
-    let loaded = progress::with_spinner(&label, || load_any(path))?;
+    let loaded = progress::with_spinner(&label, || Scene::open(path))?;
     if loaded.report.degenerate_skipped > 0 {
         eprintln!(
             "note: {}: {} degenerate (zero-area) triangles skipped",
@@ -65,33 +65,24 @@ pub(crate) fn load_mesh(path: &Path) -> Result<Loaded, CliError> {
     for w in &loaded.warnings {
         eprintln!("warning: {}: {w}", path.display());
     }
-    if let Some(note) = loaded.scene.as_ref().and_then(|s| s.note.as_ref()) {
+    if let Some(note) = loaded.desc.as_ref().and_then(|s| s.note.as_ref()) {
         eprintln!("about this scene: {note}");
     }
     Ok(loaded)
 }
 
-/// Build what `build` asks for over a loaded file; for two levels an OBJ is one placement of itself.
-pub(crate) fn build_scene(loaded: &Loaded, build: &crate::bvh::SceneBuild) -> crate::bvh::SceneBvh {
-    let single;
-    let instances = match &loaded.instances {
-        Some(i) => i,
-        None => {
-            single = crate::scene::SceneInstances {
-                meshes: vec![std::sync::Arc::new(loaded.mesh.clone())],
-                placements: vec![(0, glam::Affine3A::IDENTITY)],
-            };
-            &single
-        }
-    };
-    let meshes = instances.mesh_refs();
+/// Build what `build` asks for over a loaded file; for two levels an OBJ is one placement of
+/// itself. One level over a scene too large to flatten is refused (`Scene::check_one_level`),
+/// before anything is allocated.
+pub(crate) fn build_scene(scene: &Scene, build: &crate::bvh::SceneBuild) -> Result<crate::bvh::SceneBvh, CliError> {
+    if build.top.is_none() {
+        scene.check_one_level().map_err(|e| CliError::Usage(format!("{e} (--two-level)")))?;
+    }
     let label = if build.top.is_some() { "building the two-level BVH" } else { "building the BVH" };
-    progress::with_spinner(label, || {
-        let control = crate::work::WorkControl::new();
-        match crate::bvh::SceneBvh::build(&loaded.mesh, Some((&meshes, &instances.placements)), build, &control) {
-            Ok(b) => b,
-            Err(crate::work::Cancelled) => unreachable!("nobody else holds this control"),
-        }
+    progress::with_spinner(label, || match scene.build(build, &crate::work::WorkControl::new()) {
+        Ok(b) => Ok(b),
+        Err(SceneBuildError::Scene(e)) => Err(e.into()),
+        Err(SceneBuildError::Cancelled) => unreachable!("nobody else holds this control"),
     })
 }
 

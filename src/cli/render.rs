@@ -45,15 +45,14 @@ pub(crate) fn file_name(p: &std::path::Path) -> String {
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
-    let mesh = &loaded.mesh;
-    let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
+    let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
     let params = a.build.params(loaded.build.as_ref());
-    let bvh = build_scene(&loaded, &a.build.scene_build(params));
+    let bvh = build_scene(&loaded, &a.build.scene_build(params))?;
     let settings = RenderSettings { trace: a.build.trace(), count: a.view.is_heatmap(), progressive: false };
     let total = camera.width as u64 * camera.height as u64;
     let control = WorkControl::new();
     let frame = progress::with_bar("rendering", &control, || {
-        render_progressive(&bvh, mesh, &camera, &settings, &Default::default(), &control, |_, _| {})
+        render_progressive(&bvh, &bvh, &camera, &settings, &Default::default(), &control, |_, _| {})
     })
     .map_err(|_| CliError::Usage("render cancelled".into()))?;
     let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });

@@ -60,32 +60,32 @@ fn format_rays(camera: &Camera, trace: &crate::bvh::TraceOptions, r: &RaySummary
 pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
     let params = a.build.params(loaded.build.as_ref());
-    let bvh = build_scene(&loaded, &a.build.scene_build(params));
+    let bvh = build_scene(&loaded, &a.build.scene_build(params))?;
     let report = &loaded.report;
     let rays = if a.no_rays {
         None
     } else {
-        let camera = a.view_args.camera(&loaded.mesh.bounds(), loaded.camera.as_ref())?;
+        let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
         let settings = RenderSettings { trace: a.build.trace(), count: true, progressive: false };
-        let summary = progress::with_spinner("tracing the frame", || render(&bvh, &loaded.mesh, &camera, &settings))
-            .ray_summary();
+        let summary =
+            progress::with_spinner("tracing the frame", || render(&bvh, &bvh, &camera, &settings)).ray_summary();
         Some((camera, summary))
     };
     let rays_json = rays
         .map(|(camera, summary)| serde_json::json!({ "camera": camera, "trace": a.build.trace(), "summary": summary }));
     let rays_text = rays.map_or(String::new(), |(camera, r)| format_rays(&camera, &a.build.trace(), &r));
     match (&bvh, a.format) {
-        (SceneBvh::Single(b), StatsFormat::Json) => {
+        (SceneBvh::Single { bvh: b, .. }, StatsFormat::Json) => {
             let v =
                 serde_json::json!({ "mesh": report, "params": params, "stats": TreeStats::of(b), "rays": rays_json });
             println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
-        (SceneBvh::Single(b), StatsFormat::Text) => {
+        (SceneBvh::Single { bvh: b, .. }, StatsFormat::Text) => {
             print!("{}{rays_text}", format_text(report, &params, &TreeStats::of(b)))
         }
-        (SceneBvh::TwoLevel(t), format) => {
+        (SceneBvh::TwoLevel { bvh: t, .. }, format) => {
             let top = TreeStats::of(&t.top);
-            let names = loaded.instances.as_ref().map(|i| i.meshes.iter().map(|m| m.name.clone()).collect::<Vec<_>>());
+            let names = loaded.instances().map(|i| i.meshes.iter().map(|m| m.name.clone()).collect::<Vec<_>>());
             let bottom: Vec<(String, TreeStats)> = t
                 .bottom
                 .iter()

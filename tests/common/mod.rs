@@ -129,3 +129,23 @@ pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
     assert_eq!(reached, bvh.nodes.len(), "every node is reachable exactly once");
     check_tiling(leaf_ranges, n);
 }
+
+/// A scene file placing a generated 1,000-triangle torus `n` times on a grid.
+pub fn many_placements(dir: &std::path::Path, n: usize) -> PathBuf {
+    let torus = bvhscope::mesh::generate::torus(1.0, 0.3, 25, 20);
+    assert_eq!(torus.triangle_count(), 1000);
+    let obj = dir.join(format!("torus-{n}.obj"));
+    bvhscope::mesh::write_obj(&torus, &mut std::fs::File::create(&obj).unwrap()).unwrap();
+    let side = (n as f32).sqrt().ceil() as usize;
+    let meshes: Vec<bvhscope::scene::SceneMesh> = (0..n)
+        .map(|i| {
+            let at = glam::Vec3::new((i % side) as f32 * 3.0, 0.0, (i / side) as f32 * 3.0);
+            bvhscope::scene::SceneMesh::new(obj.clone(), glam::Affine3A::from_translation(at))
+        })
+        .collect();
+    let camera = bvhscope::render::Camera::framing(&Aabb::new(glam::Vec3::ZERO, glam::Vec3::ONE), 64, 48);
+    let text = bvhscope::scene::write_scene_file(&camera, &meshes, &bvhscope::bvh::BuildParams::default());
+    let path = dir.join(format!("many-{n}.json"));
+    std::fs::write(&path, text).unwrap();
+    path
+}

@@ -1,6 +1,9 @@
 //! The desktop app driven through egui_kittest, without a display: what a user sees and does.
 //! Built by the `ui-tests` package (see its Cargo.toml); snapshots live in `tests/snapshots/`.
 
+#[path = "../common/mod.rs"]
+mod common;
+
 use bvhscope::app::{Action, AppOptions, BvhscopeApp, MessageKind, SceneSource};
 use bvhscope::bvh::SplitStrategy;
 use egui::accesskit::Role;
@@ -317,7 +320,7 @@ fn a_scene_file_brings_its_camera_and_settings_and_can_be_saved_back() {
     let saved = scene.with_file_name("saved.json");
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveScene, saved.clone()));
     let back = bvhscope::scene::load_any(&saved).expect("the saved scene loads");
-    assert_eq!(back.mesh.triangle_count(), 8);
+    assert_eq!(back.placed_triangles(), 8);
     assert_eq!(back.build.unwrap().strategy, SplitStrategy::Midpoint);
     assert!((back.camera.unwrap().position - cam.position).length() < 1e-4);
 }
@@ -424,13 +427,12 @@ fn a_coarse_pass_is_shown_in_place_at_its_resolution_snapshot() {
     run_until(&mut h, "the first full frame", idle);
     // The 1/8 pass of the frame on screen, put where the render job would put it.
     let app = h.state();
-    let (bvh, mesh, shown) =
-        (app.current_bvh().unwrap().bvh.clone(), app.scene.mesh.clone(), app.shown.as_ref().unwrap());
+    let (bvh, shown) = (app.current_bvh().unwrap().bvh.clone(), app.shown.as_ref().unwrap());
     let (camera, style) = (shown.camera, shown.style);
     assert_ne!(camera.width % 8, 0, "a partly covered last column is part of the test");
     let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
     let mut coarse = None;
-    render_passes(&*bvh, &mesh, &camera, &settings, &Default::default(), &Default::default(), |f, _| {
+    render_passes(&*bvh, &*bvh, &camera, &settings, &Default::default(), &Default::default(), |f, _| {
         if f.stride() == 8 {
             coarse = Some(f);
         }
@@ -504,7 +506,7 @@ fn a_long_scene_note_wraps_inside_the_viewport_and_can_be_dismissed() {
     run_until(&mut h, "the first build", idle);
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/many-instances.json");
     h.input_mut().dropped_files.push(Arc::new(Dropped(scene)));
-    run_until(&mut h, "the scene", |a| a.scene.instances.is_some() && idle(a));
+    run_until(&mut h, "the scene", |a| a.scene.instances().is_some() && idle(a));
     let viewport = h.state().viewport_rect;
     let note = h.get_by_label_contains("Note: many-instances.json: 144 placements").rect();
     assert!(viewport.contains_rect(note), "the note {note:?} inside the viewport {viewport:?}");
@@ -668,4 +670,23 @@ fn the_moer_lite_lab_scene_opens_in_one_level() {
     assert!(!h.state().settings.two_level, "one placement of one mesh: one level");
     assert!(h.state().current_bvh().unwrap().bvh.two_level().is_none());
     h.get_by_label("Two levels: 1 placements of 1 meshes");
+}
+
+/// Unticking Two levels on a scene too large to flatten keeps two levels and says why.
+#[test]
+fn one_level_past_the_budget_switches_back_to_two_levels_and_says_why() {
+    let dir = std::env::temp_dir().join(format!("bvhscope-ui-many-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = common::many_placements(&dir, 21_000);
+    let mut h = harness();
+    run_until(&mut h, "the first build", idle);
+    h.input_mut().dropped_files.push(Arc::new(Dropped(scene)));
+    run_until(&mut h, "the placements", |a| a.scene.report.triangles == 21_000_000 && idle(a));
+    assert!(h.state().settings.two_level);
+    h.get_by_label("Two levels: 21000 placements of 1 meshes").click();
+    h.run_steps(3);
+    assert!(h.state().settings.two_level, "one level would flatten 21M triangles");
+    let m = h.state().messages.iter().find(|m| m.kind == MessageKind::Warning).expect("a warning says why");
+    assert!(m.text.contains("21000000 triangles") && m.text.contains("Switched to two levels"), "{}", m.text);
+    assert!(h.state().current_bvh().unwrap().bvh.two_level().is_some());
 }

@@ -1,13 +1,15 @@
-//! What the app and the CLI trace: one BVH over the whole (flattened) scene, or the two-level BVH
-//! over the scene's mesh placements. Both give the same triangle ids, so the flattened mesh shades
-//! either.
+//! What the app and the CLI trace: one BVH over one mesh (an OBJ, or a scene flattened), or the
+//! two-level BVH over the scene's mesh placements, each with the meshes it was built over, so it
+//! shades its own hits (`Surface`). Both give the same triangle ids (a two-level hit's id is the
+//! one the flattened scene gives the same triangle).
 
 use super::tree::TreeView;
 use super::{Accelerator, AnyBvh, BuildParams, Hit, TraceOptions, TraversalStats, TwoLevelBvh};
-use crate::geometry::{Ray, TriangleIntersector};
-use crate::mesh::Mesh;
+use crate::geometry::{Ray, TriangleHit, TriangleIntersector};
+use crate::mesh::{Mesh, Surface};
 use crate::work::{Cancelled, WorkControl};
-use glam::Affine3A;
+use glam::{Affine3A, Vec3};
+use std::sync::Arc;
 
 /// How to build a scene's acceleration structure.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,68 +32,68 @@ impl SceneBuild {
     }
 }
 
-/// A scene's meshes and their placements (mesh index, object-to-world transform).
-pub type Placements<'a> = (&'a [&'a Mesh], &'a [(u32, Affine3A)]);
-
 #[derive(Clone, Debug)]
 pub enum SceneBvh {
-    Single(AnyBvh),
-    TwoLevel(TwoLevelBvh),
+    Single { bvh: AnyBvh, mesh: Arc<Mesh> },
+    TwoLevel { bvh: TwoLevelBvh, meshes: Vec<Arc<Mesh>> },
 }
 
 impl SceneBvh {
-    /// Build over `flat` (single level) or over `meshes` placed by `placements` (two levels, when
-    /// `build.top` is given and there are placements; otherwise the single level is built).
-    pub fn build(
-        flat: &Mesh,
-        instances: Option<Placements>,
-        build: &SceneBuild,
+    /// One BVH over `mesh`.
+    pub fn build_single(mesh: Arc<Mesh>, params: &BuildParams, control: &WorkControl) -> Result<SceneBvh, Cancelled> {
+        Ok(SceneBvh::Single { bvh: AnyBvh::build_controlled(&mesh, params, control)?, mesh })
+    }
+
+    /// Two levels: a BVH per mesh of `meshes` with `bottom`, and the top level over `placements`
+    /// (mesh index, object-to-world transform) with `top`.
+    pub fn build_two_level(
+        meshes: Vec<Arc<Mesh>>,
+        placements: &[(u32, Affine3A)],
+        top: &BuildParams,
+        bottom: &BuildParams,
         control: &WorkControl,
     ) -> Result<SceneBvh, Cancelled> {
-        match (build.top, instances) {
-            (Some(top), Some((meshes, placements))) => {
-                Ok(SceneBvh::TwoLevel(TwoLevelBvh::build(meshes, placements, &top, &build.bvh, control)?))
-            }
-            _ => Ok(SceneBvh::Single(AnyBvh::build_controlled(flat, &build.bvh, control)?)),
-        }
+        let refs: Vec<&Mesh> = meshes.iter().map(|m| &**m).collect();
+        let bvh = TwoLevelBvh::build(&refs, placements, top, bottom, control)?;
+        Ok(SceneBvh::TwoLevel { bvh, meshes })
     }
 
     /// What this was built with.
     pub fn build_params(&self) -> SceneBuild {
         match self {
-            SceneBvh::Single(b) => SceneBuild { bvh: *b.params(), top: None },
-            SceneBvh::TwoLevel(t) => SceneBuild { bvh: t.bottom_params, top: Some(t.top.params) },
+            SceneBvh::Single { bvh: b, .. } => SceneBuild { bvh: *b.params(), top: None },
+            SceneBvh::TwoLevel { bvh: t, .. } => SceneBuild { bvh: t.bottom_params, top: Some(t.top.params) },
         }
     }
 
     /// The single BVH, or the top level of two.
     pub fn tree(&self) -> &dyn TreeView {
         match self {
-            SceneBvh::Single(b) => b,
-            SceneBvh::TwoLevel(t) => &t.top,
+            SceneBvh::Single { bvh: b, .. } => b,
+            SceneBvh::TwoLevel { bvh: t, .. } => &t.top,
         }
     }
 
     pub fn two_level(&self) -> Option<&TwoLevelBvh> {
         match self {
-            SceneBvh::TwoLevel(t) => Some(t),
-            SceneBvh::Single(_) => None,
+            SceneBvh::TwoLevel { bvh: t, .. } => Some(t),
+            SceneBvh::Single { .. } => None,
         }
     }
 
     /// Bytes of every node and index array (each mesh BVH once).
     pub fn memory_bytes(&self) -> usize {
         match self {
-            SceneBvh::Single(b) => b.memory_bytes(),
-            SceneBvh::TwoLevel(t) => t.memory_bytes(),
+            SceneBvh::Single { bvh: b, .. } => b.memory_bytes(),
+            SceneBvh::TwoLevel { bvh: t, .. } => t.memory_bytes(),
         }
     }
 
     /// Total build time.
     pub fn build_time(&self) -> std::time::Duration {
         match self {
-            SceneBvh::Single(b) => b.report().total_time(),
-            SceneBvh::TwoLevel(t) => t.bottom_time + t.top_time,
+            SceneBvh::Single { bvh: b, .. } => b.report().total_time(),
+            SceneBvh::TwoLevel { bvh: t, .. } => t.bottom_time + t.top_time,
         }
     }
 }
@@ -104,20 +106,43 @@ impl Accelerator for SceneBvh {
         stats: &mut S,
     ) -> Option<Hit> {
         match self {
-            SceneBvh::Single(b) => b.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
-            SceneBvh::TwoLevel(t) => t.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
+            SceneBvh::Single { bvh: b, .. } => b.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
+            SceneBvh::TwoLevel { bvh: t, .. } => t.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
         }
     }
 
     fn traces_packets(&self) -> bool {
-        matches!(self, SceneBvh::Single(b) if b.traces_packets())
+        matches!(self, SceneBvh::Single { bvh, .. } if bvh.traces_packets())
     }
 
     #[inline]
     fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
         match self {
-            SceneBvh::Single(b) => b.closest_hits(rays, hits, opts),
-            SceneBvh::TwoLevel(t) => t.closest_hits(rays, hits, opts),
+            SceneBvh::Single { bvh: b, .. } => b.closest_hits(rays, hits, opts),
+            SceneBvh::TwoLevel { bvh: t, .. } => t.closest_hits(rays, hits, opts),
+        }
+    }
+}
+
+impl Surface for SceneBvh {
+    /// One level: the mesh's own normal. Two levels: the placed mesh's, the ray moved into its
+    /// object space as the traversal moved it (so `t` is the same), the normal back into the
+    /// world by the inverse transpose of the placement.
+    fn shading_normal(&self, ray: &Ray, prim: u32, hit: TriangleHit) -> Vec3 {
+        match self {
+            SceneBvh::Single { mesh, .. } => mesh.shading_normal(ray, prim, hit),
+            SceneBvh::TwoLevel { bvh, meshes } => {
+                // Instances number their triangles in placement order: the last one starting at
+                // or before `prim` holds it.
+                let k = bvh.instances.partition_point(|i| i.first_prim <= prim).saturating_sub(1);
+                let inst = &bvh.instances[k];
+                let local = Ray::new(
+                    inst.to_object.transform_point3(ray.origin()),
+                    inst.to_object.transform_vector3(ray.dir()),
+                );
+                let n = meshes[inst.mesh as usize].shading_normal(&local, prim - inst.first_prim, hit);
+                (glam::Mat3::from(inst.to_object.matrix3).transpose() * n).normalize_or_zero()
+            }
         }
     }
 }

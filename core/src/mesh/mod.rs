@@ -7,8 +7,10 @@ mod mesh;
 mod obj;
 mod obj_lines;
 mod obj_parallel;
+mod surface;
 
 pub use error::{MeshError, MAX_COORDINATE};
 pub use mesh::{Mesh, MeshGroup, SurfaceInteraction};
 pub(crate) use obj::decode_text;
 pub use obj::{load_obj, parse_obj, read_user_file, write_obj, LoadReport};
+pub use surface::Surface;

@@ -10,7 +10,7 @@ use super::{Camera, Frame, FramePool, PixelSample};
 use crate::bvh::packet::{packet_position, PACKET, PACKET_SIDE};
 use crate::bvh::{Accelerator, Hit, NoStats, RayCounters, TraceOptions, TraversalStats};
 use crate::geometry::Ray;
-use crate::mesh::Mesh;
+use crate::mesh::Surface;
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -40,7 +40,12 @@ pub struct PassInfo {
 }
 
 /// Render a full frame in one pass (no cancellation, no progress).
-pub fn render<A: Accelerator>(accel: &A, mesh: &Mesh, camera: &Camera, settings: &RenderSettings) -> Frame {
+pub fn render<A: Accelerator, M: Surface + ?Sized>(
+    accel: &A,
+    mesh: &M,
+    camera: &Camera,
+    settings: &RenderSettings,
+) -> Frame {
     let settings = RenderSettings { progressive: false, ..*settings };
     match render_progressive(accel, mesh, camera, &settings, &FramePool::default(), &WorkControl::new(), |_, _| {}) {
         Ok(frame) => frame,
@@ -52,9 +57,9 @@ pub fn render<A: Accelerator>(accel: &A, mesh: &Mesh, camera: &Camera, settings:
 /// pool). The control's total is set to the pixel count and its done counter advanced as bands
 /// finish; `on_pass` sees the frame after each pass. Returns the finished frame, or `Cancelled`
 /// once the control is cancelled (checked before each band).
-pub fn render_progressive<A: Accelerator>(
+pub fn render_progressive<A: Accelerator, M: Surface + ?Sized>(
     accel: &A,
-    mesh: &Mesh,
+    mesh: &M,
     camera: &Camera,
     settings: &RenderSettings,
     frames: &FramePool,
@@ -87,9 +92,9 @@ pub fn render_progressive<A: Accelerator>(
 /// `render_progressive` for a caller that keeps each pass's frame (the app shows them while it
 /// refines): a coarse pass is handed on as a snapshot of its traced pixels (1/stride² of the frame),
 /// the last pass as the frame itself, uncopied.
-pub fn render_passes<A: Accelerator>(
+pub fn render_passes<A: Accelerator, M: Surface + ?Sized>(
     accel: &A,
-    mesh: &Mesh,
+    mesh: &M,
     camera: &Camera,
     settings: &RenderSettings,
     frames: &FramePool,
@@ -109,9 +114,9 @@ pub fn render_passes<A: Accelerator>(
 }
 
 /// One pass: the pixels on the `stride` grid that the `previous` grid (0: none) did not cover.
-struct Pass<'a, A> {
+struct Pass<'a, A, M: ?Sized> {
     accel: &'a A,
-    mesh: &'a Mesh,
+    mesh: &'a M,
     camera: &'a Camera,
     trace: TraceOptions,
     stride: u32,
@@ -119,7 +124,7 @@ struct Pass<'a, A> {
     control: &'a WorkControl,
 }
 
-impl<A: Accelerator> Pass<'_, A> {
+impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
     /// Trace the pass ray by ray, counting into `S`; returns the rays traced.
     fn trace<S: TraversalStats + Default + Into<RayCounters>>(&self, frame: &mut Frame) -> u64 {
         let Pass { accel, mesh, camera, trace, stride, previous, control } = *self;
@@ -185,17 +190,17 @@ fn for_each_band(
 }
 
 /// The pixel a ray's closest hit (or miss) shows.
-fn sample(mesh: &Mesh, ray: &Ray, hit: Option<Hit>) -> PixelSample {
+fn sample(surface: &(impl Surface + ?Sized), ray: &Ray, hit: Option<Hit>) -> PixelSample {
     match hit {
         Some(hit) => {
-            let si = mesh.fill_intersection(ray, hit.prim, hit.triangle_hit());
-            PixelSample { t: hit.t, normal: si.shading_normal, prim: hit.prim }
+            let normal = surface.shading_normal(ray, hit.prim, hit.triangle_hit());
+            PixelSample { t: hit.t, normal, prim: hit.prim }
         }
         None => PixelSample::MISS,
     }
 }
 
-impl<A: Accelerator> Pass<'_, A> {
+impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
     /// `trace` without counters, in packets: the pass's pixels grouped in blocks of 8×8 pixels of
     /// its grid (fewer rows where the band is shorter), listed in `packet_position` order, leaving
     /// out the pixels an earlier pass traced.
@@ -247,6 +252,7 @@ impl From<NoStats> for RayCounters {
 mod tests {
     use super::*;
     use crate::bvh::{BuildParams, Bvh};
+    use crate::mesh::Mesh;
     use glam::Vec3;
 
     fn quad_scene() -> (Mesh, Camera) {

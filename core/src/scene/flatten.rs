@@ -1,11 +1,10 @@
-//! Opening a scene: every distinct mesh file loaded once (what the two-level BVH instances), and the
-//! scene flattened into one mesh for the single-level BVH: every placement applied (positions by
-//! the transform, normals by its inverse transpose).
+//! A scene's meshes: every distinct mesh file loaded once (what the two-level BVH instances), and
+//! the scene flattened into one mesh for the single-level BVH: every placement applied (positions
+//! by the transform, normals by its inverse transpose).
 
-use super::{describe, SceneDesc, SceneError};
-use crate::bvh::BuildParams;
+use super::{SceneDesc, SceneError};
+use crate::geometry::Aabb;
 use crate::mesh::{load_obj, LoadReport, Mesh, MeshGroup};
-use crate::render::Camera;
 use glam::Affine3A;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -24,57 +23,33 @@ impl SceneInstances {
     pub fn mesh_refs(&self) -> Vec<&Mesh> {
         self.meshes.iter().map(|m| &**m).collect()
     }
-}
 
-/// What opening a file gives: the mesh to build over, and what a scene file adds.
-#[derive(Clone, Debug)]
-pub struct Loaded {
-    /// The whole scene as one mesh (for the single-level BVH, and for shading: its triangle ids are
-    /// the two-level BVH's global ids).
-    pub mesh: Mesh,
-    pub report: LoadReport,
-    pub camera: Option<Camera>,
-    pub build: Option<BuildParams>,
-    pub warnings: Vec<String>,
-    /// The scene's description, when the file was a scene.
-    pub scene: Option<SceneDesc>,
-    /// The scene's meshes and placements, when the file was a scene.
-    pub instances: Option<SceneInstances>,
-}
-
-/// Open an OBJ, or a scene file (`.json`: bvhscope's format or Moer-lite's).
-pub fn load_any(path: impl AsRef<Path>) -> Result<Loaded, SceneError> {
-    let path = path.as_ref();
-    let is_scene = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    if !is_scene {
-        let (mesh, report) = load_obj(path)?;
-        return Ok(Loaded {
-            mesh,
-            report,
-            camera: None,
-            build: None,
-            warnings: Vec::new(),
-            scene: None,
-            instances: None,
-        });
+    /// Triangles of the scene with every placement applied: what flattening would make.
+    pub fn placed_triangles(&self) -> u64 {
+        self.placements.iter().map(|&(k, _)| self.meshes[k as usize].triangle_count() as u64).sum()
     }
-    let start = std::time::Instant::now();
-    let desc = describe(path)?;
-    let (instances, mut report) = load_instances(path, &desc)?;
-    let mesh = flatten(path, &instances)?;
-    report.vertices = mesh.positions.len();
-    report.triangles = mesh.triangles.len();
-    report.groups = mesh.groups.len();
-    report.load_time = start.elapsed();
-    Ok(Loaded {
-        mesh,
-        report,
-        camera: desc.camera,
-        build: desc.build,
-        warnings: desc.warnings.clone(),
-        scene: Some(desc),
-        instances: Some(instances),
-    })
+
+    /// Vertices of the scene with every placement applied.
+    pub fn placed_vertices(&self) -> u64 {
+        self.placements.iter().map(|&(k, _)| self.meshes[k as usize].positions.len() as u64).sum()
+    }
+
+    /// The box of every placed vertex (as flattening would place them), computed without
+    /// flattening; `None` when a placement moves a vertex beyond the coordinates that can be
+    /// traced.
+    pub fn placed_bounds(&self) -> Option<Aabb> {
+        let mut out = Aabb::EMPTY;
+        for &(k, transform) in &self.placements {
+            for &p in &self.meshes[k as usize].positions {
+                let q = transform.transform_point3(p);
+                if !q.is_finite() || q.abs().max_element() > crate::mesh::MAX_COORDINATE {
+                    return None;
+                }
+                out = out.grow(q);
+            }
+        }
+        Some(out)
+    }
 }
 
 /// Load every distinct mesh file of the scene once.

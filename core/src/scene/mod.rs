@@ -1,13 +1,15 @@
 //! Scenes: several meshes, each placed by a transform, with a camera and the BVH settings to start
 //! with. Two formats are read: bvhscope's own scene file (`scene_file.rs`) and the Moer-lite
-//! renderer's `scene.json` (`moer_lite.rs`). A scene is flattened into one mesh (`flatten.rs`) for
-//! the single-level BVH.
+//! renderer's `scene.json` (`moer_lite.rs`). An opened file is a `Scene` (`open.rs`); a scene of
+//! placements is flattened into one mesh (`flatten.rs`) only for a one-level BVH.
 
 mod flatten;
 mod moer_lite;
+mod open;
 mod scene_file;
 
-pub use flatten::{flatten, load_any, load_instances, Loaded, SceneInstances};
+pub use flatten::{flatten, load_instances, SceneInstances};
+pub use open::{load_any, Geometry, Scene, SceneBuildError, SceneSource, MAX_FLAT_TRIANGLES};
 pub use scene_file::{parse_scene_file, write_scene_file};
 
 use crate::bvh::BuildParams;
@@ -54,6 +56,11 @@ pub enum SceneError {
     Json { path: PathBuf, line: usize, message: String },
     #[error("{}: {field}: {message}", .path.display())]
     Field { path: PathBuf, field: String, message: String },
+    #[error(
+        "{}: one level would flatten the scene into {triangles} triangles, more than the {budget} a single BVH may hold here; use two levels (a BVH per mesh, built once, and one over the placements)",
+        .path.display()
+    )]
+    TooLargeToFlatten { path: PathBuf, triangles: u64, budget: u64 },
     #[error(transparent)]
     Mesh(#[from] MeshError),
 }

@@ -36,8 +36,8 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
     }
     let has_instances = app.has_instances();
-    let placements = app.scene.instances.as_ref().map_or(0, |i| i.placements.len());
-    let meshes = app.scene.instances.as_ref().map_or(0, |i| i.meshes.len());
+    let placements = app.scene.instances().map_or(0, |i| i.placements.len());
+    let meshes = app.scene.instances().map_or(0, |i| i.meshes.len());
     let mut edited = app.settings.clone();
     let s = &mut edited;
     if has_instances {
