@@ -7,6 +7,13 @@
 //! greedy collapse of Wald, Benthin & Boulos, "Getting Rid of Packets" (RT 2008), and Pinto,
 //! "Fast BVH collapse" (2010). Leaves and the triangle order are those of the binary BVH.
 //!
+//! Counts, against the binary tree it was collapsed from: a wide node visit counts once and one
+//! box test per valid child; a leaf is reached as a child (a leaf visit, not a node visit). So for
+//! a ray no hit prunes (one that hits nothing), both layouts reach the same leaves and make the same
+//! triangle tests, and the wide layout visits at most as many nodes as the binary one visits
+//! interior nodes; box tests have no such bound (a wide node tests its grandchildren's boxes where
+//! the binary walk may have culled them at the child's). `core/tests/exact_counts.rs` checks this.
+//!
 //! Triangles are stored in leaf order, vertices inline (36 bytes each, no index indirection), so a
 //! leaf is one contiguous read. They are not precomputed into edge form: the watertight test needs
 //! the vertices themselves, and rebuilding them from stored edges would change its rounding and so

@@ -1,0 +1,244 @@
+//! The traversal counters to the exact count. Trees built by hand (a few triangles placed so the
+//! midpoint builder's tree can be drawn on paper), rays whose work is worked out by hand, every
+//! layout, both traversal orders, closest and any hit, both triangle tests. Then the relation
+//! between the binary and the wide layout's counts on the same tree (documented in `bvh::wide`),
+//! on many rays over a generated mesh.
+
+use bvhscope_core::bvh::{
+    Accelerator, BuildParams, Bvh, LinearScan, RayCounters, SplitStrategy, TraceOptions, TraversalOrder, WideBvh,
+};
+use bvhscope_core::geometry::{Ray, TriangleTest};
+use bvhscope_core::mesh::{generate, Mesh};
+use glam::Vec3;
+
+const ORDERS: [TraversalOrder; 2] = [TraversalOrder::SplitAxisSign, TraversalOrder::EntryDistance];
+const TESTS: [TriangleTest; 2] = [TriangleTest::Watertight, TriangleTest::MollerTrumbore];
+
+/// Midpoint splits, one triangle per leaf: the tree follows from the centroids alone.
+fn params() -> BuildParams {
+    BuildParams { strategy: SplitStrategy::Midpoint, max_leaf_size: 1, ..BuildParams::default() }
+}
+
+/// A triangle in the plane z = `z` with its centroid at (`x`, 0, `z`): corners (x ∓ 0.5, -0.5) and
+/// (x, 1), so its box is x ± 0.5, y -0.5..1.
+fn tri_at(positions: &mut Vec<Vec3>, x: f32, z: f32) -> [u32; 3] {
+    let i = positions.len() as u32;
+    positions.extend([Vec3::new(x - 0.5, -0.5, z), Vec3::new(x + 0.5, -0.5, z), Vec3::new(x, 1.0, z)]);
+    [i, i + 1, i + 2]
+}
+
+fn counts(n: u32, b: u32, l: u32, t: u32) -> RayCounters {
+    RayCounters { nodes_visited: n, box_tests: b, leaves_visited: l, triangle_tests: t, ..RayCounters::ZERO }
+}
+
+/// The closest hit's triangle and counters, and the any-hit answer and counters.
+fn run(accel: &impl Accelerator, ray: &Ray, opts: TraceOptions) -> (Option<u32>, RayCounters, bool, RayCounters) {
+    let (mut closest, mut any) = (RayCounters::ZERO, RayCounters::ZERO);
+    let hit = accel.closest_hit(&mut ray.clone(), opts, &mut closest).map(|h| h.prim);
+    let found = accel.any_hit(ray, opts, &mut any);
+    (hit, closest, found, any)
+}
+
+/// Four triangles in a row along x (centroids x = 0, 2, 4, 6, all in z = 0), facing the rays.
+///
+/// Binary tree (midpoint of the centroids on x, the widest axis): root splits at 3 into A = {0, 2}
+/// and B = {4, 6}; A at 1 into leaves T0 | T1, B at 5 into T2 | T3. Seven nodes, depth 2.
+/// Wide tree: the root takes A and B, then opens B (the two have equal area; the later one wins
+/// the tie), then A: one node with the four leaves as its children.
+fn row() -> Mesh {
+    let mut p = Vec::new();
+    let tris = [0.0, 2.0, 4.0, 6.0].map(|x| tri_at(&mut p, x, 0.0)).to_vec();
+    Mesh::from_triangles("row", p, tris)
+}
+
+#[test]
+fn the_row_of_four_is_built_as_drawn() {
+    let bvh = Bvh::build(&row(), &params());
+    assert_eq!(bvh.nodes.len(), 7, "root, A, B and four leaves");
+    assert_eq!(bvh.nodes.iter().filter(|n| n.is_leaf()).count(), 4);
+    assert!(bvh.nodes.iter().filter(|n| n.is_leaf()).all(|n| n.count == 1));
+    let wide = WideBvh::from_binary(bvh);
+    assert_eq!(wide.nodes.len(), 1, "one wide node");
+    assert_eq!(wide.nodes[0].valid, 0b1111, "with four children");
+    assert!(wide.nodes[0].count.iter().all(|&c| c == 1), "all leaves of one triangle");
+}
+
+#[test]
+fn the_row_of_four_counts_exactly() {
+    let mesh = row();
+    let binary = Bvh::build(&mesh, &params());
+    let wide = WideBvh::from_binary(binary.clone());
+    let down = |x: f32| Ray::new(Vec3::new(x, 0.0, 5.0), -Vec3::Z);
+    for order in ORDERS {
+        for test in TESTS {
+            let opts = TraceOptions { order, test };
+            // Straight down onto T0: only one child box is hit at each node, so both orders
+            // agree. Binary: the root's box (1 test); root visited, A and B tested (+2), A hit;
+            // A visited, T0 and T1 tested (+2), T0 hit; T0 visited, a leaf, 1 triangle test.
+            // 3 nodes, 5 box tests, 1 leaf, 1 triangle. Any hit: the same, stopping at T0.
+            let r = down(0.0);
+            assert_eq!(run(&binary, &r, opts), (Some(0), counts(3, 5, 1, 1), true, counts(3, 5, 1, 1)), "{opts:?}");
+            // Wide: the root box (1); the one node visited, its four children tested (+4), T0
+            // hit; T0 reached as a child, a leaf (not a node visit in the wide layout).
+            assert_eq!(run(&wide, &r, opts), (Some(0), counts(1, 5, 1, 1), true, counts(1, 5, 1, 1)), "{opts:?}");
+
+            // Onto T3, the last leaf: the same work on the other side.
+            let r = down(6.0);
+            assert_eq!(run(&binary, &r, opts), (Some(3), counts(3, 5, 1, 1), true, counts(3, 5, 1, 1)), "{opts:?}");
+            assert_eq!(run(&wide, &r, opts), (Some(3), counts(1, 5, 1, 1), true, counts(1, 5, 1, 1)), "{opts:?}");
+
+            // Between A and B (x = 3): inside the root's box, outside both children's. Binary:
+            // root box (1), root visited, A and B tested and missed (+2): 1 node, 3 tests.
+            let r = down(3.0);
+            assert_eq!(run(&binary, &r, opts), (None, counts(1, 3, 0, 0), false, counts(1, 3, 0, 0)), "{opts:?}");
+            // Wide: root box (1), the node visited, four children tested, none hit.
+            assert_eq!(run(&wide, &r, opts), (None, counts(1, 5, 0, 0), false, counts(1, 5, 0, 0)), "{opts:?}");
+
+            // Inside T1's box but beside the triangle (its corner region at x = 2.45, y = 0.9):
+            // the leaf is reached and its one triangle tested, in vain.
+            let r = Ray::new(Vec3::new(2.45, 0.9, 5.0), -Vec3::Z);
+            assert_eq!(run(&binary, &r, opts), (None, counts(3, 5, 1, 1), false, counts(3, 5, 1, 1)), "{opts:?}");
+            assert_eq!(run(&wide, &r, opts), (None, counts(1, 5, 1, 1), false, counts(1, 5, 1, 1)), "{opts:?}");
+
+            // Beside the root's box: one box test, nothing visited, in both layouts.
+            let r = down(10.0);
+            assert_eq!(run(&binary, &r, opts), (None, counts(0, 1, 0, 0), false, counts(0, 1, 0, 0)), "{opts:?}");
+            assert_eq!(run(&wide, &r, opts), (None, counts(0, 1, 0, 0), false, counts(0, 1, 0, 0)), "{opts:?}");
+        }
+    }
+}
+
+/// Two triangles whose boxes overlap along the split axis, at different depths: TL (centroid
+/// x = -1) wide, x -3..1, in z = -1.5; TR (centroid x = 1) small, x 0.5..1.5, in z = 0. The
+/// centroids spread 2 in x and 1.5 in z, so the root splits on x: left TL, right TR.
+fn overlapping() -> Mesh {
+    let p = vec![
+        Vec3::new(-3.0, -0.5, -1.5),
+        Vec3::new(1.0, -0.5, -1.5),
+        Vec3::new(-1.0, 1.0, -1.5),
+        Vec3::new(0.5, -0.5, 0.0),
+        Vec3::new(1.5, -0.5, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+    ];
+    Mesh::from_triangles("overlapping", p, vec![[0, 1, 2], [3, 4, 5]])
+}
+
+#[test]
+fn the_orders_differ_where_the_split_axis_rule_picks_the_far_child() {
+    let mesh = overlapping();
+    let binary = Bvh::build(&mesh, &params());
+    assert_eq!(binary.nodes.len(), 3, "root and two leaves");
+    assert_eq!(binary.nodes[0].axis, 0, "split on x");
+    let wide = WideBvh::from_binary(binary.clone());
+    assert_eq!((wide.nodes.len(), wide.nodes[0].valid), (1, 0b11), "one wide node, two leaves");
+
+    // Straight down at x = 0.75: through TR (hit at t = 5) and through TL's box (entered at
+    // t = 6.5) but beside TL itself (its slanted edge is at x = 0.33 there). The direction is
+    // written out: `-Vec3::Z` would have x = -0, whose sign picks the right child.
+    let r = Ray::new(Vec3::new(0.75, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+    for test in TESTS {
+        // Entry distance: root box (1), root visited, both children tested (+2), both hit; TR
+        // (entry 5) before TL (6.5, pushed). TR visited: a leaf, 1 triangle, hit at 5. TL is
+        // popped beyond the hit and skipped. 2 nodes, 3 box tests, 1 leaf, 1 triangle.
+        let by_distance = TraceOptions { order: TraversalOrder::EntryDistance, test };
+        assert_eq!(run(&binary, &r, by_distance), (Some(1), counts(2, 3, 1, 1), true, counts(2, 3, 1, 1)));
+        // Split-axis sign: the direction's x is +0, so the left child (TL, the far one) first:
+        // TL visited, its triangle tested and missed; then TR from the stack (entry 5 is not
+        // beyond any hit yet), tested and hit. 3 nodes, 3 box tests, 2 leaves, 2 triangles; any
+        // hit does the same (TL holds no hit to stop at).
+        let by_axis = TraceOptions { order: TraversalOrder::SplitAxisSign, test };
+        assert_eq!(run(&binary, &r, by_axis), (Some(1), counts(3, 3, 2, 2), true, counts(3, 3, 2, 2)));
+        // The wide layout always takes the nearest child first: root box (1), its node (1
+        // visit, +2 box tests), TR then TL; TL skipped after the hit at 5.
+        for opts in [by_distance, by_axis] {
+            assert_eq!(run(&wide, &r, opts), (Some(1), counts(1, 3, 1, 1), true, counts(1, 3, 1, 1)));
+        }
+    }
+
+    // From below (z = -5, up): TL's box first (entry 3.5) and TR's at 5. TL's triangle is missed,
+    // TR's hit. Both orders now take TL first (+x sign: left; and nearer): 3 nodes, 2 leaves.
+    let r = Ray::new(Vec3::new(0.75, 0.0, -5.0), Vec3::Z);
+    for order in ORDERS {
+        let opts = TraceOptions { order, test: TriangleTest::Watertight };
+        assert_eq!(run(&binary, &r, opts), (Some(1), counts(3, 3, 2, 2), true, counts(3, 3, 2, 2)), "{opts:?}");
+        assert_eq!(run(&wide, &r, opts), (Some(1), counts(1, 3, 2, 2), true, counts(1, 3, 2, 2)), "{opts:?}");
+    }
+}
+
+/// Any hit stops at the first triangle that is hit and counts only the tests made: a leaf of
+/// three stacked triangles, the ray through all three.
+#[test]
+fn any_hit_counts_only_the_triangle_tests_it_made() {
+    let mut p = Vec::new();
+    let tris = [0.0, -1.0, -2.0].map(|z| tri_at(&mut p, 0.0, z)).to_vec();
+    let mesh = Mesh::from_triangles("stack", p, tris);
+    let binary = Bvh::build(&mesh, &BuildParams { max_leaf_size: 3, ..params() });
+    assert_eq!(binary.nodes.len(), 1, "one leaf of three");
+    let wide = WideBvh::from_binary(binary.clone());
+    let r = Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z);
+    for order in ORDERS {
+        let opts = TraceOptions { order, test: TriangleTest::Watertight };
+        // Closest: root box, the leaf (1 node in binary), all three triangles tested, the top
+        // one the nearest. Any hit: the ray hits all three, so it stops after the leaf's first
+        // triangle: one test, not three.
+        let (hit, closest, found, any) = run(&binary, &r, opts);
+        assert_eq!((hit, closest, found, any), (Some(0), counts(1, 1, 1, 3), true, counts(1, 1, 1, 1)));
+        // Wide: the root is one node holding the leaf in its one slot.
+        let (hit, closest, found, any) = run(&wide, &r, opts);
+        assert_eq!((hit, closest, found, any), (Some(0), counts(1, 2, 1, 3), true, counts(1, 2, 1, 1)));
+    }
+}
+
+/// The relation documented in `bvh::wide`: on the same tree, a ray that no hit prunes (it hits
+/// nothing, so both layouts reach every leaf whose box it meets) reaches the same leaves and makes
+/// the same triangle tests in both layouts; the wide layout visits at most as many nodes as the
+/// binary one visits interior nodes. In the binary layout, box tests = 1 + 2 × (nodes visited −
+/// leaves visited) for a ray that enters the root. (Box tests have no such bound between the
+/// layouts: a wide node tests its grandchildren's boxes even where the binary walk culled them at
+/// the child's box.)
+#[test]
+fn binary_and_wide_counts_relate_as_documented() {
+    let mesh = generate::torus_knot(2, 3, 0.3, 256, 12);
+    let binary = Bvh::build(&mesh, &BuildParams { max_leaf_size: 4, ..BuildParams::default() });
+    let wide = WideBvh::from_binary(binary.clone());
+    let linear = LinearScan::new(&mesh);
+    let b = mesh.bounds();
+    let (c, r) = (b.center(), b.extent().length());
+    let mut state = 0x9e37_79b9_u32;
+    let mut rand = move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as f32 / u32::MAX as f32
+    };
+    let (mut misses, mut crossing) = (0, 0);
+    for _ in 0..20_000 {
+        let from = c + Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5).normalize_or(Vec3::X) * r;
+        let to = c + Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5) * b.extent();
+        let ray = Ray::new(from, to - from);
+        let opts = TraceOptions::default();
+        if linear.closest_hit(&mut ray.clone(), opts, &mut bvhscope_core::bvh::NoStats).is_some() {
+            continue;
+        }
+        misses += 1;
+        for order in ORDERS {
+            let opts = TraceOptions { order, ..opts };
+            let (mut cb, mut cw) = (RayCounters::ZERO, RayCounters::ZERO);
+            assert!(binary.closest_hit(&mut ray.clone(), opts, &mut cb).is_none());
+            assert!(wide.closest_hit(&mut ray.clone(), opts, &mut cw).is_none());
+            assert_eq!(cb.leaves_visited, cw.leaves_visited, "{ray:?}");
+            assert_eq!(cb.triangle_tests, cw.triangle_tests, "{ray:?}");
+            assert!(cw.nodes_visited <= cb.nodes_visited - cb.leaves_visited || cb.nodes_visited == 0, "{ray:?}");
+            if cb.nodes_visited > 0 {
+                assert_eq!(cb.box_tests, 1 + 2 * (cb.nodes_visited - cb.leaves_visited), "{ray:?}");
+            }
+        }
+        let mut cb = RayCounters::ZERO;
+        binary.closest_hit(&mut ray.clone(), TraceOptions::default(), &mut cb);
+        crossing += usize::from(cb.leaves_visited > 0);
+    }
+    assert!(
+        misses > 2_000 && crossing > 500,
+        "the rays exercise the relation: {misses} misses, {crossing} reach leaves"
+    );
+}
