@@ -345,3 +345,79 @@ fn one_level_over_too_many_placements_is_refused_and_two_levels_build() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["instances"], 21_000, "{v}");
 }
+
+/// `trace` and `render --counts` tell the same story for the same pixel: the counts file's row is
+/// the trace's totals and hit, pixel for pixel over a whole small image, in both layouts.
+#[test]
+fn trace_and_the_counts_file_agree_for_every_pixel() {
+    let mesh = tent();
+    let (w, h) = (24, 16);
+    for layout in ["binary", "wide4"] {
+        let csv = tmp(&format!("counts-{layout}.csv"));
+        let png = tmp(&format!("counts-{layout}.png"));
+        let size = format!("{w}x{h}");
+        let out = bvhscope(&[
+            "render",
+            mesh.to_str().unwrap(),
+            "--view",
+            "visits",
+            "--size",
+            &size,
+            "--layout",
+            layout,
+            "--counts",
+            csv.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("x,y,nodes_visited,box_tests,leaves_visited,triangle_tests,hit_triangle"));
+        let rows: Vec<Vec<i64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+        assert_eq!(rows.len(), w * h);
+        assert!(rows.iter().any(|r| r[6] >= 0) && rows.iter().any(|r| r[6] == -1), "hits and misses");
+        // Every 7th pixel, traced alone, gives its row.
+        for r in rows.iter().step_by(7) {
+            let pixel = format!("{},{}", r[0], r[1]);
+            let out = bvhscope(&[
+                "trace",
+                mesh.to_str().unwrap(),
+                "--pixel",
+                &pixel,
+                "--size",
+                &size,
+                "--layout",
+                layout,
+                "--format",
+                "json",
+            ]);
+            assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+            let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            let c = &v["counts"];
+            let got = [&c["nodes_visited"], &c["box_tests"], &c["leaves_visited"], &c["triangle_tests"]]
+                .map(|x| x.as_i64().unwrap());
+            assert_eq!(got[..], r[2..6], "pixel {pixel} ({layout})");
+            let hit = v["hit"]["triangle"].as_i64().unwrap_or(-1);
+            assert_eq!(hit, r[6], "pixel {pixel} ({layout})");
+            assert_eq!(v["steps"].as_array().unwrap().iter().filter(|s| s["step"] == "enter").count() as i64, got[0]);
+        }
+    }
+}
+
+#[test]
+fn trace_prints_the_steps_and_refuses_a_pixel_outside_the_image() {
+    let mesh = tent();
+    let out = bvhscope(&["trace", mesh.to_str().unwrap(), "--ray", "0,0.5,5:0,0,-1", "--layout", "binary"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    for needle in
+        ["box of node 0: hit", "enter node 0", "closest hit so far: triangle", "counts          nodes visited"]
+    {
+        assert!(text.contains(needle), "{needle}: {text}");
+    }
+    let out = bvhscope(&["trace", mesh.to_str().unwrap(), "--pixel", "40,3", "--size", "40x30"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("outside the 40x30 image"), "{err}");
+}

@@ -6,6 +6,7 @@ mod compare;
 mod progress;
 mod render;
 mod stats;
+mod trace;
 
 pub use args::{parse_camera, parse_size, BuildArgs};
 pub use compare::{compare_rows, CompareRow};
@@ -36,6 +37,8 @@ pub enum Command {
     Stats(stats::StatsArgs),
     /// Build every strategy and compare them (and a linear scan) on the same rays.
     Compare(compare::CompareArgs),
+    /// One ray's walk through the BVH, step by step (a pixel of the camera, or a typed ray).
+    Trace(trace::TraceArgs),
 }
 
 /// An error the CLI reports in one line before exiting with code 2.
@@ -99,6 +102,7 @@ impl From<SceneError> for CliError {
 pub fn run(command: Command) -> Result<(), CliError> {
     match command {
         Command::Render(a) => render::run(&a),
+        Command::Trace(a) => trace::run(&a),
         Command::Stats(a) => stats::run(&a),
         Command::Compare(a) => compare::run(&a),
     }

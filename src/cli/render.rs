@@ -27,6 +27,10 @@ pub struct RenderArgs {
     /// Fixed heatmap range MIN:MAX (default: the frame's own min and max).
     #[arg(long, value_parser = parse_range)]
     pub range: Option<(f32, f32)>,
+    /// Also write the counts behind the heatmap, one CSV row per pixel: x, y (0-based, from the
+    /// top left), nodes_visited, box_tests, leaves_visited, triangle_tests, hit_triangle (-1: miss).
+    #[arg(long, value_name = "FILE.csv")]
+    pub counts: Option<PathBuf>,
 }
 
 fn parse_range(s: &str) -> Result<(f32, f32), String> {
@@ -48,13 +52,18 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
     let params = a.build.params(loaded.build.as_ref());
     let bvh = build_scene(&loaded, &a.build.scene_build(params))?;
-    let settings = RenderSettings { trace: a.build.trace(), count: a.view.is_heatmap(), progressive: false };
+    let count = a.view.is_heatmap() || a.counts.is_some();
+    let settings = RenderSettings { trace: a.build.trace(), count, progressive: false };
     let total = camera.width as u64 * camera.height as u64;
     let control = WorkControl::new();
     let frame = progress::with_bar("rendering", &control, || {
         render_progressive(&bvh, &bvh, &camera, &settings, &Default::default(), &control, |_, _| {})
     })
     .map_err(|_| CliError::Usage("render cancelled".into()))?;
+    if let Some(path) = &a.counts {
+        let text = frame.counts_csv().expect("the frame was counted and is complete");
+        std::fs::write(path, text).map_err(|source| CliError::Write { path: path.clone(), source })?;
+    }
     let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
     let (img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
     if let Some(l) = &mut legend {

@@ -1,6 +1,11 @@
 //! Per-ray work counters, and the sink trait that lets the traversal count for free when nobody
 //! is listening: `NoStats` has empty inlined methods, so the counting code compiles away in the
-//! plain traversal (measured in `benches/`), while `RayCounters` feeds the heatmaps.
+//! plain traversal (measured in `benches/`), while `RayCounters` feeds the heatmaps. A sink that
+//! sets `STEPS` (`bvh::trace::Trace`) is also told every step of the walk, in order; for every
+//! other sink `STEPS` is a constant false and the step reports compile away.
+
+use super::trace::NodeId;
+use crate::geometry::TriangleHit;
 
 /// Where the traversal reports its work. Implementations must be cheap: these run per node.
 pub trait TraversalStats {
@@ -23,6 +28,41 @@ pub trait TraversalStats {
     /// The ray was transformed into an instance's object space to enter its mesh's BVH.
     #[inline(always)]
     fn instance_entered(&mut self) {}
+
+    /// Whether the walks report each step below (only `Trace` does). The walks test it before
+    /// each report, so for the other sinks no step costs anything, not even its arguments.
+    const STEPS: bool = false;
+    /// The walk is over a two-level BVH: its steps outside a placement are the top level's.
+    #[inline(always)]
+    fn step_levels(&mut self) {}
+    /// A box was tested against the ray: `child`'s, with the parameters at which the ray enters
+    /// and leaves it (`None`: missed, or entered beyond the closest hit so far). The root's box
+    /// is tested first.
+    #[inline(always)]
+    fn step_box(&mut self, _child: NodeId, _interval: Option<(f32, f32)>) {}
+    /// The walk moved to `node` (an interior node, or in the binary layout a leaf).
+    #[inline(always)]
+    fn step_enter(&mut self, _node: NodeId) {}
+    /// The walk reached the leaf `node`.
+    #[inline(always)]
+    fn step_leaf(&mut self, _node: NodeId) {}
+    /// The stack after a push, a pop or a sort: (node, entry parameter), bottom first.
+    #[inline(always)]
+    fn step_stack(&mut self, _entries: &[(NodeId, f32)]) {}
+    /// `node` was popped and dropped: the ray enters it at `t`, beyond the closest hit so far.
+    #[inline(always)]
+    fn step_skip(&mut self, _node: NodeId, _t: f32) {}
+    /// Triangle `prim` (its id in the mesh the walk is over) was tested; a hit is nearer than any
+    /// before it, so it is the new closest hit.
+    #[inline(always)]
+    fn step_triangle(&mut self, _prim: u32, _hit: Option<TriangleHit>) {}
+    /// The walk went into placement `instance` of a two-level BVH: its mesh's triangles are
+    /// numbered from `first_prim` in the scene, and the ray in its object space is `ray`.
+    #[inline(always)]
+    fn step_instance(&mut self, _instance: u32, _first_prim: u32, _ray: &crate::geometry::Ray) {}
+    /// The walk came back out of the placement it went into.
+    #[inline(always)]
+    fn step_instance_done(&mut self) {}
 }
 
 /// The sink of the plain traversal: counts nothing, costs nothing.

@@ -25,7 +25,8 @@ impl Accelerator for LinearScan {
         stats: &mut S,
     ) -> Option<Hit> {
         let (mut prepared, mut best) = (None, None);
-        crate::bvh::traverse::test_triangles::<T, ANY, S>(&self.tris, 0, ray, stats, &mut prepared, &mut best);
+        let id = |i: usize| i as u32;
+        crate::bvh::traverse::test_triangles::<T, ANY, S>(&self.tris, 0, ray, stats, &mut prepared, &mut best, id);
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: i as u32 })
     }
 }

@@ -28,6 +28,13 @@ impl<const N: usize, E: Copy> TraversalStack<N, E> {
         self.len += 1;
     }
 
+    /// The entries, bottom first (for a trace's report of the stack).
+    pub fn entries(&self) -> &[E] {
+        // SAFETY: every slot below `len` was written by `push`, and `MaybeUninit<E>` has `E`'s
+        // layout.
+        unsafe { std::slice::from_raw_parts(self.items.as_ptr().cast::<E>(), self.len) }
+    }
+
     #[inline(always)]
     pub fn pop(&mut self) -> Option<E> {
         if self.len == 0 {
@@ -59,13 +66,15 @@ impl<const N: usize> TraversalStack<N> {
     /// Pop entries until one the ray enters no later than `limit` (the closest hit so far,
     /// widened as `geometry::slab` explains: a box starting a rounding error beyond the closest
     /// hit may still hold a hit that rounds nearer): the next node worth visiting. Entries beyond
-    /// it are dropped: nothing in them can be nearer.
+    /// it are dropped, and `skipped` is told of each (a trace records them): nothing in them can
+    /// be nearer.
     #[inline(always)]
-    pub fn pop_nearer(&mut self, limit: f32) -> Option<u32> {
+    pub fn pop_nearer_or_skip(&mut self, limit: f32, mut skipped: impl FnMut(u32, f32)) -> Option<u32> {
         while let Some((node, t_enter)) = self.pop() {
             if t_enter <= limit {
                 return Some(node);
             }
+            skipped(node, t_enter);
         }
         None
     }
@@ -100,9 +109,12 @@ mod tests {
         for (i, t) in [(1, 1.0), (2, 5.0), (3, 2.0), (4, 9.0)] {
             s.push((i, t));
         }
-        assert_eq!(s.pop_nearer(3.0), Some(3));
-        assert_eq!(s.pop_nearer(3.0), Some(1), "entry 2 (5.0) is beyond 3.0");
-        assert_eq!(s.pop_nearer(f32::INFINITY), None);
+        let mut skipped = Vec::new();
+        assert_eq!(s.pop_nearer_or_skip(3.0, |n, t| skipped.push((n, t))), Some(3));
+        assert_eq!(skipped, [(4, 9.0)]);
+        assert_eq!(s.pop_nearer_or_skip(3.0, |n, t| skipped.push((n, t))), Some(1), "entry 2 (5.0) is beyond 3.0");
+        assert_eq!(skipped, [(4, 9.0), (2, 5.0)]);
+        assert_eq!(s.pop_nearer_or_skip(f32::INFINITY, |_, _| {}), None);
     }
 
     #[test]

@@ -11,6 +11,7 @@
 
 use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;
+use super::trace::NodeId;
 use super::{Accelerator, Hit, TraceOptions, TraversalStats};
 use crate::geometry::slab::{widen, OneRay};
 use crate::geometry::{Ray, TriangleIntersector};
@@ -77,6 +78,9 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
     let dir_neg = [inv_dir.x.is_sign_negative(), inv_dir.y.is_sign_negative(), inv_dir.z.is_sign_negative()];
     L::box_tests(stats, 1);
     let (t0, t1) = nodes[0].slab(&slab_ray, ray.t_min, limit);
+    if S::STEPS {
+        stats.step_box(NodeId::Node(0), (t0 <= t1).then_some((t0, t1)));
+    }
     if !(t0 <= t1) {
         return;
     }
@@ -85,8 +89,14 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
     loop {
         let node = &nodes[current];
         L::node_visited(stats);
+        if S::STEPS {
+            stats.step_enter(NodeId::Node(current as u32));
+        }
         if node.is_leaf() {
             L::leaf_visited(stats);
+            if S::STEPS {
+                stats.step_leaf(NodeId::Node(current as u32));
+            }
             if leaf(node.prims(), ray, stats) {
                 return;
             }
@@ -96,11 +106,18 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
             L::box_tests(stats, 2);
             let (l0, l1) = nodes[left].slab(&slab_ray, ray.t_min, limit);
             let (r0, r1) = nodes[left + 1].slab(&slab_ray, ray.t_min, limit);
+            if S::STEPS {
+                stats.step_box(NodeId::Node(left as u32), (l0 <= l1).then_some((l0, l1)));
+                stats.step_box(NodeId::Node(left as u32 + 1), (r0 <= r1).then_some((r0, r1)));
+            }
             match (l0 <= l1, r0 <= r1) {
                 (true, true) => {
                     let right_first = if BY_DISTANCE { r0 < l0 } else { dir_neg[node.axis as usize] };
                     let (near, far, far_t) = if right_first { (left + 1, left, l0) } else { (left, left + 1, r0) };
                     stack.push((far as u32, far_t));
+                    if S::STEPS {
+                        report_stack(stats, &stack);
+                    }
                     current = near;
                     continue;
                 }
@@ -116,18 +133,33 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
             }
         }
         // The next node that can still hold a hit nearer than the best so far.
-        match stack.pop_nearer(limit) {
+        let next = stack.pop_nearer_or_skip(limit, |n, t| {
+            if S::STEPS {
+                stats.step_skip(NodeId::Node(n), t);
+            }
+        });
+        if S::STEPS {
+            report_stack(stats, &stack);
+        }
+        match next {
             Some(n) => current = n as usize,
             None => return,
         }
     }
 }
 
+/// Tell a tracing sink what the binary walk's stack holds.
+fn report_stack<S: TraversalStats, const N: usize>(stats: &mut S, stack: &TraversalStack<N>) {
+    let entries: Vec<(NodeId, f32)> = stack.entries().iter().map(|&(n, t)| (NodeId::Node(n), t)).collect();
+    stats.step_stack(&entries);
+}
+
 /// Test a leaf's triangles `tris` (slot `first` onwards in leaf order) against the ray: each
 /// nearer hit shrinks `ray.t_max` and is kept in `best`; an any-hit query stops at the first. The
 /// triangle tests actually made are counted (an any-hit that stops early counts no more). The
 /// triangle test's per-ray setup waits in `prepared` for the first leaf: most rays that miss never
-/// reach one. Shared by the binary and the wide walk.
+/// reach one. `prim_of` names a slot's triangle for a trace. Shared by the binary and the wide walk
+/// and the linear scan.
 #[inline(always)]
 pub(crate) fn test_triangles<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
     tris: &[[glam::Vec3; 3]],
@@ -136,9 +168,14 @@ pub(crate) fn test_triangles<T: TriangleIntersector, const ANY: bool, S: Travers
     stats: &mut S,
     prepared: &mut Option<T::Prepared>,
     best: &mut Option<(usize, crate::geometry::TriangleHit)>,
+    prim_of: impl Fn(usize) -> u32,
 ) -> bool {
     for (k, tri) in tris.iter().enumerate() {
-        if let Some(h) = T::intersect(prepared.get_or_insert_with(|| T::prepare(ray)), ray, tri) {
+        let hit = T::intersect(prepared.get_or_insert_with(|| T::prepare(ray)), ray, tri);
+        if S::STEPS {
+            stats.step_triangle(prim_of(first + k), hit);
+        }
+        if let Some(h) = hit {
             ray.t_max = h.t;
             *best = Some((first + k, h));
             if ANY {
@@ -160,7 +197,8 @@ impl Accelerator for Bvh {
         let (mut prepared, mut best) = (None, None);
         walk::<MeshLevel, BY_DISTANCE, S>(&self.nodes, ray, stats, |range, ray, stats| {
             let first = range.start;
-            test_triangles::<T, ANY, S>(&self.tris[range], first, ray, stats, &mut prepared, &mut best)
+            let ids = |i: usize| self.prim_ids[i];
+            test_triangles::<T, ANY, S>(&self.tris[range], first, ray, stats, &mut prepared, &mut best, ids)
         });
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
     }

@@ -165,13 +165,19 @@ impl TwoLevelBvh {
         &self,
         ray: &mut Ray,
         stats: &mut S,
-        mut enter: impl FnMut(&Instance, &mut Ray, &mut S) -> bool,
+        mut enter: impl FnMut(u32, &Instance, &mut Ray, &mut S) -> bool,
     ) {
+        if S::STEPS {
+            stats.step_levels();
+        }
         if self.instances.is_empty() {
             return;
         }
         walk::<TopLevelWalk, true, S>(&self.top.nodes, ray, stats, |slots, ray, stats| {
-            slots.into_iter().any(|slot| enter(&self.instances[self.top.order[slot] as usize], ray, stats))
+            slots.into_iter().any(|slot| {
+                let k = self.top.order[slot];
+                enter(k, &self.instances[k as usize], ray, stats)
+            })
         });
     }
 
@@ -194,10 +200,17 @@ impl Accelerator for TwoLevelBvh {
         stats: &mut S,
     ) -> Option<Hit> {
         let mut best = None;
-        self.traverse(ray, stats, |inst, ray, stats| {
+        self.traverse(ray, stats, |k, inst, ray, stats| {
             stats.instance_entered();
             let mut local = Self::object_ray(inst, ray);
-            match self.bottom[inst.mesh as usize].trace::<T, BY_DISTANCE, ANY, S>(&mut local, stats) {
+            if S::STEPS {
+                stats.step_instance(k, inst.first_prim, &local);
+            }
+            let hit = self.bottom[inst.mesh as usize].trace::<T, BY_DISTANCE, ANY, S>(&mut local, stats);
+            if S::STEPS {
+                stats.step_instance_done();
+            }
+            match hit {
                 Some(h) => {
                     ray.t_max = h.t;
                     best = Some(Hit { prim: inst.first_prim + h.prim, ..h });

@@ -217,6 +217,26 @@ impl Frame {
         (&mut self.samples, &mut self.counters)
     }
 
+    /// The counts behind the heatmaps, as CSV: a header, then one row per pixel, row by row:
+    /// `x,y,nodes_visited,box_tests,leaves_visited,triangle_tests,hit_triangle` (pixels 0-based
+    /// from the top left, `-1` for a miss). `None` unless the frame is complete and counted.
+    pub fn counts_csv(&self) -> Option<String> {
+        use std::fmt::Write;
+        if !self.counted() || self.full_samples().is_none() {
+            return None;
+        }
+        let mut o = String::from("x,y,nodes_visited,box_tests,leaves_visited,triangle_tests,hit_triangle\n");
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let (s, c) = (self.sample(x, y), self.counters(x, y));
+                let hit = if s.is_hit() { s.prim as i64 } else { -1 };
+                let (n, b, l, t) = (c.nodes_visited, c.box_tests, c.leaves_visited, c.triangle_tests);
+                let _ = writeln!(o, "{x},{y},{n},{b},{l},{t},{hit}");
+            }
+        }
+        Some(o)
+    }
+
     /// Hit mask, row by row (true = hit), at full resolution.
     pub fn hit_mask(&self) -> Vec<bool> {
         (0..self.height)

@@ -12,6 +12,7 @@
 use super::{ChildRef, WideBvh, WideNode};
 use crate::bvh::simd::prefetch;
 use crate::bvh::stack::TraversalStack;
+use crate::bvh::trace::NodeId;
 use crate::bvh::traverse::test_triangles;
 use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
 use crate::geometry::slab::{widen, RayX4};
@@ -46,6 +47,9 @@ impl WideBvh {
         mut leaf: impl FnMut(usize, usize, &mut Ray, &mut S) -> bool,
     ) {
         stats.box_tests(1);
+        if S::STEPS {
+            stats.step_box(NodeId::Node(0), self.root_bounds.intersect(ray).filter(|_| !self.prim_ids.is_empty()));
+        }
         if self.prim_ids.is_empty() || self.root_bounds.intersect(ray).is_none() {
             return;
         }
@@ -60,12 +64,18 @@ impl WideBvh {
             while !cur.is_leaf() {
                 let index = cur.node();
                 let node = &self.nodes[index as usize];
+                if S::STEPS {
+                    stats.step_enter(NodeId::Node(index));
+                }
                 stats.node_visited();
                 stats.box_tests(node.valid.count_ones());
                 let (enter, mask) = sray.four_boxes(&node.boxes, node.valid as u32, t_min, limit);
+                if S::STEPS {
+                    self.report_boxes(stats, node, index, mask, &enter, ray, limit);
+                }
                 if mask == 0 {
                     // Nothing hit here: continue with the nearest useful entry of the stack.
-                    match stack.pop_nearer(limit) {
+                    match self.pop(&mut stack, limit, stats) {
                         Some(r) => {
                             cur = ChildRef::from_raw(r);
                             continue 'traversal;
@@ -93,6 +103,9 @@ impl WideBvh {
                         stack.push((r0.raw(), enter[s0]));
                         cur = r1;
                     }
+                    if S::STEPS {
+                        report_stack(stats, &stack);
+                    }
                     continue;
                 }
                 // Three or four children hit: push them all, nearest on top, and take it.
@@ -106,24 +119,90 @@ impl WideBvh {
                     k += 1;
                 }
                 stack.sort_top(k);
+                if S::STEPS {
+                    report_stack(stats, &stack);
+                }
                 cur = match stack.pop() {
                     Some((r, _)) => ChildRef::from_raw(r),
                     None => break 'traversal,
                 };
+                if S::STEPS {
+                    report_stack(stats, &stack);
+                }
             }
             let (index, slot) = cur.leaf();
             let node = &self.nodes[index];
             stats.leaf_visited();
+            if S::STEPS {
+                stats.step_leaf(node_id(cur));
+            }
             if leaf(node.child[slot] as usize, node.count[slot] as usize, ray, stats) {
                 break 'traversal;
             }
             limit = widen(ray.t_max);
-            match stack.pop_nearer(limit) {
+            match self.pop(&mut stack, limit, stats) {
                 Some(r) => cur = ChildRef::from_raw(r),
                 None => break 'traversal,
             }
         }
     }
+}
+
+impl WideBvh {
+    /// `pop_nearer`, telling a tracing sink what it skips and what the stack then holds.
+    #[inline(always)]
+    fn pop<S: TraversalStats>(&self, stack: &mut TraversalStack<STACK>, limit: f32, stats: &mut S) -> Option<u32> {
+        let next = stack.pop_nearer_or_skip(limit, |r, t| {
+            if S::STEPS {
+                stats.step_skip(node_id(ChildRef::from_raw(r)), t);
+            }
+        });
+        if S::STEPS {
+            report_stack(stats, stack);
+        }
+        next
+    }
+
+    /// Tell a tracing sink the box test of each valid child of `node` (number `index`): hit or
+    /// not as the SIMD test found, with the entry it computed; the exit, which the SIMD test does
+    /// not return, from the one-box test of the same slab module.
+    #[allow(clippy::too_many_arguments)]
+    fn report_boxes<S: TraversalStats>(
+        &self,
+        stats: &mut S,
+        node: &WideNode,
+        index: u32,
+        mask: u32,
+        enter: &[f32; 4],
+        ray: &Ray,
+        limit: f32,
+    ) {
+        for slot in (0..4).filter(|&s| node.valid & (1 << s) != 0) {
+            let child = node_id(ChildRef::of(node, index, slot));
+            let hit = mask & (1 << slot) != 0;
+            let mut r = *ray;
+            r.t_max = limit;
+            let exit = node.boxes.bounds(slot).intersect(&r).map_or(enter[slot], |i| i.1);
+            stats.step_box(child, hit.then_some((enter[slot], exit)));
+        }
+    }
+}
+
+/// The trace's name of a child reference.
+fn node_id(r: ChildRef) -> NodeId {
+    if r.is_leaf() {
+        let (node, slot) = r.leaf();
+        NodeId::Leaf { node: node as u32, slot: slot as u8 }
+    } else {
+        NodeId::Node(r.node())
+    }
+}
+
+/// Tell a tracing sink what the wide walk's stack holds.
+fn report_stack<S: TraversalStats>(stats: &mut S, stack: &TraversalStack<STACK>) {
+    let entries: Vec<(NodeId, f32)> =
+        stack.entries().iter().map(|&(r, t)| (node_id(ChildRef::from_raw(r)), t)).collect();
+    stats.step_stack(&entries);
 }
 
 impl Accelerator for WideBvh {
@@ -135,7 +214,16 @@ impl Accelerator for WideBvh {
     ) -> Option<Hit> {
         let (mut prepared, mut best) = (None, None);
         self.walk_ray(ray, stats, |first, count, ray, stats| {
-            test_triangles::<T, ANY, S>(&self.tris[first..first + count], first, ray, stats, &mut prepared, &mut best)
+            let ids = |i: usize| self.prim_ids[i];
+            test_triangles::<T, ANY, S>(
+                &self.tris[first..first + count],
+                first,
+                ray,
+                stats,
+                &mut prepared,
+                &mut best,
+                ids,
+            )
         });
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
     }

@@ -1,0 +1,250 @@
+//! One ray's walk, step by step: the statistics sink that records it. It plugs into the same walks
+//! that render (`traverse::walk`, the wide walk, the two-level walk) through the step reports of
+//! `TraversalStats`, which every other sink compiles away, so what it records is what the
+//! traversal did, not a second implementation written for display. The lab's ordered traversal
+//! (pbrt-v4 §7.3.5) is what a student sees: each box test, which child is entered first, what goes
+//! on the stack, which popped node is skipped because it starts beyond the closest hit.
+//!
+//! The totals of a trace (entered nodes, box tests, leaves, triangle tests) are the counting sink's
+//! counts for the same ray, step for step (`tests/ray_trace.rs`).
+
+use super::{Accelerator, Hit, RayCounters, TraceOptions, TraversalStats};
+use crate::geometry::{Ray, TriangleHit};
+use std::collections::HashMap;
+
+/// A node of the walk. In the binary layout every node, leaves included, is a `Node` (its index in
+/// the node array); in the 4-wide layout a `Node` is a wide node and a leaf lives in a slot of its
+/// parent (`Leaf`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NodeId {
+    Node(u32),
+    Leaf { node: u32, slot: u8 },
+}
+
+impl std::fmt::Display for NodeId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NodeId::Node(n) => write!(f, "node {n}"),
+            NodeId::Leaf { node, slot } => write!(f, "leaf {node}.{slot}"),
+        }
+    }
+}
+
+/// Which tree a step is in: the one BVH, or for two levels the top level or the mesh BVH of a
+/// placement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TraceLevel {
+    Mesh,
+    Top,
+    Bottom { instance: u32 },
+}
+
+/// One step of the walk.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "step", rename_all = "snake_case")]
+pub enum StepKind {
+    /// A box test: `node`'s box, at `depth` (0: the root), hit or missed; a hit gives the
+    /// parameters at which the ray enters and leaves the box.
+    BoxTest { node: NodeId, depth: u32, hit: bool, t_entry: Option<f32>, t_exit: Option<f32> },
+    /// The walk moved to `node`.
+    Enter { node: NodeId, depth: u32, t_entry: f32, t_exit: f32 },
+    /// The walk reached a leaf (its triangle tests follow).
+    Leaf { node: NodeId, depth: u32 },
+    /// `node` went on the stack, to be visited at `t_entry`; `stack` is the stack after it.
+    Push { node: NodeId, t_entry: f32, stack: Vec<(NodeId, f32)> },
+    /// `node` came off the stack to be visited next.
+    Pop { node: NodeId, t_entry: f32, stack: Vec<(NodeId, f32)> },
+    /// `node` came off the stack and was dropped: the ray enters it at `t_entry`, beyond the
+    /// closest hit so far (`closest_t`).
+    Skip { node: NodeId, t_entry: f32, closest_t: f32, stack: Vec<(NodeId, f32)> },
+    /// A ray–triangle test (`triangle`: the mesh's or the scene's triangle id).
+    Triangle { triangle: u32, hit: bool, t: Option<f32>, u: Option<f32>, v: Option<f32> },
+    /// The triangle just hit is the closest hit so far.
+    ClosestHit { triangle: u32, t: f32 },
+    /// The walk enters placement `instance`, the ray moved into its object space.
+    Instance { instance: u32, origin: [f32; 3], dir: [f32; 3] },
+    /// The walk is back in the top level.
+    InstanceDone { instance: u32 },
+}
+
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Step {
+    pub level: TraceLevel,
+    #[serde(flatten)]
+    pub kind: StepKind,
+}
+
+/// What a trace knows of a node from its box test: its depth, and where the ray enters and leaves
+/// its box (`None`: missed).
+type Seen = (u32, Option<(f32, f32)>);
+
+/// The statistics sink that records the steps. Its counting methods do nothing: the counts of a
+/// trace are read from its steps (`counts`).
+#[derive(Clone, Debug, Default)]
+pub struct Trace {
+    pub steps: Vec<Step>,
+    two_levels: bool,
+    instance: Option<(u32, u32)>,
+    /// Per level, each node's depth and box interval, learnt from its box test.
+    seen: HashMap<(TraceLevel, NodeId), Seen>,
+    /// The walk's stack, as its reports show it, and the depth of the node entered last: boxes
+    /// tested next are its children.
+    stack: Vec<(NodeId, f32)>,
+    entered_depth: Option<u32>,
+    /// The top level's stack and depth while the walk is inside a placement.
+    outer: (Vec<(NodeId, f32)>, Option<u32>),
+    closest_t: f32,
+}
+
+impl Trace {
+    pub fn new() -> Self {
+        Trace { closest_t: f32::INFINITY, ..Default::default() }
+    }
+
+    /// The level the walk is in now.
+    fn level(&self) -> TraceLevel {
+        match (self.two_levels, self.instance) {
+            (_, Some((instance, _))) => TraceLevel::Bottom { instance },
+            (true, None) => TraceLevel::Top,
+            (false, None) => TraceLevel::Mesh,
+        }
+    }
+
+    fn push(&mut self, kind: StepKind) {
+        self.steps.push(Step { level: self.level(), kind });
+    }
+
+    fn depth(&self, node: NodeId) -> u32 {
+        self.seen.get(&(self.level(), node)).map_or(0, |s| s.0)
+    }
+
+    /// The work the steps show, as the counting sink counts it.
+    pub fn counts(&self) -> RayCounters {
+        let mut c = RayCounters::ZERO;
+        for s in &self.steps {
+            let top = s.level == TraceLevel::Top;
+            match s.kind {
+                StepKind::BoxTest { .. } => {
+                    c.box_tests += 1;
+                    c.top_box_tests += u32::from(top);
+                }
+                StepKind::Enter { .. } => {
+                    c.nodes_visited += 1;
+                    c.top_nodes_visited += u32::from(top);
+                }
+                StepKind::Leaf { .. } if !top => c.leaves_visited += 1,
+                StepKind::Triangle { .. } => c.triangle_tests += 1,
+                StepKind::Instance { .. } => c.instances_entered += 1,
+                _ => {}
+            }
+        }
+        c
+    }
+
+    /// The last closest hit recorded: (triangle, t).
+    pub fn last_hit(&self) -> Option<(u32, f32)> {
+        self.steps.iter().rev().find_map(|s| match s.kind {
+            StepKind::ClosestHit { triangle, t } => Some((triangle, t)),
+            _ => None,
+        })
+    }
+}
+
+impl TraversalStats for Trace {
+    #[inline]
+    fn node_visited(&mut self) {}
+    #[inline]
+    fn leaf_visited(&mut self) {}
+    #[inline]
+    fn box_tests(&mut self, _: u32) {}
+    #[inline]
+    fn triangle_tests(&mut self, _: u32) {}
+
+    const STEPS: bool = true;
+
+    fn step_levels(&mut self) {
+        self.two_levels = true;
+    }
+
+    fn step_box(&mut self, node: NodeId, interval: Option<(f32, f32)>) {
+        // The box tested is a child of the node entered last (at this level), or the root.
+        let depth = self.entered_depth.map_or(0, |d| d + 1);
+        self.seen.insert((self.level(), node), (depth, interval));
+        let (t_entry, t_exit) = (interval.map(|i| i.0), interval.map(|i| i.1));
+        self.push(StepKind::BoxTest { node, depth, hit: interval.is_some(), t_entry, t_exit });
+    }
+
+    fn step_enter(&mut self, node: NodeId) {
+        let (depth, interval) = self.seen.get(&(self.level(), node)).copied().unwrap_or((0, None));
+        let (t_entry, t_exit) = interval.unwrap_or((f32::NAN, f32::NAN));
+        self.entered_depth = Some(depth);
+        self.push(StepKind::Enter { node, depth, t_entry, t_exit });
+    }
+
+    fn step_leaf(&mut self, node: NodeId) {
+        let depth = self.depth(node);
+        self.push(StepKind::Leaf { node, depth });
+    }
+
+    fn step_stack(&mut self, entries: &[(NodeId, f32)]) {
+        let kept = self.stack.iter().zip(entries).take_while(|(a, b)| a == b).count();
+        // Entries beyond what both share were popped (from the old stack), then pushed (from
+        // the new one), in that order.
+        for k in (kept..self.stack.len()).rev() {
+            let (node, t_entry) = self.stack[k];
+            let stack = self.stack[..k].to_vec();
+            self.push(StepKind::Pop { node, t_entry, stack });
+        }
+        for k in kept..entries.len() {
+            let (node, t_entry) = entries[k];
+            self.push(StepKind::Push { node, t_entry, stack: entries[..=k].to_vec() });
+        }
+        self.stack = entries.to_vec();
+    }
+
+    fn step_skip(&mut self, node: NodeId, t: f32) {
+        // The walk popped it: it is the mirror's top.
+        if self.stack.last().is_some_and(|e| e.0 == node) {
+            self.stack.pop();
+        }
+        let stack = self.stack.clone();
+        self.push(StepKind::Skip { node, t_entry: t, closest_t: self.closest_t, stack });
+    }
+
+    fn step_triangle(&mut self, prim: u32, hit: Option<TriangleHit>) {
+        let triangle = prim + self.instance.map_or(0, |i| i.1);
+        let (t, u, v) = (hit.map(|h| h.t), hit.map(|h| h.u), hit.map(|h| h.v));
+        self.push(StepKind::Triangle { triangle, hit: hit.is_some(), t, u, v });
+        if let Some(h) = hit {
+            self.closest_t = h.t;
+            self.push(StepKind::ClosestHit { triangle, t: h.t });
+        }
+    }
+
+    fn step_instance(&mut self, instance: u32, first_prim: u32, ray: &Ray) {
+        let (origin, dir) = (ray.origin().to_array(), ray.dir().to_array());
+        self.push(StepKind::Instance { instance, origin, dir });
+        self.instance = Some((instance, first_prim));
+        // The mesh BVH's walk has its own stack, empty at its start.
+        self.seen.retain(|k, _| !matches!(k.0, TraceLevel::Bottom { .. }));
+        self.outer = (std::mem::take(&mut self.stack), self.entered_depth.take());
+    }
+
+    fn step_instance_done(&mut self) {
+        if let Some((instance, _)) = self.instance {
+            // The last step inside the placement.
+            self.push(StepKind::InstanceDone { instance });
+            self.instance = None;
+            (self.stack, self.entered_depth) = std::mem::take(&mut self.outer);
+        }
+    }
+}
+
+/// Trace `ray`'s closest hit through `accel` with `opts`, recording every step.
+pub fn trace_ray<A: Accelerator + ?Sized>(accel: &A, ray: &Ray, opts: TraceOptions) -> (Option<Hit>, Trace) {
+    let mut trace = Trace::new();
+    let hit = accel.closest_hit(&mut ray.clone(), opts, &mut trace);
+    (hit, trace)
+}
