@@ -26,7 +26,11 @@
 //! traversals compute once per hit rather than per box. Every box the exact ray meets, and every
 //! box holding a triangle whose rounded distance beats `t_max`, passes; a few the ray only grazes
 //! are visited as well, which costs a little work and never a result (the triangle test decides,
-//! against the exact `t_max`). Both widenings stay off the per-node dependency chain: a widening
+//! against the exact `t_max`). This holds for the watertight test, whose distance is within a few
+//! units in the last place; Möller–Trumbore's has no fixed bound (it grows with the origin's
+//! distance against the triangle's size), so with it, of two triangles meeting where a ray is
+//! aimed, the BVH may return the one whose rounded distance is a few hundred units in the last
+//! place farther: the same point, the other triangle (`tests/watertight_traversal.rs`). Both widenings stay off the per-node dependency chain: a widening
 //! of each exit there cost a fifth of the wide traversal's speed.
 
 use super::{Aabb, Ray};
