@@ -23,6 +23,8 @@ pub enum Action {
     /// Export the statistics as CSV through the file dialog.
     ExportStats,
     ExportStatsJson,
+    /// Export the counts behind the heatmap (one CSV row per pixel).
+    ExportCounts,
     SaveScene,
     /// A file was chosen (dialog or typed path) for `Pick`.
     Picked(Pick, PathBuf),
@@ -61,6 +63,26 @@ pub enum Action {
     SetUpAxis(UpAxis),
     /// The build or view panel's form, edited: the settings as they now are.
     Edit(Box<Settings>),
+
+    /// Pin the ray of pixel (x, y) of the image on screen (0-based, from the top left).
+    PinPixel(u32, u32),
+    /// Pin the ray typed in the Ray window.
+    PinTyped,
+    /// The Ray window's typed origin and direction changed.
+    RayText {
+        origin: String,
+        dir: String,
+    },
+    Unpin(usize),
+    UnpinAll,
+    SelectPinned(usize),
+    /// Show step `k` (0-based) of the selected pinned ray.
+    RayStep(usize),
+    /// Step forwards (or back) by so many steps.
+    RayStepBy(i64),
+    RayPlay(bool),
+    /// Open the Ray window with nothing pinned (to type a ray).
+    ShowRayWindow,
 
     /// Toggle the Help window.
     Help,

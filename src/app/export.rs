@@ -17,6 +17,7 @@ pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
     let strategy = app.settings.build.strategy.name();
     match ext {
         "png" => format!("bvhscope-{scene}-{strategy}-{}.png", app.settings.view.name()),
+        "counts" => format!("bvhscope-{scene}-{strategy}-counts.csv"),
         _ => format!("bvhscope-{scene}-stats.{ext}"),
     }
 }
@@ -128,6 +129,14 @@ pub fn stats_text(app: &BvhscopeApp, format: StatsFormat) -> Result<String, Stri
         }
         StatsFormat::Csv => stats_csv(&rows),
     })
+}
+
+/// The counts behind the heatmap of the full frame on screen, one row per pixel (the format of
+/// `bvhscope render --counts`).
+pub fn save_counts(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
+    let shown = app.shown.as_ref().ok_or("nothing rendered yet")?;
+    let text = shown.frame.counts_csv().ok_or("the frame is still refining; export once it is complete")?;
+    std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
 pub fn save_stats(app: &BvhscopeApp, path: &Path, format: StatsFormat) -> Result<(), String> {

@@ -66,6 +66,7 @@ pub enum Pick {
     SaveStatsCsv,
     SaveStatsJson,
     SaveScene,
+    SaveCounts,
 }
 
 pub enum JobEvent {
@@ -221,6 +222,7 @@ impl Jobs {
                     Pick::SavePng => dialog.add_filter("PNG image", &["png"]).set_file_name(&name).save_file().await,
                     Pick::SaveStatsCsv => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
                     Pick::SaveStatsJson => dialog.add_filter("JSON", &["json"]).set_file_name(&name).save_file().await,
+                    Pick::SaveCounts => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
                 }
             };
             let path = pollster_block_on(fut).map(|h| h.path().to_path_buf());

@@ -9,6 +9,7 @@ mod jobs;
 mod orbit;
 mod overlay;
 mod panels;
+mod ray_view;
 mod scene;
 mod settings;
 mod shortcuts;
@@ -19,6 +20,7 @@ pub use action::{Action, Actions};
 pub use jobs::Pick;
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
+pub use ray_view::{PinnedRay, RayView};
 pub use scene::BuiltBvh;
 pub use settings::{BoxLevel, Settings};
 
@@ -63,6 +65,9 @@ pub struct Shown {
     pub rays_per_s: f64,
     /// The build that traced it ("SAH binned, wide4"), for captions.
     pub build_label: String,
+    /// The BVH and traversal that traced it: a pinned pixel is traced again through them.
+    pub bvh: Arc<SceneBvh>,
+    pub trace: TraceOptions,
 }
 
 /// Per-ray figures of a full frame, with what they depend on besides the BVH: the camera (and
@@ -138,6 +143,10 @@ pub struct BvhscopeApp {
     pub messages: Vec<Message>,
     pub show_help: bool,
     pub path_window: Option<PathWindow>,
+    /// Pinned rays and the step shown (the Ray window).
+    pub pins: RayView,
+    /// The Ray window is open with nothing pinned (to type a ray).
+    pub ray_window: bool,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     box_cache: std::cell::RefCell<Option<BoxCache>>,
     overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
@@ -194,6 +203,8 @@ impl BvhscopeApp {
             messages: Vec::new(),
             show_help: false,
             path_window: None,
+            pins: RayView::default(),
+            ray_window: false,
             box_cache: Default::default(),
             overlay_cache: Default::default(),
             viewport_aspect: aspect,
@@ -488,6 +499,7 @@ impl BvhscopeApp {
             Pick::SavePng => export::save_png(self, &path),
             Pick::SaveStatsCsv => export::save_stats(self, &path, export::StatsFormat::Csv),
             Pick::SaveStatsJson => export::save_stats(self, &path, export::StatsFormat::Json),
+            Pick::SaveCounts => export::save_counts(self, &path),
             Pick::SaveScene => self
                 .scene_file_text()
                 .and_then(|t| std::fs::write(&path, t).map_err(|e| format!("{}: cannot write: {e}", path.display()))),
@@ -525,6 +537,8 @@ impl BvhscopeApp {
             style: p.style,
             rays_per_s,
             build_label,
+            bvh: p.bvh,
+            trace: p.trace,
         });
     }
 
@@ -558,6 +572,7 @@ impl BvhscopeApp {
             }
             A::ExportStats => self.jobs.pick_file(Pick::SaveStatsCsv, &export::default_name(self, "csv")),
             A::ExportStatsJson => self.jobs.pick_file(Pick::SaveStatsJson, &export::default_name(self, "json")),
+            A::ExportCounts => self.jobs.pick_file(Pick::SaveCounts, &export::default_name(self, "counts")),
             A::SaveScene => {
                 let name = format!("{}.json", self.scene.title().trim_end_matches(".obj").trim_end_matches(".json"));
                 self.jobs.pick_file(Pick::SaveScene, &name);
@@ -621,6 +636,45 @@ impl BvhscopeApp {
                 self.settings = Settings { up_axis: self.settings.up_axis, ..*settings };
                 self.act(A::SetUpAxis(up));
             }
+            A::PinPixel(x, y) => {
+                let Some(s) = &self.shown else { return };
+                if x < s.camera.width && y < s.camera.height {
+                    let ray = s.camera.ray_gen().pixel_ray(x, y);
+                    self.pins.pin(PinnedRay::new(s.bvh.clone(), ray, s.trace, Some((x, y)), &self.scene.source));
+                }
+            }
+            A::PinTyped => match (self.pins.typed_ray(), self.current_bvh()) {
+                (Ok(ray), Some(b)) => {
+                    let pinned = PinnedRay::new(b.bvh.clone(), ray, self.settings.trace, None, &self.scene.source);
+                    self.pins.pin(pinned);
+                }
+                (Err(e), _) => self.message(MessageKind::Error, e),
+                (_, None) => self.message(MessageKind::Error, "no BVH is built yet to trace the ray through"),
+            },
+            A::RayText { origin, dir } => (self.pins.origin_text, self.pins.dir_text) = (origin, dir),
+            A::Unpin(i) => self.pins.unpin(i),
+            A::UnpinAll => {
+                self.pins = RayView {
+                    origin_text: self.pins.origin_text.clone(),
+                    dir_text: self.pins.dir_text.clone(),
+                    ..Default::default()
+                };
+                self.ray_window = false;
+            }
+            A::SelectPinned(i) => self.pins.select(i),
+            A::RayStep(k) => self.pins.set_step(k),
+            A::RayStepBy(d) => {
+                self.pins.set_step(self.pins.step.saturating_add_signed(d as isize));
+                self.pins.last_tick = Some(Instant::now());
+            }
+            A::RayPlay(on) => {
+                self.pins.playing = on;
+                self.pins.last_tick = Some(Instant::now());
+                if on && self.pins.current().is_some_and(|r| self.pins.step + 1 >= r.len()) {
+                    self.pins.step = 0; // play again from the start
+                }
+            }
+            A::ShowRayWindow => self.ray_window = true,
             A::Help => self.show_help = !self.show_help,
             A::SetHelp(on) => self.show_help = on,
             A::Dismiss(i) => {
@@ -664,6 +718,7 @@ impl eframe::App for BvhscopeApp {
             .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(12)))
             .show(ui, |ui| viewport::show(self, ui, out));
         panels::windows::show(self, &ctx, out);
+        panels::ray::show(self, &ctx, out);
         // What the panels asked for takes effect now, and shows in the next frame.
         if !actions.is_empty() {
             for action in actions {

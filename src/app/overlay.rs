@@ -171,6 +171,40 @@ fn add_segment(mesh: &mut Mesh, p: Pos2, q: Pos2, width: f32, color: Color32) {
     mesh.add_triangle(base, base + 2, base + 3);
 }
 
+/// A world-space line segment to draw over the image.
+#[derive(Clone, Copy, Debug)]
+pub struct Line3 {
+    pub a: Vec3,
+    pub b: Vec3,
+    pub color: Color32,
+    pub width: f32,
+}
+
+/// The 12 edges of a box (corners in `Aabb::corners` order) as lines.
+pub fn box_lines(corners: &[Vec3; 8], color: Color32, width: f32, out: &mut Vec<Line3>) {
+    out.extend(EDGES.iter().map(|&(i, j)| Line3 { a: corners[i], b: corners[j], color, width }));
+}
+
+/// Lines as one mesh of thin quads, in the camera's projection over `rect`, clipped to its near
+/// plane (which is `near` in front of the eye).
+pub fn lines_mesh(lines: &[Line3], camera: &Camera, rect: Rect, near: f32) -> Mesh {
+    let projector = Projector::new(camera, rect, near);
+    let mut mesh = Mesh::default();
+    for l in lines {
+        if let Some((a, b)) = projector.clip_segment(projector.to_camera(l.a), projector.to_camera(l.b)) {
+            add_segment(&mut mesh, projector.to_screen(a), projector.to_screen(b), l.width, l.color);
+        }
+    }
+    mesh
+}
+
+/// Where a world point shows over `rect`, if it is in front of the camera.
+pub fn project(camera: &Camera, rect: Rect, p: Vec3) -> Option<Pos2> {
+    let projector = Projector::new(camera, rect, 0.0);
+    let c = projector.to_camera(p);
+    (c.z > 0.0).then(|| projector.to_screen(c))
+}
+
 /// All boxes as one mesh of thin quads: far cheaper for egui than 12 line shapes per box, which
 /// keeps 10,000 boxes smooth. With `depth`, only the parts in front of the surface.
 pub fn boxes_mesh(boxes: &[OverlayBox], camera: &Camera, rect: Rect, width: f32, depth: Option<DepthTest>) -> Mesh {

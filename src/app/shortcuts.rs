@@ -29,6 +29,7 @@ pub const MOUSE: &[(&str, &str)] = &[
     ("Right or middle drag", "Pan"),
     ("Wheel", "Zoom"),
     ("Hover", "Exact counts of the pixel's ray"),
+    ("Click", "Pin the pixel's ray: its traversal step by step (Ray window)"),
     ("Drop an .obj", "Open it"),
 ];
 

@@ -23,6 +23,14 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         let d = response.drag_delta();
         out.push(Action::Pan { dx: d.x, dy: d.y, height: rect.height() });
     }
+    // A click (no drag) pins the ray of the pixel under it.
+    if response.clicked() {
+        if let (Some(pos), Some(shown)) = (response.interact_pointer_pos(), &app.shown) {
+            if let Some((x, y)) = pixel_at(&shown.frame, rect, pos) {
+                out.push(Action::PinPixel(x, y));
+            }
+        }
+    }
     if response.hovered() {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
@@ -68,6 +76,10 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
     }
 
+    if let Some(shown) = &app.shown {
+        draw_pinned(app, &painter, rect, &shown.camera);
+    }
+
     // Files dragged over the window.
     if ui.ctx().input(|i| !i.raw.hovered_files.is_empty()) {
         painter.rect_filled(rect, 0.0, Color32::from_black_alpha(160));
@@ -89,6 +101,78 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             let frame = shown.frame.clone();
             response.on_hover_ui_at_pointer(|ui| pixel_readout(ui, &frame, rect, pos));
         }
+    }
+}
+
+/// The colours a pinned ray's step is drawn in (the Ray window's legend names them).
+pub struct RayColors {
+    pub visited: Color32,
+    pub skipped: Color32,
+    pub tested_hit: Color32,
+    pub tested_miss: Color32,
+    pub current: Color32,
+    pub triangle_hit: Color32,
+    pub triangle_miss: Color32,
+    pub hit_point: Color32,
+}
+
+pub const RAY_COLORS: RayColors = RayColors {
+    visited: Color32::from_rgba_premultiplied(100, 100, 106, 90),
+    skipped: Color32::from_rgb(240, 160, 60),
+    tested_hit: Color32::from_rgb(80, 220, 230),
+    tested_miss: Color32::from_rgb(150, 70, 70),
+    current: Color32::from_rgb(250, 220, 60),
+    triangle_hit: Color32::from_rgb(90, 230, 90),
+    triangle_miss: Color32::from_rgb(235, 80, 70),
+    hit_point: Color32::from_rgb(90, 230, 90),
+};
+
+/// The pinned rays over the image: every pinned ray as a line (the selected one brighter), and for
+/// the selected one, at the step shown: the boxes already visited dimmed, the skipped ones orange,
+/// the box tested at this step (cyan when hit), the current node yellow, the current leaf's
+/// triangles outlined (green hit, red missed), and the closest hit so far marked. All in world
+/// space, so orbiting shows the ray from the side.
+fn draw_pinned(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, camera: &crate::render::Camera) {
+    use super::overlay::{box_lines, lines_mesh, project, Line3};
+    let rays = &app.pins;
+    let Some(sel) = rays.current() else { return };
+    let far = (camera.position - camera.look_at).length() * 2.0;
+    let mut lines = Vec::new();
+    for (i, r) in rays.pinned.iter().enumerate() {
+        let (color, width) = if i == rays.selected { (Color32::WHITE, 2.0) } else { (Color32::from_gray(150), 1.0) };
+        lines.push(Line3 { a: r.ray.origin(), b: r.end(far), color, width });
+    }
+    let pic = sel.picture(rays.step);
+    let mut add_box = |at: (crate::bvh::TraceLevel, crate::bvh::NodeId), color: Color32, width: f32| {
+        if let Some(c) = sel.bvh.node_corners(at.0, at.1) {
+            box_lines(&c, color, width, &mut lines);
+        }
+    };
+    for &v in &pic.visited {
+        add_box(v, RAY_COLORS.visited, 1.0);
+    }
+    for &s in &pic.skipped {
+        add_box(s, RAY_COLORS.skipped, 1.5);
+    }
+    if let Some((level, node, hit)) = pic.tested {
+        let color = if hit { RAY_COLORS.tested_hit } else { RAY_COLORS.tested_miss };
+        add_box((level, node), color, 1.5);
+    }
+    if let Some(cur) = pic.current {
+        add_box(cur, RAY_COLORS.current, 2.5);
+    }
+    for &(tri, hit) in &pic.triangles {
+        if let Some([a, b, c]) = sel.bvh.triangle_corners(tri) {
+            let color = if hit { RAY_COLORS.triangle_hit } else { RAY_COLORS.triangle_miss };
+            for (p, q) in [(a, b), (b, c), (c, a)] {
+                lines.push(Line3 { a: p, b: q, color, width: 2.0 });
+            }
+        }
+    }
+    let near = (camera.position - camera.look_at).length() * 1e-4;
+    painter.add(egui::Shape::Mesh(std::sync::Arc::new(lines_mesh(&lines, camera, rect, near))));
+    if let Some(p) = pic.closest_t.and_then(|t| project(camera, rect, sel.ray.at(t))) {
+        painter.circle(p, 5.0, RAY_COLORS.hit_point, Stroke::new(1.5, Color32::BLACK));
     }
 }
 

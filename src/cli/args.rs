@@ -119,6 +119,37 @@ impl BuildArgs {
     }
 }
 
+/// The options that rebuild `build` and trace with `opts`, every one given (so neither a preset
+/// nor a scene file's settings change them): what the app writes when it names the command line
+/// that reproduces what it shows. `BuildArgs` parses them back to the same values.
+pub fn build_flags(build: &SceneBuild, opts: TraceOptions) -> Vec<String> {
+    let p = &build.bvh;
+    let mut out = vec![
+        format!("--strategy {}", p.strategy.named().name),
+        format!("--max-leaf-size {}", p.max_leaf_size),
+        format!("--bins {}", p.sah_bins),
+        format!("--traversal-cost {}", p.cost.traversal),
+        format!("--layout {}", p.layout.named().name),
+        format!("--order {}", opts.order.named().name),
+        format!("--triangle-test {}", opts.test.named().name),
+    ];
+    if let Some(top) = &build.top {
+        out.push("--two-level".into());
+        out.push(format!("--top-strategy {}", top.strategy.named().name));
+        out.push(format!("--top-max-leaf-size {}", top.max_leaf_size));
+    }
+    out
+}
+
+/// A path as one shell word: as it is when it needs no quoting, else in single quotes.
+pub fn shell_word(s: &str) -> String {
+    if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "/._-+,:=@%".contains(c)) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
 /// The camera and image size of a render.
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {

@@ -6,7 +6,7 @@ mod compare;
 mod progress;
 mod render;
 mod stats;
-mod trace;
+pub mod trace;
 
 pub use args::{parse_camera, parse_size, BuildArgs};
 pub use compare::{compare_rows, CompareRow};
@@ -27,6 +27,16 @@ pub struct Cli {
     pub command: Option<Command>,
     /// A mesh (.obj) or scene (.json) to open in the desktop app.
     pub file: Option<PathBuf>,
+}
+
+impl Cli {
+    /// Parse a command line given as words, the program's name first, as `main` does (the app's
+    /// tests run the commands it shows).
+    pub fn from_words<I: IntoIterator<Item = T>, T: Into<std::ffi::OsString> + Clone>(
+        words: I,
+    ) -> Result<Cli, clap::Error> {
+        Cli::try_parse_from(words)
+    }
 }
 
 #[derive(Subcommand, Debug)]

@@ -2,14 +2,14 @@
 //! lists, from the same traversal (`bvh::trace`). The ray is a pixel of the camera (0-based, x from
 //! the left, y from the top, as everywhere) or typed as an origin and a direction.
 
-use super::args::{BuildArgs, ViewArgs};
+use super::args::{build_flags, shell_word, BuildArgs, ViewArgs};
 use super::{build_scene, load_mesh, CliError};
-use crate::bvh::{trace_ray, RayCounters, Step, StepKind, TraceLevel};
+use crate::bvh::{trace_ray, RayCounters, SceneBuild, StepKind, TraceLevel, TraceOptions};
 use crate::geometry::Ray;
 use clap::{Args, ValueEnum};
 use glam::Vec3;
 use std::fmt::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum TraceFormat {
@@ -53,47 +53,16 @@ fn parse_ray(s: &str) -> Result<(Vec3, Vec3), String> {
     Ok((o, d))
 }
 
-/// The step as one line of the table, and the depth of the node it is about (`None`: a step of
-/// the node entered last, indented under it).
-pub fn step_text(s: &Step) -> (Option<u32>, String) {
-    let t = |v: Option<f32>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
-    let stack = |st: &[(crate::bvh::NodeId, f32)]| {
-        let items: Vec<String> = st.iter().map(|(n, t)| format!("{n}@{t:.3}")).collect();
-        format!("[{}]", items.join(", "))
-    };
-    match &s.kind {
-        StepKind::BoxTest { node, depth, hit: true, t_entry, t_exit } => {
-            (Some(*depth), format!("box of {node}: hit, t {}..{}", t(*t_entry), t(*t_exit)))
-        }
-        StepKind::BoxTest { node, depth, hit: false, .. } => (Some(*depth), format!("box of {node}: miss")),
-        StepKind::Enter { node, depth, t_entry, t_exit } => {
-            (Some(*depth), format!("enter {node} (depth {depth}, t {t_entry:.4}..{t_exit:.4})"))
-        }
-        StepKind::Leaf { node, depth } => (Some(*depth), format!("leaf {node}: test its triangles")),
-        StepKind::Push { node, t_entry, stack: st } => {
-            (None, format!("push {node} (enters at {t_entry:.4})  stack {}", stack(st)))
-        }
-        StepKind::Pop { node, t_entry, stack: st } => {
-            (None, format!("pop {node} (enters at {t_entry:.4})  stack {}", stack(st)))
-        }
-        StepKind::Skip { node, t_entry, closest_t, stack: st } => (
-            None,
-            format!("skip {node}: enters at {t_entry:.4}, beyond the closest hit {closest_t:.4}  stack {}", stack(st)),
-        ),
-        StepKind::Triangle { triangle, hit, t: th, u, v } => {
-            let what = if *hit { format!("hit t {} u {} v {}", t(*th), t(*u), t(*v)) } else { "miss".into() };
-            (None, format!("triangle {triangle}: {what}"))
-        }
-        StepKind::ClosestHit { triangle, t } => (None, format!("closest hit so far: triangle {triangle} at t {t:.4}")),
-        StepKind::Instance { instance, origin, dir } => (
-            None,
-            format!(
-                "enter placement {instance}: object-space ray ({:.3}, {:.3}, {:.3}) → ({:.3}, {:.3}, {:.3})",
-                origin[0], origin[1], origin[2], dir[0], dir[1], dir[2]
-            ),
-        ),
-        StepKind::InstanceDone { instance } => (None, format!("back from placement {instance}")),
-    }
+/// The `bvhscope trace` command that rebuilds `build` over the scene file at `path` and traces
+/// `ray` as the app did (the Ray window shows it, to paste into a terminal or a lab report). The
+/// ray is given as numbers (each written so it reads back to the same `f32`), not as a pixel, so
+/// the window's size does not matter.
+pub fn command(path: &Path, ray: &Ray, build: &SceneBuild, opts: TraceOptions) -> String {
+    let v = |v: Vec3| format!("{},{},{}", v.x, v.y, v.z);
+    let mut words = vec!["bvhscope trace".to_string(), shell_word(&path.display().to_string())];
+    words.push(format!("--ray {}:{}", v(ray.origin()), v(ray.dir())));
+    words.extend(build_flags(build, opts));
+    words.join(" ")
 }
 
 fn level_text(l: TraceLevel) -> String {
@@ -112,6 +81,12 @@ fn counts_json(c: &RayCounters) -> serde_json::Value {
 }
 
 pub fn run(a: &TraceArgs) -> Result<(), CliError> {
+    print!("{}", output(a)?);
+    Ok(())
+}
+
+/// What `run` prints: the text table or the JSON (the app's tests compare it with the Ray window).
+pub fn output(a: &TraceArgs) -> Result<String, CliError> {
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
     let bvh = build_scene(&scene, &a.build.scene_build(params))?;
@@ -161,7 +136,7 @@ pub fn run(a: &TraceArgs) -> Result<(), CliError> {
             let levels = trace.steps.iter().any(|s| s.level != TraceLevel::Mesh);
             let mut entered = 0;
             for (i, s) in trace.steps.iter().enumerate() {
-                let (depth, text) = step_text(s);
+                let (depth, text) = (s.depth(), s.text());
                 if let StepKind::Enter { depth, .. } = s.kind {
                     entered = depth;
                 }
@@ -189,6 +164,5 @@ pub fn run(a: &TraceArgs) -> Result<(), CliError> {
             );
         }
     }
-    print!("{o}");
-    Ok(())
+    Ok(o)
 }

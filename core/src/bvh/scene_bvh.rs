@@ -124,6 +124,48 @@ impl Accelerator for SceneBvh {
     }
 }
 
+impl SceneBvh {
+    /// The world-space corners (`Aabb::corners` order) of the box of `node` at `level`, as a
+    /// trace names them: a placement's mesh BVH's boxes are placed by its transform.
+    pub fn node_corners(&self, level: super::TraceLevel, node: super::NodeId) -> Option<[Vec3; 8]> {
+        use super::{NodeId, TraceLevel};
+        let in_tree = |bvh: &AnyBvh| match (bvh, node) {
+            (AnyBvh::Binary(b), NodeId::Node(i)) => b.nodes.get(i as usize).map(|n| n.bounds()),
+            (AnyBvh::Wide(w), id) => w.node_box(id),
+            (AnyBvh::Binary(_), NodeId::Leaf { .. }) => None,
+        };
+        match (self, level) {
+            (SceneBvh::Single { bvh, .. }, TraceLevel::Mesh) => in_tree(bvh).map(|b| b.corners()),
+            (SceneBvh::TwoLevel { bvh, .. }, TraceLevel::Top) => match node {
+                NodeId::Node(i) => bvh.top.nodes.get(i as usize).map(|n| n.bounds().corners()),
+                NodeId::Leaf { .. } => None,
+            },
+            (SceneBvh::TwoLevel { bvh, .. }, TraceLevel::Bottom { instance }) => {
+                let inst = bvh.instances.get(instance as usize)?;
+                let b = in_tree(&bvh.bottom[inst.mesh as usize])?;
+                Some(super::two_level::placed_corners(&b, &inst.to_world))
+            }
+            _ => None,
+        }
+    }
+
+    /// The world-space corners of triangle `prim` (a hit's id: the mesh's, or for two levels the
+    /// scene's, numbered as the flattened scene numbers them).
+    pub fn triangle_corners(&self, prim: u32) -> Option<[Vec3; 3]> {
+        match self {
+            SceneBvh::Single { mesh, .. } => (prim < mesh.triangle_count() as u32).then(|| mesh.triangle(prim)),
+            SceneBvh::TwoLevel { bvh, meshes } => {
+                let k = bvh.instances.partition_point(|i| i.first_prim <= prim).checked_sub(1)?;
+                let inst = &bvh.instances[k];
+                let mesh = &meshes[inst.mesh as usize];
+                let local = prim - inst.first_prim;
+                (local < mesh.triangle_count() as u32)
+                    .then(|| mesh.triangle(local).map(|p| inst.to_world.transform_point3(p)))
+            }
+        }
+    }
+}
+
 impl Surface for SceneBvh {
     /// One level: the mesh's own normal. Two levels: the placed mesh's, the ray moved into its
     /// object space as the traversal moved it (so `t` is the same), the normal back into the

@@ -80,6 +80,70 @@ pub struct Step {
 /// its box (`None`: missed).
 type Seen = (u32, Option<(f32, f32)>);
 
+impl Step {
+    /// The depth of the node the step is about; `None` for a step of the node entered last (a
+    /// stack operation, a triangle test), which a listing indents under that node.
+    pub fn depth(&self) -> Option<u32> {
+        match self.kind {
+            StepKind::BoxTest { depth, .. } | StepKind::Enter { depth, .. } | StepKind::Leaf { depth, .. } => {
+                Some(depth)
+            }
+            _ => None,
+        }
+    }
+
+    /// The step in words, as `bvhscope trace` and the app's Ray panel list it.
+    pub fn text(&self) -> String {
+        let stack = |st: &[(NodeId, f32)]| {
+            let items: Vec<String> = st.iter().map(|(n, t)| format!("{n}@{t:.3}")).collect();
+            format!("[{}]", items.join(", "))
+        };
+        match &self.kind {
+            StepKind::BoxTest { node, hit: true, t_entry, t_exit, .. } => {
+                format!("box of {node}: hit, t {:.4}..{:.4}", t_entry.unwrap_or(f32::NAN), t_exit.unwrap_or(f32::NAN))
+            }
+            StepKind::BoxTest { node, hit: false, .. } => format!("box of {node}: miss"),
+            StepKind::Enter { node, depth, t_entry, t_exit } => {
+                format!("enter {node} (depth {depth}, t {t_entry:.4}..{t_exit:.4})")
+            }
+            StepKind::Leaf { node, .. } => format!("leaf {node}: test its triangles"),
+            StepKind::Push { node, t_entry, stack: st } => {
+                format!("push {node} (enters at {t_entry:.4})  stack {}", stack(st))
+            }
+            StepKind::Pop { node, t_entry, stack: st } => {
+                format!("pop {node} (enters at {t_entry:.4})  stack {}", stack(st))
+            }
+            StepKind::Skip { node, t_entry, closest_t, stack: st } => {
+                format!(
+                    "skip {node}: enters at {t_entry:.4}, beyond the closest hit {closest_t:.4}  stack {}",
+                    stack(st)
+                )
+            }
+            StepKind::Triangle { triangle, hit: true, t, u, v } => format!(
+                "triangle {triangle}: hit t {:.4} u {:.4} v {:.4}",
+                t.unwrap_or(f32::NAN),
+                u.unwrap_or(f32::NAN),
+                v.unwrap_or(f32::NAN)
+            ),
+            StepKind::Triangle { triangle, hit: false, .. } => format!("triangle {triangle}: miss"),
+            StepKind::ClosestHit { triangle, t } => format!("closest hit so far: triangle {triangle} at t {t:.4}"),
+            StepKind::Instance { instance, origin: o, dir: d } => format!(
+                "enter placement {instance}: object-space ray from ({:.3}, {:.3}, {:.3}) along ({:.3}, {:.3}, {:.3})",
+                o[0], o[1], o[2], d[0], d[1], d[2]
+            ),
+            StepKind::InstanceDone { instance } => format!("back from placement {instance}"),
+        }
+    }
+
+    /// The stack as it stands after this step, for steps that change it.
+    pub fn stack(&self) -> Option<&[(NodeId, f32)]> {
+        match &self.kind {
+            StepKind::Push { stack, .. } | StepKind::Pop { stack, .. } | StepKind::Skip { stack, .. } => Some(stack),
+            _ => None,
+        }
+    }
+}
+
 /// The statistics sink that records the steps. Its counting methods do nothing: the counts of a
 /// trace are read from its steps (`counts`).
 #[derive(Clone, Debug, Default)]

@@ -41,6 +41,13 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 out.push(Action::ExportStatsJson);
             }
             if ui
+                .button("Export counts as CSV…")
+                .on_hover_text("One row per pixel: x, y, nodes visited, box tests, leaves, triangle tests, hit triangle (-1: miss); the numbers the heatmaps colour")
+                .clicked()
+            {
+                out.push(Action::ExportCounts);
+            }
+            if ui
                 .button("Save scene as…")
                 .on_hover_text("The camera, the meshes and the BVH settings, as a scene file")
                 .clicked()
@@ -69,6 +76,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             item(ui, out, "Frame the mesh", Action::FrameMesh);
             item(ui, out, "Reset camera", Action::ResetView);
             item(ui, out, "Node boxes", Action::ToggleBoxes);
+            if ui.button("Trace a ray…").on_hover_text("The Ray window: click a pixel to pin its ray, or type a ray").clicked() {
+                out.push(Action::ShowRayWindow);
+            }
         });
         ui.menu_button("Help", |ui| {
             let shortcut = shortcut_text(ui.ctx(), &Action::Help);

@@ -2,6 +2,7 @@
 
 pub mod build;
 pub mod menu;
+pub mod ray;
 pub mod stats;
 pub mod status;
 pub mod view;

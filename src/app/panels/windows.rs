@@ -36,6 +36,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         Pick::SaveStatsCsv => "Export statistics (CSV)",
         Pick::SaveStatsJson => "Export statistics (JSON)",
         Pick::SaveScene => "Save the scene",
+        Pick::SaveCounts => "Export counts (CSV)",
     };
     let mut keep = true;
     let mut chosen = None;

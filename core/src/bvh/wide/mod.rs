@@ -164,6 +164,24 @@ impl WideBvh {
     }
 }
 
+impl WideBvh {
+    /// The box of a node as a trace names it (`bvh::trace::NodeId`): a leaf's is its slot's in
+    /// its parent; a wide node's is the slot that refers to it (the root's, the tree's bounds).
+    pub fn node_box(&self, id: crate::bvh::NodeId) -> Option<crate::geometry::Aabb> {
+        match id {
+            crate::bvh::NodeId::Node(0) => Some(self.root_bounds),
+            crate::bvh::NodeId::Node(i) => self.nodes.iter().find_map(|n| {
+                (0..WIDTH)
+                    .find(|&s| n.valid & (1 << s) != 0 && n.count[s] == 0 && n.child[s] == i)
+                    .map(|s| n.boxes.bounds(s))
+            }),
+            crate::bvh::NodeId::Leaf { node, slot } => {
+                self.nodes.get(node as usize).map(|n| n.boxes.bounds(slot as usize))
+            }
+        }
+    }
+}
+
 /// The binary nodes a wide node over interior binary node `bin` takes as its children: its two
 /// children, then, while fewer than four, the interior one of largest surface area replaced by
 /// its own two.

@@ -1,0 +1,234 @@
+//! The Ray window: the pinned rays (a click on the image pins its pixel's ray; one can also be
+//! typed), and the selected one's traversal step by step: the numbered steps indented by depth,
+//! hit green and miss red, a step slider with play, pause and step buttons, the stack at the
+//! current step, and the counts, the same as the hover read-out's and `bvhscope trace`'s.
+
+use crate::app::{Action, Actions, BvhscopeApp};
+use crate::bvh::{StepKind, TraceLevel};
+use egui::{Color32, RichText};
+use std::time::Duration;
+
+/// How long a step shows while playing.
+const PLAY_STEP: Duration = Duration::from_millis(180);
+
+fn step_color(kind: &StepKind) -> Option<Color32> {
+    match kind {
+        StepKind::BoxTest { hit: true, .. } | StepKind::Triangle { hit: true, .. } | StepKind::ClosestHit { .. } => {
+            Some(Color32::from_rgb(110, 200, 110))
+        }
+        StepKind::BoxTest { hit: false, .. } | StepKind::Triangle { hit: false, .. } => {
+            Some(Color32::from_rgb(225, 110, 100))
+        }
+        StepKind::Skip { .. } => Some(Color32::from_rgb(240, 160, 60)),
+        _ => None,
+    }
+}
+
+pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+    let rays = &app.pins;
+    if rays.pinned.is_empty() && !app.ray_window {
+        return;
+    }
+    let mut open = true;
+    egui::Window::new("Ray")
+        .open(&mut open)
+        // Over the statistics panel, so the image and the ray drawn on it stay in view.
+        .default_size([440.0, 520.0])
+        .default_pos(ctx.content_rect().right_top() + egui::vec2(-450.0, 40.0))
+        .show(ctx, |ui| {
+            pinned_list(app, ui, out);
+            ui.separator();
+            typed_ray(app, ui, out);
+            let Some(r) = rays.current() else {
+                ui.weak("Click a pixel of the image to pin its ray, or type one above.");
+                return;
+            };
+            ui.separator();
+            let n = r.len();
+            let k = rays.step.min(n.saturating_sub(1));
+            ui.horizontal(|ui| {
+                if ui.button("First").on_hover_text("The first step").clicked() {
+                    out.push(Action::RayStep(0));
+                }
+                if ui.button("Back").on_hover_text("One step back").clicked() {
+                    out.push(Action::RayStepBy(-1));
+                }
+                let (label, tip) = if rays.playing { ("Pause", "Stop playing") } else { ("Play", "Play the steps one after another") };
+                if ui.button(label).on_hover_text(tip).clicked() {
+                    out.push(Action::RayPlay(!rays.playing));
+                }
+                if ui.button("Step").on_hover_text("One step forward").clicked() {
+                    out.push(Action::RayStepBy(1));
+                }
+                if ui.button("Last").on_hover_text("The last step").clicked() {
+                    out.push(Action::RayStep(n.saturating_sub(1)));
+                }
+                let mut step = k + 1;
+                let slider = egui::Slider::new(&mut step, 1..=n.max(1)).text(format!("of {n}"));
+                if ui.add(slider).on_hover_text("The step the viewport shows").changed() {
+                    out.push(Action::RayStep(step - 1));
+                }
+            });
+            if rays.playing {
+                let due = rays.last_tick.is_none_or(|t| t.elapsed() >= PLAY_STEP);
+                if due {
+                    out.push(Action::RayStepBy(1));
+                }
+                ctx.request_repaint_after(PLAY_STEP);
+            }
+            let stack = r.trace.steps[..=k.min(n.saturating_sub(1))].iter().rev().find_map(|s| s.stack());
+            let stack_text = match stack {
+                Some([]) | None => "empty".to_string(),
+                Some(st) => st.iter().map(|(n, t)| format!("{n} @ {t:.3}")).collect::<Vec<_>>().join(", "),
+            };
+            command_line(r, ui);
+            ui.label(format!("Stack (bottom first): {stack_text}"))
+                .on_hover_text("What the traversal stack holds after this step: each node with the distance at which the ray enters its box");
+            legend(ui);
+            steps_list(app, ui, out, k);
+        });
+    if !open {
+        out.push(Action::UnpinAll);
+    }
+}
+
+/// The pinned rays, each with its counts and hit, to select, compare and unpin.
+fn pinned_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
+    let rays = &app.pins;
+    if rays.pinned.is_empty() {
+        return;
+    }
+    egui::Grid::new("pinned-rays").num_columns(7).striped(true).show(ui, |ui| {
+        for h in ["Pinned ray", "Nodes", "Boxes", "Leaves", "Triangles", "Hit", ""] {
+            ui.strong(h);
+        }
+        ui.end_row();
+        for (i, r) in rays.pinned.iter().enumerate() {
+            if ui.selectable_label(i == rays.selected, &r.label).on_hover_text("Show this ray's steps").clicked() {
+                out.push(Action::SelectPinned(i));
+            }
+            let c = r.counts;
+            for v in [c.nodes_visited, c.box_tests, c.leaves_visited, c.triangle_tests] {
+                ui.label(v.to_string());
+            }
+            ui.label(r.hit.map_or("nothing".to_string(), |h| format!("triangle {} at t = {:.4}", h.prim, h.t)));
+            if ui.small_button("Unpin").on_hover_text("Remove this ray").clicked() {
+                out.push(Action::Unpin(i));
+            }
+            ui.end_row();
+        }
+    });
+    ui.weak("Click another pixel (or the same one after changing the strategy) to compare.");
+}
+
+/// What the viewport's colours mean, in those colours.
+fn legend(ui: &mut egui::Ui) {
+    let c = &crate::app::viewport::RAY_COLORS;
+    ui.horizontal_wrapped(|ui| {
+        ui.spacing_mut().item_spacing.x = 8.0;
+        ui.weak("In the image:");
+        for (text, color) in [
+            ("current node", c.current),
+            ("visited", Color32::from_gray(170)),
+            ("skipped", c.skipped),
+            ("box tested: hit", c.tested_hit),
+            ("miss", c.tested_miss),
+            ("leaf triangles: hit", c.triangle_hit),
+            ("missed", c.triangle_miss),
+            ("closest hit (dot)", c.hit_point),
+        ] {
+            ui.label(RichText::new(text).color(color));
+        }
+    });
+}
+
+/// The `bvhscope trace` command that prints this ray's steps, to copy into a terminal or a report.
+fn command_line(r: &crate::app::ray_view::PinnedRay, ui: &mut egui::Ui) {
+    ui.horizontal(|ui| match &r.command {
+        Some(cmd) => {
+            if ui.button("Copy trace command").on_hover_text(cmd.as_str()).clicked() {
+                ui.ctx().copy_text(cmd.clone());
+            }
+            ui.weak("the same steps on the command line (bvhscope trace)");
+        }
+        None => {
+            ui.weak("The built-in scene has no file to name on the command line (bvhscope trace).");
+        }
+    });
+}
+
+/// Fields to type a ray from elsewhere (a student's own renderer).
+fn typed_ray(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
+    let (mut origin, mut dir) = (app.pins.origin_text.clone(), app.pins.dir_text.clone());
+    let mut pin = false;
+    ui.horizontal(|ui| {
+        let l = ui.label("Origin");
+        let o =
+            ui.add(egui::TextEdit::singleline(&mut origin).desired_width(110.0).hint_text("x, y, z")).labelled_by(l.id);
+        let l = ui.label("Direction");
+        let d =
+            ui.add(egui::TextEdit::singleline(&mut dir).desired_width(110.0).hint_text("x, y, z")).labelled_by(l.id);
+        let enter = (o.lost_focus() || d.lost_focus()) && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        pin =
+            ui.button("Pin typed ray").on_hover_text("Trace this ray (world space) through the current BVH").clicked()
+                || enter;
+    });
+    if origin != app.pins.origin_text || dir != app.pins.dir_text {
+        out.push(Action::RayText { origin, dir });
+    }
+    if pin {
+        out.push(Action::PinTyped);
+    }
+}
+
+/// The steps, numbered and indented by depth, coloured hit / miss; only the rows in view are laid
+/// out, so a long walk stays fast. Clicking a row shows that step.
+fn steps_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions, k: usize) {
+    let Some(r) = app.pins.current() else { return };
+    let steps = &r.trace.steps;
+    // A selectable label's height: its text and the button padding, at least the interact size.
+    let text_height = ui.text_style_height(&egui::TextStyle::Monospace);
+    let row_height = (text_height + 2.0 * ui.spacing().button_padding.y).max(ui.spacing().interact_size.y);
+    let levels = steps.iter().any(|s| s.level != TraceLevel::Mesh);
+    // One line per step (show_rows needs equal rows): long stacks scroll sideways.
+    let area = egui::ScrollArea::both().auto_shrink([false, false]).id_salt("ray-steps");
+    // When the step moves (a button, the slider, playing), bring it into view once.
+    let shown_id = ui.scope_id().with("ray-step-shown");
+    let moved = ui.data(|d| d.get_temp::<(usize, usize)>(shown_id)) != Some((app.pins.selected, k));
+    ui.data_mut(|d| d.insert_temp(shown_id, (app.pins.selected, k)));
+    let mut entered = 0;
+    let depths: Vec<u32> = steps
+        .iter()
+        .map(|s| {
+            if let StepKind::Enter { depth, .. } = s.kind {
+                entered = depth;
+            }
+            s.depth().unwrap_or(entered + 1)
+        })
+        .collect();
+    area.show_rows(ui, row_height, steps.len(), |ui, range| {
+        ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Extend);
+        if moved {
+            // Row k's place, from the first row laid out (rows above it are not).
+            let top = ui.cursor().top() + (k as f32 - range.start as f32) * (row_height + ui.spacing().item_spacing.y);
+            let row = egui::Rect::from_min_size(egui::pos2(ui.cursor().left(), top), egui::vec2(1.0, row_height));
+            ui.scroll_to_rect(row, None);
+        }
+        for i in range {
+            let s = &steps[i];
+            let level = match (levels, s.level) {
+                (false, _) | (_, TraceLevel::Mesh) => String::new(),
+                (true, TraceLevel::Top) => "top  ".into(),
+                (true, TraceLevel::Bottom { instance }) => format!("#{instance:<4}"),
+            };
+            let text = format!("{:>4}  {level}{}{}", i + 1, "  ".repeat(depths[i] as usize), s.text());
+            let mut rich = RichText::new(text).monospace();
+            if let Some(c) = step_color(&s.kind) {
+                rich = rich.color(c);
+            }
+            if ui.selectable_label(i == k, rich).clicked() {
+                out.push(Action::RayStep(i));
+            }
+        }
+    });
+}
