@@ -236,6 +236,8 @@ fn compare_times_single_rays_and_writes_csv_a_reader_parses() {
     }
     assert_eq!(&records[0][0], "Midpoint (binary)");
     assert_eq!(&records[4][col("build_ms")], "", "the linear scan has no build");
+    assert!(records[..4].iter().all(|r| r[col("epo")].parse::<f64>().is_ok()), "each strategy's EPO");
+    assert_eq!(&records[4][col("epo")], "");
 
     let out = bvhscope(&["compare", tent().to_str().unwrap(), "--size", "40x30", "--runs", "1", "--layout", "binary"]);
     let text = String::from_utf8_lossy(&out.stdout);
@@ -420,4 +422,55 @@ fn trace_prints_the_steps_and_refuses_a_pixel_outside_the_image() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("outside the 40x30 image"), "{err}");
+}
+
+/// `inspect` explains a node: in JSON the sweep SAH's marker is its curves' minimum, midpoint's
+/// sits at the middle of the centroid bounds on their widest axis, and the figures are there; the
+/// CSV parses with the documented columns; a node past the tree is refused in one line.
+#[test]
+fn inspect_prints_a_nodes_curves_and_each_strategys_plane() {
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    let out = bvhscope(&["inspect", torus, "--node", "1", "--strategy", "midpoint", "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["node"], 1);
+    assert_eq!(v["path"], serde_json::json!([0, 1]));
+    assert!(v["triangles"].as_u64().unwrap() > 100);
+    let sweep_min = ["x", "y", "z"]
+        .iter()
+        .flat_map(|a| v["curves"][a]["sweep"].as_array().unwrap().iter().map(|p| p["cost"].as_f64().unwrap()))
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(v["markers"]["sah-sweep"]["cost"].as_f64().unwrap(), sweep_min);
+    let (lo, hi) = (&v["centroid_bounds"]["min"], &v["centroid_bounds"]["max"]);
+    let extent: Vec<f64> = (0..3).map(|k| hi[k].as_f64().unwrap() - lo[k].as_f64().unwrap()).collect();
+    let widest = (0..3).max_by(|&a, &b| extent[a].total_cmp(&extent[b])).unwrap();
+    let m = &v["markers"]["midpoint"];
+    assert_eq!(m["axis"], ["x", "y", "z"][widest]);
+    let middle = (lo[widest].as_f64().unwrap() as f32 + hi[widest].as_f64().unwrap() as f32) * 0.5;
+    assert_eq!(m["position"].as_f64().unwrap() as f32, middle);
+    assert_eq!(v["split_axis"], m["axis"], "the midpoint tree split this node where midpoint's marker says");
+
+    let out = bvhscope(&["inspect", torus, "--node", "1", "--format", "csv"]);
+    let mut reader = csv::Reader::from_reader(&out.stdout[..]);
+    assert_eq!(reader.headers().unwrap(), vec!["axis", "position", "left_count", "right_count", "cost"]);
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    assert!(rows.len() > 100 && rows.iter().all(|r| r[4].parse::<f32>().unwrap() > 1.0));
+
+    let out = bvhscope(&["inspect", torus, "--node", "999999"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--node 999999: the tree has"));
+    let out = bvhscope(&["inspect", torus, "--node", "0"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("where each strategy splits") && text.contains("EPO share"), "{text}");
+}
+
+/// `stats` prints the tree's end-point overlap, and `compare` has it as a column.
+#[test]
+fn stats_and_compare_show_the_end_point_overlap() {
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    let out = bvhscope(&["stats", torus, "--no-rays", "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["stats"]["epo"].as_f64().unwrap() > 0.0);
+    let out = bvhscope(&["stats", torus, "--no-rays"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("EPO "));
 }

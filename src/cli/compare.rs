@@ -16,7 +16,7 @@
 use super::args::{BuildArgs, ViewArgs};
 use super::{load_mesh, progress, CliError};
 use crate::bvh::{
-    Accelerator, AnyBvh, BuildParams, LinearScan, NoStats, SplitStrategy, TraceOptions, TreeStats, TreeView,
+    epo, Accelerator, AnyBvh, BuildParams, LinearScan, NoStats, SplitStrategy, TraceOptions, TreeStats, TreeView,
 };
 use crate::render::{render, Camera, RenderSettings};
 use clap::{Args, ValueEnum};
@@ -61,6 +61,8 @@ pub struct CompareRow {
     pub max_depth: u32,
     pub mean_leaf_depth: f64,
     pub sah_cost: Option<f64>,
+    /// End-point overlap of the binary tree (the same for both layouts of a strategy).
+    pub epo: Option<f64>,
     /// Means over all primary rays.
     pub nodes_per_ray: f64,
     pub tri_tests_per_ray: f64,
@@ -164,6 +166,7 @@ pub fn compare_rows(
     let counting = RenderSettings { count: true, ..plain };
     let mut rows = Vec::new();
     let mut root_rays = 0;
+    let mut epo_of = std::collections::HashMap::new();
     let layouts = build.compare_layouts();
     for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))) {
         let params = build.params_with(scene, strategy, layout);
@@ -204,6 +207,11 @@ pub fn compare_rows(
         });
         root_rays = summary.root_rays;
         let frame_ms = median(frame_times);
+        let epo = *epo_of.entry(strategy).or_insert_with(|| {
+            progress::with_spinner(&format!("measuring the end-point overlap of {}", strategy.label()), || {
+                frames.install(|| epo::of(&bvh.binary_tree(mesh)))
+            })
+        });
         rows.push(CompareRow {
             name,
             build_ms: Some(build_ms),
@@ -211,6 +219,7 @@ pub fn compare_rows(
             max_depth: stats.max_depth,
             mean_leaf_depth: stats.mean_leaf_depth,
             sah_cost: Some(stats.sah_cost),
+            epo: Some(epo),
             nodes_per_ray: summary.mean_nodes_visited,
             tri_tests_per_ray: summary.mean_triangle_tests,
             root_nodes_per_ray: summary.root_mean_nodes_visited,
@@ -237,6 +246,7 @@ pub fn compare_rows(
         max_depth: 0,
         mean_leaf_depth: 0.0,
         sah_cost: None,
+        epo: None,
         nodes_per_ray: 0.0,
         tri_tests_per_ray: n,
         root_nodes_per_ray: 0.0,
@@ -275,6 +285,7 @@ pub fn rows_csv(rows: &[CompareRow]) -> String {
         "max_depth",
         "mean_leaf_depth",
         "sah_cost",
+        "epo",
         "nodes_per_ray",
         "tri_tests_per_ray",
         "root_box_nodes_per_ray",
@@ -294,6 +305,7 @@ pub fn rows_csv(rows: &[CompareRow]) -> String {
             r.max_depth.to_string(),
             format!("{:.2}", r.mean_leaf_depth),
             opt(r.sah_cost, 3),
+            opt(r.epo, 3),
             format!("{:.3}", r.nodes_per_ray),
             format!("{:.3}", r.tri_tests_per_ray),
             format!("{:.3}", r.root_nodes_per_ray),
@@ -330,8 +342,8 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
         }
         CompareFormat::Csv => o = rows_csv(&rows),
         CompareFormat::Markdown => {
-            let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | nodes / ray: all / in root box | tri tests / ray: all / in root box | trace ms | frame ms | speedup vs linear |");
-            let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+            let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | EPO | nodes / ray: all / in root box | tri tests / ray: all / in root box | trace ms | frame ms | speedup vs linear |");
+            let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
             for r in &rows {
                 let depth =
                     if r.nodes > 0 { format!("{} / {:.1}", r.max_depth, r.mean_leaf_depth) } else { "—".into() };
@@ -339,12 +351,13 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
                 let dash = |v: Option<f64>, d: usize| v.map_or("—".to_string(), |v| format!("{v:.d$}"));
                 let _ = writeln!(
                     o,
-                    "| {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} / {:.1} | {}{sampled} | {}{sampled} | {:.0}× |",
+                    "| {} | {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} / {:.1} | {}{sampled} | {}{sampled} | {:.0}× |",
                     r.name,
                     r.build_ms.map_or("—".to_string(), crate::bvh::fmt_ms),
                     r.nodes,
                     depth,
                     dash(r.sah_cost, 2),
+                    dash(r.epo, 2),
                     r.nodes_per_ray,
                     r.root_nodes_per_ray,
                     r.tri_tests_per_ray,
@@ -396,6 +409,7 @@ mod tests {
             max_depth: 2,
             mean_leaf_depth: 1.5,
             sah_cost: build_ms.map(|_| 3.25),
+            epo: build_ms.map(|_| 0.5),
             nodes_per_ray: 1.0,
             tri_tests_per_ray: 2.0,
             root_nodes_per_ray: 4.0,

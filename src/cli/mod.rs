@@ -3,6 +3,7 @@
 
 mod args;
 mod compare;
+pub mod inspect;
 mod progress;
 mod render;
 mod stats;
@@ -49,6 +50,8 @@ pub enum Command {
     Compare(compare::CompareArgs),
     /// One ray's walk through the BVH, step by step (a pixel of the camera, or a typed ray).
     Trace(trace::TraceArgs),
+    /// One node of the BVH explained: its figures, and where each strategy would split it.
+    Inspect(inspect::InspectArgs),
 }
 
 /// An error the CLI reports in one line before exiting with code 2.
@@ -113,6 +116,7 @@ pub fn run(command: Command) -> Result<(), CliError> {
     match command {
         Command::Render(a) => render::run(&a),
         Command::Trace(a) => trace::run(&a),
+        Command::Inspect(a) => inspect::run(&a),
         Command::Stats(a) => stats::run(&a),
         Command::Compare(a) => compare::run(&a),
     }

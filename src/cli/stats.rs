@@ -3,7 +3,7 @@
 
 use super::args::{BuildArgs, ViewArgs};
 use super::{build_scene, load_mesh, progress, CliError};
-use crate::bvh::{SceneBvh, TreeStats, TreeView};
+use crate::bvh::{epo, SceneBvh, TreeStats, TreeView};
 use crate::render::{render, Camera, RaySummary, RenderSettings};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
@@ -75,13 +75,15 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
         .map(|(camera, summary)| serde_json::json!({ "camera": camera, "trace": a.build.trace(), "summary": summary }));
     let rays_text = rays.map_or(String::new(), |(camera, r)| format_rays(&camera, &a.build.trace(), &r));
     match (&bvh, a.format) {
-        (SceneBvh::Single { bvh: b, .. }, StatsFormat::Json) => {
-            let v =
-                serde_json::json!({ "mesh": report, "params": params, "stats": TreeStats::of(b), "rays": rays_json });
-            println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
-        }
-        (SceneBvh::Single { bvh: b, .. }, StatsFormat::Text) => {
-            print!("{}{rays_text}", format_text(report, &params, &TreeStats::of(b)))
+        (SceneBvh::Single { bvh: b, mesh }, format) => {
+            let epo = progress::with_spinner("measuring the end-point overlap", || epo::of(&b.binary_tree(mesh)));
+            let stats = TreeStats { epo: Some(epo), ..TreeStats::of(b) };
+            if let StatsFormat::Json = format {
+                let v = serde_json::json!({ "mesh": report, "params": params, "stats": stats, "rays": rays_json });
+                println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
+            } else {
+                print!("{}{rays_text}", format_text(report, &params, &stats))
+            }
         }
         (SceneBvh::TwoLevel { bvh: t, .. }, format) => {
             let top = TreeStats::of(&t.top);
@@ -194,6 +196,9 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         "SAH cost        {:.3} (C_trav = {}, C_isect = {}, normalised by root area)",
         s.sah_cost, s.sah_constants.traversal, s.sah_constants.intersection
     );
+    if let Some(epo) = s.epo {
+        let _ = writeln!(o, "EPO             {epo:.3} (end-point overlap of the binary tree, Aila et al. 2013)");
+    }
     let _ = writeln!(
         o,
         "memory          {} bytes ({:.1} per triangle, nodes + indices)",

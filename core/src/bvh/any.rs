@@ -14,6 +14,18 @@ pub enum AnyBvh {
 }
 
 impl AnyBvh {
+    /// The binary tree as built: this one, or for the wide layout the binary tree it was collapsed
+    /// from, built again (the build is deterministic: the same nodes in the same places). The node
+    /// inspector's ids and the EPO are those of this tree.
+    pub fn binary_tree<'a>(&'a self, mesh: &Mesh) -> std::borrow::Cow<'a, Bvh> {
+        match self {
+            AnyBvh::Binary(b) => std::borrow::Cow::Borrowed(b),
+            AnyBvh::Wide(w) => {
+                std::borrow::Cow::Owned(Bvh::build(mesh, &BuildParams { layout: Layout::Binary, ..w.params }))
+            }
+        }
+    }
+
     /// Build the binary BVH with `params.strategy`, then lay it out as `params.layout` says.
     pub fn build(mesh: &Mesh, params: &BuildParams) -> AnyBvh {
         match Self::build_controlled(mesh, params, &WorkControl::new()) {

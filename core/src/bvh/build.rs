@@ -331,7 +331,7 @@ fn decide(
     }
     match splitter.split(range, info) {
         // A split must leave both sides non-empty.
-        Proposal::Split { axis, mid, weighted } if mid > 0 && mid < n => {
+        Proposal::Split { axis, mid, weighted, .. } if mid > 0 && mid < n => {
             if fits && weighted.is_none_or(|w| leaf_is_cheaper(n, w, info, params)) {
                 Decision::Leaf
             } else {

@@ -6,6 +6,8 @@ mod accel;
 mod any;
 mod build;
 mod counters;
+pub mod epo;
+pub mod inspect;
 mod linear;
 mod node;
 pub mod packet;

@@ -30,6 +30,9 @@ pub struct TreeStats {
     pub build_total_ms: f64,
     pub fallback_splits: u32,
     pub depth_limited_splits: u32,
+    /// End-point overlap of the binary tree as built (`bvh::epo`), when it was computed: it costs
+    /// a box query per node, so `of` leaves it out and the callers that show it add it.
+    pub epo: Option<f64>,
 }
 
 /// A time in milliseconds as the statistics print it: two decimals under 10 ms, so a fast build

@@ -22,6 +22,7 @@ impl EqualCount {
 impl Splitter for EqualCount {
     fn split(&mut self, prims: &mut [BuildPrim], node: &NodeInfo) -> Proposal {
         let (axis, mid) = Self::median(prims, node);
-        Proposal::Split { axis, mid, weighted: None }
+        let plane = prims[mid].centroid()[axis as usize];
+        Proposal::Split { axis, mid, weighted: None, plane }
     }
 }

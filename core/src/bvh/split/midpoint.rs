@@ -14,7 +14,7 @@ impl Splitter for Midpoint {
         if mid == 0 || mid == prims.len() {
             Proposal::None
         } else {
-            Proposal::Split { axis: axis as u8, mid, weighted: None }
+            Proposal::Split { axis: axis as u8, mid, weighted: None, plane: pivot }
         }
     }
 }

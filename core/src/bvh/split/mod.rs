@@ -13,8 +13,8 @@ use glam::{Vec3A, Vec4};
 
 pub use equal_count::EqualCount;
 pub use midpoint::Midpoint;
-pub use sah_binned::SahBinned;
-pub use sah_sweep::SahSweep;
+pub use sah_binned::{binned_planes, bins_for, SahBinned};
+pub use sah_sweep::{sweep_planes, SahSweep};
 
 /// The largest bin count the binned SAH accepts.
 pub const fn sah_binned_max_bins() -> usize {
@@ -116,12 +116,30 @@ pub struct NodeInfo {
 /// A strategy's answer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Proposal {
-    /// `prims[..mid]` go left. `weighted`: for a strategy that prices its split with the SAH, the
-    /// sum A_L·n_L + A_R·n_R of the two sides (the driver compares it with a leaf's cost).
-    Split { axis: u8, mid: usize, weighted: Option<f32> },
+    /// `prims[..mid]` go left: those whose centroid on `axis` lies below `plane` (for equal count,
+    /// the median centroid, with ties split by index). `weighted`: for a strategy that prices its
+    /// split with the SAH, the sum A_L·n_L + A_R·n_R of the two sides (the driver compares it
+    /// with a leaf's cost).
+    Split { axis: u8, mid: usize, weighted: Option<f32>, plane: f32 },
     /// No useful split (midpoint with one side empty, coincident centroids). The driver makes a
     /// leaf if the triangles fit in one, else splits by equal count and counts it in the statistics.
     None,
+}
+
+/// What a pricing strategy evaluated at a node, plane by plane: the node inspector's cost curves
+/// come from the very loops that choose the split, through this sink; the build passes `()`,
+/// whose `ACTIVE = false` compiles the reports away.
+pub trait PlaneSink {
+    const ACTIVE: bool = true;
+    /// A candidate plane at `position` on `axis`, with `left` and `right` triangles on its sides
+    /// and `weighted` = A_L·n_L + A_R·n_R.
+    fn plane(&mut self, axis: usize, position: f32, left: u32, right: u32, weighted: f32);
+}
+
+impl PlaneSink for () {
+    const ACTIVE: bool = false;
+    #[inline(always)]
+    fn plane(&mut self, _: usize, _: f32, _: u32, _: u32, _: f32) {}
 }
 
 /// Move the elements satisfying `left` to the front; returns how many there are. Unstable.

@@ -5,7 +5,7 @@
 //! binned in one pass over the triangles, so a node costs O(n + bins), with no per-node allocation
 //! below the top levels; big nodes are binned in parallel chunks.
 
-use super::{partition, BuildPrim, NodeInfo, Proposal, Splitter};
+use super::{partition, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
@@ -77,16 +77,35 @@ impl Splitter for SahBinned {
     }
 
     fn split(&mut self, prims: &mut [BuildPrim], node: &NodeInfo) -> Proposal {
-        binned(prims, node, self.max_bins, &mut self.bins, &mut self.plane_areas)
+        binned(prims, node, self.max_bins, &mut self.bins, &mut self.plane_areas, &mut ())
     }
 }
 
-fn binned(
+/// The binned SAH over `prims` (partitioned by its choice) with at most `max_bins` bins, reporting
+/// every plane between bins that has triangles on both sides to `sink`: the node inspector's
+/// stepped cost curve. Two triangles are split directly, without bins or reports.
+pub fn binned_planes(prims: &mut [BuildPrim], node: &NodeInfo, max_bins: usize, sink: &mut impl PlaneSink) -> Proposal {
+    binned(prims, node, max_bins, &mut Vec::new(), &mut Vec::new(), sink)
+}
+
+/// The bins a node of `n` triangles is binned into: n/3 (at least 4), at most `max_bins`.
+pub fn bins_for(n: usize, max_bins: usize) -> usize {
+    max_bins.min((n / 3).max(4)).clamp(2, MAX_BINS)
+}
+
+/// Whether `sink` records (a constant: the build's `()` compiles the reports away).
+#[inline(always)]
+fn is_active<P: PlaneSink>(_: &P) -> bool {
+    P::ACTIVE
+}
+
+fn binned<P: PlaneSink>(
     prims: &mut [BuildPrim],
     node: &NodeInfo,
     max_bins: usize,
     all: &mut Vec<Bin>,
     right_area: &mut Vec<Vec4>,
+    sink: &mut P,
 ) -> Proposal {
     let n = prims.len();
     let cb = node.centroid_bounds;
@@ -98,7 +117,7 @@ fn binned(
     // centroids seldom beat their neighbours; the sweeps, not the binning, are the cost of the
     // many small nodes near the leaves. So a node gets n/3 bins (at least 4) up to the maximum:
     // a faster build for a tenth of a percent of SAH cost (BENCHMARKS.md, "Ninth round").
-    let bins = max_bins.min((n / 3).max(4)).clamp(2, MAX_BINS);
+    let bins = bins_for(n, max_bins);
     // Axes with no extent cannot be split by a plane; their scale 0 puts everything in bin 0.
     let scale: [f32; 3] = std::array::from_fn(|a| if extent[a] > 0.0 { bins as f32 / extent[a] } else { 0.0 });
     let (lo, sc, top) = (cb.min, Vec3A::from(Vec3::from(scale)), Vec3A::splat((bins - 1) as f32));
@@ -164,6 +183,11 @@ fn binned(
         let counts = |c: [u32; 3]| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, 0.0);
         let cost = areas3(&acc) * counts(left) + right_area * counts(right);
         let usable = |a: usize| left[a] != 0 && right[a] != 0 && splittable[a];
+        if is_active(sink) {
+            for a in (0..3).filter(|&a| usable(a)) {
+                sink.plane(a, cb.min[a] + i as f32 / scale[a], left[a], right[a], cost[a]);
+            }
+        }
         let better = cost.cmplt(lane_cost) & BVec4A::new(usable(0), usable(1), usable(2), false);
         lane_cost = Vec4::select(better, cost, lane_cost);
         lane_plane = Vec4::select(better, Vec4::splat(i as f32), lane_plane);
@@ -189,7 +213,7 @@ fn binned(
         all[axis * bins..axis * bins + plane as usize].iter().map(|b| b.count as usize).sum::<usize>(),
         "the partition sends left exactly the triangles binned left of the plane"
     );
-    Proposal::Split { axis: axis as u8, mid, weighted: Some(weighted) }
+    Proposal::Split { axis: axis as u8, mid, weighted: Some(weighted), plane: lo + plane / s }
 }
 
 /// The partition's side for a scaled centroid offset and an integer plane in 1..bins: left exactly
@@ -223,7 +247,8 @@ fn split_two(prims: &mut [BuildPrim], extent: Vec3A) -> Proposal {
     if prims[0].centroid()[axis] > prims[1].centroid()[axis] {
         prims.swap(0, 1);
     }
-    Proposal::Split { axis: axis as u8, mid: 1, weighted: Some(weighted) }
+    let plane = (prims[0].centroid()[axis] + prims[1].centroid()[axis]) * 0.5;
+    Proposal::Split { axis: axis as u8, mid: 1, weighted: Some(weighted), plane }
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! ray tracing using space subdivision" (The Visual Computer, 1990); Wald 2007 §3 for the sweep.
 //! O(n log n) per node; use the binned version for big meshes in interactive work.
 
-use super::{BuildPrim, NodeInfo, Proposal, Splitter};
+use super::{BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 
@@ -28,11 +28,18 @@ impl Splitter for SahSweep {
     }
 
     fn split(&mut self, prims: &mut [BuildPrim], node: &NodeInfo) -> Proposal {
-        sweep(prims, node, &mut self.right_area)
+        sweep(prims, node, &mut self.right_area, &mut ())
     }
 }
 
-fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>) -> Proposal {
+/// The sweep over `prims` (reordered), reporting every candidate plane to `sink`: the node
+/// inspector's exact cost curve. The plane between two neighbouring centroids is reported at
+/// their midpoint.
+pub fn sweep_planes(prims: &mut [BuildPrim], node: &NodeInfo, sink: &mut impl PlaneSink) -> Proposal {
+    sweep(prims, node, &mut Vec::new(), sink)
+}
+
+fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>, sink: &mut impl PlaneSink) -> Proposal {
     let n = prims.len();
     right_area.clear();
     right_area.resize(n, 0.0);
@@ -58,6 +65,10 @@ fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>) ->
                 continue;
             }
             let cost = acc.area() * i as f32 + right_area[i] * (n - i) as f32;
+            if is_active(sink) {
+                let plane = (prims[i - 1].centroid()[axis] + prims[i].centroid()[axis]) * 0.5;
+                sink.plane(axis, plane, i as u32, (n - i) as u32, cost);
+            }
             if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, axis, i));
             }
@@ -69,5 +80,12 @@ fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>) ->
     if sorted_on != Some(axis) {
         sort_on(prims, axis);
     }
-    Proposal::Split { axis: axis as u8, mid, weighted: Some(weighted) }
+    let plane = (prims[mid - 1].centroid()[axis] + prims[mid].centroid()[axis]) * 0.5;
+    Proposal::Split { axis: axis as u8, mid, weighted: Some(weighted), plane }
+}
+
+/// Whether `sink` records (a constant: the build's `()` compiles the reports away).
+#[inline(always)]
+fn is_active<P: PlaneSink>(_: &P) -> bool {
+    P::ACTIVE
 }

@@ -1,0 +1,199 @@
+//! `bvhscope inspect MESH --node N`: one node of the binary tree as built, explained (the app's
+//! node inspector): its figures, its children, and per axis the SAH cost of splitting its
+//! triangles at every candidate plane with each strategy's choice marked (`bvh::inspect`).
+
+use super::args::BuildArgs;
+use super::{build_scene, load_mesh, CliError};
+use crate::bvh::inspect::{inspect, CurvePoint, Hierarchy, Inspection};
+use crate::bvh::{epo, SceneBvh, TreeView};
+use crate::options::Choice;
+use clap::{Args, ValueEnum};
+use std::fmt::Write;
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum InspectFormat {
+    Text,
+    Json,
+    /// The exact sweep's curves: `axis,position,left_count,right_count,cost`.
+    Csv,
+}
+
+#[derive(Args, Debug)]
+pub struct InspectArgs {
+    /// The mesh (.obj) or scene (.json, one level).
+    pub mesh: PathBuf,
+    /// The node: its id in the binary tree as built (0 is the root; the app's tree view shows
+    /// the same ids).
+    #[arg(long, default_value_t = 0)]
+    pub node: u32,
+    #[command(flatten)]
+    pub build: BuildArgs,
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: InspectFormat,
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+fn points_json(points: &[CurvePoint]) -> serde_json::Value {
+    points
+        .iter()
+        .map(|p| serde_json::json!({ "position": p.position, "left_count": p.left, "right_count": p.right, "cost": p.cost }))
+        .collect()
+}
+
+fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
+    let curves: serde_json::Map<String, serde_json::Value> = (0..3)
+        .map(|a| {
+            let v = serde_json::json!({ "sweep": points_json(&ins.sweep[a]), "binned": points_json(&ins.binned[a]) });
+            (AXES[a].to_string(), v)
+        })
+        .collect();
+    let markers: serde_json::Map<String, serde_json::Value> = ins
+        .markers
+        .iter()
+        .map(|(s, m)| {
+            let v = m.map_or(serde_json::Value::Null, |m| {
+                serde_json::json!({ "axis": AXES[m.axis as usize], "position": m.position, "cost": m.cost,
+                    "left_count": m.left, "right_count": m.right })
+            });
+            (s.named().name.to_string(), v)
+        })
+        .collect();
+    let b = |v: glam::Vec3A| v.to_array();
+    serde_json::json!({
+        "node": ins.node, "depth": ins.depth, "parent": ins.parent, "path": path, "children": ins.children,
+        "split_axis": ins.split_axis.map(|a| AXES[a as usize]),
+        "triangles": ins.triangles,
+        "bounds": { "min": b(ins.bounds.min), "max": b(ins.bounds.max) },
+        "centroid_bounds": { "min": b(ins.centroid_bounds.min), "max": b(ins.centroid_bounds.max) },
+        "area": ins.area, "area_ratio_to_parent": ins.area_ratio, "subtree_sah_cost": ins.subtree_sah,
+        "child_overlap": ins.child_overlap, "leaf_cost": ins.leaf_cost, "epo_contribution": epo_term,
+        "bins": ins.bins, "curves": curves, "markers": markers,
+    })
+}
+
+/// The node's figures and each strategy's choice, as a human-readable block.
+pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
+    let mut o = String::new();
+    let crumbs = path.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" > ");
+    let _ = writeln!(o, "node            {} (depth {}; path {crumbs})", ins.node, ins.depth);
+    match (ins.children, ins.split_axis) {
+        (Some([l, r]), Some(a)) => {
+            let _ = writeln!(o, "children        {l} and {r}, split on {}", AXES[a as usize]);
+        }
+        _ => {
+            let _ = writeln!(o, "leaf");
+        }
+    }
+    let _ = writeln!(o, "triangles       {}", ins.triangles);
+    let (lo, hi) = (ins.bounds.min, ins.bounds.max);
+    let _ = writeln!(o, "box             ({}, {}, {}) .. ({}, {}, {})", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+    let ratio = ins.area_ratio.map_or(String::new(), |r| format!(", {:.1}% of its parent's", 100.0 * r));
+    let _ = writeln!(o, "surface area    {:.6}{ratio}", ins.area);
+    let _ = writeln!(o, "subtree SAH     {:.3} (relative to this node's area)", ins.subtree_sah);
+    if let Some(ov) = ins.child_overlap {
+        let _ = writeln!(o, "child overlap   volume {:.6}, area {:.6}", ov.volume, ov.area);
+    }
+    let _ = writeln!(o, "EPO share       {epo_term:.4} (this node's term of the tree's end-point overlap)");
+    let _ = writeln!(o, "as a leaf       cost {:.3} (C_isect x triangles)", ins.leaf_cost);
+    let _ = writeln!(o);
+    let _ = writeln!(o, "where each strategy splits these triangles (cost C_trav + C_isect (A_L n_L + A_R n_R) / A):");
+    for (s, m) in &ins.markers {
+        match m {
+            Some(m) => {
+                let _ = writeln!(
+                    o,
+                    "  {:<12}  {} = {:<12}  {:>6} | {:<6}  cost {:.3}",
+                    s.named().name,
+                    AXES[m.axis as usize],
+                    m.position,
+                    m.left,
+                    m.right,
+                    m.cost
+                );
+            }
+            None => {
+                let _ = writeln!(o, "  {:<12}  no split (the builder falls back to equal count)", s.named().name);
+            }
+        }
+    }
+    let _ = writeln!(o);
+    let min = |c: &[CurvePoint]| c.iter().min_by(|p, q| p.cost.total_cmp(&q.cost)).copied();
+    let show = |p: Option<CurvePoint>| p.map_or("-".to_string(), |p| format!("{:.3} at {}", p.cost, p.position));
+    for (axis, (sweep, binned)) in AXES.iter().zip(ins.sweep.iter().zip(&ins.binned)) {
+        let _ = writeln!(
+            o,
+            "axis {axis}          {} candidate planes, cheapest {}; {} bins' planes, cheapest {}",
+            sweep.len(),
+            show(min(sweep)),
+            binned.len(),
+            show(min(binned))
+        );
+    }
+    o
+}
+
+/// The exact sweep's curves as CSV.
+pub fn csv(ins: &Inspection) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let _ = w.write_record(["axis", "position", "left_count", "right_count", "cost"]);
+    for (a, points) in ins.sweep.iter().enumerate() {
+        for p in points {
+            let _ = w.write_record([
+                AXES[a].to_string(),
+                p.position.to_string(),
+                p.left.to_string(),
+                p.right.to_string(),
+                p.cost.to_string(),
+            ]);
+        }
+    }
+    String::from_utf8(w.into_inner().expect("writing to memory")).expect("CSV of numbers is UTF-8")
+}
+
+pub fn run(a: &InspectArgs) -> Result<(), CliError> {
+    print!("{}", output(a)?);
+    Ok(())
+}
+
+/// What `run` prints.
+pub fn output(a: &InspectArgs) -> Result<String, CliError> {
+    if a.build.two_level {
+        return Err(CliError::Usage(
+            "inspect explains a node of one BVH; leave out --two-level (a scene is then flattened)".into(),
+        ));
+    }
+    let scene = load_mesh(&a.mesh)?;
+    let params = a.build.params(scene.build.as_ref());
+    let SceneBvh::Single { bvh, mesh } = build_scene(&scene, &a.build.scene_build(params))? else {
+        unreachable!("one level was asked for")
+    };
+    let tree = bvh.binary_tree(&mesh);
+    let h = Hierarchy::of(&tree);
+    let Some(ins) = inspect(&tree, &h, a.node) else {
+        return Err(CliError::Usage(format!(
+            "--node {}: the tree has {} nodes (0 to {})",
+            a.node,
+            tree.nodes.len(),
+            tree.nodes.len() - 1
+        )));
+    };
+    let path = h.path(a.node);
+    Ok(match a.format {
+        InspectFormat::Csv => csv(&ins),
+        InspectFormat::Json => {
+            let term = epo::node_term(&tree, &h, a.node as usize);
+            format!("{}\n", serde_json::to_string_pretty(&json(&ins, term, &path)).expect("plain data serialises"))
+        }
+        InspectFormat::Text => {
+            let term = epo::node_term(&tree, &h, a.node as usize);
+            {
+                let p = bvh.params();
+                let build =
+                    format!("{}, max leaf size {}, {} SAH bins", p.strategy.label(), p.max_leaf_size, p.sah_bins);
+                format!("build           {build} (the binary tree)\n{}", text(&ins, term, &path))
+            }
+        }
+    })
+}
