@@ -3,6 +3,7 @@
 //! changes it, and `BvhscopeApp::reconcile` the one place that decides, from the state alone,
 //! what to rebuild and what to re-render (the egui demo app's split of state and UI).
 
+use super::node_view::{Metric, Step as NodeStep};
 use super::{Pick, Settings};
 use crate::bvh::Preset;
 use crate::render::UpAxis;
@@ -83,6 +84,19 @@ pub enum Action {
     RayPlay(bool),
     /// Open the Ray window with nothing pinned (to type a ray).
     ShowRayWindow,
+
+    /// Open (or close) the Tree and Node windows.
+    ShowTree(bool),
+    /// Select node `n` of the binary tree as built (tree view, icicle, breadcrumb).
+    SelectNode(u32),
+    /// Select the leaf that holds the hit of pixel (x, y) of the image on screen.
+    SelectPixelNode(u32, u32),
+    /// Move the selection to the parent, a child or the sibling.
+    NodeStep(NodeStep),
+    /// Open or close a row of the tree view.
+    ToggleOpen(u32),
+    /// What the icicle colours by.
+    SetMetric(Metric),
 
     /// Toggle the Help window.
     Help,

@@ -2,6 +2,8 @@
 //! and report over one channel; the UI thread only polls. Starting a job of a kind cancels the
 //! running one of that kind, and results of superseded jobs are dropped by id.
 
+use super::node_view::{Explained, FrameVisits};
+use crate::bvh::inspect::Inspection;
 use crate::bvh::{SahCost, TraceOptions};
 use crate::bvh::{SceneBuild, SceneBvh};
 use crate::render::{
@@ -71,6 +73,9 @@ pub enum Pick {
 
 pub enum JobEvent {
     Loaded(Result<Arc<Scene>, String>),
+    Explained(Arc<Explained>),
+    Visits(FrameVisits),
+    Inspected { node: u32, explained: Arc<Explained>, inspection: Arc<Inspection> },
     Built { scene_id: u64, params: SceneBuild, result: Result<Arc<SceneBvh>, SceneBuildError> },
     Pass(PassOutput),
     Picked { pick: Pick, path: Option<PathBuf>, took: Duration },
@@ -92,6 +97,11 @@ pub struct Jobs {
     pub load: Option<Running>,
     pub build: Option<Running>,
     pub render: Option<Running>,
+    /// The node explainer's background work (`node_view`): preparing the tree, counting the
+    /// frame's visits, inspecting the selected node. Each started only when nothing above runs.
+    pub explain: Option<Running>,
+    pub visits: Option<Running>,
+    pub inspect: Option<(Running, u32)>,
     pub picking: Option<Pick>,
     /// The last render started (to tell whether a new one is needed).
     pub last_render: Option<RenderRequest>,
@@ -112,6 +122,9 @@ impl Jobs {
             load: None,
             build: None,
             render: None,
+            explain: None,
+            visits: None,
+            inspect: None,
             picking: None,
             last_render: None,
             last_build: None,
@@ -201,6 +214,46 @@ impl Jobs {
         self.last_render = Some(req);
     }
 
+    /// Prepare the binary tree behind `bvh` (a single BVH) for the Tree and Node windows.
+    pub fn explain(&mut self, bvh: Arc<SceneBvh>) {
+        let job = self.start("Preparing the tree view".to_string());
+        let send = self.sender(job.id);
+        std::thread::spawn(move || {
+            if let SceneBvh::Single { bvh: any, mesh } = &*bvh {
+                let tree = any.binary_tree(mesh).into_owned();
+                send(JobEvent::Explained(Arc::new(Explained::new(bvh.clone(), tree))));
+            }
+        });
+        self.explain = Some(job);
+    }
+
+    /// Count, per node, the visits of `camera`'s primary rays (a running count is cancelled).
+    pub fn visits(&mut self, explained: Arc<Explained>, camera: Camera, trace: TraceOptions) {
+        if let Some(old) = self.visits.take() {
+            old.control.cancel();
+        }
+        let job = self.start("Counting visits per node".to_string());
+        let (send, control) = (self.sender(job.id), job.control.clone());
+        std::thread::spawn(move || {
+            if let Ok(v) = crate::bvh::visits::frame_visits(&explained.tree, &camera, trace, &control) {
+                send(JobEvent::Visits(FrameVisits { explained, camera, trace, counts: v.counts }));
+            }
+        });
+        self.visits = Some(job);
+    }
+
+    /// Inspect `node` of the prepared tree.
+    pub fn inspect(&mut self, explained: Arc<Explained>, node: u32) {
+        let job = self.start(format!("Inspecting node {node}"));
+        let send = self.sender(job.id);
+        std::thread::spawn(move || {
+            if let Some(ins) = crate::bvh::inspect::inspect(&explained.tree, &explained.hierarchy, node) {
+                send(JobEvent::Inspected { node, explained, inspection: Arc::new(ins) });
+            }
+        });
+        self.inspect = Some((job, node));
+    }
+
     /// Ask for a file with the system dialog, off the UI thread (rfd's async dialog blocks its
     /// thread until answered where a portal or zenity exists, and returns None at once where not).
     pub fn pick_file(&mut self, pick: Pick, suggested_name: &str) {
@@ -244,6 +297,11 @@ impl Jobs {
                     }
                 }
                 JobEvent::Picked { .. } => self.picking = None,
+                JobEvent::Explained(_) if current(&self.explain) => self.explain = None,
+                JobEvent::Visits(_) if current(&self.visits) => self.visits = None,
+                JobEvent::Inspected { .. } if self.inspect.as_ref().is_some_and(|(r, _)| r.id == id) => {
+                    self.inspect = None
+                }
                 _ => continue,
             }
             out.push(event);

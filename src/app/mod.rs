@@ -6,6 +6,7 @@
 mod action;
 mod export;
 mod jobs;
+mod node_view;
 mod orbit;
 mod overlay;
 mod panels;
@@ -18,6 +19,7 @@ mod viewport;
 pub use crate::scene::{Scene, SceneSource};
 pub use action::{Action, Actions};
 pub use jobs::Pick;
+pub use node_view::{Metric, NodeView, Step as NodeStep};
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
 pub use ray_view::{PinnedRay, RayView};
@@ -147,9 +149,13 @@ pub struct BvhscopeApp {
     pub pins: RayView,
     /// The Ray window is open with nothing pinned (to type a ray).
     pub ray_window: bool,
+    /// The Tree and Node windows: the prepared tree, the node selected, its inspection.
+    pub nodes: NodeView,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     box_cache: std::cell::RefCell<Option<BoxCache>>,
     overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
+    /// The selected node's mask over the frame on screen.
+    mask_cache: std::cell::RefCell<Option<MaskCache>>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
     /// Where the viewport was drawn in the last frame (its size is the rendered image's).
@@ -166,6 +172,14 @@ struct OverlayCache {
     rect: egui::Rect,
     depth: Option<Arc<Frame>>,
     mesh: Arc<egui::Mesh>,
+}
+
+/// A node's mask: for the frame, the prepared tree and the node it was made for.
+struct MaskCache {
+    frame: Arc<Frame>,
+    tree: Arc<node_view::Explained>,
+    node: u32,
+    texture: egui::TextureHandle,
 }
 
 struct BoxCache {
@@ -205,8 +219,10 @@ impl BvhscopeApp {
             path_window: None,
             pins: RayView::default(),
             ray_window: false,
+            nodes: NodeView::default(),
             box_cache: Default::default(),
             overlay_cache: Default::default(),
+            mask_cache: Default::default(),
             viewport_aspect: aspect,
             viewport_rect: egui::Rect::NOTHING,
             viewport_pixels: (0, 0),
@@ -310,6 +326,40 @@ impl BvhscopeApp {
         self.fit_levels_to_scene();
         self.ensure_build();
         self.ensure_render();
+        self.ensure_explained();
+    }
+
+    /// The node explainer's background work, each started only when the image is done (it must
+    /// not slow a build or a render): the binary tree behind the current single BVH, the frame's
+    /// visits per node while the Tree window is open, and the selected node's inspection.
+    fn ensure_explained(&mut self) {
+        if self.jobs.is_busy() {
+            return;
+        }
+        let Some(bvh) = self.current_bvh().map(|b| b.bvh.clone()) else { return };
+        if !matches!(*bvh, SceneBvh::Single { .. }) {
+            return;
+        }
+        let Some(explained) = self.nodes.current(Some(&bvh)).cloned() else {
+            if self.jobs.explain.is_none() {
+                self.jobs.explain(bvh);
+            }
+            return;
+        };
+        if let Some(node) = self.nodes.selected.filter(|_| self.nodes.inspection.is_none()) {
+            if self.jobs.inspect.as_ref().is_none_or(|(_, n)| *n != node) {
+                self.jobs.inspect(explained.clone(), node);
+            }
+        }
+        if self.nodes.window && self.jobs.visits.is_none() {
+            let Some(shown) = self.shown.as_ref().filter(|s| Arc::ptr_eq(&s.bvh, &bvh)) else { return };
+            let fresh = self.nodes.visits.as_ref().is_some_and(|v| {
+                Arc::ptr_eq(&v.explained, &explained) && v.camera == shown.camera && v.trace == shown.trace
+            });
+            if !fresh {
+                self.jobs.visits(explained, shown.camera, shown.trace);
+            }
+        }
     }
 
     /// Box depths within the tree's depth (once it is known: until a BVH is built the chosen
@@ -385,6 +435,42 @@ impl BvhscopeApp {
         cache.as_ref().map(|c| c.boxes.clone())
     }
 
+    /// A mask over `shown`'s frame that dims every pixel whose hit is not a triangle of `node`'s
+    /// subtree (cached for the frame and the node).
+    pub fn node_mask(
+        &self,
+        ctx: &egui::Context,
+        shown: &Shown,
+        e: &Arc<node_view::Explained>,
+        node: u32,
+    ) -> Option<egui::TextureHandle> {
+        let f = &shown.frame;
+        if !f.is_complete() {
+            return None;
+        }
+        let mut cache = self.mask_cache.borrow_mut();
+        if let Some(c) = cache.as_ref() {
+            if Arc::ptr_eq(&c.frame, f) && Arc::ptr_eq(&c.tree, e) && c.node == node {
+                return Some(c.texture.clone());
+            }
+        }
+        let (w, h) = (f.width() as usize, f.height() as usize);
+        let h_ = &e.hierarchy;
+        let mut pixels = Vec::with_capacity(w * h);
+        for y in 0..h {
+            for x in 0..w {
+                let s = f.sample(x as u32, y as u32);
+                let inside = s.is_hit()
+                    && h_.slot_of_prim.get(s.prim as usize).is_some_and(|&slot| h_.holds(node as usize, slot));
+                pixels.push(if inside { egui::Color32::TRANSPARENT } else { egui::Color32::from_black_alpha(150) });
+            }
+        }
+        let image = egui::ColorImage::new([w, h], pixels);
+        let tex = ctx.load_texture("node-mask", image, egui::TextureOptions::NEAREST);
+        *cache = Some(MaskCache { frame: f.clone(), tree: e.clone(), node, texture: tex.clone() });
+        Some(tex)
+    }
+
     /// How many boxes the overlay draws (0 when it is off).
     pub fn boxes_drawn(&self) -> usize {
         let boxes = self.settings.show_boxes.then(|| self.overlay_boxes()).flatten();
@@ -421,7 +507,8 @@ impl BvhscopeApp {
     pub fn current_figures(&self) -> Option<StrategyFigures> {
         self.current_bvh().map(|b| StrategyFigures {
             label: b.bvh.build_params().label(),
-            stats: b.stats.clone(),
+            // The end-point overlap comes with the prepared tree, a moment after the image.
+            stats: TreeStats { epo: self.nodes.current(Some(&b.bvh)).map(|e| e.epo), ..b.stats.clone() },
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
             rays: self.rays,
         })
@@ -461,6 +548,24 @@ impl BvhscopeApp {
                 self.set_scene(scene);
             }
             JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
+            JobEvent::Explained(e) => {
+                // A new tree: keep the selection where the id still exists, and its open rows.
+                let n = e.tree.nodes.len() as u32;
+                self.nodes.selected = self.nodes.selected.filter(|&s| s < n);
+                self.nodes.open.retain(|&o| o < n);
+                self.nodes.inspection = None;
+                self.nodes.explained = Some(e);
+                if let Some(s) = self.nodes.selected {
+                    self.nodes.select(s);
+                }
+            }
+            JobEvent::Visits(v) => self.nodes.visits = Some(v),
+            JobEvent::Inspected { node, explained, inspection } => {
+                let current = self.nodes.explained.as_ref().is_some_and(|e| Arc::ptr_eq(e, &explained));
+                if current && self.nodes.selected == Some(node) {
+                    self.nodes.inspection = Some(inspection);
+                }
+            }
             JobEvent::Built { scene_id, result: Ok(bvh), .. } if scene_id == self.scene_id => {
                 if let Some(old) = self.current_figures() {
                     if self.current_bvh().is_some_and(|b| b.bvh.build_params() != bvh.build_params()) {
@@ -675,6 +780,43 @@ impl BvhscopeApp {
                 }
             }
             A::ShowRayWindow => self.ray_window = true,
+            A::ShowTree(open) => {
+                self.nodes.window = open;
+                if open && self.nodes.selected.is_none() {
+                    self.nodes.selected = Some(0);
+                    self.nodes.inspection = None;
+                }
+            }
+            A::SelectNode(n) => {
+                self.nodes.window = true;
+                self.nodes.select(n);
+            }
+            A::SelectPixelNode(x, y) => {
+                let Some(shown) = &self.shown else { return };
+                let explained = self.nodes.current(Some(&shown.bvh)).cloned();
+                match (explained, shown.frame.sample(x, y)) {
+                    (_, s) if !s.is_hit() => self.message(MessageKind::Info, "That pixel hits nothing: no leaf to select."),
+                    (Some(e), s) => match e.hierarchy.leaf_of_prim(s.prim) {
+                        Some(leaf) => self.act(A::SelectNode(leaf)),
+                        None => self.message(MessageKind::Warning, "The pixel's triangle is in no leaf of this tree."),
+                    },
+                    (None, _) => self.message(
+                        MessageKind::Info,
+                        "The tree view is still being prepared (or the scene is built as two levels, which it does not show).",
+                    ),
+                }
+            }
+            A::NodeStep(step) => {
+                if let Some(n) = self.nodes.step(step) {
+                    self.nodes.select(n);
+                }
+            }
+            A::ToggleOpen(n) => {
+                if !self.nodes.open.remove(&n) {
+                    self.nodes.open.insert(n);
+                }
+            }
+            A::SetMetric(m) => self.nodes.metric = m,
             A::Help => self.show_help = !self.show_help,
             A::SetHelp(on) => self.show_help = on,
             A::Dismiss(i) => {
@@ -719,6 +861,8 @@ impl eframe::App for BvhscopeApp {
             .show(ui, |ui| viewport::show(self, ui, out));
         panels::windows::show(self, &ctx, out);
         panels::ray::show(self, &ctx, out);
+        panels::tree::show(self, &ctx, out);
+        panels::node::show(self, &ctx, out);
         // What the panels asked for takes effect now, and shows in the next frame.
         if !actions.is_empty() {
             for action in actions {

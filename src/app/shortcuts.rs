@@ -1,6 +1,6 @@
 //! Keyboard shortcuts: one table, used both to handle keys and to list them in the Help window.
 
-use super::Action;
+use super::{Action, NodeStep};
 use egui::{Key, KeyboardShortcut, Modifiers};
 
 pub const SHORTCUTS: &[(KeyboardShortcut, Action, &str)] = &[
@@ -20,6 +20,26 @@ pub const SHORTCUTS: &[(KeyboardShortcut, Action, &str)] = &[
     (KeyboardShortcut::new(Modifiers::NONE, Key::OpenBracket), Action::DepthDown, "Boxes one level shallower"),
     (KeyboardShortcut::new(Modifiers::NONE, Key::S), Action::NextStrategy, "Next split strategy"),
     (KeyboardShortcut::new(Modifiers::NONE, Key::C), Action::NextColormap, "Next colour map"),
+    (
+        KeyboardShortcut::new(Modifiers::ALT, Key::ArrowUp),
+        Action::NodeStep(NodeStep::Parent),
+        "Node: select the parent",
+    ),
+    (
+        KeyboardShortcut::new(Modifiers::ALT, Key::ArrowLeft),
+        Action::NodeStep(NodeStep::Left),
+        "Node: select the left child",
+    ),
+    (
+        KeyboardShortcut::new(Modifiers::ALT, Key::ArrowRight),
+        Action::NodeStep(NodeStep::Right),
+        "Node: select the right child",
+    ),
+    (
+        KeyboardShortcut::new(Modifiers::ALT, Key::ArrowDown),
+        Action::NodeStep(NodeStep::Sibling),
+        "Node: select the sibling",
+    ),
     (KeyboardShortcut::new(Modifiers::NONE, Key::F1), Action::Help, "This help"),
 ];
 
@@ -30,6 +50,7 @@ pub const MOUSE: &[(&str, &str)] = &[
     ("Wheel", "Zoom"),
     ("Hover", "Exact counts of the pixel's ray"),
     ("Click", "Pin the pixel's ray: its traversal step by step (Ray window)"),
+    ("Shift+click", "Select the leaf the pixel's ray hits, with its ancestors (Tree and Node windows)"),
     ("Drop an .obj", "Open it"),
 ];
 
@@ -42,7 +63,9 @@ pub fn shortcut_text(ctx: &egui::Context, s: &KeyboardShortcut) -> String {
     if !text.is_empty() {
         text += names.concat;
     }
-    text + s.logical_key.symbol_or_name()
+    // The arrows' symbols (⏶ …) are not in egui's default fonts: name them.
+    let key = s.logical_key.symbol_or_name();
+    text + if key.is_ascii() { key } else { s.logical_key.name() }
 }
 
 /// The actions whose keys were pressed this frame. Single-key shortcuts are ignored while a text

@@ -23,11 +23,15 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         let d = response.drag_delta();
         out.push(Action::Pan { dx: d.x, dy: d.y, height: rect.height() });
     }
-    // A click (no drag) pins the ray of the pixel under it.
+    // A click (no drag) pins the ray of the pixel under it; a shift-click selects its hit's leaf.
     if response.clicked() {
         if let (Some(pos), Some(shown)) = (response.interact_pointer_pos(), &app.shown) {
             if let Some((x, y)) = pixel_at(&shown.frame, rect, pos) {
-                out.push(Action::PinPixel(x, y));
+                if ui.input(|i| i.modifiers.shift) {
+                    out.push(Action::SelectPixelNode(x, y));
+                } else {
+                    out.push(Action::PinPixel(x, y));
+                }
             }
         }
     }
@@ -77,6 +81,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     }
 
     if let Some(shown) = &app.shown {
+        draw_selected_node(app, &painter, rect, shown);
         draw_pinned(app, &painter, rect, &shown.camera);
     }
 
@@ -103,6 +108,81 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
     }
 }
+
+/// The selected node of the Tree and Node windows: the rest of the image dimmed (a mask over the
+/// frame: pixels whose hit is not one of its triangles), its box, its children's boxes in their
+/// own colours, and the plane the builder split it at as a translucent quad.
+fn draw_selected_node(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &super::Shown) {
+    use super::overlay::{box_lines, lines_mesh, project, Line3};
+    let Some(node) = app.nodes.selected.filter(|_| app.nodes.window) else { return };
+    let Some(e) = app.nodes.current(Some(&shown.bvh)) else { return };
+    let Some(n) = e.tree.nodes.get(node as usize) else { return };
+    if let Some(mask) = app.node_mask(ui_ctx(painter), shown, e, node) {
+        painter.image(mask.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
+    }
+    let camera = &shown.camera;
+    let mut lines = Vec::new();
+    if !n.is_leaf() {
+        for (child, color) in [(n.index, NODE_COLORS.left), (n.index + 1, NODE_COLORS.right)] {
+            box_lines(&e.tree.nodes[child as usize].bounds().corners(), color, 1.5, &mut lines);
+        }
+    }
+    box_lines(&n.bounds().corners(), NODE_COLORS.node, 2.5, &mut lines);
+    // The split plane: where the tree's own strategy cut this node (its inspection's marker).
+    let plane = app
+        .nodes
+        .inspection
+        .as_ref()
+        .filter(|i| i.node == node && !n.is_leaf())
+        .and_then(|i| i.markers.iter().find(|(s, _)| *s == e.tree.params.strategy).and_then(|(_, m)| *m));
+    if let Some(m) = plane {
+        let b = n.bounds();
+        let (a, (u, v)) = (m.axis as usize, [(1, 2), (0, 2), (0, 1)][m.axis as usize]);
+        let corner = |cu: f32, cv: f32| {
+            let mut p = glam::Vec3::ZERO;
+            p[a] = m.position;
+            p[u] = cu;
+            p[v] = cv;
+            p
+        };
+        let quad = [
+            corner(b.min[u], b.min[v]),
+            corner(b.max[u], b.min[v]),
+            corner(b.max[u], b.max[v]),
+            corner(b.min[u], b.max[v]),
+        ];
+        let pts: Option<Vec<Pos2>> = quad.iter().map(|&q| project(camera, rect, q)).collect();
+        if let Some(pts) = pts {
+            painter.add(egui::Shape::convex_polygon(pts, NODE_COLORS.plane, Stroke::new(1.0, NODE_COLORS.plane_edge)));
+        }
+        for k in 0..4 {
+            lines.push(Line3 { a: quad[k], b: quad[(k + 1) % 4], color: NODE_COLORS.plane_edge, width: 1.0 });
+        }
+    }
+    let near = (camera.position - camera.look_at).length() * 1e-4;
+    painter.add(egui::Shape::Mesh(Arc::new(lines_mesh(&lines, camera, rect, near))));
+}
+
+fn ui_ctx(painter: &egui::Painter) -> &egui::Context {
+    painter.ctx()
+}
+
+/// The colours of the selected node, its children and its split plane.
+pub struct NodeColors {
+    pub node: Color32,
+    pub left: Color32,
+    pub right: Color32,
+    pub plane: Color32,
+    pub plane_edge: Color32,
+}
+
+pub const NODE_COLORS: NodeColors = NodeColors {
+    node: Color32::WHITE,
+    left: Color32::from_rgb(80, 170, 255),
+    right: Color32::from_rgb(255, 110, 200),
+    plane: Color32::from_rgba_premultiplied(60, 50, 10, 60),
+    plane_edge: Color32::from_rgb(250, 210, 80),
+};
 
 /// The colours a pinned ray's step is drawn in (the Ray window's legend names them).
 pub struct RayColors {

@@ -409,7 +409,8 @@ fn default_view_snapshot() {
         .with_size(egui::vec2(1200.0, 760.0))
         .wgpu()
         .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
-    run_until(&mut h, "the first full frame", idle);
+    // The first full frame, and the prepared tree behind it (its EPO shows in the statistics).
+    run_until(&mut h, "the first full frame", |a| idle(a) && a.nodes.explained.is_some());
     // Timings in the status line and statistics differ run to run; allow those few pixels.
     let options = egui_kittest::SnapshotOptions::default()
         .max_failed_pixels(4000)
@@ -875,4 +876,127 @@ fn the_pinned_rays_trace_command_prints_the_same_walk() {
     assert_eq!(json["hit"]["t"].as_f64().unwrap() as f32, hit.t);
     assert_eq!(json["steps"], serde_json::to_value(&r.trace.steps).unwrap(), "step by step");
     assert_eq!(json["build"], "Midpoint, binary");
+}
+
+/// A click with modifiers held (the viewport's shift-click).
+fn click_at_with(h: &mut Harness<'_, BvhscopeApp>, pos: egui::Pos2, modifiers: egui::Modifiers) {
+    let input = h.input_mut();
+    input.events.push(egui::Event::ModifiersChanged(modifiers));
+    input.events.push(egui::Event::PointerMoved(pos));
+    let button = |pressed| egui::Event::PointerButton { pos, button: egui::PointerButton::Primary, pressed, modifiers };
+    input.events.push(button(true));
+    h.step();
+    h.input_mut().events.push(button(false));
+    h.run_steps(3);
+    h.input_mut().events.push(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.step();
+}
+
+/// The Tree and Node windows select the same node from the tree's rows, the icicle and the
+/// viewport (shift-click: the pixel's leaf, with its ancestors as the breadcrumb), and the
+/// inspector shows that node's figures and curves, computed by the core's inspector.
+#[test]
+fn a_node_is_selected_from_the_tree_the_icicle_and_the_viewport() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.get_by_role_and_label(Role::Button, "View").click();
+    h.run_steps(2);
+    h.get_by_label("Tree and node…").click();
+    run_until(&mut h, "the prepared tree", |a| {
+        idle(a) && a.nodes.current(a.current_bvh().map(|b| &b.bvh)).is_some() && a.nodes.inspection.is_some()
+    });
+    assert_eq!(h.state().nodes.selected, Some(0), "opening the windows selects the root");
+    h.get_by_label_contains("Subtree SAH");
+    h.get_by_label_contains("Axis x: ");
+
+    // The tree's rows: open the root, select its right child.
+    h.get_by_label("+").click();
+    h.run_steps(2);
+    h.get_by_label_contains("node 2 · d1").click();
+    run_until(&mut h, "node 2's inspection", |a| a.nodes.inspection.as_ref().is_some_and(|i| i.node == 2));
+    {
+        let app = h.state();
+        let e = app.nodes.explained.as_ref().unwrap();
+        let want = bvhscope::bvh::inspect::inspect(&e.tree, &e.hierarchy, 2).unwrap();
+        let got = app.nodes.inspection.as_ref().unwrap();
+        assert_eq!((got.triangles, got.markers.clone()), (want.triangles, want.markers), "the core's inspection");
+    }
+    // Keys move the selection: Alt+Up to the parent, Alt+Left to its left child.
+    h.key_press_modifiers(egui::Modifiers::ALT, egui::Key::ArrowUp);
+    h.run_steps(2);
+    assert_eq!(h.state().nodes.selected, Some(0));
+    h.key_press_modifiers(egui::Modifiers::ALT, egui::Key::ArrowLeft);
+    h.run_steps(2);
+    assert_eq!(h.state().nodes.selected, Some(1));
+
+    // The icicle: the middle of the root's left child in the second row.
+    let (rect, share) = {
+        let app = h.state();
+        let e = app.nodes.explained.as_ref().unwrap();
+        let share = e.hierarchy.count[2] as f32 / e.tree.prim_ids.len() as f32;
+        (h.get_by_label("Icicle of the tree").rect(), share)
+    };
+    // Node 2 is the root's right child: its cell ends at the right edge.
+    let pos = egui::pos2(rect.right() - rect.width() * share * 0.5, rect.top() + 12.0 * 1.5);
+    click_at_with(&mut h, pos, egui::Modifiers::NONE);
+    assert_eq!(h.state().nodes.selected, Some(2), "the icicle's cell of node 2");
+
+    // The viewport: shift-click a hit pixel selects the leaf holding its triangle.
+    let (pos, leaf) = {
+        let app = h.state();
+        let (r, f) = (app.viewport_rect, &app.shown.as_ref().unwrap().frame);
+        let (x, y) = (f.width() / 2, (0..f.height()).find(|&y| f.sample(f.width() / 2, y).is_hit()).unwrap());
+        let pos = r.min
+            + egui::vec2(
+                (x as f32 + 0.5) / f.width() as f32 * r.width(),
+                (y as f32 + 0.5) / f.height() as f32 * r.height(),
+            );
+        let e = app.nodes.explained.as_ref().unwrap();
+        (pos, e.hierarchy.leaf_of_prim(f.sample(x, y).prim).unwrap())
+    };
+    let pinned = h.state().pins.pinned.len();
+    click_at_with(&mut h, pos, egui::Modifiers::SHIFT);
+    assert_eq!(h.state().nodes.selected, Some(leaf), "the pixel's leaf");
+    assert_eq!(h.state().pins.pinned.len(), pinned, "a shift-click pins no ray");
+    let path = h.state().nodes.explained.as_ref().unwrap().hierarchy.path(leaf);
+    assert!(path.len() > 2);
+    h.get_by_label("Path:");
+    assert!(h.state().nodes.open.contains(&path[path.len() - 2]), "its ancestors are open in the tree view");
+    // The statistics show the tree's end-point overlap.
+    h.get_by_label("EPO");
+}
+
+/// The inspector's figures for a node are `bvhscope inspect`'s for the same node and build.
+#[test]
+fn the_node_inspector_and_bvhscope_inspect_agree() {
+    let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, torus.clone()));
+    run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus.clone()) && idle(a));
+    h.state_mut().act(Action::SelectNode(3));
+    run_until(&mut h, "node 3's inspection", |a| a.nodes.inspection.as_ref().is_some_and(|i| i.node == 3));
+    let ins = h.state().nodes.inspection.clone().unwrap();
+    let p = h.state().settings.build;
+    let words = [
+        "bvhscope".to_string(),
+        "inspect".into(),
+        torus.display().to_string(),
+        "--node".into(),
+        "3".into(),
+        "--strategy".into(),
+        bvhscope::options::Choice::named(p.strategy).name.to_string(),
+        "--format".into(),
+        "json".into(),
+    ];
+    let cli = bvhscope::cli::Cli::from_words(&words).unwrap();
+    let Some(bvhscope::cli::Command::Inspect(args)) = cli.command else { panic!("not inspect") };
+    let v: serde_json::Value = serde_json::from_str(&bvhscope::cli::inspect::output(&args).unwrap()).unwrap();
+    assert_eq!(v["triangles"], ins.triangles);
+    for (s, m) in &ins.markers {
+        let j = &v["markers"][bvhscope::options::Choice::named(*s).name];
+        let m = m.expect("a split");
+        assert_eq!((j["cost"].as_f64().unwrap() as f32, j["left_count"].as_u64().unwrap() as u32), (m.cost, m.left));
+    }
+    assert_eq!(v["curves"]["x"]["sweep"].as_array().unwrap().len(), ins.sweep[0].len());
 }

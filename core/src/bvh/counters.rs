@@ -29,7 +29,7 @@ pub trait TraversalStats {
     #[inline(always)]
     fn instance_entered(&mut self) {}
 
-    /// Whether the walks report each step below (only `Trace` does). The walks test it before
+    /// Whether the walks report each step below (`Trace` and `visits::NodeVisits` do). The walks test it before
     /// each report, so for the other sinks no step costs anything, not even its arguments.
     const STEPS: bool = false;
     /// The walk is over a two-level BVH: its steps outside a placement are the top level's.

@@ -22,6 +22,7 @@ pub mod trace;
 mod traverse;
 pub mod tree;
 pub mod two_level;
+pub mod visits;
 pub mod wide;
 
 pub use accel::{Accelerator, Hit, TraceOptions, TraversalOrder};

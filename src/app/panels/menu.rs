@@ -79,6 +79,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             if ui.button("Trace a ray…").on_hover_text("The Ray window: click a pixel to pin its ray, or type a ray").clicked() {
                 out.push(Action::ShowRayWindow);
             }
+            if ui.button("Tree and node…").on_hover_text("The Tree and Node windows: the hierarchy, and why a node was split where it was").clicked() {
+                out.push(Action::ShowTree(true));
+            }
         });
         ui.menu_button("Help", |ui| {
             let shortcut = shortcut_text(ui.ctx(), &Action::Help);

@@ -2,9 +2,11 @@
 
 pub mod build;
 pub mod menu;
+pub mod node;
 pub mod ray;
 pub mod stats;
 pub mod status;
+pub mod tree;
 pub mod view;
 pub mod windows;
 

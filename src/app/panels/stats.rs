@@ -46,6 +46,12 @@ const ROWS: &[Row] = &[
         value: |f| Some(format!("{:.2}", f.stats.sah_cost)),
     },
     Row {
+        name: "EPO",
+        tip: "End-point overlap (Aila, Karras & Laine 2013, \"On Quality Metrics of Bounding Volume Hierarchies\"): Σ over nodes of C(n) × the area of other subtrees' triangles inside the node's box, over the total triangle area, with C(n) = C_trav for interior nodes and C_isect × triangles for leaves. A ray that starts or ends on a surface must visit every box around that point; EPO counts the ones that are not its leaf's ancestors, which the SAH does not see. Of the binary tree as built (the 4-wide layout is collapsed from it)",
+        per_ray: false,
+        value: |f| f.stats.epo.map(|e| format!("{e:.3}")),
+    },
+    Row {
         name: "Bytes / triangle",
         tip: "Memory of the nodes and the triangle index array, per triangle",
         per_ray: false,

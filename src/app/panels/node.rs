@@ -1,0 +1,183 @@
+//! The Node window: the selected node of the binary tree explained (`bvh::inspect`, the same
+//! figures as `bvhscope inspect`): its breadcrumb, its figures, and per axis the SAH cost of
+//! splitting its triangles at every candidate plane (the exact sweep as a line, the binned SAH's
+//! bins as steps), with where each strategy puts its plane and the cost of a leaf.
+
+use crate::app::{Action, Actions, BvhscopeApp, NodeStep};
+use crate::bvh::inspect::{CurvePoint, Inspection};
+use crate::bvh::SplitStrategy;
+use egui::Color32;
+use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints, VLine};
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// Each strategy's marker colour.
+pub fn strategy_color(s: SplitStrategy) -> Color32 {
+    match s {
+        SplitStrategy::Midpoint => Color32::from_rgb(240, 120, 60),
+        SplitStrategy::EqualCount => Color32::from_rgb(200, 120, 230),
+        SplitStrategy::SahBinned => Color32::from_rgb(90, 200, 250),
+        SplitStrategy::SahSweep => Color32::from_rgb(120, 230, 120),
+    }
+}
+
+pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+    let nodes = &app.nodes;
+    let (Some(node), true) = (nodes.selected, nodes.window) else { return };
+    let mut open = true;
+    egui::Window::new("Node")
+        .open(&mut open)
+        // Over the statistics panel, so the image stays in view.
+        .default_size([440.0, 640.0])
+        .default_pos(ctx.content_rect().right_top() + egui::vec2(-450.0, 40.0))
+        .vscroll(true)
+        .show(ctx, |ui| {
+            let bvh = app.current_bvh().map(|b| b.bvh.clone());
+            let Some(e) = nodes.current(bvh.as_ref()) else {
+                ui.weak("Preparing the tree…");
+                return;
+            };
+            // The breadcrumb: the root down to the node, each a button.
+            let path = e.hierarchy.path(node);
+            ui.horizontal_wrapped(|ui| {
+                ui.label("Path:");
+                let skip = path.len().saturating_sub(14);
+                if skip > 0 {
+                    ui.weak("0 > … >");
+                }
+                for &a in &path[skip..] {
+                    if ui.selectable_label(a == node, a.to_string()).on_hover_text(format!("Select node {a}")).clicked() {
+                        out.push(Action::SelectNode(a));
+                    }
+                }
+            });
+            ui.horizontal(|ui| {
+                for (label, step, key) in [
+                    ("Parent", NodeStep::Parent, "Up"),
+                    ("Left child", NodeStep::Left, "Left"),
+                    ("Right child", NodeStep::Right, "Right"),
+                    ("Sibling", NodeStep::Sibling, "Down"),
+                ] {
+                    let enabled = nodes.step(step).is_some();
+                    let b = ui.add_enabled(enabled, egui::Button::new(label));
+                    if b.on_hover_text(format!("Key: Alt+{key}")).clicked() {
+                        out.push(Action::NodeStep(step));
+                    }
+                }
+            });
+            ui.separator();
+            let Some(ins) = nodes.inspection.as_ref().filter(|i| i.node == node) else {
+                ui.weak(format!("Inspecting node {node}…"));
+                return;
+            };
+            let visits = nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
+            figures(ui, ins, e.epo_terms[node as usize], visits.map(|v| v.counts[node as usize]));
+            ui.separator();
+            let own = e.tree.params.strategy;
+            if ins.triangles < 2 {
+                ui.weak("One triangle: nothing to split.");
+            } else {
+                ui.label(format!(
+                    "SAH cost of splitting these {} triangles at each plane (C_trav + C_isect (A_L n_L + A_R n_R) / A); this tree's strategy is {}.",
+                    ins.triangles,
+                    own.label()
+                ));
+                for axis in 0..3 {
+                    curve_plot(ui, ins, axis, own);
+                }
+            }
+        });
+    if !open {
+        out.push(Action::ShowTree(false));
+    }
+}
+
+fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<u32>) {
+    egui::Grid::new("node-figures").num_columns(2).striped(true).show(ui, |ui| {
+        let mut row = |k: &str, v: String, tip: &str| {
+            ui.label(k).on_hover_text(tip);
+            ui.label(v);
+            ui.end_row();
+        };
+        let kind = match (ins.children, ins.split_axis) {
+            (Some([l, r]), Some(a)) => format!("interior: children {l} and {r}, split on {}", AXES[a as usize]),
+            _ => "leaf".to_string(),
+        };
+        row("Node", format!("{} (depth {})", ins.node, ins.depth), "Its id in the binary tree as built (as `bvhscope inspect --node` takes it)");
+        row("Kind", kind, "");
+        row("Triangles", ins.triangles.to_string(), "Triangles in its subtree");
+        let ratio = ins.area_ratio.map_or(String::new(), |r| format!(" ({:.1}% of its parent's)", 100.0 * r));
+        row("Surface area", format!("{:.4}{ratio}", ins.area), "The surface area of its box; a ray enters it with probability area / parent's area");
+        row("Subtree SAH", format!("{:.3}", ins.subtree_sah), "The SAH cost of its subtree, relative to its own area: the expected cost of a ray that enters its box");
+        if let Some(o) = ins.child_overlap {
+            row("Children overlap", format!("volume {:.4}, area {:.4}", o.volume, o.area), "The box the two children's boxes share: rays there must visit both");
+        }
+        row("EPO share", format!("{epo:.4}"), "Its term of the tree's end-point overlap (Aila, Karras & Laine 2013): the surface of other subtrees' triangles inside its box, weighted by its cost and over the total surface");
+        row("As a leaf", format!("{:.3}", ins.leaf_cost), "What making it a leaf would cost: C_isect × triangles");
+        row("Visits", visits.map_or("…".into(), |v| v.to_string()), "Primary rays of the last frame that entered it (a binary traversal of the same rays)");
+        for (s, m) in &ins.markers {
+            let text = match m {
+                Some(m) => format!("{} = {:.4}: {} | {}, cost {:.3}", AXES[m.axis as usize], m.position, m.left, m.right, m.cost),
+                None => "no split (the builder falls back to equal count)".into(),
+            };
+            ui.label(egui::RichText::new(s.label()).color(strategy_color(*s)));
+            ui.label(text);
+            ui.end_row();
+        }
+    });
+}
+
+/// Points of a staircase through the binned planes: each plane's cost held until the next one.
+fn steps(points: &[CurvePoint]) -> Vec<[f64; 2]> {
+    let mut out = Vec::with_capacity(points.len() * 2);
+    for (i, p) in points.iter().enumerate() {
+        out.push([p.position as f64, p.cost as f64]);
+        if let Some(next) = points.get(i + 1) {
+            out.push([next.position as f64, p.cost as f64]);
+        }
+    }
+    out
+}
+
+fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: SplitStrategy) {
+    let (sweep, binned) = (&ins.sweep[axis], &ins.binned[axis]);
+    ui.label(format!("Axis {}: {} candidate planes, {} bins' planes", AXES[axis], sweep.len(), binned.len()));
+    if sweep.is_empty() {
+        ui.weak("The centroids do not spread along this axis.");
+        return;
+    }
+    Plot::new(("node-curve", axis))
+        .height(150.0)
+        .legend(Legend::default())
+        .allow_scroll(false)
+        .x_axis_label(AXES[axis])
+        .y_axis_label("cost")
+        .show(ui, |p| {
+            let line: PlotPoints = sweep.iter().map(|q| [q.position as f64, q.cost as f64]).collect();
+            p.line(Line::new("exact sweep", line).color(Color32::from_gray(220)).width(1.5));
+            if !binned.is_empty() {
+                let stairs = PlotPoints::from(steps(binned));
+                p.line(
+                    Line::new(format!("binned SAH ({} bins)", ins.bins), stairs)
+                        .color(Color32::from_rgb(90, 200, 250))
+                        .width(1.0)
+                        .style(LineStyle::dashed_loose()),
+                );
+            }
+            p.hline(
+                HLine::new("as a leaf", ins.leaf_cost as f64)
+                    .color(Color32::from_rgb(230, 200, 80))
+                    .style(LineStyle::dotted_dense()),
+            );
+            for (s, m) in &ins.markers {
+                if let Some(m) = m.filter(|m| m.axis as usize == axis) {
+                    let chosen = if *s == own { " (this tree)" } else { "" };
+                    p.vline(
+                        VLine::new(format!("{}{chosen}", s.label()), m.position as f64)
+                            .color(strategy_color(*s))
+                            .width(if *s == own { 2.5 } else { 1.5 }),
+                    );
+                }
+            }
+        });
+}

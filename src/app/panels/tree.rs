@@ -1,0 +1,201 @@
+//! The Tree window: the binary tree as built, as an icicle (one row per depth, each node as wide
+//! as its share of the triangles, coloured by a chosen metric) and as a collapsible list of
+//! rows (only the visible ones laid out, so a million nodes stay fast). Selecting in either, in
+//! the viewport (shift-click: the pixel's leaf) or in the Node window's breadcrumb selects the
+//! same node everywhere.
+
+use crate::app::node_view::{Explained, Metric, NodeView};
+use crate::app::{Action, Actions, BvhscopeApp};
+use crate::render::ColorMap;
+use egui::{Color32, Pos2, Rect, RichText, Sense, Stroke};
+
+/// Depths the icicle shows.
+const ICICLE_ROWS: u32 = 14;
+const ICICLE_ROW_HEIGHT: f32 = 12.0;
+
+pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+    if !app.nodes.window {
+        return;
+    }
+    let mut open = true;
+    egui::Window::new("Tree")
+        .open(&mut open)
+        // Over the build panel's lower half, so the image stays in view.
+        .default_size([420.0, 420.0])
+        .default_pos(ctx.content_rect().left_bottom() + egui::vec2(8.0, -470.0))
+        .show(ctx, |ui| {
+            let bvh = app.current_bvh().map(|b| b.bvh.clone());
+            let Some(e) = app.nodes.current(bvh.as_ref()) else {
+                let why = if app.built.as_ref().is_some_and(|b| b.top_stats.is_some()) {
+                    "The tree view shows one BVH; this scene is built as two levels (uncheck Two levels)."
+                } else {
+                    "Preparing the tree…"
+                };
+                ui.weak(why);
+                return;
+            };
+            ui.label(format!(
+                "The binary tree as built: {} nodes, {} triangles. Shift-click the image to select a pixel's leaf.",
+                e.tree.nodes.len(),
+                e.tree.prim_ids.len()
+            ));
+            let visits = app.nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
+            ui.horizontal(|ui| {
+                ui.label("Colour by");
+                egui::ComboBox::from_id_salt("icicle-metric").selected_text(app.nodes.metric.label()).show_ui(
+                    ui,
+                    |ui| {
+                        for m in Metric::ALL {
+                            if ui.selectable_label(app.nodes.metric == m, m.label()).on_hover_text(m.help()).clicked() {
+                                out.push(Action::SetMetric(m));
+                            }
+                        }
+                    },
+                );
+                if app.nodes.metric == Metric::Visits && visits.is_none() {
+                    ui.weak("counting…");
+                }
+            });
+            icicle(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), out);
+            ui.separator();
+            rows(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), out);
+        });
+    if !open {
+        out.push(Action::ShowTree(false));
+    }
+}
+
+/// A node's value of the metric (`None`: not known yet).
+fn metric_value(e: &Explained, metric: Metric, visits: Option<&[u32]>, n: usize) -> Option<f64> {
+    match metric {
+        Metric::Visits => visits.map(|v| v[n] as f64),
+        Metric::Sah => Some(e.sah_terms[n]),
+        Metric::Overlap => Some(e.child_overlap(n)),
+        Metric::Epo => Some(e.epo_terms[n]),
+        Metric::Depth => Some(e.hierarchy.depth[n] as f64),
+    }
+}
+
+/// The nodes the icicle draws (down to `ICICLE_ROWS`, at least a pixel wide), with their rects.
+fn icicle_cells(e: &Explained, rect: Rect) -> Vec<(u32, Rect)> {
+    let total = e.tree.prim_ids.len().max(1) as f32;
+    let mut out = Vec::new();
+    let mut stack = vec![0u32];
+    while let Some(n) = stack.pop() {
+        let i = n as usize;
+        let (d, first, count) = (e.hierarchy.depth[i], e.hierarchy.first[i], e.hierarchy.count[i]);
+        let x0 = rect.left() + rect.width() * first as f32 / total;
+        let x1 = rect.left() + rect.width() * (first + count) as f32 / total;
+        let y0 = rect.top() + d as f32 * ICICLE_ROW_HEIGHT;
+        if d >= ICICLE_ROWS || x1 - x0 < 1.0 {
+            continue;
+        }
+        out.push((n, Rect::from_min_max(Pos2::new(x0, y0), Pos2::new(x1, y0 + ICICLE_ROW_HEIGHT))));
+        let node = &e.tree.nodes[i];
+        if !node.is_leaf() {
+            stack.extend([node.index, node.index + 1]);
+        }
+    }
+    out
+}
+
+fn icicle(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u32]>, out: &mut Actions) {
+    let depth = e.hierarchy.depth.iter().copied().max().unwrap_or(0).min(ICICLE_ROWS - 1) + 1;
+    let size = egui::vec2(ui.available_width(), depth as f32 * ICICLE_ROW_HEIGHT);
+    let (rect, response) = ui.allocate_exact_size(size, Sense::click());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Icicle of the tree"));
+    let cells = icicle_cells(e, rect);
+    let values: Vec<Option<f64>> =
+        cells.iter().map(|&(n, _)| metric_value(e, view.metric, visits, n as usize)).collect();
+    let max = values.iter().flatten().copied().fold(0.0, f64::max);
+    let painter = ui.painter_at(rect);
+    let selected_path = view.selected.map(|s| e.hierarchy.path(s)).unwrap_or_default();
+    for (&(n, r), v) in cells.iter().zip(&values) {
+        let fill = match v {
+            Some(v) if max > 0.0 => {
+                // Visits and shares span orders of magnitude: a square root keeps the small visible.
+                let [r8, g8, b8] = ColorMap::Viridis.map((v / max).sqrt() as f32);
+                Color32::from_rgb(r8, g8, b8)
+            }
+            _ => Color32::from_gray(60),
+        };
+        painter.rect_filled(r.shrink(0.25), 0.0, fill);
+        if selected_path.contains(&n) {
+            let color = if Some(n) == view.selected { Color32::WHITE } else { Color32::from_gray(200) };
+            painter.rect_stroke(r, 0.0, Stroke::new(1.5, color), egui::StrokeKind::Inside);
+        }
+    }
+    if response.clicked() {
+        if let Some(pos) = response.interact_pointer_pos() {
+            // The deepest cell under the pointer.
+            if let Some(&(n, _)) =
+                cells.iter().filter(|(_, r)| r.contains(pos)).max_by_key(|(n, _)| e.hierarchy.depth[*n as usize])
+            {
+                out.push(Action::SelectNode(n));
+            }
+        }
+    }
+    response.on_hover_text(format!(
+        "One row per depth (the first {ICICLE_ROWS}), each node as wide as its triangles; colour: {} (square root of the share of the largest). Click to select.",
+        view.metric.label()
+    ));
+}
+
+fn rows(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u32]>, out: &mut Actions) {
+    let rows = view.rows();
+    let row_height = ui.spacing().interact_size.y;
+    let mut area = egui::ScrollArea::vertical().auto_shrink([false, false]).id_salt("tree-rows");
+    // Bring a newly selected node's row into view once (from the icicle, the viewport, a key).
+    let scrolled_id = ui.scope_id().with("tree-scrolled-to");
+    let moved = ui.data(|d| d.get_temp::<Option<u32>>(scrolled_id)) != Some(view.selected);
+    ui.data_mut(|d| d.insert_temp(scrolled_id, view.selected));
+    if moved {
+        if let Some(k) = view.selected.and_then(|s| rows.iter().position(|&r| r == s)) {
+            // The row in the middle of what the list shows.
+            let step = row_height + ui.spacing().item_spacing.y;
+            let visible = (ui.available_height() / step).max(1.0);
+            area = area.vertical_scroll_offset((k as f32 - visible / 2.0).max(0.0) * step);
+        }
+    }
+    ui.horizontal(|ui| {
+        ui.strong("node · depth · triangles · area of parent's · SAH share · visits");
+    });
+    area.show_rows(ui, row_height, rows.len(), |ui, range| {
+        ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Extend);
+        for &n in &rows[range] {
+            let i = n as usize;
+            let node = &e.tree.nodes[i];
+            ui.horizontal(|ui| {
+                ui.add_space(e.hierarchy.depth[i] as f32 * 10.0);
+                if node.is_leaf() {
+                    ui.add_sized([18.0, row_height], egui::Label::new(" "));
+                } else {
+                    let sign = if view.open.contains(&n) { "-" } else { "+" };
+                    if ui.add_sized([18.0, row_height], egui::Button::new(sign).small()).clicked() {
+                        out.push(Action::ToggleOpen(n));
+                    }
+                }
+                let parent = e.hierarchy.parent[i];
+                let ratio = if parent == u32::MAX {
+                    "root".to_string()
+                } else {
+                    let pa = e.tree.nodes[parent as usize].bounds().area();
+                    if pa > 0.0 {
+                        format!("{:.0}%", 100.0 * node.bounds().area() / pa)
+                    } else {
+                        "-".into()
+                    }
+                };
+                let kind = if node.is_leaf() { "leaf" } else { "node" };
+                let v = visits.map_or("…".to_string(), |v| v[i].to_string());
+                let text = format!(
+                    "{kind} {n} · d{} · {} tris · {ratio} · {:.3} · {v}",
+                    e.hierarchy.depth[i], e.hierarchy.count[i], e.sah_terms[i]
+                );
+                if ui.selectable_label(view.selected == Some(n), RichText::new(text).monospace()).clicked() {
+                    out.push(Action::SelectNode(n));
+                }
+            });
+        }
+    });
+}
