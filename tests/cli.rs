@@ -450,6 +450,12 @@ fn inspect_prints_a_nodes_curves_and_each_strategys_plane() {
     assert_eq!(m["position"].as_f64().unwrap() as f32, middle);
     assert_eq!(v["split_axis"], m["axis"], "the midpoint tree split this node where midpoint's marker says");
 
+    // In the (default) 4-wide layout, the wide node it is collapsed into.
+    let out = bvhscope(&["inspect", torus, "--node", "1", "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["wide_node"]["top"], 0, "node 1 is swallowed by the root's wide node: {}", v["wide_node"]);
+    assert!(v["wide_node"]["collapsed"].as_array().unwrap().contains(&serde_json::json!(1)));
+
     let out = bvhscope(&["inspect", torus, "--node", "1", "--format", "csv"]);
     let mut reader = csv::Reader::from_reader(&out.stdout[..]);
     assert_eq!(reader.headers().unwrap(), vec!["axis", "position", "left_count", "right_count", "cost"]);

@@ -28,7 +28,12 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         if let (Some(pos), Some(shown)) = (response.interact_pointer_pos(), &app.shown) {
             if let Some((x, y)) = pixel_at(&shown.frame, rect, pos) {
                 if ui.input(|i| i.modifiers.shift) {
-                    out.push(Action::SelectPixelNode(x, y));
+                    // A drawn box's edge under the pointer selects that box's node; elsewhere the
+                    // pixel's leaf.
+                    match drawn_box_node(app, rect, shown, pos) {
+                        Some(n) => out.push(Action::SelectNode(n)),
+                        None => out.push(Action::SelectPixelNode(x, y)),
+                    }
                 } else {
                     out.push(Action::PinPixel(x, y));
                 }
@@ -107,6 +112,19 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             response.on_hover_ui_at_pointer(|ui| pixel_readout(ui, &frame, rect, pos));
         }
     }
+}
+
+/// The node of the binary tree whose drawn box has an edge under `pos` (the overlay's boxes are
+/// the current layout's; a wide child's box is its binary node's, so it is found by its bounds).
+fn drawn_box_node(app: &BvhscopeApp, rect: Rect, shown: &super::Shown, pos: Pos2) -> Option<u32> {
+    if !app.settings.show_boxes {
+        return None;
+    }
+    let e = app.nodes.current(Some(&shown.bvh))?;
+    let boxes = app.overlay_boxes()?;
+    let i = super::overlay::box_near(&boxes, &shown.camera, rect, pos, 5.0)?;
+    let corners = boxes[i].corners;
+    e.tree.nodes.iter().position(|n| n.bounds().corners() == corners).map(|n| n as u32)
 }
 
 /// The selected node of the Tree and Node windows: the rest of the image dimmed (a mask over the

@@ -5,7 +5,8 @@
 use super::args::BuildArgs;
 use super::{build_scene, load_mesh, CliError};
 use crate::bvh::inspect::{inspect, CurvePoint, Hierarchy, Inspection};
-use crate::bvh::{epo, SceneBvh, TreeView};
+use crate::bvh::wide::{wide_group_of, WideGroup};
+use crate::bvh::{epo, Layout, SceneBvh, TreeView};
 use crate::options::Choice;
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
@@ -134,6 +135,18 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
     o
 }
 
+/// Which wide node of the 4-wide layout binary node `node` is collapsed into.
+pub fn wide_group_text(node: u32, g: &WideGroup) -> String {
+    let list = |v: &[u32]| v.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ");
+    let role = if g.collapsed.contains(&node) { "is collapsed into" } else { "is a leaf slot of" };
+    format!(
+        "In the 4-wide layout, node {node} {role} the wide node over binary node {}, which swallows binary nodes {} and has children {}.",
+        g.top,
+        list(&g.collapsed),
+        list(&g.children)
+    )
+}
+
 /// The exact sweep's curves as CSV.
 pub fn csv(ins: &Inspection) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
@@ -180,11 +193,16 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
         )));
     };
     let path = h.path(a.node);
+    let wide = (bvh.params().layout == Layout::Wide4).then(|| wide_group_of(&tree.nodes, &h.parent, a.node)).flatten();
     Ok(match a.format {
         InspectFormat::Csv => csv(&ins),
         InspectFormat::Json => {
             let term = epo::node_term(&tree, &h, a.node as usize);
-            format!("{}\n", serde_json::to_string_pretty(&json(&ins, term, &path)).expect("plain data serialises"))
+            let mut v = json(&ins, term, &path);
+            if let Some(g) = &wide {
+                v["wide_node"] = serde_json::json!({ "top": g.top, "collapsed": g.collapsed, "children": g.children });
+            }
+            format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises"))
         }
         InspectFormat::Text => {
             let term = epo::node_term(&tree, &h, a.node as usize);
@@ -192,7 +210,8 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
                 let p = bvh.params();
                 let build =
                     format!("{}, max leaf size {}, {} SAH bins", p.strategy.label(), p.max_leaf_size, p.sah_bins);
-                format!("build           {build} (the binary tree)\n{}", text(&ins, term, &path))
+                let wide = wide.map_or(String::new(), |g| format!("\n{}\n", wide_group_text(a.node, &g)));
+                format!("build           {build} (the binary tree)\n{}{wide}", text(&ins, term, &path))
             }
         }
     })

@@ -28,7 +28,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
     egui::Window::new("Node")
         .open(&mut open)
         // Over the statistics panel, so the image stays in view.
-        .default_size([440.0, 640.0])
+        .default_size([440.0, 760.0])
         .default_pos(ctx.content_rect().right_top() + egui::vec2(-450.0, 40.0))
         .vscroll(true)
         .show(ctx, |ui| {
@@ -72,6 +72,13 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             };
             let visits = nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
             figures(ui, ins, e.epo_terms[node as usize], visits.map(|v| v.counts[node as usize]));
+            if e.bvh.build_params().bvh.layout == crate::bvh::Layout::Wide4 {
+                if let Some(g) = crate::bvh::wide::wide_group_of(&e.tree.nodes, &e.hierarchy.parent, node) {
+                    ui.label(wide_group_text(node, &g)).on_hover_text(
+                        "The 4-wide layout collapses the binary tree: a wide node takes the children of a binary node and, while it has fewer than four, opens the largest interior one",
+                    );
+                }
+            }
             ui.separator();
             let own = e.tree.params.strategy;
             if ins.triangles < 2 {
@@ -90,6 +97,11 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
     if !open {
         out.push(Action::ShowTree(false));
     }
+}
+
+/// Which wide node a binary node ends up in (the CLI's `inspect` prints the same sentence).
+pub fn wide_group_text(node: u32, g: &crate::bvh::wide::WideGroup) -> String {
+    crate::cli::inspect::wide_group_text(node, g)
 }
 
 fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<u32>) {
@@ -147,7 +159,7 @@ fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: SplitStrate
         return;
     }
     Plot::new(("node-curve", axis))
-        .height(150.0)
+        .height(105.0)
         .legend(Legend::default())
         .allow_scroll(false)
         .x_axis_label(AXES[axis])

@@ -35,7 +35,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 return;
             };
             ui.label(format!(
-                "The binary tree as built: {} nodes, {} triangles. Shift-click the image to select a pixel's leaf.",
+                "The binary tree as built: {} nodes, {} triangles. Shift-click the image to select a pixel's leaf, or a drawn box's edge.",
                 e.tree.nodes.len(),
                 e.tree.prim_ids.len()
             ));

@@ -182,6 +182,53 @@ impl WideBvh {
     }
 }
 
+/// How the collapse groups binary nodes into one wide node: the binary node at its top, the
+/// interior binary nodes it swallows (the top included), and its children, each a binary leaf or
+/// the top of another wide node. The node inspector says this of a node in the 4-wide layout.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WideGroup {
+    pub top: u32,
+    pub collapsed: Vec<u32>,
+    pub children: Vec<u32>,
+}
+
+/// The wide node that binary node `node` is collapsed into (for a leaf: the wide node holding it
+/// as a slot), found by walking the collapse (`wide_children`, the same choice `from_binary`
+/// makes) from the root; `parent` is each binary node's parent (`inspect::Hierarchy::parent`).
+pub fn wide_group_of(b: &[BvhNode], parent: &[u32], node: u32) -> Option<WideGroup> {
+    if b.get(node as usize)?.is_leaf() && node == 0 || b[0].is_leaf() {
+        return None;
+    }
+    // The binary path from the root down to `node`.
+    let mut path = vec![node];
+    while let Some(&p) = parent.get(*path.last()? as usize).filter(|&&p| p != u32::MAX) {
+        path.push(p);
+    }
+    path.reverse();
+    let mut top = 0usize;
+    loop {
+        let (kids, n) = wide_children(b, top);
+        let kids = &kids[..n];
+        // The swallowed nodes: every binary node from the top down to (not including) a child.
+        let mut collapsed = vec![top as u32];
+        for &k in kids {
+            let mut a = parent[k] as usize;
+            while a != top && !collapsed.contains(&(a as u32)) {
+                collapsed.push(a as u32);
+                a = parent[a] as usize;
+            }
+        }
+        collapsed.sort_unstable();
+        let children: Vec<u32> = kids.iter().map(|&k| k as u32).collect();
+        let is_slot = children.contains(&node) && b[node as usize].is_leaf();
+        if collapsed.contains(&node) || is_slot {
+            return Some(WideGroup { top: top as u32, collapsed, children });
+        }
+        // Go down to the child on the path to `node`.
+        top = *kids.iter().find(|&&k| path.contains(&(k as u32)))?;
+    }
+}
+
 /// The binary nodes a wide node over interior binary node `bin` takes as its children: its two
 /// children, then, while fewer than four, the interior one of largest surface area replaced by
 /// its own two.
@@ -360,6 +407,38 @@ impl TreeView for WideBvh {
 
 #[cfg(test)]
 mod tests {
+
+    /// Every interior binary node is collapsed into exactly one wide node, every leaf is a slot
+    /// of one, and the groups are as many as the wide nodes the collapse makes.
+    #[test]
+    fn every_binary_node_has_its_wide_group() {
+        let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 64, 8);
+        let binary = crate::bvh::Bvh::build(
+            &mesh,
+            &crate::bvh::BuildParams { layout: crate::bvh::Layout::Binary, ..Default::default() },
+        );
+        let h = crate::bvh::inspect::Hierarchy::of(&binary);
+        let mut tops = std::collections::HashSet::new();
+        let mut swallowed = 0;
+        for (i, n) in binary.nodes.iter().enumerate() {
+            let g = super::wide_group_of(&binary.nodes, &h.parent, i as u32).expect("a group");
+            assert!((2..=WIDTH).contains(&g.children.len()));
+            if n.is_leaf() {
+                assert!(g.children.contains(&(i as u32)));
+            } else {
+                assert!(g.collapsed.contains(&(i as u32)));
+                if g.top == i as u32 {
+                    swallowed += g.collapsed.len();
+                }
+            }
+            tops.insert(g.top);
+        }
+        let interior = binary.nodes.iter().filter(|n| !n.is_leaf()).count();
+        assert_eq!(swallowed, interior, "each interior node swallowed once");
+        let wide = WideBvh::from_binary(binary);
+        assert_eq!(tops.len(), wide.nodes.len());
+    }
+
     use super::*;
     use crate::bvh::BuildParams;
 
