@@ -50,7 +50,10 @@ pub const MOUSE: &[(&str, &str)] = &[
     ("Wheel", "Zoom"),
     ("Hover", "Exact counts of the pixel's ray"),
     ("Click", "Pin the pixel's ray: its traversal step by step (Ray window)"),
-    ("Shift+click", "Select the node of a drawn box's edge, else the leaf the pixel's ray hits (Tree and Node windows)"),
+    (
+        "Shift+click",
+        "Select the node of a drawn box's edge, else the leaf the pixel's ray hits (Tree and Node windows)",
+    ),
     ("Drop an .obj", "Open it"),
 ];
 

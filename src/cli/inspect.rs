@@ -2,7 +2,7 @@
 //! node inspector): its figures, its children, and per axis the SAH cost of splitting its
 //! triangles at every candidate plane with each strategy's choice marked (`bvh::inspect`).
 
-use super::args::BuildArgs;
+use super::args::{BuildArgs, ViewArgs};
 use super::{build_scene, load_mesh, CliError};
 use crate::bvh::inspect::{inspect, CurvePoint, Hierarchy, Inspection};
 use crate::bvh::wide::{wide_group_of, WideGroup};
@@ -30,6 +30,10 @@ pub struct InspectArgs {
     pub node: u32,
     #[command(flatten)]
     pub build: BuildArgs,
+    /// The frame whose primary rays are counted per node (the Tree window's visits; camera and
+    /// size as `render` takes them).
+    #[command(flatten)]
+    pub view_args: ViewArgs,
     #[arg(long, value_enum, default_value = "text")]
     pub format: InspectFormat,
 }
@@ -193,12 +197,19 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
         )));
     };
     let path = h.path(a.node);
+    // The visits of the frame's primary rays, through the binary tree (as the Tree window counts).
+    let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
+    let visits = crate::bvh::visits::frame_visits(&tree, &camera, a.build.trace(), &crate::work::WorkControl::new())
+        .map_err(|_| CliError::Usage("cancelled".into()))?
+        .counts[a.node as usize];
     let wide = (bvh.params().layout == Layout::Wide4).then(|| wide_group_of(&tree.nodes, &h.parent, a.node)).flatten();
     Ok(match a.format {
         InspectFormat::Csv => csv(&ins),
         InspectFormat::Json => {
             let term = epo::node_term(&tree, &h, a.node as usize);
             let mut v = json(&ins, term, &path);
+            v["visits"] = serde_json::json!(visits);
+            v["camera"] = serde_json::json!(camera);
             if let Some(g) = &wide {
                 v["wide_node"] = serde_json::json!({ "top": g.top, "collapsed": g.collapsed, "children": g.children });
             }
@@ -211,7 +222,11 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
                 let build =
                     format!("{}, max leaf size {}, {} SAH bins", p.strategy.label(), p.max_leaf_size, p.sah_bins);
                 let wide = wide.map_or(String::new(), |g| format!("\n{}\n", wide_group_text(a.node, &g)));
-                format!("build           {build} (the binary tree)\n{}{wide}", text(&ins, term, &path))
+                let visits = format!(
+                    "visits          {visits} of the {}x{} frame's primary rays entered it (binary traversal)\n",
+                    camera.width, camera.height
+                );
+                format!("build           {build} (the binary tree)\n{}{visits}{wide}", text(&ins, term, &path))
             }
         }
     })

@@ -975,9 +975,16 @@ fn the_node_inspector_and_bvhscope_inspect_agree() {
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, torus.clone()));
     run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus.clone()) && idle(a));
     h.state_mut().act(Action::SelectNode(3));
-    run_until(&mut h, "node 3's inspection", |a| a.nodes.inspection.as_ref().is_some_and(|i| i.node == 3));
+    run_until(&mut h, "node 3's inspection and the frame's visits", |a| {
+        a.nodes.inspection.as_ref().is_some_and(|i| i.node == 3) && a.nodes.visits.is_some()
+    });
     let ins = h.state().nodes.inspection.clone().unwrap();
     let p = h.state().settings.build;
+    let (c, visits) = {
+        let v = h.state().nodes.visits.as_ref().unwrap();
+        (v.camera, v.counts[3])
+    };
+    let v3 = |v: glam::Vec3| format!("{},{},{}", v.x, v.y, v.z);
     let words = [
         "bvhscope".to_string(),
         "inspect".into(),
@@ -986,6 +993,12 @@ fn the_node_inspector_and_bvhscope_inspect_agree() {
         "3".into(),
         "--strategy".into(),
         bvhscope::options::Choice::named(p.strategy).name.to_string(),
+        "--camera".into(),
+        format!("{}:{}:{}", v3(c.position), v3(c.look_at), v3(c.up)),
+        "--fov".into(),
+        c.vfov_deg.to_string(),
+        "--size".into(),
+        format!("{}x{}", c.width, c.height),
         "--format".into(),
         "json".into(),
     ];
@@ -999,4 +1012,6 @@ fn the_node_inspector_and_bvhscope_inspect_agree() {
         assert_eq!((j["cost"].as_f64().unwrap() as f32, j["left_count"].as_u64().unwrap() as u32), (m.cost, m.left));
     }
     assert_eq!(v["curves"]["x"]["sweep"].as_array().unwrap().len(), ins.sweep[0].len());
+    assert_eq!(v["visits"], visits, "the Tree window's visits of node 3 for the same camera");
+    assert!(visits > 0);
 }
