@@ -139,6 +139,33 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<u32>) {
     });
 }
 
+/// Most points a curve is drawn with: a root of millions of triangles has a candidate plane per
+/// centroid, more than a plot can redraw each frame.
+const MAX_PLOTTED: usize = 4000;
+
+/// The curve for drawing: all of it when short; else, for each of `MAX_PLOTTED / 2` runs of
+/// neighbouring planes, its cheapest and its dearest point in order, so the shape, and the minimum
+/// the sweep takes, stay exactly where they are.
+fn thinned(points: &[CurvePoint]) -> Vec<CurvePoint> {
+    if points.len() <= MAX_PLOTTED {
+        return points.to_vec();
+    }
+    let run = points.len().div_ceil(MAX_PLOTTED / 2);
+    let mut out = Vec::with_capacity(MAX_PLOTTED);
+    for chunk in points.chunks(run) {
+        let lo = chunk.iter().min_by(|a, b| a.cost.total_cmp(&b.cost)).copied();
+        let hi = chunk.iter().max_by(|a, b| a.cost.total_cmp(&b.cost)).copied();
+        if let (Some(lo), Some(hi)) = (lo, hi) {
+            let (a, b) = if lo.position <= hi.position { (lo, hi) } else { (hi, lo) };
+            out.push(a);
+            if b != a {
+                out.push(b);
+            }
+        }
+    }
+    out
+}
+
 /// Points of a staircase through the binned planes: each plane's cost held until the next one.
 fn steps(points: &[CurvePoint]) -> Vec<[f64; 2]> {
     let mut out = Vec::with_capacity(points.len() * 2);
@@ -165,7 +192,7 @@ fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: SplitStrate
         .x_axis_label(AXES[axis])
         .y_axis_label("cost")
         .show(ui, |p| {
-            let line: PlotPoints = sweep.iter().map(|q| [q.position as f64, q.cost as f64]).collect();
+            let line: PlotPoints = thinned(sweep).into_iter().map(|q| [q.position as f64, q.cost as f64]).collect();
             p.line(Line::new("exact sweep", line).color(Color32::from_gray(220)).width(1.5));
             if !binned.is_empty() {
                 let stairs = PlotPoints::from(steps(binned));
@@ -192,4 +219,25 @@ fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: SplitStrate
                 }
             }
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_curve_is_thinned_keeping_its_minimum_and_order() {
+        let points: Vec<CurvePoint> = (0..100_000)
+            .map(|i| {
+                let x = i as f32 / 1000.0;
+                CurvePoint { position: x, left: i, right: 100_000 - i, cost: (x - 37.123).powi(2) + (x * 7.0).sin() }
+            })
+            .collect();
+        let t = thinned(&points);
+        assert!(t.len() <= MAX_PLOTTED);
+        let min = |v: &[CurvePoint]| v.iter().map(|p| p.cost).fold(f32::INFINITY, f32::min);
+        assert_eq!(min(&t), min(&points));
+        assert!(t.windows(2).all(|w| w[0].position <= w[1].position));
+        assert_eq!(thinned(&points[..10]), points[..10].to_vec());
+    }
 }
