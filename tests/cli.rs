@@ -480,3 +480,44 @@ fn stats_and_compare_show_the_end_point_overlap() {
     let out = bvhscope(&["stats", torus, "--no-rays"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("EPO "));
 }
+
+/// `render --against`: the difference of two identical builds is zero everywhere, and B − A is,
+/// pixel by pixel, the difference of the two builds' `--counts` files.
+#[test]
+fn render_against_writes_the_per_pixel_difference_of_two_builds() {
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    let (a_csv, b_csv, d_csv, png) =
+        (tmp("against-a.csv"), tmp("against-b.csv"), tmp("against-d.csv"), tmp("against.png"));
+    let common = ["--size", "48x32", "--view", "visits", "--layout", "binary"];
+    let run = |extra: &[&str]| {
+        let mut args = vec!["render", torus];
+        args.extend(common);
+        args.extend(extra);
+        let out = bvhscope(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let p = |path: &PathBuf| path.to_str().unwrap().to_string();
+    let err = run(&["--strategy", "midpoint", "--against", "midpoint", "-o", &p(&png)]);
+    assert!(err.contains("less work at 0 pixels, the same at 1536, more at 0"), "{err}");
+    run(&["--strategy", "midpoint", "--counts", &p(&a_csv), "-o", &p(&png)]);
+    run(&["--strategy", "sah", "--counts", &p(&b_csv), "-o", &p(&png)]);
+    run(&["--strategy", "midpoint", "--against", "sah", "--difference", &p(&d_csv), "-o", &p(&png)]);
+    let rows = |path: &PathBuf| -> Vec<csv::StringRecord> {
+        csv::Reader::from_path(path).unwrap().records().map(|r| r.unwrap()).collect()
+    };
+    let (a, b, d) = (rows(&a_csv), rows(&b_csv), rows(&d_csv));
+    assert_eq!((a.len(), b.len(), d.len()), (1536, 1536, 1536));
+    let mut differ = 0;
+    for ((a, b), d) in a.iter().zip(&b).zip(&d) {
+        assert_eq!((&a[0], &a[1]), (&d[0], &d[1]), "the same pixel");
+        let (na, nb): (f32, f32) = (a[2].parse().unwrap(), b[2].parse().unwrap());
+        assert_eq!(d[4].parse::<f32>().unwrap(), nb - na, "pixel {},{}", &d[0], &d[1]);
+        differ += (nb != na) as usize;
+    }
+    assert!(differ > 0, "midpoint and SAH differ somewhere");
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert!(img.width() >= 48 && img.height() > 32, "the image with its legend strip below");
+    let out = bvhscope(&["render", torus, "--against", "sah", "--view", "normals", "-o", &p(&png)]);
+    assert_eq!(out.status.code(), Some(2), "only heatmaps have a difference");
+}

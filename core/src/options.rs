@@ -199,7 +199,7 @@ const VIEWS: [Named<View>; 8] = [
 ];
 choice!(View, VIEWS, 8);
 
-const COLOR_MAPS: [Named<ColorMap>; 4] = [
+const COLOR_MAPS: [Named<ColorMap>; 5] = [
     Named { value: ColorMap::Viridis, name: "viridis", label: "viridis", help: "perceptually uniform, blue to yellow" },
     Named {
         value: ColorMap::Inferno,
@@ -209,8 +209,14 @@ const COLOR_MAPS: [Named<ColorMap>; 4] = [
     },
     Named { value: ColorMap::Magma, name: "magma", label: "magma", help: "perceptually uniform, black to white" },
     Named { value: ColorMap::Turbo, name: "turbo", label: "turbo", help: "rainbow-like, more contrast, not uniform" },
+    Named {
+        value: ColorMap::Diverging,
+        name: "blue-red",
+        label: "blue-red",
+        help: "diverging, white in the middle: made for differences (render --against uses it)",
+    },
 ];
-choice!(ColorMap, COLOR_MAPS, 4);
+choice!(ColorMap, COLOR_MAPS, 5);
 
 const UP_AXES: [Named<UpAxis>; 2] = [
     Named { value: UpAxis::Y, name: "y", label: "Y up", help: "+y is up (most formats, the handout)" },

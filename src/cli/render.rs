@@ -31,6 +31,14 @@ pub struct RenderArgs {
     /// top left), nodes_visited, box_tests, leaves_visited, triangle_tests, hit_triangle (-1: miss).
     #[arg(long, value_name = "FILE.csv")]
     pub counts: Option<PathBuf>,
+    /// Compare with a second build that differs only in its split strategy: the PNG shows the
+    /// difference of the heatmap's metric, this strategy's minus the build's, per pixel (blue:
+    /// less work, red: more; --range MIN:MAX sets ±max(|MIN|, |MAX|)).
+    #[arg(long, value_parser = super::args::choice::<crate::bvh::SplitStrategy>(), value_name = "STRATEGY")]
+    pub against: Option<crate::bvh::SplitStrategy>,
+    /// With --against: also write the difference as CSV, one row per pixel: x, y, a, b, b_minus_a.
+    #[arg(long, value_name = "FILE.csv", requires = "against")]
+    pub difference: Option<PathBuf>,
 }
 
 fn parse_range(s: &str) -> Result<(f32, f32), String> {
@@ -40,6 +48,73 @@ fn parse_range(s: &str) -> Result<(f32, f32), String> {
         (Ok(a), Ok(b)) if a.is_finite() && b.is_finite() && a < b => Ok((a, b)),
         _ => Err(format!("'{s}' is not MIN:MAX with MIN < MAX")),
     }
+}
+
+fn write_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), CliError> {
+    img.save(path).map_err(|e| CliError::Write {
+        path: path.to_path_buf(),
+        source: match e {
+            image::ImageError::IoError(io) => io,
+            other => std::io::Error::other(other.to_string()),
+        },
+    })
+}
+
+/// `render --against`: render the second build on the same camera and write B − A.
+fn run_against(
+    a: &RenderArgs,
+    loaded: &crate::scene::Scene,
+    camera: &crate::render::Camera,
+    settings: &RenderSettings,
+    frame_a: &crate::render::Frame,
+    bvh_a: &crate::bvh::SceneBvh,
+    against: crate::bvh::SplitStrategy,
+) -> Result<(), CliError> {
+    use crate::render::diff::{difference, difference_image, tally};
+    if !a.view.is_heatmap() {
+        return Err(CliError::Usage(
+            "--against compares two builds' heatmaps: add --view visits, tri-tests or cost".into(),
+        ));
+    }
+    let params_a = bvh_a.build_params();
+    let params_b =
+        crate::bvh::SceneBuild { bvh: crate::bvh::BuildParams { strategy: against, ..params_a.bvh }, ..params_a };
+    let bvh_b = build_scene(loaded, &params_b)?;
+    let control = WorkControl::new();
+    let frame_b = progress::with_bar("rendering the second build", &control, || {
+        render_progressive(&bvh_b, &bvh_b, camera, settings, &Default::default(), &control, |_, _| {})
+    })
+    .map_err(|_| CliError::Usage("render cancelled".into()))?;
+    let cost = params_a.bvh.cost;
+    let d = difference(frame_a, &frame_b, a.view, cost).expect("two complete counted frames of one camera");
+    if let Some(path) = &a.difference {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let _ = w.write_record(["x", "y", "a", "b", "b_minus_a"]);
+        for (i, v) in d.iter().enumerate() {
+            let (x, y) = (i as u32 % camera.width, i as u32 / camera.width);
+            let (va, vb) = (a.view.metric(&frame_a.counters(x, y), cost), a.view.metric(&frame_b.counters(x, y), cost));
+            let _ = w.write_record([x.to_string(), y.to_string(), va.to_string(), vb.to_string(), v.to_string()]);
+        }
+        let bytes = w.into_inner().expect("writing to memory");
+        std::fs::write(path, bytes).map_err(|source| CliError::Write { path: path.clone(), source })?;
+    }
+    let range = a.range.map(|(lo, hi)| lo.abs().max(hi.abs()));
+    let (img, mut legend) = difference_image(camera.width, &d, a.view, range);
+    legend.subject = format!("{}: A {}, B {}", file_name(&a.mesh), params_a.label(), params_b.label());
+    let img = draw_legend(&img, &legend);
+    write_png(&img, &a.output)?;
+    let (less, same, more) = tally(&d);
+    eprintln!(
+        "wrote {} ({}x{} difference of {}, B {} minus A {}: B does less work at {less} pixels, the same at {same}, more at {more}; mean {:.3})",
+        a.output.display(),
+        camera.width,
+        camera.height,
+        a.view.label().to_lowercase(),
+        params_b.label(),
+        params_a.label(),
+        legend.mean
+    );
+    Ok(())
 }
 
 /// The file name of a path, for captions.
@@ -63,6 +138,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     if let Some(path) = &a.counts {
         let text = frame.counts_csv().expect("the frame was counted and is complete");
         std::fs::write(path, text).map_err(|source| CliError::Write { path: path.clone(), source })?;
+    }
+    if let Some(against) = a.against {
+        return run_against(a, &loaded, &camera, &settings, &frame, &bvh, against);
     }
     let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
     let (img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);

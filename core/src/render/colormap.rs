@@ -1,5 +1,5 @@
 //! Perceptual colour maps for heatmaps, from the `colorous` crate (viridis and inferno: van der
-//! Walt & Smith's matplotlib maps; turbo: Mikhailov 2019).
+//! Walt & Smith's matplotlib maps; turbo: Mikhailov 2019; the diverging red–blue: ColorBrewer's RdBu).
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum ColorMap {
@@ -8,6 +8,8 @@ pub enum ColorMap {
     Inferno,
     Magma,
     Turbo,
+    /// Blue through white to red (colorous's red–blue, reversed): for differences, centred on 0.5.
+    Diverging,
 }
 
 impl ColorMap {
@@ -17,6 +19,7 @@ impl ColorMap {
             ColorMap::Inferno => colorous::INFERNO,
             ColorMap::Magma => colorous::MAGMA,
             ColorMap::Turbo => colorous::TURBO,
+            ColorMap::Diverging => colorous::RED_BLUE,
         }
     }
 
@@ -24,6 +27,8 @@ impl ColorMap {
     #[inline]
     pub fn map(self, x: f32) -> [u8; 3] {
         let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+        // Red–blue runs from red at 0 to blue at 1; a difference's negative end (less work) is blue.
+        let x = if self == ColorMap::Diverging { 1.0 - x } else { x };
         let c = self.gradient().eval_continuous(x as f64);
         [c.r, c.g, c.b]
     }

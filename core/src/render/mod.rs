@@ -4,6 +4,7 @@
 
 mod camera;
 mod colormap;
+pub mod diff;
 mod frame;
 pub mod legend;
 mod raycast;
