@@ -521,3 +521,42 @@ fn render_against_writes_the_per_pixel_difference_of_two_builds() {
     let out = bvhscope(&["render", torus, "--against", "sah", "--view", "normals", "-o", &p(&png)]);
     assert_eq!(out.status.code(), Some(2), "only heatmaps have a difference");
 }
+
+/// `replay` writes the build as an animated PNG, a frame per step from the root alone to the
+/// finished tree, and prints each step's SAH cost: the first is one leaf of every triangle, the
+/// last the finished binary tree's (as `stats` prints it).
+#[test]
+fn replay_writes_an_animated_png_and_the_sah_cost_per_step() {
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    let apng = tmp("replay.png");
+    let out = bvhscope(&[
+        "replay",
+        torus,
+        "--strategy",
+        "midpoint",
+        "--size",
+        "48x32",
+        "--frames",
+        "6",
+        "-o",
+        apng.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let table = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<Vec<f64>> =
+        table.lines().skip(1).map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect()).collect();
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&apng).unwrap()));
+    let reader = decoder.read_info().unwrap();
+    let frames = reader.info().animation_control.expect("an animated PNG").num_frames;
+    assert_eq!(frames as usize, rows.len(), "a frame per step");
+    assert!(rows.len() >= 5);
+    let triangles = rows[0][1];
+    assert_eq!(rows[0][0], 0.0);
+    assert!(triangles > 100.0, "the root alone costs a test of every triangle");
+    assert!(rows.windows(2).all(|w| w[1][0] > w[0][0]), "k grows");
+    assert!(rows.last().unwrap()[1] < triangles / 5.0, "the finished tree costs far less than one leaf");
+    let stats = bvhscope(&["stats", torus, "--strategy", "midpoint", "--layout", "binary", "--no-rays"]);
+    let text = String::from_utf8_lossy(&stats.stdout);
+    let sah = text.lines().find(|l| l.starts_with("SAH cost")).unwrap().split_whitespace().nth(2).unwrap().to_string();
+    assert_eq!(format!("{:.3}", rows.last().unwrap()[1]), sah, "the last step is the finished tree");
+}

@@ -6,6 +6,7 @@ mod compare;
 pub mod inspect;
 mod progress;
 mod render;
+pub mod replay;
 mod stats;
 pub mod trace;
 
@@ -52,6 +53,8 @@ pub enum Command {
     Trace(trace::TraceArgs),
     /// One node of the BVH explained: its figures, and where each strategy would split it.
     Inspect(inspect::InspectArgs),
+    /// The build played back split by split, as an animated PNG and a table of the SAH cost.
+    Replay(replay::ReplayArgs),
 }
 
 /// An error the CLI reports in one line before exiting with code 2.
@@ -117,6 +120,7 @@ pub fn run(command: Command) -> Result<(), CliError> {
         Command::Render(a) => render::run(&a),
         Command::Trace(a) => trace::run(&a),
         Command::Inspect(a) => inspect::run(&a),
+        Command::Replay(a) => replay::run(&a),
         Command::Stats(a) => stats::run(&a),
         Command::Compare(a) => compare::run(&a),
     }

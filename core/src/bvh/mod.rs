@@ -12,6 +12,7 @@ mod linear;
 mod node;
 pub mod packet;
 mod preset;
+pub mod replay;
 mod scene_bvh;
 mod simd;
 pub mod split;

@@ -1,0 +1,142 @@
+//! `bvhscope replay MESH`: the build played back as an animated PNG, one frame per step on a log
+//! scale of the number of splits k (the first splits change the most), each the heatmap of the tree
+//! after k splits on one colour scale; and the table of k, the partial tree's SAH cost and the mean
+//! of the heatmap's metric, for a lab report (`bvh::replay`).
+
+use super::args::{BuildArgs, ViewArgs};
+use super::render::file_name;
+use super::{build_scene, load_mesh, progress, CliError};
+use crate::bvh::replay::Replay;
+use crate::bvh::{Layout, SceneBvh};
+use crate::render::{draw_legend, render, ColorMap, Legend, RenderSettings, View};
+use clap::Args;
+use std::fmt::Write;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+#[derive(Args, Debug)]
+pub struct ReplayArgs {
+    /// The mesh (.obj) or scene (.json, one level).
+    pub mesh: PathBuf,
+    #[command(flatten)]
+    pub build: BuildArgs,
+    #[command(flatten)]
+    pub view_args: ViewArgs,
+    /// The heatmap each frame shows (combined cost by default: it falls as the tree grows, while
+    /// nodes visited rise and triangle tests fall).
+    #[arg(long, value_parser = super::args::choice::<View>(), default_value = "cost")]
+    pub view: View,
+    #[arg(long, value_parser = super::args::choice::<ColorMap>(), default_value = "viridis")]
+    pub colormap: ColorMap,
+    /// Frames (steps on a log scale of k, from the root alone to the finished tree).
+    #[arg(long, default_value_t = 24, value_parser = clap::value_parser!(u32).range(2..=400))]
+    pub frames: u32,
+    /// How long each frame shows, in milliseconds.
+    #[arg(long, default_value_t = 400, value_parser = clap::value_parser!(u16).range(20..))]
+    pub delay_ms: u16,
+    /// The animated PNG to write.
+    #[arg(long, short, default_value = "build.png")]
+    pub output: PathBuf,
+}
+
+/// `frames` split counts from 0 to `n` on a log scale of k + 1, without repeats.
+pub fn steps(n: usize, frames: u32) -> Vec<usize> {
+    let top = ((n + 1) as f64).ln();
+    let mut ks: Vec<usize> = (0..frames)
+        .map(|i| ((top * i as f64 / (frames - 1).max(1) as f64).exp().round() as usize).saturating_sub(1).min(n))
+        .collect();
+    ks.dedup();
+    if ks.last() != Some(&n) {
+        ks.push(n);
+    }
+    ks
+}
+
+pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
+    if a.build.two_level {
+        return Err(CliError::Usage("replay plays back one BVH's build; leave out --two-level".into()));
+    }
+    if !a.view.is_heatmap() {
+        return Err(CliError::Usage("replay shows a heatmap: --view visits, tri-tests or cost".into()));
+    }
+    let scene = load_mesh(&a.mesh)?;
+    let params = a.build.params(scene.build.as_ref());
+    let SceneBvh::Single { bvh, mesh } = build_scene(&scene, &a.build.scene_build(params))? else {
+        unreachable!("one level was asked for")
+    };
+    if params.layout != Layout::Binary {
+        eprintln!("note: the replay is of the binary tree as built (the 4-wide layout is collapsed from it)");
+    }
+    let replay = Replay::of(Arc::new(bvh.binary_tree(&mesh).into_owned()));
+    let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
+    let settings = RenderSettings { trace: a.build.trace(), count: true, progressive: false };
+    let ks = steps(replay.splits(), a.frames);
+    let cost = params.cost;
+    // Each step's metric per pixel; then one colour scale for all of them.
+    let values: Vec<Vec<f32>> = progress::with_spinner("rendering the steps", || {
+        ks.iter()
+            .map(|&k| {
+                let partial = replay.partial(k);
+                let f = render(&partial, &*mesh, &camera, &settings);
+                (0..camera.height)
+                    .flat_map(|y| (0..camera.width).map(move |x| (x, y)))
+                    .map(|(x, y)| a.view.metric(&f.counters(x, y), cost))
+                    .collect()
+            })
+            .collect()
+    });
+    let max = values.iter().flatten().copied().fold(0f32, f32::max).max(1e-20);
+    let subject = format!("{}, {}, log scale", file_name(&a.mesh), params.strategy.label());
+    let mut table = format!("{:>8}  {:>12}  mean {} per ray\n", "splits", "SAH cost", a.view.label().to_lowercase());
+    let mut images = Vec::new();
+    for (&k, v) in ks.iter().zip(&values) {
+        let mean = v.iter().map(|&x| x as f64).sum::<f64>() / v.len().max(1) as f64;
+        let _ = writeln!(table, "{k:>8}  {:>12.3}  {mean:.3}", replay.sah[k]);
+        // One scale for every step, 0 to the largest value of any, logarithmic: the first steps
+        // cost hundreds of times what the last do, and both should show.
+        let log_max = (1.0 + max).ln();
+        let img = image::RgbImage::from_fn(camera.width, camera.height, |x, y| {
+            image::Rgb(a.colormap.map((1.0 + v[(y * camera.width + x) as usize]).ln() / log_max))
+        });
+        let legend = Legend {
+            title: format!(
+                "{}: {k}/{} splits, SAH {:.1}",
+                a.view.label().to_lowercase(),
+                replay.splits(),
+                replay.sah[k]
+            ),
+            subject: subject.clone(),
+            colormap: a.colormap,
+            range_min: 0.0,
+            range_max: max,
+            min: v.iter().copied().fold(f32::INFINITY, f32::min),
+            max: v.iter().copied().fold(0.0, f32::max),
+            mean,
+        };
+        images.push(draw_legend(&img, &legend));
+    }
+    write_apng(&images, a.delay_ms, &a.output)?;
+    print!("{table}");
+    eprintln!("wrote {} ({} frames, {}x{})", a.output.display(), images.len(), images[0].width(), images[0].height());
+    Ok(())
+}
+
+/// Frames of one size as an animated PNG that loops.
+fn write_apng(frames: &[image::RgbImage], delay_ms: u16, path: &std::path::Path) -> Result<(), CliError> {
+    let err = |e: png::EncodingError| CliError::Write {
+        path: path.to_path_buf(),
+        source: std::io::Error::other(e.to_string()),
+    };
+    let file = std::fs::File::create(path).map_err(|source| CliError::Write { path: path.to_path_buf(), source })?;
+    let (w, h) = frames[0].dimensions();
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_animated(frames.len() as u32, 0).map_err(err)?;
+    let mut writer = enc.write_header().map_err(err)?;
+    for f in frames {
+        writer.set_frame_delay(delay_ms, 1000).map_err(err)?;
+        writer.write_image_data(f.as_raw()).map_err(err)?;
+    }
+    writer.finish().map_err(err)
+}
