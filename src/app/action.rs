@@ -98,6 +98,9 @@ pub enum Action {
     /// What the icicle colours by.
     SetMetric(Metric),
 
+    /// Highlight the pixels whose heatmap value is above this (None: no highlight).
+    SetThreshold(Option<f32>),
+
     /// Toggle the Help window.
     Help,
     SetHelp(bool),

@@ -151,11 +151,16 @@ pub struct BvhscopeApp {
     pub ray_window: bool,
     /// The Tree and Node windows: the prepared tree, the node selected, its inspection.
     pub nodes: NodeView,
+    /// The legend histogram's threshold: pixels whose heatmap value is above it are highlighted.
+    pub threshold: Option<f32>,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     box_cache: std::cell::RefCell<Option<BoxCache>>,
     overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
     /// The selected node's mask over the frame on screen.
     mask_cache: std::cell::RefCell<Option<MaskCache>>,
+    /// The legend's histogram of the frame on screen, and the threshold's mask over it.
+    histogram_cache: std::cell::RefCell<Option<HistogramCache>>,
+    threshold_cache: std::cell::RefCell<Option<ThresholdCache>>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
     /// Where the viewport was drawn in the last frame (its size is the rendered image's).
@@ -173,6 +178,11 @@ struct OverlayCache {
     depth: Option<Arc<Frame>>,
     mesh: Arc<egui::Mesh>,
 }
+
+/// The legend's histogram, for a frame and view.
+type HistogramCache = (Arc<Frame>, View, Vec<u32>);
+/// The threshold's mask, for a frame, view and threshold.
+type ThresholdCache = (Arc<Frame>, View, f32, egui::TextureHandle);
 
 /// A node's mask: for the frame, the prepared tree and the node it was made for.
 struct MaskCache {
@@ -220,9 +230,12 @@ impl BvhscopeApp {
             pins: RayView::default(),
             ray_window: false,
             nodes: NodeView::default(),
+            threshold: None,
             box_cache: Default::default(),
             overlay_cache: Default::default(),
             mask_cache: Default::default(),
+            histogram_cache: Default::default(),
+            threshold_cache: Default::default(),
             viewport_aspect: aspect,
             viewport_rect: egui::Rect::NOTHING,
             viewport_pixels: (0, 0),
@@ -471,6 +484,64 @@ impl BvhscopeApp {
         Some(tex)
     }
 
+    /// The legend's histogram of the heatmap on screen (`render::histogram` over the legend's
+    /// range, `viewport::HISTOGRAM_BINS` bins; cached for the frame and view).
+    pub fn legend_histogram(&self) -> Option<Vec<u32>> {
+        let shown = self.shown.as_ref()?;
+        let legend = shown.legend.as_ref()?;
+        let view = shown.style.view;
+        let mut cache = self.histogram_cache.borrow_mut();
+        if let Some((f, v, h)) = cache.as_ref() {
+            if Arc::ptr_eq(f, &shown.frame) && *v == view {
+                return Some(h.clone());
+            }
+        }
+        let h = crate::render::histogram(
+            &shown.frame,
+            view,
+            shown.style.cost,
+            legend.range_min,
+            legend.range_max,
+            viewport::HISTOGRAM_BINS,
+        );
+        *cache = Some((shown.frame.clone(), view, h.clone()));
+        Some(h)
+    }
+
+    /// A mask over the heatmap on screen dimming the pixels at or below the threshold (cached).
+    pub fn threshold_mask(&self, ctx: &egui::Context, shown: &Shown) -> Option<egui::TextureHandle> {
+        let t = self.threshold?;
+        shown.legend.as_ref()?;
+        let (f, view) = (&shown.frame, shown.style.view);
+        if !f.is_complete() || !f.counted() {
+            return None;
+        }
+        let mut cache = self.threshold_cache.borrow_mut();
+        if let Some((cf, cv, ct, tex)) = cache.as_ref() {
+            if Arc::ptr_eq(cf, f) && *cv == view && *ct == t {
+                return Some(tex.clone());
+            }
+        }
+        let (w, h) = (f.width(), f.height());
+        let pixels = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                if view.metric(&f.counters(x, y), shown.style.cost) > t {
+                    egui::Color32::TRANSPARENT
+                } else {
+                    egui::Color32::from_black_alpha(170)
+                }
+            })
+            .collect();
+        let tex = ctx.load_texture(
+            "threshold-mask",
+            egui::ColorImage::new([w as usize, h as usize], pixels),
+            egui::TextureOptions::NEAREST,
+        );
+        *cache = Some((f.clone(), view, t, tex.clone()));
+        Some(tex)
+    }
+
     /// How many boxes the overlay draws (0 when it is off).
     pub fn boxes_drawn(&self) -> usize {
         let boxes = self.settings.show_boxes.then(|| self.overlay_boxes()).flatten();
@@ -707,7 +778,11 @@ impl BvhscopeApp {
                 self.viewport_aspect = rect.width() / rect.height().max(1.0);
                 self.viewport_pixels = pixels;
             }
-            A::View(i) => self.settings.view = View::ALL[i.min(View::ALL.len() - 1)],
+            A::View(i) => {
+                self.settings.view = View::ALL[i.min(View::ALL.len() - 1)];
+                self.threshold = None;
+            }
+            A::SetThreshold(t) => self.threshold = t,
             A::ToggleBoxes => self.settings.show_boxes = !self.settings.show_boxes,
             A::DepthUp => {
                 let max = self.current_bvh().map_or(0, |b| b.bottom_max_depth());

@@ -76,6 +76,13 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         painter.text(rect.center(), egui::Align2::CENTER_CENTER, busy, egui::FontId::proportional(18.0), Color32::GRAY);
     }
 
+    // The legend histogram's threshold: the pixels at or below it dimmed.
+    if let Some(shown) = &app.shown {
+        if let Some(mask) = app.threshold_mask(ui.ctx(), shown) {
+            painter.image(mask.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
+        }
+    }
+
     // Node boxes, in the camera of the image they are drawn over.
     if app.settings.show_boxes {
         if let (Some(boxes), Some(camera)) = (app.overlay_boxes(), app.shown.as_ref().map(|s| s.camera)) {
@@ -105,7 +112,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     messages(app, ui, rect, out);
     if let Some(shown) = &app.shown {
         if let Some(legend) = &shown.legend {
-            legend_area(ui, rect, legend);
+            legend_area(app, ui, rect, legend, out);
         }
         if let Some(pos) = response.hover_pos() {
             let frame = shown.frame.clone();
@@ -321,16 +328,22 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
 
 /// The heatmap legend in the viewport's lower-left corner: title, colour bar with its ends, and
 /// the frame's min / mean / max. Real labels, so screen readers and UI tests see the numbers.
-fn legend_area(ui: &egui::Ui, rect: Rect, legend: &Legend) {
+/// Bins of the legend's histogram.
+pub const HISTOGRAM_BINS: usize = 32;
+
+fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, out: &mut Actions) {
     egui::Area::new(ui.scope_id().with("heatmap-legend"))
-        .fixed_pos(rect.left_bottom() + Vec2::new(12.0, -96.0))
+        .fixed_pos(rect.left_bottom() + Vec2::new(12.0, -158.0))
         .order(egui::Order::Foreground)
         .show(ui.ctx(), |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.set_max_width(330.0);
                 ui.label(egui::RichText::new(format!("Legend: {}", legend.title)).strong());
+                let mut bar_x = 0.0..=0.0;
                 ui.horizontal(|ui| {
                     ui.label(fmt_value(legend.range_min as f64));
                     let (bar, _) = ui.allocate_exact_size(Vec2::new(220.0, 14.0), Sense::hover());
+                    bar_x = bar.x_range().min..=bar.x_range().max;
                     let steps = 110;
                     for i in 0..steps {
                         let t = i as f32 / (steps - 1) as f32;
@@ -346,6 +359,7 @@ fn legend_area(ui: &egui::Ui, rect: Rect, legend: &Legend) {
                     ui.painter().rect_stroke(bar, 0.0, Stroke::new(1.0, Color32::GRAY), egui::StrokeKind::Outside);
                     ui.label(fmt_value(legend.range_max as f64));
                 });
+                histogram_bars(app, ui, legend, bar_x, out);
                 ui.label(format!(
                     "min {}   mean {:.2}   max {}   (all traced rays)",
                     fmt_value(legend.min as f64),
@@ -354,6 +368,56 @@ fn legend_area(ui: &egui::Ui, rect: Rect, legend: &Legend) {
                 ));
             });
         });
+}
+
+/// The distribution of the heatmap's per-pixel values under the colour bar, on its range; a click
+/// or drag sets a threshold above which the image's pixels are highlighted (the rest dimmed).
+fn histogram_bars(
+    app: &BvhscopeApp,
+    ui: &mut egui::Ui,
+    legend: &Legend,
+    x: std::ops::RangeInclusive<f32>,
+    out: &mut Actions,
+) {
+    let Some(counts) = app.legend_histogram() else { return };
+    // The bars sit under the colour bar, bin for bin.
+    let (row, response) = ui
+        .horizontal(|ui| {
+            ui.add_space((*x.start() - ui.cursor().min.x).max(0.0));
+            ui.allocate_exact_size(Vec2::new(x.end() - x.start(), 44.0), Sense::click_and_drag())
+        })
+        .inner;
+    let bars = row;
+    let painter = ui.painter_at(row);
+    let top = counts.iter().copied().max().unwrap_or(1).max(1) as f32;
+    let w = bars.width() / counts.len() as f32;
+    for (i, &c) in counts.iter().enumerate() {
+        // A square root keeps the rare high values visible beside the crowd at the low end.
+        let h = bars.height() * (c as f32 / top).sqrt();
+        let x0 = bars.min.x + w * i as f32;
+        let [r, g, b] = legend.colormap.map((i as f32 + 0.5) / counts.len() as f32);
+        painter.rect_filled(
+            Rect::from_min_max(Pos2::new(x0, bars.max.y - h), Pos2::new(x0 + w - 0.5, bars.max.y)),
+            0.0,
+            Color32::from_rgb(r, g, b),
+        );
+    }
+    let span = legend.range_max - legend.range_min;
+    if let Some(t) = app.threshold {
+        let px = bars.min.x + bars.width() * ((t - legend.range_min) / span.max(1e-20)).clamp(0.0, 1.0);
+        painter.line_segment([Pos2::new(px, row.min.y), Pos2::new(px, row.max.y)], Stroke::new(2.0, Color32::WHITE));
+    }
+    if let Some(pos) = response.interact_pointer_pos().filter(|_| response.clicked() || response.dragged()) {
+        let t = legend.range_min + span * ((pos.x - bars.min.x) / bars.width()).clamp(0.0, 1.0);
+        out.push(Action::SetThreshold(Some(t)));
+    }
+    if response.double_clicked() || response.secondary_clicked() {
+        out.push(Action::SetThreshold(None));
+    }
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Histogram of the heatmap"));
+    let above = app.threshold.map_or(String::new(), |t| format!(" Pixels above {}: highlighted.", fmt_value(t as f64)));
+    ui.weak(format!("Pixels per value (square root scale). Click or drag to highlight the pixels above a value; double-click to clear.{above}"))
+        .on_hover_text("The same bins as `bvhscope render --histogram 32`");
 }
 
 /// Errors (until dismissed) and notes (for a few seconds) across the top of the viewport. Each

@@ -36,6 +36,10 @@ pub struct RenderArgs {
     /// less work, red: more; --range MIN:MAX sets ±max(|MIN|, |MAX|)).
     #[arg(long, value_parser = super::args::choice::<crate::bvh::SplitStrategy>(), value_name = "STRATEGY")]
     pub against: Option<crate::bvh::SplitStrategy>,
+    /// Print the heatmap's histogram as CSV (`bin_low,bin_high,pixels`): BINS equal bins over the
+    /// legend's range, the bars under the app's legend (which has 32).
+    #[arg(long, value_name = "BINS", value_parser = clap::value_parser!(u32).range(1..=10000))]
+    pub histogram: Option<u32>,
     /// With --against: also write the difference as CSV, one row per pixel: x, y, a, b, b_minus_a.
     #[arg(long, value_name = "FILE.csv", requires = "against")]
     pub difference: Option<PathBuf>,
@@ -146,6 +150,18 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let (img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
     if let Some(l) = &mut legend {
         l.subject = format!("{}, {}", file_name(&a.mesh), bvh.build_params().label());
+    }
+    if let (Some(bins), Some(l)) = (a.histogram, &legend) {
+        let counts = crate::render::histogram(&frame, a.view, params.cost, l.range_min, l.range_max, bins as usize);
+        let width = (l.range_max - l.range_min) / bins as f32;
+        let mut o = String::from("bin_low,bin_high,pixels\n");
+        for (i, c) in counts.iter().enumerate() {
+            let lo = l.range_min + width * i as f32;
+            o += &format!("{lo},{},{c}\n", lo + width);
+        }
+        print!("{o}");
+    } else if a.histogram.is_some() {
+        return Err(CliError::Usage("--histogram is of a heatmap: add --view visits, tri-tests or cost".into()));
     }
     let img = match &legend {
         Some(l) => draw_legend(&img, l),

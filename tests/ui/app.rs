@@ -1015,3 +1015,29 @@ fn the_node_inspector_and_bvhscope_inspect_agree() {
     assert_eq!(v["visits"], visits, "the Tree window's visits of node 3 for the same camera");
     assert!(visits > 0);
 }
+
+/// The legend's histogram counts every pixel of the heatmap; a click on it sets the threshold
+/// above which pixels are highlighted, a double click clears it, and another view drops it.
+#[test]
+fn the_heatmap_histogram_sets_a_threshold() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::View(2));
+    run_until(&mut h, "the heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+    let (counts, pixels, legend) = {
+        let app = h.state();
+        let s = app.shown.as_ref().unwrap();
+        (app.legend_histogram().unwrap(), s.frame.width() * s.frame.height(), s.legend.clone().unwrap())
+    };
+    assert_eq!(counts.iter().sum::<u32>(), pixels, "every pixel in a bin");
+    let rect = h.get_by_label("Histogram of the heatmap").rect();
+    // The bars span the colour bar: a click in the middle of the widget lands near the range's middle.
+    click_at_with(&mut h, rect.center(), egui::Modifiers::NONE);
+    let t = h.state().threshold.expect("a threshold");
+    assert!(t > legend.range_min && t < legend.range_max, "{t} in {}..{}", legend.range_min, legend.range_max);
+    h.get_by_label_contains("highlighted");
+    assert!(h.state().pins.pinned.is_empty(), "a click on the legend pins no ray");
+    h.state_mut().act(Action::View(3));
+    h.run_steps(2);
+    assert_eq!(h.state().threshold, None, "another view, another scale: the threshold goes");
+}

@@ -92,6 +92,20 @@ pub fn metric_stats(frame: &Frame, view: View, cost: SahCost) -> (f32, f32, f64)
     }
 }
 
+/// How many traced pixels' `view` metric falls in each of `bins` equal bins over `lo..=hi` (values
+/// outside go to the end bins): the heatmap's histogram under the app's legend and `render
+/// --histogram`'s table.
+pub fn histogram(frame: &Frame, view: View, cost: SahCost, lo: f32, hi: f32, bins: usize) -> Vec<u32> {
+    let n = bins.max(1);
+    let mut out = vec![0u32; n];
+    let scale = if hi > lo { n as f32 / (hi - lo) } else { 0.0 };
+    for (_, c) in frame.traced() {
+        let b = ((view.metric(&c, cost) - lo) * scale).floor();
+        out[(b.max(0.0) as usize).min(n - 1)] += 1;
+    }
+    out
+}
+
 /// The frame as an RGB image in the given view, one pixel per traced pixel (so a coarse pass's image
 /// is 1/stride of the frame in each direction, to be shown stretched); for heatmaps also the
 /// legend's numbers.
@@ -172,6 +186,34 @@ fn grid_image(frame: &Frame, pixel: impl Fn(&super::PixelSample, RayCounters) ->
         }
     });
     RgbImage::from_raw(w, h, buf).expect("the buffer holds w×h pixels")
+}
+
+#[cfg(test)]
+mod histogram_tests {
+    use super::*;
+    use crate::bvh::{AnyBvh, BuildParams};
+    use crate::render::{render, Camera, RenderSettings, UpAxis};
+
+    /// Every traced pixel is counted once, in the bin its value falls in.
+    #[test]
+    fn the_histogram_counts_every_pixel_in_its_bin() {
+        let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 64, 8);
+        let bvh = AnyBvh::build(&mesh, &BuildParams::default());
+        let camera = Camera::framing_up(&mesh.bounds(), 40, 30, UpAxis::Y, 45.0);
+        let f = render(&bvh, &mesh, &camera, &RenderSettings { count: true, ..Default::default() });
+        let cost = SahCost::default();
+        let (lo, hi, _) = metric_stats(&f, View::Visits, cost);
+        let h = histogram(&f, View::Visits, cost, lo, hi, 8);
+        assert_eq!(h.iter().sum::<u32>(), 1200);
+        let bin = |v: f32| (((v - lo) * 8.0 / (hi - lo)).floor() as usize).min(7);
+        let mut want = vec![0u32; 8];
+        for y in 0..30 {
+            for x in 0..40 {
+                want[bin(f.counters(x, y).nodes_visited as f32)] += 1;
+            }
+        }
+        assert_eq!(h, want);
+    }
 }
 
 #[cfg(test)]
