@@ -98,6 +98,11 @@ pub enum Action {
     /// What the icicle colours by.
     SetMetric(Metric),
 
+    /// Open (or close) the Replay window: the viewport shows the tree after some splits.
+    ShowReplay(bool),
+    /// Show the tree after `k` splits.
+    ReplayStep(usize),
+    ReplayPlay(bool),
     /// Highlight the pixels whose heatmap value is above this (None: no highlight).
     SetThreshold(Option<f32>),
 

@@ -4,6 +4,7 @@
 
 use super::node_view::{Explained, FrameVisits};
 use crate::bvh::inspect::Inspection;
+use crate::bvh::replay::PartialBvh;
 use crate::bvh::{SahCost, TraceOptions};
 use crate::bvh::{SceneBuild, SceneBvh};
 use crate::render::{
@@ -34,6 +35,8 @@ pub struct RenderRequest {
     pub trace: TraceOptions,
     pub style: ViewStyle,
     pub progressive: bool,
+    /// The build replay's partial tree of `bvh` (a single BVH) to trace instead of it.
+    pub partial: Option<Arc<PartialBvh>>,
 }
 
 impl RenderRequest {
@@ -44,6 +47,11 @@ impl RenderRequest {
             && self.trace == o.trace
             && self.style == o.style
             && self.progressive == o.progressive
+            && match (&self.partial, &o.partial) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (None, None) => true,
+                _ => false,
+            }
     }
 }
 
@@ -58,6 +66,8 @@ pub struct PassOutput {
     pub camera: Camera,
     pub trace: TraceOptions,
     pub style: ViewStyle,
+    /// The partial tree of a build replay that traced the frame, if it was one.
+    pub partial: Option<Arc<PartialBvh>>,
 }
 
 /// What a file dialog was opened for.
@@ -202,13 +212,21 @@ impl Jobs {
             // Always count: the heatmaps and the hover read-out need the counters, and counting
             // costs little next to shading.
             let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive };
-            let _ = render_passes(&*r.bvh, &*r.bvh, &r.camera, &settings, &frames, &control, |frame, info| {
+            let on_pass = |frame: Frame, info: PassInfo| {
                 let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
-                let (bvh, camera, style, trace) = (r.bvh.clone(), r.camera, r.style, r.trace);
+                let (bvh, camera, style, trace, partial) =
+                    (r.bvh.clone(), r.camera, r.style, r.trace, r.partial.clone());
                 let frame = Arc::new(frame);
-                send(JobEvent::Pass(PassOutput { bvh, frame, image, legend, info, camera, trace, style }));
-            });
+                send(JobEvent::Pass(PassOutput { bvh, frame, image, legend, info, camera, trace, style, partial }));
+            };
+            // A replay's partial tree traces in place of the BVH it is part of; the mesh shades.
+            let _ = match (&r.partial, &*r.bvh) {
+                (Some(p), SceneBvh::Single { mesh, .. }) => {
+                    render_passes(&**p, &**mesh, &r.camera, &settings, &frames, &control, on_pass)
+                }
+                _ => render_passes(&*r.bvh, &*r.bvh, &r.camera, &settings, &frames, &control, on_pass),
+            };
         });
         self.render = Some(job);
         self.last_render = Some(req);
@@ -220,7 +238,7 @@ impl Jobs {
         let send = self.sender(job.id);
         std::thread::spawn(move || {
             if let SceneBvh::Single { bvh: any, mesh } = &*bvh {
-                let tree = any.binary_tree(mesh).into_owned();
+                let tree = Arc::new(any.binary_tree(mesh).into_owned());
                 send(JobEvent::Explained(Arc::new(Explained::new(bvh.clone(), tree))));
             }
         });

@@ -11,6 +11,7 @@ mod orbit;
 mod overlay;
 mod panels;
 mod ray_view;
+mod replay_view;
 mod scene;
 mod settings;
 mod shortcuts;
@@ -23,6 +24,7 @@ pub use node_view::{Metric, NodeView, Step as NodeStep};
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
 pub use ray_view::{PinnedRay, RayView};
+pub use replay_view::ReplayView;
 pub use scene::BuiltBvh;
 pub use settings::{BoxLevel, Settings};
 
@@ -63,6 +65,8 @@ pub struct Shown {
     pub camera: Camera,
     pub legend: Option<Legend>,
     pub style: ViewStyle,
+    /// The build replay's partial tree that traced the image, if it was one.
+    pub partial: Option<Arc<crate::bvh::replay::PartialBvh>>,
     /// Rays per second of the last pass.
     pub rays_per_s: f64,
     /// The build that traced it ("SAH binned, wide4"), for captions.
@@ -153,6 +157,8 @@ pub struct BvhscopeApp {
     pub nodes: NodeView,
     /// The legend histogram's threshold: pixels whose heatmap value is above it are highlighted.
     pub threshold: Option<f32>,
+    /// The Replay window: the build played back split by split.
+    pub replay: ReplayView,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     box_cache: std::cell::RefCell<Option<BoxCache>>,
     overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
@@ -231,6 +237,7 @@ impl BvhscopeApp {
             ray_window: false,
             nodes: NodeView::default(),
             threshold: None,
+            replay: ReplayView::default(),
             box_cache: Default::default(),
             overlay_cache: Default::default(),
             mask_cache: Default::default(),
@@ -359,6 +366,17 @@ impl BvhscopeApp {
             }
             return;
         };
+        if self.replay.window {
+            let before = self.replay.partial.clone();
+            self.replay.fit(&explained);
+            let changed = match (&before, &self.replay.partial) {
+                (Some(a), Some(b)) => !Arc::ptr_eq(a, b),
+                _ => true,
+            };
+            if changed {
+                self.ensure_render();
+            }
+        }
         if let Some(node) = self.nodes.selected.filter(|_| self.nodes.inspection.is_none()) {
             if self.jobs.inspect.as_ref().is_none_or(|(_, n)| *n != node) {
                 self.jobs.inspect(explained.clone(), node);
@@ -425,6 +443,7 @@ impl BvhscopeApp {
             trace: self.settings.trace,
             style: self.view_style(),
             progressive: self.settings.progressive,
+            partial: self.replay_partial(),
         };
         if req.camera.validate().is_ok() && !self.jobs.last_render.as_ref().is_some_and(|last| last.same_as(&req)) {
             self.jobs.render(req);
@@ -482,6 +501,14 @@ impl BvhscopeApp {
         let tex = ctx.load_texture("node-mask", image, egui::TextureOptions::NEAREST);
         *cache = Some(MaskCache { frame: f.clone(), tree: e.clone(), node, texture: tex.clone() });
         Some(tex)
+    }
+
+    /// The partial tree the viewport shows while the Replay window is open (of the current BVH).
+    pub fn replay_partial(&self) -> Option<Arc<crate::bvh::replay::PartialBvh>> {
+        let bvh = self.current_bvh()?.bvh.clone();
+        let e = self.nodes.current(Some(&bvh))?;
+        let p = self.replay.partial.as_ref().filter(|_| self.replay.window)?;
+        Arc::ptr_eq(&p.tree, &e.tree).then(|| p.clone())
     }
 
     /// The legend's histogram of the heatmap on screen (`render::histogram` over the legend's
@@ -693,7 +720,8 @@ impl BvhscopeApp {
             self.last_full_frame = Some(p.info.elapsed);
             // Per-ray figures belong to the BVH that traced them; a pass of an older BVH that
             // arrives after a rebuild must not be shown (or remembered) under the new strategy.
-            if self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
+            // A replay's partial tree is not the strategy's tree: its figures are not recorded.
+            if p.partial.is_none() && self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
                 self.rays = Some(MeasuredRays { summary: p.frame.ray_summary(), camera: p.camera, trace: p.trace });
             }
         }
@@ -715,6 +743,7 @@ impl BvhscopeApp {
             build_label,
             bvh: p.bvh,
             trace: p.trace,
+            partial: p.partial,
         });
     }
 
@@ -783,6 +812,22 @@ impl BvhscopeApp {
                 self.threshold = None;
             }
             A::SetThreshold(t) => self.threshold = t,
+            A::ShowReplay(open) => {
+                self.replay.window = open;
+                self.replay.playing = false;
+            }
+            A::ReplayStep(k) => {
+                self.replay.set(k);
+                self.replay.last_tick = Some(Instant::now());
+            }
+            A::ReplayPlay(on) => {
+                let n = self.replay.replay.as_ref().map_or(0, |r| r.splits());
+                if on && self.replay.k >= n {
+                    self.replay.k = 0;
+                }
+                self.replay.playing = on;
+                self.replay.last_tick = Some(Instant::now());
+            }
             A::ToggleBoxes => self.settings.show_boxes = !self.settings.show_boxes,
             A::DepthUp => {
                 let max = self.current_bvh().map_or(0, |b| b.bottom_max_depth());
@@ -818,6 +863,12 @@ impl BvhscopeApp {
             }
             A::PinPixel(x, y) => {
                 let Some(s) = &self.shown else { return };
+                if s.partial.is_some() {
+                    let note =
+                        "The image shows a partial tree of the build replay: close the Replay window to pin a ray.";
+                    self.message(MessageKind::Info, note);
+                    return;
+                }
                 if x < s.camera.width && y < s.camera.height {
                     let ray = s.camera.ray_gen().pixel_ray(x, y);
                     self.pins.pin(PinnedRay::new(s.bvh.clone(), ray, s.trace, Some((x, y)), &self.scene.source));
@@ -938,6 +989,7 @@ impl eframe::App for BvhscopeApp {
         panels::ray::show(self, &ctx, out);
         panels::tree::show(self, &ctx, out);
         panels::node::show(self, &ctx, out);
+        panels::replay::show(self, &ctx, out);
         // What the panels asked for takes effect now, and shows in the next frame.
         if !actions.is_empty() {
             for action in actions {

@@ -15,7 +15,7 @@ use std::sync::Arc;
 pub struct Explained {
     /// The BVH this explains (the app's current one while `Arc::ptr_eq`).
     pub bvh: Arc<SceneBvh>,
-    pub tree: Bvh,
+    pub tree: Arc<Bvh>,
     pub hierarchy: Hierarchy,
     /// Each node's term of the end-point overlap (`bvh::epo`), and their sum.
     pub epo_terms: Vec<f64>,
@@ -25,7 +25,7 @@ pub struct Explained {
 }
 
 impl Explained {
-    pub fn new(bvh: Arc<SceneBvh>, tree: Bvh) -> Explained {
+    pub fn new(bvh: Arc<SceneBvh>, tree: Arc<Bvh>) -> Explained {
         let hierarchy = Hierarchy::of(&tree);
         let epo_terms = crate::bvh::epo::node_terms(&tree, &hierarchy);
         let epo = epo_terms.iter().sum();

@@ -93,6 +93,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     }
 
     if let Some(shown) = &app.shown {
+        draw_replay(app, &painter, rect, shown);
         draw_selected_node(app, &painter, rect, shown);
         draw_pinned(app, &painter, rect, &shown.camera);
     }
@@ -119,6 +120,39 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             response.on_hover_ui_at_pointer(|ui| pixel_readout(ui, &frame, rect, pos));
         }
     }
+}
+
+/// Most frontier boxes the replay draws (past this, only the newest split's).
+const MAX_FRONTIER_BOXES: usize = 4000;
+
+/// A build replay's image: the frontier's boxes (its nodes acting as leaves) and the newest
+/// split's two children in the selected node's colours.
+fn draw_replay(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &super::Shown) {
+    use super::overlay::{box_lines, lines_mesh};
+    let (Some(p), Some(r)) = (&shown.partial, &app.replay.replay) else { return };
+    if !Arc::ptr_eq(&p.tree, &r.tree) {
+        return;
+    }
+    let mut lines = Vec::new();
+    if p.splits < MAX_FRONTIER_BOXES {
+        for n in p.frontier() {
+            box_lines(
+                &p.tree.nodes[n as usize].bounds().corners(),
+                Color32::from_rgba_premultiplied(120, 120, 130, 120),
+                1.0,
+                &mut lines,
+            );
+        }
+    }
+    if let Some(&newest) = p.splits.checked_sub(1).and_then(|i| r.order.get(i)) {
+        let l = p.tree.nodes[newest as usize].index as usize;
+        for (c, color) in [(l, NODE_COLORS.left), (l + 1, NODE_COLORS.right)] {
+            box_lines(&p.tree.nodes[c].bounds().corners(), color, 2.0, &mut lines);
+        }
+    }
+    let camera = &shown.camera;
+    let near = (camera.position - camera.look_at).length() * 1e-4;
+    painter.add(egui::Shape::Mesh(Arc::new(lines_mesh(&lines, camera, rect, near))));
 }
 
 /// The node of the binary tree whose drawn box has an edge under `pos` (the overlay's boxes are

@@ -1041,3 +1041,80 @@ fn the_heatmap_histogram_sets_a_threshold() {
     h.run_steps(2);
     assert_eq!(h.state().threshold, None, "another view, another scale: the threshold goes");
 }
+
+/// The Replay window traces the tree after k splits: at 0 every ray that enters the root box
+/// tests every triangle; at the last split every pixel's counts are the finished binary tree's;
+/// Play moves on; closing the window brings back the full tree, and the strategy's per-ray figures
+/// are never those of a partial tree.
+#[test]
+fn the_build_replay_traces_the_partial_tree() {
+    use bvhscope::bvh::{Accelerator, RayCounters};
+    // A small mesh: at step 0 every ray tests every triangle.
+    let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, torus.clone()));
+    run_until(&mut h, "the torus and its tree", |a| {
+        a.scene.source == SceneSource::File(torus.clone())
+            && idle(a)
+            && a.nodes.current(a.current_bvh().map(|b| &b.bvh)).is_some()
+    });
+    let rays_before = h.state().rays.map(|r| r.summary.mean_nodes_visited);
+    h.get_by_role_and_label(Role::Button, "View").click();
+    h.run_steps(2);
+    h.get_by_label("Replay the build…").click();
+    let step_done = |k: usize| {
+        move |a: &BvhscopeApp| {
+            idle(a)
+                && a.shown
+                    .as_ref()
+                    .is_some_and(|s| s.partial.as_ref().is_some_and(|p| p.splits == k) && s.frame.is_complete())
+        }
+    };
+    run_until(&mut h, "the replay", |a| a.replay.replay.is_some());
+    h.get_by_label("First").click();
+    run_until(&mut h, "the root alone", step_done(0));
+    let n_tris = h.state().scene.report.triangles as u32;
+    {
+        let f = &h.state().shown.as_ref().unwrap().frame;
+        let entered: Vec<RayCounters> = (0..f.height())
+            .flat_map(|y| (0..f.width()).map(move |x| (x, y)))
+            .map(|(x, y)| f.counters(x, y))
+            .filter(|c| c.leaves_visited > 0)
+            .collect();
+        assert!(!entered.is_empty());
+        assert!(
+            entered.iter().all(|c| c.triangle_tests == n_tris && c.nodes_visited == 1),
+            "one leaf of every triangle"
+        );
+    }
+    h.get_by_label("Last").click();
+    let n = h.state().replay.replay.as_ref().unwrap().splits();
+    run_until(&mut h, "the finished tree", step_done(n));
+    {
+        let app = h.state();
+        let s = app.shown.as_ref().unwrap();
+        let tree = &app.nodes.explained.as_ref().unwrap().tree;
+        let rays = s.camera.ray_gen();
+        for (x, y) in
+            (0..s.frame.height()).step_by(7).flat_map(|y| (0..s.frame.width()).step_by(5).map(move |x| (x, y)))
+        {
+            let mut c = RayCounters::default();
+            tree.closest_hit(&mut rays.pixel_ray(x, y), s.trace, &mut c);
+            assert_eq!(s.frame.counters(x, y), c, "pixel {x},{y}: the finished binary tree's counts");
+        }
+    }
+    h.get_by_label("Play").click();
+    h.run_steps(2);
+    run_until(&mut h, "a step of playing", |a| a.replay.k > 0 && a.replay.k < n);
+    h.get_by_label("Pause").click();
+    h.run_steps(2);
+    assert!(!h.state().replay.playing);
+    h.state_mut().act(Action::ShowReplay(false));
+    run_until(&mut h, "the full tree again", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.partial.is_none()));
+    assert_eq!(
+        h.state().rays.map(|r| r.summary.mean_nodes_visited),
+        rays_before,
+        "the strategy's figures stay its own"
+    );
+}

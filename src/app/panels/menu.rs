@@ -82,6 +82,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             if ui.button("Tree and node…").on_hover_text("The Tree and Node windows: the hierarchy, and why a node was split where it was").clicked() {
                 out.push(Action::ShowTree(true));
             }
+            if ui.button("Replay the build…").on_hover_text("The Replay window: the tree after each split, traced").clicked() {
+                out.push(Action::ShowReplay(true));
+            }
         });
         ui.menu_button("Help", |ui| {
             let shortcut = shortcut_text(ui.ctx(), &Action::Help);

@@ -4,6 +4,7 @@ pub mod build;
 pub mod menu;
 pub mod node;
 pub mod ray;
+pub mod replay;
 pub mod stats;
 pub mod status;
 pub mod tree;

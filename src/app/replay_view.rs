@@ -1,0 +1,51 @@
+//! The build replay's state behind the Replay window: the replay of the current single BVH's
+//! binary tree (`bvh::replay`, prepared with the tree view's `Explained`), the step shown and
+//! whether it plays. While the window is open the viewport shows the tree after `k` splits.
+
+use super::node_view::Explained;
+use crate::bvh::replay::{PartialBvh, Replay};
+use std::sync::Arc;
+use std::time::Instant;
+
+#[derive(Default)]
+pub struct ReplayView {
+    pub window: bool,
+    pub replay: Option<Arc<Replay>>,
+    /// The splits made so far (0: the root alone).
+    pub k: usize,
+    /// The tree after `k` splits, what the viewport traces.
+    pub partial: Option<Arc<PartialBvh>>,
+    pub playing: bool,
+    pub last_tick: Option<Instant>,
+}
+
+impl ReplayView {
+    /// The replay of `e`'s tree, made if missing (O(nodes)), with the partial tree at `k`.
+    pub fn fit(&mut self, e: &Explained) {
+        let fresh = self.replay.as_ref().is_some_and(|r| Arc::ptr_eq(&r.tree, &e.tree));
+        if !fresh {
+            let r = Arc::new(Replay::of(e.tree.clone()));
+            self.k = self.k.min(r.splits());
+            self.replay = Some(r);
+            self.partial = None;
+        }
+        if self.partial.as_ref().is_none_or(|p| p.splits != self.k) {
+            self.partial = self.replay.as_ref().map(|r| Arc::new(r.partial(self.k)));
+        }
+    }
+
+    /// Go to step `k` (clamped to the replay's splits).
+    pub fn set(&mut self, k: usize) {
+        let n = self.replay.as_ref().map_or(0, |r| r.splits());
+        self.k = k.min(n);
+        if self.k == n {
+            self.playing = false;
+        }
+    }
+
+    /// The next step of playing: about an eighth more splits each time, so a play runs through
+    /// the first splits one by one and through the last thousands in a few seconds.
+    pub fn next_play_step(&self) -> usize {
+        self.k + (self.k / 8).max(1)
+    }
+}
