@@ -98,6 +98,12 @@ pub enum Action {
     /// What the icicle colours by.
     SetMetric(Metric),
 
+    /// Side by side: show B (another strategy's build) next to A.
+    Compare(bool),
+    CompareStrategy(crate::bvh::SplitStrategy),
+    CompareMode(super::CompareMode),
+    /// Where the wipe line is, 0 (left) to 1 (right).
+    Wipe(f32),
     /// Open (or close) the Replay window: the viewport shows the tree after some splits.
     ShowReplay(bool),
     /// Show the tree after `k` splits.

@@ -2,6 +2,7 @@
 //! and report over one channel; the UI thread only polls. Starting a job of a kind cancels the
 //! running one of that kind, and results of superseded jobs are dropped by id.
 
+use super::compare_view::CompareB;
 use super::node_view::{Explained, FrameVisits};
 use crate::bvh::inspect::Inspection;
 use crate::bvh::replay::PartialBvh;
@@ -84,11 +85,25 @@ pub enum Pick {
 pub enum JobEvent {
     Loaded(Result<Arc<Scene>, String>),
     Explained(Arc<Explained>),
+    /// B of the side-by-side view, built (or reused) and traced.
+    Compared(Box<CompareB>),
     Visits(FrameVisits),
-    Inspected { node: u32, explained: Arc<Explained>, inspection: Arc<Inspection> },
-    Built { scene_id: u64, params: SceneBuild, result: Result<Arc<SceneBvh>, SceneBuildError> },
+    Inspected {
+        node: u32,
+        explained: Arc<Explained>,
+        inspection: Arc<Inspection>,
+    },
+    Built {
+        scene_id: u64,
+        params: SceneBuild,
+        result: Result<Arc<SceneBvh>, SceneBuildError>,
+    },
     Pass(PassOutput),
-    Picked { pick: Pick, path: Option<PathBuf>, took: Duration },
+    Picked {
+        pick: Pick,
+        path: Option<PathBuf>,
+        took: Duration,
+    },
 }
 
 /// A job in flight.
@@ -112,6 +127,10 @@ pub struct Jobs {
     pub explain: Option<Running>,
     pub visits: Option<Running>,
     pub inspect: Option<(Running, u32)>,
+    /// B of the side-by-side view: built if needed, then traced on A's camera.
+    pub compare: Option<Running>,
+    /// What the last compare job was asked for.
+    pub last_compare: Option<(SceneBuild, u64, Camera, TraceOptions)>,
     pub picking: Option<Pick>,
     /// The last render started (to tell whether a new one is needed).
     pub last_render: Option<RenderRequest>,
@@ -135,6 +154,8 @@ impl Jobs {
             explain: None,
             visits: None,
             inspect: None,
+            compare: None,
+            last_compare: None,
             picking: None,
             last_render: None,
             last_build: None,
@@ -245,6 +266,45 @@ impl Jobs {
         self.explain = Some(job);
     }
 
+    /// Build B (unless `have` is already B's build) and trace it on `camera`, counting; a running
+    /// compare job is cancelled.
+    #[allow(clippy::too_many_arguments)]
+    pub fn compare(
+        &mut self,
+        scene: Arc<Scene>,
+        scene_id: u64,
+        build: SceneBuild,
+        have: Option<Arc<SceneBvh>>,
+        camera: Camera,
+        trace: TraceOptions,
+    ) {
+        if let Some(old) = self.compare.take() {
+            old.control.cancel();
+        }
+        let job = self.start(format!("Building and tracing B ({})", build.bvh.strategy.label()));
+        let (send, control, frames) = (self.sender(job.id), job.control.clone(), self.frames.clone());
+        std::thread::spawn(move || {
+            let bvh = match have.filter(|b| b.build_params() == build) {
+                Some(b) => b,
+                None => match scene.build(&build, &control) {
+                    Ok(b) => Arc::new(b),
+                    Err(_) => return,
+                },
+            };
+            let settings = RenderSettings { trace, count: true, progressive: false };
+            let mut last = None;
+            let _ = render_passes(&*bvh, &*bvh, &camera, &settings, &frames, &control, |frame, _| last = Some(frame));
+            if let Some(frame) = last.filter(|f| f.is_complete()) {
+                let stats = crate::bvh::TreeStats::of(bvh.tree());
+                let summary = frame.ray_summary();
+                let b = CompareB { scene_id, build, bvh, stats, frame: Arc::new(frame), camera, trace, summary };
+                send(JobEvent::Compared(Box::new(b)));
+            }
+        });
+        self.compare = Some(job);
+        self.last_compare = Some((build, scene_id, camera, trace));
+    }
+
     /// Count, per node, the visits of `camera`'s primary rays (a running count is cancelled).
     pub fn visits(&mut self, explained: Arc<Explained>, camera: Camera, trace: TraceOptions) {
         if let Some(old) = self.visits.take() {
@@ -316,6 +376,7 @@ impl Jobs {
                 }
                 JobEvent::Picked { .. } => self.picking = None,
                 JobEvent::Explained(_) if current(&self.explain) => self.explain = None,
+                JobEvent::Compared(_) if current(&self.compare) => self.compare = None,
                 JobEvent::Visits(_) if current(&self.visits) => self.visits = None,
                 JobEvent::Inspected { .. } if self.inspect.as_ref().is_some_and(|(r, _)| r.id == id) => {
                     self.inspect = None

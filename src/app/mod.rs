@@ -4,6 +4,7 @@
 //! Data flows one way: mesh → BVH → renderer → image → screen.
 
 mod action;
+mod compare_view;
 mod export;
 mod jobs;
 mod node_view;
@@ -19,6 +20,7 @@ mod viewport;
 
 pub use crate::scene::{Scene, SceneSource};
 pub use action::{Action, Actions};
+pub use compare_view::{CompareMode, CompareView};
 pub use jobs::Pick;
 pub use node_view::{Metric, NodeView, Step as NodeStep};
 pub use orbit::OrbitCamera;
@@ -159,6 +161,8 @@ pub struct BvhscopeApp {
     pub threshold: Option<f32>,
     /// The Replay window: the build played back split by split.
     pub replay: ReplayView,
+    /// Side by side: B, another strategy's build of the same scene on the same camera.
+    pub compare: CompareView,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     box_cache: std::cell::RefCell<Option<BoxCache>>,
     overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
@@ -166,6 +170,8 @@ pub struct BvhscopeApp {
     mask_cache: std::cell::RefCell<Option<MaskCache>>,
     /// The legend's histogram of the frame on screen, and the threshold's mask over it.
     histogram_cache: std::cell::RefCell<Option<HistogramCache>>,
+    /// The side-by-side images of the frames on screen.
+    compare_cache: std::cell::RefCell<Option<Arc<compare_view::CompareImages>>>,
     threshold_cache: std::cell::RefCell<Option<ThresholdCache>>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
@@ -238,10 +244,12 @@ impl BvhscopeApp {
             nodes: NodeView::default(),
             threshold: None,
             replay: ReplayView::default(),
+            compare: CompareView::default(),
             box_cache: Default::default(),
             overlay_cache: Default::default(),
             mask_cache: Default::default(),
             histogram_cache: Default::default(),
+            compare_cache: Default::default(),
             threshold_cache: Default::default(),
             viewport_aspect: aspect,
             viewport_rect: egui::Rect::NOTHING,
@@ -347,6 +355,87 @@ impl BvhscopeApp {
         self.ensure_build();
         self.ensure_render();
         self.ensure_explained();
+        self.ensure_compare();
+    }
+
+    /// B of the side-by-side view: once A's image is done, B is built (or kept) and traced on the
+    /// same camera and traversal, unless it already was.
+    fn ensure_compare(&mut self) {
+        if !self.compare.on || self.jobs.is_busy() {
+            return;
+        }
+        let Some(shown) = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none()) else { return };
+        if !self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &shown.bvh)) {
+            return;
+        }
+        let build = self.compare.build_for(self.wanted_build());
+        let wanted = (build, self.scene_id, shown.camera, shown.trace);
+        let have = self.compare.b.as_ref().is_some_and(|b| (b.build, b.scene_id, b.camera, b.trace) == wanted);
+        if !have && self.jobs.last_compare != Some(wanted) {
+            let keep = self.compare.b.as_ref().filter(|b| b.scene_id == self.scene_id).map(|b| b.bvh.clone());
+            self.jobs.compare(self.scene.clone(), self.scene_id, build, keep, shown.camera, shown.trace);
+        }
+    }
+
+    /// The side-by-side images (A's and B's on one scale, and their difference), once both frames
+    /// of one camera are there (cached for the pair and the view).
+    pub fn compare_images(&self, ctx: &egui::Context) -> Option<Arc<compare_view::CompareImages>> {
+        use crate::render::{diff, metric_stats, view_image, HeatRange};
+        if !self.compare.on {
+            return None;
+        }
+        let shown = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none())?;
+        let b = self
+            .compare
+            .b
+            .as_ref()
+            .filter(|b| b.camera == shown.camera && b.trace == shown.trace && b.scene_id == self.scene_id)?;
+        let (view, colormap, cost) = (shown.style.view, shown.style.colormap, shown.style.cost);
+        let mut cache = self.compare_cache.borrow_mut();
+        if let Some(c) = cache.as_ref() {
+            if Arc::ptr_eq(&c.a_frame, &shown.frame)
+                && Arc::ptr_eq(&c.b_frame, &b.frame)
+                && c.view == view
+                && c.colormap == colormap
+            {
+                return Some(c.clone());
+            }
+        }
+        // One scale for both: the fixed range if set, else from the lower minimum to the higher maximum.
+        let range = match shown.style.range {
+            HeatRange::Fixed { min, max } => HeatRange::Fixed { min, max },
+            HeatRange::Auto if view.is_heatmap() => {
+                let (a0, a1, _) = metric_stats(&shown.frame, view, cost);
+                let (b0, b1, _) = metric_stats(&b.frame, view, cost);
+                HeatRange::Fixed { min: a0.min(b0), max: a1.max(b1) }
+            }
+            HeatRange::Auto => HeatRange::Auto,
+        };
+        let texture = |name: &str, img: image::RgbImage| {
+            let c = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
+            ctx.load_texture(name, c, egui::TextureOptions::NEAREST)
+        };
+        let (img_a, mut legend) = view_image(&shown.frame, view, colormap, range, cost);
+        if let Some(l) = &mut legend {
+            l.title += " (A and B on one scale; min, mean, max of A)";
+        }
+        let (img_b, _) = view_image(&b.frame, view, colormap, range, cost);
+        let diff = diff::difference(&shown.frame, &b.frame, view, cost).map(|d| {
+            let (img, legend) = diff::difference_image(shown.frame.width(), &d, view, None);
+            (texture("compare-diff", img), d, legend)
+        });
+        let images = Arc::new(compare_view::CompareImages {
+            a_frame: shown.frame.clone(),
+            b_frame: b.frame.clone(),
+            view,
+            colormap,
+            a: texture("compare-a", img_a),
+            b: texture("compare-b", img_b),
+            diff,
+            legend,
+        });
+        *cache = Some(images.clone());
+        Some(images)
     }
 
     /// The node explainer's background work, each started only when the image is done (it must
@@ -658,6 +747,11 @@ impl BvhscopeApp {
                 }
             }
             JobEvent::Visits(v) => self.nodes.visits = Some(v),
+            JobEvent::Compared(b) => {
+                if b.scene_id == self.scene_id {
+                    self.compare.b = Some(*b);
+                }
+            }
             JobEvent::Inspected { node, explained, inspection } => {
                 let current = self.nodes.explained.as_ref().is_some_and(|e| Arc::ptr_eq(e, &explained));
                 if current && self.nodes.selected == Some(node) {
@@ -812,8 +906,20 @@ impl BvhscopeApp {
                 self.threshold = None;
             }
             A::SetThreshold(t) => self.threshold = t,
+            A::Compare(on) => {
+                self.compare.on = on;
+                if on {
+                    self.replay.window = false;
+                }
+            }
+            A::CompareStrategy(st) => self.compare.strategy = st,
+            A::CompareMode(m) => self.compare.mode = m,
+            A::Wipe(x) => self.compare.wipe = x.clamp(0.0, 1.0),
             A::ShowReplay(open) => {
                 self.replay.window = open;
+                if open {
+                    self.compare.on = false;
+                }
                 self.replay.playing = false;
             }
             A::ReplayStep(k) => {
@@ -990,6 +1096,7 @@ impl eframe::App for BvhscopeApp {
         panels::tree::show(self, &ctx, out);
         panels::node::show(self, &ctx, out);
         panels::replay::show(self, &ctx, out);
+        panels::compare::show(self, &ctx, out);
         // What the panels asked for takes effect now, and shows in the next frame.
         if !actions.is_empty() {
             for action in actions {

@@ -76,9 +76,15 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         painter.text(rect.center(), egui::Align2::CENTER_CENTER, busy, egui::FontId::proportional(18.0), Color32::GRAY);
     }
 
+    // Side by side: A and B over the image, as halves, a wipe, or their difference.
+    let compared = app.compare_images(ui.ctx());
+    if let Some(c) = &compared {
+        draw_compare(app, ui, &painter, rect, c, out);
+    }
+
     // The legend histogram's threshold: the pixels at or below it dimmed.
     if let Some(shown) = &app.shown {
-        if let Some(mask) = app.threshold_mask(ui.ctx(), shown) {
+        if let Some(mask) = app.threshold_mask(ui.ctx(), shown).filter(|_| compared.is_none()) {
             painter.image(mask.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
         }
     }
@@ -112,12 +118,91 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
 
     messages(app, ui, rect, out);
     if let Some(shown) = &app.shown {
-        if let Some(legend) = &shown.legend {
-            legend_area(app, ui, rect, legend, out);
+        let compare_legend = compared.as_ref().and_then(|c| match app.compare.mode {
+            super::CompareMode::Difference => c.diff.as_ref().map(|d| d.2.clone()),
+            _ => c.legend.clone(),
+        });
+        // The histogram is of the image's own values: not drawn for a side-by-side pair.
+        if let Some(legend) = compare_legend.as_ref() {
+            legend_area(app, ui, rect, legend, false, out);
+        } else if let Some(legend) = shown.legend.as_ref() {
+            legend_area(app, ui, rect, legend, true, out);
         }
         if let Some(pos) = response.hover_pos() {
             let frame = shown.frame.clone();
             response.on_hover_ui_at_pointer(|ui| pixel_readout(ui, &frame, rect, pos));
+        }
+    }
+}
+
+/// A and B over the viewport: each the left or right part of its image, split at the middle or at
+/// the wipe line (dragged), or the difference image; each side labelled with its build.
+fn draw_compare(
+    app: &BvhscopeApp,
+    ui: &egui::Ui,
+    painter: &egui::Painter,
+    rect: Rect,
+    c: &super::compare_view::CompareImages,
+    out: &mut Actions,
+) {
+    use super::CompareMode;
+    let label = |p: Pos2, align: egui::Align2, text: String| {
+        let g = painter.layout_no_wrap(text, egui::FontId::proportional(14.0), Color32::WHITE);
+        let r = align.anchor_size(p, g.size()).expand(4.0);
+        painter.rect_filled(r, 3.0, Color32::from_black_alpha(170));
+        painter.galley(r.min + Vec2::splat(4.0), g, Color32::WHITE);
+    };
+    let b_label = app.compare.b.as_ref().map_or(String::new(), |b| b.bvh.build_params().label());
+    let a_label = app.shown.as_ref().map_or(String::new(), |s| s.build_label.clone());
+    let full = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+    match app.compare.mode {
+        CompareMode::Difference => match &c.diff {
+            Some((tex, _, _)) => {
+                painter.image(tex.id(), rect, full, Color32::WHITE);
+                label(
+                    rect.left_top() + Vec2::new(8.0, 8.0),
+                    egui::Align2::LEFT_TOP,
+                    format!("B - A: {b_label} minus {a_label}"),
+                );
+            }
+            None => label(
+                rect.center_top() + Vec2::new(0.0, 8.0),
+                egui::Align2::CENTER_TOP,
+                "The difference is of heatmaps: choose a heatmap view".into(),
+            ),
+        },
+        mode => {
+            let split = if mode == CompareMode::Wipe { app.compare.wipe } else { 0.5 };
+            let x = rect.left() + rect.width() * split;
+            let (left, right) = (
+                Rect::from_min_max(rect.min, Pos2::new(x, rect.max.y)),
+                Rect::from_min_max(Pos2::new(x, rect.min.y), rect.max),
+            );
+            painter.image(c.a.id(), left, Rect::from_min_max(Pos2::ZERO, Pos2::new(split, 1.0)), Color32::WHITE);
+            painter.image(
+                c.b.id(),
+                right,
+                Rect::from_min_max(Pos2::new(split, 0.0), Pos2::new(1.0, 1.0)),
+                Color32::WHITE,
+            );
+            painter.line_segment(
+                [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
+                Stroke::new(2.0, Color32::WHITE),
+            );
+            label(rect.left_top() + Vec2::new(8.0, 8.0), egui::Align2::LEFT_TOP, format!("A: {a_label}"));
+            label(rect.right_top() + Vec2::new(-8.0, 8.0), egui::Align2::RIGHT_TOP, format!("B: {b_label}"));
+            if mode == CompareMode::Wipe {
+                // The line's handle: drag it (over the image a drag orbits).
+                let handle = Rect::from_center_size(Pos2::new(x, rect.center().y), Vec2::new(14.0, rect.height()));
+                let r = ui.interact(handle, ui.scope_id().with("compare-wipe"), Sense::drag());
+                r.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Splitter, true, "Wipe line"));
+                if r.hovered() || r.dragged() {
+                    ui.ctx().set_cursor_icon(egui::CursorIcon::ResizeHorizontal);
+                }
+                if let Some(p) = r.interact_pointer_pos().filter(|_| r.dragged()) {
+                    out.push(Action::Wipe((p.x - rect.left()) / rect.width()));
+                }
+            }
         }
     }
 }
@@ -365,7 +450,7 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
 /// Bins of the legend's histogram.
 pub const HISTOGRAM_BINS: usize = 32;
 
-fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, out: &mut Actions) {
+fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, histogram: bool, out: &mut Actions) {
     egui::Area::new(ui.scope_id().with("heatmap-legend"))
         .fixed_pos(rect.left_bottom() + Vec2::new(12.0, -158.0))
         .order(egui::Order::Foreground)
@@ -393,7 +478,9 @@ fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, ou
                     ui.painter().rect_stroke(bar, 0.0, Stroke::new(1.0, Color32::GRAY), egui::StrokeKind::Outside);
                     ui.label(fmt_value(legend.range_max as f64));
                 });
-                histogram_bars(app, ui, legend, bar_x, out);
+                if histogram {
+                    histogram_bars(app, ui, legend, bar_x, out);
+                }
                 ui.label(format!(
                     "min {}   mean {:.2}   max {}   (all traced rays)",
                     fmt_value(legend.min as f64),

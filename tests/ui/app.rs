@@ -1118,3 +1118,103 @@ fn the_build_replay_traces_the_partial_tree() {
         "the strategy's figures stay its own"
     );
 }
+
+/// Side by side: B (another strategy) is built and traced on A's camera; the difference view is,
+/// pixel by pixel, B's counts minus A's; the modes switch and the wipe line drags; with B's
+/// strategy the same as A's the difference is zero everywhere; changing A rebuilds only A.
+#[test]
+fn two_strategies_side_by_side_and_their_difference() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    let mut s = h.state().settings.clone();
+    s.build.strategy = SplitStrategy::Midpoint;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    h.state_mut().act(Action::View(2));
+    run_until(&mut h, "midpoint's heatmap", |a| {
+        idle(a)
+            && a.shown
+                .as_ref()
+                .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
+    });
+    h.get_by_role_and_label(Role::Button, "View").click();
+    h.run_steps(2);
+    h.get_by_label("Compare side by side…").click();
+    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a));
+    let ctx = h.ctx.clone();
+    let b_bvh = {
+        let app = h.state();
+        let images = app.compare_images(&ctx).expect("both frames");
+        let (a, b) = (&app.shown.as_ref().unwrap().frame, &app.compare.b.as_ref().unwrap().frame);
+        let d = &images.diff.as_ref().expect("a heatmap has a difference").1;
+        let mut differ = 0;
+        for y in 0..a.height() {
+            for x in 0..a.width() {
+                let want = b.counters(x, y).nodes_visited as f32 - a.counters(x, y).nodes_visited as f32;
+                assert_eq!(d[(y * a.width() + x) as usize], want);
+                differ += (want != 0.0) as usize;
+            }
+        }
+        assert!(differ > 0, "midpoint and SAH differ somewhere");
+        let legend = images.legend.as_ref().unwrap();
+        assert_eq!(
+            legend.range_max as u32,
+            a.ray_summary().max_nodes_visited.max(b.ray_summary().max_nodes_visited),
+            "one scale"
+        );
+        app.compare.b.as_ref().unwrap().bvh.clone()
+    };
+    assert!(h.query_all_by_label("Nodes visited / ray").count() >= 2, "the Compare window's row beside the panel's");
+    h.get_by_label("B - A");
+
+    // Modes: the wipe line drags; the difference mode.
+    h.get_by_label("Wipe").click();
+    h.run_steps(2);
+    assert_eq!(h.state().compare.mode, bvhscope::app::CompareMode::Wipe);
+    let line = h.get_by_label("Wipe line").rect();
+    let (from, to) = (line.center(), line.center() - egui::vec2(120.0, 0.0));
+    h.input_mut().events.push(egui::Event::PointerMoved(from));
+    h.input_mut().events.push(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    for k in 1..=6 {
+        h.input_mut().events.push(egui::Event::PointerMoved(from + (to - from) * (k as f32 / 6.0)));
+        h.step();
+    }
+    h.input_mut().events.push(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.run_steps(2);
+    assert!(h.state().compare.wipe < 0.45, "dragged left: {}", h.state().compare.wipe);
+    h.get_by_label("Difference B - A").click();
+    h.run_steps(2);
+    assert_eq!(h.state().compare.mode, bvhscope::app::CompareMode::Difference);
+
+    // A changes: only A is rebuilt, B is kept.
+    let mut s = h.state().settings.clone();
+    s.build.strategy = SplitStrategy::EqualCount;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    run_until(&mut h, "equal count as A", |a| {
+        idle(a)
+            && a.jobs.compare.is_none()
+            && a.shown.as_ref().is_some_and(|s| s.bvh.build_params().bvh.strategy == SplitStrategy::EqualCount)
+    });
+    assert!(Arc::ptr_eq(&h.state().compare.b.as_ref().unwrap().bvh, &b_bvh), "B was not rebuilt");
+
+    // B the same as A: no difference anywhere.
+    h.state_mut().act(Action::CompareStrategy(SplitStrategy::EqualCount));
+    run_until(&mut h, "B as equal count", |a| {
+        idle(a)
+            && a.jobs.compare.is_none()
+            && a.compare.b.as_ref().is_some_and(|b| b.build.bvh.strategy == SplitStrategy::EqualCount)
+    });
+    let app = h.state();
+    let images = app.compare_images(&ctx).unwrap();
+    assert!(images.diff.as_ref().unwrap().1.iter().all(|&v| v == 0.0), "two identical builds differ nowhere");
+}

@@ -85,6 +85,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             if ui.button("Replay the build…").on_hover_text("The Replay window: the tree after each split, traced").clicked() {
                 out.push(Action::ShowReplay(true));
             }
+            if ui.button("Compare side by side…").on_hover_text("B, another strategy's build, next to A on the same camera and scale").clicked() {
+                out.push(Action::Compare(true));
+            }
         });
         ui.menu_button("Help", |ui| {
             let shortcut = shortcut_text(ui.ctx(), &Action::Help);

@@ -1,6 +1,7 @@
 //! The panels around the viewport; each reads and changes the app state, nothing more.
 
 pub mod build;
+pub mod compare;
 pub mod menu;
 pub mod node;
 pub mod ray;

@@ -1,0 +1,80 @@
+//! Two builds side by side: A is the app's build, B the same scene and settings split by another
+//! strategy, both traced on the same camera. The viewport shows them as two halves, with a
+//! draggable wipe line, or as the difference B − A of the heatmap (`render::diff`), all on one
+//! colour scale; the Compare window gives both builds' figures and their difference. B is built
+//! and traced in the background; it is kept, so flipping modes is instant and changing A's
+//! strategy rebuilds only A.
+
+use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
+use crate::render::{Camera, Frame, Legend, RaySummary};
+use std::sync::Arc;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CompareMode {
+    /// A on the left half, B on the right.
+    #[default]
+    Halves,
+    /// A left of a draggable line, B right of it.
+    Wipe,
+    /// B − A per pixel through a diverging colour map.
+    Difference,
+}
+
+impl CompareMode {
+    pub const ALL: [CompareMode; 3] = [CompareMode::Halves, CompareMode::Wipe, CompareMode::Difference];
+    pub fn label(self) -> &'static str {
+        match self {
+            CompareMode::Halves => "Halves",
+            CompareMode::Wipe => "Wipe",
+            CompareMode::Difference => "Difference B - A",
+        }
+    }
+}
+
+/// B: its build and its frame of one camera.
+pub struct CompareB {
+    pub scene_id: u64,
+    pub build: SceneBuild,
+    pub bvh: Arc<SceneBvh>,
+    pub stats: TreeStats,
+    pub frame: Arc<Frame>,
+    pub camera: Camera,
+    pub trace: TraceOptions,
+    pub summary: RaySummary,
+}
+
+/// The images shown in compare mode, for one pair of frames and one view.
+pub struct CompareImages {
+    pub a_frame: Arc<Frame>,
+    pub b_frame: Arc<Frame>,
+    pub view: crate::render::View,
+    pub colormap: crate::render::ColorMap,
+    pub a: egui::TextureHandle,
+    pub b: egui::TextureHandle,
+    /// The difference (heatmaps only), its values and legend.
+    pub diff: Option<(egui::TextureHandle, Vec<f32>, Legend)>,
+    /// The one scale of both heatmaps.
+    pub legend: Option<Legend>,
+}
+
+pub struct CompareView {
+    pub on: bool,
+    pub strategy: SplitStrategy,
+    pub mode: CompareMode,
+    /// Where the wipe line is, from 0 (left) to 1 (right).
+    pub wipe: f32,
+    pub b: Option<CompareB>,
+}
+
+impl Default for CompareView {
+    fn default() -> Self {
+        Self { on: false, strategy: SplitStrategy::SahBinned, mode: CompareMode::Halves, wipe: 0.5, b: None }
+    }
+}
+
+impl CompareView {
+    /// B's build for A's `build`: the same with B's strategy.
+    pub fn build_for(&self, build: SceneBuild) -> SceneBuild {
+        SceneBuild { bvh: crate::bvh::BuildParams { strategy: self.strategy, ..build.bvh }, ..build }
+    }
+}
