@@ -101,6 +101,12 @@ pub enum Action {
     /// Side by side: show B (another strategy's build) next to A.
     Compare(bool),
     CompareStrategy(crate::bvh::SplitStrategy),
+    /// B's leaf size, layout and traversal.
+    CompareB {
+        max_leaf_size: u32,
+        layout: crate::bvh::Layout,
+        trace: crate::bvh::TraceOptions,
+    },
     CompareMode(super::CompareMode),
     /// Where the wipe line is, 0 (left) to 1 (right).
     Wipe(f32),

@@ -59,7 +59,12 @@ pub struct CompareImages {
 
 pub struct CompareView {
     pub on: bool,
+    /// B's own choices; the rest of B's build is A's.
     pub strategy: SplitStrategy,
+    pub max_leaf_size: u32,
+    pub layout: crate::bvh::Layout,
+    /// How B is traversed (order and triangle test).
+    pub trace: TraceOptions,
     pub mode: CompareMode,
     /// Where the wipe line is, from 0 (left) to 1 (right).
     pub wipe: f32,
@@ -68,13 +73,36 @@ pub struct CompareView {
 
 impl Default for CompareView {
     fn default() -> Self {
-        Self { on: false, strategy: SplitStrategy::SahBinned, mode: CompareMode::Halves, wipe: 0.5, b: None }
+        let p = crate::bvh::BuildParams::default();
+        Self {
+            on: false,
+            strategy: SplitStrategy::SahBinned,
+            max_leaf_size: p.max_leaf_size,
+            layout: p.layout,
+            trace: TraceOptions::default(),
+            mode: CompareMode::Halves,
+            wipe: 0.5,
+            b: None,
+        }
     }
 }
 
 impl CompareView {
-    /// B's build for A's `build`: the same with B's strategy.
+    /// B's build for A's `build`: A's with B's strategy, leaf size and layout.
     pub fn build_for(&self, build: SceneBuild) -> SceneBuild {
-        SceneBuild { bvh: crate::bvh::BuildParams { strategy: self.strategy, ..build.bvh }, ..build }
+        let bvh = crate::bvh::BuildParams {
+            strategy: self.strategy,
+            max_leaf_size: self.max_leaf_size,
+            layout: self.layout,
+            ..build.bvh
+        };
+        SceneBuild { bvh, ..build }
+    }
+
+    /// Start from A's build and traversal, with another strategy than A's.
+    pub fn start_from(&mut self, a: &crate::bvh::BuildParams, trace: TraceOptions) {
+        self.strategy =
+            if a.strategy == SplitStrategy::SahBinned { SplitStrategy::Midpoint } else { SplitStrategy::SahBinned };
+        (self.max_leaf_size, self.layout, self.trace) = (a.max_leaf_size, a.layout, trace);
     }
 }

@@ -369,11 +369,11 @@ impl BvhscopeApp {
             return;
         }
         let build = self.compare.build_for(self.wanted_build());
-        let wanted = (build, self.scene_id, shown.camera, shown.trace);
+        let wanted = (build, self.scene_id, shown.camera, self.compare.trace);
         let have = self.compare.b.as_ref().is_some_and(|b| (b.build, b.scene_id, b.camera, b.trace) == wanted);
         if !have && self.jobs.last_compare != Some(wanted) {
             let keep = self.compare.b.as_ref().filter(|b| b.scene_id == self.scene_id).map(|b| b.bvh.clone());
-            self.jobs.compare(self.scene.clone(), self.scene_id, build, keep, shown.camera, shown.trace);
+            self.jobs.compare(self.scene.clone(), self.scene_id, build, keep, shown.camera, self.compare.trace);
         }
     }
 
@@ -385,11 +385,7 @@ impl BvhscopeApp {
             return None;
         }
         let shown = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none())?;
-        let b = self
-            .compare
-            .b
-            .as_ref()
-            .filter(|b| b.camera == shown.camera && b.trace == shown.trace && b.scene_id == self.scene_id)?;
+        let b = self.compare.b.as_ref().filter(|b| b.camera == shown.camera && b.scene_id == self.scene_id)?;
         let (view, colormap, cost) = (shown.style.view, shown.style.colormap, shown.style.cost);
         let mut cache = self.compare_cache.borrow_mut();
         if let Some(c) = cache.as_ref() {
@@ -907,12 +903,21 @@ impl BvhscopeApp {
             }
             A::SetThreshold(t) => self.threshold = t,
             A::Compare(on) => {
+                if on && !self.compare.on {
+                    self.compare.start_from(&self.settings.build, self.settings.trace);
+                }
                 self.compare.on = on;
                 if on {
                     self.replay.window = false;
                 }
             }
             A::CompareStrategy(st) => self.compare.strategy = st,
+            A::CompareB { max_leaf_size, layout, trace } => {
+                let n = &crate::options::MAX_LEAF_SIZE;
+                self.compare.max_leaf_size = max_leaf_size.clamp(n.min, n.max);
+                self.compare.layout = layout;
+                self.compare.trace = trace;
+            }
             A::CompareMode(m) => self.compare.mode = m,
             A::Wipe(x) => self.compare.wipe = x.clamp(0.0, 1.0),
             A::ShowReplay(open) => {

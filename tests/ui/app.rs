@@ -1214,7 +1214,24 @@ fn two_strategies_side_by_side_and_their_difference() {
             && a.jobs.compare.is_none()
             && a.compare.b.as_ref().is_some_and(|b| b.build.bvh.strategy == SplitStrategy::EqualCount)
     });
+    {
+        let app = h.state();
+        let images = app.compare_images(&ctx).unwrap();
+        assert!(images.diff.as_ref().unwrap().1.iter().all(|&v| v == 0.0), "two identical builds differ nowhere");
+    }
+    // B's own leaf size, layout and order: B is rebuilt with them, A stays.
+    let trace =
+        bvhscope::bvh::TraceOptions { order: bvhscope::bvh::TraversalOrder::SplitAxisSign, ..h.state().compare.trace };
+    h.state_mut().act(Action::CompareB { max_leaf_size: 2, layout: bvhscope::bvh::Layout::Binary, trace });
+    run_until(&mut h, "B with leaves of 2, binary", |a| {
+        idle(a) && a.jobs.compare.is_none() && a.compare.b.as_ref().is_some_and(|b| b.build.bvh.max_leaf_size == 2)
+    });
     let app = h.state();
-    let images = app.compare_images(&ctx).unwrap();
-    assert!(images.diff.as_ref().unwrap().1.iter().all(|&v| v == 0.0), "two identical builds differ nowhere");
+    let b = app.compare.b.as_ref().unwrap();
+    assert_eq!(
+        (b.build.bvh.layout, b.trace.order),
+        (bvhscope::bvh::Layout::Binary, bvhscope::bvh::TraversalOrder::SplitAxisSign)
+    );
+    assert_eq!(app.settings.build.max_leaf_size, 4, "A keeps its own");
+    assert!(app.compare_images(&ctx).is_some());
 }

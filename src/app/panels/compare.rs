@@ -3,7 +3,7 @@
 //! panel gives them for A.
 
 use crate::app::{Action, Actions, BvhscopeApp, CompareMode};
-use crate::bvh::SplitStrategy;
+use crate::bvh::{Layout, SplitStrategy, TraversalOrder};
 use crate::options::Choice;
 
 pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
@@ -27,8 +27,30 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                         }
                     }
                 });
-                ui.weak("(A's other settings)");
+                ui.weak("(the rest as A)");
             });
+            // B's leaf size, layout and traversal.
+            let (mut leaf, mut layout, mut trace) = (c.max_leaf_size, c.layout, c.trace);
+            let n = &crate::options::MAX_LEAF_SIZE;
+            let mut changed = ui
+                .add(egui::Slider::new(&mut leaf, n.min..=n.max).text("B's max leaf size"))
+                .on_hover_text(n.help)
+                .changed();
+            ui.horizontal(|ui| {
+                for l in Layout::ALL {
+                    changed |= ui.radio_value(&mut layout, l, l.label()).changed();
+                }
+                ui.separator();
+                for o in TraversalOrder::ALL {
+                    changed |= ui
+                        .radio_value(&mut trace.order, o, o.label())
+                        .on_hover_text("B's traversal order (binary layout)")
+                        .changed();
+                }
+            });
+            if changed {
+                out.push(Action::CompareB { max_leaf_size: leaf, layout, trace });
+            }
             ui.horizontal(|ui| {
                 for m in CompareMode::ALL {
                     if ui.radio(c.mode == m, m.label()).clicked() {
@@ -47,7 +69,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 );
                 return;
             };
-            let same_camera = app.rays.as_ref().is_some_and(|r| r.camera == b.camera && r.trace == b.trace);
+            let same_camera = app.rays.as_ref().is_some_and(|r| r.camera == b.camera);
             egui::Grid::new("compare-figures").num_columns(4).striped(true).show(ui, |ui| {
                 for h in ["", "A", "B", "B - A"] {
                     ui.strong(h);
