@@ -697,6 +697,17 @@ impl BvhscopeApp {
         })
     }
 
+    /// B's figures for the statistics panel's second column, while comparing side by side.
+    pub fn compare_figures(&self) -> Option<StrategyFigures> {
+        let b = self.compare.b.as_ref().filter(|b| self.compare.on && b.scene_id == self.scene_id)?;
+        Some(StrategyFigures {
+            label: format!("B: {}", b.bvh.build_params().label()),
+            stats: b.stats.clone(),
+            build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
+            rays: Some(MeasuredRays { summary: b.summary, camera: b.camera, trace: b.trace }),
+        })
+    }
+
     /// The camera and traversal the current per-ray figures come from (or, before the first
     /// full frame, the ones the image on screen was made with).
     pub fn rays_key(&self) -> Option<(Camera, TraceOptions)> {

@@ -1164,7 +1164,8 @@ fn two_strategies_side_by_side_and_their_difference() {
         app.compare.b.as_ref().unwrap().bvh.clone()
     };
     assert!(h.query_all_by_label("Nodes visited / ray").count() >= 2, "the Compare window's row beside the panel's");
-    h.get_by_label("B - A");
+    assert_eq!(h.query_all_by_label("B - A").count(), 2, "the Compare window's and the statistics panel's columns");
+    assert!(h.query_all_by_label_contains("B: SAH binned").count() >= 1, "B in the statistics panel");
 
     // Modes: the wipe line drags; the difference mode.
     h.get_by_label("Wipe").click();

@@ -212,26 +212,37 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
         });
         return;
     };
-    let previous = app.previous.clone();
+    // Side by side, the second column is B and a third gives B − A; otherwise it is the strategy
+    // shown before this one.
+    let b = app.compare_figures();
+    let comparing = b.is_some();
+    let previous = b.or_else(|| app.previous.clone());
     let key = app.rays_key();
-    // "Before" per-ray figures count only when they come from the same rays as the current ones.
+    // The second column's per-ray figures count only when they come from the same rays as the
+    // current ones (B: the same camera; its traversal is its own).
     let comparable = |f: &StrategyFigures| match (&f.rays, &key) {
+        (Some(r), Some((camera, _))) if comparing => r.camera == *camera,
         (Some(r), Some((camera, trace))) => r.comparable(camera, trace),
         _ => false,
     };
-    let width = 0.4 * ui.available_width();
-    egui::Grid::new("bvh-stats").num_columns(3).striped(true).max_col_width(width).show(ui, |ui| {
+    let columns = if comparing { 4 } else { 3 };
+    let width = if comparing { 0.3 } else { 0.4 } * ui.available_width();
+    egui::Grid::new("bvh-stats").num_columns(columns).striped(true).max_col_width(width).show(ui, |ui| {
         ui.label("");
         ui.strong(&current.label);
         match &previous {
-            Some(p) => ui.weak(format!("before: {}", p.label)),
-            None => ui.weak("before: —"),
+            Some(p) if comparing => ui.strong(&p.label).on_hover_text("B, the build compared side by side"),
+            Some(p) => ui.weak(format!("before: {}", p.label)).on_hover_text("The strategy shown before this one, for comparison"),
+            None => ui.weak("before: —").on_hover_text("The strategy shown before this one, for comparison"),
+        };
+        if comparing {
+            ui.strong("B - A");
         }
-        .on_hover_text("The strategy shown before this one, for comparison");
         ui.end_row();
         for row in ROWS {
             ui.label(row.name).on_hover_text(row.tip);
-            ui.label((row.value)(&current).unwrap_or_else(|| "…".into()));
+            let a = (row.value)(&current);
+            ui.label(a.clone().unwrap_or_else(|| "…".into()));
             match &previous {
                 Some(p) if row.per_ray && !comparable(p) => {
                     let was = (row.value)(p).unwrap_or_else(|| "not measured".into());
@@ -239,12 +250,25 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
                         "Measured with another camera, image size or traversal order (was {was}); not comparable with this frame"
                     ));
                 }
+                Some(p) if comparing => {
+                    let b = (row.value)(p);
+                    ui.label(b.clone().unwrap_or_default());
+                    // The difference of the rows that are one number (a percentage's too).
+                    let num = |v: &Option<String>| v.as_deref().and_then(|t| t.trim_end_matches(" %").parse::<f64>().ok());
+                    match (num(&a), num(&b)) {
+                        (Some(x), Some(y)) => ui.label(format!("{:+.2}", y - x)),
+                        _ => ui.label(""),
+                    };
+                }
                 Some(p) => {
                     ui.weak((row.value)(p).unwrap_or_default());
                 }
                 None => {
                     ui.label("");
                 }
+            }
+            if comparing && previous.as_ref().is_some_and(|p| row.per_ray && !comparable(p)) {
+                ui.label("");
             }
             ui.end_row();
         }
