@@ -3,6 +3,7 @@
 //! whether it plays. While the window is open the viewport shows the tree after `k` splits.
 
 use super::node_view::Explained;
+use crate::bvh::inspect::{CurvePoint, Marker};
 use crate::bvh::replay::{PartialBvh, Replay};
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,7 +18,14 @@ pub struct ReplayView {
     pub partial: Option<Arc<PartialBvh>>,
     pub playing: bool,
     pub last_tick: Option<Instant>,
+    /// The newest split: its node, the plane the tree's strategy cut it at, and for the binned
+    /// SAH the cost at its bins' planes per axis (not computed for nodes over
+    /// `MAX_PLANE_TRIANGLES`, whose sweep would hold up the window).
+    pub newest: Option<(u32, Option<Marker>, [Vec<CurvePoint>; 3])>,
 }
+
+/// The largest newest split whose plane the replay computes as it steps.
+pub const MAX_PLANE_TRIANGLES: u32 = 300_000;
 
 impl ReplayView {
     /// The replay of `e`'s tree, made if missing (O(nodes)), with the partial tree at `k`.
@@ -31,6 +39,15 @@ impl ReplayView {
         }
         if self.partial.as_ref().is_none_or(|p| p.splits != self.k) {
             self.partial = self.replay.as_ref().map(|r| Arc::new(r.partial(self.k)));
+            let r = self.replay.as_ref().expect("made above");
+            self.newest = self.k.checked_sub(1).map(|i| r.order[i]).map(|n| {
+                if e.hierarchy.count[n as usize] <= MAX_PLANE_TRIANGLES {
+                    let (m, bins) = crate::bvh::inspect::own_split(&e.tree, &e.hierarchy, n);
+                    (n, m, bins)
+                } else {
+                    (n, None, Default::default())
+                }
+            });
         }
     }
 

@@ -229,13 +229,17 @@ fn draw_replay(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &s
             );
         }
     }
+    let camera = &shown.camera;
     if let Some(&newest) = p.splits.checked_sub(1).and_then(|i| r.order.get(i)) {
         let l = p.tree.nodes[newest as usize].index as usize;
         for (c, color) in [(l, NODE_COLORS.left), (l + 1, NODE_COLORS.right)] {
             box_lines(&p.tree.nodes[c].bounds().corners(), color, 2.0, &mut lines);
         }
+        // The plane the strategy cut it at.
+        if let Some((_, Some(m), _)) = app.replay.newest.as_ref().filter(|(n, _, _)| *n == newest) {
+            draw_plane(painter, rect, camera, &p.tree.nodes[newest as usize].bounds(), m, &mut lines);
+        }
     }
-    let camera = &shown.camera;
     let near = (camera.position - camera.look_at).length() * 1e-4;
     painter.add(egui::Shape::Mesh(Arc::new(lines_mesh(&lines, camera, rect, near))));
 }
@@ -257,7 +261,7 @@ fn drawn_box_node(app: &BvhscopeApp, rect: Rect, shown: &super::Shown, pos: Pos2
 /// frame: pixels whose hit is not one of its triangles), its box, its children's boxes in their
 /// own colours, and the plane the builder split it at as a translucent quad.
 fn draw_selected_node(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &super::Shown) {
-    use super::overlay::{box_lines, lines_mesh, project, Line3};
+    use super::overlay::{box_lines, lines_mesh};
     let Some(node) = app.nodes.selected.filter(|_| app.nodes.window) else { return };
     let Some(e) = app.nodes.current(Some(&shown.bvh)) else { return };
     let Some(n) = e.tree.nodes.get(node as usize) else { return };
@@ -280,31 +284,44 @@ fn draw_selected_node(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, sh
         .filter(|i| i.node == node && !n.is_leaf())
         .and_then(|i| i.markers.iter().find(|(s, _)| *s == e.tree.params.strategy).and_then(|(_, m)| *m));
     if let Some(m) = plane {
-        let b = n.bounds();
-        let (a, (u, v)) = (m.axis as usize, [(1, 2), (0, 2), (0, 1)][m.axis as usize]);
-        let corner = |cu: f32, cv: f32| {
-            let mut p = glam::Vec3::ZERO;
-            p[a] = m.position;
-            p[u] = cu;
-            p[v] = cv;
-            p
-        };
-        let quad = [
-            corner(b.min[u], b.min[v]),
-            corner(b.max[u], b.min[v]),
-            corner(b.max[u], b.max[v]),
-            corner(b.min[u], b.max[v]),
-        ];
-        let pts: Option<Vec<Pos2>> = quad.iter().map(|&q| project(camera, rect, q)).collect();
-        if let Some(pts) = pts {
-            painter.add(egui::Shape::convex_polygon(pts, NODE_COLORS.plane, Stroke::new(1.0, NODE_COLORS.plane_edge)));
-        }
-        for k in 0..4 {
-            lines.push(Line3 { a: quad[k], b: quad[(k + 1) % 4], color: NODE_COLORS.plane_edge, width: 1.0 });
-        }
+        draw_plane(painter, rect, camera, &n.bounds(), &m, &mut lines);
     }
     let near = (camera.position - camera.look_at).length() * 1e-4;
     painter.add(egui::Shape::Mesh(Arc::new(lines_mesh(&lines, camera, rect, near))));
+}
+
+/// A split plane across a node's box: a translucent quad at the marker's position on its axis,
+/// outlined (its outline added to `lines`).
+fn draw_plane(
+    painter: &egui::Painter,
+    rect: Rect,
+    camera: &crate::render::Camera,
+    b: &crate::geometry::Aabb,
+    m: &crate::bvh::inspect::Marker,
+    lines: &mut Vec<super::overlay::Line3>,
+) {
+    use super::overlay::{project, Line3};
+    let (a, (u, v)) = (m.axis as usize, [(1, 2), (0, 2), (0, 1)][m.axis as usize]);
+    let corner = |cu: f32, cv: f32| {
+        let mut p = glam::Vec3::ZERO;
+        p[a] = m.position;
+        p[u] = cu;
+        p[v] = cv;
+        p
+    };
+    let quad = [
+        corner(b.min[u], b.min[v]),
+        corner(b.max[u], b.min[v]),
+        corner(b.max[u], b.max[v]),
+        corner(b.min[u], b.max[v]),
+    ];
+    let pts: Option<Vec<Pos2>> = quad.iter().map(|&q| project(camera, rect, q)).collect();
+    if let Some(pts) = pts {
+        painter.add(egui::Shape::convex_polygon(pts, NODE_COLORS.plane, Stroke::new(1.0, NODE_COLORS.plane_edge)));
+    }
+    for k in 0..4 {
+        lines.push(Line3 { a: quad[k], b: quad[(k + 1) % 4], color: NODE_COLORS.plane_edge, width: 1.0 });
+    }
 }
 
 fn ui_ctx(painter: &egui::Painter) -> &egui::Context {

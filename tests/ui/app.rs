@@ -1088,6 +1088,8 @@ fn the_build_replay_traces_the_partial_tree() {
             "one leaf of every triangle"
         );
     }
+    h.get_by_label("Step").click();
+    run_until(&mut h, "one split", step_done(1));
     h.get_by_label("Last").click();
     let n = h.state().replay.replay.as_ref().unwrap().splits();
     run_until(&mut h, "the finished tree", step_done(n));
@@ -1104,6 +1106,19 @@ fn the_build_replay_traces_the_partial_tree() {
             assert_eq!(s.frame.counters(x, y), c, "pixel {x},{y}: the finished binary tree's counts");
         }
     }
+    // The newest split's plane is the tree's own strategy's (the inspector's marker).
+    {
+        let app = h.state();
+        let r = app.replay.replay.as_ref().unwrap();
+        let newest = r.order[n - 1];
+        let (node, marker, _) = app.replay.newest.as_ref().expect("the newest split");
+        assert_eq!(*node, newest);
+        let e = app.nodes.explained.as_ref().unwrap();
+        let ins = bvhscope::bvh::inspect::inspect(&e.tree, &e.hierarchy, newest).unwrap();
+        let own = e.tree.params.strategy;
+        assert_eq!(*marker, ins.markers.iter().find(|(s, _)| *s == own).unwrap().1);
+    }
+    h.get_by_label_contains("Newest split: node");
     h.get_by_label("Play").click();
     h.run_steps(2);
     run_until(&mut h, "a step of playing", |a| a.replay.k > 0 && a.replay.k < n);

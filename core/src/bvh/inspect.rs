@@ -227,6 +227,55 @@ pub fn subtree_sah(bvh: &Bvh, node: usize) -> f64 {
     cost
 }
 
+/// Where `strategy`'s own splitter cuts `prims` (a copy is partitioned), and at what cost; none
+/// when it finds no split.
+fn marker(
+    strategy: SplitStrategy,
+    prims: &[BuildPrim],
+    info: &NodeInfo,
+    params: &super::BuildParams,
+) -> Option<Marker> {
+    let area = info.bounds.area();
+    if prims.len() < 2 || area <= 0.0 {
+        return None;
+    }
+    let mut p = prims.to_vec();
+    match strategy.splitter(params).split(&mut p, info) {
+        Proposal::Split { axis, mid, plane, .. } if mid > 0 && mid < p.len() => {
+            let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, q| b.union(q.bounds()));
+            let (l, r) = (side(&p[..mid]), side(&p[mid..]));
+            let weighted = l.area() * mid as f32 + r.area() * (p.len() - mid) as f32;
+            Some(Marker {
+                strategy,
+                axis,
+                position: plane,
+                left: mid as u32,
+                right: (p.len() - mid) as u32,
+                cost: split_cost(params.cost, weighted, area),
+            })
+        }
+        _ => None,
+    }
+}
+
+/// The split the tree's own strategy makes at `node` (its plane, for the build replay), and for
+/// the binned SAH the cost at each of its bins' planes per axis (empty otherwise).
+pub fn own_split(bvh: &Bvh, h: &Hierarchy, node: u32) -> (Option<Marker>, [Vec<CurvePoint>; 3]) {
+    let i = node as usize;
+    if i >= bvh.nodes.len() {
+        return (None, Default::default());
+    }
+    let (prims, info) = node_prims(bvh, h, i);
+    let params = bvh.params;
+    let mut binned = <[Vec<CurvePoint>; 3]>::default();
+    let area = info.bounds.area();
+    if params.strategy == SplitStrategy::SahBinned && prims.len() >= 2 && area > 0.0 {
+        let bins = params.sah_bins as usize;
+        binned_planes(&mut prims.clone(), &info, bins, &mut Curves { out: &mut binned, cost: params.cost, area });
+    }
+    (marker(params.strategy, &prims, &info, &params), binned)
+}
+
 /// Explain `node` of `bvh` (a node id of the binary tree as built).
 pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
     let i = node as usize;
@@ -244,32 +293,8 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         sweep_planes(&mut prims.clone(), &info, &mut Curves { out: &mut sweep, cost: params.cost, area });
         binned_planes(&mut prims.clone(), &info, bins, &mut Curves { out: &mut binned, cost: params.cost, area });
     }
-    let markers = SplitStrategy::ALL
-        .into_iter()
-        .map(|strategy| {
-            let mut p = prims.clone();
-            let marker = match (count >= 2, area > 0.0) {
-                (true, true) => match strategy.splitter(&params).split(&mut p, &info) {
-                    Proposal::Split { axis, mid, plane, .. } if mid > 0 && mid < p.len() => {
-                        let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, q| b.union(q.bounds()));
-                        let (l, r) = (side(&p[..mid]), side(&p[mid..]));
-                        let weighted = l.area() * mid as f32 + r.area() * (p.len() - mid) as f32;
-                        Some(Marker {
-                            strategy,
-                            axis,
-                            position: plane,
-                            left: mid as u32,
-                            right: (p.len() - mid) as u32,
-                            cost: split_cost(params.cost, weighted, area),
-                        })
-                    }
-                    _ => None,
-                },
-                _ => None,
-            };
-            (strategy, marker)
-        })
-        .collect();
+    let markers =
+        SplitStrategy::ALL.into_iter().map(|strategy| (strategy, marker(strategy, &prims, &info, &params))).collect();
     let child_overlap =
         children.map(|[l, r]| Overlap::of(&bvh.nodes[l as usize].bounds(), &bvh.nodes[r as usize].bounds()));
     Some(Inspection {
@@ -376,6 +401,22 @@ mod tests {
             }
             let interior = bvh.nodes.iter().filter(|n| !n.is_leaf()).count();
             assert!(checked * 10 >= interior * 9, "{strategy:?}: {checked} of {interior} nodes have a marker");
+        }
+    }
+
+    /// What the build replay shows of a split (the tree's own strategy's plane, and the binned
+    /// SAH's bins) is what the inspector shows.
+    #[test]
+    fn own_split_is_the_inspectors_marker_of_the_trees_strategy() {
+        for strategy in SplitStrategy::ALL {
+            let (bvh, h) = built(strategy, 4);
+            for node in [0u32, 1, 2, 3] {
+                let ins = inspect(&bvh, &h, node).unwrap();
+                let (m, binned) = own_split(&bvh, &h, node);
+                assert_eq!(m, ins.markers.iter().find(|(s, _)| *s == strategy).unwrap().1, "{strategy:?} {node}");
+                let want = if strategy == SplitStrategy::SahBinned { ins.binned.clone() } else { Default::default() };
+                assert_eq!(binned, want);
+            }
         }
     }
 

@@ -70,13 +70,30 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 Some(newest) => {
                     let node = &r.tree.nodes[newest as usize];
                     let (l, rr) = (node.index, node.index + 1);
+                    let axis = ["x", "y", "z"][node.axis as usize];
+                    let plane = match view.newest.as_ref().filter(|(n, _, _)| *n == newest) {
+                        Some((_, Some(m), _)) => format!(" at {axis} = {:.4} (split cost {:.2})", m.position, m.cost),
+                        _ => String::new(),
+                    };
                     ui.label(format!(
-                        "Newest split: node {newest} on {} into {l} ({} triangles) and {rr} ({}); SAH cost of the partial tree {:.2}",
-                        ["x", "y", "z"][node.axis as usize],
+                        "Newest split: node {newest} on {axis}{plane} into {l} ({} triangles) and {rr} ({}); SAH cost of the partial tree {:.2}",
                         r.hierarchy.count[l as usize],
                         r.hierarchy.count[rr as usize],
                         r.sah[k]
                     ));
+                    // The binned SAH: the cost at each of that node's bins' planes on the chosen axis.
+                    if let Some((_, Some(m), bins)) = view.newest.as_ref().filter(|(n, _, b)| *n == newest && !b[node.axis as usize].is_empty()) {
+                        let a = node.axis as usize;
+                        let pts: PlotPoints = bins[a].iter().map(|p| [p.position as f64, p.cost as f64]).collect();
+                        Plot::new("replay-bins")
+                            .height(90.0)
+                            .allow_scroll(false)
+                            .x_axis_label(format!("{axis}: the newest split's bins"))
+                            .show(ui, |p| {
+                                p.line(Line::new("cost at each bin plane", pts).color(Color32::from_rgb(90, 200, 250)));
+                                p.vline(VLine::new("chosen plane", m.position as f64).color(Color32::from_rgb(250, 210, 80)));
+                            });
+                    }
                 }
                 None => {
                     ui.label(format!("No split yet: the root is one leaf; SAH cost {:.2}", r.sah[0]));
