@@ -10,6 +10,8 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // `check` has printed its report: exit 1 says the BVH has defects.
+        Err(CliError::Defects(_)) => ExitCode::from(1),
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(2)

@@ -560,3 +560,62 @@ fn replay_writes_an_animated_png_and_the_sah_cost_per_step() {
     let sah = text.lines().find(|l| l.starts_with("SAH cost")).unwrap().split_whitespace().nth(2).unwrap().to_string();
     assert_eq!(format!("{:.3}", rows.last().unwrap()[1]), sah, "the last step is the finished tree");
 }
+
+/// `export-bvh` writes a built-in tree; `check` passes it (exit 0, the imported row equal to the
+/// strategy's), finds a shrunken leaf box (exit 1, naming the node and the triangle, with wrong
+/// rays), and refuses an unreadable dump in one line (exit 2).
+#[test]
+fn check_passes_an_exported_tree_and_names_what_is_wrong_with_a_broken_one() {
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    let (good, bad, junk) = (tmp("good-bvh.txt"), tmp("bad-bvh.txt"), tmp("junk-bvh.json"));
+    let p = |x: &PathBuf| x.to_str().unwrap().to_string();
+    let out = bvhscope(&["export-bvh", torus, "--strategy", "midpoint", "-o", &p(&good)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let check = |file: &PathBuf| bvhscope(&["check", torus, "--bvh", &p(file), "--rays", "20000", "--size", "64x48"]);
+    let out = check(&good);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("0 defects"), "{text}");
+    let row = |name: &str| {
+        text.lines()
+            .find(|l| l.starts_with(name))
+            .unwrap()
+            .split_whitespace()
+            .skip(if name == "Midpoint" { 1 } else { 2 })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(row("imported:"), row("Midpoint"), "the same nodes, depth, SAH, EPO and work per ray");
+
+    // Shrink the first leaf's box to half its width in x.
+    let dump = std::fs::read_to_string(&good).unwrap();
+    let mut leaf = None;
+    let lines: Vec<String> = dump
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            if leaf.is_none() && w.first() == Some(&"node") && w.get(7) == Some(&"leaf") {
+                let node = dump.lines().take(i).filter(|x| x.starts_with("node ")).count();
+                leaf = Some(node);
+                let (lo, hi): (f32, f32) = (w[1].parse().unwrap(), w[4].parse().unwrap());
+                let mut w: Vec<String> = w.iter().map(|s| s.to_string()).collect();
+                w[4] = ((lo + hi) / 2.0).to_string();
+                return w.join(" ");
+            }
+            l.to_string()
+        })
+        .collect();
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    let leaf = leaf.unwrap();
+    let out = check(&bad);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(text.contains(&format!("(in leaf node {leaf}) sticks out of its leaf's box, node {leaf}")), "{text}");
+    assert!(text.lines().any(|l| l.starts_with("bounds (")), "grouped: {text}");
+
+    std::fs::write(&junk, r#"{"format": "bvhscope-bvh", "version": 7, "primitives": [], "nodes": []}"#).unwrap();
+    let out = check(&junk);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("junk-bvh.json") && err.contains("version 7"), "{err}");
+}

@@ -2,6 +2,7 @@
 //! Errors print one line naming the file and the problem and exit with code 2.
 
 mod args;
+pub mod check;
 mod compare;
 pub mod inspect;
 mod progress;
@@ -55,6 +56,11 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
     /// The build played back split by split, as an animated PNG and a table of the SAH cost.
     Replay(replay::ReplayArgs),
+    /// Check a BVH written by another program against the mesh and the linear scan (exit 0: correct,
+    /// 1: defects, 2: unreadable).
+    Check(check::CheckArgs),
+    /// Write a built-in strategy's binary tree in the bvhscope-bvh format.
+    ExportBvh(check::ExportArgs),
 }
 
 /// An error the CLI reports in one line before exiting with code 2.
@@ -68,6 +74,9 @@ pub enum CliError {
     Usage(String),
     #[error("{}: cannot write: {source}", .path.display())]
     Write { path: PathBuf, source: std::io::Error },
+    /// `check` found defects (reported on stdout): exit code 1.
+    #[error("{0} defects")]
+    Defects(usize),
 }
 
 /// Load a mesh or a scene with a spinner when it takes over a second, and print what was skipped.
@@ -121,6 +130,8 @@ pub fn run(command: Command) -> Result<(), CliError> {
         Command::Trace(a) => trace::run(&a),
         Command::Inspect(a) => inspect::run(&a),
         Command::Replay(a) => replay::run(&a),
+        Command::Check(a) => check::run(&a),
+        Command::ExportBvh(a) => check::export(&a),
         Command::Stats(a) => stats::run(&a),
         Command::Compare(a) => compare::run(&a),
     }

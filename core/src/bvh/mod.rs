@@ -5,7 +5,9 @@
 mod accel;
 mod any;
 mod build;
+pub mod check;
 mod counters;
+pub mod dump;
 pub mod epo;
 pub mod inspect;
 mod linear;

@@ -1,0 +1,297 @@
+//! The `bvhscope-bvh` format: a BVH written by another program (a student's renderer) or by
+//! bvhscope itself, to be checked, drawn and compared. Version 1 (the README documents it):
+//!
+//! - JSON: `{"format": "bvhscope-bvh", "version": 1, "mesh": "monkey.obj", "primitives": [..],
+//!   "nodes": [{"min": [x,y,z], "max": [x,y,z], "children": [a, b], "axis": 0} |
+//!   {"min": .., "max": .., "first": f, "count": n}]}`; node 0 is the root, nodes in any order,
+//!   2 to 4 children, a leaf holds `primitives[first .. first + count]`, a primitive is a triangle
+//!   index of the mesh (faces in file order, fan-triangulated, degenerate ones included);
+//! - the same gzip-compressed (`.json.gz`);
+//! - a plain text form a C++ program prints without a JSON library, one line per item:
+//!   `bvhscope-bvh 1`, optionally `mesh FILE`, `primitives P0 P1 ...` (any number of such
+//!   lines, concatenated), then one line per node in index order:
+//!   `node MINX MINY MINZ MAXX MAXY MAXZ children C1 C2 [C3 C4] [axis A]` or
+//!   `node MINX MINY MINZ MAXX MAXY MAXZ leaf FIRST COUNT`; `#` starts a comment.
+
+use super::{Bvh, BvhNode};
+use crate::geometry::Aabb;
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use std::io::Read;
+use std::path::Path;
+
+pub const FORMAT: &str = "bvhscope-bvh";
+pub const VERSION: u32 = 1;
+
+/// One node as written: interior (`children`) or leaf (`first`, `count`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DumpNode {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub children: Option<Vec<u32>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub count: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<u8>,
+}
+
+impl DumpNode {
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(Vec3::from(self.min), Vec3::from(self.max))
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BvhDump {
+    pub format: String,
+    pub version: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<String>,
+    pub primitives: Vec<u32>,
+    pub nodes: Vec<DumpNode>,
+}
+
+/// Why a dump cannot be read (the checker's exit code 2).
+#[derive(Debug, thiserror::Error)]
+pub enum DumpError {
+    #[error("{path}: cannot read: {source}")]
+    Io { path: String, source: std::io::Error },
+    #[error("{path}: not a bvhscope-bvh file: {why}")]
+    NotTheFormat { path: String, why: String },
+    #[error("{path}: version {found} of the bvhscope-bvh format; this bvhscope reads version {VERSION}")]
+    FutureVersion { path: String, found: u32 },
+    #[error("{path}: line {line}: {why}")]
+    Text { path: String, line: usize, why: String },
+}
+
+impl BvhDump {
+    /// Read a dump: JSON, gzip-compressed JSON (`.gz`), or the text form (anything whose first
+    /// word is `bvhscope-bvh`).
+    pub fn read(path: &Path) -> Result<BvhDump, DumpError> {
+        let name = path.display().to_string();
+        let io = |source| DumpError::Io { path: name.clone(), source };
+        let mut bytes = std::fs::read(path).map_err(io)?;
+        if bytes.starts_with(&[0x1f, 0x8b]) {
+            let mut out = Vec::new();
+            flate2::read::GzDecoder::new(&bytes[..]).read_to_end(&mut out).map_err(io)?;
+            bytes = out;
+        }
+        let text = String::from_utf8(bytes)
+            .map_err(|_| DumpError::NotTheFormat { path: name.clone(), why: "not text (nor gzip)".into() })?;
+        let dump = if text.trim_start().starts_with('{') {
+            Self::from_json(&text, &name)?
+        } else {
+            Self::from_text(&text, &name)?
+        };
+        if dump.format != FORMAT {
+            return Err(DumpError::NotTheFormat { path: name, why: format!("its format is \"{}\"", dump.format) });
+        }
+        if dump.version != VERSION {
+            return Err(DumpError::FutureVersion { path: name, found: dump.version });
+        }
+        Ok(dump)
+    }
+
+    fn from_json(text: &str, name: &str) -> Result<BvhDump, DumpError> {
+        // The format and version first, so a future version is named as such, not as broken JSON.
+        #[derive(Deserialize)]
+        struct Head {
+            format: Option<String>,
+            version: Option<u32>,
+        }
+        let head: Head = serde_json::from_str(text)
+            .map_err(|e| DumpError::NotTheFormat { path: name.into(), why: format!("broken JSON: {e}") })?;
+        match (head.format.as_deref(), head.version) {
+            (Some(FORMAT), Some(v)) if v != VERSION => {
+                return Err(DumpError::FutureVersion { path: name.into(), found: v })
+            }
+            (Some(FORMAT), Some(_)) => {}
+            (f, _) => {
+                let why = f.map_or("no \"format\" field".to_string(), |f| format!("its format is \"{f}\""));
+                return Err(DumpError::NotTheFormat { path: name.into(), why });
+            }
+        }
+        serde_json::from_str(text).map_err(|e| DumpError::NotTheFormat { path: name.into(), why: e.to_string() })
+    }
+
+    fn from_text(text: &str, name: &str) -> Result<BvhDump, DumpError> {
+        let err = |line: usize, why: String| DumpError::Text { path: name.into(), line, why };
+        let mut dump =
+            BvhDump { format: String::new(), version: 0, mesh: None, primitives: Vec::new(), nodes: Vec::new() };
+        for (i, raw) in text.lines().enumerate() {
+            let line = raw.split('#').next().unwrap_or("").trim();
+            let n = i + 1;
+            let mut words = line.split_whitespace();
+            let Some(head) = words.next() else { continue };
+            let rest: Vec<&str> = words.collect();
+            let num = |s: &str| s.parse::<f32>().map_err(|_| err(n, format!("'{s}' is not a number")));
+            let int = |s: &str| s.parse::<u32>().map_err(|_| err(n, format!("'{s}' is not a whole number")));
+            match head {
+                FORMAT if dump.format.is_empty() => {
+                    dump.format = FORMAT.into();
+                    dump.version = int(rest.first().copied().unwrap_or("?"))?;
+                    if dump.version != VERSION {
+                        return Err(DumpError::FutureVersion { path: name.into(), found: dump.version });
+                    }
+                }
+                _ if dump.format.is_empty() => {
+                    return Err(DumpError::NotTheFormat {
+                        path: name.into(),
+                        why: "the first line is not 'bvhscope-bvh 1' (nor is the file JSON)".into(),
+                    })
+                }
+                "mesh" => dump.mesh = Some(rest.join(" ")),
+                "primitives" => {
+                    for w in rest {
+                        dump.primitives.push(int(w)?);
+                    }
+                }
+                "node" => {
+                    if rest.len() < 8 {
+                        return Err(err(
+                            n,
+                            "a node is 'node MIN(3) MAX(3) children C..' or '... leaf FIRST COUNT'".into(),
+                        ));
+                    }
+                    let f: Vec<f32> = rest[..6].iter().map(|w| num(w)).collect::<Result<_, _>>()?;
+                    let mut node = DumpNode {
+                        min: [f[0], f[1], f[2]],
+                        max: [f[3], f[4], f[5]],
+                        children: None,
+                        first: None,
+                        count: None,
+                        axis: None,
+                    };
+                    match rest[6] {
+                        "leaf" if rest.len() == 9 => {
+                            node.first = Some(int(rest[7])?);
+                            node.count = Some(int(rest[8])?);
+                        }
+                        "children" => {
+                            let mut kids = Vec::new();
+                            let mut k = 7;
+                            while k < rest.len() && rest[k] != "axis" {
+                                kids.push(int(rest[k])?);
+                                k += 1;
+                            }
+                            if k < rest.len() {
+                                let a = rest.get(k + 1).ok_or_else(|| err(n, "'axis' without a value".into()))?;
+                                node.axis = Some(int(a)? as u8);
+                            }
+                            node.children = Some(kids);
+                        }
+                        other => return Err(err(n, format!("'{other}': expected 'children' or 'leaf FIRST COUNT'"))),
+                    }
+                    dump.nodes.push(node);
+                }
+                other => return Err(err(n, format!("'{other}' is not mesh, primitives or node"))),
+            }
+        }
+        if dump.format.is_empty() {
+            return Err(DumpError::NotTheFormat { path: name.into(), why: "the file is empty".into() });
+        }
+        Ok(dump)
+    }
+
+    /// The text form.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write;
+        let mut o = format!("{FORMAT} {VERSION}\n");
+        if let Some(m) = &self.mesh {
+            let _ = writeln!(o, "mesh {m}");
+        }
+        for chunk in self.primitives.chunks(32) {
+            let words: Vec<String> = chunk.iter().map(|p| p.to_string()).collect();
+            let _ = writeln!(o, "primitives {}", words.join(" "));
+        }
+        for n in &self.nodes {
+            let (a, b) = (n.min, n.max);
+            let _ = write!(o, "node {} {} {} {} {} {}", a[0], a[1], a[2], b[0], b[1], b[2]);
+            match (&n.children, n.first, n.count) {
+                (Some(kids), _, _) => {
+                    let words: Vec<String> = kids.iter().map(|k| k.to_string()).collect();
+                    let _ = write!(o, " children {}", words.join(" "));
+                    if let Some(axis) = n.axis {
+                        let _ = write!(o, " axis {axis}");
+                    }
+                }
+                (None, f, c) => {
+                    let _ = write!(o, " leaf {} {}", f.unwrap_or(0), c.unwrap_or(0));
+                }
+            }
+            o.push('\n');
+        }
+        o
+    }
+
+    /// A binary tree of bvhscope's, as a dump (its leaf order is the primitives' order).
+    pub fn of_bvh(bvh: &Bvh, mesh: Option<String>) -> BvhDump {
+        let nodes = bvh
+            .nodes
+            .iter()
+            .map(|n| {
+                let b = n.bounds();
+                let (min, max) = (glam::Vec3::from(b.min).to_array(), glam::Vec3::from(b.max).to_array());
+                if n.is_leaf() {
+                    DumpNode { min, max, children: None, first: Some(n.index), count: Some(n.count as u32), axis: None }
+                } else {
+                    let kids = vec![n.index, n.index + 1];
+                    DumpNode { min, max, children: Some(kids), first: None, count: None, axis: Some(n.axis) }
+                }
+            })
+            .collect();
+        BvhDump { format: FORMAT.into(), version: VERSION, mesh, primitives: bvh.prim_ids.clone(), nodes }
+    }
+
+    /// bvhscope's binary tree of a structurally sound binary dump (`check` finds no structure
+    /// defect): nodes renumbered depth first so each node's two children are adjacent, leaves'
+    /// triangles copied into leaf order (a triangle in two leaves is there twice); the boxes are
+    /// kept as written, so a wrong box misses rays as it would in the student's renderer. `None`
+    /// for a tree with more than two children somewhere or a leaf of more than 65,535 triangles.
+    pub fn to_bvh(&self, mesh: &crate::mesh::Mesh, params: super::BuildParams) -> Option<Bvh> {
+        let mut nodes = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
+        let (mut prim_ids, mut tris) = (Vec::new(), Vec::new());
+        // (dump node, its slot in `nodes`)
+        let mut stack = vec![(0usize, 0usize)];
+        while let Some((d, slot)) = stack.pop() {
+            // A cycle would never end (the checker reports it; here it only stops the copy).
+            if nodes.len() > 2 * self.nodes.len() + 2 {
+                return None;
+            }
+            let n = self.nodes.get(d)?;
+            match &n.children {
+                Some(kids) if kids.len() == 2 => {
+                    let first = nodes.len();
+                    nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
+                    nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
+                    nodes[slot] = BvhNode::interior(n.bounds(), first as u32, n.axis.unwrap_or(0).min(2));
+                    stack.push((kids[1] as usize, first + 1));
+                    stack.push((kids[0] as usize, first));
+                }
+                Some(_) => return None,
+                None => {
+                    let (f, c) = (n.first? as usize, n.count? as usize);
+                    if c > u16::MAX as usize || f + c > self.primitives.len() {
+                        return None;
+                    }
+                    if c == 0 {
+                        continue; // an empty leaf: its empty box is never entered
+                    }
+                    let start = prim_ids.len() as u32;
+                    for &p in &self.primitives[f..f + c] {
+                        if p as usize >= mesh.triangle_count() {
+                            return None;
+                        }
+                        prim_ids.push(p);
+                        tris.push(mesh.triangle(p));
+                    }
+                    nodes[slot] = BvhNode::leaf(n.bounds(), start, c as u16);
+                }
+            }
+        }
+        Some(Bvh { nodes, prim_ids, tris, params, report: Default::default() })
+    }
+}

@@ -1,0 +1,167 @@
+//! `bvhscope check MESH --bvh FILE`: a BVH written by another program, checked against the mesh
+//! and the linear scan (`bvh::check`), then set next to bvhscope's strategies on the same mesh.
+//! Exit 0: correct (warnings allowed); 1: defects; 2: the input cannot be read.
+//! `bvhscope export-bvh MESH -o FILE`: a built-in strategy's tree in the same format.
+
+use super::args::{BuildArgs, ViewArgs};
+use super::{load_mesh, progress, CliError};
+use crate::bvh::check::{check, Finding, Group};
+use crate::bvh::dump::BvhDump;
+use crate::bvh::{epo, BuildParams, Bvh, Layout, SplitStrategy, TreeStats};
+use crate::render::{render, RenderSettings};
+use clap::{Args, ValueEnum};
+use std::fmt::Write;
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum CheckFormat {
+    Text,
+    Json,
+}
+
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// The mesh the BVH was built over (.obj; faces in file order).
+    pub mesh: PathBuf,
+    /// The BVH: bvhscope-bvh JSON, .json.gz, or the text form (see the README).
+    #[arg(long)]
+    pub bvh: PathBuf,
+    /// Random rays traced against the linear scan, besides the frame's primary rays.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub rays: usize,
+    /// The frame whose primary rays are traced and counted.
+    #[command(flatten)]
+    pub view_args: ViewArgs,
+    #[command(flatten)]
+    pub build: BuildArgs,
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: CheckFormat,
+}
+
+/// One row of the quality table.
+#[derive(serde::Serialize)]
+struct Quality {
+    name: String,
+    nodes: usize,
+    max_depth: u32,
+    sah_cost: f64,
+    epo: f64,
+    nodes_per_ray: f64,
+    tri_tests_per_ray: f64,
+}
+
+fn quality(
+    name: String,
+    bvh: &Bvh,
+    mesh: &crate::mesh::Mesh,
+    camera: &crate::render::Camera,
+    trace: crate::bvh::TraceOptions,
+) -> Quality {
+    let s = TreeStats::of(bvh);
+    let f = render(bvh, mesh, camera, &RenderSettings { trace, count: true, progressive: false });
+    let r = f.ray_summary();
+    Quality {
+        name,
+        nodes: s.nodes,
+        max_depth: s.max_depth,
+        sah_cost: s.sah_cost,
+        epo: epo::of(bvh),
+        nodes_per_ray: r.mean_nodes_visited,
+        tri_tests_per_ray: r.mean_triangle_tests,
+    }
+}
+
+pub fn run(a: &CheckArgs) -> Result<(), CliError> {
+    let dump = BvhDump::read(&a.bvh).map_err(|e| CliError::Usage(e.to_string()))?;
+    let scene = load_mesh(&a.mesh)?;
+    let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
+    let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
+    let trace = a.build.trace();
+    let (findings, imported) =
+        progress::with_spinner("checking the BVH", || check(&dump, &mesh, &camera, a.rays, trace));
+    let defects = findings.iter().filter(|f| f.defect).count();
+    // The imported tree next to bvhscope's strategies, on the same mesh, frame and constants.
+    let mut table = Vec::new();
+    if let Some(t) = &imported {
+        table.push(quality(format!("imported: {}", super::render::file_name(&a.bvh)), t, &mesh, &camera, trace));
+        for s in SplitStrategy::ALL {
+            let b = Bvh::build(&mesh, &BuildParams { strategy: s, layout: Layout::Binary, ..BuildParams::default() });
+            table.push(quality(s.label().to_string(), &b, &mesh, &camera, trace));
+        }
+    }
+    let mut o = String::new();
+    match a.format {
+        CheckFormat::Json => {
+            let v = serde_json::json!({ "defects": defects, "findings": findings, "quality": table });
+            let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
+        }
+        CheckFormat::Text => o = text(&a.bvh, &findings, &table),
+    }
+    print!("{o}");
+    if defects > 0 {
+        return Err(CliError::Defects(defects));
+    }
+    Ok(())
+}
+
+fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality]) -> String {
+    let mut o = String::new();
+    let defects = findings.iter().filter(|f| f.defect).count();
+    let warnings = findings.len() - defects;
+    let _ = writeln!(o, "{}: {defects} defects, {warnings} warnings", path.display());
+    for g in Group::ALL {
+        let here: Vec<&Finding> = findings.iter().filter(|f| f.group == g).collect();
+        if here.is_empty() {
+            continue;
+        }
+        let d = here.iter().filter(|f| f.defect).count();
+        let _ = writeln!(o, "\n{} ({d} defects, {} warnings)", g.label(), here.len() - d);
+        for f in here {
+            let _ = writeln!(o, "  {} {}", if f.defect { "defect: " } else { "warning:" }, f.text);
+        }
+    }
+    if !table.is_empty() {
+        let _ = writeln!(
+            o,
+            "\n{:<28} {:>8} {:>6} {:>9} {:>7} {:>12} {:>12}",
+            "tree", "nodes", "depth", "SAH cost", "EPO", "nodes / ray", "tri tests / ray"
+        );
+        for q in table {
+            let _ = writeln!(
+                o,
+                "{:<28} {:>8} {:>6} {:>9.2} {:>7.3} {:>12.2} {:>12.2}",
+                q.name, q.nodes, q.max_depth, q.sah_cost, q.epo, q.nodes_per_ray, q.tri_tests_per_ray
+            );
+        }
+    }
+    o
+}
+
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    /// The mesh (.obj).
+    pub mesh: PathBuf,
+    #[command(flatten)]
+    pub build: BuildArgs,
+    /// The file to write: JSON, or the text form when it ends in .txt.
+    #[arg(long, short)]
+    pub output: PathBuf,
+}
+
+/// `export-bvh`: the binary tree as built, in the bvhscope-bvh format.
+pub fn export(a: &ExportArgs) -> Result<(), CliError> {
+    let scene = load_mesh(&a.mesh)?;
+    let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
+    let params = BuildParams { layout: Layout::Binary, ..a.build.params(scene.build.as_ref()) };
+    let bvh = Bvh::build(&mesh, &params);
+    let name = super::render::file_name(&a.mesh);
+    let dump = BvhDump::of_bvh(&bvh, Some(name));
+    let text = if a.output.extension().is_some_and(|e| e == "txt") {
+        dump.to_text()
+    } else {
+        serde_json::to_string(&dump).expect("plain data serialises")
+    };
+    std::fs::write(&a.output, text).map_err(|source| CliError::Write { path: a.output.clone(), source })?;
+    eprintln!("wrote {} ({} nodes, {} primitives)", a.output.display(), dump.nodes.len(), dump.primitives.len());
+    Ok(())
+}
