@@ -619,3 +619,37 @@ fn check_passes_an_exported_tree_and_names_what_is_wrong_with_a_broken_one() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("junk-bvh.json") && err.contains("version 7"), "{err}");
 }
+
+/// Primitives are the file's triangle numbers, zero-area ones included (the loader drops those):
+/// an exported dump of a mesh with a zero-area face skips its number, and the checker warns that
+/// it is in no leaf without calling it a defect.
+#[test]
+fn dumps_number_triangles_as_the_file_does() {
+    let obj = tmp("with-degenerate.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 0\nv 4 0 0\nv 5 0 0\nv 4 1 0\n\
+         f 1 2 3\nf 1 2 2\nf 4 5 6\nf 7 8 9\n",
+    )
+    .unwrap();
+    let dump = tmp("with-degenerate.json");
+    let out = bvhscope(&["export-bvh", obj.to_str().unwrap(), "-o", dump.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&dump).unwrap()).unwrap();
+    let mut prims: Vec<u64> = v["primitives"].as_array().unwrap().iter().map(|p| p.as_u64().unwrap()).collect();
+    prims.sort();
+    assert_eq!(prims, vec![0, 2, 3], "the zero-area face is number 1 in the file");
+    let out = bvhscope(&[
+        "check",
+        obj.to_str().unwrap(),
+        "--bvh",
+        dump.to_str().unwrap(),
+        "--rays",
+        "2000",
+        "--size",
+        "32x24",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("triangle 1 is in no leaf (it is degenerate"), "{text}");
+}

@@ -155,7 +155,7 @@ pub fn export(a: &ExportArgs) -> Result<(), CliError> {
     let params = BuildParams { layout: Layout::Binary, ..a.build.params(scene.build.as_ref()) };
     let bvh = Bvh::build(&mesh, &params);
     let name = super::render::file_name(&a.mesh);
-    let dump = BvhDump::of_bvh(&bvh, Some(name));
+    let dump = BvhDump::of_bvh(&bvh, &mesh, Some(name));
     let text = if a.output.extension().is_some_and(|e| e == "txt") {
         dump.to_text()
     } else {

@@ -60,7 +60,10 @@ fn excess(b: &Aabb, t: &[Vec3; 3]) -> f32 {
 /// dump printed with six decimals rounds its boxes by half a millionth).
 pub fn check_tree(dump: &BvhDump, mesh: &Mesh, tolerance: f32) -> Vec<Finding> {
     let mut out = Vec::new();
-    let (nodes, prims, tris) = (&dump.nodes, &dump.primitives, mesh.triangle_count());
+    // Primitives are numbers of the file's triangles (zero-area ones included, which the loader
+    // drops); findings name triangles by those numbers.
+    let by_file = mesh.triangles_by_file_number();
+    let (nodes, prims, tris) = (&dump.nodes, &dump.primitives, by_file.len());
     if nodes.is_empty() {
         out.push(defect(Group::Structure, None, None, "the dump has no nodes (node 0 is the root)".into()));
         return out;
@@ -191,7 +194,8 @@ pub fn check_tree(dump: &BvhDump, mesh: &Mesh, tolerance: f32) -> Vec<Finding> {
             continue;
         }
         for &p in &prims[f..f + c] {
-            let Some(t) = (p as usize).lt(&tris).then(|| mesh.triangle(p)) else { continue };
+            let Some(Some(m)) = by_file.get(p as usize) else { continue };
+            let t = mesh.triangle(*m);
             covered[p as usize] = true;
             // The highest node on the path from the root whose box does not hold the triangle.
             let mut path = vec![i];
@@ -212,8 +216,8 @@ pub fn check_tree(dump: &BvhDump, mesh: &Mesh, tolerance: f32) -> Vec<Finding> {
         }
     }
     for (t, _) in covered.iter().enumerate().filter(|(_, c)| !**c) {
-        let tri = mesh.triangle(t as u32);
-        let degenerate = crate::geometry::triangle_double_area(&tri) <= 0.0;
+        // A number the loader dropped is a zero-area triangle.
+        let degenerate = by_file[t].is_none_or(|m| crate::geometry::triangle_double_area(&mesh.triangle(m)) <= 0.0);
         let text = format!(
             "triangle {t} is in no leaf{}",
             if degenerate { " (it is degenerate: no ray can hit it)" } else { "" }
@@ -251,7 +255,7 @@ pub struct WrongRay {
 /// whose hits differ (a different distance; a different triangle only at a different distance).
 pub fn wrong_rays(bvh: &Bvh, mesh: &Mesh, rays: &[(Ray, Option<(u32, u32)>)], opts: TraceOptions) -> Vec<WrongRay> {
     let linear = LinearScan::new(mesh);
-    let key = |h: Option<Hit>| h.map(|h| (h.prim, h.t));
+    let key = |h: Option<Hit>| h.map(|h| (mesh.file_number(h.prim), h.t));
     rays.par_iter()
         .filter_map(|(r, pixel)| {
             let want = linear.closest_hit(&mut r.clone(), opts, &mut NoStats);
@@ -458,7 +462,7 @@ mod tests {
     fn a_round_trip_gives_back_the_same_tree() {
         let mesh = generate::torus_knot(2, 3, 0.3, 64, 8);
         let bvh = Bvh::build(&mesh, &BuildParams { layout: crate::bvh::Layout::Binary, ..BuildParams::default() });
-        let dump = BvhDump::of_bvh(&bvh, None);
+        let dump = BvhDump::of_bvh(&bvh, &mesh, None);
         let json: BvhDump = serde_json::from_str(&serde_json::to_string(&dump).unwrap()).unwrap();
         let dir = std::env::temp_dir().join(format!("bvhscope-dump-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

@@ -227,8 +227,9 @@ impl BvhDump {
         o
     }
 
-    /// A binary tree of bvhscope's, as a dump (its leaf order is the primitives' order).
-    pub fn of_bvh(bvh: &Bvh, mesh: Option<String>) -> BvhDump {
+    /// A binary tree of bvhscope's over `mesh`, as a dump (its leaf order is the primitives'
+    /// order, each triangle by its number in the file: `Mesh::file_number`).
+    pub fn of_bvh(bvh: &Bvh, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
         let nodes = bvh
             .nodes
             .iter()
@@ -243,15 +244,18 @@ impl BvhDump {
                 }
             })
             .collect();
-        BvhDump { format: FORMAT.into(), version: VERSION, mesh, primitives: bvh.prim_ids.clone(), nodes }
+        let primitives = bvh.prim_ids.iter().map(|&p| mesh.file_number(p)).collect();
+        BvhDump { format: FORMAT.into(), version: VERSION, mesh: name, primitives, nodes }
     }
 
     /// bvhscope's binary tree of a structurally sound binary dump (`check` finds no structure
     /// defect): nodes renumbered depth first so each node's two children are adjacent, leaves'
-    /// triangles copied into leaf order (a triangle in two leaves is there twice); the boxes are
+    /// triangles copied into leaf order (a triangle in two leaves is there twice; primitives are
+    /// file numbers, `Mesh::triangles_by_file_number`); the boxes are
     /// kept as written, so a wrong box misses rays as it would in the student's renderer. `None`
     /// for a tree with more than two children somewhere or a leaf of more than 65,535 triangles.
     pub fn to_bvh(&self, mesh: &crate::mesh::Mesh, params: super::BuildParams) -> Option<Bvh> {
+        let by_file = mesh.triangles_by_file_number();
         let mut nodes = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
         let (mut prim_ids, mut tris) = (Vec::new(), Vec::new());
         // (dump node, its slot in `nodes`)
@@ -282,13 +286,18 @@ impl BvhDump {
                     }
                     let start = prim_ids.len() as u32;
                     for &p in &self.primitives[f..f + c] {
-                        if p as usize >= mesh.triangle_count() {
-                            return None;
+                        // A zero-area triangle the loader dropped cannot be hit: left out.
+                        if let Some(t) = *by_file.get(p as usize)? {
+                            prim_ids.push(t);
+                            tris.push(mesh.triangle(t));
                         }
-                        prim_ids.push(p);
-                        tris.push(mesh.triangle(p));
                     }
-                    nodes[slot] = BvhNode::leaf(n.bounds(), start, c as u16);
+                    let kept = prim_ids.len() as u32 - start;
+                    nodes[slot] = if kept == 0 {
+                        BvhNode::leaf(Aabb::EMPTY, 0, 0)
+                    } else {
+                        BvhNode::leaf(n.bounds(), start, kept as u16)
+                    };
                 }
             }
         }

@@ -21,6 +21,10 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     pub triangles: Vec<[u32; 3]>,
     pub groups: Vec<MeshGroup>,
+    /// For a mesh read from an OBJ: each triangle's number in the file, counting the faces in
+    /// order, fan-triangulated, zero-area ones included (the loader drops those): what a BVH dump's
+    /// primitives refer to. Empty otherwise (a triangle's number is its index).
+    pub file_numbers: Vec<u32>,
 }
 
 /// Everything a shading step needs about a hit, in world space.
@@ -47,7 +51,27 @@ impl Mesh {
             uvs: Vec::new(),
             triangles,
             groups: vec![MeshGroup { name: name.to_string(), triangles: 0..n }],
+            file_numbers: Vec::new(),
         }
+    }
+
+    /// The file's number of triangle `t` (see `file_numbers`).
+    pub fn file_number(&self, t: u32) -> u32 {
+        self.file_numbers.get(t as usize).copied().unwrap_or(t)
+    }
+
+    /// For each file number, the triangle it became, or `None` for a zero-area triangle the loader
+    /// dropped; `len` covers the file's triangles.
+    pub fn triangles_by_file_number(&self) -> Vec<Option<u32>> {
+        if self.file_numbers.is_empty() {
+            return (0..self.triangles.len() as u32).map(Some).collect();
+        }
+        let n = self.file_numbers.iter().copied().max().map_or(0, |m| m as usize + 1);
+        let mut out = vec![None; n];
+        for (t, &f) in self.file_numbers.iter().enumerate() {
+            out[f as usize] = Some(t as u32);
+        }
+        out
     }
 
     pub fn triangle_count(&self) -> usize {

@@ -262,6 +262,7 @@ fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport
     let has_normals = models.iter().any(|m| !m.mesh.normals.is_empty());
     let has_uvs = models.iter().any(|m| !m.mesh.texcoords.is_empty());
     let mut degenerate = 0usize;
+    let mut file_base = 0u32;
     for model in &models {
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
@@ -292,13 +293,17 @@ fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport
             let verts = tri.map(|i| positions[i as usize]);
             !(verts.iter().all(|v| v.is_finite()) && double_area(&verts) == 0.0)
         };
-        let kept: Vec<[u32; 3]> = if m.indices.len() >= 3 << 14 {
-            m.indices.par_chunks_exact(3).map(corners).filter(keep).collect()
+        // Each kept triangle with its number in the file (zero-area ones counted, as dumps do).
+        let numbered = |(i, f): (usize, &[u32])| (file_base + i as u32, corners(f));
+        let kept: Vec<(u32, [u32; 3])> = if m.indices.len() >= 3 << 14 {
+            m.indices.par_chunks_exact(3).enumerate().map(numbered).filter(|(_, t)| keep(t)).collect()
         } else {
-            m.indices.chunks_exact(3).map(corners).filter(keep).collect()
+            m.indices.chunks_exact(3).enumerate().map(numbered).filter(|(_, t)| keep(t)).collect()
         };
+        file_base += (m.indices.len() / 3) as u32;
         degenerate += m.indices.len() / 3 - kept.len();
-        mesh.triangles.extend_from_slice(&kept);
+        mesh.triangles.extend(kept.iter().map(|&(_, t)| t));
+        mesh.file_numbers.extend(kept.iter().map(|&(f, _)| f));
         let last = mesh.triangles.len() as u32;
         if last > first {
             mesh.groups.push(MeshGroup { name: model.name.clone(), triangles: first..last });
