@@ -612,6 +612,19 @@ fn check_passes_an_exported_tree_and_names_what_is_wrong_with_a_broken_one() {
     assert_eq!(out.status.code(), Some(1), "{text}");
     assert!(text.contains(&format!("(in leaf node {leaf}) sticks out of its leaf's box, node {leaf}")), "{text}");
     assert!(text.lines().any(|l| l.starts_with("bounds (")), "grouped: {text}");
+    // The example ray, traced through the imported tree, misses what the linear scan hits.
+    let example = text.lines().find(|l| l.contains("hit differently")).expect("wrong rays");
+    let (flag, value) = match example.split("--pixel ").nth(1) {
+        Some(rest) => ("--pixel", rest.split([' ', ')']).next().unwrap().to_string()),
+        None => ("--ray", example.split("--ray ").nth(1).unwrap().split([' ', ')']).next().unwrap().to_string()),
+    };
+    let want: u32 =
+        example.split("the linear scan hits triangle ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    let out = bvhscope(&["trace", torus, "--bvh", &p(&bad), flag, &value, "--size", "64x48", "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["build"].as_str().unwrap().starts_with("imported:"));
+    assert_ne!(v["hit"]["triangle"].as_u64(), Some(want as u64), "{example}");
 
     std::fs::write(&junk, r#"{"format": "bvhscope-bvh", "version": 7, "primitives": [], "nodes": []}"#).unwrap();
     let out = check(&junk);

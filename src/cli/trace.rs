@@ -10,6 +10,7 @@ use clap::{Args, ValueEnum};
 use glam::Vec3;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum TraceFormat {
@@ -34,6 +35,10 @@ pub struct TraceArgs {
     pub view_args: ViewArgs,
     #[arg(long, value_enum, default_value = "text")]
     pub format: TraceFormat,
+    /// Trace through a BVH written by another program (bvhscope-bvh, as `check` reads it) instead
+    /// of building one.
+    #[arg(long, value_name = "FILE")]
+    pub bvh: Option<PathBuf>,
 }
 
 fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
@@ -80,6 +85,28 @@ fn counts_json(c: &RayCounters) -> serde_json::Value {
     })
 }
 
+/// A dump read and made into bvhscope's tree over the scene's mesh (its structure must be sound:
+/// `check` says what is wrong otherwise).
+fn import(
+    scene: &crate::scene::Scene,
+    path: &std::path::Path,
+) -> Result<(crate::bvh::Bvh, Vec<u32>, Arc<crate::mesh::Mesh>), CliError> {
+    let dump = crate::bvh::dump::BvhDump::read(path).map_err(|e| CliError::Usage(e.to_string()))?;
+    let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
+    let params = crate::bvh::BuildParams { layout: crate::bvh::Layout::Binary, ..Default::default() };
+    let structure = crate::bvh::check::check_tree(&dump, &mesh, 1e-6 * mesh.bounds().extent().length().max(1.0));
+    if structure.iter().any(|f| f.defect && f.group == crate::bvh::check::Group::Structure) {
+        return Err(CliError::Usage(format!(
+            "{}: its structure has defects; run bvhscope check to see them",
+            path.display()
+        )));
+    }
+    let (bvh, ids) = dump
+        .to_bvh_with_ids(&mesh, params)
+        .ok_or_else(|| CliError::Usage(format!("{}: only binary trees are traced in this version", path.display())))?;
+    Ok((bvh, ids, mesh))
+}
+
 pub fn run(a: &TraceArgs) -> Result<(), CliError> {
     print!("{}", output(a)?);
     Ok(())
@@ -89,6 +116,10 @@ pub fn run(a: &TraceArgs) -> Result<(), CliError> {
 pub fn output(a: &TraceArgs) -> Result<String, CliError> {
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
+    let imported = match &a.bvh {
+        Some(path) => Some(import(&scene, path)?),
+        None => None,
+    };
     let bvh = build_scene(&scene, &a.build.scene_build(params))?;
     let (ray, source) = match (a.pixel, a.ray) {
         (_, Some((o, d))) => (Ray::new(o, d), serde_json::json!({ "typed": true })),
@@ -105,14 +136,29 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
         (None, None) => unreachable!("clap requires --pixel or --ray"),
     };
     let opts = a.build.trace();
-    let (hit, trace) = trace_ray(&bvh, &ray, opts);
+    let (mut hit, mut trace) = match &imported {
+        Some((t, _, _)) => trace_ray(t, &ray, opts),
+        None => trace_ray(&bvh, &ray, opts),
+    };
+    // An imported tree's nodes by the dump's ids, its triangles by the file's numbers.
+    if let Some((_, ids, mesh)) = &imported {
+        let node = |i: u32| ids.get(i as usize).copied().unwrap_or(i);
+        trace.steps = trace.steps.iter().map(|s| s.renamed(node, |t| mesh.file_number(t))).collect();
+        if let Some(h) = &mut hit {
+            h.prim = mesh.file_number(h.prim);
+        }
+    }
+    let build_label = match &a.bvh {
+        Some(p) => format!("imported: {}", p.display()),
+        None => bvh.build_params().label(),
+    };
     let counts = trace.counts();
     let mut o = String::new();
     match a.format {
         TraceFormat::Json => {
             let v = serde_json::json!({
                 "ray": { "origin": ray.origin().to_array(), "dir": ray.dir().to_array(), "from": source },
-                "build": bvh.build_params().label(),
+                "build": build_label,
                 "trace": opts,
                 "hit": hit.map(|h| serde_json::json!({ "triangle": h.prim, "t": h.t })),
                 "counts": counts_json(&counts),
@@ -130,7 +176,7 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
             if let Some((x, y)) = a.pixel.filter(|_| a.ray.is_none()) {
                 let _ = writeln!(o, "pixel           {x},{y}");
             }
-            let _ = writeln!(o, "build           {}", bvh.build_params().label());
+            let _ = writeln!(o, "build           {build_label}");
             let _ = writeln!(o, "traversal       {} order, {} test", opts.order.label(), opts.test.label());
             let _ = writeln!(o);
             let levels = trace.steps.iter().any(|s| s.level != TraceLevel::Mesh);

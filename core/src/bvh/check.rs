@@ -326,10 +326,18 @@ pub fn check(
     };
     let all = check_rays(mesh, camera, rays);
     let wrong = wrong_rays(&bvh, mesh, &all, opts);
-    if let Some(w) = wrong.first() {
+    // A pixel's ray for the example when there is one (easier to find in the image).
+    if let Some(w) = wrong.iter().find(|w| w.pixel.is_some()).or(wrong.first()) {
+        let v = |a: [f32; 3]| format!("{},{},{}", a[0], a[1], a[2]);
         let at = match w.pixel {
-            Some((x, y)) => format!("pixel {x},{y} (trace --pixel {x},{y})"),
-            None => format!("the ray {:?}:{:?}", w.origin, w.dir),
+            Some((x, y)) => format!("pixel {x},{y} (trace MESH --bvh FILE --pixel {x},{y} shows its walk)"),
+            None => format!(
+                "the ray {}:{} (trace MESH --bvh FILE --ray {}:{} shows its walk)",
+                v(w.origin),
+                v(w.dir),
+                v(w.origin),
+                v(w.dir)
+            ),
         };
         let show = |h: Option<(u32, f32)>| h.map_or("nothing".to_string(), |(p, t)| format!("triangle {p} at t = {t}"));
         out.push(defect(Group::Rays, None, w.got.or(w.want).map(|h| h.0), format!(

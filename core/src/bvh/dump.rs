@@ -255,7 +255,14 @@ impl BvhDump {
     /// kept as written, so a wrong box misses rays as it would in the student's renderer. `None`
     /// for a tree with more than two children somewhere or a leaf of more than 65,535 triangles.
     pub fn to_bvh(&self, mesh: &crate::mesh::Mesh, params: super::BuildParams) -> Option<Bvh> {
+        self.to_bvh_with_ids(mesh, params).map(|(b, _)| b)
+    }
+
+    /// `to_bvh`, and for each of its nodes the dump's id of that node (to name nodes as the
+    /// student's program does).
+    pub fn to_bvh_with_ids(&self, mesh: &crate::mesh::Mesh, params: super::BuildParams) -> Option<(Bvh, Vec<u32>)> {
         let by_file = mesh.triangles_by_file_number();
+        let mut ids = vec![0u32];
         let mut nodes = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
         let (mut prim_ids, mut tris) = (Vec::new(), Vec::new());
         // (dump node, its slot in `nodes`)
@@ -271,6 +278,7 @@ impl BvhDump {
                     let first = nodes.len();
                     nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
                     nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
+                    ids.extend([kids[0], kids[1]]);
                     nodes[slot] = BvhNode::interior(n.bounds(), first as u32, n.axis.unwrap_or(0).min(2));
                     stack.push((kids[1] as usize, first + 1));
                     stack.push((kids[0] as usize, first));
@@ -301,6 +309,6 @@ impl BvhDump {
                 }
             }
         }
-        Some(Bvh { nodes, prim_ids, tris, params, report: Default::default() })
+        Some((Bvh { nodes, prim_ids, tris, params, report: Default::default() }, ids))
     }
 }

@@ -76,6 +76,42 @@ pub struct Step {
     pub kind: StepKind,
 }
 
+impl Step {
+    /// The same step with nodes and triangles named otherwise (an imported tree's own node ids,
+    /// the file's triangle numbers): `node` maps a `NodeId::Node` id, `triangle` a triangle id.
+    pub fn renamed(&self, node: impl Fn(u32) -> u32, triangle: impl Fn(u32) -> u32) -> Step {
+        let n = |id: NodeId| match id {
+            NodeId::Node(i) => NodeId::Node(node(i)),
+            other => other,
+        };
+        let st = |v: &[(NodeId, f32)]| v.iter().map(|&(id, t)| (n(id), t)).collect::<Vec<_>>();
+        let kind = match &self.kind {
+            StepKind::BoxTest { node, depth, hit, t_entry, t_exit } => {
+                StepKind::BoxTest { node: n(*node), depth: *depth, hit: *hit, t_entry: *t_entry, t_exit: *t_exit }
+            }
+            StepKind::Enter { node, depth, t_entry, t_exit } => {
+                StepKind::Enter { node: n(*node), depth: *depth, t_entry: *t_entry, t_exit: *t_exit }
+            }
+            StepKind::Leaf { node, depth } => StepKind::Leaf { node: n(*node), depth: *depth },
+            StepKind::Push { node, t_entry, stack } => {
+                StepKind::Push { node: n(*node), t_entry: *t_entry, stack: st(stack) }
+            }
+            StepKind::Pop { node, t_entry, stack } => {
+                StepKind::Pop { node: n(*node), t_entry: *t_entry, stack: st(stack) }
+            }
+            StepKind::Skip { node, t_entry, closest_t, stack } => {
+                StepKind::Skip { node: n(*node), t_entry: *t_entry, closest_t: *closest_t, stack: st(stack) }
+            }
+            StepKind::Triangle { triangle: tri, hit, t, u, v } => {
+                StepKind::Triangle { triangle: triangle(*tri), hit: *hit, t: *t, u: *u, v: *v }
+            }
+            StepKind::ClosestHit { triangle: tri, t } => StepKind::ClosestHit { triangle: triangle(*tri), t: *t },
+            other => other.clone(),
+        };
+        Step { level: self.level, kind }
+    }
+}
+
 /// What a trace knows of a node from its box test: its depth, and where the ray enters and leaves
 /// its box (`None`: missed).
 type Seen = (u32, Option<(f32, f32)>);
