@@ -36,6 +36,10 @@ pub struct CheckArgs {
     pub build: BuildArgs,
     #[arg(long, value_enum, default_value = "text")]
     pub format: CheckFormat,
+    /// Leave out the quality table (it builds every strategy and measures each tree's EPO: most
+    /// of the time on a big mesh).
+    #[arg(long)]
+    pub no_compare: bool,
 }
 
 /// One row of the quality table.
@@ -82,7 +86,7 @@ pub fn run(a: &CheckArgs) -> Result<(), CliError> {
     let defects = findings.iter().filter(|f| f.defect).count();
     // The imported tree next to bvhscope's strategies, on the same mesh, frame and constants.
     let mut table = Vec::new();
-    if let Some(t) = &imported {
+    if let Some(t) = imported.as_ref().filter(|_| !a.no_compare) {
         table.push(quality(format!("imported: {}", super::render::file_name(&a.bvh)), t, &mesh, &camera, trace));
         for s in SplitStrategy::ALL {
             let b = Bvh::build(&mesh, &BuildParams { strategy: s, layout: Layout::Binary, ..BuildParams::default() });
@@ -121,15 +125,16 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality]) -> Stri
         }
     }
     if !table.is_empty() {
+        let w = table.iter().map(|q| q.name.chars().count()).max().unwrap_or(4).max(4);
         let _ = writeln!(
             o,
-            "\n{:<28} {:>8} {:>6} {:>9} {:>7} {:>12} {:>12}",
+            "\n{:<w$} {:>8} {:>6} {:>9} {:>7} {:>12} {:>15}",
             "tree", "nodes", "depth", "SAH cost", "EPO", "nodes / ray", "tri tests / ray"
         );
         for q in table {
             let _ = writeln!(
                 o,
-                "{:<28} {:>8} {:>6} {:>9.2} {:>7.3} {:>12.2} {:>12.2}",
+                "{:<w$} {:>8} {:>6} {:>9.2} {:>7.3} {:>12.2} {:>15.2}",
                 q.name, q.nodes, q.max_depth, q.sah_cost, q.epo, q.nodes_per_ray, q.tri_tests_per_ray
             );
         }

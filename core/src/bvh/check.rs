@@ -241,6 +241,9 @@ fn is_ancestor(parent: &[u32], a: usize, mut n: usize) -> bool {
     true
 }
 
+/// Meshes up to this many triangles are checked against the linear scan itself.
+pub const LINEAR_REFERENCE_MAX: usize = 4096;
+
 /// A ray whose hit through the imported tree differs from the linear scan's.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct WrongRay {
@@ -254,11 +257,20 @@ pub struct WrongRay {
 /// Trace `rays` (with their pixels, if from a frame) through `bvh` and the linear scan; the ones
 /// whose hits differ (a different distance; a different triangle only at a different distance).
 pub fn wrong_rays(bvh: &Bvh, mesh: &Mesh, rays: &[(Ray, Option<(u32, u32)>)], opts: TraceOptions) -> Vec<WrongRay> {
+    // The linear scan's hits. Past a few thousand triangles they are found through bvhscope's own
+    // SAH tree instead, which returns the linear scan's hit for every ray (tests/correctness.rs,
+    // tests/watertight_traversal.rs): a million rays over a million triangles one by one would
+    // take days.
     let linear = LinearScan::new(mesh);
+    let tree = (mesh.triangle_count() > LINEAR_REFERENCE_MAX)
+        .then(|| Bvh::build(mesh, &BuildParams { layout: super::Layout::Binary, ..BuildParams::default() }));
     let key = |h: Option<Hit>| h.map(|h| (mesh.file_number(h.prim), h.t));
     rays.par_iter()
         .filter_map(|(r, pixel)| {
-            let want = linear.closest_hit(&mut r.clone(), opts, &mut NoStats);
+            let want = match &tree {
+                Some(t) => t.closest_hit(&mut r.clone(), opts, &mut NoStats),
+                None => linear.closest_hit(&mut r.clone(), opts, &mut NoStats),
+            };
             let got = bvh.closest_hit(&mut r.clone(), opts, &mut NoStats);
             let same = match (want, got) {
                 (None, None) => true,
