@@ -505,6 +505,20 @@ mod tests {
         }
     }
 
+    /// A dump compressed with gzip reads as the JSON it holds.
+    #[test]
+    fn a_gzip_dump_reads_like_its_json() {
+        use std::io::Write;
+        let dir = std::env::temp_dir().join(format!("bvhscope-dump-gz-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let d = good();
+        let path = dir.join("tree.json.gz");
+        let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        gz.write_all(serde_json::to_string(&d).unwrap().as_bytes()).unwrap();
+        std::fs::write(&path, gz.finish().unwrap()).unwrap();
+        assert_eq!(BvhDump::read(&path).unwrap(), d);
+    }
+
     #[test]
     fn unreadable_dumps_say_why() {
         let dir = std::env::temp_dir().join(format!("bvhscope-dump-bad-{}", std::process::id()));
