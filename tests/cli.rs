@@ -666,3 +666,60 @@ fn dumps_number_triangles_as_the_file_does() {
     assert_eq!(out.status.code(), Some(0), "{text}");
     assert!(text.contains("triangle 1 is in no leaf (it is degenerate"), "{text}");
 }
+
+/// The README's dumping snippets (examples/dump/): the C++ one compiled and run when a C++
+/// compiler is present, the Python one when Python is; their dumps of a hand-made tree check clean.
+#[test]
+fn the_dumping_snippets_write_dumps_that_check_clean() {
+    let dir = std::env::temp_dir().join(format!("bvhscope-snippets-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let row = dir.join("row.obj");
+    let mut obj = String::new();
+    for k in 0..4 {
+        obj += &format!("v {k} 0 0\nv {} 0 0\nv {k} 1 0\n", k + 1);
+    }
+    for k in 0..4 {
+        obj += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+    }
+    std::fs::write(&row, obj).unwrap();
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/dump");
+    let check = |dump: &std::path::Path| {
+        let out = bvhscope(&[
+            "check",
+            row.to_str().unwrap(),
+            "--bvh",
+            dump.to_str().unwrap(),
+            "--rays",
+            "2000",
+            "--size",
+            "32x24",
+        ]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let exe = dir.join("dump_bvh");
+    match Command::new("c++").args(["-std=c++17", "-O1", "-o"]).arg(&exe).arg(examples.join("dump_bvh.cpp")).output() {
+        Ok(out) if out.status.success() => {
+            let run = Command::new(&exe).output().unwrap();
+            let txt = dir.join("tree.txt");
+            std::fs::write(&txt, run.stdout).unwrap();
+            check(&txt);
+        }
+        Ok(out) => panic!("dump_bvh.cpp does not compile: {}", String::from_utf8_lossy(&out.stderr)),
+        Err(_) => eprintln!("notice: no C++ compiler (c++): the C++ dumping snippet is not compiled"),
+    }
+    match Command::new("python3").arg(examples.join("dump_bvh.py")).output() {
+        Ok(out) if out.status.success() => {
+            let json = dir.join("tree.json");
+            std::fs::write(&json, out.stdout).unwrap();
+            check(&json);
+        }
+        Ok(out) => panic!("dump_bvh.py fails: {}", String::from_utf8_lossy(&out.stderr)),
+        Err(_) => eprintln!("notice: no python3: the Python dumping snippet is not run"),
+    }
+}
