@@ -723,3 +723,37 @@ fn the_dumping_snippets_write_dumps_that_check_clean() {
         Err(_) => eprintln!("notice: no python3: the Python dumping snippet is not run"),
     }
 }
+
+/// `render --bvh FILE` traces an imported tree: an exported midpoint tree gives, pixel for pixel,
+/// the counts of midpoint's own binary tree; with --against it is A of the difference.
+#[test]
+fn render_through_an_imported_tree() {
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    let (dump, a, b, png, d) = (
+        tmp("render-bvh.json"),
+        tmp("render-bvh-a.csv"),
+        tmp("render-bvh-b.csv"),
+        tmp("render-bvh.png"),
+        tmp("render-bvh-d.csv"),
+    );
+    let p = |x: &PathBuf| x.to_str().unwrap().to_string();
+    assert!(bvhscope(&["export-bvh", torus, "--strategy", "midpoint", "-o", &p(&dump)]).status.success());
+    let common = ["--size", "48x32", "--view", "visits", "--layout", "binary"];
+    let run = |extra: &[&str]| {
+        let mut args = vec!["render", torus];
+        args.extend(common);
+        args.extend(extra);
+        let out = bvhscope(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    run(&["--bvh", &p(&dump), "--counts", &p(&a), "-o", &p(&png)]);
+    run(&["--strategy", "midpoint", "--counts", &p(&b), "-o", &p(&png)]);
+    assert_eq!(
+        std::fs::read_to_string(&a).unwrap(),
+        std::fs::read_to_string(&b).unwrap(),
+        "the same counts at every pixel"
+    );
+    let err = run(&["--bvh", &p(&dump), "--against", "sah", "--difference", &p(&d), "-o", &p(&png)]);
+    assert!(err.contains("minus A imported: render-bvh.json"), "{err}");
+}

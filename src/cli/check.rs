@@ -142,6 +142,28 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality]) -> Stri
     o
 }
 
+/// A dump read and made into bvhscope's tree over the scene's mesh (its structure must be sound:
+/// `check` says what is wrong otherwise).
+pub(crate) fn import_dump(
+    scene: &crate::scene::Scene,
+    path: &std::path::Path,
+) -> Result<(crate::bvh::Bvh, Vec<u32>, std::sync::Arc<crate::mesh::Mesh>), CliError> {
+    let dump = crate::bvh::dump::BvhDump::read(path).map_err(|e| CliError::Usage(e.to_string()))?;
+    let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
+    let params = crate::bvh::BuildParams { layout: crate::bvh::Layout::Binary, ..Default::default() };
+    let structure = crate::bvh::check::check_tree(&dump, &mesh, 1e-6 * mesh.bounds().extent().length().max(1.0));
+    if structure.iter().any(|f| f.defect && f.group == crate::bvh::check::Group::Structure) {
+        return Err(CliError::Usage(format!(
+            "{}: its structure has defects; run bvhscope check to see them",
+            path.display()
+        )));
+    }
+    let (bvh, ids) = dump
+        .to_bvh_with_ids(&mesh, params)
+        .ok_or_else(|| CliError::Usage(format!("{}: only binary trees are traced in this version", path.display())))?;
+    Ok((bvh, ids, mesh))
+}
+
 #[derive(Args, Debug)]
 pub struct ExportArgs {
     /// The mesh (.obj).

@@ -40,6 +40,10 @@ pub struct RenderArgs {
     /// legend's range, the bars under the app's legend (which has 32).
     #[arg(long, value_name = "BINS", value_parser = clap::value_parser!(u32).range(1..=10000))]
     pub histogram: Option<u32>,
+    /// Render through a BVH written by another program (bvhscope-bvh, as `check` reads it) instead
+    /// of building one; with --against, it is A.
+    #[arg(long, value_name = "FILE")]
+    pub bvh: Option<PathBuf>,
     /// With --against: also write the difference as CSV, one row per pixel: x, y, a, b, b_minus_a.
     #[arg(long, value_name = "FILE.csv", requires = "against")]
     pub difference: Option<PathBuf>,
@@ -71,7 +75,8 @@ fn run_against(
     camera: &crate::render::Camera,
     settings: &RenderSettings,
     frame_a: &crate::render::Frame,
-    bvh_a: &crate::bvh::SceneBvh,
+    params_a: &crate::bvh::SceneBuild,
+    label_a: &str,
     against: crate::bvh::SplitStrategy,
 ) -> Result<(), CliError> {
     use crate::render::diff::{difference, difference_image, tally};
@@ -80,7 +85,7 @@ fn run_against(
             "--against compares two builds' heatmaps: add --view visits, tri-tests or cost".into(),
         ));
     }
-    let params_a = bvh_a.build_params();
+    let params_a = *params_a;
     let params_b =
         crate::bvh::SceneBuild { bvh: crate::bvh::BuildParams { strategy: against, ..params_a.bvh }, ..params_a };
     let bvh_b = build_scene(loaded, &params_b)?;
@@ -104,7 +109,7 @@ fn run_against(
     }
     let range = a.range.map(|(lo, hi)| lo.abs().max(hi.abs()));
     let (img, mut legend) = difference_image(camera.width, &d, a.view, range);
-    legend.subject = format!("{}: A {}, B {}", file_name(&a.mesh), params_a.label(), params_b.label());
+    legend.subject = format!("{}: A {label_a}, B {}", file_name(&a.mesh), params_b.label());
     let img = draw_legend(&img, &legend);
     write_png(&img, &a.output)?;
     let (less, same, more) = tally(&d);
@@ -115,7 +120,7 @@ fn run_against(
         camera.height,
         a.view.label().to_lowercase(),
         params_b.label(),
-        params_a.label(),
+        label_a,
         legend.mean
     );
     Ok(())
@@ -131,25 +136,37 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
     let params = a.build.params(loaded.build.as_ref());
     let bvh = build_scene(&loaded, &a.build.scene_build(params))?;
+    let imported = match &a.bvh {
+        Some(path) => Some(super::check::import_dump(&loaded, path)?),
+        None => None,
+    };
     let count = a.view.is_heatmap() || a.counts.is_some();
     let settings = RenderSettings { trace: a.build.trace(), count, progressive: false };
     let total = camera.width as u64 * camera.height as u64;
     let control = WorkControl::new();
-    let frame = progress::with_bar("rendering", &control, || {
-        render_progressive(&bvh, &bvh, &camera, &settings, &Default::default(), &control, |_, _| {})
+    let frame = progress::with_bar("rendering", &control, || match &imported {
+        Some((t, _, mesh)) => {
+            render_progressive(t, &**mesh, &camera, &settings, &Default::default(), &control, |_, _| {})
+        }
+        None => render_progressive(&bvh, &bvh, &camera, &settings, &Default::default(), &control, |_, _| {}),
     })
     .map_err(|_| CliError::Usage("render cancelled".into()))?;
+    // What A is called in captions: the build, or the imported file.
+    let label_a = match &a.bvh {
+        Some(p) => format!("imported: {}", file_name(p)),
+        None => bvh.build_params().label(),
+    };
     if let Some(path) = &a.counts {
         let text = frame.counts_csv().expect("the frame was counted and is complete");
         std::fs::write(path, text).map_err(|source| CliError::Write { path: path.clone(), source })?;
     }
     if let Some(against) = a.against {
-        return run_against(a, &loaded, &camera, &settings, &frame, &bvh, against);
+        return run_against(a, &loaded, &camera, &settings, &frame, &bvh.build_params(), &label_a, against);
     }
     let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
     let (img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
     if let Some(l) = &mut legend {
-        l.subject = format!("{}, {}", file_name(&a.mesh), bvh.build_params().label());
+        l.subject = format!("{}, {label_a}", file_name(&a.mesh));
     }
     if let (Some(bins), Some(l)) = (a.histogram, &legend) {
         let counts = crate::render::histogram(&frame, a.view, params.cost, l.range_min, l.range_max, bins as usize);

@@ -10,7 +10,6 @@ use clap::{Args, ValueEnum};
 use glam::Vec3;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum TraceFormat {
@@ -85,28 +84,6 @@ fn counts_json(c: &RayCounters) -> serde_json::Value {
     })
 }
 
-/// A dump read and made into bvhscope's tree over the scene's mesh (its structure must be sound:
-/// `check` says what is wrong otherwise).
-fn import(
-    scene: &crate::scene::Scene,
-    path: &std::path::Path,
-) -> Result<(crate::bvh::Bvh, Vec<u32>, Arc<crate::mesh::Mesh>), CliError> {
-    let dump = crate::bvh::dump::BvhDump::read(path).map_err(|e| CliError::Usage(e.to_string()))?;
-    let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
-    let params = crate::bvh::BuildParams { layout: crate::bvh::Layout::Binary, ..Default::default() };
-    let structure = crate::bvh::check::check_tree(&dump, &mesh, 1e-6 * mesh.bounds().extent().length().max(1.0));
-    if structure.iter().any(|f| f.defect && f.group == crate::bvh::check::Group::Structure) {
-        return Err(CliError::Usage(format!(
-            "{}: its structure has defects; run bvhscope check to see them",
-            path.display()
-        )));
-    }
-    let (bvh, ids) = dump
-        .to_bvh_with_ids(&mesh, params)
-        .ok_or_else(|| CliError::Usage(format!("{}: only binary trees are traced in this version", path.display())))?;
-    Ok((bvh, ids, mesh))
-}
-
 pub fn run(a: &TraceArgs) -> Result<(), CliError> {
     print!("{}", output(a)?);
     Ok(())
@@ -117,7 +94,7 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
     let imported = match &a.bvh {
-        Some(path) => Some(import(&scene, path)?),
+        Some(path) => Some(super::check::import_dump(&scene, path)?),
         None => None,
     };
     let bvh = build_scene(&scene, &a.build.scene_build(params))?;
