@@ -69,6 +69,7 @@ fn write_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), CliErr
 }
 
 /// `render --against`: render the second build on the same camera and write B − A.
+#[allow(clippy::too_many_arguments)]
 fn run_against(
     a: &RenderArgs,
     loaded: &crate::scene::Scene,
