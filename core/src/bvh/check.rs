@@ -505,6 +505,47 @@ mod tests {
         }
     }
 
+    /// A triangle in two leaves (as spatial splits make) is fine, and traced in both; a 4-wide
+    /// tree is checked for structure, coverage and bounds (and said not traced).
+    #[test]
+    fn duplicated_references_and_four_wide_trees() {
+        let mesh = row();
+        let mut d = good();
+        // Triangle 1 spans x 1..2: also put it in the right leaf, whose box then grows to hold it.
+        d.primitives = vec![1, 0, 3, 2, 1];
+        d.nodes[1].first = Some(2);
+        d.nodes[1].count = Some(3);
+        d.nodes[1].min[0] = 1.0;
+        let (f, bvh) = check(&d, &mesh, &camera(&mesh), 2000, TraceOptions::default());
+        assert!(f.iter().all(|f| !f.defect), "{f:?}");
+        assert_eq!(bvh.unwrap().prim_ids.len(), 5, "triangle 1 twice");
+        // Four leaves under one root: 4-wide.
+        let leaf = |k: u32| {
+            let mut n = node([k as f32, 0.0, 0.0], [k as f32 + 1.0, 1.0, 0.0]);
+            (n.first, n.count) = (Some(k), Some(1));
+            n
+        };
+        let mut root = node([0.0, 0.0, 0.0], [4.0, 1.0, 0.0]);
+        root.children = Some(vec![1, 2, 3, 4]);
+        let wide = BvhDump {
+            format: "bvhscope-bvh".into(),
+            version: 1,
+            mesh: None,
+            primitives: vec![0, 1, 2, 3],
+            nodes: vec![root, leaf(0), leaf(1), leaf(2), leaf(3)],
+        };
+        let (f, bvh) = check(&wide, &mesh, &camera(&mesh), 100, TraceOptions::default());
+        assert!(f.iter().all(|f| !f.defect) && bvh.is_none(), "{f:?}");
+        assert!(f.iter().any(|f| f.group == Group::Rays && f.text.contains("only binary trees")));
+        let mut broken = wide.clone();
+        broken.nodes[3].max[0] = 2.5;
+        let (f, _) = check(&broken, &mesh, &camera(&mesh), 100, TraceOptions::default());
+        assert!(
+            f.iter().any(|f| f.defect && f.group == Group::Bounds && f.node == Some(3) && f.triangle == Some(2)),
+            "{f:?}"
+        );
+    }
+
     /// A dump compressed with gzip reads as the JSON it holds.
     #[test]
     fn a_gzip_dump_reads_like_its_json() {
