@@ -633,6 +633,12 @@ fn check_passes_an_exported_tree_and_names_what_is_wrong_with_a_broken_one() {
     assert!(err.contains("junk-bvh.json") && err.contains("version 7"), "{err}");
 }
 
+/// `check` of a small mesh: a few rays and a small frame.
+fn check_small(mesh: &std::path::Path, dump: &std::path::Path) -> std::process::Output {
+    let (m, d) = (mesh.to_str().unwrap(), dump.to_str().unwrap());
+    bvhscope(&["check", m, "--bvh", d, "--rays", "2000", "--size", "32x24"])
+}
+
 /// Primitives are the file's triangle numbers, zero-area ones included (the loader drops those):
 /// an exported dump of a mesh with a zero-area face skips its number, and the checker warns that
 /// it is in no leaf without calling it a defect.
@@ -652,16 +658,7 @@ fn dumps_number_triangles_as_the_file_does() {
     let mut prims: Vec<u64> = v["primitives"].as_array().unwrap().iter().map(|p| p.as_u64().unwrap()).collect();
     prims.sort();
     assert_eq!(prims, vec![0, 2, 3], "the zero-area face is number 1 in the file");
-    let out = bvhscope(&[
-        "check",
-        obj.to_str().unwrap(),
-        "--bvh",
-        dump.to_str().unwrap(),
-        "--rays",
-        "2000",
-        "--size",
-        "32x24",
-    ]);
+    let out = check_small(&obj, &dump);
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{text}");
     assert!(text.contains("triangle 1 is in no leaf (it is degenerate"), "{text}");
@@ -684,16 +681,7 @@ fn the_dumping_snippets_write_dumps_that_check_clean() {
     std::fs::write(&row, obj).unwrap();
     let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/dump");
     let check = |dump: &std::path::Path| {
-        let out = bvhscope(&[
-            "check",
-            row.to_str().unwrap(),
-            "--bvh",
-            dump.to_str().unwrap(),
-            "--rays",
-            "2000",
-            "--size",
-            "32x24",
-        ]);
+        let out = check_small(&row, dump);
         assert_eq!(
             out.status.code(),
             Some(0),
