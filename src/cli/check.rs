@@ -166,7 +166,7 @@ pub(crate) fn import_dump(
 
 #[derive(Args, Debug)]
 pub struct ExportArgs {
-    /// The mesh (.obj).
+    /// The mesh (.obj). The tree written is the binary one unless --layout wide4 is given.
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
@@ -179,10 +179,14 @@ pub struct ExportArgs {
 pub fn export(a: &ExportArgs) -> Result<(), CliError> {
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
-    let params = BuildParams { layout: Layout::Binary, ..a.build.params(scene.build.as_ref()) };
-    let bvh = Bvh::build(&mesh, &params);
+    // The binary tree unless --layout wide4 asks for the 4-wide one.
+    let layout = a.build.layout.unwrap_or(Layout::Binary);
+    let params = BuildParams { layout, ..a.build.params(scene.build.as_ref()) };
     let name = super::render::file_name(&a.mesh);
-    let dump = BvhDump::of_bvh(&bvh, &mesh, Some(name));
+    let dump = match crate::bvh::AnyBvh::build(&mesh, &params) {
+        crate::bvh::AnyBvh::Binary(b) => BvhDump::of_bvh(&b, &mesh, Some(name)),
+        crate::bvh::AnyBvh::Wide(w) => BvhDump::of_wide(&w, &mesh, Some(name)),
+    };
     let text = if a.output.extension().is_some_and(|e| e == "txt") {
         dump.to_text()
     } else {

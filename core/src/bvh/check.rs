@@ -546,6 +546,23 @@ mod tests {
         );
     }
 
+    /// bvhscope's 4-wide tree written as a dump checks clean: every node of 2 to 4 children, every
+    /// triangle in a leaf inside its boxes.
+    #[test]
+    fn an_exported_four_wide_tree_checks_clean() {
+        let mesh = generate::torus_knot(2, 3, 0.3, 64, 8);
+        let w = crate::bvh::WideBvh::from_binary(Bvh::build(&mesh, &BuildParams::default()));
+        let d = BvhDump::of_wide(&w, &mesh, None);
+        assert!(d.nodes.iter().any(|n| n.children.as_ref().is_some_and(|k| k.len() > 2)));
+        let f = check_tree(&d, &mesh, 1e-5);
+        assert!(f.is_empty(), "{f:?}");
+        let tiny = Mesh::from_triangles("one", vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]);
+        let w = crate::bvh::WideBvh::from_binary(Bvh::build(&tiny, &BuildParams::default()));
+        let d = BvhDump::of_wide(&w, &tiny, None);
+        assert_eq!(d.nodes.len(), 1, "one leaf");
+        assert!(check_tree(&d, &tiny, 1e-5).is_empty());
+    }
+
     /// A dump compressed with gzip reads as the JSON it holds.
     #[test]
     fn a_gzip_dump_reads_like_its_json() {

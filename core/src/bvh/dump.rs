@@ -248,6 +248,51 @@ impl BvhDump {
         BvhDump { format: FORMAT.into(), version: VERSION, mesh: name, primitives, nodes }
     }
 
+    /// A 4-wide tree of bvhscope's over `mesh`, as a dump: wide node i is dump node i (its box
+    /// is its slot's in its parent, the root's the tree's), and each leaf slot a dump leaf after them.
+    pub fn of_wide(w: &super::WideBvh, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
+        let arr = |v: glam::Vec3A| glam::Vec3::from(v).to_array();
+        let mut boxes = vec![w.root_bounds; w.nodes.len()];
+        let mut leaves = Vec::new();
+        let mut kids: Vec<Vec<u32>> = vec![Vec::new(); w.nodes.len()];
+        for (i, n) in w.nodes.iter().enumerate() {
+            for s in n.slots() {
+                let b = n.boxes.bounds(s);
+                if n.count[s] == 0 {
+                    boxes[n.child[s] as usize] = b;
+                    kids[i].push(n.child[s]);
+                } else {
+                    kids[i].push((w.nodes.len() + leaves.len()) as u32);
+                    leaves.push(DumpNode {
+                        min: arr(b.min),
+                        max: arr(b.max),
+                        children: None,
+                        first: Some(n.child[s]),
+                        count: Some(n.count[s] as u32),
+                        axis: None,
+                    });
+                }
+            }
+        }
+        let primitives: Vec<u32> = w.prim_ids.iter().map(|&p| mesh.file_number(p)).collect();
+        // A tree of one leaf (a mesh of a few triangles): that leaf is the root.
+        if w.nodes.len() == 1 && leaves.len() == 1 {
+            return BvhDump { format: FORMAT.into(), version: VERSION, mesh: name, primitives, nodes: leaves };
+        }
+        let mut nodes: Vec<DumpNode> = (0..w.nodes.len())
+            .map(|i| DumpNode {
+                min: arr(boxes[i].min),
+                max: arr(boxes[i].max),
+                children: Some(kids[i].clone()),
+                first: None,
+                count: None,
+                axis: None,
+            })
+            .collect();
+        nodes.extend(leaves);
+        BvhDump { format: FORMAT.into(), version: VERSION, mesh: name, primitives, nodes }
+    }
+
     /// bvhscope's binary tree of a structurally sound binary dump (`check` finds no structure
     /// defect): nodes renumbered depth first so each node's two children are adjacent, leaves'
     /// triangles copied into leaf order (a triangle in two leaves is there twice; primitives are
