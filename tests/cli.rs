@@ -481,6 +481,15 @@ fn stats_and_compare_show_the_end_point_overlap() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("EPO "));
 }
 
+/// `render MESH` of a small binary-layout visits heatmap with `extra` options; its stderr.
+fn render_small_visits(mesh: &str, extra: &[&str]) -> String {
+    let mut args = vec!["render", mesh, "--size", "48x32", "--view", "visits", "--layout", "binary"];
+    args.extend(extra);
+    let out = bvhscope(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
 /// `render --against`: the difference of two identical builds is zero everywhere, and B − A is,
 /// pixel by pixel, the difference of the two builds' `--counts` files.
 #[test]
@@ -488,15 +497,7 @@ fn render_against_writes_the_per_pixel_difference_of_two_builds() {
     let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
     let (a_csv, b_csv, d_csv, png) =
         (tmp("against-a.csv"), tmp("against-b.csv"), tmp("against-d.csv"), tmp("against.png"));
-    let common = ["--size", "48x32", "--view", "visits", "--layout", "binary"];
-    let run = |extra: &[&str]| {
-        let mut args = vec!["render", torus];
-        args.extend(common);
-        args.extend(extra);
-        let out = bvhscope(&args);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        String::from_utf8_lossy(&out.stderr).into_owned()
-    };
+    let run = |extra: &[&str]| render_small_visits(torus, extra);
     let p = |path: &PathBuf| path.to_str().unwrap().to_string();
     let err = run(&["--strategy", "midpoint", "--against", "midpoint", "-o", &p(&png)]);
     assert!(err.contains("less work at 0 pixels, the same at 1536, more at 0"), "{err}");
@@ -726,15 +727,7 @@ fn render_through_an_imported_tree() {
     );
     let p = |x: &PathBuf| x.to_str().unwrap().to_string();
     assert!(bvhscope(&["export-bvh", torus, "--strategy", "midpoint", "-o", &p(&dump)]).status.success());
-    let common = ["--size", "48x32", "--view", "visits", "--layout", "binary"];
-    let run = |extra: &[&str]| {
-        let mut args = vec!["render", torus];
-        args.extend(common);
-        args.extend(extra);
-        let out = bvhscope(&args);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        String::from_utf8_lossy(&out.stderr).into_owned()
-    };
+    let run = |extra: &[&str]| render_small_visits(torus, extra);
     run(&["--bvh", &p(&dump), "--counts", &p(&a), "-o", &p(&png)]);
     run(&["--strategy", "midpoint", "--counts", &p(&b), "-o", &p(&png)]);
     assert_eq!(

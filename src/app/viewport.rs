@@ -265,7 +265,7 @@ fn draw_selected_node(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, sh
     let Some(node) = app.nodes.selected.filter(|_| app.nodes.window) else { return };
     let Some(e) = app.nodes.current(Some(&shown.bvh)) else { return };
     let Some(n) = e.tree.nodes.get(node as usize) else { return };
-    if let Some(mask) = app.node_mask(ui_ctx(painter), shown, e, node) {
+    if let Some(mask) = app.node_mask(painter.ctx(), shown, e, node) {
         painter.image(mask.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
     }
     let camera = &shown.camera;
@@ -322,10 +322,6 @@ fn draw_plane(
     for k in 0..4 {
         lines.push(Line3 { a: quad[k], b: quad[(k + 1) % 4], color: NODE_COLORS.plane_edge, width: 1.0 });
     }
-}
-
-fn ui_ctx(painter: &egui::Painter) -> &egui::Context {
-    painter.ctx()
 }
 
 /// The colours of the selected node, its children and its split plane.

@@ -804,22 +804,26 @@ fn clicking_a_pixel_pins_its_ray_and_the_ray_window_steps_through_it() {
 fn a_typed_ray_is_pinned_and_a_bad_one_is_refused() {
     let mut h = harness();
     run_until(&mut h, "the first frame", idle);
+    let (view, boxes, strategy) =
+        (h.state().settings.view, h.state().settings.show_boxes, h.state().settings.build.strategy);
     h.state_mut().act(Action::ShowRayWindow);
     h.run_steps(2);
     h.get_by_label("Origin").click();
     h.run_steps(1);
-    type_keys(&mut h, "0, 0, 10");
+    type_keys(&mut h, "0, 0.3, 10");
     h.get_by_label("Direction").click();
     h.run_steps(1);
     type_keys(&mut h, "0 0 -1");
     h.get_by_label("Pin typed ray").click();
     h.run_steps(3);
     let app = h.state();
+    // "3" (the nodes-visited view's key) typed into a field fires no shortcut.
+    assert_eq!((app.settings.view, app.settings.show_boxes, app.settings.build.strategy), (view, boxes, strategy));
     assert_eq!(app.pins.pinned.len(), 1);
     let r = &app.pins.pinned[0];
     assert_eq!(r.pixel, None);
     assert!(r.label.starts_with("typed ray"), "{}", r.label);
-    assert_eq!((r.ray.origin(), r.ray.dir()), (glam::Vec3::new(0.0, 0.0, 10.0), glam::Vec3::new(0.0, 0.0, -1.0)));
+    assert_eq!((r.ray.origin(), r.ray.dir()), (glam::Vec3::new(0.0, 0.3, 10.0), glam::Vec3::new(0.0, 0.0, -1.0)));
     h.state_mut().act(Action::RayText { origin: "1, 2".into(), dir: "0, 0, -1".into() });
     h.state_mut().act(Action::PinTyped);
     h.run_steps(2);

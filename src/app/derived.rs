@@ -1,0 +1,159 @@
+//! Images derived from the frame on screen for the overlays, each cached while its inputs stay
+//! the same: the side-by-side pair and their difference, the selected node's mask, the legend's
+//! histogram and its threshold's mask.
+
+use super::{compare_view, node_view, viewport, BvhscopeApp, MaskCache, Shown};
+use std::sync::Arc;
+
+impl BvhscopeApp {
+    /// The side-by-side images (A's and B's on one scale, and their difference), once both frames
+    /// of one camera are there (cached for the pair and the view).
+    pub fn compare_images(&self, ctx: &egui::Context) -> Option<Arc<compare_view::CompareImages>> {
+        use crate::render::{diff, metric_stats, view_image, HeatRange};
+        if !self.compare.on {
+            return None;
+        }
+        let shown = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none())?;
+        let b = self.compare.b.as_ref().filter(|b| b.camera == shown.camera && b.scene_id == self.scene_id)?;
+        let (view, colormap, cost) = (shown.style.view, shown.style.colormap, shown.style.cost);
+        let mut cache = self.compare_cache.borrow_mut();
+        if let Some(c) = cache.as_ref() {
+            if Arc::ptr_eq(&c.a_frame, &shown.frame)
+                && Arc::ptr_eq(&c.b_frame, &b.frame)
+                && c.view == view
+                && c.colormap == colormap
+            {
+                return Some(c.clone());
+            }
+        }
+        // One scale for both: the fixed range if set, else from the lower minimum to the higher maximum.
+        let range = match shown.style.range {
+            HeatRange::Fixed { min, max } => HeatRange::Fixed { min, max },
+            HeatRange::Auto if view.is_heatmap() => {
+                let (a0, a1, _) = metric_stats(&shown.frame, view, cost);
+                let (b0, b1, _) = metric_stats(&b.frame, view, cost);
+                HeatRange::Fixed { min: a0.min(b0), max: a1.max(b1) }
+            }
+            HeatRange::Auto => HeatRange::Auto,
+        };
+        let texture = |name: &str, img: image::RgbImage| {
+            let c = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
+            ctx.load_texture(name, c, egui::TextureOptions::NEAREST)
+        };
+        let (img_a, mut legend) = view_image(&shown.frame, view, colormap, range, cost);
+        if let Some(l) = &mut legend {
+            l.title += " (A and B on one scale; min, mean, max of A)";
+        }
+        let (img_b, _) = view_image(&b.frame, view, colormap, range, cost);
+        let diff = diff::difference(&shown.frame, &b.frame, view, cost).map(|d| {
+            let (img, legend) = diff::difference_image(shown.frame.width(), &d, view, None);
+            (texture("compare-diff", img), d, legend)
+        });
+        let images = Arc::new(compare_view::CompareImages {
+            a_frame: shown.frame.clone(),
+            b_frame: b.frame.clone(),
+            view,
+            colormap,
+            a: texture("compare-a", img_a),
+            b: texture("compare-b", img_b),
+            diff,
+            legend,
+        });
+        *cache = Some(images.clone());
+        Some(images)
+    }
+
+    /// A mask over `shown`'s frame that dims every pixel whose hit is not a triangle of `node`'s
+    /// subtree (cached for the frame and the node).
+    pub fn node_mask(
+        &self,
+        ctx: &egui::Context,
+        shown: &Shown,
+        e: &Arc<node_view::Explained>,
+        node: u32,
+    ) -> Option<egui::TextureHandle> {
+        let f = &shown.frame;
+        if !f.is_complete() {
+            return None;
+        }
+        let mut cache = self.mask_cache.borrow_mut();
+        if let Some(c) = cache.as_ref() {
+            if Arc::ptr_eq(&c.frame, f) && Arc::ptr_eq(&c.tree, e) && c.node == node {
+                return Some(c.texture.clone());
+            }
+        }
+        let (w, h) = (f.width() as usize, f.height() as usize);
+        let h_ = &e.hierarchy;
+        let mut pixels = Vec::with_capacity(w * h);
+        for y in 0..h {
+            for x in 0..w {
+                let s = f.sample(x as u32, y as u32);
+                let inside = s.is_hit()
+                    && h_.slot_of_prim.get(s.prim as usize).is_some_and(|&slot| h_.holds(node as usize, slot));
+                pixels.push(if inside { egui::Color32::TRANSPARENT } else { egui::Color32::from_black_alpha(150) });
+            }
+        }
+        let image = egui::ColorImage::new([w, h], pixels);
+        let tex = ctx.load_texture("node-mask", image, egui::TextureOptions::NEAREST);
+        *cache = Some(MaskCache { frame: f.clone(), tree: e.clone(), node, texture: tex.clone() });
+        Some(tex)
+    }
+
+    /// The legend's histogram of the heatmap on screen (`render::histogram` over the legend's
+    /// range, `viewport::HISTOGRAM_BINS` bins; cached for the frame and view).
+    pub fn legend_histogram(&self) -> Option<Vec<u32>> {
+        let shown = self.shown.as_ref()?;
+        let legend = shown.legend.as_ref()?;
+        let view = shown.style.view;
+        let mut cache = self.histogram_cache.borrow_mut();
+        if let Some((f, v, h)) = cache.as_ref() {
+            if Arc::ptr_eq(f, &shown.frame) && *v == view {
+                return Some(h.clone());
+            }
+        }
+        let h = crate::render::histogram(
+            &shown.frame,
+            view,
+            shown.style.cost,
+            legend.range_min,
+            legend.range_max,
+            viewport::HISTOGRAM_BINS,
+        );
+        *cache = Some((shown.frame.clone(), view, h.clone()));
+        Some(h)
+    }
+
+    /// A mask over the heatmap on screen dimming the pixels at or below the threshold (cached).
+    pub fn threshold_mask(&self, ctx: &egui::Context, shown: &Shown) -> Option<egui::TextureHandle> {
+        let t = self.threshold?;
+        shown.legend.as_ref()?;
+        let (f, view) = (&shown.frame, shown.style.view);
+        if !f.is_complete() || !f.counted() {
+            return None;
+        }
+        let mut cache = self.threshold_cache.borrow_mut();
+        if let Some((cf, cv, ct, tex)) = cache.as_ref() {
+            if Arc::ptr_eq(cf, f) && *cv == view && *ct == t {
+                return Some(tex.clone());
+            }
+        }
+        let (w, h) = (f.width(), f.height());
+        let pixels = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                if view.metric(&f.counters(x, y), shown.style.cost) > t {
+                    egui::Color32::TRANSPARENT
+                } else {
+                    egui::Color32::from_black_alpha(170)
+                }
+            })
+            .collect();
+        let tex = ctx.load_texture(
+            "threshold-mask",
+            egui::ColorImage::new([w as usize, h as usize], pixels),
+            egui::TextureOptions::NEAREST,
+        );
+        *cache = Some((f.clone(), view, t, tex.clone()));
+        Some(tex)
+    }
+}
