@@ -258,7 +258,7 @@ impl Jobs {
         let job = self.start("Preparing the tree view".to_string());
         let send = self.sender(job.id);
         std::thread::spawn(move || {
-            if let SceneBvh::Single { bvh: any, mesh } = &*bvh {
+            if let SceneBvh::Single { bvh: any, mesh, .. } = &*bvh {
                 let tree = Arc::new(any.binary_tree(mesh).into_owned());
                 send(JobEvent::Explained(Arc::new(Explained::new(bvh.clone(), tree))));
             }

@@ -7,7 +7,7 @@ use super::args::{BuildArgs, ViewArgs};
 use super::{load_mesh, progress, CliError};
 use crate::bvh::check::{check, Finding, Group};
 use crate::bvh::dump::BvhDump;
-use crate::bvh::{epo, BuildParams, Bvh, Layout, SplitStrategy, TreeStats};
+use crate::bvh::{epo, AnyBvh, BuildParams, Layout, SceneBvh, SplitStrategy, TreeStats, TreeView};
 use crate::render::{render, RenderSettings};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
@@ -49,14 +49,15 @@ struct Quality {
     nodes: usize,
     max_depth: u32,
     sah_cost: f64,
-    epo: f64,
+    /// Of binary trees (`bvh::epo` sums over a binary tree's nodes).
+    epo: Option<f64>,
     nodes_per_ray: f64,
     tri_tests_per_ray: f64,
 }
 
 fn quality(
     name: String,
-    bvh: &Bvh,
+    bvh: &AnyBvh,
     mesh: &crate::mesh::Mesh,
     camera: &crate::render::Camera,
     trace: crate::bvh::TraceOptions,
@@ -69,7 +70,10 @@ fn quality(
         nodes: s.nodes,
         max_depth: s.max_depth,
         sah_cost: s.sah_cost,
-        epo: epo::of(bvh),
+        epo: match bvh {
+            AnyBvh::Binary(b) => Some(epo::of(b)),
+            AnyBvh::Wide(_) => None,
+        },
         nodes_per_ray: r.mean_nodes_visited,
         tri_tests_per_ray: r.mean_triangle_tests,
     }
@@ -77,20 +81,23 @@ fn quality(
 
 pub fn run(a: &CheckArgs) -> Result<(), CliError> {
     let dump = BvhDump::read(&a.bvh).map_err(|e| CliError::Usage(e.to_string()))?;
+    let name = super::render::file_name(&a.bvh);
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
     let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
     let trace = a.build.trace();
     let (findings, imported) =
-        progress::with_spinner("checking the BVH", || check(&dump, &mesh, &camera, a.rays, trace));
+        progress::with_spinner("checking the BVH", || check(&dump, name.clone(), &mesh, &camera, a.rays, trace));
     let defects = findings.iter().filter(|f| f.defect).count();
     // The imported tree next to bvhscope's strategies, on the same mesh, frame and constants.
     let mut table = Vec::new();
-    if let Some(t) = imported.as_ref().filter(|_| !a.no_compare) {
-        table.push(quality(format!("imported: {}", super::render::file_name(&a.bvh)), t, &mesh, &camera, trace));
+    if let Some((t, names)) = imported.as_ref().filter(|_| !a.no_compare) {
+        table.push(quality(names.label(), t, &mesh, &camera, trace));
+        // bvhscope's trees in the imported one's layout.
+        let layout = t.params().layout;
         for s in SplitStrategy::ALL {
-            let b = Bvh::build(&mesh, &BuildParams { strategy: s, layout: Layout::Binary, ..BuildParams::default() });
-            table.push(quality(s.label().to_string(), &b, &mesh, &camera, trace));
+            let b = AnyBvh::build(&mesh, &BuildParams { strategy: s, layout, ..BuildParams::default() });
+            table.push(quality(format!("{}, {}", s.label(), layout.name()), &b, &mesh, &camera, trace));
         }
     }
     let mut o = String::new();
@@ -134,34 +141,30 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality]) -> Stri
         for q in table {
             let _ = writeln!(
                 o,
-                "{:<w$} {:>8} {:>6} {:>9.2} {:>7.3} {:>12.2} {:>15.2}",
-                q.name, q.nodes, q.max_depth, q.sah_cost, q.epo, q.nodes_per_ray, q.tri_tests_per_ray
+                "{:<w$} {:>8} {:>6} {:>9.2} {:>7} {:>12.2} {:>15.2}",
+                q.name,
+                q.nodes,
+                q.max_depth,
+                q.sah_cost,
+                q.epo.map_or("–".into(), |e| format!("{e:.3}")),
+                q.nodes_per_ray,
+                q.tri_tests_per_ray
             );
         }
     }
     o
 }
 
-/// A dump read and made into bvhscope's tree over the scene's mesh (its structure must be sound:
-/// `check` says what is wrong otherwise).
-pub(crate) fn import_dump(
-    scene: &crate::scene::Scene,
-    path: &std::path::Path,
-) -> Result<(crate::bvh::Bvh, Vec<u32>, std::sync::Arc<crate::mesh::Mesh>), CliError> {
-    let dump = crate::bvh::dump::BvhDump::read(path).map_err(|e| CliError::Usage(e.to_string()))?;
+/// A dump read and made into bvhscope's tree over the scene's mesh, as every command traces it
+/// (its structure must be sound: `check` says what is wrong otherwise).
+pub(crate) fn import_dump(scene: &crate::scene::Scene, path: &std::path::Path) -> Result<SceneBvh, CliError> {
+    let dump = BvhDump::read(path).map_err(|e| CliError::Usage(e.to_string()))?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
-    let params = crate::bvh::BuildParams { layout: crate::bvh::Layout::Binary, ..Default::default() };
-    let structure = crate::bvh::check::check_tree(&dump, &mesh, 1e-6 * mesh.bounds().extent().length().max(1.0));
-    if structure.iter().any(|f| f.defect && f.group == crate::bvh::check::Group::Structure) {
-        return Err(CliError::Usage(format!(
-            "{}: its structure has defects; run bvhscope check to see them",
-            path.display()
-        )));
-    }
-    let (bvh, ids) = dump
-        .to_bvh_with_ids(&mesh, params)
-        .ok_or_else(|| CliError::Usage(format!("{}: only binary trees are traced in this version", path.display())))?;
-    Ok((bvh, ids, mesh))
+    let structure = crate::bvh::check::check_tree(&dump, &mesh, crate::bvh::check::tolerance(&mesh));
+    let name = super::render::file_name(path);
+    let (bvh, imported) = crate::bvh::check::traceable(&structure, &dump, &mesh, name)
+        .map_err(|why| CliError::Usage(format!("{}: {why}; bvhscope check lists what is wrong", path.display())))?;
+    Ok(SceneBvh::imported(bvh, mesh, imported))
 }
 
 #[derive(Args, Debug)]

@@ -183,7 +183,7 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     }
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
-    let SceneBvh::Single { bvh, mesh } = build_scene(&scene, &a.build.scene_build(params))? else {
+    let SceneBvh::Single { bvh, mesh, .. } = build_scene(&scene, &a.build.scene_build(params))? else {
         unreachable!("one level was asked for")
     };
     let tree = bvh.binary_tree(&mesh);

@@ -136,27 +136,20 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let loaded = load_mesh(&a.mesh)?;
     let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
     let params = a.build.params(loaded.build.as_ref());
-    let bvh = build_scene(&loaded, &a.build.scene_build(params))?;
-    let imported = match &a.bvh {
-        Some(path) => Some(super::check::import_dump(&loaded, path)?),
-        None => None,
+    let bvh = match &a.bvh {
+        Some(path) => super::check::import_dump(&loaded, path)?,
+        None => build_scene(&loaded, &a.build.scene_build(params))?,
     };
     let count = a.view.is_heatmap() || a.counts.is_some();
     let settings = RenderSettings { trace: a.build.trace(), count, progressive: false };
     let total = camera.width as u64 * camera.height as u64;
     let control = WorkControl::new();
-    let frame = progress::with_bar("rendering", &control, || match &imported {
-        Some((t, _, mesh)) => {
-            render_progressive(t, &**mesh, &camera, &settings, &Default::default(), &control, |_, _| {})
-        }
-        None => render_progressive(&bvh, &bvh, &camera, &settings, &Default::default(), &control, |_, _| {}),
+    let frame = progress::with_bar("rendering", &control, || {
+        render_progressive(&bvh, &bvh, &camera, &settings, &Default::default(), &control, |_, _| {})
     })
     .map_err(|_| CliError::Usage("render cancelled".into()))?;
     // What A is called in captions: the build, or the imported file.
-    let label_a = match &a.bvh {
-        Some(p) => format!("imported: {}", file_name(p)),
-        None => bvh.build_params().label(),
-    };
+    let label_a = bvh.label();
     if let Some(path) = &a.counts {
         let text = frame.counts_csv().expect("the frame was counted and is complete");
         std::fs::write(path, text).map_err(|source| CliError::Write { path: path.clone(), source })?;

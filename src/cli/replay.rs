@@ -61,7 +61,7 @@ pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
     }
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
-    let SceneBvh::Single { bvh, mesh } = build_scene(&scene, &a.build.scene_build(params))? else {
+    let SceneBvh::Single { bvh, mesh, .. } = build_scene(&scene, &a.build.scene_build(params))? else {
         unreachable!("one level was asked for")
     };
     if params.layout != Layout::Binary {

@@ -75,7 +75,7 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
         .map(|(camera, summary)| serde_json::json!({ "camera": camera, "trace": a.build.trace(), "summary": summary }));
     let rays_text = rays.map_or(String::new(), |(camera, r)| format_rays(&camera, &a.build.trace(), &r));
     match (&bvh, a.format) {
-        (SceneBvh::Single { bvh: b, mesh }, format) => {
+        (SceneBvh::Single { bvh: b, mesh, .. }, format) => {
             let epo = progress::with_spinner("measuring the end-point overlap", || epo::of(&b.binary_tree(mesh)));
             let stats = TreeStats { epo: Some(epo), ..TreeStats::of(b) };
             if let StatsFormat::Json = format {

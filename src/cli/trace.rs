@@ -4,7 +4,7 @@
 
 use super::args::{build_flags, shell_word, BuildArgs, ViewArgs};
 use super::{build_scene, load_mesh, CliError};
-use crate::bvh::{trace_ray, RayCounters, SceneBuild, StepKind, TraceLevel, TraceOptions};
+use crate::bvh::{trace_ray, RayCounters, SceneBuild, SceneBvh, StepKind, TraceLevel, TraceOptions};
 use crate::geometry::Ray;
 use clap::{Args, ValueEnum};
 use glam::Vec3;
@@ -93,11 +93,10 @@ pub fn run(a: &TraceArgs) -> Result<(), CliError> {
 pub fn output(a: &TraceArgs) -> Result<String, CliError> {
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
-    let imported = match &a.bvh {
-        Some(path) => Some(super::check::import_dump(&scene, path)?),
-        None => None,
+    let bvh = match &a.bvh {
+        Some(path) => super::check::import_dump(&scene, path)?,
+        None => build_scene(&scene, &a.build.scene_build(params))?,
     };
-    let bvh = build_scene(&scene, &a.build.scene_build(params))?;
     let (ray, source) = match (a.pixel, a.ray) {
         (_, Some((o, d))) => (Ray::new(o, d), serde_json::json!({ "typed": true })),
         (Some((x, y)), None) => {
@@ -113,22 +112,15 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
         (None, None) => unreachable!("clap requires --pixel or --ray"),
     };
     let opts = a.build.trace();
-    let (mut hit, mut trace) = match &imported {
-        Some((t, _, _)) => trace_ray(t, &ray, opts),
-        None => trace_ray(&bvh, &ray, opts),
-    };
+    let (mut hit, mut trace) = trace_ray(&bvh, &ray, opts);
     // An imported tree's nodes by the dump's ids, its triangles by the file's numbers.
-    if let Some((_, ids, mesh)) = &imported {
-        let node = |i: u32| ids.get(i as usize).copied().unwrap_or(i);
-        trace.steps = trace.steps.iter().map(|s| s.renamed(node, |t| mesh.file_number(t))).collect();
+    if let (SceneBvh::Single { mesh, imported: Some(names), .. }, true) = (&bvh, a.bvh.is_some()) {
+        trace.steps = trace.steps.iter().map(|s| names.rename(s, mesh)).collect();
         if let Some(h) = &mut hit {
             h.prim = mesh.file_number(h.prim);
         }
     }
-    let build_label = match &a.bvh {
-        Some(p) => format!("imported: {}", p.display()),
-        None => bvh.build_params().label(),
-    };
+    let build_label = bvh.label();
     let counts = trace.counts();
     let mut o = String::new();
     match a.format {

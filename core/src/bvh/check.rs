@@ -5,7 +5,8 @@
 //! by bvhscope's own traversal against the linear scan).
 
 use super::dump::BvhDump;
-use super::{Accelerator, BuildParams, Bvh, Hit, LinearScan, NoStats, TraceOptions};
+use super::imported::Imported;
+use super::{Accelerator, AnyBvh, BuildParams, Bvh, Hit, LinearScan, NoStats, TraceOptions};
 use crate::geometry::{Aabb, Ray};
 use crate::mesh::Mesh;
 use glam::Vec3;
@@ -256,7 +257,12 @@ pub struct WrongRay {
 
 /// Trace `rays` (with their pixels, if from a frame) through `bvh` and the linear scan; the ones
 /// whose hits differ (a different distance; a different triangle only at a different distance).
-pub fn wrong_rays(bvh: &Bvh, mesh: &Mesh, rays: &[(Ray, Option<(u32, u32)>)], opts: TraceOptions) -> Vec<WrongRay> {
+pub fn wrong_rays(
+    bvh: &(impl Accelerator + Sync),
+    mesh: &Mesh,
+    rays: &[(Ray, Option<(u32, u32)>)],
+    opts: TraceOptions,
+) -> Vec<WrongRay> {
     // The linear scan's hits. Past a few thousand triangles they are found through bvhscope's own
     // SAH tree instead, which returns the linear scan's hit for every ray (tests/correctness.rs,
     // tests/watertight_traversal.rs): a million rays over a million triangles one by one would
@@ -313,28 +319,46 @@ pub fn check_rays(mesh: &Mesh, camera: &crate::render::Camera, n: usize) -> Vec<
     out
 }
 
-/// Findings of every group for `dump` over `mesh`: the tree's, then, when its structure is sound
-/// and it is binary, the rays'. Returns the findings and the imported tree (when it could be made).
+/// How far a dump's boxes may miss their triangles over `mesh` (a dump printed with six decimals
+/// rounds its boxes by half a millionth of the mesh's size).
+pub fn tolerance(mesh: &Mesh) -> f32 {
+    1e-6 * mesh.bounds().extent().length().max(1.0)
+}
+
+/// The tree of `dump` as bvhscope traces it (`imported::import`), when its structure is sound and
+/// it can be traced; otherwise why not.
+pub fn traceable(
+    findings: &[Finding],
+    dump: &BvhDump,
+    mesh: &Mesh,
+    name: String,
+) -> Result<(AnyBvh, Imported), String> {
+    if findings.iter().any(|f| f.group == Group::Structure && f.defect) {
+        return Err("its structure has defects".into());
+    }
+    super::imported::import(dump, mesh, name)
+}
+
+/// Findings of every group for `dump` (named `name`) over `mesh`: the tree's, then, when its
+/// structure is sound, the rays'. Returns the findings and the imported tree (when it could be made).
 pub fn check(
     dump: &BvhDump,
+    name: String,
     mesh: &Mesh,
     camera: &crate::render::Camera,
     rays: usize,
     opts: TraceOptions,
-) -> (Vec<Finding>, Option<Bvh>) {
-    let tolerance = 1e-6 * mesh.bounds().extent().length().max(1.0);
-    let mut out = check_tree(dump, mesh, tolerance);
+) -> (Vec<Finding>, Option<(AnyBvh, Imported)>) {
+    let mut out = check_tree(dump, mesh, tolerance(mesh));
     if out.iter().any(|f| f.group == Group::Structure && f.defect) {
         return (out, None);
     }
-    let Some(bvh) = dump.to_bvh(mesh, BuildParams { layout: super::Layout::Binary, ..BuildParams::default() }) else {
-        out.push(warning(
-            Group::Rays,
-            None,
-            None,
-            "rays not traced: only binary trees (2 children per node) are traced in this version".into(),
-        ));
-        return (out, None);
+    let (bvh, imported) = match super::imported::import(dump, mesh, name) {
+        Ok(b) => b,
+        Err(why) => {
+            out.push(warning(Group::Rays, None, None, format!("rays not traced: {why}")));
+            return (out, None);
+        }
     };
     let all = check_rays(mesh, camera, rays);
     let wrong = wrong_rays(&bvh, mesh, &all, opts);
@@ -357,7 +381,7 @@ pub fn check(
             wrong.len(), all.len(), show(w.want), show(w.got)
         )));
     }
-    (out, Some(bvh))
+    (out, Some((bvh, imported)))
 }
 
 #[cfg(test)]
@@ -410,19 +434,26 @@ mod tests {
         crate::render::Camera::framing_up(&mesh.bounds(), 32, 24, crate::render::UpAxis::Y, 45.0)
     }
 
+    /// The findings and the traced tree of `d` over `mesh`, with `n` random rays.
+    fn run(d: &BvhDump, mesh: &Mesh, n: usize) -> (Vec<Finding>, Option<AnyBvh>) {
+        let (f, t) = check(d, "test.json".into(), mesh, &camera(mesh), n, TraceOptions::default());
+        (f, t.map(|(b, _)| b))
+    }
+
     #[test]
     fn a_correct_shuffled_dump_has_no_defect_and_traces_like_the_linear_scan() {
         let mesh = row();
-        let (f, bvh) = check(&good(), &mesh, &camera(&mesh), 2000, TraceOptions::default());
+        let (f, bvh) = run(&good(), &mesh, 2000);
         assert!(f.iter().all(|f| !f.defect), "{f:?}");
         assert_eq!(f.iter().filter(|f| f.node == Some(2)).count(), 1, "node 2 is never reached: a warning");
-        assert_eq!(bvh.unwrap().nodes.len(), 3);
+        let Some(AnyBvh::Binary(bvh)) = bvh else { panic!("a binary tree") };
+        assert_eq!(bvh.nodes.len(), 3);
     }
 
     #[test]
     fn each_defect_names_its_node_or_triangle() {
         let mesh = row();
-        let find = |d: &BvhDump| check(d, &mesh, &camera(&mesh), 500, TraceOptions::default()).0;
+        let find = |d: &BvhDump| run(d, &mesh, 500).0;
         let has = |f: &[Finding], group: Group, node: Option<u32>, tri: Option<u32>, words: &str| {
             f.iter()
                 .any(|x| x.defect && x.group == group && x.node == node && x.triangle == tri && x.text.contains(words))
@@ -490,9 +521,9 @@ mod tests {
         std::fs::write(&text_path, dump.to_text()).unwrap();
         let text = BvhDump::read(&text_path).unwrap();
         for back in [json, text] {
-            let (f, imported) = check(&back, &mesh, &camera(&mesh), 2000, TraceOptions::default());
+            let (f, imported) = run(&back, &mesh, 2000);
             assert!(f.iter().all(|f| !f.defect), "{f:?}");
-            let imported = imported.unwrap();
+            let Some(AnyBvh::Binary(imported)) = imported else { panic!("a binary tree") };
             assert_eq!(imported.nodes.len(), bvh.nodes.len());
             let (a, b) = (crate::bvh::TreeStats::of(&bvh).sah_cost, crate::bvh::TreeStats::of(&imported).sah_cost);
             assert!((a - b).abs() <= 1e-9 * a, "{a} vs {b}");
@@ -506,7 +537,7 @@ mod tests {
     }
 
     /// A triangle in two leaves (as spatial splits make) is fine, and traced in both; a 4-wide
-    /// tree is checked for structure, coverage and bounds (and said not traced).
+    /// tree is checked for structure, coverage and bounds, and traced.
     #[test]
     fn duplicated_references_and_four_wide_trees() {
         let mesh = row();
@@ -516,9 +547,10 @@ mod tests {
         d.nodes[1].first = Some(2);
         d.nodes[1].count = Some(3);
         d.nodes[1].min[0] = 1.0;
-        let (f, bvh) = check(&d, &mesh, &camera(&mesh), 2000, TraceOptions::default());
+        let (f, bvh) = run(&d, &mesh, 2000);
         assert!(f.iter().all(|f| !f.defect), "{f:?}");
-        assert_eq!(bvh.unwrap().prim_ids.len(), 5, "triangle 1 twice");
+        let Some(AnyBvh::Binary(bvh)) = bvh else { panic!("a binary tree") };
+        assert_eq!(bvh.prim_ids.len(), 5, "triangle 1 twice");
         // Four leaves under one root: 4-wide.
         let leaf = |k: u32| {
             let mut n = node([k as f32, 0.0, 0.0], [k as f32 + 1.0, 1.0, 0.0]);
@@ -534,16 +566,19 @@ mod tests {
             primitives: vec![0, 1, 2, 3],
             nodes: vec![root, leaf(0), leaf(1), leaf(2), leaf(3)],
         };
-        let (f, bvh) = check(&wide, &mesh, &camera(&mesh), 100, TraceOptions::default());
-        assert!(f.iter().all(|f| !f.defect) && bvh.is_none(), "{f:?}");
-        assert!(f.iter().any(|f| f.group == Group::Rays && f.text.contains("only binary trees")));
+        let (f, bvh) = run(&wide, &mesh, 100);
+        assert!(f.iter().all(|f| !f.defect), "{f:?}");
+        let Some(AnyBvh::Wide(w)) = bvh else { panic!("a 4-wide tree") };
+        assert_eq!((w.nodes.len(), w.nodes[0].valid), (1, 0b1111), "one wide node of four leaves");
         let mut broken = wide.clone();
         broken.nodes[3].max[0] = 2.5;
-        let (f, _) = check(&broken, &mesh, &camera(&mesh), 100, TraceOptions::default());
+        let (f, _) = run(&broken, &mesh, 100);
         assert!(
             f.iter().any(|f| f.defect && f.group == Group::Bounds && f.node == Some(3) && f.triangle == Some(2)),
             "{f:?}"
         );
+        // The box too small misses rays through the 4-wide traversal too, named by a pixel.
+        assert!(f.iter().any(|f| f.defect && f.group == Group::Rays && f.text.contains("pixel")), "{f:?}");
     }
 
     /// bvhscope's 4-wide tree written as a dump checks clean: every node of 2 to 4 children, every

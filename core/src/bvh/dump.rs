@@ -13,7 +13,7 @@
 //!   `node MINX MINY MINZ MAXX MAXY MAXZ children C1 C2 [C3 C4] [axis A]` or
 //!   `node MINX MINY MINZ MAXX MAXY MAXZ leaf FIRST COUNT`; `#` starts a comment.
 
-use super::{Bvh, BvhNode};
+use super::Bvh;
 use crate::geometry::Aabb;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -291,69 +291,5 @@ impl BvhDump {
             .collect();
         nodes.extend(leaves);
         BvhDump { format: FORMAT.into(), version: VERSION, mesh: name, primitives, nodes }
-    }
-
-    /// bvhscope's binary tree of a structurally sound binary dump (`check` finds no structure
-    /// defect): nodes renumbered depth first so each node's two children are adjacent, leaves'
-    /// triangles copied into leaf order (a triangle in two leaves is there twice; primitives are
-    /// file numbers, `Mesh::triangles_by_file_number`); the boxes are
-    /// kept as written, so a wrong box misses rays as it would in the student's renderer. `None`
-    /// for a tree with more than two children somewhere or a leaf of more than 65,535 triangles.
-    pub fn to_bvh(&self, mesh: &crate::mesh::Mesh, params: super::BuildParams) -> Option<Bvh> {
-        self.to_bvh_with_ids(mesh, params).map(|(b, _)| b)
-    }
-
-    /// `to_bvh`, and for each of its nodes the dump's id of that node (to name nodes as the
-    /// student's program does).
-    pub fn to_bvh_with_ids(&self, mesh: &crate::mesh::Mesh, params: super::BuildParams) -> Option<(Bvh, Vec<u32>)> {
-        let by_file = mesh.triangles_by_file_number();
-        let mut ids = vec![0u32];
-        let mut nodes = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
-        let (mut prim_ids, mut tris) = (Vec::new(), Vec::new());
-        // (dump node, its slot in `nodes`)
-        let mut stack = vec![(0usize, 0usize)];
-        while let Some((d, slot)) = stack.pop() {
-            // A cycle would never end (the checker reports it; here it only stops the copy).
-            if nodes.len() > 2 * self.nodes.len() + 2 {
-                return None;
-            }
-            let n = self.nodes.get(d)?;
-            match &n.children {
-                Some(kids) if kids.len() == 2 => {
-                    let first = nodes.len();
-                    nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
-                    nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
-                    ids.extend([kids[0], kids[1]]);
-                    nodes[slot] = BvhNode::interior(n.bounds(), first as u32, n.axis.unwrap_or(0).min(2));
-                    stack.push((kids[1] as usize, first + 1));
-                    stack.push((kids[0] as usize, first));
-                }
-                Some(_) => return None,
-                None => {
-                    let (f, c) = (n.first? as usize, n.count? as usize);
-                    if c > u16::MAX as usize || f + c > self.primitives.len() {
-                        return None;
-                    }
-                    if c == 0 {
-                        continue; // an empty leaf: its empty box is never entered
-                    }
-                    let start = prim_ids.len() as u32;
-                    for &p in &self.primitives[f..f + c] {
-                        // A zero-area triangle the loader dropped cannot be hit: left out.
-                        if let Some(t) = *by_file.get(p as usize)? {
-                            prim_ids.push(t);
-                            tris.push(mesh.triangle(t));
-                        }
-                    }
-                    let kept = prim_ids.len() as u32 - start;
-                    nodes[slot] = if kept == 0 {
-                        BvhNode::leaf(Aabb::EMPTY, 0, 0)
-                    } else {
-                        BvhNode::leaf(n.bounds(), start, kept as u16)
-                    };
-                }
-            }
-        }
-        Some((Bvh { nodes, prim_ids, tris, params, report: Default::default() }, ids))
     }
 }

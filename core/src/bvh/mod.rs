@@ -9,6 +9,7 @@ pub mod check;
 mod counters;
 pub mod dump;
 pub mod epo;
+pub mod imported;
 pub mod inspect;
 mod linear;
 mod node;

@@ -3,6 +3,7 @@
 //! shades its own hits (`Surface`). Both give the same triangle ids (a two-level hit's id is the
 //! one the flattened scene gives the same triangle).
 
+use super::imported::Imported;
 use super::tree::TreeView;
 use super::{Accelerator, AnyBvh, BuildParams, Hit, TraceOptions, TraversalStats, TwoLevelBvh};
 use crate::geometry::{Ray, TriangleHit, TriangleIntersector};
@@ -34,14 +35,44 @@ impl SceneBuild {
 
 #[derive(Clone, Debug)]
 pub enum SceneBvh {
-    Single { bvh: AnyBvh, mesh: Arc<Mesh> },
-    TwoLevel { bvh: TwoLevelBvh, meshes: Vec<Arc<Mesh>> },
+    /// `imported`: the tree was read from a dump (`bvh::imported`), not built.
+    Single {
+        bvh: AnyBvh,
+        mesh: Arc<Mesh>,
+        imported: Option<Arc<Imported>>,
+    },
+    TwoLevel {
+        bvh: TwoLevelBvh,
+        meshes: Vec<Arc<Mesh>>,
+    },
 }
 
 impl SceneBvh {
     /// One BVH over `mesh`.
     pub fn build_single(mesh: Arc<Mesh>, params: &BuildParams, control: &WorkControl) -> Result<SceneBvh, Cancelled> {
-        Ok(SceneBvh::Single { bvh: AnyBvh::build_controlled(&mesh, params, control)?, mesh })
+        Ok(SceneBvh::Single { bvh: AnyBvh::build_controlled(&mesh, params, control)?, mesh, imported: None })
+    }
+
+    /// A tree imported from a dump over `mesh` (`bvh::imported::import`).
+    pub fn imported(bvh: AnyBvh, mesh: Arc<Mesh>, imported: Imported) -> SceneBvh {
+        SceneBvh::Single { bvh, mesh, imported: Some(Arc::new(imported)) }
+    }
+
+    /// Where the tree came from when it was imported, not built.
+    pub fn import(&self) -> Option<&Imported> {
+        match self {
+            SceneBvh::Single { imported, .. } => imported.as_deref(),
+            SceneBvh::TwoLevel { .. } => None,
+        }
+    }
+
+    /// How captions, tables and the strategy list name the tree: "SAH binned, wide4" (the build's
+    /// label) or "imported: FILE, binary".
+    pub fn label(&self) -> String {
+        match self.import() {
+            Some(i) => format!("{}, {}", i.label(), self.build_params().bvh.layout.name()),
+            None => self.build_params().label(),
+        }
     }
 
     /// Two levels: a BVH per mesh of `meshes` with `bottom`, and the top level over `placements`

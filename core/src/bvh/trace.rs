@@ -78,12 +78,9 @@ pub struct Step {
 
 impl Step {
     /// The same step with nodes and triangles named otherwise (an imported tree's own node ids,
-    /// the file's triangle numbers): `node` maps a `NodeId::Node` id, `triangle` a triangle id.
-    pub fn renamed(&self, node: impl Fn(u32) -> u32, triangle: impl Fn(u32) -> u32) -> Step {
-        let n = |id: NodeId| match id {
-            NodeId::Node(i) => NodeId::Node(node(i)),
-            other => other,
-        };
+    /// the file's triangle numbers): `node` maps a node, `triangle` a triangle id.
+    pub fn renamed(&self, node: impl Fn(NodeId) -> NodeId, triangle: impl Fn(u32) -> u32) -> Step {
+        let n = &node;
         let st = |v: &[(NodeId, f32)]| v.iter().map(|&(id, t)| (n(id), t)).collect::<Vec<_>>();
         let kind = match &self.kind {
             StepKind::BoxTest { node, depth, hit, t_entry, t_exit } => {

@@ -53,7 +53,7 @@ impl WideNode {
     pub const EMPTY: WideNode =
         WideNode { boxes: Boxes4::EMPTY, child: [u32::MAX; WIDTH], count: [0; WIDTH], valid: 0, _pad: [0; 11] };
 
-    fn set(&mut self, slot: usize, b: Aabb, child: u32, count: u8) {
+    pub(crate) fn set(&mut self, slot: usize, b: Aabb, child: u32, count: u8) {
         let (lo, hi) = b.planes();
         self.boxes.set(slot, lo, hi);
         self.child[slot] = child;

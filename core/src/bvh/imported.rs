@@ -1,0 +1,257 @@
+//! A BVH another program wrote (`dump`), made into one of bvhscope's own layouts so that every
+//! view and command traces it with the same traversal as the built-in strategies: a binary dump
+//! becomes a `Bvh`, a dump with nodes of 3 or 4 children a `WideBvh` (each dump node one wide node,
+//! its children in the order written). Boxes are kept as written, so a wrong box misses rays as it
+//! would in the student's renderer; nodes are renumbered, and `Imported` keeps the dump's id of
+//! each so that traces and the tree view name nodes as the student's program does.
+
+use super::dump::BvhDump;
+use super::wide::{WideNode, WIDTH};
+use super::{AnyBvh, BuildParams, Bvh, BvhNode, Layout, NodeId, WideBvh};
+use crate::geometry::Aabb;
+use crate::mesh::Mesh;
+
+/// What tells an imported tree from a built one: its file, and the dump's id of each node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Imported {
+    /// The dump's file name, for captions ("imported: FILE").
+    pub name: String,
+    /// For each node of the traced tree (binary node i, or wide node i), the dump's id.
+    pub node_ids: Vec<u32>,
+    /// Wide layout: the dump's id of the leaf in slot s of wide node i, at `WIDTH·i + s`
+    /// (`u32::MAX` where the slot holds no leaf). Empty for the binary layout.
+    pub leaf_ids: Vec<u32>,
+}
+
+impl Imported {
+    /// "imported: FILE", as the strategy list, captions and tables name the tree.
+    pub fn label(&self) -> String {
+        format!("imported: {}", self.name)
+    }
+
+    /// A node as a trace names it, by the dump's id.
+    pub fn dump_id(&self, id: NodeId) -> Option<u32> {
+        match id {
+            NodeId::Node(i) => self.node_ids.get(i as usize).copied(),
+            NodeId::Leaf { node, slot } => {
+                self.leaf_ids.get(node as usize * WIDTH + slot as usize).copied().filter(|&d| d != u32::MAX)
+            }
+        }
+    }
+
+    /// The traced tree's node that is the dump's node `dump` (`None` for one not reached from the
+    /// root, or an empty leaf, which the traced tree leaves out).
+    pub fn node_of_dump(&self, dump: u32) -> Option<NodeId> {
+        if let Some(i) = self.node_ids.iter().position(|&d| d == dump) {
+            return Some(NodeId::Node(i as u32));
+        }
+        let k = self.leaf_ids.iter().position(|&d| d == dump)?;
+        Some(NodeId::Leaf { node: (k / WIDTH) as u32, slot: (k % WIDTH) as u8 })
+    }
+
+    /// A trace step with nodes named by the dump's ids and triangles by their numbers in the file.
+    pub fn rename(&self, step: &super::Step, mesh: &Mesh) -> super::Step {
+        step.renamed(|id| self.dump_id(id).map_or(id, NodeId::Node), |t| mesh.file_number(t))
+    }
+}
+
+/// Why a dump cannot be traced.
+pub fn untraceable(dump: &BvhDump) -> Option<String> {
+    let kids = dump.nodes.iter().filter_map(|n| n.children.as_ref().map(|k| k.len()));
+    let widest = kids.clone().max().unwrap_or(2);
+    let binary = widest == 2;
+    let (most, cap) = if binary { (u16::MAX as u32, "65,535") } else { (u8::MAX as u32, "255") };
+    if widest > WIDTH || kids.clone().any(|k| k < 2) {
+        return Some("its nodes have fewer than 2 or more than 4 children".into());
+    }
+    let big = dump.nodes.iter().filter(|n| n.children.is_none()).filter_map(|n| n.count).max().unwrap_or(0);
+    (big > most).then(|| {
+        format!(
+            "a leaf holds {big} triangles; a {} tree's leaves hold at most {cap}",
+            if binary { "binary" } else { "4-wide" }
+        )
+    })
+}
+
+/// The dump as bvhscope traces it: binary when every interior node has two children, 4-wide
+/// otherwise. The dump's structure must be sound (`check::check_tree` finds no structure defect);
+/// `Err` says why a tree cannot be traced when it cannot.
+pub fn import(dump: &BvhDump, mesh: &Mesh, name: String) -> Result<(AnyBvh, Imported), String> {
+    if let Some(why) = untraceable(dump) {
+        return Err(why);
+    }
+    let binary = dump.nodes.iter().all(|n| n.children.as_ref().is_none_or(|k| k.len() == 2));
+    let copy = Leaves { dump, by_file: mesh.triangles_by_file_number(), mesh, prim_ids: Vec::new(), tris: Vec::new() };
+    let broken = || "its structure has defects (bvhscope check lists them)".to_string();
+    if binary {
+        let (bvh, ids) = to_binary(copy).ok_or_else(broken)?;
+        Ok((AnyBvh::Binary(bvh), Imported { name, node_ids: ids, leaf_ids: Vec::new() }))
+    } else {
+        let (wide, node_ids, leaf_ids) = to_wide(copy).ok_or_else(broken)?;
+        Ok((AnyBvh::Wide(wide), Imported { name, node_ids, leaf_ids }))
+    }
+}
+
+/// The leaves' triangles copied into leaf order as they are reached (a triangle in two leaves is
+/// there twice; primitives are file numbers, `Mesh::triangles_by_file_number`).
+struct Leaves<'a> {
+    dump: &'a BvhDump,
+    by_file: Vec<Option<u32>>,
+    mesh: &'a Mesh,
+    prim_ids: Vec<u32>,
+    tris: Vec<[glam::Vec3; 3]>,
+}
+
+impl Leaves<'_> {
+    /// Copy dump node `d`'s triangles: (first in leaf order, how many). A zero-area triangle the
+    /// loader dropped cannot be hit and is left out.
+    fn copy(&mut self, d: usize) -> Option<(u32, u32)> {
+        let n = self.dump.nodes.get(d)?;
+        let (f, c) = (n.first? as usize, n.count? as usize);
+        let start = self.prim_ids.len() as u32;
+        for &p in self.dump.primitives.get(f..f + c)? {
+            if let Some(t) = *self.by_file.get(p as usize)? {
+                self.prim_ids.push(t);
+                self.tris.push(self.mesh.triangle(t));
+            }
+        }
+        Some((start, self.prim_ids.len() as u32 - start))
+    }
+
+    fn params(layout: Layout) -> BuildParams {
+        BuildParams { layout, ..BuildParams::default() }
+    }
+}
+
+/// Nodes renumbered depth first so each node's two children are adjacent.
+fn to_binary(mut leaves: Leaves) -> Option<(Bvh, Vec<u32>)> {
+    let dump = leaves.dump;
+    let mut ids = vec![0u32];
+    let mut nodes = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
+    // (dump node, its slot in `nodes`)
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((d, slot)) = stack.pop() {
+        // A cycle would never end (the checker reports it; here it only stops the copy).
+        if nodes.len() > 2 * dump.nodes.len() + 2 {
+            return None;
+        }
+        let n = dump.nodes.get(d)?;
+        match &n.children {
+            Some(kids) => {
+                let first = nodes.len();
+                nodes.extend([BvhNode::leaf(Aabb::EMPTY, 0, 0); 2]);
+                ids.extend([kids[0], kids[1]]);
+                nodes[slot] = BvhNode::interior(n.bounds(), first as u32, n.axis.unwrap_or(0).min(2));
+                stack.push((kids[1] as usize, first + 1));
+                stack.push((kids[0] as usize, first));
+            }
+            None => {
+                // An empty leaf's empty box is never entered.
+                let (start, kept) = leaves.copy(d)?;
+                if kept > 0 {
+                    nodes[slot] = BvhNode::leaf(n.bounds(), start, kept as u16);
+                }
+            }
+        }
+    }
+    let params = Leaves::params(Layout::Binary);
+    Some((Bvh { nodes, prim_ids: leaves.prim_ids, tris: leaves.tris, params, report: Default::default() }, ids))
+}
+
+/// Each interior dump node one wide node (numbered depth first), each leaf a slot of its parent.
+fn to_wide(mut leaves: Leaves) -> Option<(WideBvh, Vec<u32>, Vec<u32>)> {
+    let dump = leaves.dump;
+    let root = dump.nodes.first()?;
+    let mut nodes = vec![WideNode::EMPTY];
+    let mut ids = vec![0u32];
+    let mut leaf_ids = vec![u32::MAX; WIDTH];
+    // A tree of one leaf: the root wide node holds it in slot 0.
+    if root.children.is_none() {
+        let (start, kept) = leaves.copy(0)?;
+        if kept > 0 {
+            nodes[0].set(0, root.bounds(), start, kept as u8);
+            leaf_ids[0] = 0;
+        }
+    }
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((d, w)) = stack.pop() {
+        if nodes.len() > dump.nodes.len() + 1 {
+            return None; // a cycle (see `to_binary`)
+        }
+        for (s, &k) in dump.nodes.get(d)?.children.iter().flatten().enumerate() {
+            let c = dump.nodes.get(k as usize)?;
+            if c.children.is_some() {
+                let index = nodes.len();
+                nodes.push(WideNode::EMPTY);
+                ids.push(k);
+                leaf_ids.extend([u32::MAX; WIDTH]);
+                nodes[w].set(s, c.bounds(), index as u32, 0);
+                stack.push((k as usize, index));
+            } else {
+                let (start, kept) = leaves.copy(k as usize)?;
+                if kept > 0 {
+                    nodes[w].set(s, c.bounds(), start, kept as u8);
+                    leaf_ids[w * WIDTH + s] = k;
+                }
+            }
+        }
+    }
+    let (prim_ids, tris) = (leaves.prim_ids, leaves.tris);
+    let params = Leaves::params(Layout::Wide4);
+    let wide = WideBvh { nodes, prim_ids, tris, root_bounds: root.bounds(), params, report: Default::default() };
+    Some((wide, ids, leaf_ids))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::{check::check_rays, Accelerator, RayCounters, TraceOptions, TreeStats, TreeView};
+    use crate::mesh::generate;
+
+    /// bvhscope's own trees, exported and imported again, trace every ray as the trees they were
+    /// written from: the same hit and the same counts, binary and 4-wide alike; and each node's
+    /// dump id leads back to it.
+    #[test]
+    fn export_then_import_traces_as_the_original_in_both_layouts() {
+        let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);
+        let camera = crate::render::Camera::framing_up(&mesh.bounds(), 40, 30, crate::render::UpAxis::Y, 45.0);
+        let rays = check_rays(&mesh, &camera, 500);
+        for layout in [Layout::Binary, Layout::Wide4] {
+            let built = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::default() });
+            let dump = match &built {
+                AnyBvh::Binary(b) => BvhDump::of_bvh(b, &mesh, None),
+                AnyBvh::Wide(w) => BvhDump::of_wide(w, &mesh, None),
+            };
+            let (back, names) = import(&dump, &mesh, "t.json".into()).unwrap();
+            assert_eq!(back.params().layout, layout);
+            let (a, b) = (TreeStats::of(&built), TreeStats::of(&back));
+            assert_eq!((a.nodes, a.leaves), (b.nodes, b.leaves), "{layout:?}");
+            assert!((a.sah_cost - b.sah_cost).abs() <= 1e-9 * a.sah_cost, "{layout:?}: {a:?} vs {b:?}");
+            for (r, _) in &rays {
+                let (mut ca, mut cb) = (RayCounters::default(), RayCounters::default());
+                let ha = built.closest_hit(&mut r.clone(), TraceOptions::default(), &mut ca);
+                let hb = back.closest_hit(&mut r.clone(), TraceOptions::default(), &mut cb);
+                assert_eq!((ha, ca), (hb, cb), "{layout:?}");
+            }
+            for d in 0..dump.nodes.len() as u32 {
+                let id = names.node_of_dump(d).unwrap_or_else(|| panic!("{layout:?}: dump node {d} is traced"));
+                assert_eq!(names.dump_id(id), Some(d));
+            }
+        }
+    }
+
+    /// Nodes of 5 children, and leaves too large for the layout, are refused with the reason.
+    #[test]
+    fn untraceable_trees_say_why() {
+        let mesh = generate::torus_knot(2, 3, 0.3, 16, 4);
+        let b = Bvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..BuildParams::default() });
+        let mut d = BvhDump::of_bvh(&b, &mesh, None);
+        d.nodes[0].children.as_mut().unwrap().extend([1, 1, 1]);
+        assert!(import(&d, &mesh, "x".into()).unwrap_err().contains("more than 4 children"));
+        let mut d = BvhDump::of_bvh(&b, &mesh, None);
+        d.nodes[0].children.as_mut().unwrap().push(2);
+        let leaf = d.nodes.iter_mut().find(|n| n.children.is_none()).unwrap();
+        leaf.count = Some(300);
+        assert!(import(&d, &mesh, "x".into()).unwrap_err().contains("at most 255"));
+    }
+}
