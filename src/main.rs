@@ -6,7 +6,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(command) => run(command),
-        None => open_app(cli.file),
+        None => open_app(cli.file, cli.bvh),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -20,12 +20,12 @@ fn main() -> ExitCode {
 }
 
 #[cfg(feature = "gui")]
-fn open_app(file: Option<std::path::PathBuf>) -> Result<(), CliError> {
-    bvhscope::app::run(bvhscope::app::AppOptions { file }).map_err(CliError::Usage)
+fn open_app(file: Option<std::path::PathBuf>, bvh: Option<std::path::PathBuf>) -> Result<(), CliError> {
+    bvhscope::app::run(bvhscope::app::AppOptions { file, bvh }).map_err(CliError::Usage)
 }
 
 #[cfg(not(feature = "gui"))]
-fn open_app(_file: Option<std::path::PathBuf>) -> Result<(), CliError> {
+fn open_app(_file: Option<std::path::PathBuf>, _bvh: Option<std::path::PathBuf>) -> Result<(), CliError> {
     Err(CliError::Usage(
         "this build has no desktop app (built without the `gui` feature); use a subcommand, see --help".into(),
     ))

@@ -776,3 +776,23 @@ fn render_through_an_imported_tree() {
     let steps = v["steps"].to_string();
     assert!(steps.contains("\"step\":\"leaf\"") && !steps.contains("slot"), "leaves named as dump nodes: {steps}");
 }
+
+/// A reader that stops early (`bvhscope stats … | head -1`) closes the pipe: the program ends
+/// quietly with status 141, as a Unix tool killed by SIGPIPE, and never panics.
+#[test]
+fn a_closed_pipe_ends_the_output_without_a_panic() {
+    use std::io::Read;
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bvhscope"))
+        .args(["inspect", torus, "--node", "0", "--format", "json"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader is gone before the first byte
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(status.code(), Some(141), "{err}");
+}

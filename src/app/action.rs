@@ -29,6 +29,21 @@ pub enum Action {
     SaveScene,
     /// A file was chosen (dialog or typed path) for `Pick`.
     Picked(Pick, PathBuf),
+    /// File ▸ Open BVH…: a dump for the current mesh, by the dialog, a typed path, or a file.
+    OpenBvh,
+    OpenBvhPath,
+    ImportFile(PathBuf),
+    /// File ▸ Export BVH…: the current tree as a dump.
+    ExportBvh,
+    /// Show the imported tree (true) or the chosen strategy's build (false).
+    UseImported(bool),
+    /// The Imported BVH window (the checker's findings).
+    ShowImported(bool),
+    /// The red mask over the pixels whose hit through the imported tree is wrong.
+    WrongMask(bool),
+    /// Select a node or a triangle as the dump names them (a finding's).
+    SelectDumpNode(u32),
+    SelectTriangle(u32),
     /// The typed-path window's text changed.
     PathText(String),
     /// The typed-path window's field has taken the keyboard.

@@ -18,6 +18,7 @@ pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
     match ext {
         "png" => format!("bvhscope-{scene}-{strategy}-{}.png", app.settings.view.name()),
         "counts" => format!("bvhscope-{scene}-{strategy}-counts.csv"),
+        "bvh" => format!("{scene}-{strategy}-{}.json", app.settings.build.layout.name()),
         _ => format!("bvhscope-{scene}-stats.{ext}"),
     }
 }
@@ -137,6 +138,21 @@ pub fn save_counts(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
     let shown = app.shown.as_ref().ok_or("nothing rendered yet")?;
     let text = shown.frame.counts_csv().ok_or("the frame is still refining; export once it is complete")?;
     std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+/// The current single BVH as a bvhscope-bvh dump (`bvhscope export-bvh` writes the same), JSON or
+/// the text form by the file's extension.
+pub fn save_bvh(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
+    let built = app.current_bvh().ok_or("no BVH is built yet")?;
+    let crate::bvh::SceneBvh::Single { bvh, mesh, .. } = &*built.bvh else {
+        return Err("a two-level BVH is not written as one dump: turn two levels off in the Build panel".into());
+    };
+    let name = match &app.scene.source {
+        crate::scene::SceneSource::File(p) => p.file_name().map(|n| n.to_string_lossy().into_owned()),
+        crate::scene::SceneSource::Builtin => None,
+    };
+    let dump = crate::bvh::dump::BvhDump::of_any(bvh, mesh, name);
+    dump.write(path).map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
 pub fn save_stats(app: &BvhscopeApp, path: &Path, format: StatsFormat) -> Result<(), String> {

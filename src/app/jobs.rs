@@ -3,6 +3,7 @@
 //! running one of that kind, and results of superseded jobs are dropped by id.
 
 use super::compare_view::CompareB;
+use super::import_view::{ImportedTree, WrongPixels, CHECK_RAYS};
 use super::node_view::{Explained, FrameVisits};
 use crate::bvh::inspect::Inspection;
 use crate::bvh::replay::PartialBvh;
@@ -80,6 +81,10 @@ pub enum Pick {
     SaveStatsJson,
     SaveScene,
     SaveCounts,
+    /// A BVH dump to import for the current mesh.
+    OpenBvh,
+    /// Where to write the current tree as a dump.
+    SaveBvh,
 }
 
 pub enum JobEvent {
@@ -99,6 +104,10 @@ pub enum JobEvent {
         result: Result<Arc<SceneBvh>, SceneBuildError>,
     },
     Pass(PassOutput),
+    /// A dump read and checked for scene `scene_id`.
+    Imported(Box<ImportedTree>),
+    /// A frame's pixels whose hit through the imported tree is wrong.
+    Wrong(WrongPixels),
     Picked {
         pick: Pick,
         path: Option<PathBuf>,
@@ -129,6 +138,9 @@ pub struct Jobs {
     pub inspect: Option<(Running, u32)>,
     /// B of the side-by-side view: built if needed, then traced on A's camera.
     pub compare: Option<Running>,
+    /// Reading and checking a dump; finding the frame's wrong pixels of an imported tree.
+    pub import: Option<Running>,
+    pub wrong: Option<Running>,
     /// What the last compare job was asked for.
     pub last_compare: Option<(SceneBuild, u64, Camera, TraceOptions)>,
     pub picking: Option<Pick>,
@@ -155,6 +167,8 @@ impl Jobs {
             visits: None,
             inspect: None,
             compare: None,
+            import: None,
+            wrong: None,
             last_compare: None,
             picking: None,
             last_render: None,
@@ -258,8 +272,8 @@ impl Jobs {
         let job = self.start("Preparing the tree view".to_string());
         let send = self.sender(job.id);
         std::thread::spawn(move || {
-            if let SceneBvh::Single { bvh: any, mesh, .. } = &*bvh {
-                let tree = Arc::new(any.binary_tree(mesh).into_owned());
+            if let Some(tree) = bvh.binary_tree() {
+                let tree = Arc::new(tree.into_owned());
                 send(JobEvent::Explained(Arc::new(Explained::new(bvh.clone(), tree))));
             }
         });
@@ -320,6 +334,33 @@ impl Jobs {
         self.visits = Some(job);
     }
 
+    /// Read the dump at `path` for `scene`'s mesh and check it as `bvhscope check` does, with
+    /// `CHECK_RAYS` random rays and `camera`'s primary rays.
+    pub fn import(&mut self, path: PathBuf, scene: Arc<Scene>, scene_id: u64, camera: Camera, trace: TraceOptions) {
+        let job = self.start(format!("Checking {}", path.display()));
+        let send = self.sender(job.id);
+        std::thread::spawn(move || {
+            let tree = import_tree(path, &scene, scene_id, &camera, trace);
+            send(JobEvent::Imported(Box::new(tree)));
+        });
+        self.import = Some(job);
+    }
+
+    /// The pixels of `camera`'s frame whose hit through `bvh` (an imported tree) differs from the
+    /// linear scan's.
+    pub fn wrong(&mut self, bvh: Arc<SceneBvh>, camera: Camera, trace: TraceOptions) {
+        let job = self.start("Finding wrong pixels".to_string());
+        let send = self.sender(job.id);
+        std::thread::spawn(move || {
+            let SceneBvh::Single { mesh, .. } = &*bvh else { return };
+            let rays = crate::bvh::check::check_rays(mesh, &camera, 0);
+            let wrong = crate::bvh::check::wrong_rays(&*bvh, mesh, &rays, trace);
+            let pixels = wrong.iter().filter_map(|w| w.pixel).collect();
+            send(JobEvent::Wrong(WrongPixels { bvh, camera, trace, pixels }));
+        });
+        self.wrong = Some(job);
+    }
+
     /// Inspect `node` of the prepared tree.
     pub fn inspect(&mut self, explained: Arc<Explained>, node: u32) {
         let job = self.start(format!("Inspecting node {node}"));
@@ -354,6 +395,12 @@ impl Jobs {
                     Pick::SaveStatsCsv => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
                     Pick::SaveStatsJson => dialog.add_filter("JSON", &["json"]).set_file_name(&name).save_file().await,
                     Pick::SaveCounts => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
+                    Pick::OpenBvh => dialog.add_filter("bvhscope-bvh dumps", &["json", "gz", "txt"]).pick_file().await,
+                    Pick::SaveBvh => {
+                        let filters =
+                            dialog.add_filter("bvhscope-bvh JSON", &["json"]).add_filter("text form", &["txt"]);
+                        filters.set_file_name(&name).save_file().await
+                    }
                 }
             };
             let path = pollster_block_on(fut).map(|h| h.path().to_path_buf());
@@ -378,6 +425,8 @@ impl Jobs {
                 JobEvent::Explained(_) if current(&self.explain) => self.explain = None,
                 JobEvent::Compared(_) if current(&self.compare) => self.compare = None,
                 JobEvent::Visits(_) if current(&self.visits) => self.visits = None,
+                JobEvent::Imported(_) if current(&self.import) => self.import = None,
+                JobEvent::Wrong(_) if current(&self.wrong) => self.wrong = None,
                 JobEvent::Inspected { .. } if self.inspect.as_ref().is_some_and(|(r, _)| r.id == id) => {
                     self.inspect = None
                 }
@@ -387,6 +436,36 @@ impl Jobs {
         }
         out
     }
+}
+
+/// A dump read and checked (`bvh::check::check`) for `scene`, as the Imported BVH window shows it;
+/// a file that cannot be read is one finding that says why.
+fn import_tree(path: PathBuf, scene: &Scene, scene_id: u64, camera: &Camera, trace: TraceOptions) -> ImportedTree {
+    use crate::bvh::check::{check, Finding, Group};
+    let unreadable = |path: PathBuf, text: String| ImportedTree {
+        path,
+        scene_id,
+        bvh: Err(text.clone()),
+        findings: vec![Finding { group: Group::Structure, defect: true, text, node: None, triangle: None }],
+        rays: 0,
+    };
+    let dump = match crate::bvh::dump::BvhDump::read(&path) {
+        Ok(d) => d,
+        Err(e) => return unreadable(path, e.to_string()),
+    };
+    let mesh = match scene.flat_mesh() {
+        Ok(m) => m,
+        Err(e) => return unreadable(path, format!("{}: {e}", scene.title())),
+    };
+    let (findings, traced) = check(&dump, &path, &mesh, camera, CHECK_RAYS, trace);
+    let bvh = match traced {
+        Some((bvh, names)) => Ok(Arc::new(SceneBvh::imported(bvh, mesh, names))),
+        None => Err(findings
+            .iter()
+            .find(|f| f.group == Group::Rays || f.group == Group::Structure)
+            .map_or("it cannot be traced".into(), |f| f.text.clone())),
+    };
+    ImportedTree { path, scene_id, bvh, findings, rays: CHECK_RAYS }
 }
 
 /// Run a future to completion on this thread (rfd's dialogs are futures).

@@ -7,6 +7,7 @@ mod action;
 mod compare_view;
 mod derived;
 mod export;
+mod import_view;
 mod jobs;
 mod node_view;
 mod orbit;
@@ -22,6 +23,7 @@ mod viewport;
 pub use crate::scene::{Scene, SceneSource};
 pub use action::{Action, Actions};
 pub use compare_view::{CompareMode, CompareView};
+pub use import_view::{ImportView, ImportedTree};
 pub use jobs::Pick;
 pub use node_view::{Metric, NodeView, Step as NodeStep};
 pub use orbit::OrbitCamera;
@@ -31,6 +33,7 @@ pub use replay_view::ReplayView;
 pub use scene::BuiltBvh;
 pub use settings::{BoxLevel, Settings};
 
+use crate::bvh::dump::BvhDump;
 use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
 use crate::render::{Camera, ColorMap, Frame, Legend, RaySummary, UpAxis, View};
 use crate::scene::SceneBuildError;
@@ -44,6 +47,8 @@ use std::time::{Duration, Instant};
 pub struct AppOptions {
     /// A mesh to open at start (the built-in scene shows until it is loaded).
     pub file: Option<PathBuf>,
+    /// A BVH dump to import for it once it is loaded.
+    pub bvh: Option<PathBuf>,
 }
 
 /// Open the window and run until it is closed.
@@ -164,6 +169,10 @@ pub struct BvhscopeApp {
     pub replay: ReplayView,
     /// Side by side: B, another strategy's build of the same scene on the same camera.
     pub compare: CompareView,
+    /// Bring your own BVH: the imported dump, its findings, the wrong pixels.
+    pub import: ImportView,
+    /// A dump to import once the scene being loaded is there.
+    pending_import: Option<PathBuf>,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     box_cache: std::cell::RefCell<Option<BoxCache>>,
     overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
@@ -174,6 +183,8 @@ pub struct BvhscopeApp {
     /// The side-by-side images of the frames on screen.
     compare_cache: std::cell::RefCell<Option<Arc<compare_view::CompareImages>>>,
     threshold_cache: std::cell::RefCell<Option<ThresholdCache>>,
+    /// The imported tree's wrong pixels' mask, for the result it was drawn from.
+    wrong_cache: std::cell::RefCell<Option<(Arc<SceneBvh>, Camera, TraceOptions, egui::TextureHandle)>>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
     /// Where the viewport was drawn in the last frame (its size is the rendered image's).
@@ -246,18 +257,26 @@ impl BvhscopeApp {
             threshold: None,
             replay: ReplayView::default(),
             compare: CompareView::default(),
+            import: ImportView { mask: true, ..Default::default() },
+            pending_import: options.bvh.clone(),
             box_cache: Default::default(),
             overlay_cache: Default::default(),
             mask_cache: Default::default(),
             histogram_cache: Default::default(),
             compare_cache: Default::default(),
             threshold_cache: Default::default(),
+            wrong_cache: Default::default(),
             viewport_aspect: aspect,
             viewport_rect: egui::Rect::NOTHING,
             viewport_pixels: (0, 0),
         };
-        if let Some(file) = options.file {
-            app.act(Action::OpenFile(file));
+        match (options.file, app.pending_import.take()) {
+            (Some(file), bvh) => {
+                app.pending_import = bvh;
+                app.act(Action::OpenFile(file));
+            }
+            (None, Some(bvh)) => app.act(Action::ImportFile(bvh)),
+            (None, None) => {}
         }
         app.reconcile();
         app
@@ -298,6 +317,34 @@ impl BvhscopeApp {
         self.scene = scene;
         self.scene_id += 1;
         self.previous = None;
+        self.rays = None;
+        // A dump numbers the triangles of the mesh it was written for.
+        self.import = ImportView { mask: self.import.mask, ..Default::default() };
+    }
+
+    /// Read and check a dump for the current mesh (in the background; the view stays as it is).
+    fn import_file(&mut self, path: PathBuf) {
+        let (w, h) = match self.viewport_pixels {
+            (0, _) | (_, 0) => (640, 400),
+            p => p,
+        };
+        let camera = self.orbit.camera(w, h);
+        self.jobs.import(path, self.scene.clone(), self.scene_id, camera, self.settings.trace);
+    }
+
+    /// Make `bvh` the current BVH; the one it replaces gives the statistics' "before" column.
+    fn set_built(&mut self, bvh: Arc<SceneBvh>) {
+        if let Some(old) = self.current_figures() {
+            if self
+                .current_bvh()
+                .is_some_and(|b| b.bvh.label() != bvh.label() || b.bvh.build_params() != bvh.build_params())
+            {
+                self.previous = Some(old);
+            }
+        }
+        let names: Vec<String> =
+            self.scene.instances().iter().flat_map(|i| &i.meshes).map(|m| m.name.clone()).collect();
+        self.built = Some(BuiltBvh::new(bvh, &names, self.scene_id));
         self.rays = None;
     }
 
@@ -357,6 +404,19 @@ impl BvhscopeApp {
         self.ensure_render();
         self.ensure_explained();
         self.ensure_compare();
+        self.ensure_wrong();
+    }
+
+    /// The red mask's pixels: once an image of the imported tree is done, the frame's primary
+    /// rays are traced against the linear scan (unless they were for this camera).
+    fn ensure_wrong(&mut self) {
+        if !self.import.on || self.jobs.is_busy() || self.jobs.wrong.is_some() {
+            return;
+        }
+        let Some(s) = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none()) else { return };
+        if s.bvh.import().is_some() && self.import.wrong_for(&s.bvh, &s.camera, &s.trace).is_none() {
+            self.jobs.wrong(s.bvh.clone(), s.camera, s.trace);
+        }
     }
 
     /// B of the side-by-side view: once A's image is done, B is built (or kept) and traced on the
@@ -450,9 +510,18 @@ impl BvhscopeApp {
 
     /// Start a build when the settings or the scene differ from what was built or is building.
     fn ensure_build(&mut self) {
+        // The imported tree, when it is chosen, is the current BVH: nothing to build.
+        if let Some(bvh) = self.import.shown(self.scene_id).cloned() {
+            self.jobs.cancel_build();
+            self.jobs.last_build = None;
+            if !self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &bvh)) {
+                self.set_built(bvh);
+            }
+            return;
+        }
         let build = self.wanted_build();
         let wanted = (build, self.scene_id);
-        let have = self.current_bvh().is_some_and(|b| b.bvh.build_params() == build);
+        let have = self.current_bvh().is_some_and(|b| b.bvh.import().is_none() && b.bvh.build_params() == build);
         if have {
             // Switched back to what is built while another build ran: that build is not wanted.
             self.jobs.cancel_build();
@@ -539,7 +608,7 @@ impl BvhscopeApp {
     /// Figures of the current strategy for the statistics panel.
     pub fn current_figures(&self) -> Option<StrategyFigures> {
         self.current_bvh().map(|b| StrategyFigures {
-            label: b.bvh.build_params().label(),
+            label: b.bvh.label(),
             // The end-point overlap comes with the prepared tree, a moment after the image.
             stats: TreeStats { epo: self.nodes.current(Some(&b.bvh)).map(|e| e.epo), ..b.stats.clone() },
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
@@ -551,7 +620,7 @@ impl BvhscopeApp {
     pub fn compare_figures(&self) -> Option<StrategyFigures> {
         let b = self.compare.b.as_ref().filter(|b| self.compare.on && b.scene_id == self.scene_id)?;
         Some(StrategyFigures {
-            label: format!("B: {}", b.bvh.build_params().label()),
+            label: format!("B: {}", b.bvh.label()),
             stats: b.stats.clone(),
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
             rays: Some(MeasuredRays { summary: b.summary, camera: b.camera, trace: b.trace }),
@@ -590,6 +659,9 @@ impl BvhscopeApp {
                 }
                 self.message(MessageKind::Info, text);
                 self.set_scene(scene);
+                if let Some(dump) = self.pending_import.take() {
+                    self.import_file(dump);
+                }
             }
             JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
             JobEvent::Explained(e) => {
@@ -615,17 +687,26 @@ impl BvhscopeApp {
                     self.nodes.inspection = Some(inspection);
                 }
             }
-            JobEvent::Built { scene_id, result: Ok(bvh), .. } if scene_id == self.scene_id => {
-                if let Some(old) = self.current_figures() {
-                    if self.current_bvh().is_some_and(|b| b.bvh.build_params() != bvh.build_params()) {
-                        self.previous = Some(old);
-                    }
-                }
-                let names: Vec<String> =
-                    self.scene.instances().iter().flat_map(|i| &i.meshes).map(|m| m.name.clone()).collect();
-                self.built = Some(BuiltBvh::new(bvh, &names, scene_id));
-                self.rays = None;
+            JobEvent::Built { scene_id, result: Ok(bvh), .. }
+                if scene_id == self.scene_id && self.import.shown(scene_id).is_none() =>
+            {
+                self.set_built(bvh)
             }
+            JobEvent::Imported(tree) if tree.scene_id == self.scene_id => {
+                let (d, w) = (tree.defects(), tree.findings.len() - tree.defects());
+                let kind = if d > 0 { MessageKind::Warning } else { MessageKind::Info };
+                let shown = match &tree.bvh {
+                    Ok(_) => "shown as \"imported\" in the strategy list".to_string(),
+                    Err(why) => format!("not traced: {why}"),
+                };
+                self.message(kind, format!("Checked {}: {d} defects, {w} warnings; {shown}", tree.name()));
+                self.import.on = tree.bvh.is_ok();
+                self.import.window = true;
+                self.import.wrong = None;
+                self.import.tree = Some(*tree);
+            }
+            JobEvent::Imported(_) => {}
+            JobEvent::Wrong(w) => self.import.wrong = Some(w),
             JobEvent::Built { scene_id, result: Err(SceneBuildError::Scene(e)), .. } if scene_id == self.scene_id => {
                 self.message(MessageKind::Error, e.to_string());
             }
@@ -654,6 +735,11 @@ impl BvhscopeApp {
             Pick::SaveStatsCsv => export::save_stats(self, &path, export::StatsFormat::Csv),
             Pick::SaveStatsJson => export::save_stats(self, &path, export::StatsFormat::Json),
             Pick::SaveCounts => export::save_counts(self, &path),
+            Pick::OpenBvh => {
+                self.import_file(path);
+                return;
+            }
+            Pick::SaveBvh => export::save_bvh(self, &path),
             Pick::SaveScene => self
                 .scene_file_text()
                 .and_then(|t| std::fs::write(&path, t).map_err(|e| format!("{}: cannot write: {e}", path.display()))),
@@ -683,7 +769,7 @@ impl BvhscopeApp {
             }
             None => ctx.load_texture("bvhscope-view", p.image, options),
         };
-        let build_label = p.bvh.build_params().label();
+        let build_label = p.bvh.label();
         self.shown = Some(Shown {
             texture,
             frame: p.frame,
@@ -706,7 +792,9 @@ impl BvhscopeApp {
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
         });
-        actions.extend(dropped.into_iter().take(1).map(Action::OpenFile));
+        // A dump dropped is imported for the current mesh; anything else is opened.
+        let open = |p: PathBuf| if BvhDump::sniff(&p) { Action::ImportFile(p) } else { Action::OpenFile(p) };
+        actions.extend(dropped.into_iter().take(1).map(open));
         actions.extend(shortcuts::pressed(ctx));
         // Info messages fade out; errors stay until dismissed.
         self.messages.retain(|m| m.kind != MessageKind::Info || m.at.elapsed() < Duration::from_secs(6));
@@ -733,6 +821,15 @@ impl BvhscopeApp {
                 let name = format!("{}.json", self.scene.title().trim_end_matches(".obj").trim_end_matches(".json"));
                 self.jobs.pick_file(Pick::SaveScene, &name);
             }
+            A::OpenBvh => self.jobs.pick_file(Pick::OpenBvh, ""),
+            A::OpenBvhPath => self.path_window = Some(PathWindow::new(Pick::OpenBvh, String::new(), None)),
+            A::ImportFile(path) => self.import_file(path),
+            A::ExportBvh => self.jobs.pick_file(Pick::SaveBvh, &export::default_name(self, "bvh")),
+            A::UseImported(on) => self.import.on = on && self.import.traced(self.scene_id).is_some(),
+            A::ShowImported(open) => self.import.window = open,
+            A::WrongMask(on) => self.import.mask = on,
+            A::SelectDumpNode(d) => self.select_dump_node(d),
+            A::SelectTriangle(t) => self.select_triangle(t),
             A::Picked(pick, path) => {
                 self.path_window = None;
                 self.picked(pick, path);
@@ -811,6 +908,7 @@ impl BvhscopeApp {
                 self.settings.show_boxes = true;
             }
             A::NextStrategy => {
+                self.import.on = false;
                 let i = SplitStrategy::ALL.iter().position(|s| *s == self.settings.build.strategy).unwrap_or(0);
                 self.settings.build.strategy = SplitStrategy::ALL[(i + 1) % SplitStrategy::ALL.len()];
             }
@@ -963,6 +1061,7 @@ impl eframe::App for BvhscopeApp {
         panels::node::show(self, &ctx, out);
         panels::replay::show(self, &ctx, out);
         panels::compare::show(self, &ctx, out);
+        panels::imported::show(self, &ctx, out);
         // What the panels asked for takes effect now, and shows in the next frame.
         if !actions.is_empty() {
             for action in actions {

@@ -22,6 +22,8 @@ pub struct PinnedRay {
     pub opts: TraceOptions,
     pub hit: Option<Hit>,
     pub trace: Trace,
+    /// The steps as the Ray window lists them: an imported tree's nodes by the dump's ids.
+    pub named: Vec<crate::bvh::Step>,
     /// The trace's totals: the counting sink's counts for this ray.
     pub counts: RayCounters,
     /// The `bvhscope trace` command that traces this ray through the same build (the scene's
@@ -42,13 +44,22 @@ impl PinnedRay {
             Some((x, y)) => format!("pixel {x}, {y}"),
             None => "typed ray".to_string(),
         };
-        let label = format!("{at} · {}", bvh.build_params().label());
+        let label = format!("{at} · {}", bvh.label());
         let counts = trace.counts();
         let command = match source {
-            SceneSource::File(path) => Some(crate::cli::trace::command(path, &ray, &bvh.build_params(), opts)),
+            SceneSource::File(path) => {
+                let dump = bvh.import().map(|i| i.path.as_path());
+                Some(crate::cli::trace::command(path, &ray, &bvh.build_params(), opts, dump))
+            }
             SceneSource::Builtin => None,
         };
-        Self { label, pixel, ray, bvh, opts, hit, trace, counts, command }
+        // An imported tree's nodes by the dump's ids and its triangles by the file's numbers, as
+        // `bvhscope trace --bvh` prints them.
+        let named = match (&*bvh, bvh.import()) {
+            (SceneBvh::Single { mesh, .. }, Some(i)) => trace.steps.iter().map(|s| i.rename(s, mesh)).collect(),
+            _ => trace.steps.clone(),
+        };
+        Self { label, pixel, ray, bvh, opts, hit, trace, named, counts, command }
     }
 
     pub fn len(&self) -> usize {

@@ -88,6 +88,10 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             painter.image(mask.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
         }
     }
+    // An imported tree's pixels whose hit differs from the linear scan's, in red.
+    if let Some((mask, _)) = app.wrong_mask(ui.ctx()).filter(|_| compared.is_none()) {
+        painter.image(mask.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
+    }
 
     // Node boxes, in the camera of the image they are drawn over.
     if app.settings.show_boxes {
@@ -110,7 +114,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         painter.text(
             rect.center(),
             egui::Align2::CENTER_CENTER,
-            "Drop an .obj file to open it",
+            "Drop a mesh or scene to open it, or a BVH dump to import it",
             egui::FontId::proportional(22.0),
             Color32::WHITE,
         );
@@ -152,7 +156,7 @@ fn draw_compare(
         painter.rect_filled(r, 3.0, Color32::from_black_alpha(170));
         painter.galley(r.min + Vec2::splat(4.0), g, Color32::WHITE);
     };
-    let b_label = app.compare.b.as_ref().map_or(String::new(), |b| b.bvh.build_params().label());
+    let b_label = app.compare.b.as_ref().map_or(String::new(), |b| b.bvh.label());
     let a_label = app.shown.as_ref().map_or(String::new(), |s| s.build_label.clone());
     let full = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
     match app.compare.mode {

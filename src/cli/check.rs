@@ -81,13 +81,12 @@ fn quality(
 
 pub fn run(a: &CheckArgs) -> Result<(), CliError> {
     let dump = BvhDump::read(&a.bvh).map_err(|e| CliError::Usage(e.to_string()))?;
-    let name = super::render::file_name(&a.bvh);
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
     let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
     let trace = a.build.trace();
     let (findings, imported) =
-        progress::with_spinner("checking the BVH", || check(&dump, name.clone(), &mesh, &camera, a.rays, trace));
+        progress::with_spinner("checking the BVH", || check(&dump, &a.bvh, &mesh, &camera, a.rays, trace));
     let defects = findings.iter().filter(|f| f.defect).count();
     // The imported tree next to bvhscope's strategies, on the same mesh, frame and constants.
     let mut table = Vec::new();
@@ -108,7 +107,7 @@ pub fn run(a: &CheckArgs) -> Result<(), CliError> {
         }
         CheckFormat::Text => o = text(&a.bvh, &findings, &table),
     }
-    print!("{o}");
+    super::out(&o);
     if defects > 0 {
         return Err(CliError::Defects(defects));
     }
@@ -161,8 +160,7 @@ pub(crate) fn import_dump(scene: &crate::scene::Scene, path: &std::path::Path) -
     let dump = BvhDump::read(path).map_err(|e| CliError::Usage(e.to_string()))?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
     let structure = crate::bvh::check::check_tree(&dump, &mesh, crate::bvh::check::tolerance(&mesh));
-    let name = super::render::file_name(path);
-    let (bvh, imported) = crate::bvh::check::traceable(&structure, &dump, &mesh, name)
+    let (bvh, imported) = crate::bvh::check::traceable(&structure, &dump, &mesh, path)
         .map_err(|why| CliError::Usage(format!("{}: {why}; bvhscope check lists what is wrong", path.display())))?;
     Ok(SceneBvh::imported(bvh, mesh, imported))
 }
@@ -186,16 +184,8 @@ pub fn export(a: &ExportArgs) -> Result<(), CliError> {
     let layout = a.build.layout.unwrap_or(Layout::Binary);
     let params = BuildParams { layout, ..a.build.params(scene.build.as_ref()) };
     let name = super::render::file_name(&a.mesh);
-    let dump = match crate::bvh::AnyBvh::build(&mesh, &params) {
-        crate::bvh::AnyBvh::Binary(b) => BvhDump::of_bvh(&b, &mesh, Some(name)),
-        crate::bvh::AnyBvh::Wide(w) => BvhDump::of_wide(&w, &mesh, Some(name)),
-    };
-    let text = if a.output.extension().is_some_and(|e| e == "txt") {
-        dump.to_text()
-    } else {
-        serde_json::to_string(&dump).expect("plain data serialises")
-    };
-    std::fs::write(&a.output, text).map_err(|source| CliError::Write { path: a.output.clone(), source })?;
+    let dump = BvhDump::of_any(&AnyBvh::build(&mesh, &params), &mesh, Some(name));
+    dump.write(&a.output).map_err(|source| CliError::Write { path: a.output.clone(), source })?;
     eprintln!("wrote {} ({} nodes, {} primitives)", a.output.display(), dump.nodes.len(), dump.primitives.len());
     Ok(())
 }

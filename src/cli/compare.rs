@@ -393,7 +393,7 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
             }
         }
     }
-    print!("{o}");
+    super::out(&o);
     Ok(())
 }
 

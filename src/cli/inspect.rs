@@ -170,7 +170,7 @@ pub fn csv(ins: &Inspection) -> String {
 }
 
 pub fn run(a: &InspectArgs) -> Result<(), CliError> {
-    print!("{}", output(a)?);
+    super::out(&output(a)?);
     Ok(())
 }
 

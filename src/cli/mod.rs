@@ -30,6 +30,21 @@ pub struct Cli {
     pub command: Option<Command>,
     /// A mesh (.obj) or scene (.json) to open in the desktop app.
     pub file: Option<PathBuf>,
+    /// A BVH dump (bvhscope-bvh) to import for it in the app, as File ▸ Open BVH does.
+    #[arg(long, value_name = "DUMP")]
+    pub bvh: Option<PathBuf>,
+}
+
+/// Write a command's output to stdout. A reader that stops early (`| head`) closes the pipe: the
+/// rest is not wanted, so the program ends quietly, with the status a Unix tool killed by SIGPIPE
+/// has (141), where `print!` would panic.
+pub fn out(text: &str) {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    match stdout.write_all(text.as_bytes()).and_then(|_| stdout.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(141),
+        _ => {}
+    }
 }
 
 impl Cli {

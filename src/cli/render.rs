@@ -170,7 +170,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             let lo = l.range_min + width * i as f32;
             o += &format!("{lo},{},{c}\n", lo + width);
         }
-        print!("{o}");
+        super::out(&o);
     } else if a.histogram.is_some() {
         return Err(CliError::Usage("--histogram is of a heatmap: add --view visits, tri-tests or cost".into()));
     }

@@ -116,7 +116,7 @@ pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
         images.push(draw_legend(&img, &legend));
     }
     write_apng(&images, a.delay_ms, &a.output)?;
-    print!("{table}");
+    super::out(&table);
     eprintln!("wrote {} ({} frames, {}x{})", a.output.display(), images.len(), images[0].width(), images[0].height());
     Ok(())
 }

@@ -80,9 +80,9 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
             let stats = TreeStats { epo: Some(epo), ..TreeStats::of(b) };
             if let StatsFormat::Json = format {
                 let v = serde_json::json!({ "mesh": report, "params": params, "stats": stats, "rays": rays_json });
-                println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
+                super::out(&format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises")));
             } else {
-                print!("{}{rays_text}", format_text(report, &params, &stats))
+                super::out(&format!("{}{rays_text}", format_text(report, &params, &stats)))
             }
         }
         (SceneBvh::TwoLevel { bvh: t, .. }, format) => {
@@ -109,9 +109,9 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
                     "top": { "params": t.top.params, "stats": top }, "bottom": { "params": params, "meshes": bottom_json },
                     "rays": rays_json,
                 });
-                println!("{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
+                super::out(&format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises")));
             } else {
-                print!("{}{rays_text}", format_two_level(report, t, &top, &bottom));
+                super::out(&format!("{}{rays_text}", format_two_level(report, t, &top, &bottom)));
             }
         }
     }

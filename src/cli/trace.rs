@@ -61,11 +61,22 @@ fn parse_ray(s: &str) -> Result<(Vec3, Vec3), String> {
 /// `ray` as the app did (the Ray window shows it, to paste into a terminal or a lab report). The
 /// ray is given as numbers (each written so it reads back to the same `f32`), not as a pixel, so
 /// the window's size does not matter.
-pub fn command(path: &Path, ray: &Ray, build: &SceneBuild, opts: TraceOptions) -> String {
+/// An imported tree's trace names its dump (`--bvh`) instead of the build.
+pub fn command(path: &Path, ray: &Ray, build: &SceneBuild, opts: TraceOptions, dump: Option<&Path>) -> String {
     let v = |v: Vec3| format!("{},{},{}", v.x, v.y, v.z);
     let mut words = vec!["bvhscope trace".to_string(), shell_word(&path.display().to_string())];
     words.push(format!("--ray {}:{}", v(ray.origin()), v(ray.dir())));
-    words.extend(build_flags(build, opts));
+    match dump {
+        Some(d) => {
+            words.push(format!("--bvh {}", shell_word(&d.display().to_string())));
+            words.extend(
+                build_flags(build, opts)
+                    .into_iter()
+                    .filter(|w| w.starts_with("--order") || w.starts_with("--triangle-test")),
+            );
+        }
+        None => words.extend(build_flags(build, opts)),
+    }
     words.join(" ")
 }
 
@@ -85,7 +96,7 @@ fn counts_json(c: &RayCounters) -> serde_json::Value {
 }
 
 pub fn run(a: &TraceArgs) -> Result<(), CliError> {
-    print!("{}", output(a)?);
+    super::out(&output(a)?);
     Ok(())
 }
 

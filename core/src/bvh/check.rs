@@ -331,19 +331,19 @@ pub fn traceable(
     findings: &[Finding],
     dump: &BvhDump,
     mesh: &Mesh,
-    name: String,
+    path: &std::path::Path,
 ) -> Result<(AnyBvh, Imported), String> {
     if findings.iter().any(|f| f.group == Group::Structure && f.defect) {
         return Err("its structure has defects".into());
     }
-    super::imported::import(dump, mesh, name)
+    super::imported::import(dump, mesh, path)
 }
 
-/// Findings of every group for `dump` (named `name`) over `mesh`: the tree's, then, when its
+/// Findings of every group for `dump` (read from `path`) over `mesh`: the tree's, then, when its
 /// structure is sound, the rays'. Returns the findings and the imported tree (when it could be made).
 pub fn check(
     dump: &BvhDump,
-    name: String,
+    path: &std::path::Path,
     mesh: &Mesh,
     camera: &crate::render::Camera,
     rays: usize,
@@ -353,7 +353,7 @@ pub fn check(
     if out.iter().any(|f| f.group == Group::Structure && f.defect) {
         return (out, None);
     }
-    let (bvh, imported) = match super::imported::import(dump, mesh, name) {
+    let (bvh, imported) = match super::imported::import(dump, mesh, path) {
         Ok(b) => b,
         Err(why) => {
             out.push(warning(Group::Rays, None, None, format!("rays not traced: {why}")));
@@ -436,7 +436,7 @@ mod tests {
 
     /// The findings and the traced tree of `d` over `mesh`, with `n` random rays.
     fn run(d: &BvhDump, mesh: &Mesh, n: usize) -> (Vec<Finding>, Option<AnyBvh>) {
-        let (f, t) = check(d, "test.json".into(), mesh, &camera(mesh), n, TraceOptions::default());
+        let (f, t) = check(d, "test.json".as_ref(), mesh, &camera(mesh), n, TraceOptions::default());
         (f, t.map(|(b, _)| b))
     }
 

@@ -68,6 +68,15 @@ pub enum DumpError {
 }
 
 impl BvhDump {
+    /// Whether `path` looks like a dump rather than a mesh or a scene (what a file dropped on the
+    /// app is taken for): gzip, or the format's name in its first kilobytes.
+    pub fn sniff(path: &Path) -> bool {
+        let mut head = [0u8; 4096];
+        let Ok(n) = std::fs::File::open(path).and_then(|mut f| f.read(&mut head)) else { return false };
+        let head = &head[..n];
+        head.starts_with(&[0x1f, 0x8b]) || head.windows(FORMAT.len()).any(|w| w == FORMAT.as_bytes())
+    }
+
     /// Read a dump: JSON, gzip-compressed JSON (`.gz`), or the text form (anything whose first
     /// word is `bvhscope-bvh`).
     pub fn read(path: &Path) -> Result<BvhDump, DumpError> {
@@ -225,6 +234,24 @@ impl BvhDump {
             o.push('\n');
         }
         o
+    }
+
+    /// A tree of bvhscope's in either layout (`of_bvh`, `of_wide`).
+    pub fn of_any(bvh: &super::AnyBvh, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
+        match bvh {
+            super::AnyBvh::Binary(b) => Self::of_bvh(b, mesh, name),
+            super::AnyBvh::Wide(w) => Self::of_wide(w, mesh, name),
+        }
+    }
+
+    /// Write the dump to `path`: the text form when its name ends in `.txt`, else JSON.
+    pub fn write(&self, path: &Path) -> std::io::Result<()> {
+        let text = if path.extension().is_some_and(|e| e == "txt") {
+            self.to_text()
+        } else {
+            serde_json::to_string(self).expect("plain data serialises")
+        };
+        std::fs::write(path, text)
     }
 
     /// A binary tree of bvhscope's over `mesh`, as a dump (its leaf order is the primitives'

@@ -12,15 +12,22 @@ use crate::geometry::Aabb;
 use crate::mesh::Mesh;
 
 /// What tells an imported tree from a built one: its file, and the dump's id of each node.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Imported {
     /// The dump's file name, for captions ("imported: FILE").
     pub name: String,
+    /// Where it was read from (for the `bvhscope trace --bvh` command that repeats a trace).
+    pub path: std::path::PathBuf,
     /// For each node of the traced tree (binary node i, or wide node i), the dump's id.
     pub node_ids: Vec<u32>,
     /// Wide layout: the dump's id of the leaf in slot s of wide node i, at `WIDTH·i + s`
     /// (`u32::MAX` where the slot holds no leaf). Empty for the binary layout.
     pub leaf_ids: Vec<u32>,
+    /// Wide layout: the binary tree the tree view and the node inspector show (as they show the
+    /// binary tree a built 4-wide tree was collapsed from): each node of k > 2 children split
+    /// into binary nodes over its children in the order written, the added nodes' boxes the union
+    /// of their children's; with the dump's id of each node (`u32::MAX` for an added one).
+    pub binary: Option<(std::sync::Arc<Bvh>, Vec<u32>)>,
 }
 
 impl Imported {
@@ -47,6 +54,19 @@ impl Imported {
         }
         let k = self.leaf_ids.iter().position(|&d| d == dump)?;
         Some(NodeId::Leaf { node: (k / WIDTH) as u32, slot: (k % WIDTH) as u8 })
+    }
+
+    /// The binary tree node that is the dump's node `dump`, in the binary tree the tree view shows
+    /// (`SceneBvh::binary_tree`): this tree, or for a 4-wide one its binarised form.
+    pub fn binary_node_of_dump(&self, dump: u32) -> Option<u32> {
+        let ids = self.binary.as_ref().map_or(&self.node_ids, |(_, ids)| ids);
+        ids.iter().position(|&d| d == dump).map(|i| i as u32)
+    }
+
+    /// The dump's id of binary tree node `node` (`None` for a node added to binarise the tree).
+    pub fn dump_of_binary_node(&self, node: u32) -> Option<u32> {
+        let ids = self.binary.as_ref().map_or(&self.node_ids, |(_, ids)| ids);
+        ids.get(node as usize).copied().filter(|&d| d != u32::MAX)
     }
 
     /// A trace step with nodes named by the dump's ids and triangles by their numbers in the file.
@@ -76,7 +96,9 @@ pub fn untraceable(dump: &BvhDump) -> Option<String> {
 /// The dump as bvhscope traces it: binary when every interior node has two children, 4-wide
 /// otherwise. The dump's structure must be sound (`check::check_tree` finds no structure defect);
 /// `Err` says why a tree cannot be traced when it cannot.
-pub fn import(dump: &BvhDump, mesh: &Mesh, name: String) -> Result<(AnyBvh, Imported), String> {
+pub fn import(dump: &BvhDump, mesh: &Mesh, path: &std::path::Path) -> Result<(AnyBvh, Imported), String> {
+    let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let path = path.to_path_buf();
     if let Some(why) = untraceable(dump) {
         return Err(why);
     }
@@ -85,11 +107,55 @@ pub fn import(dump: &BvhDump, mesh: &Mesh, name: String) -> Result<(AnyBvh, Impo
     let broken = || "its structure has defects (bvhscope check lists them)".to_string();
     if binary {
         let (bvh, ids) = to_binary(copy).ok_or_else(broken)?;
-        Ok((AnyBvh::Binary(bvh), Imported { name, node_ids: ids, leaf_ids: Vec::new() }))
+        Ok((AnyBvh::Binary(bvh), Imported { name, path, node_ids: ids, leaf_ids: Vec::new(), binary: None }))
     } else {
         let (wide, node_ids, leaf_ids) = to_wide(copy).ok_or_else(broken)?;
-        Ok((AnyBvh::Wide(wide), Imported { name, node_ids, leaf_ids }))
+        let (split, added) = binarised(dump);
+        let again =
+            Leaves { dump: &split, by_file: mesh.triangles_by_file_number(), mesh, prim_ids: vec![], tris: vec![] };
+        let (bvh, ids) = to_binary(again).ok_or_else(broken)?;
+        let ids = ids.into_iter().map(|d| if d >= added { u32::MAX } else { d }).collect();
+        let binary = Some((std::sync::Arc::new(bvh), ids));
+        Ok((AnyBvh::Wide(wide), Imported { name, path, node_ids, leaf_ids, binary }))
     }
+}
+
+/// The dump with every node of k > 2 children split into binary nodes: children c0..ck-1 become
+/// (c0..c⌈k/2⌉-1) and (the rest), each half one added node unless it is a single child (a
+/// collapse run backwards). Added nodes have ids from the returned number on.
+fn binarised(dump: &BvhDump) -> (BvhDump, u32) {
+    let mut out = dump.clone();
+    let first_added = out.nodes.len() as u32;
+    let mut i = 0;
+    while i < out.nodes.len() {
+        if let Some(kids) = out.nodes[i].children.clone().filter(|k| k.len() > 2) {
+            let (a, b) = kids.split_at(kids.len().div_ceil(2));
+            let half = |out: &mut BvhDump, part: &[u32]| -> u32 {
+                if let [one] = part {
+                    return *one;
+                }
+                let b = part
+                    .iter()
+                    .filter_map(|&c| out.nodes.get(c as usize))
+                    .fold(Aabb::EMPTY, |b, n| b.union(n.bounds()));
+                let (min, max) = (glam::Vec3::from(b.min).to_array(), glam::Vec3::from(b.max).to_array());
+                let node = super::dump::DumpNode {
+                    min,
+                    max,
+                    children: Some(part.to_vec()),
+                    first: None,
+                    count: None,
+                    axis: None,
+                };
+                out.nodes.push(node);
+                out.nodes.len() as u32 - 1
+            };
+            let (l, r) = (half(&mut out, a), half(&mut out, b));
+            out.nodes[i].children = Some(vec![l, r]);
+        }
+        i += 1;
+    }
+    (out, first_added)
 }
 
 /// The leaves' triangles copied into leaf order as they are reached (a triangle in two leaves is
@@ -222,7 +288,7 @@ mod tests {
                 AnyBvh::Binary(b) => BvhDump::of_bvh(b, &mesh, None),
                 AnyBvh::Wide(w) => BvhDump::of_wide(w, &mesh, None),
             };
-            let (back, names) = import(&dump, &mesh, "t.json".into()).unwrap();
+            let (back, names) = import(&dump, &mesh, "t.json".as_ref()).unwrap();
             assert_eq!(back.params().layout, layout);
             let (a, b) = (TreeStats::of(&built), TreeStats::of(&back));
             assert_eq!((a.nodes, a.leaves), (b.nodes, b.leaves), "{layout:?}");
@@ -240,6 +306,32 @@ mod tests {
         }
     }
 
+    /// A 4-wide dump's binary form (what the tree view shows) holds the same leaves and reaches
+    /// the same hit for every ray; each of its nodes that is a dump node is named by that id.
+    #[test]
+    fn a_four_wide_dump_is_binarised_for_the_tree_view() {
+        let mesh = generate::torus_knot(2, 3, 0.3, 64, 8);
+        let w = WideBvh::from_binary(Bvh::build(&mesh, &BuildParams::default()));
+        let dump = BvhDump::of_wide(&w, &mesh, None);
+        let (wide, names) = import(&dump, &mesh, "w.json".as_ref()).unwrap();
+        let (bin, ids) = names.binary.clone().expect("a binarised tree");
+        assert!(bin.nodes.iter().all(|n| n.is_leaf() || n.index as usize + 1 < bin.nodes.len()));
+        let leaves = |t: &dyn crate::bvh::TreeView| TreeStats::of(t).leaves;
+        assert_eq!(leaves(&*bin), leaves(&wide));
+        assert_eq!(ids.len(), bin.nodes.len());
+        for d in 0..dump.nodes.len() as u32 {
+            let n = names.binary_node_of_dump(d).expect("every dump node is in the binary tree");
+            assert_eq!(names.dump_of_binary_node(n), Some(d));
+        }
+        let camera = crate::render::Camera::framing_up(&mesh.bounds(), 24, 16, crate::render::UpAxis::Y, 45.0);
+        for (r, _) in check_rays(&mesh, &camera, 300) {
+            let t = |h: Option<crate::bvh::Hit>| h.map(|h| h.t);
+            let a = wide.closest_hit(&mut r.clone(), TraceOptions::default(), &mut crate::bvh::NoStats);
+            let b = bin.closest_hit(&mut r.clone(), TraceOptions::default(), &mut crate::bvh::NoStats);
+            assert_eq!(t(a), t(b));
+        }
+    }
+
     /// Nodes of 5 children, and leaves too large for the layout, are refused with the reason.
     #[test]
     fn untraceable_trees_say_why() {
@@ -247,11 +339,11 @@ mod tests {
         let b = Bvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..BuildParams::default() });
         let mut d = BvhDump::of_bvh(&b, &mesh, None);
         d.nodes[0].children.as_mut().unwrap().extend([1, 1, 1]);
-        assert!(import(&d, &mesh, "x".into()).unwrap_err().contains("more than 4 children"));
+        assert!(import(&d, &mesh, "x".as_ref()).unwrap_err().contains("more than 4 children"));
         let mut d = BvhDump::of_bvh(&b, &mesh, None);
         d.nodes[0].children.as_mut().unwrap().push(2);
         let leaf = d.nodes.iter_mut().find(|n| n.children.is_none()).unwrap();
         leaf.count = Some(300);
-        assert!(import(&d, &mesh, "x".into()).unwrap_err().contains("at most 255"));
+        assert!(import(&d, &mesh, "x".as_ref()).unwrap_err().contains("at most 255"));
     }
 }

@@ -66,6 +66,22 @@ impl SceneBvh {
         }
     }
 
+    /// The binary tree the tree view, the node inspector and the replay show for a single BVH:
+    /// the tree itself, the binary tree a built 4-wide tree was collapsed from (built again), or an
+    /// imported 4-wide tree binarised (`Imported::binary`). `None` for two levels.
+    pub fn binary_tree(&self) -> Option<std::borrow::Cow<'_, super::Bvh>> {
+        use std::borrow::Cow;
+        match self {
+            SceneBvh::Single { bvh, imported: Some(i), .. } => match (&i.binary, bvh) {
+                (Some((b, _)), _) => Some(Cow::Borrowed(&**b)),
+                (None, AnyBvh::Binary(b)) => Some(Cow::Borrowed(b)),
+                (None, AnyBvh::Wide(_)) => None,
+            },
+            SceneBvh::Single { bvh, mesh, imported: None } => Some(bvh.binary_tree(mesh)),
+            SceneBvh::TwoLevel { .. } => None,
+        }
+    }
+
     /// How captions, tables and the strategy list name the tree: "SAH binned, wide4" (the build's
     /// label) or "imported: FILE, binary".
     pub fn label(&self) -> String {

@@ -60,27 +60,57 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             ui.label("Bottom level (each mesh's BVH)");
         }
     }
+    // The strategies, and an imported tree (File ▸ Open BVH) as one more entry.
+    let imported = app.import.tree.as_ref().filter(|t| t.scene_id == app.scene_id);
+    let on = app.import.on && imported.is_some();
     let label = ui.label("Split strategy");
+    let selected = match imported.filter(|_| on) {
+        Some(t) => format!("imported: {}", t.name()),
+        None => s.build.strategy.label().to_string(),
+    };
     egui::ComboBox::from_id_salt("strategy")
-        .selected_text(s.build.strategy.label())
+        .selected_text(selected)
         .width(200.0)
         .show_ui(ui, |ui| {
             for k in SplitStrategy::ALL {
-                ui.selectable_value(&mut s.build.strategy, k, k.label()).on_hover_text(k.help());
+                if ui.selectable_label(!on && s.build.strategy == k, k.label()).on_hover_text(k.help()).clicked() {
+                    s.build.strategy = k;
+                    out.push(Action::UseImported(false));
+                }
+            }
+            if let Some(t) = imported {
+                let text = format!("imported: {}", t.name());
+                let tip = format!(
+                    "The BVH read from {}, traced as written. {} defects, {} warnings (View ▸ Imported BVH…)",
+                    t.path.display(),
+                    t.defects(),
+                    t.findings.len() - t.defects()
+                );
+                let item = ui.add_enabled(t.bvh.is_ok(), egui::Button::selectable(on, text));
+                let why = t.bvh.as_ref().err().cloned().unwrap_or_default();
+                if item.on_hover_text(tip).on_disabled_hover_text(format!("Cannot be traced: {why}")).clicked() {
+                    out.push(Action::UseImported(true));
+                }
             }
         })
         .response
         .labelled_by(label.id)
-        .on_hover_text(s.build.strategy.help());
+        .on_hover_text(if on { "The imported BVH, as its program wrote it" } else { s.build.strategy.help() });
 
-    number(ui, &mut s.build.max_leaf_size, &MAX_LEAF_SIZE, true);
-    let sah = s.build.strategy == SplitStrategy::SahBinned;
-    ui.add_enabled_ui(sah, |ui| number(ui, &mut s.build.sah_bins, &SAH_BINS, true));
-    number(ui, &mut s.build.cost.traversal, &TRAVERSAL_COST, true);
+    // An imported tree is traced as written: the build's parameters do not apply to it.
+    ui.add_enabled_ui(!on, |ui| {
+        number(ui, &mut s.build.max_leaf_size, &MAX_LEAF_SIZE, true);
+        let sah = s.build.strategy == SplitStrategy::SahBinned;
+        ui.add_enabled_ui(sah, |ui| number(ui, &mut s.build.sah_bins, &SAH_BINS, true));
+        number(ui, &mut s.build.cost.traversal, &TRAVERSAL_COST, true);
+    });
 
     ui.add_space(4.0);
     ui.label("Layout");
-    radios(ui, &mut s.build.layout);
+    ui.add_enabled_ui(!on, |ui| radios(ui, &mut s.build.layout));
+    if on {
+        ui.weak("The imported tree keeps its own layout and leaves.");
+    }
     ui.label("Traversal order (binary layout)");
     radios(ui, &mut s.trace.order);
     ui.label("Triangle test");

@@ -94,7 +94,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             ui.weak(format!(
                 "A: {}. B: {}. Per-ray figures over all the frame's primary rays, one camera.",
                 a.label,
-                b.bvh.build_params().label()
+                b.bvh.label()
             ));
         });
     if !open {

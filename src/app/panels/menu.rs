@@ -35,6 +35,24 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 out.push(Action::ShowBuiltin);
             }
             ui.separator();
+            if ui
+                .button("Open BVH…")
+                .on_hover_text("A BVH written by your own renderer (bvhscope-bvh: JSON, .json.gz or the text form; see the README) for this mesh: checked, then shown as \"imported\" in the strategy list")
+                .clicked()
+            {
+                out.push(Action::OpenBvh);
+            }
+            if ui.button("Open BVH path…").on_hover_text("Type the dump's path").clicked() {
+                out.push(Action::OpenBvhPath);
+            }
+            if ui
+                .button("Export BVH…")
+                .on_hover_text("The current tree in the bvhscope-bvh format (JSON; the text form when the name ends in .txt), as bvhscope export-bvh writes it")
+                .clicked()
+            {
+                out.push(Action::ExportBvh);
+            }
+            ui.separator();
             item(ui, out, "Save view as PNG…", Action::SavePng);
             item(ui, out, "Export statistics as CSV…", Action::ExportStats);
             if ui.button("Export statistics as JSON…").clicked() {
@@ -84,6 +102,14 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             }
             if ui.button("Replay the build…").on_hover_text("The Replay window: the tree after each split, traced").clicked() {
                 out.push(Action::ShowReplay(true));
+            }
+            if ui
+                .add_enabled(app.import.tree.is_some(), egui::Button::new("Imported BVH…"))
+                .on_hover_text("The checker's findings of the imported BVH")
+                .on_disabled_hover_text("No BVH is imported: File ▸ Open BVH…")
+                .clicked()
+            {
+                out.push(Action::ShowImported(true));
             }
             if ui.button("Compare side by side…").on_hover_text("B, another strategy's build, next to A on the same camera and scale").clicked() {
                 out.push(Action::Compare(true));

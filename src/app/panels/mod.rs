@@ -2,6 +2,7 @@
 
 pub mod build;
 pub mod compare;
+pub mod imported;
 pub mod menu;
 pub mod node;
 pub mod ray;

@@ -185,7 +185,7 @@ fn typed_ray(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
 /// out, so a long walk stays fast. Clicking a row shows that step.
 fn steps_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions, k: usize) {
     let Some(r) = app.pins.current() else { return };
-    let steps = &r.trace.steps;
+    let steps = &r.named;
     // A selectable label's height: its text and the button padding, at least the interact size.
     let text_height = ui.text_style_height(&egui::TextStyle::Monospace);
     let row_height = (text_height + 2.0 * ui.spacing().button_padding.y).max(ui.spacing().interact_size.y);

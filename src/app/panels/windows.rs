@@ -37,6 +37,8 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         Pick::SaveStatsJson => "Export statistics (JSON)",
         Pick::SaveScene => "Save the scene",
         Pick::SaveCounts => "Export counts (CSV)",
+        Pick::OpenBvh => "Import a BVH dump for this mesh",
+        Pick::SaveBvh => "Export the BVH as a dump",
     };
     let mut keep = true;
     let mut chosen = None;
@@ -57,7 +59,11 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             keep = false;
         }
         ui.horizontal(|ui| {
-            let verb = if window.pick == Pick::Open { "Open" } else { "Save" };
+            let verb = match window.pick {
+                Pick::Open => "Open",
+                Pick::OpenBvh => "Import",
+                _ => "Save",
+            };
             if (ui.button(verb).clicked() || enter) && !text.trim().is_empty() {
                 chosen = Some((window.pick, PathBuf::from(text.trim())));
             }
