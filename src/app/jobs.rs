@@ -104,8 +104,8 @@ pub enum JobEvent {
         result: Result<Arc<SceneBvh>, SceneBuildError>,
     },
     Pass(PassOutput),
-    /// A dump read and checked for scene `scene_id`.
-    Imported(Box<ImportedTree>),
+    /// A dump read and checked for scene `scene_id`, or why it cannot be read.
+    Imported(Result<Box<ImportedTree>, String>),
     /// A frame's pixels whose hit through the imported tree is wrong.
     Wrong(WrongPixels),
     Picked {
@@ -341,7 +341,7 @@ impl Jobs {
         let send = self.sender(job.id);
         std::thread::spawn(move || {
             let tree = import_tree(path, &scene, scene_id, &camera, trace);
-            send(JobEvent::Imported(Box::new(tree)));
+            send(JobEvent::Imported(tree.map(Box::new)));
         });
         self.import = Some(job);
     }
@@ -438,26 +438,20 @@ impl Jobs {
     }
 }
 
-/// A dump read and checked (`bvh::check::check`) for `scene`, as the Imported BVH window shows it;
-/// a file that cannot be read is one finding that says why.
-fn import_tree(path: PathBuf, scene: &Scene, scene_id: u64, camera: &Camera, trace: TraceOptions) -> ImportedTree {
-    use crate::bvh::check::{check, Finding, Group};
-    let unreadable = |path: PathBuf, text: String| ImportedTree {
-        path,
-        scene_id,
-        bvh: Err(text.clone()),
-        findings: vec![Finding { group: Group::Structure, defect: true, text, node: None, triangle: None }],
-        rays: 0,
-    };
-    let dump = match crate::bvh::dump::BvhDump::read(&path) {
-        Ok(d) => d,
-        Err(e) => return unreadable(path, e.to_string()),
-    };
-    let mesh = match scene.flat_mesh() {
-        Ok(m) => m,
-        Err(e) => return unreadable(path, format!("{}: {e}", scene.title())),
-    };
-    let (findings, traced) = check(&dump, &path, &mesh, camera, CHECK_RAYS, trace);
+/// A dump read and checked (`bvh::check::check`) for `scene`, as the Imported BVH window shows it,
+/// or one line naming the file and why it cannot be read.
+fn import_tree(
+    path: PathBuf,
+    scene: &Scene,
+    scene_id: u64,
+    camera: &Camera,
+    trace: TraceOptions,
+) -> Result<ImportedTree, String> {
+    use crate::bvh::check::{check, Group};
+    let dump = crate::bvh::dump::BvhDump::read(&path).map_err(|e| e.to_string())?;
+    let mesh = scene.flat_mesh().map_err(|e| format!("{}: {e}", scene.title()))?;
+    let checked = check(&dump, &path, &mesh, camera, CHECK_RAYS, trace);
+    let (findings, traced) = (checked.findings, checked.tree);
     let bvh = match traced {
         Some((bvh, names)) => Ok(Arc::new(SceneBvh::imported(bvh, mesh, names))),
         None => Err(findings
@@ -465,7 +459,7 @@ fn import_tree(path: PathBuf, scene: &Scene, scene_id: u64, camera: &Camera, tra
             .find(|f| f.group == Group::Rays || f.group == Group::Structure)
             .map_or("it cannot be traced".into(), |f| f.text.clone())),
     };
-    ImportedTree { path, scene_id, bvh, findings, rays: CHECK_RAYS }
+    Ok(ImportedTree { path, scene_id, bvh, findings, rays: CHECK_RAYS })
 }
 
 /// Run a future to completion on this thread (rfd's dialogs are futures).

@@ -184,7 +184,7 @@ pub struct BvhscopeApp {
     compare_cache: std::cell::RefCell<Option<Arc<compare_view::CompareImages>>>,
     threshold_cache: std::cell::RefCell<Option<ThresholdCache>>,
     /// The imported tree's wrong pixels' mask, for the result it was drawn from.
-    wrong_cache: std::cell::RefCell<Option<(Arc<SceneBvh>, Camera, TraceOptions, egui::TextureHandle)>>,
+    wrong_cache: std::cell::RefCell<Option<WrongCache>>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
     /// Where the viewport was drawn in the last frame (its size is the rendered image's).
@@ -205,6 +205,8 @@ struct OverlayCache {
 
 /// The legend's histogram, for a frame and view.
 type HistogramCache = (Arc<Frame>, View, Vec<u32>);
+/// The wrong pixels' mask, for the imported tree, camera and traversal it was traced with.
+type WrongCache = (Arc<SceneBvh>, Camera, TraceOptions, egui::TextureHandle);
 /// The threshold's mask, for a frame, view and threshold.
 type ThresholdCache = (Arc<Frame>, View, f32, egui::TextureHandle);
 
@@ -692,7 +694,8 @@ impl BvhscopeApp {
             {
                 self.set_built(bvh)
             }
-            JobEvent::Imported(tree) if tree.scene_id == self.scene_id => {
+            JobEvent::Imported(Err(e)) => self.message(MessageKind::Error, e),
+            JobEvent::Imported(Ok(tree)) if tree.scene_id == self.scene_id => {
                 let (d, w) = (tree.defects(), tree.findings.len() - tree.defects());
                 let kind = if d > 0 { MessageKind::Warning } else { MessageKind::Info };
                 let shown = match &tree.bvh {

@@ -41,7 +41,8 @@ impl ReplayView {
             self.partial = self.replay.as_ref().map(|r| Arc::new(r.partial(self.k)));
             let r = self.replay.as_ref().expect("made above");
             self.newest = self.k.checked_sub(1).map(|i| r.order[i]).map(|n| {
-                if e.hierarchy.count[n as usize] <= MAX_PLANE_TRIANGLES {
+                // An imported tree has no strategy of bvhscope's to find its plane with.
+                if e.hierarchy.count[n as usize] <= MAX_PLANE_TRIANGLES && e.bvh.import().is_none() {
                     let (m, bins) = crate::bvh::inspect::own_split(&e.tree, &e.hierarchy, n);
                     (n, m, bins)
                 } else {

@@ -80,13 +80,24 @@ fn quality(
 }
 
 pub fn run(a: &CheckArgs) -> Result<(), CliError> {
+    let (o, defects) = output(a)?;
+    super::out(&o);
+    if defects > 0 {
+        return Err(CliError::Defects(defects));
+    }
+    Ok(())
+}
+
+/// What `run` prints, and the number of defects (the app's tests compare it with the Imported BVH
+/// window).
+pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
     let dump = BvhDump::read(&a.bvh).map_err(|e| CliError::Usage(e.to_string()))?;
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
     let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
     let trace = a.build.trace();
-    let (findings, imported) =
-        progress::with_spinner("checking the BVH", || check(&dump, &a.bvh, &mesh, &camera, a.rays, trace));
+    let checked = progress::with_spinner("checking the BVH", || check(&dump, &a.bvh, &mesh, &camera, a.rays, trace));
+    let (findings, imported) = (checked.findings, checked.tree);
     let defects = findings.iter().filter(|f| f.defect).count();
     // The imported tree next to bvhscope's strategies, on the same mesh, frame and constants.
     let mut table = Vec::new();
@@ -102,16 +113,18 @@ pub fn run(a: &CheckArgs) -> Result<(), CliError> {
     let mut o = String::new();
     match a.format {
         CheckFormat::Json => {
-            let v = serde_json::json!({ "defects": defects, "findings": findings, "quality": table });
+            let v = serde_json::json!({
+                "defects": defects,
+                "findings": findings,
+                "quality": table,
+                "camera": camera,
+                "wrong_pixels": checked.wrong_pixels,
+            });
             let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
         CheckFormat::Text => o = text(&a.bvh, &findings, &table),
     }
-    super::out(&o);
-    if defects > 0 {
-        return Err(CliError::Defects(defects));
-    }
-    Ok(())
+    Ok((o, defects))
 }
 
 fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality]) -> String {

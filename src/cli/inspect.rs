@@ -25,9 +25,13 @@ pub struct InspectArgs {
     /// The mesh (.obj) or scene (.json, one level).
     pub mesh: PathBuf,
     /// The node: its id in the binary tree as built (0 is the root; the app's tree view shows
-    /// the same ids).
+    /// the same ids); with --bvh, the dump's own id of the node.
     #[arg(long, default_value_t = 0)]
     pub node: u32,
+    /// Explain a node of a BVH written by another program (bvhscope-bvh, as `check` reads it)
+    /// instead of a build; a 4-wide dump is binarised as the app's tree view shows it.
+    #[arg(long, value_name = "DUMP")]
+    pub bvh: Option<PathBuf>,
     #[command(flatten)]
     pub build: BuildArgs,
     /// The frame whose primary rays are counted per node (the Tree window's visits; camera and
@@ -74,7 +78,7 @@ fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
         "centroid_bounds": { "min": b(ins.centroid_bounds.min), "max": b(ins.centroid_bounds.max) },
         "area": ins.area, "area_ratio_to_parent": ins.area_ratio, "subtree_sah_cost": ins.subtree_sah,
         "child_overlap": ins.child_overlap, "leaf_cost": ins.leaf_cost, "epo_contribution": epo_term,
-        "bins": ins.bins, "curves": curves, "markers": markers,
+        "bins": ins.bins, "curves": curves, "markers": markers, "own_cost": ins.own_cost,
     })
 }
 
@@ -122,6 +126,13 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
                 let _ = writeln!(o, "  {:<12}  no split (the builder falls back to equal count)", s.named().name);
             }
         }
+    }
+    if let Some(c) = ins.own_cost {
+        let _ = writeln!(
+            o,
+            "  {:<12}  the split this tree made: cost {c:.3} (its children's boxes as stored)",
+            "this tree"
+        );
     }
     let _ = writeln!(o);
     let min = |c: &[CurvePoint]| c.iter().min_by(|p, q| p.cost.total_cmp(&q.cost)).copied();
@@ -183,12 +194,22 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     }
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
-    let SceneBvh::Single { bvh, mesh, .. } = build_scene(&scene, &a.build.scene_build(params))? else {
-        unreachable!("one level was asked for")
+    let built = match &a.bvh {
+        Some(path) => super::check::import_dump(&scene, path)?,
+        None => build_scene(&scene, &a.build.scene_build(params))?,
     };
-    let tree = bvh.binary_tree(&mesh);
+    let SceneBvh::Single { bvh, .. } = &built else { unreachable!("one level was asked for") };
+    let tree = built.binary_tree().expect("a single BVH has a binary tree");
     let h = Hierarchy::of(&tree);
-    let Some(ins) = inspect(&tree, &h, a.node) else {
+    // An imported tree's node by the dump's id.
+    let names = built.import();
+    let node = match names {
+        Some(n) => n.binary_node_of_dump(a.node).ok_or_else(|| {
+            CliError::Usage(format!("--node {}: the dump's node {} is not reached from its root", a.node, a.node))
+        })?,
+        None => a.node,
+    };
+    let Some(ins) = inspect(&tree, &h, node) else {
         return Err(CliError::Usage(format!(
             "--node {}: the tree has {} nodes (0 to {})",
             a.node,
@@ -196,32 +217,43 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
             tree.nodes.len() - 1
         )));
     };
-    let path = h.path(a.node);
+    let path = h.path(node);
     // The visits of the frame's primary rays, through the binary tree (as the Tree window counts).
     let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
     let visits = crate::bvh::visits::frame_visits(&tree, &camera, a.build.trace(), &crate::work::WorkControl::new())
         .map_err(|_| CliError::Usage("cancelled".into()))?
-        .counts[a.node as usize];
-    let wide = (bvh.params().layout == Layout::Wide4).then(|| wide_group_of(&tree.nodes, &h.parent, a.node)).flatten();
+        .counts[node as usize];
+    // A built 4-wide tree is collapsed from the binary one; an imported one is not.
+    let wide = (bvh.params().layout == Layout::Wide4 && names.is_none())
+        .then(|| wide_group_of(&tree.nodes, &h.parent, node))
+        .flatten();
+    let dump_id = names.map(|n| n.dump_of_binary_node(node));
     Ok(match a.format {
         InspectFormat::Csv => csv(&ins),
         InspectFormat::Json => {
-            let term = epo::node_term(&tree, &h, a.node as usize);
+            let term = epo::node_term(&tree, &h, node as usize);
             let mut v = json(&ins, term, &path);
             v["visits"] = serde_json::json!(visits);
             v["camera"] = serde_json::json!(camera);
+            if let Some(d) = dump_id {
+                v["dump_node"] = serde_json::json!(d);
+            }
             if let Some(g) = &wide {
                 v["wide_node"] = serde_json::json!({ "top": g.top, "collapsed": g.collapsed, "children": g.children });
             }
             format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises"))
         }
         InspectFormat::Text => {
-            let term = epo::node_term(&tree, &h, a.node as usize);
+            let term = epo::node_term(&tree, &h, node as usize);
             {
                 let p = bvh.params();
-                let build =
-                    format!("{}, max leaf size {}, {} SAH bins", p.strategy.label(), p.max_leaf_size, p.sah_bins);
-                let wide = wide.map_or(String::new(), |g| format!("\n{}\n", wide_group_text(a.node, &g)));
+                let build = match names {
+                    Some(n) => format!("{} (dump node {})", n.label(), dump_text(dump_id.flatten())),
+                    None => {
+                        format!("{}, max leaf size {}, {} SAH bins", p.strategy.label(), p.max_leaf_size, p.sah_bins)
+                    }
+                };
+                let wide = wide.map_or(String::new(), |g| format!("\n{}\n", wide_group_text(node, &g)));
                 let visits = format!(
                     "visits          {visits} of the {}x{} frame's primary rays entered it (binary traversal)\n",
                     camera.width, camera.height
@@ -230,4 +262,9 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
             }
         }
     })
+}
+
+/// "12", or for a node added to binarise a 4-wide dump, what it is.
+pub fn dump_text(d: Option<u32>) -> String {
+    d.map_or("none: added to binarise a node of more than two children".into(), |d| d.to_string())
 }

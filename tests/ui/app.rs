@@ -3,57 +3,17 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+mod support;
+use support::*;
 
 use bvhscope::app::{Action, AppOptions, BvhscopeApp, MessageKind, SceneSource};
 use bvhscope::bvh::SplitStrategy;
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
-
-fn harness() -> Harness<'static, BvhscopeApp> {
-    Harness::builder()
-        .with_size(egui::vec2(1400.0, 860.0))
-        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()))
-}
-
-/// Step the app until `done` holds (background jobs report asynchronously).
-fn run_until(h: &mut Harness<'_, BvhscopeApp>, what: &str, done: impl Fn(&BvhscopeApp) -> bool) {
-    let start = Instant::now();
-    while !done(h.state()) {
-        assert!(start.elapsed() < Duration::from_secs(120), "timed out waiting for {what}");
-        h.step();
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    h.step();
-    h.step();
-}
-
-fn idle(app: &BvhscopeApp) -> bool {
-    app.current_bvh().is_some() && !app.jobs.is_busy() && app.shown.as_ref().is_some_and(|s| s.frame.is_complete())
-}
-
-fn temp_file(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bvhscope-ui-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-#[derive(Debug)]
-struct Dropped(PathBuf);
-
-impl egui::DroppedFile for Dropped {
-    fn path(&self) -> &Path {
-        &self.0
-    }
-    fn bytes(&self) -> Result<Vec<u8>, String> {
-        std::fs::read(&self.0).map_err(|e| e.to_string())
-    }
-}
+use std::time::Duration;
 
 #[test]
 fn starts_on_the_builtin_scene_and_shows_its_triangle_count() {

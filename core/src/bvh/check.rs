@@ -258,7 +258,7 @@ pub struct WrongRay {
 /// Trace `rays` (with their pixels, if from a frame) through `bvh` and the linear scan; the ones
 /// whose hits differ (a different distance; a different triangle only at a different distance).
 pub fn wrong_rays(
-    bvh: &(impl Accelerator + Sync),
+    bvh: &impl Accelerator,
     mesh: &Mesh,
     rays: &[(Ray, Option<(u32, u32)>)],
     opts: TraceOptions,
@@ -339,6 +339,16 @@ pub fn traceable(
     super::imported::import(dump, mesh, path)
 }
 
+/// What `check` found.
+pub struct Checked {
+    pub findings: Vec<Finding>,
+    /// The tree as traced, when its structure is sound and it can be traced.
+    pub tree: Option<(AnyBvh, Imported)>,
+    /// The camera's pixels whose hit through the tree differs from the linear scan's (the app's
+    /// red mask).
+    pub wrong_pixels: Vec<(u32, u32)>,
+}
+
 /// Findings of every group for `dump` (read from `path`) over `mesh`: the tree's, then, when its
 /// structure is sound, the rays'. Returns the findings and the imported tree (when it could be made).
 pub fn check(
@@ -348,16 +358,16 @@ pub fn check(
     camera: &crate::render::Camera,
     rays: usize,
     opts: TraceOptions,
-) -> (Vec<Finding>, Option<(AnyBvh, Imported)>) {
+) -> Checked {
     let mut out = check_tree(dump, mesh, tolerance(mesh));
     if out.iter().any(|f| f.group == Group::Structure && f.defect) {
-        return (out, None);
+        return Checked { findings: out, tree: None, wrong_pixels: Vec::new() };
     }
     let (bvh, imported) = match super::imported::import(dump, mesh, path) {
         Ok(b) => b,
         Err(why) => {
             out.push(warning(Group::Rays, None, None, format!("rays not traced: {why}")));
-            return (out, None);
+            return Checked { findings: out, tree: None, wrong_pixels: Vec::new() };
         }
     };
     let all = check_rays(mesh, camera, rays);
@@ -381,7 +391,8 @@ pub fn check(
             wrong.len(), all.len(), show(w.want), show(w.got)
         )));
     }
-    (out, Some((bvh, imported)))
+    let wrong_pixels = wrong.iter().filter_map(|w| w.pixel).collect();
+    Checked { findings: out, tree: Some((bvh, imported)), wrong_pixels }
 }
 
 #[cfg(test)]
@@ -436,8 +447,8 @@ mod tests {
 
     /// The findings and the traced tree of `d` over `mesh`, with `n` random rays.
     fn run(d: &BvhDump, mesh: &Mesh, n: usize) -> (Vec<Finding>, Option<AnyBvh>) {
-        let (f, t) = check(d, "test.json".as_ref(), mesh, &camera(mesh), n, TraceOptions::default());
-        (f, t.map(|(b, _)| b))
+        let c = check(d, "test.json".as_ref(), mesh, &camera(mesh), n, TraceOptions::default());
+        (c.findings, c.tree.map(|(b, _)| b))
     }
 
     #[test]

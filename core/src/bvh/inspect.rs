@@ -170,6 +170,10 @@ pub struct Inspection {
     /// Each strategy's plane, or none when it finds no split (all centroids on one side or
     /// coinciding: the builder then falls back to equal count).
     pub markers: Vec<(SplitStrategy, Option<Marker>)>,
+    /// The cost of the split this tree made, by the curves' formula over its children's boxes as
+    /// stored and their triangle counts: where an imported tree's split stands against the curves
+    /// (a built tree's children's boxes are tight, so this is its strategy's marker cost).
+    pub own_cost: Option<f32>,
 }
 
 /// Collects a sweep's planes as curve points.
@@ -297,6 +301,10 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         SplitStrategy::ALL.into_iter().map(|strategy| (strategy, marker(strategy, &prims, &info, &params))).collect();
     let child_overlap =
         children.map(|[l, r]| Overlap::of(&bvh.nodes[l as usize].bounds(), &bvh.nodes[r as usize].bounds()));
+    let own_cost = children.filter(|_| area > 0.0).map(|[l, r]| {
+        let side = |c: u32| bvh.nodes[c as usize].bounds().area() * h.count[c as usize] as f32;
+        params.cost.traversal + params.cost.intersection * (side(l) + side(r)) / area
+    });
     Some(Inspection {
         node,
         depth: h.depth[i],
@@ -322,6 +330,7 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         binned,
         bins: super::split::bins_for(count as usize, bins),
         markers,
+        own_cost,
     })
 }
 
@@ -416,6 +425,21 @@ mod tests {
                 assert_eq!(m, ins.markers.iter().find(|(s, _)| *s == strategy).unwrap().1, "{strategy:?} {node}");
                 let want = if strategy == SplitStrategy::SahBinned { ins.binned.clone() } else { Default::default() };
                 assert_eq!(binned, want);
+            }
+        }
+    }
+
+    /// A built tree's own split cost, from its children's stored boxes, is the cost its
+    /// strategy's marker gives on the curve (both SAH strategies; the boxes are tight).
+    #[test]
+    fn own_cost_is_the_strategys_marker_cost_for_a_built_tree() {
+        for strategy in [SplitStrategy::SahSweep, SplitStrategy::SahBinned] {
+            let (bvh, h) = built(strategy, 4);
+            for node in [0u32, 1, 2, 3, 4] {
+                let ins = inspect(&bvh, &h, node).unwrap();
+                let m = ins.markers.iter().find(|(s, _)| *s == strategy).unwrap().1.unwrap();
+                let own = ins.own_cost.unwrap();
+                assert!((own - m.cost).abs() <= 1e-4 * m.cost, "{strategy:?} {node}: {own} vs {}", m.cost);
             }
         }
     }

@@ -72,7 +72,13 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             };
             let visits = nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
             figures(ui, ins, e.epo_terms[node as usize], visits.map(|v| v.counts[node as usize]));
-            if e.bvh.build_params().bvh.layout == crate::bvh::Layout::Wide4 {
+            let imported = e.bvh.import();
+            if let Some(names) = imported {
+                let d = crate::cli::inspect::dump_text(names.dump_of_binary_node(node));
+                ui.label(format!("Imported from {}: dump node {d}.", names.name))
+                    .on_hover_text("The node's id in the dump; bvhscope inspect MESH --bvh DUMP --node ID takes that id");
+            }
+            if e.bvh.build_params().bvh.layout == crate::bvh::Layout::Wide4 && imported.is_none() {
                 if let Some(g) = crate::bvh::wide::wide_group_of(&e.tree.nodes, &e.hierarchy.parent, node) {
                     ui.label(wide_group_text(node, &g)).on_hover_text(
                         "The 4-wide layout collapses the binary tree: a wide node takes the children of a binary node and, while it has fewer than four, opens the largest interior one",
@@ -80,14 +86,19 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 }
             }
             ui.separator();
-            let own = e.tree.params.strategy;
+            // An imported tree has no strategy of bvhscope's: its own split is drawn as its cost.
+            let own = imported.is_none().then_some(e.tree.params.strategy);
             if ins.triangles < 2 {
                 ui.weak("One triangle: nothing to split.");
             } else {
+                let whose = match (own, ins.own_cost) {
+                    (Some(s), _) => format!("this tree's strategy is {}", s.label()),
+                    (None, Some(c)) => format!("this tree's own split costs {c:.3} (the red line)"),
+                    (None, None) => "this imported node is a leaf".into(),
+                };
                 ui.label(format!(
-                    "SAH cost of splitting these {} triangles at each plane (C_trav + C_isect (A_L n_L + A_R n_R) / A); this tree's strategy is {}.",
-                    ins.triangles,
-                    own.label()
+                    "SAH cost of splitting these {} triangles at each plane (C_trav + C_isect (A_L n_L + A_R n_R) / A); {whose}.",
+                    ins.triangles
                 ));
                 for axis in 0..3 {
                     curve_plot(ui, ins, axis, own);
@@ -178,7 +189,9 @@ fn steps(points: &[CurvePoint]) -> Vec<[f64; 2]> {
     out
 }
 
-fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: SplitStrategy) {
+/// `own`: the tree's strategy, whose marker is "(this tree)"; `None` for an imported tree, whose
+/// own split is drawn as a line at its cost.
+fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: Option<SplitStrategy>) {
     let (sweep, binned) = (&ins.sweep[axis], &ins.binned[axis]);
     ui.label(format!("Axis {}: {} candidate planes, {} bins' planes", AXES[axis], sweep.len(), binned.len()));
     if sweep.is_empty() {
@@ -208,13 +221,16 @@ fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: SplitStrate
                     .color(Color32::from_rgb(230, 200, 80))
                     .style(LineStyle::dotted_dense()),
             );
+            if let (None, Some(c)) = (own, ins.own_cost) {
+                p.hline(HLine::new("this tree's split", c as f64).color(Color32::from_rgb(240, 80, 70)).width(2.0));
+            }
             for (s, m) in &ins.markers {
                 if let Some(m) = m.filter(|m| m.axis as usize == axis) {
-                    let chosen = if *s == own { " (this tree)" } else { "" };
+                    let chosen = if Some(*s) == own { " (this tree)" } else { "" };
                     p.vline(
                         VLine::new(format!("{}{chosen}", s.label()), m.position as f64)
                             .color(strategy_color(*s))
-                            .width(if *s == own { 2.5 } else { 1.5 }),
+                            .width(if Some(*s) == own { 2.5 } else { 1.5 }),
                     );
                 }
             }

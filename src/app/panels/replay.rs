@@ -35,7 +35,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             let k = view.k;
             ui.label(format!(
                 "The binary tree as built ({}), split by split in breadth-first order: after {k} of {n} splits the image is traced through the partial tree, its frontier nodes acting as leaves.",
-                r.tree.params.strategy.label()
+                app.current_bvh().map_or(r.tree.params.strategy.label().to_string(), |b| b.bvh.label())
             ));
             ui.horizontal(|ui| {
                 if ui.button("First").on_hover_text("The root alone, one leaf of every triangle").clicked() {

@@ -1,0 +1,233 @@
+//! Bring your own BVH in the app: a dump dropped or opened is checked as `bvhscope check` checks it,
+//! listed as "imported: FILE" among the strategies, and traced by every view; the app's figures
+//! are the command line's (`check`, `render --bvh`, `inspect --bvh`).
+
+mod support;
+
+use bvhscope::app::{Action, BvhscopeApp, MessageKind, Pick, SceneSource};
+use bvhscope::bvh::check::Group;
+use bvhscope::cli::{Cli, Command};
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use support::*;
+
+fn torus() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj")
+}
+
+fn words(args: &[String]) -> Command {
+    let mut all = vec!["bvhscope".to_string()];
+    all.extend(args.iter().cloned());
+    Cli::from_words(&all).unwrap().command.unwrap()
+}
+
+fn s(x: impl ToString) -> String {
+    x.to_string()
+}
+
+/// `--camera … --fov … --size …`: the camera of the image on screen, for the command line.
+fn camera_words(c: &bvhscope::render::Camera) -> Vec<String> {
+    let v3 = |v: glam::Vec3| format!("{},{},{}", v.x, v.y, v.z);
+    vec![
+        s("--camera"),
+        format!("{}:{}:{}", v3(c.position), v3(c.look_at), v3(c.up)),
+        s("--fov"),
+        s(c.vfov_deg),
+        s("--size"),
+        format!("{}x{}", c.width, c.height),
+    ]
+}
+
+/// Export `strategy`'s tree of the torus in `layout` to `name` (through the command line).
+fn export(name: &str, strategy: &str, layout: &str) -> PathBuf {
+    let out = temp_file(name, "");
+    let args = [s("export-bvh"), s(torus().display()), s("--strategy"), s(strategy), s("--layout"), s(layout), s("-o")];
+    let mut args = args.to_vec();
+    args.push(s(out.display()));
+    bvhscope::cli::run(words(&args)).unwrap();
+    out
+}
+
+/// The app on the torus, idle.
+fn on_the_torus() -> Harness<'static, BvhscopeApp> {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::Picked(Pick::Open, torus()));
+    run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus()) && idle(a));
+    h
+}
+
+fn shows_imported(a: &BvhscopeApp) -> bool {
+    idle(a) && a.shown.as_ref().is_some_and(|s| s.bvh.import().is_some()) && a.jobs.wrong.is_none()
+}
+
+/// A midpoint tree with its leaves' boxes halved in x, dropped on the window: checked (the
+/// same findings and wrong pixels as `bvhscope check`), chosen in the strategy list, its image's
+/// counts those of `render --bvh`, its findings linked to the tree view, its rays named by the
+/// dump's ids, side by side against SAH; and back to the built strategy.
+#[test]
+fn a_dropped_dump_is_checked_and_traced_by_every_view() {
+    let good = export("good.json", "midpoint", "binary");
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&good).unwrap()).unwrap();
+    let leaf = v["nodes"].as_array().unwrap().iter().position(|n| n.get("first").is_some()).unwrap();
+    for n in v["nodes"].as_array_mut().unwrap().iter_mut().filter(|n| n.get("first").is_some()) {
+        let (lo, hi) = (n["min"][0].as_f64().unwrap(), n["max"][0].as_f64().unwrap());
+        n["max"][0] = serde_json::json!((lo + hi) / 2.0);
+    }
+    let broken = temp_file("broken.json", &v.to_string());
+
+    let mut h = on_the_torus();
+    h.input_mut().dropped_files.push(Arc::new(Dropped(broken.clone())));
+    run_until(&mut h, "the imported tree's image and wrong pixels", |a| shows_imported(a) && a.import.wrong.is_some());
+    assert_eq!(h.state().scene.source, SceneSource::File(torus()), "a dump is imported, not opened");
+    // The strategy list holds it, chosen; a built-in strategy in the list goes back to a build.
+    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split strategy").click();
+    h.run_steps(2);
+    h.get_by_label("imported: broken.json");
+    assert!(h.state().import.on);
+    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split strategy").click();
+    h.run_steps(2);
+    h.get_by_label("Imported BVH");
+    assert!(h.state().messages.iter().any(|m| m.kind == MessageKind::Warning && m.text.contains("broken.json")));
+
+    // The checker's findings and the red mask: as `bvhscope check` finds them for the same camera.
+    let (shown_camera, findings, wrong) = {
+        let app = h.state();
+        let t = app.import.tree.as_ref().unwrap();
+        let w = app.import.wrong.as_ref().unwrap();
+        (app.shown.as_ref().unwrap().camera, t.findings.clone(), w.pixels.clone())
+    };
+    let mut args = vec![s("check"), s(torus().display()), s("--bvh"), s(broken.display())];
+    args.extend(camera_words(&shown_camera));
+    args.extend([s("--rays"), s(0), s("--no-compare"), s("--format"), s("json")]);
+    let Command::Check(check_args) = words(&args) else { panic!("check") };
+    let (json, defects) = bvhscope::cli::check::output(&check_args).unwrap();
+    let cli: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let tree_findings = |f: &[bvhscope::bvh::check::Finding]| {
+        f.iter().filter(|f| f.group != Group::Rays).map(|f| serde_json::to_value(f).unwrap()).collect::<Vec<_>>()
+    };
+    let cli_tree: Vec<serde_json::Value> =
+        cli["findings"].as_array().unwrap().iter().filter(|f| f["group"] != "Rays").cloned().collect();
+    assert_eq!(tree_findings(&findings), cli_tree, "structure, coverage and bounds findings");
+    assert!(defects > 0 && findings.iter().any(|f| f.group == Group::Bounds && f.node == Some(leaf as u32)));
+    let cli_wrong: Vec<(u32, u32)> = serde_json::from_value(cli["wrong_pixels"].clone()).unwrap();
+    assert!(!wrong.is_empty(), "a halved leaf box misses rays");
+    let mut sorted = wrong.clone();
+    sorted.sort();
+    let mut cli_sorted = cli_wrong;
+    cli_sorted.sort();
+    assert_eq!(sorted, cli_sorted, "the red mask's pixels are check's wrong pixels");
+    h.get_by_label_contains(&format!("{} of", wrong.len()));
+    assert!(h.state().wrong_mask(&h.ctx.clone()).is_some_and(|(_, n)| n == wrong.len()));
+
+    // The heatmap's counts: `render --bvh` on the same camera gives them pixel for pixel.
+    h.state_mut().act(Action::View(2));
+    run_until(&mut h, "the visits heatmap", |a| shows_imported(a) && a.shown.as_ref().unwrap().legend.is_some());
+    let csv = temp_file("imported-counts.csv", "");
+    let mut args = vec![s("render"), s(torus().display()), s("--bvh"), s(broken.display()), s("--view"), s("visits")];
+    args.extend(camera_words(&shown_camera));
+    args.extend([s("--counts"), s(csv.display()), s("-o"), s(temp_file("imported.png", "").display())]);
+    bvhscope::cli::run(words(&args)).unwrap();
+    let app_counts = h.state().shown.as_ref().unwrap().frame.counts_csv().unwrap();
+    assert_eq!(app_counts, std::fs::read_to_string(&csv).unwrap(), "the app's counts are render --bvh's");
+
+    // A finding that names a node selects it in the tree view (by the dump's id).
+    h.get_by_role_and_label(
+        egui::accesskit::Role::Link,
+        &format!("defect: {}", findings.iter().find(|f| f.group == Group::Bounds).unwrap().text),
+    )
+    .click();
+    run_until(&mut h, "the node selected", |a| {
+        a.nodes.selected.is_some() && a.nodes.current(a.current_bvh().map(|b| &b.bvh)).is_some()
+    });
+    {
+        let app = h.state();
+        let bvh = &app.current_bvh().unwrap().bvh;
+        let selected = app.nodes.selected.unwrap();
+        assert_eq!(bvh.import().unwrap().dump_of_binary_node(selected), Some(leaf as u32));
+        assert!(app.nodes.window);
+    }
+
+    // A pinned ray names the dump's nodes and gives the trace command with --bvh.
+    h.state_mut().act(Action::PinPixel(shown_camera.width / 2, shown_camera.height / 2));
+    h.run_steps(2);
+    {
+        let r = h.state().pins.current().unwrap();
+        assert!(r.label.contains("imported: broken.json"), "{}", r.label);
+        assert!(r.command.as_ref().unwrap().contains(&format!("--bvh {}", broken.display())));
+        assert_eq!(r.named.len(), r.trace.steps.len());
+    }
+
+    // Side by side: B, SAH's build, against the imported tree.
+    h.state_mut().act(Action::Compare(true));
+    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a) && a.jobs.compare.is_none());
+    assert!(h.state().compare_images(&h.ctx.clone()).is_some());
+    assert!(h.query_all_by_label_contains("imported: broken.json").count() >= 1);
+    h.state_mut().act(Action::Compare(false));
+
+    // Back to the built strategy: chosen in the list (the one built before, SAH).
+    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split strategy").click();
+    h.run_steps(2);
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "SAH binned").click();
+    run_until(&mut h, "the built tree again", |a| idle(a) && a.shown.as_ref().unwrap().bvh.import().is_none());
+}
+
+/// A 4-wide dump is traced as 4-wide and binarised for the tree view; the node inspector's figures
+/// for a dump node are `bvhscope inspect --bvh DUMP --node ID`'s.
+#[test]
+fn a_four_wide_dump_is_explained_like_a_built_tree() {
+    let wide = export("wide.json", "sah", "wide4");
+    let mut h = on_the_torus();
+    h.state_mut().act(Action::ImportFile(wide.clone()));
+    run_until(&mut h, "the imported 4-wide tree", shows_imported);
+    assert_eq!(h.state().import.tree.as_ref().unwrap().defects(), 0);
+    assert!(h.state().import.wrong.as_ref().unwrap().pixels.is_empty(), "a correct tree hits as the linear scan");
+    assert_eq!(h.state().current_bvh().unwrap().bvh.build_params().bvh.layout, bvhscope::bvh::Layout::Wide4);
+    let dump_node = 5;
+    h.state_mut().act(Action::SelectDumpNode(dump_node));
+    run_until(&mut h, "its inspection", |a| a.nodes.inspection.is_some() && a.nodes.visits.is_some() && idle(a));
+    let ins = h.state().nodes.inspection.clone().unwrap();
+    let mut args = vec![s("inspect"), s(torus().display()), s("--bvh"), s(wide.display()), s("--node"), s(dump_node)];
+    args.extend(camera_words(&h.state().shown.as_ref().unwrap().camera));
+    args.extend([s("--format"), s("json")]);
+    let Command::Inspect(a) = words(&args) else { panic!("inspect") };
+    let v: serde_json::Value = serde_json::from_str(&bvhscope::cli::inspect::output(&a).unwrap()).unwrap();
+    assert_eq!(v["dump_node"], dump_node);
+    assert_eq!(v["node"], ins.node);
+    assert_eq!(v["triangles"], ins.triangles);
+    assert_eq!(v["own_cost"].as_f64().map(|c| c as f32), ins.own_cost);
+    let visits = h.state().nodes.visits.as_ref().unwrap().counts[ins.node as usize];
+    assert_eq!(v["visits"], visits);
+    h.get_by_label_contains(&format!("dump node {dump_node}."));
+}
+
+/// A file that is no dump is refused in one message naming it, and the scene and tree stay; a dump
+/// whose structure is broken is listed with its findings but cannot be chosen.
+#[test]
+fn unreadable_and_broken_dumps_say_why() {
+    let mut h = on_the_torus();
+    let nodes = h.state().current_bvh().unwrap().stats.nodes;
+    let junk = temp_file("junk.json", "{\"format\": \"bvhscope-bvh\", \"version\": 7}");
+    h.state_mut().act(Action::ImportFile(junk));
+    run_until(&mut h, "the refusal", |a| a.messages.iter().any(|m| m.kind == MessageKind::Error));
+    h.get_by_label_contains("junk.json: version 7 of the bvhscope-bvh format");
+    assert!(!h.state().import.on && h.state().import.tree.is_none());
+    assert_eq!(h.state().current_bvh().unwrap().stats.nodes, nodes, "the built tree stays");
+
+    let good = export("cycle.json", "midpoint", "binary");
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&good).unwrap()).unwrap();
+    v["nodes"][1]["children"] = serde_json::json!([0, 2]);
+    v["nodes"][1].as_object_mut().unwrap().remove("first");
+    v["nodes"][1].as_object_mut().unwrap().remove("count");
+    std::fs::write(&good, v.to_string()).unwrap();
+    h.state_mut().act(Action::ImportFile(good));
+    run_until(&mut h, "the broken dump's findings", |a| {
+        a.import.tree.as_ref().is_some_and(|t| t.path.ends_with("cycle.json")) && a.jobs.import.is_none()
+    });
+    let t = h.state().import.tree.as_ref().unwrap();
+    assert!(t.bvh.is_err() && !h.state().import.on);
+    assert!(t.findings.iter().any(|f| f.text.contains("a cycle")));
+    h.get_by_label_contains("Not traced");
+}
