@@ -711,6 +711,19 @@ fn the_dumping_snippets_write_dumps_that_check_clean() {
         Ok(out) => panic!("dump_bvh.py fails: {}", String::from_utf8_lossy(&out.stderr)),
         Err(_) => eprintln!("notice: no python3: the Python dumping snippet is not run"),
     }
+    // The README walkthrough's broken dump: centroid boxes made from an exported tree are found
+    // out, by the bounds they miss and the rays that miss with them.
+    let (mid, bad) = (dir.join("mid.txt"), dir.join("centroid.txt"));
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    assert!(bvhscope(&["export-bvh", torus, "--strategy", "midpoint", "-o", mid.to_str().unwrap()]).status.success());
+    if let Ok(out) = Command::new("python3").arg(examples.join("centroid_boxes.py")).arg(torus).arg(&mid).output() {
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        std::fs::write(&bad, out.stdout).unwrap();
+        let out = bvhscope(&["check", torus, "--bvh", bad.to_str().unwrap(), "--rays", "2000", "--size", "48x32"]);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), Some(1), "{text}");
+        assert!(text.contains("sticks out of") && text.contains("rays hit differently"), "{text}");
+    }
 }
 
 /// `render --bvh FILE` traces an imported tree: an exported midpoint tree gives, pixel for pixel,

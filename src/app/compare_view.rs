@@ -5,7 +5,7 @@
 //! and traced in the background; it is kept, so flipping modes is instant and changing A's
 //! strategy rebuilds only A.
 
-use crate::bvh::{SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
+use crate::bvh::{Layout, SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
 use crate::render::{Camera, Frame, Legend, RaySummary};
 use std::sync::Arc;
 
@@ -99,10 +99,14 @@ impl CompareView {
         SceneBuild { bvh, ..build }
     }
 
-    /// Start from A's build and traversal, with another strategy than A's.
-    pub fn start_from(&mut self, a: &crate::bvh::BuildParams, trace: TraceOptions) {
-        self.strategy =
-            if a.strategy == SplitStrategy::SahBinned { SplitStrategy::Midpoint } else { SplitStrategy::SahBinned };
-        (self.max_leaf_size, self.layout, self.trace) = (a.max_leaf_size, a.layout, trace);
+    /// Start from A's build and traversal, with another strategy than A's; against an imported
+    /// tree (`imported`: its layout), the reference: SAH binned in that layout.
+    pub fn start_from(&mut self, a: &crate::bvh::BuildParams, trace: TraceOptions, imported: Option<Layout>) {
+        self.strategy = if a.strategy == SplitStrategy::SahBinned && imported.is_none() {
+            SplitStrategy::Midpoint
+        } else {
+            SplitStrategy::SahBinned
+        };
+        (self.max_leaf_size, self.layout, self.trace) = (a.max_leaf_size, imported.unwrap_or(a.layout), trace);
     }
 }

@@ -865,7 +865,8 @@ impl BvhscopeApp {
             A::SetThreshold(t) => self.threshold = t,
             A::Compare(on) => {
                 if on && !self.compare.on {
-                    self.compare.start_from(&self.settings.build, self.settings.trace);
+                    let imported = self.import.shown(self.scene_id).map(|b| b.build_params().bvh.layout);
+                    self.compare.start_from(&self.settings.build, self.settings.trace, imported);
                 }
                 self.compare.on = on;
                 if on {
