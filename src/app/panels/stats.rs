@@ -226,7 +226,8 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
         _ => false,
     };
     let columns = if comparing { 4 } else { 3 };
-    let width = if comparing { 0.3 } else { 0.4 } * ui.available_width();
+    // Four columns share the width (a long label such as an imported file's wraps within its own).
+    let width = if comparing { super::grid_column_width(ui, columns) } else { 0.4 * ui.available_width() };
     egui::Grid::new("bvh-stats").num_columns(columns).striped(true).max_col_width(width).show(ui, |ui| {
         ui.label("");
         ui.strong(&current.label);
