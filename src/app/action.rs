@@ -4,10 +4,13 @@
 //! what to rebuild and what to re-render (the egui demo app's split of state and UI).
 
 use super::node_view::{Metric, Step as NodeStep};
-use super::{Pick, Settings};
-use crate::bvh::Preset;
-use crate::render::UpAxis;
+use super::{export, BvhscopeApp, MessageKind, PathWindow, Pick, PinnedRay, RayView, Settings};
+use crate::bvh::{Preset, SplitStrategy};
+use crate::render::{ColorMap, UpAxis, View};
+use crate::scene::Scene;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Action {
@@ -142,3 +145,229 @@ pub enum Action {
 
 /// Where panels put the actions they emit during one frame.
 pub type Actions = Vec<Action>;
+
+impl BvhscopeApp {
+    /// Apply one action: the only place the state changes in answer to the user.
+    pub fn act(&mut self, action: Action) {
+        use Action as A;
+        match action {
+            A::Open => self.jobs.pick_file(Pick::Open, ""),
+            A::OpenPath => self.path_window = Some(PathWindow::new(Pick::Open, String::new(), None)),
+            // Loads in the background; the current scene stays until it has loaded.
+            A::OpenFile(path) => self.jobs.load(path),
+            A::ShowBuiltin => self.set_scene(Arc::new(Scene::builtin())),
+            A::SavePng => self.jobs.pick_file(Pick::SavePng, &export::default_name(self, "png")),
+            A::SavePngTyped => {
+                let name = export::default_name(self, "png");
+                self.path_window = Some(PathWindow::new(Pick::SavePng, name, None));
+            }
+            A::ExportStats => self.jobs.pick_file(Pick::SaveStatsCsv, &export::default_name(self, "csv")),
+            A::ExportStatsJson => self.jobs.pick_file(Pick::SaveStatsJson, &export::default_name(self, "json")),
+            A::ExportCounts => self.jobs.pick_file(Pick::SaveCounts, &export::default_name(self, "counts")),
+            A::SaveScene => {
+                let name = format!("{}.json", self.scene.title().trim_end_matches(".obj").trim_end_matches(".json"));
+                self.jobs.pick_file(Pick::SaveScene, &name);
+            }
+            A::OpenBvh => self.jobs.pick_file(Pick::OpenBvh, ""),
+            A::OpenBvhPath => self.path_window = Some(PathWindow::new(Pick::OpenBvh, String::new(), None)),
+            A::ImportFile(path) => self.import_file(path),
+            A::ExportBvh => self.jobs.pick_file(Pick::SaveBvh, &export::default_name(self, "bvh")),
+            A::UseImported(on) => self.import.on = on && self.import.traced(self.scene_id).is_some(),
+            A::ShowImported(open) => self.import.window = open,
+            A::WrongMask(on) => self.import.mask = on,
+            A::SelectDumpNode(d) => self.select_dump_node(d),
+            A::SelectTriangle(t) => self.select_triangle(t),
+            A::Picked(pick, path) => {
+                self.path_window = None;
+                self.picked(pick, path);
+            }
+            A::PathText(text) => {
+                if let Some(w) = &mut self.path_window {
+                    w.text = text;
+                }
+            }
+            A::PathFocused => {
+                if let Some(w) = &mut self.path_window {
+                    w.focus = false;
+                }
+            }
+            A::ClosePathWindow => self.path_window = None,
+            A::Orbit(dx, dy) => self.orbit.orbit(dx, dy),
+            A::Pan { dx, dy, height } => self.orbit.pan(dx, dy, height),
+            A::Zoom(amount) => self.orbit.zoom(amount),
+            A::FrameMesh => self.orbit.frame(&self.scene.bounds(), self.viewport_aspect),
+            A::ResetView => self.reset_view(),
+            A::Viewport { rect, pixels } => {
+                self.viewport_rect = rect;
+                self.viewport_aspect = rect.width() / rect.height().max(1.0);
+                self.viewport_pixels = pixels;
+            }
+            A::View(i) => {
+                self.settings.view = View::ALL[i.min(View::ALL.len() - 1)];
+                self.threshold = None;
+            }
+            A::SetThreshold(t) => self.threshold = t,
+            A::Compare(on) => {
+                if on && !self.compare.on {
+                    let imported = self.import.shown(self.scene_id).map(|b| b.build_params().bvh.layout);
+                    self.compare.start_from(&self.settings.build, self.settings.trace, imported);
+                }
+                self.compare.on = on;
+                if on {
+                    self.replay.window = false;
+                }
+            }
+            A::CompareStrategy(st) => self.compare.strategy = st,
+            A::CompareB { max_leaf_size, layout, trace } => {
+                let n = &crate::options::MAX_LEAF_SIZE;
+                self.compare.max_leaf_size = max_leaf_size.clamp(n.min, n.max);
+                self.compare.layout = layout;
+                self.compare.trace = trace;
+            }
+            A::CompareMode(m) => self.compare.mode = m,
+            A::Wipe(x) => self.compare.wipe = x.clamp(0.0, 1.0),
+            A::ShowReplay(open) => {
+                self.replay.window = open;
+                if open {
+                    self.compare.on = false;
+                }
+                self.replay.playing = false;
+            }
+            A::ReplayStep(k) => {
+                self.replay.set(k);
+                self.replay.last_tick = Some(Instant::now());
+            }
+            A::ReplayPlay(on) => {
+                let n = self.replay.replay.as_ref().map_or(0, |r| r.splits());
+                if on && self.replay.k >= n {
+                    self.replay.k = 0;
+                }
+                self.replay.playing = on;
+                self.replay.last_tick = Some(Instant::now());
+            }
+            A::ToggleBoxes => self.settings.show_boxes = !self.settings.show_boxes,
+            A::DepthUp => {
+                let max = self.current_bvh().map_or(0, |b| b.bottom_max_depth());
+                self.settings.box_depth = (self.settings.box_depth + 1).min(max);
+                self.settings.show_boxes = true;
+            }
+            A::DepthDown => {
+                self.settings.box_depth = self.settings.box_depth.saturating_sub(1);
+                self.settings.show_boxes = true;
+            }
+            A::NextStrategy => {
+                self.import.on = false;
+                let i = SplitStrategy::ALL.iter().position(|s| *s == self.settings.build.strategy).unwrap_or(0);
+                self.settings.build.strategy = SplitStrategy::ALL[(i + 1) % SplitStrategy::ALL.len()];
+            }
+            A::NextColormap => {
+                let i = ColorMap::ALL.iter().position(|c| *c == self.settings.colormap).unwrap_or(0);
+                self.settings.colormap = ColorMap::ALL[(i + 1) % ColorMap::ALL.len()];
+            }
+            A::ApplyPreset(preset) => {
+                self.settings.apply_preset(preset);
+                self.message(MessageKind::Info, format!("{}: {}", preset.label(), preset.help()));
+            }
+            A::SetUpAxis(up) => {
+                if self.settings.up_axis != up {
+                    self.settings.up_axis = up;
+                    self.reset_view();
+                }
+            }
+            A::Edit(settings) => {
+                let up = settings.up_axis;
+                self.settings = Settings { up_axis: self.settings.up_axis, ..*settings };
+                self.act(A::SetUpAxis(up));
+            }
+            A::PinPixel(x, y) => {
+                let Some(s) = &self.shown else { return };
+                if s.partial.is_some() {
+                    let note =
+                        "The image shows a partial tree of the build replay: close the Replay window to pin a ray.";
+                    self.message(MessageKind::Info, note);
+                    return;
+                }
+                if x < s.camera.width && y < s.camera.height {
+                    let ray = s.camera.ray_gen().pixel_ray(x, y);
+                    self.pins.pin(PinnedRay::new(s.bvh.clone(), ray, s.trace, Some((x, y)), &self.scene.source));
+                }
+            }
+            A::PinTyped => match (self.pins.typed_ray(), self.current_bvh()) {
+                (Ok(ray), Some(b)) => {
+                    let pinned = PinnedRay::new(b.bvh.clone(), ray, self.settings.trace, None, &self.scene.source);
+                    self.pins.pin(pinned);
+                }
+                (Err(e), _) => self.message(MessageKind::Error, e),
+                (_, None) => self.message(MessageKind::Error, "no BVH is built yet to trace the ray through"),
+            },
+            A::RayText { origin, dir } => (self.pins.origin_text, self.pins.dir_text) = (origin, dir),
+            A::Unpin(i) => self.pins.unpin(i),
+            A::UnpinAll => {
+                self.pins = RayView {
+                    origin_text: self.pins.origin_text.clone(),
+                    dir_text: self.pins.dir_text.clone(),
+                    ..Default::default()
+                };
+                self.ray_window = false;
+            }
+            A::SelectPinned(i) => self.pins.select(i),
+            A::RayStep(k) => self.pins.set_step(k),
+            A::RayStepBy(d) => {
+                self.pins.set_step(self.pins.step.saturating_add_signed(d as isize));
+                self.pins.last_tick = Some(Instant::now());
+            }
+            A::RayPlay(on) => {
+                self.pins.playing = on;
+                self.pins.last_tick = Some(Instant::now());
+                if on && self.pins.current().is_some_and(|r| self.pins.step + 1 >= r.len()) {
+                    self.pins.step = 0; // play again from the start
+                }
+            }
+            A::ShowRayWindow => self.ray_window = true,
+            A::ShowTree(open) => {
+                self.nodes.window = open;
+                if open && self.nodes.selected.is_none() {
+                    self.nodes.selected = Some(0);
+                    self.nodes.inspection = None;
+                }
+            }
+            A::SelectNode(n) => {
+                self.nodes.window = true;
+                self.nodes.select(n);
+            }
+            A::SelectPixelNode(x, y) => {
+                let Some(shown) = &self.shown else { return };
+                let explained = self.nodes.current(Some(&shown.bvh)).cloned();
+                match (explained, shown.frame.sample(x, y)) {
+                    (_, s) if !s.is_hit() => self.message(MessageKind::Info, "That pixel hits nothing: no leaf to select."),
+                    (Some(e), s) => match e.hierarchy.leaf_of_prim(s.prim) {
+                        Some(leaf) => self.act(A::SelectNode(leaf)),
+                        None => self.message(MessageKind::Warning, "The pixel's triangle is in no leaf of this tree."),
+                    },
+                    (None, _) => self.message(
+                        MessageKind::Info,
+                        "The tree view is still being prepared (or the scene is built as two levels, which it does not show).",
+                    ),
+                }
+            }
+            A::NodeStep(step) => {
+                if let Some(n) = self.nodes.step(step) {
+                    self.nodes.select(n);
+                }
+            }
+            A::ToggleOpen(n) => {
+                if !self.nodes.open.remove(&n) {
+                    self.nodes.open.insert(n);
+                }
+            }
+            A::SetMetric(m) => self.nodes.metric = m,
+            A::Help => self.show_help = !self.show_help,
+            A::SetHelp(on) => self.show_help = on,
+            A::Dismiss(i) => {
+                if i < self.messages.len() {
+                    self.messages.remove(i);
+                }
+            }
+        }
+    }
+}
