@@ -167,6 +167,17 @@ fn a_dropped_dump_is_checked_and_traced_by_every_view() {
     assert!(h.query_all_by_label_contains("imported: broken.json").count() >= 1);
     h.state_mut().act(Action::Compare(false));
 
+    // Its node boxes are drawn, and File ▸ Export BVH writes it back: the same nodes.
+    let mut settings = h.state().settings.clone();
+    (settings.show_boxes, settings.box_depth) = (true, 3);
+    h.state_mut().act(Action::Edit(Box::new(settings)));
+    h.run_steps(2);
+    assert_eq!(h.state().boxes_drawn(), 8, "a binary tree has 8 nodes at depth 3 here");
+    let written = temp_file("written.json", "");
+    h.state_mut().act(Action::Picked(Pick::SaveBvh, written.clone()));
+    let back = bvhscope::bvh::dump::BvhDump::read(&written).unwrap();
+    assert_eq!(back.nodes.len(), v["nodes"].as_array().unwrap().len());
+
     // Back to the built strategy: chosen in the list (the one built before, SAH).
     h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split strategy").click();
     h.run_steps(2);
