@@ -71,7 +71,7 @@ macro_rules! choice {
     };
 }
 
-const STRATEGIES: [Named<SplitStrategy>; 4] = [
+const STRATEGIES: [Named<SplitStrategy>; 5] = [
     Named {
         value: SplitStrategy::Midpoint,
         name: "midpoint",
@@ -96,8 +96,14 @@ const STRATEGIES: [Named<SplitStrategy>; 4] = [
         label: "SAH sweep",
         help: "surface area heuristic tried between every pair of centroids; exact, slowest to build",
     },
+    Named {
+        value: SplitStrategy::Lbvh,
+        name: "lbvh",
+        label: "LBVH (Morton)",
+        help: "linear BVH: centroids sorted by Morton code, split where the code's top differing bit flips; fastest to build, blocky trees",
+    },
 ];
-choice!(SplitStrategy, STRATEGIES, 4);
+choice!(SplitStrategy, STRATEGIES, 5);
 
 const LAYOUTS: [Named<Layout>; 2] = [
     Named {

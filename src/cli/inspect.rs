@@ -122,6 +122,9 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
                     m.cost
                 );
             }
+            None if !s.splits_top_down() => {
+                let _ = writeln!(o, "  {:<12}  no plane priced here: it builds from the Morton order", s.named().name);
+            }
             None => {
                 let _ = writeln!(o, "  {:<12}  no split (the builder falls back to equal count)", s.named().name);
             }

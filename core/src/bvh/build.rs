@@ -187,25 +187,30 @@ fn progress_levels(n: usize, params: &BuildParams) -> u32 {
 }
 
 /// The build's progress: a control and the levels its primitives are counted over.
-struct Progress<'a> {
+pub(super) struct Progress<'a> {
     control: &'a WorkControl,
     levels: u32,
 }
 
-impl Progress<'_> {
-    fn check(&self) -> Result<(), Cancelled> {
+impl<'a> Progress<'a> {
+    #[cfg(test)]
+    pub(super) fn new(control: &'a WorkControl, levels: u32) -> Self {
+        Progress { control, levels }
+    }
+
+    pub(super) fn check(&self) -> Result<(), Cancelled> {
         self.control.check()
     }
 
     /// A node of `n` primitives at `depth` was partitioned.
-    fn split(&self, n: usize, depth: u32) {
+    pub(super) fn split(&self, n: usize, depth: u32) {
         if depth < self.levels {
             self.control.add_done(n as u64);
         }
     }
 
     /// A leaf of `n` primitives was made at `depth`: the levels its primitives will not pass.
-    fn leaf(&self, n: usize, depth: u32) {
+    pub(super) fn leaf(&self, n: usize, depth: u32) {
         self.control.add_done(n as u64 * self.levels.saturating_sub(depth) as u64);
     }
 }
@@ -236,7 +241,12 @@ fn build_nodes(
 ) -> Result<(Vec<BvhNode>, BuildReport), Cancelled> {
     let t1 = Instant::now();
     let progress = Progress { control, levels: progress_levels(prims.len(), params) };
-    let (tree, over) = build_subtree(prims, 0, 0, params, &progress)?;
+    let (tree, over) = if params.strategy.splits_top_down() {
+        build_subtree(prims, 0, 0, params, &progress)?
+    } else {
+        let (tree, fallback) = super::lbvh::build(prims, params, &progress)?;
+        (tree, Overrides { fallback, depth_limited: 0 })
+    };
     let nodes = tree.into_nodes();
     Ok((
         nodes,
@@ -353,6 +363,11 @@ const PARALLEL_MIN_PRIMS: usize = 4096;
 /// ... down to this depth, which bounds the recursion; deeper work uses the explicit stack.
 const PARALLEL_MAX_DEPTH: u32 = 16;
 
+/// The splitter of a top-down strategy (`build_nodes` sends the others to their own builders).
+fn top_down(params: &BuildParams) -> Box<dyn super::split::Splitter> {
+    params.strategy.splitter(params).expect("build_nodes builds only top-down strategies with the driver")
+}
+
 /// Build the subtree over `prims`, which start at `offset` in the full primitive array. Leaf
 /// indices are global, child indices local to the subtree.
 fn build_subtree(
@@ -371,7 +386,7 @@ fn build_subtree(
     progress.check()?;
     let info = node_info(prims);
     let mut over = Overrides::default();
-    let decision = decide(prims, &info, depth, params, &mut *params.strategy.splitter(params), &mut over);
+    let decision = decide(prims, &info, depth, params, &mut *top_down(params), &mut over);
     let Decision::Split { axis, mid } = decision else {
         return sequential(prims);
     };
@@ -402,7 +417,7 @@ fn build_sequential(
     if prims.is_empty() {
         return Ok((nodes, over)); // one empty leaf: every ray misses its empty box
     }
-    let mut splitter = params.strategy.splitter(params);
+    let mut splitter = top_down(params);
     let mut stack = vec![Task { node: 0, start: 0, end: prims.len() as u32, depth: depth0 }];
     let mut steps = 0u32;
     while let Some(task) = stack.pop() {
@@ -445,7 +460,9 @@ mod tests {
         // Big enough for several parallel levels (and parallel binning at the root).
         let mesh = torus(2.0, 0.5, 256, 160);
         assert!(mesh.triangle_count() > 16 * PARALLEL_MIN_PRIMS);
-        for strategy in SplitStrategy::ALL.into_iter().filter(|&s| s != SplitStrategy::SahSweep) {
+        // (LBVH's own parallel build is compared with its one-thread build in `bvh::lbvh`.)
+        for strategy in SplitStrategy::ALL.into_iter().filter(|&s| s != SplitStrategy::SahSweep && s.splits_top_down())
+        {
             let params = BuildParams::with_strategy(strategy).clamped();
             let bvh = Bvh::build(&mesh, &params);
             let mut prims: Vec<BuildPrim> = (0..mesh.triangle_count())

@@ -244,7 +244,7 @@ fn marker(
         return None;
     }
     let mut p = prims.to_vec();
-    match strategy.splitter(params).split(&mut p, info) {
+    match strategy.splitter(params)?.split(&mut p, info) {
         Proposal::Split { axis, mid, plane, .. } if mid > 0 && mid < p.len() => {
             let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, q| b.union(q.bounds()));
             let (l, r) = (side(&p[..mid]), side(&p[mid..]));
@@ -387,7 +387,7 @@ mod tests {
     /// centroids. The inspector runs the builder's code, not a copy of it.
     #[test]
     fn each_trees_own_strategy_marks_the_split_it_made() {
-        for strategy in SplitStrategy::ALL {
+        for strategy in SplitStrategy::ALL.into_iter().filter(|s| s.splits_top_down()) {
             let (bvh, h) = built(strategy, 2);
             let mut checked = 0;
             for (i, n) in bvh.nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {

@@ -18,6 +18,7 @@ pub fn strategy_color(s: SplitStrategy) -> Color32 {
         SplitStrategy::EqualCount => Color32::from_rgb(200, 120, 230),
         SplitStrategy::SahBinned => Color32::from_rgb(90, 200, 250),
         SplitStrategy::SahSweep => Color32::from_rgb(120, 230, 120),
+        SplitStrategy::Lbvh => Color32::from_rgb(240, 120, 200),
     }
 }
 
@@ -141,6 +142,7 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<u32>) {
         for (s, m) in &ins.markers {
             let text = match m {
                 Some(m) => format!("{} = {:.4}: {} | {}, cost {:.3}", AXES[m.axis as usize], m.position, m.left, m.right, m.cost),
+                None if !s.splits_top_down() => "no plane priced here: it builds from the Morton order".into(),
                 None => "no split (the builder falls back to equal count)".into(),
             };
             ui.label(egui::RichText::new(s.label()).color(strategy_color(*s)));

@@ -36,14 +36,21 @@ pub trait Splitter: Send {
 }
 
 impl SplitStrategy {
-    /// A splitter of this strategy for a build with `params`.
-    pub fn splitter(self, params: &crate::bvh::BuildParams) -> Box<dyn Splitter> {
+    /// A splitter of this strategy for a build with `params`; `None` for a builder that does not
+    /// split node by node at a plane it chooses there (LBVH: its planes follow from the sort).
+    pub fn splitter(self, params: &crate::bvh::BuildParams) -> Option<Box<dyn Splitter>> {
         match self {
-            SplitStrategy::Midpoint => Box::new(Midpoint),
-            SplitStrategy::EqualCount => Box::new(EqualCount),
-            SplitStrategy::SahBinned => Box::new(SahBinned::new(params)),
-            SplitStrategy::SahSweep => Box::new(SahSweep::new(params)),
+            SplitStrategy::Midpoint => Some(Box::new(Midpoint)),
+            SplitStrategy::EqualCount => Some(Box::new(EqualCount)),
+            SplitStrategy::SahBinned => Some(Box::new(SahBinned::new(params))),
+            SplitStrategy::SahSweep => Some(Box::new(SahSweep::new(params))),
+            SplitStrategy::Lbvh => None,
         }
+    }
+
+    /// Whether the top-down driver (`bvh::build`) builds with this strategy's splitter.
+    pub fn splits_top_down(self) -> bool {
+        self != SplitStrategy::Lbvh
     }
 }
 
@@ -59,6 +66,9 @@ pub enum SplitStrategy {
     SahBinned,
     /// Surface area heuristic, evaluated between every pair of neighbouring centroids.
     SahSweep,
+    /// Not a split strategy but a builder of its own (`bvh::lbvh`): the hierarchy of the
+    /// centroids' sorted Morton codes.
+    Lbvh,
 }
 
 /// A triangle as the builder sees it: its bounds in SIMD registers' layout (a box union is two

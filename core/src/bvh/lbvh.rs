@@ -1,0 +1,256 @@
+//! LBVH: the linear BVH of Lauterbach et al., "Fast BVH Construction on GPUs" (Eurographics 2009).
+//! Each primitive's centroid gets a 63-bit Morton code (21 bits per axis of the centroid bounds,
+//! interleaved x, y, z from the top), the codes are radix sorted (rdst, all threads), and the
+//! hierarchy follows from the sorted codes alone: a range of codes is split where its highest
+//! differing bit flips (the same tree as Karras, "Maximizing Parallelism in the Construction of
+//! BVHs, Octrees, and k-d Trees", HPG 2012, builds node by node; here top-down with `rayon::join`).
+//! No box is priced: the build is a sort and a pass of binary searches, and the tree is blocky,
+//! each split an axis-aligned plane of the Morton grid. A range of at most `max_leaf_size`
+//! primitives is a leaf; one of equal codes (centroids in one grid cell) above that is cut in the
+//! middle (counted as a fallback split). Boxes are made bottom-up, once per node.
+
+use super::build::{BuildParams, Progress};
+use super::node::BvhNode;
+use super::split::BuildPrim;
+use super::subtree::Subtree;
+use crate::geometry::Aabb;
+use crate::work::Cancelled;
+use glam::Vec3A;
+use rayon::prelude::*;
+
+/// Ranges at least this long are split in parallel.
+const PARALLEL_MIN: usize = 1 << 14;
+
+/// Bits per axis of the 63-bit code.
+const BITS: u32 = 21;
+
+/// Spread the low 21 bits of `v` so that bit i lands on bit 3i.
+fn spread(v: u64) -> u64 {
+    let mut x = v & 0x1f_ffff;
+    x = (x | x << 32) & 0x001f_0000_0000_ffff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
+/// The Morton code of point `p` in the grid over `lo` with `scale` cells per unit.
+fn morton(p: Vec3A, lo: Vec3A, scale: Vec3A) -> u64 {
+    let max = ((1u32 << BITS) - 1) as f32;
+    let q = ((p - lo) * scale).clamp(Vec3A::ZERO, Vec3A::splat(max));
+    spread(q.x as u64) << 2 | spread(q.y as u64) << 1 | spread(q.z as u64)
+}
+
+/// The axis a code bit belongs to (x on bits 3i + 2, y on 3i + 1, z on 3i).
+fn axis_of(bit: u32) -> u8 {
+    2 - (bit % 3) as u8
+}
+
+/// A sort record: the code and where the primitive was.
+#[derive(Clone, Copy)]
+struct Keyed {
+    code: u64,
+    slot: u32,
+}
+
+impl rdst::RadixKey for Keyed {
+    const LEVELS: usize = 8;
+    #[inline]
+    fn get_level(&self, level: usize) -> u8 {
+        (self.code >> (level * 8)) as u8
+    }
+}
+
+/// Where a range of sorted codes is split, and on which axis: `None` when all codes are equal.
+fn split_of(codes: &[u64]) -> Option<(usize, u8)> {
+    let (a, b) = (codes[0], codes[codes.len() - 1]);
+    if a == b {
+        return None;
+    }
+    let bit = 63 - (a ^ b).leading_zeros();
+    let mask = 1u64 << bit;
+    // The codes share every bit above `bit`: those without it come first.
+    Some((codes.partition_point(|c| c & mask == 0), axis_of(bit)))
+}
+
+/// Sort `prims` into Morton order and build the hierarchy over them (left in leaf order). The
+/// subtree and the number of ranges of equal codes cut in the middle.
+pub(super) fn build(
+    prims: &mut [BuildPrim],
+    params: &BuildParams,
+    progress: &Progress,
+) -> Result<(Subtree, u32), Cancelled> {
+    if prims.is_empty() {
+        return Ok((Subtree::Flat(vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)]), 0));
+    }
+    let codes = sort(prims);
+    progress.check()?;
+    let leaf = params.max_leaf_size as usize;
+    subtree(prims, &codes, 0, 0, leaf, progress)
+}
+
+/// Sort `prims` by the Morton codes of their centroids in the grid over the centroid bounds;
+/// the codes in that order.
+fn sort(prims: &mut [BuildPrim]) -> Vec<u64> {
+    let centroids = prims
+        .par_iter()
+        .with_min_len(4096)
+        .fold(|| Aabb::EMPTY, |b, p| b.grow(p.centroid()))
+        .reduce(|| Aabb::EMPTY, |a, b| a.union(b));
+    let extent = centroids.max - centroids.min;
+    let cells = ((1u32 << BITS) - 1) as f32;
+    let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO);
+    let mut keyed: Vec<Keyed> = prims
+        .par_iter()
+        .with_min_len(4096)
+        .enumerate()
+        .map(|(i, p)| Keyed { code: morton(p.centroid(), centroids.min, scale), slot: i as u32 })
+        .collect();
+    rdst::RadixSort::radix_sort_unstable(&mut keyed);
+    let sorted: Vec<BuildPrim> = keyed.par_iter().with_min_len(4096).map(|k| prims[k.slot as usize]).collect();
+    prims.par_iter_mut().with_min_len(4096).zip(sorted.par_iter()).for_each(|(to, from)| *to = *from);
+    keyed.par_iter().with_min_len(4096).map(|k| k.code).collect()
+}
+
+/// The subtree over `prims` (with their `codes`), which start at `offset` in the full array.
+fn subtree(
+    prims: &[BuildPrim],
+    codes: &[u64],
+    offset: u32,
+    depth: u32,
+    leaf: usize,
+    progress: &Progress,
+) -> Result<(Subtree, u32), Cancelled> {
+    if prims.len() < PARALLEL_MIN {
+        return sequential(prims, codes, offset, depth, leaf, progress).map(|(n, f)| (Subtree::Flat(n), f));
+    }
+    progress.check()?;
+    let (mid, axis, fallback) = match split_of(codes) {
+        Some((mid, axis)) => (mid, axis, 0),
+        None => (prims.len() / 2, 0, 1),
+    };
+    progress.split(prims.len(), depth);
+    let ((lp, rp), (lc, rc)) = (prims.split_at(mid), codes.split_at(mid));
+    let (left, right) = rayon::join(
+        || subtree(lp, lc, offset, depth + 1, leaf, progress),
+        || subtree(rp, rc, offset + mid as u32, depth + 1, leaf, progress),
+    );
+    let ((left, lf), (right, rf)) = (left?, right?);
+    let bounds = root_bounds(&left).union(root_bounds(&right));
+    let len = 1 + left.len() + right.len();
+    Ok((Subtree::Split { bounds, axis, left: Box::new(left), right: Box::new(right), len }, fallback + lf + rf))
+}
+
+fn root_bounds(t: &Subtree) -> Aabb {
+    match t {
+        Subtree::Flat(nodes) => nodes[0].bounds(),
+        Subtree::Split { bounds, .. } => *bounds,
+    }
+}
+
+/// One thread's subtree, laid out as `build::build_sequential` lays out its nodes (each node's
+/// children a pair, the left subtree right after it): the topology top-down, then the boxes from
+/// the leaves up (children come after their parent, so one pass backwards).
+fn sequential(
+    prims: &[BuildPrim],
+    codes: &[u64],
+    offset: u32,
+    depth0: u32,
+    leaf: usize,
+    progress: &Progress,
+) -> Result<(Vec<BvhNode>, u32), Cancelled> {
+    let mut nodes = Vec::with_capacity(2 * prims.len() / leaf.max(1) + 1);
+    nodes.push(BvhNode::leaf(Aabb::EMPTY, offset, 0));
+    let mut fallback = 0;
+    // (node, start, end, depth)
+    let mut stack = vec![(0usize, 0usize, prims.len(), depth0)];
+    let mut steps = 0u32;
+    while let Some((node, start, end, depth)) = stack.pop() {
+        steps += 1;
+        if steps.is_multiple_of(256) {
+            progress.check()?;
+        }
+        let n = end - start;
+        if n <= leaf {
+            let b = prims[start..end].iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds()));
+            nodes[node] = BvhNode::leaf(b, offset + start as u32, n as u16);
+            progress.leaf(n, depth);
+            continue;
+        }
+        let (mid, axis) = split_of(&codes[start..end]).unwrap_or_else(|| {
+            fallback += 1;
+            (n / 2, 0)
+        });
+        let left = nodes.len();
+        nodes.extend([BvhNode::leaf(Aabb::EMPTY, 0, 0); 2]);
+        nodes[node] = BvhNode::interior(Aabb::EMPTY, left as u32, axis);
+        progress.split(n, depth);
+        stack.push((left + 1, start + mid, end, depth + 1));
+        stack.push((left, start, start + mid, depth + 1));
+    }
+    for i in (0..nodes.len()).rev() {
+        let n = nodes[i];
+        if !n.is_leaf() {
+            let b = nodes[n.index as usize].bounds().union(nodes[n.index as usize + 1].bounds());
+            nodes[i] = BvhNode::interior(b, n.index, n.axis);
+        }
+    }
+    Ok((nodes, fallback))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_interleave_x_y_z_from_the_top() {
+        assert_eq!(spread(0b101), 0b1_000_001);
+        assert_eq!(spread(0x1f_ffff).count_ones(), 21);
+        let (lo, scale) = (Vec3A::ZERO, Vec3A::splat(((1u32 << BITS) - 1) as f32));
+        // The far corner on x only sets x's bits: 3i + 2.
+        let x = morton(Vec3A::new(1.0, 0.0, 0.0), lo, scale);
+        assert_eq!(x, spread(0x1f_ffff) << 2);
+        assert_eq!(axis_of(62), 0, "the top bit is x's");
+        assert_eq!((axis_of(61), axis_of(60)), (1, 2));
+    }
+
+    /// The parallel build lays out the tree one thread lays out over the same sorted primitives.
+    #[test]
+    fn the_parallel_build_lays_out_the_same_tree_as_one_thread() {
+        let mesh = crate::mesh::generate::torus(2.0, 0.5, 256, 160);
+        assert!(mesh.triangle_count() > 4 * PARALLEL_MIN);
+        let prims = || -> Vec<BuildPrim> {
+            (0..mesh.triangle_count())
+                .map(|i| BuildPrim::new(Aabb::from_points(&mesh.triangle(i as u32)), i as u32))
+                .collect()
+        };
+        let control = crate::work::WorkControl::new();
+        let progress = Progress::new(&control, 1);
+        let params = BuildParams { max_leaf_size: 4, ..BuildParams::default() };
+        let mut a = prims();
+        let (tree, _) = build(&mut a, &params, &progress).unwrap();
+        let mut b = prims();
+        let codes = sort(&mut b);
+        assert!(codes.windows(2).all(|w| w[0] <= w[1]), "sorted");
+        let (nodes, _) = sequential(&b, &codes, 0, 0, 4, &progress).unwrap();
+        assert!(tree.into_nodes() == nodes);
+        assert!(a.iter().map(|p| p.index()).eq(b.iter().map(|p| p.index())));
+        // Every leaf holds at most 4, and each interior box is its children's union.
+        for n in &nodes {
+            if n.is_leaf() {
+                assert!(n.count <= 4);
+            } else {
+                let (l, r) = (nodes[n.index as usize].bounds(), nodes[n.index as usize + 1].bounds());
+                assert_eq!(n.bounds(), l.union(r));
+            }
+        }
+    }
+
+    #[test]
+    fn a_range_splits_where_its_highest_differing_bit_flips() {
+        let codes = [0b0001, 0b0011, 0b0100, 0b0110, 0b0111];
+        assert_eq!(split_of(&codes).map(|s| s.0), Some(2), "bit 2 flips between 0b0011 and 0b0100");
+        assert_eq!(split_of(&[5, 5, 5]), None);
+    }
+}
