@@ -107,12 +107,13 @@ fn stats_and_compare_print_their_tables() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     let rows = v["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 11, "five strategies in two layouts, and the linear scan");
+    assert_eq!(rows.len(), 13, "six strategies in two layouts, and the linear scan");
     assert_eq!(rows[0]["name"], "Midpoint (binary)");
     assert_eq!(rows[1]["name"], "Midpoint (wide4)");
     assert_eq!(rows[8]["name"], "LBVH (Morton) (binary)");
-    assert_eq!(rows[10]["name"], "Linear scan");
-    assert_eq!(rows[10]["tri_tests_per_ray"], 4.0);
+    assert_eq!(rows[10]["name"], "PLOC (binary)");
+    assert_eq!(rows[12]["name"], "Linear scan");
+    assert_eq!(rows[12]["tri_tests_per_ray"], 4.0);
     for r in rows {
         assert!(r["frame_ms"].as_f64().unwrap() > 0.0);
     }
@@ -130,7 +131,7 @@ fn stats_and_compare_print_their_tables() {
         "wide4",
     ]);
     let csv = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(csv.lines().count(), 7, "header, five strategies in the chosen layout, linear: {csv}");
+    assert_eq!(csv.lines().count(), 8, "header, six strategies in the chosen layout, linear: {csv}");
     assert!(csv.starts_with("strategy,build_ms"));
 }
 
@@ -227,7 +228,7 @@ fn compare_times_single_rays_and_writes_csv_a_reader_parses() {
     let mut r = csv::Reader::from_reader(&out.stdout[..]);
     let header = r.headers().unwrap().clone();
     let records: Vec<csv::StringRecord> = r.records().map(|r| r.unwrap()).collect();
-    assert_eq!(records.len(), 6, "five strategies in the preset's binary layout, and the linear scan");
+    assert_eq!(records.len(), 7, "six strategies in the preset's binary layout, and the linear scan");
     let col = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name} in {header:?}"));
     for rec in &records {
         assert_eq!(rec.len(), header.len());
@@ -236,9 +237,9 @@ fn compare_times_single_rays_and_writes_csv_a_reader_parses() {
         assert!(root.parse::<f64>().unwrap() >= all.parse::<f64>().unwrap());
     }
     assert_eq!(&records[0][0], "Midpoint (binary)");
-    assert_eq!(&records[5][col("build_ms")], "", "the linear scan has no build");
-    assert!(records[..5].iter().all(|r| r[col("epo")].parse::<f64>().is_ok()), "each strategy's EPO");
-    assert_eq!(&records[5][col("epo")], "");
+    assert_eq!(&records[6][col("build_ms")], "", "the linear scan has no build");
+    assert!(records[..6].iter().all(|r| r[col("epo")].parse::<f64>().is_ok()), "each strategy's EPO");
+    assert_eq!(&records[6][col("epo")], "");
 
     let out = bvhscope(&["compare", tent().to_str().unwrap(), "--size", "40x30", "--runs", "1", "--layout", "binary"]);
     let text = String::from_utf8_lossy(&out.stdout);

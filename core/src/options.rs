@@ -71,7 +71,7 @@ macro_rules! choice {
     };
 }
 
-const STRATEGIES: [Named<SplitStrategy>; 5] = [
+const STRATEGIES: [Named<SplitStrategy>; 6] = [
     Named {
         value: SplitStrategy::Midpoint,
         name: "midpoint",
@@ -102,8 +102,14 @@ const STRATEGIES: [Named<SplitStrategy>; 5] = [
         label: "LBVH (Morton)",
         help: "linear BVH: centroids sorted by Morton code, split where the code's top differing bit flips; fastest to build, blocky trees",
     },
+    Named {
+        value: SplitStrategy::Ploc,
+        name: "ploc",
+        label: "PLOC",
+        help: "bottom-up: clusters in Morton order merge with their nearest neighbour (smallest joint box) within a search radius; SAH-like trees, fast parallel build",
+    },
 ];
-choice!(SplitStrategy, STRATEGIES, 5);
+choice!(SplitStrategy, STRATEGIES, 6);
 
 const LAYOUTS: [Named<Layout>; 2] = [
     Named {
@@ -303,6 +309,16 @@ pub const SAH_BINS: Number<u32> = Number {
     help: "Bins per axis of the binned SAH: more bins, closer to the exact sweep, slower build. Nodes of fewer than three triangles per bin use a third of their count, at least 4 (never more than asked for).",
     min: 2,
     max: crate::bvh::split::sah_binned_max_bins() as u32,
+    default: 16,
+};
+
+pub const PLOC_RADIUS: Number<u32> = Number {
+    name: "ploc-radius",
+    key: "ploc_radius",
+    label: "PLOC radius",
+    help: "Clusters PLOC searches on each side (in Morton order) for a cluster's nearest neighbour: larger, better trees, slower build.",
+    min: 1,
+    max: 64,
     default: 16,
 };
 

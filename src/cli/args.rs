@@ -3,7 +3,7 @@
 
 use crate::bvh::{BuildParams, Layout, Preset, SahCost, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder};
 use crate::geometry::{Aabb, TriangleTest};
-use crate::options::{Choice, Number, MAX_LEAF_SIZE, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
+use crate::options::{Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
 use crate::render::{Camera, UpAxis};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
@@ -39,6 +39,8 @@ pub struct BuildArgs {
     pub max_leaf_size: Option<u32>,
     #[arg(long, value_parser = whole(&SAH_BINS), help = number_help(&SAH_BINS))]
     pub bins: Option<u32>,
+    #[arg(long, value_parser = whole(&PLOC_RADIUS), help = number_help(&PLOC_RADIUS))]
+    pub ploc_radius: Option<u32>,
     #[arg(long, value_parser = parse_traversal_cost, help = number_help(&TRAVERSAL_COST))]
     pub traversal_cost: Option<f32>,
     /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
@@ -88,6 +90,7 @@ impl BuildArgs {
             layout,
             max_leaf_size: self.max_leaf_size.unwrap_or(base.max_leaf_size),
             sah_bins: self.bins.unwrap_or(base.sah_bins),
+            ploc_radius: self.ploc_radius.unwrap_or(base.ploc_radius),
             cost: SahCost { traversal: self.traversal_cost.unwrap_or(base.cost.traversal), ..base.cost },
         }
     }
@@ -128,6 +131,7 @@ pub fn build_flags(build: &SceneBuild, opts: TraceOptions) -> Vec<String> {
         format!("--strategy {}", p.strategy.named().name),
         format!("--max-leaf-size {}", p.max_leaf_size),
         format!("--bins {}", p.sah_bins),
+        format!("--ploc-radius {}", p.ploc_radius),
         format!("--traversal-cost {}", p.cost.traversal),
         format!("--layout {}", p.layout.named().name),
         format!("--order {}", opts.order.named().name),

@@ -9,7 +9,7 @@ use super::split::{BuildPrim, EqualCount, NodeInfo, Proposal, SplitStrategy, Spl
 use super::subtree::Subtree;
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
-use crate::options::{MAX_LEAF_SIZE, SAH_BINS, TRAVERSAL_COST};
+use crate::options::{MAX_LEAF_SIZE, PLOC_RADIUS, SAH_BINS, TRAVERSAL_COST};
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -60,6 +60,8 @@ pub struct BuildParams {
     pub sah_bins: u32,
     pub cost: SahCost,
     pub layout: Layout,
+    /// PLOC's neighbour search: clusters each side in Morton order (default 16).
+    pub ploc_radius: u32,
 }
 
 impl Default for BuildParams {
@@ -70,6 +72,7 @@ impl Default for BuildParams {
             sah_bins: SAH_BINS.default,
             cost: SahCost::default(),
             layout: Layout::default(),
+            ploc_radius: PLOC_RADIUS.default,
         }
     }
 }
@@ -161,6 +164,7 @@ impl BuildParams {
         BuildParams {
             max_leaf_size: MAX_LEAF_SIZE.clamp(self.max_leaf_size),
             sah_bins: SAH_BINS.clamp(self.sah_bins),
+            ploc_radius: PLOC_RADIUS.clamp(self.ploc_radius),
             cost: SahCost { traversal: TRAVERSAL_COST.clamp(self.cost.traversal), ..self.cost },
             ..*self
         }
@@ -241,11 +245,16 @@ fn build_nodes(
 ) -> Result<(Vec<BvhNode>, BuildReport), Cancelled> {
     let t1 = Instant::now();
     let progress = Progress { control, levels: progress_levels(prims.len(), params) };
-    let (tree, over) = if params.strategy.splits_top_down() {
-        build_subtree(prims, 0, 0, params, &progress)?
-    } else {
-        let (tree, fallback) = super::lbvh::build(prims, params, &progress)?;
-        (tree, Overrides { fallback, depth_limited: 0 })
+    let (tree, over) = match params.strategy {
+        SplitStrategy::Lbvh => {
+            let (tree, fallback) = super::lbvh::build(prims, params, &progress)?;
+            (tree, Overrides { fallback, depth_limited: 0 })
+        }
+        SplitStrategy::Ploc => {
+            let (tree, _) = super::ploc::build(prims, params, params.ploc_radius as usize, &progress)?;
+            (tree, Overrides::default())
+        }
+        _ => build_subtree(prims, 0, 0, params, &progress)?,
     };
     let nodes = tree.into_nodes();
     Ok((

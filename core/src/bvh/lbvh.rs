@@ -92,7 +92,7 @@ pub(super) fn build(
 
 /// Sort `prims` by the Morton codes of their centroids in the grid over the centroid bounds;
 /// the codes in that order.
-fn sort(prims: &mut [BuildPrim]) -> Vec<u64> {
+pub(super) fn sort(prims: &mut [BuildPrim]) -> Vec<u64> {
     let centroids = prims
         .par_iter()
         .with_min_len(4096)

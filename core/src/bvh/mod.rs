@@ -15,6 +15,7 @@ mod lbvh;
 mod linear;
 mod node;
 pub mod packet;
+mod ploc;
 mod preset;
 pub mod replay;
 mod scene_bvh;

@@ -3,7 +3,7 @@
 
 use crate::app::{Action, Actions, BvhscopeApp};
 use crate::bvh::{Preset, SplitStrategy};
-use crate::options::{Choice, Number, MAX_LEAF_SIZE, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
+use crate::options::{Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
 
 /// A slider over a number's whole range (logarithmic: leaf sizes of 1..255 and costs of 0.01..100
 /// are chosen near their small ends), labelled and explained by the option table.
@@ -102,6 +102,8 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         number(ui, &mut s.build.max_leaf_size, &MAX_LEAF_SIZE, true);
         let sah = s.build.strategy == SplitStrategy::SahBinned;
         ui.add_enabled_ui(sah, |ui| number(ui, &mut s.build.sah_bins, &SAH_BINS, true));
+        let ploc = s.build.strategy == SplitStrategy::Ploc;
+        ui.add_enabled_ui(ploc, |ui| number(ui, &mut s.build.ploc_radius, &PLOC_RADIUS, true));
         number(ui, &mut s.build.cost.traversal, &TRAVERSAL_COST, true);
     });
 

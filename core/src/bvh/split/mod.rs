@@ -44,13 +44,13 @@ impl SplitStrategy {
             SplitStrategy::EqualCount => Some(Box::new(EqualCount)),
             SplitStrategy::SahBinned => Some(Box::new(SahBinned::new(params))),
             SplitStrategy::SahSweep => Some(Box::new(SahSweep::new(params))),
-            SplitStrategy::Lbvh => None,
+            SplitStrategy::Lbvh | SplitStrategy::Ploc => None,
         }
     }
 
     /// Whether the top-down driver (`bvh::build`) builds with this strategy's splitter.
     pub fn splits_top_down(self) -> bool {
-        self != SplitStrategy::Lbvh
+        !matches!(self, SplitStrategy::Lbvh | SplitStrategy::Ploc)
     }
 }
 
@@ -69,6 +69,9 @@ pub enum SplitStrategy {
     /// Not a split strategy but a builder of its own (`bvh::lbvh`): the hierarchy of the
     /// centroids' sorted Morton codes.
     Lbvh,
+    /// A bottom-up builder of its own (`bvh::ploc`): clusters merged with their nearest
+    /// neighbours in Morton order.
+    Ploc,
 }
 
 /// A triangle as the builder sees it: its bounds in SIMD registers' layout (a box union is two
