@@ -811,3 +811,26 @@ fn a_closed_pipe_ends_the_output_without_a_panic() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(status.code(), Some(141), "{err}");
 }
+
+/// The bonus builders on the command line: LBVH and PLOC build and report, `--ploc-radius` is
+/// taken, and `--reinsert-passes` reports the SAH cost before and after, never higher.
+#[test]
+fn lbvh_ploc_and_reinsertion_on_the_command_line() {
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    for args in [
+        vec!["stats", torus, "--strategy", "lbvh", "--layout", "binary"],
+        vec!["stats", torus, "--strategy", "ploc", "--ploc-radius", "4", "--layout", "binary"],
+    ] {
+        let out = bvhscope(&args);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success() && text.contains("SAH cost"), "{text}");
+    }
+    let out = bvhscope(&["stats", torus, "--strategy", "lbvh", "--layout", "binary", "--reinsert-passes", "3"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().find(|l| l.starts_with("reinsertion")).unwrap_or_else(|| panic!("{text}"));
+    let w: Vec<&str> = line.split_whitespace().collect();
+    let (before, after): (f64, f64) = (w[3].parse().unwrap(), w[5].parse().unwrap());
+    assert!(after < before, "{line}");
+    let out = bvhscope(&["stats", torus, "--ploc-radius", "0"]);
+    assert_eq!(out.status.code(), Some(2), "a radius of 0 is refused");
+}

@@ -322,6 +322,16 @@ pub const PLOC_RADIUS: Number<u32> = Number {
     default: 16,
 };
 
+pub const REINSERT_PASSES: Number<u32> = Number {
+    name: "reinsert-passes",
+    key: "reinsert_passes",
+    label: "Optimise: reinsertion passes",
+    help: "After the build, move nodes to where they cost least under the SAH (Bittner, Hapala & Havran 2013), largest boxes first, for up to this many passes over the tree (0: off). Works on any strategy's binary tree.",
+    min: 0,
+    max: 32,
+    default: 0,
+};
+
 pub const TRAVERSAL_COST: Number<f32> = Number {
     name: "traversal-cost",
     key: "traversal_cost",

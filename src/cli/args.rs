@@ -3,7 +3,9 @@
 
 use crate::bvh::{BuildParams, Layout, Preset, SahCost, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder};
 use crate::geometry::{Aabb, TriangleTest};
-use crate::options::{Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
+use crate::options::{
+    Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST,
+};
 use crate::render::{Camera, UpAxis};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
@@ -41,6 +43,8 @@ pub struct BuildArgs {
     pub bins: Option<u32>,
     #[arg(long, value_parser = whole(&PLOC_RADIUS), help = number_help(&PLOC_RADIUS))]
     pub ploc_radius: Option<u32>,
+    #[arg(long, value_parser = whole(&REINSERT_PASSES), help = number_help(&REINSERT_PASSES))]
+    pub reinsert_passes: Option<u32>,
     #[arg(long, value_parser = parse_traversal_cost, help = number_help(&TRAVERSAL_COST))]
     pub traversal_cost: Option<f32>,
     /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
@@ -91,6 +95,7 @@ impl BuildArgs {
             max_leaf_size: self.max_leaf_size.unwrap_or(base.max_leaf_size),
             sah_bins: self.bins.unwrap_or(base.sah_bins),
             ploc_radius: self.ploc_radius.unwrap_or(base.ploc_radius),
+            reinsert_passes: self.reinsert_passes.unwrap_or(base.reinsert_passes),
             cost: SahCost { traversal: self.traversal_cost.unwrap_or(base.cost.traversal), ..base.cost },
         }
     }
@@ -132,6 +137,7 @@ pub fn build_flags(build: &SceneBuild, opts: TraceOptions) -> Vec<String> {
         format!("--max-leaf-size {}", p.max_leaf_size),
         format!("--bins {}", p.sah_bins),
         format!("--ploc-radius {}", p.ploc_radius),
+        format!("--reinsert-passes {}", p.reinsert_passes),
         format!("--traversal-cost {}", p.cost.traversal),
         format!("--layout {}", p.layout.named().name),
         format!("--order {}", opts.order.named().name),

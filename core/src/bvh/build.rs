@@ -9,7 +9,7 @@ use super::split::{BuildPrim, EqualCount, NodeInfo, Proposal, SplitStrategy, Spl
 use super::subtree::Subtree;
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
-use crate::options::{MAX_LEAF_SIZE, PLOC_RADIUS, SAH_BINS, TRAVERSAL_COST};
+use crate::options::{MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, TRAVERSAL_COST};
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -62,6 +62,8 @@ pub struct BuildParams {
     pub layout: Layout,
     /// PLOC's neighbour search: clusters each side in Morton order (default 16).
     pub ploc_radius: u32,
+    /// Passes of reinsertion after the build (`bvh::reinsert`; 0, the default: none).
+    pub reinsert_passes: u32,
 }
 
 impl Default for BuildParams {
@@ -73,6 +75,7 @@ impl Default for BuildParams {
             cost: SahCost::default(),
             layout: Layout::default(),
             ploc_radius: PLOC_RADIUS.default,
+            reinsert_passes: REINSERT_PASSES.default,
         }
     }
 }
@@ -99,11 +102,14 @@ pub struct BuildReport {
     pub fallback_splits: u32,
     /// Nodes split by equal count because they were deeper than `HEURISTIC_DEPTH_LIMIT`.
     pub depth_limited_splits: u32,
+    /// The reinsertion pass after the build, when asked for (`BuildParams::reinsert_passes`).
+    pub reinsertion: Option<super::reinsert::Reinsertion>,
 }
 
 impl BuildReport {
     pub fn total_time(&self) -> Duration {
-        self.setup_time + self.split_time + self.reorder_time + self.collapse_time
+        let optimise = self.reinsertion.map_or(Duration::ZERO, |r| r.time);
+        self.setup_time + self.split_time + self.reorder_time + self.collapse_time + optimise
     }
 }
 
@@ -154,7 +160,12 @@ impl Bvh {
         let prim_ids: Vec<u32> = prims.iter().map(|p| p.index()).collect();
         let tris = prim_ids.par_iter().with_min_len(4096).map(|&i| mesh.triangle(i)).collect();
         report.reorder_time = t2.elapsed();
-        Ok(Bvh { nodes, prim_ids, tris, params, report })
+        let mut bvh = Bvh { nodes, prim_ids, tris, params, report };
+        if params.reinsert_passes > 0 {
+            control.check()?;
+            bvh.report.reinsertion = Some(super::reinsert::optimise(&mut bvh, params.reinsert_passes));
+        }
+        Ok(bvh)
     }
 }
 
@@ -165,6 +176,7 @@ impl BuildParams {
             max_leaf_size: MAX_LEAF_SIZE.clamp(self.max_leaf_size),
             sah_bins: SAH_BINS.clamp(self.sah_bins),
             ploc_radius: PLOC_RADIUS.clamp(self.ploc_radius),
+            reinsert_passes: REINSERT_PASSES.clamp(self.reinsert_passes),
             cost: SahCost { traversal: TRAVERSAL_COST.clamp(self.cost.traversal), ..self.cost },
             ..*self
         }
@@ -204,6 +216,25 @@ impl<'a> Progress<'a> {
 
     pub(super) fn check(&self) -> Result<(), Cancelled> {
         self.control.check()
+    }
+
+    /// The units of a split of `n` primitives at `depth` (`split`), for a caller that adds many
+    /// at once (`add`): one shared counter bumped per node costs a builder whose nodes are cheap.
+    pub(super) fn split_units(&self, n: usize, depth: u32) -> u64 {
+        if depth < self.levels {
+            n as u64
+        } else {
+            0
+        }
+    }
+
+    /// The units of a leaf of `n` primitives at `depth` (`leaf`).
+    pub(super) fn leaf_units(&self, n: usize, depth: u32) -> u64 {
+        n as u64 * self.levels.saturating_sub(depth) as u64
+    }
+
+    pub(super) fn add(&self, units: u64) {
+        self.control.add_done(units);
     }
 
     /// A node of `n` primitives at `depth` was partitioned.

@@ -165,17 +165,18 @@ fn sequential(
     let mut fallback = 0;
     // (node, start, end, depth)
     let mut stack = vec![(0usize, 0usize, prims.len(), depth0)];
-    let mut steps = 0u32;
+    let (mut steps, mut done) = (0u32, 0u64);
     while let Some((node, start, end, depth)) = stack.pop() {
         steps += 1;
         if steps.is_multiple_of(256) {
+            progress.add(std::mem::take(&mut done));
             progress.check()?;
         }
         let n = end - start;
         if n <= leaf {
             let b = prims[start..end].iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds()));
             nodes[node] = BvhNode::leaf(b, offset + start as u32, n as u16);
-            progress.leaf(n, depth);
+            done += progress.leaf_units(n, depth);
             continue;
         }
         let (mid, axis) = split_of(&codes[start..end]).unwrap_or_else(|| {
@@ -185,10 +186,11 @@ fn sequential(
         let left = nodes.len();
         nodes.extend([BvhNode::leaf(Aabb::EMPTY, 0, 0); 2]);
         nodes[node] = BvhNode::interior(Aabb::EMPTY, left as u32, axis);
-        progress.split(n, depth);
+        done += progress.split_units(n, depth);
         stack.push((left + 1, start + mid, end, depth + 1));
         stack.push((left, start, start + mid, depth + 1));
     }
+    progress.add(done);
     for i in (0..nodes.len()).rev() {
         let n = nodes[i];
         if !n.is_leaf() {

@@ -17,6 +17,7 @@ mod node;
 pub mod packet;
 mod ploc;
 mod preset;
+pub mod reinsert;
 pub mod replay;
 mod scene_bvh;
 mod simd;

@@ -50,10 +50,12 @@ pub(super) fn build(
         .collect();
     nodes.reserve(n.saturating_sub(1));
     let mut clusters: Vec<u32> = (0..n as u32).collect();
+    // The clusters' boxes side by side in cluster order: the search reads them in a row.
+    let mut boxes: Vec<Aabb> = nodes.iter().map(|c| c.bounds).collect();
     let radius = radius.max(1);
     while clusters.len() > 1 {
         progress.check()?;
-        let mut nearest = nearest_neighbours(&nodes, &clusters, radius);
+        let mut nearest = nearest_neighbours(&boxes, radius);
         // The closest pair of the whole list is always mutual, but equal areas could make a
         // round without one: then the first cluster and its nearest are made mutual.
         if !(0..clusters.len()).any(|i| nearest[nearest[i]] == i) {
@@ -61,53 +63,71 @@ pub(super) fn build(
             nearest[j] = 0;
         }
         let mut next = Vec::with_capacity(clusters.len());
+        let mut next_boxes = Vec::with_capacity(clusters.len());
         for (i, &c) in clusters.iter().enumerate() {
             let j = nearest[i];
             if nearest[j] == i {
                 // Mutual: the first of the pair makes the merged cluster, in its place.
                 if i < j {
-                    let d = clusters[j];
-                    let bounds = nodes[c as usize].bounds.union(nodes[d as usize].bounds);
-                    nodes.push(Cluster { bounds, left: c, right: d });
+                    let bounds = boxes[i].union(boxes[j]);
+                    nodes.push(Cluster { bounds, left: c, right: clusters[j] });
                     next.push(nodes.len() as u32 - 1);
+                    next_boxes.push(bounds);
                 }
             } else {
                 next.push(c);
+                next_boxes.push(boxes[i]);
             }
         }
-        clusters = next;
+        (clusters, boxes) = (next, next_boxes);
     }
     let root = clusters[0];
     Ok((Subtree::Flat(layout(&nodes, root, prims, params, progress)?), 0))
 }
 
-/// For each cluster, the index (in `clusters`) of the one within `radius` whose union with it has
-/// the smallest area. Ties go to the nearer in order; at equal distance d, a cluster in an even
+/// For each cluster (by its box in `boxes`), the index of the one within `radius` whose union
+/// with it has the smallest area. Ties go to the nearer in order; at equal distance d, a cluster in an even
 /// block of d (i / d even) takes the one after it, in an odd block the one before, so that equal
 /// boxes (a million copies of one triangle) pair up, all of them each round, instead of one pair.
-fn nearest_neighbours(nodes: &[Cluster], clusters: &[u32], radius: usize) -> Vec<usize> {
-    let len = clusters.len();
-    (0..len)
-        .into_par_iter()
-        .with_min_len(1024)
-        .map(|i| {
-            let b = nodes[clusters[i] as usize].bounds;
-            let (lo, hi) = (i.saturating_sub(radius), (i + radius).min(len - 1));
+fn nearest_neighbours(boxes: &[Aabb], radius: usize) -> Vec<usize> {
+    const CHUNK: usize = 2048;
+    let len = boxes.len();
+    let mut out = vec![0usize; len];
+    // Each pair's area is computed once: a chunk of clusters first works out, for every cluster
+    // from `radius` before the chunk to its end, the areas with the `radius` clusters after it,
+    // then each cluster of the chunk reads its pairs both ways from that table.
+    out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
+        let start = c * CHUNK;
+        let from = start.saturating_sub(radius);
+        let end = start + out.len();
+        let mut ahead = vec![f32::INFINITY; (end - from) * radius];
+        for i in from..end {
+            for k in 1..=radius.min(len - 1 - i.min(len - 1)) {
+                ahead[(i - from) * radius + k - 1] = boxes[i].union(boxes[i + k]).area();
+            }
+        }
+        for (o, i) in out.iter_mut().zip(start..end) {
             let rank = |j: usize| {
                 let d = j.abs_diff(i);
                 let toward = if (i / d).is_multiple_of(2) { j > i } else { j < i };
                 (d, !toward)
             };
             let mut best = (f32::INFINITY, usize::MAX);
-            for j in (lo..=hi).filter(|&j| j != i) {
-                let a = b.union(nodes[clusters[j] as usize].bounds).area();
+            let mut consider = |a: f32, j: usize| {
                 if best.1 == usize::MAX || a < best.0 || (a == best.0 && rank(j) < rank(best.1)) {
                     best = (a, j);
                 }
+            };
+            for k in 1..=radius.min(i) {
+                consider(ahead[(i - k - from) * radius + k - 1], i - k);
             }
-            best.1
-        })
-        .collect()
+            for k in 1..=radius.min(len - 1 - i) {
+                consider(ahead[(i - from) * radius + k - 1], i + k);
+            }
+            *o = best.1;
+        }
+    });
+    out
 }
 
 /// The clustered tree in bvhscope's layout (each node's children a pair, parents before
@@ -145,6 +165,7 @@ fn layout(
     let mut order: Vec<BuildPrim> = Vec::with_capacity(prims.len());
     let mut stack = vec![(root, 0usize, 0u32)];
     let mut under = Vec::new();
+    let mut done = 0u64;
     while let Some((k, slot, depth)) = stack.pop() {
         let c = nodes[k as usize];
         if leaf[k as usize] {
@@ -160,7 +181,7 @@ fn layout(
                 }
             }
             out[slot] = BvhNode::leaf(c.bounds, first, count[k as usize] as u16);
-            progress.leaf(count[k as usize] as usize, depth);
+            done += progress.leaf_units(count[k as usize] as usize, depth);
             continue;
         }
         let left = out.len();
@@ -174,10 +195,11 @@ fn layout(
             2
         };
         out[slot] = BvhNode::interior(c.bounds, left as u32, axis);
-        progress.split(count[k as usize] as usize, depth);
+        done += progress.split_units(count[k as usize] as usize, depth);
         stack.push((c.right, left + 1, depth + 1));
         stack.push((c.left, left, depth + 1));
     }
+    progress.add(done);
     prims.copy_from_slice(&order);
     Ok(out)
 }
@@ -221,23 +243,17 @@ mod tests {
     #[test]
     fn equal_boxes_all_pair_up() {
         let b = Aabb::new(glam::Vec3::ZERO, glam::Vec3::ONE);
-        let nodes: Vec<Cluster> = (0..8).map(|i| Cluster { bounds: b, left: LEAF, right: i }).collect();
-        let nn = nearest_neighbours(&nodes, &(0..8).collect::<Vec<_>>(), 4);
+        let nn = nearest_neighbours(&vec![b; 8], 4);
         assert!((0..8).all(|i| nn[nn[i]] == i), "{nn:?}");
     }
 
     #[test]
     fn mutual_nearest_neighbours_in_a_row_pair_up() {
         // Boxes at x = 0, 1, 10, 11: (0, 1) and (10, 11) are each other's nearest.
-        let nodes: Vec<Cluster> = [0.0f32, 1.0, 10.0, 11.0]
+        let boxes: Vec<Aabb> = [0.0f32, 1.0, 10.0, 11.0]
             .iter()
-            .enumerate()
-            .map(|(i, &x)| Cluster {
-                bounds: Aabb::new(glam::Vec3::new(x, 0.0, 0.0), glam::Vec3::new(x + 0.5, 1.0, 1.0)),
-                left: LEAF,
-                right: i as u32,
-            })
+            .map(|&x| Aabb::new(glam::Vec3::new(x, 0.0, 0.0), glam::Vec3::new(x + 0.5, 1.0, 1.0)))
             .collect();
-        assert_eq!(nearest_neighbours(&nodes, &[0, 1, 2, 3], 2), vec![1, 0, 3, 2]);
+        assert_eq!(nearest_neighbours(&boxes, 2), vec![1, 0, 3, 2]);
     }
 }

@@ -33,6 +33,8 @@ pub struct TreeStats {
     /// End-point overlap of the binary tree as built (`bvh::epo`), when it was computed: it costs
     /// a box query per node, so `of` leaves it out and the callers that show it add it.
     pub epo: Option<f64>,
+    /// The reinsertion after the build, if one was asked for (its SAH cost before and after).
+    pub reinsertion: Option<super::reinsert::Reinsertion>,
 }
 
 /// A time in milliseconds as the statistics print it: two decimals under 10 ms, so a fast build
@@ -65,6 +67,7 @@ impl TreeStats {
             build_total_ms: ms(report.total_time()),
             fallback_splits: report.fallback_splits,
             depth_limited_splits: report.depth_limited_splits,
+            reinsertion: report.reinsertion,
             ..Default::default()
         };
         let mut depth_sum = 0u64;

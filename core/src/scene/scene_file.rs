@@ -128,7 +128,7 @@ fn transform(t: &serde_json::Value, field: &str, f: &Fields) -> Result<Affine3A,
 
 /// The scene's `bvh` object: the names and limits of `crate::options`, as the CLI takes them.
 fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
-    use crate::options::{Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, SAH_BINS, TRAVERSAL_COST};
+    use crate::options::{Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, TRAVERSAL_COST};
     fn choice<T: Choice>(v: &serde_json::Value, field: &str, f: &Fields) -> Result<T, SceneError> {
         v.as_str().and_then(T::from_name).ok_or_else(|| f.err(field, format!("expected one of {}", T::names())))
     }
@@ -148,13 +148,22 @@ fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
             k if k == MAX_LEAF_SIZE.key => p.max_leaf_size = whole(v, &MAX_LEAF_SIZE, &field, f)?,
             k if k == SAH_BINS.key => p.sah_bins = whole(v, &SAH_BINS, &field, f)?,
             k if k == PLOC_RADIUS.key => p.ploc_radius = whole(v, &PLOC_RADIUS, &field, f)?,
+            k if k == REINSERT_PASSES.key => p.reinsert_passes = whole(v, &REINSERT_PASSES, &field, f)?,
             k if k == TRAVERSAL_COST.key => match v.as_f64() {
                 Some(x) if TRAVERSAL_COST.contains(x as f32) => p.cost.traversal = x as f32,
                 _ => return Err(f.err(&field, format!("expected a number {}", TRAVERSAL_COST.range_text()))),
             },
             _ => {
-                let keys = ["strategy", "layout", MAX_LEAF_SIZE.key, SAH_BINS.key, PLOC_RADIUS.key, TRAVERSAL_COST.key]
-                    .join(", ");
+                let keys = [
+                    "strategy",
+                    "layout",
+                    MAX_LEAF_SIZE.key,
+                    SAH_BINS.key,
+                    PLOC_RADIUS.key,
+                    REINSERT_PASSES.key,
+                    TRAVERSAL_COST.key,
+                ]
+                .join(", ");
                 return Err(f.err(&field, format!("unknown field (expected {keys})")));
             }
         }
@@ -191,6 +200,7 @@ pub fn write_scene_file(camera: &Camera, meshes: &[super::SceneMesh], build: &Bu
         "bvh": {
             "strategy": build.strategy.name(), "layout": build.layout.name(),
             "max_leaf_size": build.max_leaf_size, "bins": build.sah_bins, "ploc_radius": build.ploc_radius,
+            "reinsert_passes": build.reinsert_passes,
             "traversal_cost": build.cost.traversal,
         },
     });

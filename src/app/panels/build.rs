@@ -3,7 +3,17 @@
 
 use crate::app::{Action, Actions, BvhscopeApp};
 use crate::bvh::{Preset, SplitStrategy};
-use crate::options::{Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST};
+use crate::options::{
+    Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST,
+};
+
+/// The reinsertion the current single BVH's build made, if any.
+fn reinsertion_of(bvh: &crate::bvh::SceneBvh) -> Option<crate::bvh::reinsert::Reinsertion> {
+    match bvh {
+        crate::bvh::SceneBvh::Single { bvh, .. } => crate::bvh::TreeView::report(bvh).reinsertion,
+        crate::bvh::SceneBvh::TwoLevel { .. } => None,
+    }
+}
 
 /// A slider over a number's whole range (logarithmic: leaf sizes of 1..255 and costs of 0.01..100
 /// are chosen near their small ends), labelled and explained by the option table.
@@ -104,6 +114,19 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         ui.add_enabled_ui(sah, |ui| number(ui, &mut s.build.sah_bins, &SAH_BINS, true));
         let ploc = s.build.strategy == SplitStrategy::Ploc;
         ui.add_enabled_ui(ploc, |ui| number(ui, &mut s.build.ploc_radius, &PLOC_RADIUS, true));
+        number(ui, &mut s.build.reinsert_passes, &REINSERT_PASSES, false);
+        // What the last build's reinsertion did (the binary tree's SAH cost before and after).
+        if let Some(r) = app.current_bvh().and_then(|b| reinsertion_of(&b.bvh)) {
+            ui.weak(format!(
+                "Reinsertion: SAH cost {:.2} → {:.2} ({:+.1} %), {} moves in {} passes, {:.0} ms",
+                r.sah_before,
+                r.sah_after,
+                100.0 * (r.sah_after / r.sah_before - 1.0),
+                r.moves,
+                r.passes,
+                r.time.as_secs_f64() * 1e3
+            ));
+        }
         number(ui, &mut s.build.cost.traversal, &TRAVERSAL_COST, true);
     });
 
