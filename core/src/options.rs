@@ -325,7 +325,7 @@ pub const PLOC_RADIUS: Number<u32> = Number {
 pub const REINSERT_PASSES: Number<u32> = Number {
     name: "reinsert-passes",
     key: "reinsert_passes",
-    label: "Optimise: reinsertion passes",
+    label: "Reinsertion passes",
     help: "After the build, move nodes to where they cost least under the SAH (Bittner, Hapala & Havran 2013), largest boxes first, for up to this many passes over the tree (0: off). Works on any strategy's binary tree.",
     min: 0,
     max: 32,

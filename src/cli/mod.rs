@@ -8,7 +8,7 @@ pub mod inspect;
 mod progress;
 mod render;
 pub mod replay;
-mod stats;
+pub mod stats;
 pub mod trace;
 
 pub use args::{parse_camera, parse_size, BuildArgs};

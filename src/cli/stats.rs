@@ -58,6 +58,12 @@ fn format_rays(camera: &Camera, trace: &crate::bvh::TraceOptions, r: &RaySummary
 }
 
 pub fn run(a: &StatsArgs) -> Result<(), CliError> {
+    super::out(&output(a)?);
+    Ok(())
+}
+
+/// What `run` prints (the app's tests compare it with the build panel and statistics).
+pub fn output(a: &StatsArgs) -> Result<String, CliError> {
     let loaded = load_mesh(&a.mesh)?;
     let params = a.build.params(loaded.build.as_ref());
     let bvh = build_scene(&loaded, &a.build.scene_build(params))?;
@@ -74,15 +80,15 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     let rays_json = rays
         .map(|(camera, summary)| serde_json::json!({ "camera": camera, "trace": a.build.trace(), "summary": summary }));
     let rays_text = rays.map_or(String::new(), |(camera, r)| format_rays(&camera, &a.build.trace(), &r));
-    match (&bvh, a.format) {
+    Ok(match (&bvh, a.format) {
         (SceneBvh::Single { bvh: b, mesh, .. }, format) => {
             let epo = progress::with_spinner("measuring the end-point overlap", || epo::of(&b.binary_tree(mesh)));
             let stats = TreeStats { epo: Some(epo), ..TreeStats::of(b) };
             if let StatsFormat::Json = format {
                 let v = serde_json::json!({ "mesh": report, "params": params, "stats": stats, "rays": rays_json });
-                super::out(&format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises")));
+                format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises"))
             } else {
-                super::out(&format!("{}{rays_text}", format_text(report, &params, &stats)))
+                format!("{}{rays_text}", format_text(report, &params, &stats))
             }
         }
         (SceneBvh::TwoLevel { bvh: t, .. }, format) => {
@@ -109,13 +115,12 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
                     "top": { "params": t.top.params, "stats": top }, "bottom": { "params": params, "meshes": bottom_json },
                     "rays": rays_json,
                 });
-                super::out(&format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises")));
+                format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises"))
             } else {
-                super::out(&format!("{}{rays_text}", format_two_level(report, t, &top, &bottom)));
+                format!("{}{rays_text}", format_two_level(report, t, &top, &bottom))
             }
         }
-    }
-    Ok(())
+    })
 }
 
 /// A two-level BVH's statistics: the top level over placements, then each mesh's BVH.
