@@ -195,16 +195,7 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         s.build_total_ms, s.build_setup_ms, s.build_split_ms, s.build_reorder_ms
     );
     if let Some(r) = &s.reinsertion {
-        let _ = writeln!(
-            o,
-            "reinsertion     SAH cost {:.3} -> {:.3} ({:+.1} %), {} moves in {} passes, {:.2} ms (in the build time)",
-            r.sah_before,
-            r.sah_after,
-            100.0 * (r.sah_after / r.sah_before - 1.0),
-            r.moves,
-            r.passes,
-            r.time.as_secs_f64() * 1e3
-        );
+        let _ = writeln!(o, "reinsertion     {} (in the build time)", r.summary());
     }
     let _ = writeln!(o, "nodes           {} ({} interior, {} leaves)", s.nodes, s.interior_nodes, s.leaves);
     let _ = writeln!(o, "depth           max {}, mean leaf depth {:.2}", s.max_depth, s.mean_leaf_depth);

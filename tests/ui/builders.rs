@@ -35,7 +35,7 @@ fn ploc_with_reinsertion_shows_what_stats_prints() {
         let b = h.state().current_bvh().unwrap();
         (b.stats.clone(), b.stats.reinsertion.unwrap())
     };
-    h.get_by_label_contains(&format!("Reinsertion: SAH cost {:.2} to {:.2}", r.sah_before, r.sah_after));
+    h.get_by_label_contains(&format!("Reinsertion: SAH cost {:.3} to {:.3}", r.sah_before, r.sah_after));
     let words = [
         "bvhscope",
         "stats",

@@ -1,5 +1,6 @@
 //! What the app's UI tests share: the app in a harness, stepping it until its background work is
-//! done, files to open.
+//! done, files to open. Each test binary uses some of it.
+#![allow(dead_code)]
 
 use bvhscope::app::{AppOptions, BvhscopeApp};
 use egui_kittest::Harness;

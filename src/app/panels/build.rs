@@ -117,15 +117,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         number(ui, &mut s.build.reinsert_passes, &REINSERT_PASSES, false);
         // What the last build's reinsertion did (the binary tree's SAH cost before and after).
         if let Some(r) = app.current_bvh().and_then(|b| reinsertion_of(&b.bvh)) {
-            ui.weak(format!(
-                "Reinsertion: SAH cost {:.2} to {:.2} ({:+.1} %), {} moves in {} passes, {:.0} ms",
-                r.sah_before,
-                r.sah_after,
-                100.0 * (r.sah_after / r.sah_before - 1.0),
-                r.moves,
-                r.passes,
-                r.time.as_secs_f64() * 1e3
-            ));
+            ui.weak(format!("Reinsertion: {}", r.summary()));
         }
         number(ui, &mut s.build.cost.traversal, &TRAVERSAL_COST, true);
     });
