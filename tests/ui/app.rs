@@ -153,20 +153,6 @@ fn opening_a_broken_obj_shows_an_error_and_keeps_the_old_scene() {
 
 /// Type `text` as a keyboard does: per character a key press (when the character has a key),
 /// its text, and the key release, one frame each, with nothing focused by the test.
-fn type_keys(h: &mut Harness<'_, BvhscopeApp>, text: &str) {
-    for c in text.chars() {
-        let key = egui::Key::from_name(&c.to_uppercase().to_string());
-        if let Some(key) = key {
-            h.key_down(key);
-        }
-        h.event(egui::Event::Text(c.to_string()));
-        if let Some(key) = key {
-            h.key_up(key);
-        }
-        h.step();
-    }
-}
-
 #[test]
 fn a_typed_path_goes_into_the_field_and_fires_no_shortcut() {
     let mut h = harness();

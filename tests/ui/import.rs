@@ -242,3 +242,28 @@ fn unreadable_and_broken_dumps_say_why() {
     assert!(t.findings.iter().any(|f| f.text.contains("a cycle")));
     h.get_by_label_contains("Not traced");
 }
+
+/// File ▸ Open BVH path…: the field takes the keyboard (the keys of a typed path fire no
+/// shortcut), and Enter imports the dump.
+#[test]
+fn a_dump_opened_by_typing_its_path_is_imported() {
+    let dump = export("typed-sbc-12345].json", "midpoint", "binary");
+    let mut h = on_the_torus();
+    let (settings, orbit) = (h.state().settings.clone(), h.state().orbit);
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "File").click();
+    h.run_steps(2);
+    h.get_by_label("Open BVH path…").click();
+    h.run_steps(2);
+    assert!(h.state().path_window.is_some(), "the path window opens");
+    h.run_steps(3);
+    assert!(h.get_by_label("Path").is_focused(), "the field takes the keyboard when it opens");
+    let typed = dump.display().to_string();
+    type_keys(&mut h, &typed);
+    assert_eq!(h.state().path_window.as_ref().map(|w| w.text.as_str()), Some(typed.as_str()));
+    assert_eq!(h.state().settings, settings, "no setting changed while typing");
+    assert_eq!(h.state().orbit, orbit, "the camera did not move");
+    h.key_press(egui::Key::Enter);
+    run_until(&mut h, "the typed dump, imported and shown", shows_imported);
+    assert!(h.state().path_window.is_none());
+    assert!(h.state().import.tree.as_ref().is_some_and(|t| t.path == dump && t.defects() == 0));
+}

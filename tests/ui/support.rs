@@ -48,3 +48,18 @@ impl egui::DroppedFile for Dropped {
         std::fs::read(&self.0).map_err(|e| e.to_string())
     }
 }
+
+/// Type `text` key by key, as a person would (each character its key and its text).
+pub fn type_keys(h: &mut Harness<'_, BvhscopeApp>, text: &str) {
+    for c in text.chars() {
+        let key = egui::Key::from_name(&c.to_uppercase().to_string());
+        if let Some(key) = key {
+            h.key_down(key);
+        }
+        h.event(egui::Event::Text(c.to_string()));
+        if let Some(key) = key {
+            h.key_up(key);
+        }
+        h.step();
+    }
+}
