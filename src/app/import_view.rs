@@ -25,6 +25,8 @@ pub struct ImportedTree {
     pub findings: Vec<Finding>,
     /// Random rays traced against the linear scan, besides the frame's.
     pub rays: usize,
+    /// What the rays were checked against (kept for the wrong pixels of every view).
+    pub reference: Option<Arc<crate::bvh::check::Reference>>,
 }
 
 impl ImportedTree {

@@ -348,13 +348,19 @@ impl Jobs {
 
     /// The pixels of `camera`'s frame whose hit through `bvh` (an imported tree) differs from the
     /// linear scan's.
-    pub fn wrong(&mut self, bvh: Arc<SceneBvh>, camera: Camera, trace: TraceOptions) {
+    pub fn wrong(
+        &mut self,
+        bvh: Arc<SceneBvh>,
+        reference: Arc<crate::bvh::check::Reference>,
+        camera: Camera,
+        trace: TraceOptions,
+    ) {
         let job = self.start("Finding wrong pixels".to_string());
         let send = self.sender(job.id);
         std::thread::spawn(move || {
             let SceneBvh::Single { mesh, .. } = &*bvh else { return };
             let rays = crate::bvh::check::check_rays(mesh, &camera, 0);
-            let wrong = crate::bvh::check::wrong_rays(&*bvh, mesh, &rays, trace);
+            let wrong = crate::bvh::check::wrong_rays(&*bvh, mesh, &reference, &rays, trace);
             let pixels = wrong.iter().filter_map(|w| w.pixel).collect();
             send(JobEvent::Wrong(WrongPixels { bvh, camera, trace, pixels }));
         });
@@ -451,7 +457,7 @@ fn import_tree(
     let dump = crate::bvh::dump::BvhDump::read(&path).map_err(|e| e.to_string())?;
     let mesh = scene.flat_mesh().map_err(|e| format!("{}: {e}", scene.title()))?;
     let checked = check(&dump, &path, &mesh, camera, CHECK_RAYS, trace);
-    let (findings, traced) = (checked.findings, checked.tree);
+    let (findings, traced, reference) = (checked.findings, checked.tree, checked.reference.map(Arc::new));
     let bvh = match traced {
         Some((bvh, names)) => Ok(Arc::new(SceneBvh::imported(bvh, mesh, names))),
         None => Err(findings
@@ -459,7 +465,7 @@ fn import_tree(
             .find(|f| f.group == Group::Rays || f.group == Group::Structure)
             .map_or("it cannot be traced".into(), |f| f.text.clone())),
     };
-    Ok(ImportedTree { path, scene_id, bvh, findings, rays: CHECK_RAYS })
+    Ok(ImportedTree { path, scene_id, bvh, findings, rays: CHECK_RAYS, reference })
 }
 
 /// Run a future to completion on this thread (rfd's dialogs are futures).

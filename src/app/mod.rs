@@ -416,8 +416,9 @@ impl BvhscopeApp {
             return;
         }
         let Some(s) = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none()) else { return };
+        let Some(reference) = self.import.tree.as_ref().and_then(|t| t.reference.clone()) else { return };
         if s.bvh.import().is_some() && self.import.wrong_for(&s.bvh, &s.camera, &s.trace).is_none() {
-            self.jobs.wrong(s.bvh.clone(), s.camera, s.trace);
+            self.jobs.wrong(s.bvh.clone(), reference, s.camera, s.trace);
         }
     }
 

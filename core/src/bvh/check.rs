@@ -255,28 +255,46 @@ pub struct WrongRay {
     pub got: Option<(u32, f32)>,
 }
 
-/// Trace `rays` (with their pixels, if from a frame) through `bvh` and the linear scan; the ones
+/// Where the checker takes a ray's true hit from: the linear scan's hits. Past a few thousand
+/// triangles they are found through bvhscope's own SAH tree instead, which returns the linear
+/// scan's hit for every ray (tests/bvh_matches_linear.rs, tests/watertight_traversal.rs): a
+/// million rays over a million triangles one by one would take days. Made once per mesh (the
+/// app keeps it for every view of an imported tree).
+pub enum Reference {
+    Linear(LinearScan),
+    Tree(Bvh),
+}
+
+impl Reference {
+    pub fn of(mesh: &Mesh) -> Reference {
+        if mesh.triangle_count() > LINEAR_REFERENCE_MAX {
+            Reference::Tree(Bvh::build(mesh, &BuildParams { layout: super::Layout::Binary, ..BuildParams::default() }))
+        } else {
+            Reference::Linear(LinearScan::new(mesh))
+        }
+    }
+
+    fn closest_hit(&self, ray: &Ray, opts: TraceOptions) -> Option<Hit> {
+        match self {
+            Reference::Linear(l) => l.closest_hit(&mut ray.clone(), opts, &mut NoStats),
+            Reference::Tree(t) => t.closest_hit(&mut ray.clone(), opts, &mut NoStats),
+        }
+    }
+}
+
+/// Trace `rays` (with their pixels, if from a frame) through `bvh` and the `reference`; the ones
 /// whose hits differ (a different distance; a different triangle only at a different distance).
 pub fn wrong_rays(
     bvh: &impl Accelerator,
     mesh: &Mesh,
+    reference: &Reference,
     rays: &[(Ray, Option<(u32, u32)>)],
     opts: TraceOptions,
 ) -> Vec<WrongRay> {
-    // The linear scan's hits. Past a few thousand triangles they are found through bvhscope's own
-    // SAH tree instead, which returns the linear scan's hit for every ray (tests/correctness.rs,
-    // tests/watertight_traversal.rs): a million rays over a million triangles one by one would
-    // take days.
-    let linear = LinearScan::new(mesh);
-    let tree = (mesh.triangle_count() > LINEAR_REFERENCE_MAX)
-        .then(|| Bvh::build(mesh, &BuildParams { layout: super::Layout::Binary, ..BuildParams::default() }));
     let key = |h: Option<Hit>| h.map(|h| (mesh.file_number(h.prim), h.t));
     rays.par_iter()
         .filter_map(|(r, pixel)| {
-            let want = match &tree {
-                Some(t) => t.closest_hit(&mut r.clone(), opts, &mut NoStats),
-                None => linear.closest_hit(&mut r.clone(), opts, &mut NoStats),
-            };
+            let want = reference.closest_hit(r, opts);
             let got = bvh.closest_hit(&mut r.clone(), opts, &mut NoStats);
             let same = match (want, got) {
                 (None, None) => true,
@@ -347,6 +365,8 @@ pub struct Checked {
     /// The camera's pixels whose hit through the tree differs from the linear scan's (the app's
     /// red mask).
     pub wrong_pixels: Vec<(u32, u32)>,
+    /// What the rays were checked against, when they were traced.
+    pub reference: Option<Reference>,
 }
 
 /// Findings of every group for `dump` (read from `path`) over `mesh`: the tree's, then, when its
@@ -361,17 +381,18 @@ pub fn check(
 ) -> Checked {
     let mut out = check_tree(dump, mesh, tolerance(mesh));
     if out.iter().any(|f| f.group == Group::Structure && f.defect) {
-        return Checked { findings: out, tree: None, wrong_pixels: Vec::new() };
+        return Checked { findings: out, tree: None, wrong_pixels: Vec::new(), reference: None };
     }
     let (bvh, imported) = match super::imported::import(dump, mesh, path) {
         Ok(b) => b,
         Err(why) => {
             out.push(warning(Group::Rays, None, None, format!("rays not traced: {why}")));
-            return Checked { findings: out, tree: None, wrong_pixels: Vec::new() };
+            return Checked { findings: out, tree: None, wrong_pixels: Vec::new(), reference: None };
         }
     };
     let all = check_rays(mesh, camera, rays);
-    let wrong = wrong_rays(&bvh, mesh, &all, opts);
+    let reference = Reference::of(mesh);
+    let wrong = wrong_rays(&bvh, mesh, &reference, &all, opts);
     // A pixel's ray for the example when there is one (easier to find in the image).
     if let Some(w) = wrong.iter().find(|w| w.pixel.is_some()).or(wrong.first()) {
         let v = |a: [f32; 3]| format!("{},{},{}", a[0], a[1], a[2]);
@@ -392,7 +413,7 @@ pub fn check(
         )));
     }
     let wrong_pixels = wrong.iter().filter_map(|w| w.pixel).collect();
-    Checked { findings: out, tree: Some((bvh, imported)), wrong_pixels }
+    Checked { findings: out, tree: Some((bvh, imported)), wrong_pixels, reference: Some(reference) }
 }
 
 #[cfg(test)]
