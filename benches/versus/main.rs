@@ -3,9 +3,11 @@
 //! median of several runs; hit counts are printed so nobody wins by missing.
 //! `BENCH_QUICK=1` runs a reduced set (under two minutes on 2 cores). For iterating on one thing:
 //! `BENCH_ONLY=sah,medium` keeps contenders whose names contain a word, `BENCH_MESH=bunny` one mesh,
-//! `BENCH_APP=1` prints only the app figures, `BENCH_OVERHEAD=1` only the counting overhead.
+//! `BENCH_APP=1` prints only the app figures, `BENCH_OVERHEAD=1` only the counting overhead,
+//! `BENCH_COUNTS=1` only the work per ray (nodes, triangle tests) of our strategies' trees.
 
 mod contenders;
+mod counts;
 mod rays;
 mod scenes;
 
@@ -433,6 +435,14 @@ fn main() {
     if let Ok(m) = std::env::var("BENCH_MESH") {
         meshes.retain(|mesh| mesh.name.to_lowercase().contains(&m.to_lowercase()));
     }
+    // BENCH_COUNTS=1: only the work per ray of our strategies' trees (no timing).
+    if std::env::var("BENCH_COUNTS").is_ok_and(|v| v == "1") {
+        for mesh in &meshes {
+            let (p, i) = (rays::primary(mesh, s.primary_size), rays::incoherent(mesh, s.incoherent, 0x5EED));
+            print!("{}", all.install(|| counts::table(mesh, &p, &i)));
+        }
+        return;
+    }
     // BENCH_OVERHEAD=1: only the counting overhead.
     if std::env::var("BENCH_OVERHEAD").is_ok_and(|v| v == "1") {
         for mesh in &meshes {
@@ -448,7 +458,9 @@ fn main() {
     for mesh in &meshes {
         eprintln!("{} ({} triangles)", mesh.name, mesh.triangle_count());
         let rows = run_mesh(mesh, &contenders, &s, &one, &all);
-        let t = table(mesh, &rows, &s, threads);
+        let mut t = table(mesh, &rows, &s, threads);
+        let (p, i) = (rays::primary(mesh, s.primary_size), rays::incoherent(mesh, s.incoherent, 0x5EED));
+        t += &all.install(|| counts::table(mesh, &p, &i));
         print!("{t}");
         out += &t;
         closing += &ratios(mesh, &rows);

@@ -4,7 +4,8 @@
 use crate::bvh::{BuildParams, Layout, Preset, SahCost, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder};
 use crate::geometry::{Aabb, TriangleTest};
 use crate::options::{
-    Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST,
+    Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TOP_MAX_LEAF_SIZE,
+    TRAVERSAL_COST,
 };
 use crate::render::{Camera, UpAxis};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
@@ -45,6 +46,10 @@ pub struct BuildArgs {
     pub ploc_radius: Option<u32>,
     #[arg(long, value_parser = whole(&REINSERT_PASSES), help = number_help(&REINSERT_PASSES))]
     pub reinsert_passes: Option<u32>,
+    #[arg(long, value_parser = parse_sbvh_alpha, help = number_help(&SBVH_ALPHA))]
+    pub sbvh_alpha: Option<f32>,
+    #[arg(long, value_parser = whole(&SBVH_GROWTH), help = number_help(&SBVH_GROWTH))]
+    pub sbvh_growth: Option<u32>,
     #[arg(long, value_parser = parse_traversal_cost, help = number_help(&TRAVERSAL_COST))]
     pub traversal_cost: Option<f32>,
     /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
@@ -96,6 +101,8 @@ impl BuildArgs {
             sah_bins: self.bins.unwrap_or(base.sah_bins),
             ploc_radius: self.ploc_radius.unwrap_or(base.ploc_radius),
             reinsert_passes: self.reinsert_passes.unwrap_or(base.reinsert_passes),
+            sbvh_alpha: self.sbvh_alpha.unwrap_or(base.sbvh_alpha),
+            sbvh_growth: self.sbvh_growth.unwrap_or(base.sbvh_growth),
             cost: SahCost { traversal: self.traversal_cost.unwrap_or(base.cost.traversal), ..base.cost },
         }
     }
@@ -138,6 +145,8 @@ pub fn build_flags(build: &SceneBuild, opts: TraceOptions) -> Vec<String> {
         format!("--bins {}", p.sah_bins),
         format!("--ploc-radius {}", p.ploc_radius),
         format!("--reinsert-passes {}", p.reinsert_passes),
+        format!("--sbvh-alpha {}", p.sbvh_alpha),
+        format!("--sbvh-growth {}", p.sbvh_growth),
         format!("--traversal-cost {}", p.cost.traversal),
         format!("--layout {}", p.layout.named().name),
         format!("--order {}", opts.order.named().name),
@@ -207,9 +216,18 @@ pub fn parse_fov(s: &str) -> Result<f32, String> {
 
 /// A traversal cost within its limits.
 pub fn parse_traversal_cost(s: &str) -> Result<f32, String> {
+    real(s, &TRAVERSAL_COST)
+}
+
+fn parse_sbvh_alpha(s: &str) -> Result<f32, String> {
+    real(s, &SBVH_ALPHA)
+}
+
+/// A number within a table's limits.
+fn real(s: &str, n: &Number<f32>) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
-        Ok(v) if TRAVERSAL_COST.contains(v) => Ok(v),
-        _ => Err(format!("'{s}' is not a number {}", TRAVERSAL_COST.range_text())),
+        Ok(v) if n.contains(v) => Ok(v),
+        _ => Err(format!("'{s}' is not a number {}", n.range_text())),
     }
 }
 

@@ -198,6 +198,15 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         let _ = writeln!(o, "reinsertion     {} (in the build time)", r.summary());
     }
     let _ = writeln!(o, "nodes           {} ({} interior, {} leaves)", s.nodes, s.interior_nodes, s.leaves);
+    if s.references != s.triangles || params.strategy == crate::bvh::SplitStrategy::Sbvh {
+        let _ = writeln!(
+            o,
+            "references      {} ({:.3} per triangle; {} spatial splits cut triangles)",
+            s.references,
+            s.references_per_triangle(),
+            s.spatial_splits
+        );
+    }
     let _ = writeln!(o, "depth           max {}, mean leaf depth {:.2}", s.max_depth, s.mean_leaf_depth);
     let _ = writeln!(
         o,

@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use bvhscope::bvh::{AnyBvh, Bvh, BvhNode, WideBvh};
+use bvhscope::bvh::{AnyBvh, BuildParams, Bvh, BvhNode, SplitStrategy, WideBvh};
 use bvhscope::geometry::Aabb;
 use bvhscope::mesh::{load_obj, Mesh};
 use std::path::PathBuf;
@@ -35,16 +35,64 @@ pub fn check_any(bvh: &AnyBvh, mesh: &Mesh) {
     }
 }
 
-fn check_prims(prim_ids: &[u32], tris: &[[glam::Vec3; 3]], mesh: &Mesh) {
+/// The leaf slots: a permutation of the triangles, or for the SBVH every triangle at least once
+/// and at most its growth bound more references in all. Returns each triangle's references.
+fn check_prims(prim_ids: &[u32], tris: &[[glam::Vec3; 3]], mesh: &Mesh, params: &BuildParams) -> Vec<u32> {
     let n = mesh.triangle_count();
-    assert_eq!(prim_ids.len(), n, "primitive array length");
     let mut seen = vec![0u32; n];
     for &p in prim_ids {
         seen[p as usize] += 1;
     }
-    assert!(seen.iter().all(|&c| c == 1), "prim_ids is not a permutation");
+    if params.strategy == SplitStrategy::Sbvh {
+        assert!(seen.iter().all(|&c| c >= 1), "every triangle in a leaf");
+        let bound = n + n * params.sbvh_growth as usize / 100;
+        assert!(prim_ids.len() <= bound, "{} references, more than the growth bound {bound}", prim_ids.len());
+    } else {
+        assert_eq!(prim_ids.len(), n, "primitive array length");
+        assert!(seen.iter().all(|&c| c == 1), "prim_ids is not a permutation");
+    }
     for (i, &p) in prim_ids.iter().enumerate() {
         assert_eq!(tris[i], mesh.triangle(p), "reordered triangle {i}");
+    }
+    seen
+}
+
+/// Leaves (box, slot range) hold their triangles: one referenced once lies inside its leaf's box;
+/// one cut among several leaves (SBVH) has every point inside one of them (a barycentric grid of
+/// 12 steps a side, edges and vertices included). Leaves never hold one triangle twice.
+fn check_leaves_hold(leaves: &[(Aabb, std::ops::Range<usize>)], prim_ids: &[u32], tris: &[[glam::Vec3; 3]], refs: &[u32]) {
+    let inside = |b: &Aabb, v: glam::Vec3| b.contains_box(&Aabb::new(v, v));
+    let mut parts: std::collections::HashMap<u32, Vec<Aabb>> = Default::default();
+    for (b, range) in leaves {
+        let mut here: Vec<u32> = prim_ids[range.clone()].to_vec();
+        here.sort();
+        assert!(here.windows(2).all(|w| w[0] != w[1]), "a leaf holds a triangle twice");
+        for k in range.clone() {
+            if refs[prim_ids[k] as usize] == 1 {
+                assert!(tris[k].iter().all(|&v| inside(b, v)), "a leaf does not contain its triangle");
+            } else {
+                parts.entry(prim_ids[k]).or_default().push(*b);
+            }
+        }
+    }
+    for (p, boxes) in parts {
+        let t = tris[prim_ids.iter().position(|&q| q == p).unwrap()];
+        const STEPS: u32 = 12;
+        for i in 0..=STEPS {
+            for j in 0..=STEPS - i {
+                let (u, v) = (i as f32 / STEPS as f32, j as f32 / STEPS as f32);
+                let q = match (i, j) {
+                    (0, 0) => t[0],
+                    (STEPS, _) => t[1],
+                    (_, STEPS) => t[2],
+                    _ => t[0] * (1.0 - u - v) + t[1] * u + t[2] * v,
+                };
+                // Interpolated points round: a few units in the last place of slack.
+                let slack = q.abs().max_element() * 4.0 * f32::EPSILON;
+                let near = |b: &Aabb| (0..3).all(|a| b.min[a] - slack <= q[a] && q[a] <= b.max[a] + slack);
+                assert!(boxes.iter().any(near), "triangle {p} cut among {} leaves: {q:?} is in none", boxes.len());
+            }
+        }
     }
 }
 
@@ -61,8 +109,9 @@ fn check_tiling(mut ranges: Vec<std::ops::Range<usize>>, n: usize) {
 /// The wide layout: every slot box inside its parent's, leaf ranges tiling the triangles, each
 /// node reached exactly once, valid masks matching the slots.
 pub fn check_wide(w: &WideBvh, mesh: &Mesh) {
-    check_prims(&w.prim_ids, &w.tris, mesh);
+    let refs = check_prims(&w.prim_ids, &w.tris, mesh, &w.params);
     let mut ranges = Vec::new();
+    let mut leaves = Vec::new();
     let mut reached = vec![0u32; w.nodes.len()];
     let mut stack = vec![(0usize, w.root_bounds)];
     while let Some((i, parent)) = stack.pop() {
@@ -79,11 +128,7 @@ pub fn check_wide(w: &WideBvh, mesh: &Mesh) {
             let (child, count) = (node.child[slot] as usize, node.count[slot] as usize);
             if count > 0 {
                 assert!(count as u32 <= w.params.max_leaf_size);
-                for t in &w.tris[child..child + count] {
-                    for v in t {
-                        assert!(b.contains_box(&Aabb::new(*v, *v)), "leaf slot does not contain its triangle");
-                    }
-                }
+                leaves.push((b, child..child + count));
                 ranges.push(child..child + count);
             } else {
                 assert!(child > i && child < w.nodes.len(), "child index");
@@ -94,14 +139,14 @@ pub fn check_wide(w: &WideBvh, mesh: &Mesh) {
     if !w.prim_ids.is_empty() {
         assert!(reached.iter().all(|&c| c == 1), "every wide node is reached exactly once");
     }
-    check_tiling(ranges, mesh.triangle_count());
+    check_leaves_hold(&leaves, &w.prim_ids, &w.tris, &refs);
+    check_tiling(ranges, w.prim_ids.len());
 }
 
 /// The structure every binary BVH must have, whatever the strategy.
 pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
-    let n = mesh.triangle_count();
-    check_prims(&bvh.prim_ids, &bvh.tris, mesh);
-
+    let refs = check_prims(&bvh.prim_ids, &bvh.tris, mesh, &bvh.params);
+    let mut leaves = Vec::new();
     let mut leaf_ranges = Vec::new();
     let mut reached = 0usize;
     let mut stack = vec![(0usize, None::<Aabb>)];
@@ -113,11 +158,7 @@ pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
         }
         if node.is_leaf() {
             assert!(node.count as u32 <= bvh.params.max_leaf_size, "leaf {i} has {} > max", node.count);
-            for k in node.prims() {
-                for v in bvh.tris[k] {
-                    assert!(node.bounds().contains_box(&Aabb::new(v, v)), "leaf {i} does not contain its triangle");
-                }
-            }
+            leaves.push((node.bounds(), node.prims()));
             leaf_ranges.push(node.prims());
         } else {
             let l = node.index as usize;
@@ -127,7 +168,8 @@ pub fn check_invariants(bvh: &Bvh, mesh: &Mesh) {
         }
     }
     assert_eq!(reached, bvh.nodes.len(), "every node is reachable exactly once");
-    check_tiling(leaf_ranges, n);
+    check_leaves_hold(&leaves, &bvh.prim_ids, &bvh.tris, &refs);
+    check_tiling(leaf_ranges, bvh.prim_ids.len());
 }
 
 /// A scene file placing a generated 1,000-triangle torus `n` times on a grid.

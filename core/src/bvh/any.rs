@@ -90,6 +90,10 @@ impl TreeView for AnyBvh {
     fn triangle_count(&self) -> usize {
         self.tree().triangle_count()
     }
+
+    fn distinct_triangles(&self) -> usize {
+        self.tree().distinct_triangles()
+    }
     fn memory_bytes(&self) -> usize {
         self.tree().memory_bytes()
     }

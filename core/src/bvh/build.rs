@@ -9,7 +9,7 @@ use super::split::{BuildPrim, EqualCount, NodeInfo, Proposal, SplitStrategy, Spl
 use super::subtree::Subtree;
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
-use crate::options::{MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, TRAVERSAL_COST};
+use crate::options::{MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TRAVERSAL_COST};
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -64,6 +64,11 @@ pub struct BuildParams {
     pub ploc_radius: u32,
     /// Passes of reinsertion after the build (`bvh::reinsert`; 0, the default: none).
     pub reinsert_passes: u32,
+    /// SBVH: spatial splits are priced where the object split's children share more than this
+    /// fraction of the root's surface area (Stich et al.'s α; default 1e-5).
+    pub sbvh_alpha: f32,
+    /// SBVH: at most this many percent more references than triangles (default 30).
+    pub sbvh_growth: u32,
 }
 
 impl Default for BuildParams {
@@ -76,6 +81,8 @@ impl Default for BuildParams {
             layout: Layout::default(),
             ploc_radius: PLOC_RADIUS.default,
             reinsert_passes: REINSERT_PASSES.default,
+            sbvh_alpha: SBVH_ALPHA.default,
+            sbvh_growth: SBVH_GROWTH.default,
         }
     }
 }
@@ -102,6 +109,8 @@ pub struct BuildReport {
     pub fallback_splits: u32,
     /// Nodes split by equal count because they were deeper than `HEURISTIC_DEPTH_LIMIT`.
     pub depth_limited_splits: u32,
+    /// SBVH: nodes split by a spatial split (the others by object splits).
+    pub spatial_splits: u32,
     /// The reinsertion pass after the build, when asked for (`BuildParams::reinsert_passes`).
     pub reinsertion: Option<super::reinsert::Reinsertion>,
 }
@@ -153,7 +162,8 @@ impl Bvh {
         let setup_time = t0.elapsed();
         control.check()?;
 
-        let (nodes, mut report) = build_nodes(&mut prims, &params, control)?;
+        let tri = |i: u32| mesh.triangle(i);
+        let (nodes, mut report) = build_nodes(&mut prims, Some(&tri), &params, control)?;
         report.setup_time = setup_time;
 
         let t2 = Instant::now();
@@ -177,6 +187,8 @@ impl BuildParams {
             sah_bins: SAH_BINS.clamp(self.sah_bins),
             ploc_radius: PLOC_RADIUS.clamp(self.ploc_radius),
             reinsert_passes: REINSERT_PASSES.clamp(self.reinsert_passes),
+            sbvh_alpha: SBVH_ALPHA.clamp(self.sbvh_alpha),
+            sbvh_growth: SBVH_GROWTH.clamp(self.sbvh_growth),
             cost: SahCost { traversal: TRAVERSAL_COST.clamp(self.cost.traversal), ..self.cost },
             ..*self
         }
@@ -263,19 +275,35 @@ pub fn build_over_boxes(
     let params = params.clamped();
     let mut prims: Vec<BuildPrim> = boxes.iter().enumerate().map(|(i, b)| BuildPrim::new(*b, i as u32)).collect();
     let setup_time = t0.elapsed();
-    let (nodes, mut report) = build_nodes(&mut prims, &params, control)?;
+    // No triangles to clip: an SBVH top level makes object splits only.
+    let (nodes, mut report) = build_nodes(&mut prims, None, &params, control)?;
     report.setup_time = setup_time;
     Ok((nodes, prims.iter().map(|p| p.index()).collect(), report))
 }
 
-/// The top-down splitting over prepared primitives, which it leaves in leaf order.
+/// The top-down splitting over prepared primitives, which it leaves in leaf order (the SBVH's
+/// references replace them: more than one per triangle where spatial splits cut triangles of
+/// `tri`).
 fn build_nodes(
-    prims: &mut [BuildPrim],
+    prims: &mut Vec<BuildPrim>,
+    tri: Option<super::sbvh::Triangles>,
     params: &BuildParams,
     control: &WorkControl,
 ) -> Result<(Vec<BvhNode>, BuildReport), Cancelled> {
     let t1 = Instant::now();
     let progress = Progress { control, levels: progress_levels(prims.len(), params) };
+    if params.strategy == SplitStrategy::Sbvh {
+        let (nodes, refs, kinds) = super::sbvh::build(std::mem::take(prims), tri, params, &progress)?;
+        *prims = refs;
+        let report = BuildReport {
+            split_time: t1.elapsed(),
+            fallback_splits: kinds.over.fallback,
+            depth_limited_splits: kinds.over.depth_limited,
+            spatial_splits: kinds.spatial,
+            ..Default::default()
+        };
+        return Ok((nodes, report));
+    }
     let (tree, over) = match params.strategy {
         SplitStrategy::Lbvh => {
             let (tree, fallback) = super::lbvh::build(prims, params, &progress)?;
@@ -300,7 +328,7 @@ fn build_nodes(
 }
 
 /// The node's bounds and centroid bounds (in parallel for big ranges).
-fn node_info(prims: &[BuildPrim]) -> NodeInfo {
+pub(super) fn node_info(prims: &[BuildPrim]) -> NodeInfo {
     const EMPTY: NodeInfo = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY };
     let add = |i: NodeInfo, p: &BuildPrim| NodeInfo {
         bounds: i.bounds.union(p.bounds()),
@@ -319,9 +347,9 @@ fn node_info(prims: &[BuildPrim]) -> NodeInfo {
 
 /// Nodes where the driver overrode or replaced the strategy's answer.
 #[derive(Clone, Copy, Debug, Default)]
-struct Overrides {
-    fallback: u32,
-    depth_limited: u32,
+pub(super) struct Overrides {
+    pub fallback: u32,
+    pub depth_limited: u32,
 }
 
 impl std::ops::AddAssign for Overrides {
@@ -345,7 +373,7 @@ enum Decision {
 /// The SAH's comparison of a leaf with the best split (Goldsmith & Salmon 1987; pbrt-v4 §7.3.2): a
 /// leaf costs C_isect·n; the split costs C_trav + C_isect·(A_L·n_L + A_R·n_R)/A, where `weighted`
 /// is the sum in parentheses.
-fn leaf_is_cheaper(n: usize, weighted: f32, node: &NodeInfo, params: &BuildParams) -> bool {
+pub(super) fn leaf_is_cheaper(n: usize, weighted: f32, node: &NodeInfo, params: &BuildParams) -> bool {
     let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
     let leaf_cost = params.cost.intersection * n as f32;
     leaf_cost <= split_cost
@@ -527,7 +555,7 @@ mod tests {
                 let n = mesh.triangle_count() as u64;
                 assert!(control.total() >= n * 8, "4096 triangles pass at least 8 levels");
                 assert_eq!(control.done(), control.total(), "{strategy:?}/{max_leaf_size}: the work adds up");
-                assert_eq!(bvh.prim_ids.len(), mesh.triangle_count());
+                assert_eq!(super::super::tree::distinct(&bvh.prim_ids), mesh.triangle_count(), "every triangle in a leaf");
             }
         }
 

@@ -185,24 +185,45 @@ pub fn check_tree(dump: &BvhDump, mesh: &Mesh, tolerance: f32) -> Vec<Finding> {
             ),
         ));
     }
-    // Coverage and bounds over the reached leaves.
-    let mut covered = vec![false; tris];
-    for i in (0..nodes.len()).filter(|&i| reached[i]) {
-        let n = &nodes[i];
-        let (Some(f), Some(c), None) = (n.first, n.count, &n.children) else { continue };
-        let (f, c) = (f as usize, c as usize);
-        if f + c > prims.len() {
-            continue;
+    // Coverage and bounds over the reached leaves. A triangle in one leaf must lie inside that
+    // leaf's box and every ancestor's; one referenced by several leaves (an SBVH's spatial splits
+    // cut it) may be split among them, so each of its points must lie inside one of them.
+    let reached_leaves = || {
+        (0..nodes.len()).filter(|&i| reached[i]).filter_map(|i| {
+            let n = &nodes[i];
+            let (Some(f), Some(c), None) = (n.first, n.count, &n.children) else { return None };
+            let (f, c) = (f as usize, c as usize);
+            (f + c <= prims.len()).then(|| (i, &prims[f..f + c]))
+        })
+    };
+    let path_of = |i: usize| {
+        let mut path = vec![i];
+        while let Some(&q) = parent.get(*path.last().unwrap()).filter(|&&q| q != u32::MAX) {
+            path.push(q as usize);
         }
-        for &p in &prims[f..f + c] {
-            let Some(Some(m)) = by_file.get(p as usize) else { continue };
-            let t = mesh.triangle(*m);
-            covered[p as usize] = true;
-            // The highest node on the path from the root whose box does not hold the triangle.
-            let mut path = vec![i];
-            while let Some(&q) = parent.get(*path.last().unwrap()).filter(|&&q| q != u32::MAX) {
-                path.push(q as usize);
+        path
+    };
+    let mut references = vec![0u32; tris];
+    for (_, leaf) in reached_leaves() {
+        for &p in leaf {
+            if let Some(r) = references.get_mut(p as usize) {
+                *r += 1;
             }
+        }
+    }
+    let mut covered = vec![false; tris];
+    let mut shared: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+    for (i, leaf) in reached_leaves() {
+        for &p in leaf {
+            let Some(Some(m)) = by_file.get(p as usize) else { continue };
+            covered[p as usize] = true;
+            if references[p as usize] > 1 {
+                shared.entry(p).or_default().push(i);
+                continue;
+            }
+            let t = mesh.triangle(*m);
+            // The highest node on the path from the root whose box does not hold the triangle.
+            let path = path_of(i);
             if let Some(&worst) = path.iter().rev().find(|&&a| excess(&nodes[a].bounds(), &t) > tolerance) {
                 let by = excess(&nodes[worst].bounds(), &t);
                 let whose =
@@ -214,6 +235,39 @@ pub fn check_tree(dump: &BvhDump, mesh: &Mesh, tolerance: f32) -> Vec<Finding> {
                     format!("triangle {p} (in leaf node {i}) sticks out of {whose} box, node {worst}, by {by}"),
                 ));
             }
+        }
+    }
+    for (p, leaves) in shared {
+        let Some(Some(m)) = by_file.get(p as usize) else { continue };
+        let t = mesh.triangle(*m);
+        // What a ray reaches of each leaf: the part of its box inside every ancestor's box.
+        let reach: Vec<Aabb> = leaves
+            .iter()
+            .map(|&i| {
+                path_of(i).iter().fold(Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY), |b, &a| {
+                    let n = nodes[a].bounds();
+                    Aabb { min: b.min.max(n.min), max: b.max.min(n.max) }
+                })
+            })
+            .collect();
+        let inside = |q: Vec3| reach.iter().any(|b| excess(b, &[q; 3]) <= tolerance);
+        let outside = triangle_samples(&t).find(|&q| !inside(q));
+        if let Some(q) = outside {
+            let list: Vec<String> = leaves.iter().take(6).map(|i| format!("node {i}")).collect();
+            out.push(defect(
+                Group::Bounds,
+                Some(leaves[0] as u32),
+                Some(p),
+                format!(
+                    "triangle {p} is split among {} leaves ({}{}), but its point ({}, {}, {}) lies in none of their boxes within their ancestors'",
+                    leaves.len(),
+                    list.join(", "),
+                    if leaves.len() > 6 { ", …" } else { "" },
+                    q.x,
+                    q.y,
+                    q.z
+                ),
+            ));
         }
     }
     for (t, _) in covered.iter().enumerate().filter(|(_, c)| !**c) {
@@ -230,6 +284,23 @@ pub fn check_tree(dump: &BvhDump, mesh: &Mesh, tolerance: f32) -> Vec<Finding> {
         });
     }
     out
+}
+
+/// Points of a triangle a split among leaves must cover: its vertices, and a barycentric grid of
+/// 16 steps a side (edges included).
+fn triangle_samples(t: &[Vec3; 3]) -> impl Iterator<Item = Vec3> + '_ {
+    const STEPS: u32 = 16;
+    (0..=STEPS).flat_map(move |i| {
+        (0..=STEPS - i).map(move |j| {
+            let (u, v) = (i as f32 / STEPS as f32, j as f32 / STEPS as f32);
+            match (i, j) {
+                (0, 0) => t[0],
+                (STEPS, _) => t[1],
+                (_, STEPS) => t[2],
+                _ => t[0] * (1.0 - u - v) + t[1] * u + t[2] * v,
+            }
+        })
+    })
 }
 
 fn is_ancestor(parent: &[u32], a: usize, mut n: usize) -> bool {

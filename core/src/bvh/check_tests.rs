@@ -241,3 +241,42 @@ fn unreadable_dumps_say_why() {
     assert!(w("other.json", r#"{"format": "gltf"}"#).contains("\"gltf\""));
     assert!(w("bad.txt", "bvhscope-bvh 1\nnode 0 0 0 1 1 x leaf 0 1\n").contains("line 2"));
 }
+
+/// An SBVH's tree, whose spatial splits cut triangles among leaves, checks clean (each part in
+/// its own leaf's box covers the triangle); with the box of one leaf holding part of a cut
+/// triangle shrunk to a point, the part left uncovered is named.
+#[test]
+fn an_sbvh_tree_checks_clean_and_an_uncovered_part_of_a_cut_triangle_is_named() {
+    let mesh = generate::diagonal_rods(2, 6, 4.0, 0.05, 0.3);
+    let params = BuildParams {
+        strategy: crate::bvh::SplitStrategy::Sbvh,
+        layout: crate::bvh::Layout::Binary,
+        sbvh_growth: 100,
+        ..BuildParams::default()
+    };
+    let bvh = Bvh::build(&mesh, &params);
+    assert!(bvh.prim_ids.len() > mesh.triangle_count() * 5 / 4, "spatial splits cut many slivers");
+    let dump = BvhDump::of_bvh(&bvh, &mesh, None);
+    let (f, traced) = run(&dump, &mesh, 4000);
+    assert!(f.iter().all(|f| !f.defect), "{f:?}");
+    assert_eq!(crate::bvh::TreeView::triangle_count(&traced.unwrap()), bvh.prim_ids.len());
+    let mut refs = vec![0; mesh.triangle_count()];
+    for &p in &bvh.prim_ids {
+        refs[p as usize] += 1;
+    }
+    let mut named = 0;
+    let cut = bvh.nodes.iter().enumerate().filter(|(_, n)| n.is_leaf()).flat_map(|(i, n)| {
+        n.prims().filter(|&s| refs[bvh.prim_ids[s] as usize] > 1).map(move |s| (i, s))
+    });
+    for (leaf, slot) in cut.take(8) {
+        let mut broken = dump.clone();
+        broken.nodes[leaf].max = broken.nodes[leaf].min;
+        let tri = mesh.file_number(bvh.prim_ids[slot]);
+        let (f, _) = run(&broken, &mesh, 0);
+        named += f
+            .iter()
+            .any(|f| f.defect && f.group == Group::Bounds && f.triangle == Some(tri) && f.text.contains("split among"))
+            as u32;
+    }
+    assert!(named >= 6, "{named} of 8 shrunk leaves of cut triangles named");
+}

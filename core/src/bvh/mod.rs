@@ -18,6 +18,7 @@ pub mod packet;
 mod ploc;
 mod preset;
 pub mod reinsert;
+mod sbvh;
 pub mod replay;
 mod scene_bvh;
 mod simd;

@@ -110,6 +110,10 @@ impl super::tree::TreeView for Bvh {
         self.prim_ids.len()
     }
 
+    fn distinct_triangles(&self) -> usize {
+        super::tree::distinct(&self.prim_ids)
+    }
+
     fn memory_bytes(&self) -> usize {
         Bvh::memory_bytes(self)
     }

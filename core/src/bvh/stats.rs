@@ -11,7 +11,13 @@ use std::time::Duration;
 
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct TreeStats {
+    /// Different triangles in the leaves.
     pub triangles: usize,
+    /// Triangle references in the leaves: more than `triangles` where spatial splits (SBVH) cut
+    /// triangles, each part referenced by its own leaf.
+    pub references: usize,
+    /// SBVH: nodes split by a spatial split.
+    pub spatial_splits: u32,
     pub nodes: usize,
     pub interior_nodes: usize,
     pub leaves: usize,
@@ -39,6 +45,13 @@ pub struct TreeStats {
 
 /// A time in milliseconds as the statistics print it: two decimals under 10 ms, so a fast build
 /// does not read as 0.0, one above.
+impl TreeStats {
+    /// References per triangle (1 unless spatial splits cut triangles).
+    pub fn references_per_triangle(&self) -> f64 {
+        self.references as f64 / self.triangles.max(1) as f64
+    }
+}
+
 pub fn fmt_ms(ms: f64) -> String {
     if ms < 10.0 {
         format!("{ms:.2}")
@@ -58,7 +71,9 @@ impl TreeStats {
         let report = tree.report();
         let mut root_area = 0f64;
         let mut s = TreeStats {
-            triangles: tree.triangle_count(),
+            triangles: tree.distinct_triangles(),
+            references: tree.triangle_count(),
+            spatial_splits: report.spatial_splits,
             sah_constants: c,
             memory_bytes: tree.memory_bytes(),
             build_setup_ms: ms(report.setup_time),

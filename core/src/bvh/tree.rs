@@ -23,7 +23,13 @@ pub struct NodeView {
 pub trait TreeView {
     /// Visit every node, parents before children; `f` returns whether to visit the node's children.
     fn walk(&self, f: &mut dyn FnMut(&NodeView) -> bool);
+    /// Triangle references in leaves: the triangles, plus the duplicates of any cut by spatial
+    /// splits (SBVH).
     fn triangle_count(&self) -> usize;
+    /// Different triangles in leaves (a triangle referenced by several leaves counted once).
+    fn distinct_triangles(&self) -> usize {
+        self.triangle_count()
+    }
     /// Bytes of nodes and primitive indices.
     fn memory_bytes(&self) -> usize;
     fn params(&self) -> &BuildParams;
@@ -42,4 +48,11 @@ pub trait TreeView {
         });
         out
     }
+}
+
+/// Different values among leaf slots' triangle ids.
+pub(crate) fn distinct(prim_ids: &[u32]) -> usize {
+    let Some(&max) = prim_ids.iter().max() else { return 0 };
+    let mut seen = vec![false; max as usize + 1];
+    prim_ids.iter().filter(|&&p| !std::mem::replace(&mut seen[p as usize], true)).count()
 }

@@ -128,7 +128,9 @@ fn transform(t: &serde_json::Value, field: &str, f: &Fields) -> Result<Affine3A,
 
 /// The scene's `bvh` object: the names and limits of `crate::options`, as the CLI takes them.
 fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
-    use crate::options::{Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, TRAVERSAL_COST};
+    use crate::options::{
+        Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TRAVERSAL_COST,
+    };
     fn choice<T: Choice>(v: &serde_json::Value, field: &str, f: &Fields) -> Result<T, SceneError> {
         v.as_str().and_then(T::from_name).ok_or_else(|| f.err(field, format!("expected one of {}", T::names())))
     }
@@ -136,6 +138,12 @@ fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
         match v.as_u64() {
             Some(x) if x <= u32::MAX as u64 && n.contains(x as u32) => Ok(x as u32),
             _ => Err(f.err(field, format!("expected a whole number {}", n.range_text()))),
+        }
+    }
+    fn real(v: &serde_json::Value, n: &Number<f32>, field: &str, f: &Fields) -> Result<f32, SceneError> {
+        match v.as_f64() {
+            Some(x) if n.contains(x as f32) => Ok(x as f32),
+            _ => Err(f.err(field, format!("expected a number {}", n.range_text()))),
         }
     }
     let o = b.as_object().ok_or_else(|| f.err("bvh", format!("expected an object, found {}", kind(b))))?;
@@ -149,10 +157,9 @@ fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
             k if k == SAH_BINS.key => p.sah_bins = whole(v, &SAH_BINS, &field, f)?,
             k if k == PLOC_RADIUS.key => p.ploc_radius = whole(v, &PLOC_RADIUS, &field, f)?,
             k if k == REINSERT_PASSES.key => p.reinsert_passes = whole(v, &REINSERT_PASSES, &field, f)?,
-            k if k == TRAVERSAL_COST.key => match v.as_f64() {
-                Some(x) if TRAVERSAL_COST.contains(x as f32) => p.cost.traversal = x as f32,
-                _ => return Err(f.err(&field, format!("expected a number {}", TRAVERSAL_COST.range_text()))),
-            },
+            k if k == SBVH_GROWTH.key => p.sbvh_growth = whole(v, &SBVH_GROWTH, &field, f)?,
+            k if k == SBVH_ALPHA.key => p.sbvh_alpha = real(v, &SBVH_ALPHA, &field, f)?,
+            k if k == TRAVERSAL_COST.key => p.cost.traversal = real(v, &TRAVERSAL_COST, &field, f)?,
             _ => {
                 let keys = [
                     "strategy",
@@ -161,6 +168,8 @@ fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
                     SAH_BINS.key,
                     PLOC_RADIUS.key,
                     REINSERT_PASSES.key,
+                    SBVH_ALPHA.key,
+                    SBVH_GROWTH.key,
                     TRAVERSAL_COST.key,
                 ]
                 .join(", ");
@@ -200,7 +209,7 @@ pub fn write_scene_file(camera: &Camera, meshes: &[super::SceneMesh], build: &Bu
         "bvh": {
             "strategy": build.strategy.name(), "layout": build.layout.name(),
             "max_leaf_size": build.max_leaf_size, "bins": build.sah_bins, "ploc_radius": build.ploc_radius,
-            "reinsert_passes": build.reinsert_passes,
+            "reinsert_passes": build.reinsert_passes, "sbvh_alpha": build.sbvh_alpha, "sbvh_growth": build.sbvh_growth,
             "traversal_cost": build.cost.traversal,
         },
     });

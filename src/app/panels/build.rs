@@ -4,7 +4,8 @@
 use crate::app::{Action, Actions, BvhscopeApp};
 use crate::bvh::{Preset, SplitStrategy};
 use crate::options::{
-    Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, TOP_MAX_LEAF_SIZE, TRAVERSAL_COST,
+    Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TOP_MAX_LEAF_SIZE,
+    TRAVERSAL_COST,
 };
 
 /// The reinsertion the current single BVH's build made, if any.
@@ -110,10 +111,15 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     // An imported tree is traced as written: the build's parameters do not apply to it.
     ui.add_enabled_ui(!on, |ui| {
         number(ui, &mut s.build.max_leaf_size, &MAX_LEAF_SIZE, true);
-        let sah = s.build.strategy == SplitStrategy::SahBinned;
+        let sbvh = s.build.strategy == SplitStrategy::Sbvh;
+        let sah = s.build.strategy == SplitStrategy::SahBinned || sbvh;
         ui.add_enabled_ui(sah, |ui| number(ui, &mut s.build.sah_bins, &SAH_BINS, true));
         let ploc = s.build.strategy == SplitStrategy::Ploc;
         ui.add_enabled_ui(ploc, |ui| number(ui, &mut s.build.ploc_radius, &PLOC_RADIUS, true));
+        ui.add_enabled_ui(sbvh, |ui| {
+            number(ui, &mut s.build.sbvh_alpha, &SBVH_ALPHA, true);
+            number(ui, &mut s.build.sbvh_growth, &SBVH_GROWTH, false);
+        });
         number(ui, &mut s.build.reinsert_passes, &REINSERT_PASSES, false);
         // What the last build's reinsertion did (the binary tree's SAH cost before and after).
         if let Some(r) = app.current_bvh().and_then(|b| reinsertion_of(&b.bvh)) {

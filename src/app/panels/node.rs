@@ -20,6 +20,7 @@ pub fn strategy_color(s: SplitStrategy) -> Color32 {
         SplitStrategy::SahSweep => Color32::from_rgb(120, 230, 120),
         SplitStrategy::Lbvh => Color32::from_rgb(240, 120, 200),
         SplitStrategy::Ploc => Color32::from_rgb(160, 140, 255),
+        SplitStrategy::Sbvh => Color32::from_rgb(250, 220, 80),
     }
 }
 

@@ -52,6 +52,12 @@ const ROWS: &[Row] = &[
         value: |f| f.stats.epo.map(|e| format!("{e:.3}")),
     },
     Row {
+        name: "References / triangle",
+        tip: "Leaf entries per triangle: 1, unless SBVH's spatial splits cut triangles so several leaves reference the parts of one (its growth bound limits this). In parentheses: the spatial splits",
+        per_ray: false,
+        value: |f| Some(format!("{:.3} ({})", f.stats.references_per_triangle(), f.stats.spatial_splits)),
+    },
+    Row {
         name: "Bytes / triangle",
         tip: "Memory of the nodes and the triangle index array, per triangle",
         per_ray: false,

@@ -7,6 +7,7 @@ mod equal_count;
 mod midpoint;
 mod sah_binned;
 mod sah_sweep;
+mod spatial;
 
 use crate::geometry::Aabb;
 use glam::{Vec3A, Vec4};
@@ -15,6 +16,7 @@ pub use equal_count::EqualCount;
 pub use midpoint::Midpoint;
 pub use sah_binned::{binned_planes, bins_for, SahBinned};
 pub use sah_sweep::{sweep_planes, SahSweep};
+pub use spatial::{spatial_partition, spatial_planes, split_reference, SpatialSplit};
 
 /// The largest bin count the binned SAH accepts.
 pub const fn sah_binned_max_bins() -> usize {
@@ -37,20 +39,21 @@ pub trait Splitter: Send {
 
 impl SplitStrategy {
     /// A splitter of this strategy for a build with `params`; `None` for a builder that does not
-    /// split node by node at a plane it chooses there (LBVH: its planes follow from the sort).
+    /// split node by node at a plane it chooses there (LBVH: its planes follow from the sort), or
+    /// that splits references rather than partitions triangles (SBVH, its own driver).
     pub fn splitter(self, params: &crate::bvh::BuildParams) -> Option<Box<dyn Splitter>> {
         match self {
             SplitStrategy::Midpoint => Some(Box::new(Midpoint)),
             SplitStrategy::EqualCount => Some(Box::new(EqualCount)),
             SplitStrategy::SahBinned => Some(Box::new(SahBinned::new(params))),
             SplitStrategy::SahSweep => Some(Box::new(SahSweep::new(params))),
-            SplitStrategy::Lbvh | SplitStrategy::Ploc => None,
+            SplitStrategy::Lbvh | SplitStrategy::Ploc | SplitStrategy::Sbvh => None,
         }
     }
 
     /// Whether the top-down driver (`bvh::build`) builds with this strategy's splitter.
     pub fn splits_top_down(self) -> bool {
-        !matches!(self, SplitStrategy::Lbvh | SplitStrategy::Ploc)
+        !matches!(self, SplitStrategy::Lbvh | SplitStrategy::Ploc | SplitStrategy::Sbvh)
     }
 }
 
@@ -72,6 +75,9 @@ pub enum SplitStrategy {
     /// A bottom-up builder of its own (`bvh::ploc`): clusters merged with their nearest
     /// neighbours in Morton order.
     Ploc,
+    /// The binned SAH with spatial splits (`bvh::sbvh`): triangles cut where that beats sorting
+    /// them to one side, so a triangle may be referenced by several leaves.
+    Sbvh,
 }
 
 /// A triangle as the builder sees it: its bounds in SIMD registers' layout (a box union is two
@@ -147,6 +153,12 @@ pub trait PlaneSink {
     /// A candidate plane at `position` on `axis`, with `left` and `right` triangles on its sides
     /// and `weighted` = A_L·n_L + A_R·n_R.
     fn plane(&mut self, axis: usize, position: f32, left: u32, right: u32, weighted: f32);
+}
+
+/// Whether `sink` records (a constant: the build's `()` compiles the reports away).
+#[inline(always)]
+pub(crate) fn is_active<P: PlaneSink>(_: &P) -> bool {
+    P::ACTIVE
 }
 
 impl PlaneSink for () {

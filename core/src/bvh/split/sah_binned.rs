@@ -5,7 +5,7 @@
 //! binned in one pass over the triangles, so a node costs O(n + bins), with no per-node allocation
 //! below the top levels; big nodes are binned in parallel chunks.
 
-use super::{partition, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
+use super::{is_active, partition, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
@@ -91,12 +91,6 @@ pub fn binned_planes(prims: &mut [BuildPrim], node: &NodeInfo, max_bins: usize, 
 /// The bins a node of `n` triangles is binned into: n/3 (at least 4), at most `max_bins`.
 pub fn bins_for(n: usize, max_bins: usize) -> usize {
     max_bins.min((n / 3).max(4)).clamp(2, MAX_BINS)
-}
-
-/// Whether `sink` records (a constant: the build's `()` compiles the reports away).
-#[inline(always)]
-fn is_active<P: PlaneSink>(_: &P) -> bool {
-    P::ACTIVE
 }
 
 fn binned<P: PlaneSink>(

@@ -3,7 +3,7 @@
 //! ray tracing using space subdivision" (The Visual Computer, 1990); Wald 2007 §3 for the sweep.
 //! O(n log n) per node; use the binned version for big meshes in interactive work.
 
-use super::{BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
+use super::{is_active, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 
@@ -82,10 +82,4 @@ fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>, si
     }
     let plane = (prims[mid - 1].centroid()[axis] + prims[mid].centroid()[axis]) * 0.5;
     Proposal::Split { axis: axis as u8, mid, weighted: Some(weighted), plane }
-}
-
-/// Whether `sink` records (a constant: the build's `()` compiles the reports away).
-#[inline(always)]
-fn is_active<P: PlaneSink>(_: &P) -> bool {
-    P::ACTIVE
 }

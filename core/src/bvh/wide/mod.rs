@@ -392,6 +392,10 @@ impl TreeView for WideBvh {
         self.prim_ids.len()
     }
 
+    fn distinct_triangles(&self) -> usize {
+        crate::bvh::tree::distinct(&self.prim_ids)
+    }
+
     fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<WideNode>() + self.prim_ids.len() * 4
     }
