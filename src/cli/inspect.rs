@@ -54,7 +54,8 @@ fn points_json(points: &[CurvePoint]) -> serde_json::Value {
 fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
     let curves: serde_json::Map<String, serde_json::Value> = (0..3)
         .map(|a| {
-            let v = serde_json::json!({ "sweep": points_json(&ins.sweep[a]), "binned": points_json(&ins.binned[a]) });
+            let v = serde_json::json!({ "sweep": points_json(&ins.sweep[a]), "binned": points_json(&ins.binned[a]),
+                "spatial": points_json(&ins.spatial[a]) });
             (AXES[a].to_string(), v)
         })
         .collect();
@@ -79,6 +80,10 @@ fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
         "area": ins.area, "area_ratio_to_parent": ins.area_ratio, "subtree_sah_cost": ins.subtree_sah,
         "child_overlap": ins.child_overlap, "leaf_cost": ins.leaf_cost, "epo_contribution": epo_term,
         "bins": ins.bins, "curves": curves, "markers": markers, "own_cost": ins.own_cost,
+        "sbvh": ins.sbvh.map(|e| serde_json::json!({
+            "split": e.split.map(|s| s.kind), "overlap_ratio": e.overlap_ratio,
+            "spatial_priced": e.spatial_priced, "budget": e.budget, "over_budget": e.over_budget,
+        })),
     })
 }
 
@@ -122,6 +127,9 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
                     m.cost
                 );
             }
+            None if *s == crate::bvh::SplitStrategy::Sbvh => {
+                let _ = writeln!(o, "  {:<12}  makes a leaf here", s.named().name);
+            }
             None if !s.splits_top_down() => {
                 let _ = writeln!(o, "  {:<12}  no plane priced here: it builds from the Morton order", s.named().name);
             }
@@ -137,13 +145,22 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
             "this tree"
         );
     }
+    if let Some(line) = sbvh_text(ins) {
+        let _ = writeln!(o, "{line}");
+    }
     let _ = writeln!(o);
     let min = |c: &[CurvePoint]| c.iter().min_by(|p, q| p.cost.total_cmp(&q.cost)).copied();
     let show = |p: Option<CurvePoint>| p.map_or("-".to_string(), |p| format!("{:.3} at {}", p.cost, p.position));
-    for (axis, (sweep, binned)) in AXES.iter().zip(ins.sweep.iter().zip(&ins.binned)) {
+    for (a, axis) in AXES.iter().enumerate() {
+        let (sweep, binned, spatial) = (&ins.sweep[a], &ins.binned[a], &ins.spatial[a]);
+        let cuts = if spatial.is_empty() {
+            String::new()
+        } else {
+            format!("; {} spatial planes, cheapest {}", spatial.len(), show(min(spatial)))
+        };
         let _ = writeln!(
             o,
-            "axis {axis}          {} candidate planes, cheapest {}; {} bins' planes, cheapest {}",
+            "axis {axis}          {} candidate planes, cheapest {}; {} bins' planes, cheapest {}{cuts}",
             sweep.len(),
             show(min(sweep)),
             binned.len(),
@@ -151,6 +168,35 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
         );
     }
     o
+}
+
+/// What the SBVH does at the node, in a line (the app's Node window shows the same line).
+pub fn sbvh_text(ins: &Inspection) -> Option<String> {
+    let e = ins.sbvh?;
+    let what = match e.split.map(|s| s.kind) {
+        None => "makes a leaf".to_string(),
+        Some(k) => format!(
+            "splits by {}",
+            match k {
+                crate::bvh::sbvh::SplitKind::Object => "an object split",
+                crate::bvh::sbvh::SplitKind::Spatial => "a spatial split (cutting triangles)",
+                crate::bvh::sbvh::SplitKind::EqualCount => "equal count (fallback)",
+            }
+        ),
+    };
+    let priced = if let Some(d) = e.over_budget {
+        format!("the cheaper spatial split would add {d} references, over the budget")
+    } else if e.spatial_priced {
+        "spatial planes priced".to_string()
+    } else if e.budget == 0 {
+        "no spatial planes: no reference budget left".to_string()
+    } else {
+        "no spatial planes: overlap not above α".to_string()
+    };
+    Some(format!(
+        "SBVH here        {what}; object split's overlap {:.2e} of the root's area; {priced}; {} extra references left",
+        e.overlap_ratio, e.budget
+    ))
 }
 
 /// Which wide node of the 4-wide layout binary node `node` is collapsed into.

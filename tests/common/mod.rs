@@ -60,7 +60,12 @@ fn check_prims(prim_ids: &[u32], tris: &[[glam::Vec3; 3]], mesh: &Mesh, params: 
 /// Leaves (box, slot range) hold their triangles: one referenced once lies inside its leaf's box;
 /// one cut among several leaves (SBVH) has every point inside one of them (a barycentric grid of
 /// 12 steps a side, edges and vertices included). Leaves never hold one triangle twice.
-fn check_leaves_hold(leaves: &[(Aabb, std::ops::Range<usize>)], prim_ids: &[u32], tris: &[[glam::Vec3; 3]], refs: &[u32]) {
+fn check_leaves_hold(
+    leaves: &[(Aabb, std::ops::Range<usize>)],
+    prim_ids: &[u32],
+    tris: &[[glam::Vec3; 3]],
+    refs: &[u32],
+) {
     let inside = |b: &Aabb, v: glam::Vec3| b.contains_box(&Aabb::new(v, v));
     let mut parts: std::collections::HashMap<u32, Vec<Aabb>> = Default::default();
     for (b, range) in leaves {

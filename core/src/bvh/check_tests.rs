@@ -265,9 +265,12 @@ fn an_sbvh_tree_checks_clean_and_an_uncovered_part_of_a_cut_triangle_is_named() 
         refs[p as usize] += 1;
     }
     let mut named = 0;
-    let cut = bvh.nodes.iter().enumerate().filter(|(_, n)| n.is_leaf()).flat_map(|(i, n)| {
-        n.prims().filter(|&s| refs[bvh.prim_ids[s] as usize] > 1).map(move |s| (i, s))
-    });
+    let cut = bvh
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| n.is_leaf())
+        .flat_map(|(i, n)| n.prims().filter(|&s| refs[bvh.prim_ids[s] as usize] > 1).map(move |s| (i, s)));
     for (leaf, slot) in cut.take(8) {
         let mut broken = dump.clone();
         broken.nodes[leaf].max = broken.nodes[leaf].min;

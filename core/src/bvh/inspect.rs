@@ -167,6 +167,13 @@ pub struct Inspection {
     /// at a node of this size (`bins`).
     pub binned: [Vec<CurvePoint>; 3],
     pub bins: usize,
+    /// Per axis: the SBVH's spatial split's cost at each plane between its bins (it cuts the
+    /// triangles that straddle a plane, counting them on both sides), when it priced them here:
+    /// only where the object split's children overlap by more than α of the root's area.
+    pub spatial: [Vec<CurvePoint>; 3],
+    /// What the SBVH does here: for an SBVH tree what its build did, for another tree what it
+    /// would do with these triangles.
+    pub sbvh: Option<super::sbvh::Explained>,
     /// Each strategy's plane, or none when it finds no split (all centroids on one side or
     /// coinciding: the builder then falls back to equal count).
     pub markers: Vec<(SplitStrategy, Option<Marker>)>,
@@ -194,18 +201,57 @@ fn split_cost(c: SahCost, weighted: f32, area: f32) -> f32 {
     c.traversal + c.intersection * weighted / area
 }
 
-/// The node's triangles as the builder saw them (in leaf order; every strategy's choice is
-/// independent of the order), and their bounds.
+/// The tree's triangles by id (from its leaves), for the SBVH's clipping.
+fn triangles_by_id(bvh: &Bvh) -> Vec<[glam::Vec3; 3]> {
+    let n = bvh.prim_ids.iter().max().map_or(0, |&m| m as usize + 1);
+    let mut out = vec![[glam::Vec3::ZERO; 3]; n];
+    for (t, &p) in bvh.tris.iter().zip(&bvh.prim_ids) {
+        out[p as usize] = *t;
+    }
+    out
+}
+
+/// The node's references as the builder saw them: for an SBVH tree, the parts of triangles its
+/// build held there (found by replaying its decisions from the root, `sbvh::descend`); for the
+/// others the node's triangles, in leaf order (every strategy's choice is independent of the
+/// order). With their bounds, and the SBVH's work there.
+fn node_work(bvh: &Bvh, h: &Hierarchy, tris: &[[glam::Vec3; 3]], node: usize) -> (super::sbvh::Work, NodeInfo) {
+    let params = &bvh.params;
+    let prims: Vec<BuildPrim> = if params.strategy == SplitStrategy::Sbvh {
+        let path = h.path(node as u32);
+        let steps: Vec<bool> = path.windows(2).map(|w| bvh.nodes[w[0] as usize].index != w[1]).collect();
+        let root = tris.iter().enumerate().map(|(i, t)| BuildPrim::new(Aabb::from_points(t), i as u32)).collect();
+        let tri = |i: u32| tris[i as usize];
+        match super::sbvh::descend(root, &tri, params, &steps) {
+            Some(work) => {
+                let info = info_of(&work.refs);
+                return (work, info);
+            }
+            None => Vec::new(),
+        }
+    } else {
+        let range = h.first[node] as usize..(h.first[node] + h.count[node]) as usize;
+        range.map(|s| BuildPrim::new(Aabb::from_points(&bvh.tris[s]), bvh.prim_ids[s])).collect()
+    };
+    let info = info_of(&prims);
+    (super::sbvh::work_of(prims, params, h.depth[node]), info)
+}
+
+/// The node's triangles as the builder saw them, and their bounds (`node_work`).
+#[cfg(test)]
 fn node_prims(bvh: &Bvh, h: &Hierarchy, node: usize) -> (Vec<BuildPrim>, NodeInfo) {
-    let range = h.first[node] as usize..(h.first[node] + h.count[node]) as usize;
-    let prims: Vec<BuildPrim> =
-        range.map(|s| BuildPrim::new(Aabb::from_points(&bvh.tris[s]), bvh.prim_ids[s])).collect();
+    let tris = if bvh.params.strategy == SplitStrategy::Sbvh { triangles_by_id(bvh) } else { Vec::new() };
+    let (work, info) = node_work(bvh, h, &tris, node);
+    (work.refs, info)
+}
+
+fn info_of(prims: &[BuildPrim]) -> NodeInfo {
     let mut info = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY };
-    for p in &prims {
+    for p in prims {
         info.bounds = info.bounds.union(p.bounds());
         info.centroid_bounds = info.centroid_bounds.grow(p.centroid());
     }
-    (prims, info)
+    info
 }
 
 /// The SAH cost of the subtree under `node`, relative to its area (as `TreeStats` costs the whole
@@ -244,7 +290,8 @@ fn marker(
         return None;
     }
     let mut p = prims.to_vec();
-    match strategy.splitter(params)?.split(&mut p, info) {
+    let Some(mut splitter) = strategy.splitter(params) else { return None };
+    match splitter.split(&mut p, info) {
         Proposal::Split { axis, mid, plane, .. } if mid > 0 && mid < p.len() => {
             let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, q| b.union(q.bounds()));
             let (l, r) = (side(&p[..mid]), side(&p[mid..]));
@@ -269,22 +316,49 @@ pub fn own_split(bvh: &Bvh, h: &Hierarchy, node: u32) -> (Option<Marker>, [Vec<C
     if i >= bvh.nodes.len() {
         return (None, Default::default());
     }
-    let (prims, info) = node_prims(bvh, h, i);
     let params = bvh.params;
+    let tris = if params.strategy == SplitStrategy::Sbvh { triangles_by_id(bvh) } else { Vec::new() };
+    let (work, info) = node_work(bvh, h, &tris, i);
+    let prims = work.refs.clone();
     let mut binned = <[Vec<CurvePoint>; 3]>::default();
     let area = info.bounds.area();
-    if params.strategy == SplitStrategy::SahBinned && prims.len() >= 2 && area > 0.0 {
+    let binning = matches!(params.strategy, SplitStrategy::SahBinned | SplitStrategy::Sbvh);
+    if binning && prims.len() >= 2 && area > 0.0 {
         let bins = params.sah_bins as usize;
         binned_planes(&mut prims.clone(), &info, bins, &mut Curves { out: &mut binned, cost: params.cost, area });
     }
-    (marker(params.strategy, &prims, &info, &params), binned)
+    let own = if params.strategy == SplitStrategy::Sbvh {
+        let tri = |i: u32| tris[i as usize];
+        let e = super::sbvh::explain(work, &tri, &params, &bvh.root_bounds(), &mut ());
+        sbvh_marker(&e, &params, area)
+    } else {
+        marker(params.strategy, &prims, &info, &params)
+    };
+    (own, binned)
+}
+
+/// The SBVH's split as a marker (its left and right counts are references: a cut triangle is on
+/// both sides).
+fn sbvh_marker(e: &super::sbvh::Explained, params: &super::BuildParams, area: f32) -> Option<Marker> {
+    let s = e.split.filter(|_| area > 0.0)?;
+    Some(Marker {
+        strategy: SplitStrategy::Sbvh,
+        axis: s.axis,
+        position: s.plane,
+        left: s.left,
+        right: s.right,
+        cost: split_cost(params.cost, s.weighted, area),
+    })
 }
 
 /// Explain `node` of `bvh` (a node id of the binary tree as built).
 pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
     let i = node as usize;
     let n = bvh.nodes.get(i)?;
-    let (prims, info) = node_prims(bvh, h, i);
+    // The SBVH clips triangles: it needs them by id (for any tree: its marker is on every one).
+    let tris = triangles_by_id(bvh);
+    let (work, info) = node_work(bvh, h, &tris, i);
+    let prims = work.refs.clone();
     let bounds = n.bounds();
     let area = info.bounds.area();
     let parent = (h.parent[i] != u32::MAX).then_some(h.parent[i]);
@@ -297,11 +371,26 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         sweep_planes(&mut prims.clone(), &info, &mut Curves { out: &mut sweep, cost: params.cost, area });
         binned_planes(&mut prims.clone(), &info, bins, &mut Curves { out: &mut binned, cost: params.cost, area });
     }
-    let markers =
-        SplitStrategy::ALL.into_iter().map(|strategy| (strategy, marker(strategy, &prims, &info, &params))).collect();
+    let mut spatial = <[Vec<CurvePoint>; 3]>::default();
+    let sbvh = (count >= 1).then(|| {
+        let tri = |i: u32| tris[i as usize];
+        let sink = &mut Curves { out: &mut spatial, cost: params.cost, area: area.max(f32::MIN_POSITIVE) };
+        super::sbvh::explain(work, &tri, &params, &bvh.root_bounds(), sink)
+    });
+    let markers = SplitStrategy::ALL
+        .into_iter()
+        .map(|strategy| {
+            let m = match (strategy, &sbvh) {
+                (SplitStrategy::Sbvh, Some(e)) => sbvh_marker(e, &params, area),
+                _ => marker(strategy, &prims, &info, &params),
+            };
+            (strategy, m)
+        })
+        .collect();
     let child_overlap =
         children.map(|[l, r]| Overlap::of(&bvh.nodes[l as usize].bounds(), &bvh.nodes[r as usize].bounds()));
-    let own_cost = children.filter(|_| area > 0.0).map(|[l, r]| {
+    // (An SBVH subtree's leaves hold more references than its node did: its marker is its split.)
+    let own_cost = children.filter(|_| area > 0.0 && params.strategy != SplitStrategy::Sbvh).map(|[l, r]| {
         let side = |c: u32| bvh.nodes[c as usize].bounds().area() * h.count[c as usize] as f32;
         params.cost.traversal + params.cost.intersection * (side(l) + side(r)) / area
     });
@@ -329,6 +418,8 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         sweep,
         binned,
         bins: super::split::bins_for(count as usize, bins),
+        spatial,
+        sbvh,
         markers,
         own_cost,
     })
@@ -423,10 +514,46 @@ mod tests {
                 let ins = inspect(&bvh, &h, node).unwrap();
                 let (m, binned) = own_split(&bvh, &h, node);
                 assert_eq!(m, ins.markers.iter().find(|(s, _)| *s == strategy).unwrap().1, "{strategy:?} {node}");
-                let want = if strategy == SplitStrategy::SahBinned { ins.binned.clone() } else { Default::default() };
+                let binning = matches!(strategy, SplitStrategy::SahBinned | SplitStrategy::Sbvh);
+                let want = if binning { ins.binned.clone() } else { Default::default() };
                 assert_eq!(binned, want);
             }
         }
+    }
+
+    /// An SBVH tree's inspector replays its build: at every interior node the SBVH marker is the
+    /// split the tree has (its axis, and as many references on each side as the children hold
+    /// when they are inspected in turn), spatial splits among them, and where the SBVH priced
+    /// spatial planes the curve's cheapest point is no dearer than its split.
+    #[test]
+    fn an_sbvh_trees_inspector_replays_its_build() {
+        let mesh = generate::diagonal_rods(3, 6, 6.0, 0.03, 0.2);
+        let params = BuildParams {
+            strategy: SplitStrategy::Sbvh,
+            layout: Layout::Binary,
+            sbvh_growth: 100,
+            ..Default::default()
+        };
+        let bvh = Bvh::build(&mesh, &params);
+        let h = Hierarchy::of(&bvh);
+        let (mut spatial, mut curves) = (0, 0);
+        for (i, n) in bvh.nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
+            let ins = inspect(&bvh, &h, i as u32).unwrap();
+            let m = ins.markers.iter().find(|(s, _)| *s == SplitStrategy::Sbvh).unwrap().1.unwrap();
+            let count = |c: u32| inspect(&bvh, &h, c).unwrap().triangles;
+            assert_eq!((m.axis, m.left, m.right), (n.axis, count(n.index), count(n.index + 1)), "node {i}");
+            let e = ins.sbvh.unwrap();
+            if e.split.unwrap().kind == crate::bvh::sbvh::SplitKind::Spatial {
+                spatial += 1;
+                let cheapest = ins.spatial.iter().flatten().map(|p| p.cost).fold(f32::INFINITY, f32::min);
+                assert!(cheapest <= m.cost * 1.0001, "node {i}: the bins' best {cheapest}, the split {}", m.cost);
+            }
+            curves += (!ins.spatial.iter().all(Vec::is_empty)) as u32;
+            assert_eq!(ins.spatial.iter().all(Vec::is_empty), !e.spatial_priced, "node {i}");
+        }
+        assert!(spatial >= 5 && curves >= spatial, "{spatial} spatial splits, {curves} spatial curves");
+        assert_eq!(spatial, bvh.report.spatial_splits, "the replay finds every spatial split the build made");
+        assert_eq!(inspect(&bvh, &h, 0).unwrap().triangles as usize, mesh.triangle_count());
     }
 
     /// A built tree's own split cost, from its children's stored boxes, is the cost its

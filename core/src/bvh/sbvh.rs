@@ -19,7 +19,9 @@
 
 use super::build::{leaf_is_cheaper, node_info, BuildParams, Overrides, Progress, HEURISTIC_DEPTH_LIMIT};
 use super::node::BvhNode;
-use super::split::{binned_planes, spatial_partition, spatial_planes, BuildPrim, EqualCount, NodeInfo, PlaneSink, Proposal};
+use super::split::{
+    binned_planes, spatial_partition, spatial_planes, BuildPrim, EqualCount, NodeInfo, PlaneSink, Proposal,
+};
 use super::subtree::Subtree;
 use crate::geometry::Aabb;
 use crate::work::Cancelled;
@@ -82,6 +84,8 @@ pub(super) struct Decided {
     pub overlap: f32,
     /// Whether a spatial split was priced here (the overlap test passed and budget was left).
     pub spatial_priced: bool,
+    /// The duplicates a cheaper spatial split would have added, when that was over the budget.
+    pub over_budget: Option<u64>,
     over: Overrides,
 }
 
@@ -100,7 +104,13 @@ pub(super) fn split_node(
     spatials: &mut impl PlaneSink,
 ) -> Decided {
     let n = work.refs.len();
-    let mut decided = Decided { outcome: Outcome::Leaf(Vec::new()), overlap: 0.0, spatial_priced: false, over: Overrides::default() };
+    let mut decided = Decided {
+        outcome: Outcome::Leaf(Vec::new()),
+        overlap: 0.0,
+        spatial_priced: false,
+        over_budget: None,
+        over: Overrides::default(),
+    };
     let params = &ctx.params;
     if n <= 1 {
         decided.outcome = Outcome::Leaf(work.refs);
@@ -132,7 +142,9 @@ pub(super) fn split_node(
             let added = (l.len() + r.len() - n) as u64;
             // A cut of references that all straddle the plane leaves both children as many as
             // the parent, but every such split spends budget, so the splitting ends.
-            if !l.is_empty() && !r.is_empty() && added <= work.budget {
+            if added > work.budget {
+                decided.over_budget = Some(added);
+            } else if !l.is_empty() && !r.is_empty() {
                 let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds())).area();
                 let weighted = side(&l) * l.len() as f32 + side(&r) * r.len() as f32;
                 spatial = Some((s.axis, s.position, weighted, l, r, added));
@@ -180,7 +192,8 @@ fn equal_count(mut work: Work, info: &NodeInfo) -> Outcome {
 /// up to one duplicate per reference, the other the rest.
 fn share(parent: &Work, l: Vec<BuildPrim>, r: Vec<BuildPrim>, added: u64) -> (Work, Work) {
     let (nl, nr) = (l.len() as u64, r.len() as u64);
-    let weight = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds())).area() as f64 * s.len() as f64;
+    let weight =
+        |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds())).area() as f64 * s.len() as f64;
     let budget = parent.budget - added;
     let (bl, br) = if budget == 0 {
         (0, 0)
@@ -202,10 +215,7 @@ fn share(parent: &Work, l: Vec<BuildPrim>, r: Vec<BuildPrim>, added: u64) -> (Wo
     };
     let wl = parent.weight * nl / (nl + nr);
     let depth = parent.depth + 1;
-    (
-        Work { refs: l, budget: bl, weight: wl, depth },
-        Work { refs: r, budget: br, weight: parent.weight - wl, depth },
-    )
+    (Work { refs: l, budget: bl, weight: wl, depth }, Work { refs: r, budget: br, weight: parent.weight - wl, depth })
 }
 
 fn intersection(a: &Aabb, b: &Aabb) -> Option<Aabb> {
@@ -338,18 +348,11 @@ fn build_sequential(
     Ok((nodes, out, kinds))
 }
 
-/// What the builder saw at a node: its references and the decision made there, found by walking
-/// from the root through `path` (each step: `true` for the right child) with the build's own
-/// `split_node`, the curves of the last node reported to `objects` and `spatials`. `refs` are the
-/// root's references in the build's order (triangle i's bounds at place i).
-pub(super) fn replay(
-    refs: Vec<BuildPrim>,
-    tri: Triangles,
-    params: &BuildParams,
-    path: &[bool],
-    objects: &mut impl PlaneSink,
-    spatials: &mut impl PlaneSink,
-) -> Option<Replayed> {
+/// The work of the node at the end of `path` (from the root, each step `true` for the right
+/// child) as the build had it, found by walking down through the build's own `split_node` from
+/// `refs`, the root's references in the build's order (triangle i's bounds at place i). `None`
+/// when the path runs past a leaf.
+pub(super) fn descend(refs: Vec<BuildPrim>, tri: Triangles, params: &BuildParams, path: &[bool]) -> Option<Work> {
     let root = node_info(&refs);
     let ctx = Ctx::new(Some(tri), params, &root.bounds);
     let mut work = Work::root(refs, params);
@@ -360,12 +363,30 @@ pub(super) fn replay(
             Outcome::Leaf(_) => return None,
         }
     }
+    Some(work)
+}
+
+/// A node's references, the duplicates it may still add and its depth: for a tree of another
+/// strategy, its triangles whole with a fresh budget (what the SBVH would do with them).
+pub(super) fn work_of(refs: Vec<BuildPrim>, params: &BuildParams, depth: u32) -> Work {
+    Work { depth, ..Work::root(refs, params) }
+}
+
+/// What the SBVH builder decides at `work` (a tree whose root box is `root`), with the spatial
+/// split's planes reported to `spatials`: the node inspector's explanation.
+pub(super) fn explain(
+    work: Work,
+    tri: Triangles,
+    params: &BuildParams,
+    root: &Aabb,
+    spatials: &mut impl PlaneSink,
+) -> Explained {
+    let ctx = Ctx::new(Some(tri), params, root);
     let info = node_info(&work.refs);
-    let refs = work.refs.clone();
     let budget = work.budget;
-    let decided = split_node(work, &info, &ctx, objects, spatials);
+    let decided = split_node(work, &info, &ctx, &mut (), spatials);
     let split = match &decided.outcome {
-        Outcome::Split { kind, axis, plane, left, right } => Some(ReplayedSplit {
+        Outcome::Split { kind, axis, plane, left, right } => Some(ExplainedSplit {
             kind: *kind,
             axis: *axis,
             plane: *plane,
@@ -378,32 +399,37 @@ pub(super) fn replay(
         }),
         Outcome::Leaf(_) => None,
     };
-    Some(Replayed {
-        refs,
-        info,
+    let area = if root.is_empty() { 0.0 } else { root.area() };
+    Explained {
         budget,
-        overlap_ratio: if root.bounds.area() > 0.0 { decided.overlap / root.bounds.area() } else { 0.0 },
+        overlap_ratio: if area > 0.0 { decided.overlap / area } else { 0.0 },
         spatial_priced: decided.spatial_priced,
+        over_budget: decided.over_budget,
         split,
-    })
+    }
 }
 
-/// A node as the SBVH builder saw it (`replay`).
-pub(super) struct Replayed {
-    pub refs: Vec<BuildPrim>,
-    pub info: NodeInfo,
+/// What the SBVH builder made of a node (`explain`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Explained {
     /// Duplicates its subtree could still add.
     pub budget: u64,
-    /// λ / A(root): the object split's children's common area over the root's area.
+    /// λ / A(root): the object split's children's common area over the root's (spatial splits
+    /// are priced when it exceeds α).
     pub overlap_ratio: f32,
     pub spatial_priced: bool,
-    pub split: Option<ReplayedSplit>,
+    /// The duplicates the cheaper spatial split needed, when they were more than the budget.
+    pub over_budget: Option<u64>,
+    /// `None`: a leaf.
+    pub split: Option<ExplainedSplit>,
 }
 
-pub(super) struct ReplayedSplit {
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExplainedSplit {
     pub kind: SplitKind,
     pub axis: u8,
     pub plane: f32,
+    /// References of each child (a cut triangle in both).
     pub left: u32,
     pub right: u32,
     /// A_L·n_L + A_R·n_R of the children made.

@@ -103,6 +103,11 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                     "SAH cost of splitting these {} triangles at each plane (C_trav + C_isect (A_L n_L + A_R n_R) / A); {whose}.",
                     ins.triangles
                 ));
+                if let Some(line) = crate::cli::inspect::sbvh_text(ins) {
+                    ui.label(line).on_hover_text(
+                        "Stich et al. 2009: the SBVH prices spatial splits (which cut triangles straddling the plane) only where the object split's two boxes overlap by more than α of the root's area, while its budget of extra references lasts",
+                    );
+                }
                 for axis in 0..3 {
                     curve_plot(ui, ins, axis, own);
                 }
@@ -196,8 +201,9 @@ fn steps(points: &[CurvePoint]) -> Vec<[f64; 2]> {
 /// `own`: the tree's strategy, whose marker is "(this tree)"; `None` for an imported tree, whose
 /// own split is drawn as a line at its cost.
 fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: Option<SplitStrategy>) {
-    let (sweep, binned) = (&ins.sweep[axis], &ins.binned[axis]);
-    ui.label(format!("Axis {}: {} candidate planes, {} bins' planes", AXES[axis], sweep.len(), binned.len()));
+    let (sweep, binned, spatial) = (&ins.sweep[axis], &ins.binned[axis], &ins.spatial[axis]);
+    let cuts = if spatial.is_empty() { String::new() } else { format!(", {} spatial planes", spatial.len()) };
+    ui.label(format!("Axis {}: {} candidate planes, {} bins' planes{cuts}", AXES[axis], sweep.len(), binned.len()));
     if sweep.is_empty() {
         ui.weak("The centroids do not spread along this axis.");
         return;
@@ -218,6 +224,14 @@ fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: Option<Spli
                         .color(Color32::from_rgb(90, 200, 250))
                         .width(1.0)
                         .style(LineStyle::dashed_loose()),
+                );
+            }
+            if !spatial.is_empty() {
+                p.line(
+                    Line::new("SBVH spatial split", PlotPoints::from(steps(spatial)))
+                        .color(strategy_color(SplitStrategy::Sbvh))
+                        .width(1.0)
+                        .style(LineStyle::dashed_dense()),
                 );
             }
             p.hline(
