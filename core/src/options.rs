@@ -341,7 +341,7 @@ pub const REINSERT_PASSES: Number<u32> = Number {
 pub const SBVH_ALPHA: Number<f32> = Number {
     name: "sbvh-alpha",
     key: "sbvh_alpha",
-    label: "SBVH overlap α",
+    label: "SBVH α",
     help: "SBVH: spatial splits are tried only where an object split's two boxes share more than this fraction of the root's surface area (Stich et al.'s α; 0: everywhere, 1: nowhere).",
     min: 0.0,
     max: 1.0,

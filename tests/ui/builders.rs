@@ -7,21 +7,27 @@ use bvhscope::app::{Action, Pick, SceneSource};
 use bvhscope::bvh::SplitStrategy;
 use bvhscope::cli::{Cli, Command};
 use egui_kittest::kittest::Queryable;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use support::*;
+
+/// The app with `asset` open and `strategy` (its label) chosen from the strategy list.
+fn open_with(asset: &str, strategy: &str) -> (egui_kittest::Harness<'static, bvhscope::app::BvhscopeApp>, PathBuf) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets").join(asset);
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::Picked(Pick::Open, path.clone()));
+    run_until(&mut h, asset, |a| a.scene.source == SceneSource::File(path.clone()) && idle(a));
+    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split strategy").click();
+    h.run_steps(2);
+    h.get_by_label(strategy).click();
+    h.run_steps(1);
+    (h, path)
+}
 
 #[test]
 fn ploc_with_reinsertion_shows_what_stats_prints() {
-    let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
-    let mut h = harness();
-    run_until(&mut h, "the first frame", idle);
-    h.state_mut().act(Action::Picked(Pick::Open, torus.clone()));
-    run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus.clone()) && idle(a));
     // PLOC from the list, then two passes of reinsertion and the binary layout.
-    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split strategy").click();
-    h.run_steps(2);
-    h.get_by_label("PLOC").click();
-    h.run_steps(1);
+    let (mut h, torus) = open_with("torus.obj", "PLOC");
     let mut s = h.state().settings.clone();
     (s.build.reinsert_passes, s.build.layout) = (2, bvhscope::bvh::Layout::Binary);
     h.state_mut().act(Action::Edit(Box::new(s)));
@@ -69,4 +75,58 @@ fn ploc_with_reinsertion_shows_what_stats_prints() {
     h.state_mut().act(Action::SelectNode(0));
     run_until(&mut h, "the root's inspection", |a| a.nodes.inspection.is_some() && idle(a));
     assert!(h.query_all_by_label_contains("no plane priced here").count() >= 2, "LBVH and PLOC rows");
+}
+
+/// The SBVH chosen in the list, its growth bound set in the build panel: the references per
+/// triangle and the spatial splits the statistics panel shows are `bvhscope stats`'s, and the Node
+/// window says what the SBVH did at the root, with `inspect`'s line.
+#[test]
+fn sbvh_shows_its_references_as_stats_and_inspect_print_them() {
+    let (mut h, rods) = open_with("diagonal-rods.obj", "SBVH (spatial splits)");
+    let mut s = h.state().settings.clone();
+    (s.build.sbvh_growth, s.build.layout) = (50, bvhscope::bvh::Layout::Binary);
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    run_until(&mut h, "the SBVH", |a| {
+        idle(a)
+            && a.current_bvh().is_some_and(|b| {
+                let p = b.bvh.build_params().bvh;
+                p.strategy == SplitStrategy::Sbvh && p.sbvh_growth == 50
+            })
+    });
+    let stats = h.state().current_bvh().unwrap().stats.clone();
+    assert!(stats.references > stats.triangles, "spatial splits cut triangles");
+    h.get_by_label(&format!("{:.3} ({})", stats.references_per_triangle(), stats.spatial_splits));
+    let words = [
+        "bvhscope",
+        "stats",
+        rods.to_str().unwrap(),
+        "--strategy",
+        "sbvh",
+        "--sbvh-growth",
+        "50",
+        "--layout",
+        "binary",
+        "--no-rays",
+        "--format",
+        "json",
+    ];
+    let Some(Command::Stats(args)) = Cli::from_words(words).unwrap().command else { panic!("stats") };
+    let v: serde_json::Value = serde_json::from_str(&bvhscope::cli::stats::output(&args).unwrap()).unwrap();
+    let cli = &v["stats"];
+    assert_eq!((cli["nodes"].clone(), cli["references"].clone()), (stats.nodes.into(), stats.references.into()));
+    assert_eq!(cli["spatial_splits"], stats.spatial_splits);
+    assert_eq!(cli["sah_cost"].as_f64().unwrap(), stats.sah_cost);
+
+    h.state_mut().act(Action::SelectNode(0));
+    run_until(&mut h, "the root's inspection", |a| a.nodes.inspection.is_some() && idle(a));
+    let ins = h.state().nodes.inspection.clone().unwrap();
+    let line = bvhscope::cli::inspect::sbvh_text(&ins).expect("the SBVH's line");
+    h.get_by_label(&line);
+    let words = ["bvhscope", "inspect", rods.to_str().unwrap(), "--strategy", "sbvh", "--sbvh-growth", "50"];
+    let Some(Command::Inspect(args)) =
+        Cli::from_words(words.into_iter().chain(["--layout", "binary", "--node", "0"])).unwrap().command
+    else {
+        panic!("inspect")
+    };
+    assert!(bvhscope::cli::inspect::output(&args).unwrap().contains(&line), "inspect prints the same line");
 }
