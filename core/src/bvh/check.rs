@@ -333,13 +333,16 @@ pub struct WrongRay {
 /// app keeps it for every view of an imported tree).
 pub enum Reference {
     Linear(LinearScan),
-    Tree(Bvh),
+    Tree(Box<Bvh>),
 }
 
 impl Reference {
     pub fn of(mesh: &Mesh) -> Reference {
         if mesh.triangle_count() > LINEAR_REFERENCE_MAX {
-            Reference::Tree(Bvh::build(mesh, &BuildParams { layout: super::Layout::Binary, ..BuildParams::default() }))
+            Reference::Tree(Box::new(Bvh::build(
+                mesh,
+                &BuildParams { layout: super::Layout::Binary, ..BuildParams::default() },
+            )))
         } else {
             Reference::Linear(LinearScan::new(mesh))
         }

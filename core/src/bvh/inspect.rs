@@ -290,7 +290,7 @@ fn marker(
         return None;
     }
     let mut p = prims.to_vec();
-    let Some(mut splitter) = strategy.splitter(params) else { return None };
+    let mut splitter = strategy.splitter(params)?;
     match splitter.split(&mut p, info) {
         Proposal::Split { axis, mid, plane, .. } if mid > 0 && mid < p.len() => {
             let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, q| b.union(q.bounds()));

@@ -126,9 +126,9 @@ pub fn spatial_planes(
             let mut rest = b;
             if first < last {
                 let t = tri(r.index());
-                for k in first..last {
+                for (k, slice) in slices.iter_mut().enumerate().take(last).skip(first) {
                     let (l, right) = split_reference(&t, &rest, axis, plane(lo, width, k + 1));
-                    slices[k].bounds = slices[k].bounds.union(l);
+                    slice.bounds = slice.bounds.union(l);
                     rest = right;
                 }
             }
