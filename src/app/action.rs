@@ -340,7 +340,7 @@ impl BvhscopeApp {
                 let explained = self.nodes.current(Some(&shown.bvh)).cloned();
                 match (explained, shown.frame.sample(x, y)) {
                     (_, s) if !s.is_hit() => self.message(MessageKind::Info, "That pixel hits nothing: no leaf to select."),
-                    (Some(e), s) => match e.hierarchy.leaf_of_prim(s.prim) {
+                    (Some(e), s) => match e.hierarchy.leaf_of_hit(&e.tree, s.prim, shown.camera.ray_gen().pixel_ray(x, y).at(s.t)) {
                         Some(leaf) => self.act(A::SelectNode(leaf)),
                         None => self.message(MessageKind::Warning, "The pixel's triangle is in no leaf of this tree."),
                     },

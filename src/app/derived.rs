@@ -88,8 +88,8 @@ impl BvhscopeApp {
         for y in 0..h {
             for x in 0..w {
                 let s = f.sample(x as u32, y as u32);
-                let inside = s.is_hit()
-                    && h_.slot_of_prim.get(s.prim as usize).is_some_and(|&slot| h_.holds(node as usize, slot));
+                // (A triangle cut by spatial splits is in the node if any of its parts is.)
+                let inside = s.is_hit() && h_.slots_of_prim(s.prim).any(|slot| h_.holds(node as usize, slot));
                 pixels.push(if inside { egui::Color32::TRANSPARENT } else { egui::Color32::from_black_alpha(150) });
             }
         }

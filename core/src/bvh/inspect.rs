@@ -28,8 +28,11 @@ pub struct Hierarchy {
     pub count: Vec<u32>,
     /// The leaf holding each slot of the leaf order.
     pub leaf_of_slot: Vec<u32>,
-    /// The slot of each mesh triangle in the leaf order.
+    /// The slot of each mesh triangle in the leaf order (of a triangle in several leaves, an
+    /// SBVH's cut triangle, its last slot: `other_slots` has the rest).
     pub slot_of_prim: Vec<u32>,
+    /// The other slots of triangles in several leaves (empty unless spatial splits cut some).
+    pub other_slots: std::collections::HashMap<u32, Vec<u32>>,
 }
 
 impl Hierarchy {
@@ -42,6 +45,7 @@ impl Hierarchy {
             count: vec![0; n],
             leaf_of_slot: vec![0; bvh.prim_ids.len()],
             slot_of_prim: vec![u32::MAX; bvh.prim_ids.len()],
+            other_slots: Default::default(),
         };
         // Parents come before their children in the node array, so one pass down sets parents and
         // depths, and one pass back up sums the ranges.
@@ -69,10 +73,31 @@ impl Hierarchy {
         }
         for (slot, &prim) in bvh.prim_ids.iter().enumerate() {
             if let Some(s) = h.slot_of_prim.get_mut(prim as usize) {
+                if *s != u32::MAX {
+                    h.other_slots.entry(prim).or_default().push(*s);
+                }
                 *s = slot as u32;
             }
         }
         h
+    }
+
+    /// Every slot of a triangle in the leaf order (more than one where spatial splits cut it).
+    pub fn slots_of_prim(&self, prim: u32) -> impl Iterator<Item = u32> + '_ {
+        let last = self.slot_of_prim.get(prim as usize).copied().filter(|&s| s != u32::MAX);
+        last.into_iter().chain(self.other_slots.get(&prim).into_iter().flatten().copied())
+    }
+
+    /// The leaf that holds the part of triangle `prim` at `point` (a pixel's hit): its leaf, or of
+    /// a triangle cut among several leaves the one whose box is nearest the point (holds it, but
+    /// for rounding).
+    pub fn leaf_of_hit(&self, bvh: &Bvh, prim: u32, point: glam::Vec3) -> Option<u32> {
+        let away = |leaf: u32| {
+            let b = bvh.nodes[leaf as usize].bounds();
+            (glam::Vec3::from(b.min) - point).max(point - glam::Vec3::from(b.max)).max(glam::Vec3::ZERO).length()
+        };
+        let leaves = self.slots_of_prim(prim).filter_map(|s| self.leaf_of_slot.get(s as usize).copied());
+        leaves.min_by(|&a, &b| away(a).total_cmp(&away(b)))
     }
 
     /// The node's ancestors from the root down, the node last: the breadcrumb.
@@ -464,6 +489,7 @@ mod tests {
             assert_eq!(h.first[l], h.first[i], "the left child's range starts the parent's");
             assert_eq!(h.first[r], h.first[l] + h.count[l], "the right one follows it");
         }
+        assert!(h.other_slots.is_empty(), "no triangle in two leaves");
         for (prim, _) in bvh.prim_ids.iter().enumerate() {
             let leaf = h.leaf_of_prim(prim as u32).unwrap();
             let path = h.path(leaf);
@@ -554,6 +580,29 @@ mod tests {
         assert!(spatial >= 5 && curves >= spatial, "{spatial} spatial splits, {curves} spatial curves");
         assert_eq!(spatial, bvh.report.spatial_splits, "the replay finds every spatial split the build made");
         assert_eq!(inspect(&bvh, &h, 0).unwrap().triangles as usize, mesh.triangle_count());
+        // A cut triangle's hit point selects the leaf holding that part of it.
+        let (&prim, others) = h.other_slots.iter().next().expect("cut triangles");
+        let mut parts = 0;
+        for &slot in others.iter().chain([&h.slot_of_prim[prim as usize]]) {
+            let leaf = h.leaf_of_slot[slot as usize];
+            let b = bvh.nodes[leaf as usize].bounds();
+            let t = bvh.tris[slot as usize];
+            let inside = (0..=20)
+                .flat_map(|i| (0..=20 - i).map(move |j| (i as f32 / 20.0, j as f32 / 20.0)))
+                .map(|(u, v)| t[0] * (1.0 - u - v) + t[1] * u + t[2] * v)
+                .find(|p| {
+                    let others_hold = h.slots_of_prim(prim).filter(|&s| s != slot).any(|s| {
+                        let o = bvh.nodes[h.leaf_of_slot[s as usize] as usize].bounds();
+                        (0..3).all(|a| o.min[a] <= p[a] && p[a] <= o.max[a])
+                    });
+                    (0..3).all(|a| b.min[a] < p[a] && p[a] < b.max[a]) && !others_hold
+                });
+            if let Some(p) = inside {
+                assert_eq!(h.leaf_of_hit(&bvh, prim, p), Some(leaf), "the part at {p:?}");
+                parts += 1;
+            }
+        }
+        assert!(parts >= 2, "{parts} parts of triangle {prim} found inside their own leaf only");
     }
 
     /// A built tree's own split cost, from its children's stored boxes, is the cost its

@@ -34,8 +34,14 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 ui.weak(why);
                 return;
             };
+            let cut = e.hierarchy.other_slots.len();
+            let refs = if cut > 0 {
+                format!(" (references: spatial splits cut {cut} triangles among several leaves, and the counts below count each part)")
+            } else {
+                String::new()
+            };
             ui.label(format!(
-                "The binary tree as built: {} nodes, {} triangles. Shift-click the image to select a pixel's leaf, or a drawn box's edge.",
+                "The binary tree as built: {} nodes, {} triangles{refs}. Shift-click the image to select a pixel's leaf, or a drawn box's edge.",
                 e.tree.nodes.len(),
                 e.tree.prim_ids.len()
             ));
