@@ -4,6 +4,7 @@
 
 use super::node_view::Explained;
 use crate::bvh::inspect::{CurvePoint, Marker};
+use crate::bvh::lbvh::MortonOrder;
 use crate::bvh::replay::{PartialBvh, Replay};
 use std::sync::Arc;
 use std::time::Instant;
@@ -22,6 +23,8 @@ pub struct ReplayView {
     /// SAH the cost at its bins' planes per axis (not computed for nodes over
     /// `MAX_PLANE_TRIANGLES`, whose sweep would hold up the window).
     pub newest: Option<(u32, Option<Marker>, [Vec<CurvePoint>; 3])>,
+    /// An LBVH tree's Morton order (its leaf order), drawn as the curve its splits cut.
+    pub morton: Option<Arc<MortonOrder>>,
 }
 
 /// The largest newest split whose plane the replay computes as it steps.
@@ -34,6 +37,7 @@ impl ReplayView {
         if !fresh {
             let r = Arc::new(Replay::of(e.tree.clone()));
             self.k = self.k.min(r.splits());
+            self.morton = MortonOrder::of(&r.tree).map(Arc::new);
             self.replay = Some(r);
             self.partial = None;
         }

@@ -233,6 +233,10 @@ fn draw_replay(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &s
             );
         }
     }
+    // LBVH: the Morton curve through the centroids in leaf order, a colour per frontier node.
+    if let Some(m) = &app.replay.morton {
+        morton_lines(m, p, &r.hierarchy, &mut lines);
+    }
     let camera = &shown.camera;
     if let Some(&newest) = p.splits.checked_sub(1).and_then(|i| r.order.get(i)) {
         let l = p.tree.nodes[newest as usize].index as usize;
@@ -246,6 +250,32 @@ fn draw_replay(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &s
     }
     let near = (camera.position - camera.look_at).length() * 1e-4;
     painter.add(egui::Shape::Mesh(Arc::new(lines_mesh(&lines, camera, rect, near))));
+}
+
+/// Most segments of the Morton curve drawn (a bigger frontier is drawn through every k-th node).
+const MAX_MORTON_SEGMENTS: usize = 20_000;
+
+/// The Morton curve of an LBVH tree at the replay's resolution: the frontier nodes in leaf order
+/// (which is Morton order), each at the mean centroid of its triangles, joined in that order and
+/// coloured from its start (blue) to its end (yellow). After one split it is two points, after
+/// seven the eight octant-like cells in Z order, and it refines as the tree is split.
+fn morton_lines(
+    m: &crate::bvh::lbvh::MortonOrder,
+    p: &crate::bvh::replay::PartialBvh,
+    h: &crate::bvh::inspect::Hierarchy,
+    out: &mut Vec<super::overlay::Line3>,
+) {
+    let mut pieces: Vec<(u32, u32)> =
+        p.frontier().iter().map(|&n| (h.first[n as usize], h.count[n as usize])).collect();
+    pieces.sort_unstable();
+    let step = pieces.len().div_ceil(MAX_MORTON_SEGMENTS).max(1);
+    let points: Vec<glam::Vec3> = pieces.iter().step_by(step).map(|&(f, c)| m.mean(f, c)).collect();
+    let n = points.len().saturating_sub(1).max(1) as f32;
+    for (k, w) in points.windows(2).enumerate() {
+        let t = k as f32 / n;
+        let color = Color32::from_rgb((40.0 + 210.0 * t) as u8, (120.0 + 100.0 * t) as u8, (250.0 - 200.0 * t) as u8);
+        out.push(super::overlay::Line3 { a: w[0], b: w[1], color, width: 3.0 });
+    }
 }
 
 /// The node of the binary tree whose drawn box has an edge under `pos` (the overlay's boxes are

@@ -53,6 +53,12 @@ pub fn steps(n: usize, frames: u32) -> Vec<usize> {
 }
 
 pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
+    super::out(&output(a)?);
+    Ok(())
+}
+
+/// Write the animated PNG; the table `run` prints.
+pub fn output(a: &ReplayArgs) -> Result<String, CliError> {
     if a.build.two_level {
         return Err(CliError::Usage("replay plays back one BVH's build; leave out --two-level".into()));
     }
@@ -88,10 +94,17 @@ pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
     let max = values.iter().flatten().copied().fold(0f32, f32::max).max(1e-20);
     let subject = format!("{}, {}, log scale", file_name(&a.mesh), params.strategy.label());
     let mut table = format!("{:>8}  {:>12}  mean {} per ray\n", "splits", "SAH cost", a.view.label().to_lowercase());
+    // An LBVH tree's splits follow the Morton order: each step names the newest one's bit.
+    let morton = crate::bvh::lbvh::MortonOrder::of(&replay.tree);
     let mut images = Vec::new();
     for (&k, v) in ks.iter().zip(&values) {
         let mean = v.iter().map(|&x| x as f64).sum::<f64>() / v.len().max(1) as f64;
-        let _ = writeln!(table, "{k:>8}  {:>12.3}  {mean:.3}", replay.sah[k]);
+        let newest = k.checked_sub(1).map(|i| replay.order[i]);
+        let split = match (&morton, newest) {
+            (Some(m), Some(n)) => morton_text(m, &replay, n).map_or(String::new(), |t| format!("  node {n}: {t}")),
+            _ => String::new(),
+        };
+        let _ = writeln!(table, "{k:>8}  {:>12.3}  {mean:.3}{split}", replay.sah[k]);
         // One scale for every step, 0 to the largest value of any, logarithmic: the first steps
         // cost hundreds of times what the last do, and both should show.
         let log_max = (1.0 + max).ln();
@@ -116,9 +129,25 @@ pub fn run(a: &ReplayArgs) -> Result<(), CliError> {
         images.push(draw_legend(&img, &legend));
     }
     write_apng(&images, a.delay_ms, &a.output)?;
-    super::out(&table);
     eprintln!("wrote {} ({} frames, {}x{})", a.output.display(), images.len(), images[0].width(), images[0].height());
-    Ok(())
+    Ok(table)
+}
+
+/// An LBVH split in the Morton order's words (the Replay window shows the same): where the codes
+/// of the node's slots flip, and how many slots go each way.
+pub fn morton_text(order: &crate::bvh::lbvh::MortonOrder, r: &Replay, node: u32) -> Option<String> {
+    let h = &r.hierarchy;
+    let (first, count) = (h.first[node as usize], h.count[node as usize]);
+    let s = order.split(first, count)?;
+    let axis = ["x", "y", "z"][s.axis as usize];
+    Some(format!(
+        "Morton bit {} ({axis}, grid level {}): slots {first}..{} | {}..{} of the Morton order",
+        s.bit,
+        s.level,
+        first + s.left,
+        first + s.left,
+        first + count
+    ))
 }
 
 /// Frames of one size as an animated PNG that loops.

@@ -130,3 +130,38 @@ fn sbvh_shows_its_references_as_stats_and_inspect_print_them() {
     };
     assert!(bvhscope::cli::inspect::output(&args).unwrap().contains(&line), "inspect prints the same line");
 }
+
+/// LBVH's build replay shows its Morton order: the Replay window names the newest split by the
+/// Morton bit where its slots' codes flip, in the words `bvhscope replay` prints for that step.
+#[test]
+fn the_lbvh_replay_names_each_split_by_its_morton_bit_as_replay_prints_it() {
+    let (mut h, torus) = open_with("torus.obj", "LBVH (Morton)");
+    let mut s = h.state().settings.clone();
+    s.build.layout = bvhscope::bvh::Layout::Binary;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    run_until(&mut h, "LBVH", |a| {
+        idle(a)
+            && a.current_bvh().is_some_and(|b| {
+                b.bvh.build_params().bvh.strategy == SplitStrategy::Lbvh
+                    && b.bvh.build_params().bvh.layout == bvhscope::bvh::Layout::Binary
+            })
+    });
+    h.state_mut().act(Action::ShowReplay(true));
+    run_until(&mut h, "the replay", |a| a.replay.replay.is_some() && a.replay.morton.is_some() && idle(a));
+    let apng = temp_file("lbvh-replay.png", "");
+    let words =
+        ["bvhscope", "replay", torus.to_str().unwrap(), "--strategy", "lbvh", "--size", "32x24", "--frames", "5"];
+    let Some(Command::Replay(args)) =
+        Cli::from_words(words.into_iter().chain(["-o", apng.to_str().unwrap()])).unwrap().command
+    else {
+        panic!("replay")
+    };
+    let table = bvhscope::cli::replay::output(&args).unwrap();
+    // A step past the first few splits, as the CLI played it.
+    let line = table.lines().skip(3).find(|l| l.contains("Morton bit")).expect("a step named by its Morton bit");
+    let k: usize = line.split_whitespace().next().unwrap().parse().unwrap();
+    let text = line.split_once(": ").unwrap().1.to_string();
+    h.state_mut().act(Action::ReplayStep(k));
+    run_until(&mut h, "the step", |a| a.replay.k == k && idle(a));
+    assert!(h.query_all_by_label_contains(&text).count() == 1, "the Replay window says {text}");
+}

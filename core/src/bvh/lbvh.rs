@@ -101,6 +101,21 @@ pub(super) fn build(
 /// Sort `prims` by the Morton codes of their centroids in the grid over the centroid bounds;
 /// the codes in that order.
 pub(super) fn sort(prims: &mut [BuildPrim]) -> Vec<u64> {
+    let (lo, scale) = grid(prims);
+    let mut keyed: Vec<Keyed> = prims
+        .par_iter()
+        .with_min_len(4096)
+        .enumerate()
+        .map(|(i, p)| Keyed(morton(p.centroid(), lo, scale) << 32 | i as u64))
+        .collect();
+    rdst::RadixSort::radix_sort_unstable(&mut keyed);
+    let sorted: Vec<BuildPrim> = keyed.par_iter().with_min_len(4096).map(|k| prims[k.slot()]).collect();
+    prims.copy_from_slice(&sorted);
+    keyed.par_iter().with_min_len(4096).map(|k| k.code()).collect()
+}
+
+/// The Morton grid over the primitives' centroid bounds: its lower corner and cells per unit.
+fn grid(prims: &[BuildPrim]) -> (Vec3A, Vec3A) {
     let centroids = prims
         .par_iter()
         .with_min_len(4096)
@@ -108,17 +123,70 @@ pub(super) fn sort(prims: &mut [BuildPrim]) -> Vec<u64> {
         .reduce(|| Aabb::EMPTY, |a, b| a.union(b));
     let extent = centroids.max - centroids.min;
     let cells = ((1u32 << BITS) - 1) as f32;
-    let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO);
-    let mut keyed: Vec<Keyed> = prims
-        .par_iter()
-        .with_min_len(4096)
-        .enumerate()
-        .map(|(i, p)| Keyed(morton(p.centroid(), centroids.min, scale) << 32 | i as u64))
-        .collect();
-    rdst::RadixSort::radix_sort_unstable(&mut keyed);
-    let sorted: Vec<BuildPrim> = keyed.par_iter().with_min_len(4096).map(|k| prims[k.slot()]).collect();
-    prims.copy_from_slice(&sorted);
-    keyed.par_iter().with_min_len(4096).map(|k| k.code()).collect()
+    (centroids.min, Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO))
+}
+
+/// An LBVH tree's Morton order, for the build replay: its leaf order *is* the sort, so each leaf
+/// slot's triangle centroid and code (computed again with the build's grid and `morton`), in slot
+/// order, are the curve the build followed, and each split is where a bit of the codes flips.
+pub struct MortonOrder {
+    /// The triangle centroids in leaf order: the Morton curve.
+    pub centroids: Vec<glam::Vec3>,
+    /// Their codes (non-decreasing: `of` checks).
+    pub codes: Vec<u64>,
+    /// Running sums of the centroids (`sums[i]`: of slots `..i`), for `mean`.
+    sums: Vec<glam::DVec3>,
+}
+
+/// Where the codes of a range split: the bit, its axis (0 = x) and its level of the grid (1 =
+/// halves, 2 = quarters, … down to `BITS`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MortonSplit {
+    pub bit: u32,
+    pub axis: u8,
+    pub level: u32,
+    /// Slots before the flip (the left child's).
+    pub left: u32,
+}
+
+impl MortonOrder {
+    /// The order of an LBVH tree as built (`None` for other strategies, or after reinsertion,
+    /// which moves subtrees out of Morton order).
+    pub fn of(bvh: &super::Bvh) -> Option<MortonOrder> {
+        if bvh.params.strategy != super::SplitStrategy::Lbvh || bvh.report.reinsertion.is_some() {
+            return None;
+        }
+        let prims: Vec<BuildPrim> =
+            bvh.tris.iter().zip(&bvh.prim_ids).map(|(t, &i)| BuildPrim::new(Aabb::from_points(t), i)).collect();
+        let (lo, scale) = grid(&prims);
+        let codes: Vec<u64> = prims.iter().map(|p| morton(p.centroid(), lo, scale)).collect();
+        if !codes.windows(2).all(|w| w[0] <= w[1]) {
+            return None;
+        }
+        let centroids: Vec<glam::Vec3> = prims.iter().map(|p| p.centroid().into()).collect();
+        let mut sums = Vec::with_capacity(centroids.len() + 1);
+        sums.push(glam::DVec3::ZERO);
+        for c in &centroids {
+            sums.push(*sums.last().expect("pushed above") + c.as_dvec3());
+        }
+        Some(MortonOrder { centroids, codes, sums })
+    }
+
+    /// The mean centroid of slots `first..first + count`: where a stretch of the curve (a node of
+    /// the tree) sits, so the frontier's means in order are the curve at the replay's resolution.
+    pub fn mean(&self, first: u32, count: u32) -> glam::Vec3 {
+        let (a, b) = (first as usize, (first + count) as usize);
+        ((self.sums[b] - self.sums[a]) / count.max(1) as f64).as_vec3()
+    }
+
+    /// How slots `first..first + count` split: at the highest bit where their codes differ
+    /// (`None` when all are equal: the build then cut the range in the middle).
+    pub fn split(&self, first: u32, count: u32) -> Option<MortonSplit> {
+        let codes = self.codes.get(first as usize..(first + count) as usize)?;
+        let (mid, axis) = split_of(codes)?;
+        let bit = 63 - (codes[0] ^ codes[codes.len() - 1]).leading_zeros();
+        Some(MortonSplit { bit, axis, level: BITS - bit / 3, left: mid as u32 })
+    }
 }
 
 /// The subtree over `prims` (with their `codes`), which start at `offset` in the full array.
@@ -207,6 +275,38 @@ fn sequential(
         }
     }
     Ok((nodes, fallback))
+}
+
+#[cfg(test)]
+mod morton_order_tests {
+    use super::MortonOrder;
+    use crate::bvh::inspect::Hierarchy;
+    use crate::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
+    use crate::mesh::generate;
+
+    /// The leaf order of an LBVH tree is its Morton order, and every split of the tree (not a
+    /// fallback) is where the order says: the left child holds the slots before the bit flips.
+    #[test]
+    fn an_lbvh_trees_leaf_order_is_its_morton_order_and_splits_follow_it() {
+        let mesh = generate::torus_knot(2, 3, 0.3, 256, 12);
+        let params = BuildParams { strategy: SplitStrategy::Lbvh, layout: Layout::Binary, ..Default::default() };
+        let bvh = Bvh::build(&mesh, &params);
+        let order = MortonOrder::of(&bvh).expect("an LBVH tree");
+        assert_eq!(order.centroids.len(), bvh.prim_ids.len());
+        let h = Hierarchy::of(&bvh);
+        let mut checked = 0;
+        for (i, n) in bvh.nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
+            let s = order.split(h.first[i], h.count[i]).expect("distinct codes");
+            assert_eq!((s.left, s.axis), (h.count[n.index as usize], n.axis), "node {i}");
+            assert!(s.level >= 1 && s.level <= super::BITS);
+            checked += 1;
+        }
+        assert!(checked > 1000);
+        let sah = Bvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..Default::default() });
+        assert!(MortonOrder::of(&sah).is_none(), "other strategies have no Morton order");
+        let reinserted = Bvh::build(&mesh, &BuildParams { reinsert_passes: 1, ..params });
+        assert!(MortonOrder::of(&reinserted).is_none(), "nor has a tree reinsertion changed");
+    }
 }
 
 #[cfg(test)]

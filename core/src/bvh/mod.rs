@@ -11,7 +11,7 @@ pub mod dump;
 pub mod epo;
 pub mod imported;
 pub mod inspect;
-mod lbvh;
+pub mod lbvh;
 mod linear;
 mod node;
 pub mod packet;

@@ -71,12 +71,14 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                     let node = &r.tree.nodes[newest as usize];
                     let (l, rr) = (node.index, node.index + 1);
                     let axis = ["x", "y", "z"][node.axis as usize];
-                    let plane = match view.newest.as_ref().filter(|(n, _, _)| *n == newest) {
-                        Some((_, Some(m), _)) => format!(" at {axis} = {:.4} (split cost {:.2})", m.position, m.cost),
-                        _ => String::new(),
+                    let morton = view.morton.as_ref().and_then(|m| crate::cli::replay::morton_text(m, r, newest));
+                    let plane = match (view.newest.as_ref().filter(|(n, _, _)| *n == newest), &morton) {
+                        (_, Some(t)) => format!(" at {t},"),
+                        (Some((_, Some(m), _)), _) => format!(" on {axis} at {axis} = {:.4} (split cost {:.2})", m.position, m.cost),
+                        _ => format!(" on {axis}"),
                     };
                     ui.label(format!(
-                        "Newest split: node {newest} on {axis}{plane} into {l} ({} triangles) and {rr} ({}); SAH cost of the partial tree {:.2}",
+                        "Newest split: node {newest}{plane} into {l} ({} triangles) and {rr} ({}); SAH cost of the partial tree {:.2}",
                         r.hierarchy.count[l as usize],
                         r.hierarchy.count[rr as usize],
                         r.sah[k]
@@ -98,6 +100,9 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 None => {
                     ui.label(format!("No split yet: the root is one leaf; SAH cost {:.2}", r.sah[0]));
                 }
+            }
+            if view.morton.is_some() {
+                ui.weak("LBVH: the line is the Morton order, the order the build sorted the triangles in and its leaves keep, drawn through the frontier nodes (each at its triangles' mean centroid) from blue to yellow; each split cuts a node's stretch where a bit of the codes flips, so the curve refines in Z order as the tree grows.");
             }
             // The SAH cost against k, on a log scale of k + 1 (as the slider).
             let points: PlotPoints = thin(&r.sah).into_iter().map(|(i, c)| [((i + 1) as f64).log10(), c]).collect();
