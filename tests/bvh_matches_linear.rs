@@ -71,6 +71,9 @@ fn build_all(mesh: &Mesh) -> Vec<AnyBvh> {
                 BuildParams::with_strategy(s),
                 BuildParams { max_leaf_size: 1, sah_bins: 4, ..BuildParams::with_strategy(s) },
                 BuildParams { max_leaf_size: 7, sah_bins: 3, ..BuildParams::with_strategy(s) },
+                // Reinsertion after any build (single triangles move, then leaves are gathered
+                // again); for the SBVH, spatial splits priced everywhere with room to cut.
+                BuildParams { reinsert_passes: 2, sbvh_alpha: 0.0, sbvh_growth: 100, ..BuildParams::with_strategy(s) },
             ]
         })
         .flat_map(|p| Layout::ALL.map(|layout| BuildParams { layout, ..p }))
