@@ -152,6 +152,11 @@ impl Bvh {
         let t0 = Instant::now();
         let params = params.clamped();
         let n = mesh.triangle_count();
+        if params.strategy == SplitStrategy::Lbvh {
+            let progress = Progress { control, levels: progress_levels(n, &params) };
+            let (nodes, prim_ids, tris, report) = super::lbvh::build_mesh(mesh, &params, &progress)?;
+            return Self::finish(Bvh { nodes, prim_ids, tris, params, report }, control);
+        }
         let make = |i: usize| {
             let tri = mesh.triangle(i as u32);
             let bounds = Aabb::from_points(&tri);
@@ -170,10 +175,15 @@ impl Bvh {
         let prim_ids: Vec<u32> = prims.iter().map(|p| p.index()).collect();
         let tris = prim_ids.par_iter().with_min_len(4096).map(|&i| mesh.triangle(i)).collect();
         report.reorder_time = t2.elapsed();
-        let mut bvh = Bvh { nodes, prim_ids, tris, params, report };
-        if params.reinsert_passes > 0 {
+        Self::finish(Bvh { nodes, prim_ids, tris, params, report }, control)
+    }
+
+    /// The reinsertion after a build, if asked for.
+    fn finish(mut bvh: Bvh, control: &WorkControl) -> Result<Bvh, Cancelled> {
+        let passes = bvh.params.reinsert_passes;
+        if passes > 0 {
             control.check()?;
-            bvh.report.reinsertion = Some(super::reinsert::optimise(&mut bvh, params.reinsert_passes));
+            bvh.report.reinsertion = Some(super::reinsert::optimise(&mut bvh, passes));
         }
         Ok(bvh)
     }

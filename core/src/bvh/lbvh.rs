@@ -85,7 +85,7 @@ fn split_of(codes: &[u64]) -> Option<(usize, u8)> {
 /// Sort `prims` into Morton order and build the hierarchy over them (left in leaf order). The
 /// subtree and the number of ranges of equal codes cut in the middle.
 pub(super) fn build(
-    prims: &mut [BuildPrim],
+    prims: &mut Vec<BuildPrim>,
     params: &BuildParams,
     progress: &Progress,
 ) -> Result<(Subtree, u32), Cancelled> {
@@ -95,13 +95,71 @@ pub(super) fn build(
     let codes = sort(prims);
     progress.check()?;
     let leaf = params.max_leaf_size as usize;
-    subtree(prims, &codes, 0, 0, leaf, progress)
+    subtree(prims.as_slice(), &codes, 0, 0, leaf, progress)
+}
+
+/// The LBVH of a mesh without the general build's records: the centroids (as the records would
+/// give them, the centres of the triangles' boxes) are coded and sorted as slot numbers, the
+/// triangles gathered into that order once, and the leaves' boxes made from them as they lie in
+/// memory. The general path also gathered its 32-byte records into the sorted order and read them
+/// back for the boxes, a fifth of the build on the 2M knot (BENCHMARKS.md); the tree is the same
+/// (a test builds both).
+pub(super) fn build_mesh(
+    mesh: &crate::mesh::Mesh,
+    params: &BuildParams,
+    progress: &Progress,
+) -> Result<(Vec<BvhNode>, Vec<u32>, Vec<[glam::Vec3; 3]>, super::BuildReport), Cancelled> {
+    let t0 = std::time::Instant::now();
+    let n = mesh.triangle_count();
+    let centroids: Vec<Vec3A> = (0..n as u32)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|i| {
+            let b = Aabb::from_points(&mesh.triangle(i));
+            (b.min + b.max) * 0.5
+        })
+        .collect();
+    let setup_time = t0.elapsed();
+    progress.check()?;
+    let t1 = std::time::Instant::now();
+    let (lo, scale) = grid(centroids.par_iter().copied());
+    let mut keyed: Vec<Keyed> = centroids
+        .par_iter()
+        .with_min_len(4096)
+        .enumerate()
+        .map(|(i, &c)| Keyed(morton(c, lo, scale) << 32 | i as u64))
+        .collect();
+    drop(centroids);
+    rdst::RadixSort::radix_sort_unstable(&mut keyed);
+    let codes: Vec<u64> = keyed.par_iter().with_min_len(4096).map(|k| k.code()).collect();
+    let prim_ids: Vec<u32> = keyed.par_iter().with_min_len(4096).map(|k| k.slot() as u32).collect();
+    drop(keyed);
+    progress.check()?;
+    let sort_time = t1.elapsed();
+    let t2 = std::time::Instant::now();
+    let tris: Vec<[glam::Vec3; 3]> = prim_ids.par_iter().with_min_len(4096).map(|&i| mesh.triangle(i)).collect();
+    let reorder_time = t2.elapsed();
+    let t3 = std::time::Instant::now();
+    let (tree, fallback) = if tris.is_empty() {
+        (Subtree::Flat(vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)]), 0)
+    } else {
+        subtree(tris.as_slice(), &codes, 0, 0, params.max_leaf_size as usize, progress)?
+    };
+    let nodes = tree.into_nodes();
+    let report = super::BuildReport {
+        setup_time,
+        split_time: sort_time + t3.elapsed(),
+        reorder_time,
+        fallback_splits: fallback,
+        ..Default::default()
+    };
+    Ok((nodes, prim_ids, tris, report))
 }
 
 /// Sort `prims` by the Morton codes of their centroids in the grid over the centroid bounds;
 /// the codes in that order.
-pub(super) fn sort(prims: &mut [BuildPrim]) -> Vec<u64> {
-    let (lo, scale) = grid(prims);
+pub(super) fn sort(prims: &mut Vec<BuildPrim>) -> Vec<u64> {
+    let (lo, scale) = grid(prims.par_iter().map(|p| p.centroid()));
     let mut keyed: Vec<Keyed> = prims
         .par_iter()
         .with_min_len(4096)
@@ -109,18 +167,15 @@ pub(super) fn sort(prims: &mut [BuildPrim]) -> Vec<u64> {
         .map(|(i, p)| Keyed(morton(p.centroid(), lo, scale) << 32 | i as u64))
         .collect();
     rdst::RadixSort::radix_sort_unstable(&mut keyed);
-    let sorted: Vec<BuildPrim> = keyed.par_iter().with_min_len(4096).map(|k| prims[k.slot()]).collect();
-    prims.copy_from_slice(&sorted);
+    // The sorted records replace the vector (a copy back into it cost a pass over all of them).
+    *prims = keyed.par_iter().with_min_len(4096).map(|k| prims[k.slot()]).collect();
     keyed.par_iter().with_min_len(4096).map(|k| k.code()).collect()
 }
 
-/// The Morton grid over the primitives' centroid bounds: its lower corner and cells per unit.
-fn grid(prims: &[BuildPrim]) -> (Vec3A, Vec3A) {
-    let centroids = prims
-        .par_iter()
-        .with_min_len(4096)
-        .fold(|| Aabb::EMPTY, |b, p| b.grow(p.centroid()))
-        .reduce(|| Aabb::EMPTY, |a, b| a.union(b));
+/// The Morton grid over the centroids' bounds: its lower corner and cells per unit.
+fn grid(centroids: impl rayon::iter::IndexedParallelIterator<Item = Vec3A>) -> (Vec3A, Vec3A) {
+    let centroids =
+        centroids.with_min_len(4096).fold(|| Aabb::EMPTY, |b, c| b.grow(c)).reduce(|| Aabb::EMPTY, |a, b| a.union(b));
     let extent = centroids.max - centroids.min;
     let cells = ((1u32 << BITS) - 1) as f32;
     (centroids.min, Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(cells) / extent, Vec3A::ZERO))
@@ -158,7 +213,7 @@ impl MortonOrder {
         }
         let prims: Vec<BuildPrim> =
             bvh.tris.iter().zip(&bvh.prim_ids).map(|(t, &i)| BuildPrim::new(Aabb::from_points(t), i)).collect();
-        let (lo, scale) = grid(&prims);
+        let (lo, scale) = grid(prims.par_iter().map(|p| p.centroid()));
         let codes: Vec<u64> = prims.iter().map(|p| morton(p.centroid(), lo, scale)).collect();
         if !codes.windows(2).all(|w| w[0] <= w[1]) {
             return None;
@@ -189,9 +244,28 @@ impl MortonOrder {
     }
 }
 
+/// What a leaf's box is made of: build records, or (the mesh path) triangles in leaf order.
+trait Bounded: Sync {
+    fn bounds(&self) -> Aabb;
+}
+
+impl Bounded for BuildPrim {
+    #[inline]
+    fn bounds(&self) -> Aabb {
+        BuildPrim::bounds(self)
+    }
+}
+
+impl Bounded for [glam::Vec3; 3] {
+    #[inline]
+    fn bounds(&self) -> Aabb {
+        Aabb::from_points(self)
+    }
+}
+
 /// The subtree over `prims` (with their `codes`), which start at `offset` in the full array.
-fn subtree(
-    prims: &[BuildPrim],
+fn subtree<T: Bounded>(
+    prims: &[T],
     codes: &[u64],
     offset: u32,
     depth: u32,
@@ -228,8 +302,8 @@ fn root_bounds(t: &Subtree) -> Aabb {
 /// One thread's subtree, laid out as `build::build_sequential` lays out its nodes (each node's
 /// children a pair, the left subtree right after it): the topology top-down, then the boxes from
 /// the leaves up (children come after their parent, so one pass backwards).
-fn sequential(
-    prims: &[BuildPrim],
+fn sequential<T: Bounded>(
+    prims: &[T],
     codes: &[u64],
     offset: u32,
     depth0: u32,
@@ -343,9 +417,14 @@ mod tests {
         let mut b = prims();
         let codes = sort(&mut b);
         assert!(codes.windows(2).all(|w| w[0] <= w[1]), "sorted");
-        let (nodes, _) = sequential(&b, &codes, 0, 0, 4, &progress).unwrap();
+        let (nodes, _) = sequential(b.as_slice(), &codes, 0, 0, 4, &progress).unwrap();
         assert!(tree.into_nodes() == nodes);
         assert!(a.iter().map(|p| p.index()).eq(b.iter().map(|p| p.index())));
+        // The mesh path (no build records) makes the same tree, with the triangles in its order.
+        let (mesh_nodes, ids, tris, _) = build_mesh(&mesh, &params, &progress).unwrap();
+        assert!(mesh_nodes == nodes, "the mesh path's tree");
+        assert!(ids.iter().copied().eq(a.iter().map(|p| p.index())));
+        assert!(ids.iter().zip(&tris).all(|(&i, t)| *t == mesh.triangle(i)));
         // Every leaf holds at most 4, and each interior box is its children's union.
         for n in &nodes {
             if n.is_leaf() {

@@ -32,7 +32,7 @@ const LEAF: u32 = u32::MAX;
 
 /// Build the tree over `prims` (left in leaf order) with a neighbour search `radius` each side.
 pub(super) fn build(
-    prims: &mut [BuildPrim],
+    prims: &mut Vec<BuildPrim>,
     params: &BuildParams,
     radius: usize,
     progress: &Progress,
