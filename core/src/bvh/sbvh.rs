@@ -127,8 +127,7 @@ pub(super) fn split_node(
         _ => None,
     };
     if let Some((_, mid, _, _)) = object {
-        let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds()));
-        let common = intersection(&side(&work.refs[..mid]), &side(&work.refs[mid..]));
+        let common = intersection(&bounds_of(&work.refs[..mid]), &bounds_of(&work.refs[mid..]));
         decided.overlap = common.map_or(0.0, |c| c.area());
     }
     // §4.4: spatial splits only where the object split's children overlap by more than α of the
@@ -145,9 +144,12 @@ pub(super) fn split_node(
             if added > work.budget {
                 decided.over_budget = Some(added);
             } else if !l.is_empty() && !r.is_empty() {
-                let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds())).area();
-                let weighted = side(&l) * l.len() as f32 + side(&r) * r.len() as f32;
-                spatial = Some((s.axis, s.position, weighted, l, r, added));
+                // The children as partitioned (unsplitting changes the bins' estimate) must still
+                // beat the object split.
+                let weighted = area_of(&l) * l.len() as f32 + area_of(&r) * r.len() as f32;
+                if object.is_none_or(|(_, _, w, _)| weighted < w) {
+                    spatial = Some((s.axis, s.position, weighted, l, r, added));
+                }
             }
         }
     }
@@ -192,8 +194,7 @@ fn equal_count(mut work: Work, info: &NodeInfo) -> Outcome {
 /// up to one duplicate per reference, the other the rest.
 fn share(parent: &Work, l: Vec<BuildPrim>, r: Vec<BuildPrim>, added: u64) -> (Work, Work) {
     let (nl, nr) = (l.len() as u64, r.len() as u64);
-    let weight =
-        |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds())).area() as f64 * s.len() as f64;
+    let weight = |s: &[BuildPrim]| area_of(s) as f64 * s.len() as f64;
     let budget = parent.budget - added;
     let (bl, br) = if budget == 0 {
         (0, 0)
@@ -216,6 +217,15 @@ fn share(parent: &Work, l: Vec<BuildPrim>, r: Vec<BuildPrim>, added: u64) -> (Wo
     let wl = parent.weight * nl / (nl + nr);
     let depth = parent.depth + 1;
     (Work { refs: l, budget: bl, weight: wl, depth }, Work { refs: r, budget: br, weight: parent.weight - wl, depth })
+}
+
+/// The box of some references.
+fn bounds_of(refs: &[BuildPrim]) -> Aabb {
+    refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds()))
+}
+
+fn area_of(refs: &[BuildPrim]) -> f32 {
+    bounds_of(refs).area()
 }
 
 fn intersection(a: &Aabb, b: &Aabb) -> Option<Aabb> {
@@ -392,10 +402,7 @@ pub(super) fn explain(
             plane: *plane,
             left: left.refs.len() as u32,
             right: right.refs.len() as u32,
-            weighted: [&left.refs, &right.refs]
-                .iter()
-                .map(|s| s.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds())).area() * s.len() as f32)
-                .sum(),
+            weighted: [&left.refs, &right.refs].iter().map(|s| area_of(s) * s.len() as f32).sum(),
         }),
         Outcome::Leaf(_) => None,
     };
