@@ -9,118 +9,17 @@ use super::split::{BuildPrim, EqualCount, NodeInfo, Proposal, SplitStrategy, Spl
 use super::subtree::Subtree;
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
-use crate::options::{MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TRAVERSAL_COST};
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
-use std::time::{Duration, Instant};
+use std::time::Instant;
+
+pub use super::params::{BuildParams, BuildReport, Layout, SahCost};
 
 /// Below this depth a node is always split by equal count, whatever the strategy says. Equal
 /// count halves the range, so the tree depth stays under `HEURISTIC_DEPTH_LIMIT + 32`, inside the
 /// traversal's fixed stack, even for adversarial inputs where midpoint splits peel off one
 /// triangle at a time.
 pub const HEURISTIC_DEPTH_LIMIT: u32 = (TRAVERSAL_STACK_SIZE as u32) - 33;
-
-/// Cost constants of the surface area heuristic (Goldsmith & Salmon 1987; MacDonald & Booth 1990).
-/// The defaults, 1 and 1, make the normalised SAH cost of a tree read as "expected traversal steps
-/// plus triangle tests per ray that hits the root box". They are parameters because the right
-/// ratio depends on the traversal code; the builder and the statistics use the same values.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SahCost {
-    /// Cost of visiting an interior node (one step: two child box tests).
-    pub traversal: f32,
-    /// Cost of one ray–triangle test.
-    pub intersection: f32,
-}
-
-impl Default for SahCost {
-    fn default() -> Self {
-        Self { traversal: TRAVERSAL_COST.default, intersection: 1.0 }
-    }
-}
-
-/// How the built tree is laid out for traversal.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-pub enum Layout {
-    /// The binary BVH as built: two children per node, the handout's structure.
-    Binary,
-    /// The binary BVH collapsed into 4-wide nodes traversed with SIMD box tests (`bvh::wide`).
-    #[default]
-    Wide4,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default)]
-pub struct BuildParams {
-    pub strategy: SplitStrategy,
-    /// Most triangles in a leaf (default 4). The SAH strategies may stop earlier when a leaf is
-    /// cheaper than a split; no strategy makes a larger leaf.
-    pub max_leaf_size: u32,
-    /// Bins per axis for `SahBinned` (default 16); nodes of fewer than three triangles per bin
-    /// use n/3 bins (at least 4, never more than asked for).
-    pub sah_bins: u32,
-    pub cost: SahCost,
-    pub layout: Layout,
-    /// PLOC's neighbour search: clusters each side in Morton order (default 16).
-    pub ploc_radius: u32,
-    /// Passes of reinsertion after the build (`bvh::reinsert`; 0, the default: none).
-    pub reinsert_passes: u32,
-    /// SBVH: spatial splits are priced where the object split's children share more than this
-    /// fraction of the root's surface area (Stich et al.'s α; default 1e-5).
-    pub sbvh_alpha: f32,
-    /// SBVH: at most this many percent more references than triangles (default 30).
-    pub sbvh_growth: u32,
-}
-
-impl Default for BuildParams {
-    fn default() -> Self {
-        Self {
-            strategy: SplitStrategy::SahBinned,
-            max_leaf_size: MAX_LEAF_SIZE.default,
-            sah_bins: SAH_BINS.default,
-            cost: SahCost::default(),
-            layout: Layout::default(),
-            ploc_radius: PLOC_RADIUS.default,
-            reinsert_passes: REINSERT_PASSES.default,
-            sbvh_alpha: SBVH_ALPHA.default,
-            sbvh_growth: SBVH_GROWTH.default,
-        }
-    }
-}
-
-impl BuildParams {
-    pub fn with_strategy(strategy: SplitStrategy) -> Self {
-        Self { strategy, ..Self::default() }
-    }
-}
-
-/// What the build did and how long each phase took.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
-pub struct BuildReport {
-    /// Triangle bounds and centroids.
-    pub setup_time: Duration,
-    /// The top-down splitting.
-    pub split_time: Duration,
-    /// Copying triangles into leaf order.
-    pub reorder_time: Duration,
-    /// Collapsing the binary tree into wide nodes (wide layout only).
-    pub collapse_time: Duration,
-    /// Nodes where the strategy found no useful split (midpoint with an empty side, SAH with
-    /// coincident centroids) and an equal-count split was used instead.
-    pub fallback_splits: u32,
-    /// Nodes split by equal count because they were deeper than `HEURISTIC_DEPTH_LIMIT`.
-    pub depth_limited_splits: u32,
-    /// SBVH: nodes split by a spatial split (the others by object splits).
-    pub spatial_splits: u32,
-    /// The reinsertion pass after the build, when asked for (`BuildParams::reinsert_passes`).
-    pub reinsertion: Option<super::reinsert::Reinsertion>,
-}
-
-impl BuildReport {
-    pub fn total_time(&self) -> Duration {
-        let optimise = self.reinsertion.map_or(Duration::ZERO, |r| r.time);
-        self.setup_time + self.split_time + self.reorder_time + self.collapse_time + optimise
-    }
-}
 
 struct Task {
     node: u32,
@@ -154,8 +53,7 @@ impl Bvh {
         let n = mesh.triangle_count();
         if params.strategy == SplitStrategy::Lbvh {
             let progress = Progress { control, levels: progress_levels(n, &params) };
-            let (nodes, prim_ids, tris, report) = super::lbvh::build_mesh(mesh, &params, &progress)?;
-            return Self::finish(Bvh { nodes, prim_ids, tris, params, report }, control);
+            return Self::finish(super::lbvh::build_mesh(mesh, &params, &progress)?, control);
         }
         let make = |i: usize| {
             let tri = mesh.triangle(i as u32);
@@ -186,22 +84,6 @@ impl Bvh {
             bvh.report.reinsertion = Some(super::reinsert::optimise(&mut bvh, passes));
         }
         Ok(bvh)
-    }
-}
-
-impl BuildParams {
-    /// The parameters with every field in the range the builder accepts.
-    fn clamped(&self) -> BuildParams {
-        BuildParams {
-            max_leaf_size: MAX_LEAF_SIZE.clamp(self.max_leaf_size),
-            sah_bins: SAH_BINS.clamp(self.sah_bins),
-            ploc_radius: PLOC_RADIUS.clamp(self.ploc_radius),
-            reinsert_passes: REINSERT_PASSES.clamp(self.reinsert_passes),
-            sbvh_alpha: SBVH_ALPHA.clamp(self.sbvh_alpha),
-            sbvh_growth: SBVH_GROWTH.clamp(self.sbvh_growth),
-            cost: SahCost { traversal: TRAVERSAL_COST.clamp(self.cost.traversal), ..self.cost },
-            ..*self
-        }
     }
 }
 
@@ -529,95 +411,5 @@ fn build_sequential(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::mesh::generate::torus;
-
-    #[test]
-    fn the_parallel_build_lays_out_the_same_tree_as_the_sequential_one() {
-        // Big enough for several parallel levels (and parallel binning at the root).
-        let mesh = torus(2.0, 0.5, 256, 160);
-        assert!(mesh.triangle_count() > 16 * PARALLEL_MIN_PRIMS);
-        // (LBVH's own parallel build is compared with its one-thread build in `bvh::lbvh`.)
-        for strategy in SplitStrategy::ALL.into_iter().filter(|&s| s != SplitStrategy::SahSweep && s.splits_top_down())
-        {
-            let params = BuildParams::with_strategy(strategy).clamped();
-            let bvh = Bvh::build(&mesh, &params);
-            let mut prims: Vec<BuildPrim> = (0..mesh.triangle_count())
-                .map(|i| BuildPrim::new(Aabb::from_points(&mesh.triangle(i as u32)), i as u32))
-                .collect();
-            let progress = Progress { control: &WorkControl::new(), levels: 1 };
-            let (nodes, _) = build_sequential(&mut prims, 0, 0, &params, &progress).unwrap();
-            assert_eq!(bvh.nodes.len(), nodes.len(), "{strategy:?}");
-            assert!(bvh.nodes == nodes, "{strategy:?}: the same nodes in the same places");
-            assert!(bvh.prim_ids.iter().copied().eq(prims.iter().map(|p| p.index())), "{strategy:?}");
-        }
-    }
-
-    #[test]
-    fn build_reports_progress_and_can_be_cancelled() {
-        let mesh = torus(2.0, 0.5, 64, 32);
-        for strategy in SplitStrategy::ALL {
-            for max_leaf_size in [1, 4, 16] {
-                let control = WorkControl::new();
-                let params = BuildParams { max_leaf_size, ..BuildParams::with_strategy(strategy) };
-                let bvh = Bvh::build_controlled(&mesh, &params, &control).unwrap();
-                let n = mesh.triangle_count() as u64;
-                assert!(control.total() >= n * 8, "4096 triangles pass at least 8 levels");
-                assert_eq!(control.done(), control.total(), "{strategy:?}/{max_leaf_size}: the work adds up");
-                assert_eq!(
-                    super::super::tree::distinct(&bvh.prim_ids),
-                    mesh.triangle_count(),
-                    "every triangle in a leaf"
-                );
-            }
-        }
-
-        let cancelled = WorkControl::new();
-        cancelled.cancel();
-        assert_eq!(Bvh::build_controlled(&mesh, &BuildParams::default(), &cancelled).unwrap_err(), Cancelled);
-    }
-
-    #[test]
-    fn progress_moves_at_the_first_split_not_only_at_the_first_leaf() {
-        // The exact sweep's first splits of a million triangles are the slow part of its build;
-        // progress that counted only triangles placed in leaves stayed at 0 through them.
-        let mesh = torus(2.0, 0.5, 1024, 512);
-        let n = mesh.triangle_count() as u64;
-        let control = WorkControl::new();
-        let first_seen = std::thread::scope(|s| {
-            let build = s
-                .spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(SplitStrategy::SahSweep), &control));
-            let mut seen = 0;
-            while seen == 0 && !build.is_finished() {
-                seen = control.done();
-            }
-            control.cancel();
-            let _ = build.join().expect("the build thread does not panic");
-            seen
-        });
-        assert!(
-            first_seen >= n,
-            "the root's split counts its {n} triangles at once (first progress seen: {first_seen})"
-        );
-        assert!(first_seen < control.total(), "and is only part of the work");
-    }
-
-    #[test]
-    fn a_build_cancelled_while_running_stops() {
-        // A million triangles: the build runs long enough to be cancelled once it has made leaves.
-        let mesh = torus(2.0, 0.5, 1024, 512);
-        let control = WorkControl::new();
-        let result = std::thread::scope(|s| {
-            let build = s
-                .spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(SplitStrategy::SahSweep), &control));
-            while control.done() == 0 && !build.is_finished() {
-                std::thread::yield_now();
-            }
-            control.cancel();
-            build.join().expect("the build thread does not panic")
-        });
-        assert_eq!(result.unwrap_err(), Cancelled, "cancelled part-way, after {} units", control.done());
-        assert!(control.done() < control.total());
-    }
-}
+#[path = "build_tests.rs"]
+mod tests;

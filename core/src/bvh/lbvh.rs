@@ -108,7 +108,7 @@ pub(super) fn build_mesh(
     mesh: &crate::mesh::Mesh,
     params: &BuildParams,
     progress: &Progress,
-) -> Result<(Vec<BvhNode>, Vec<u32>, Vec<[glam::Vec3; 3]>, super::BuildReport), Cancelled> {
+) -> Result<super::Bvh, Cancelled> {
     let t0 = std::time::Instant::now();
     let n = mesh.triangle_count();
     let centroids: Vec<Vec3A> = (0..n as u32)
@@ -153,7 +153,7 @@ pub(super) fn build_mesh(
         fallback_splits: fallback,
         ..Default::default()
     };
-    Ok((nodes, prim_ids, tris, report))
+    Ok(super::Bvh { nodes, prim_ids, tris, params: *params, report })
 }
 
 /// Sort `prims` by the Morton codes of their centroids in the grid over the centroid bounds;
@@ -421,10 +421,10 @@ mod tests {
         assert!(tree.into_nodes() == nodes);
         assert!(a.iter().map(|p| p.index()).eq(b.iter().map(|p| p.index())));
         // The mesh path (no build records) makes the same tree, with the triangles in its order.
-        let (mesh_nodes, ids, tris, _) = build_mesh(&mesh, &params, &progress).unwrap();
-        assert!(mesh_nodes == nodes, "the mesh path's tree");
-        assert!(ids.iter().copied().eq(a.iter().map(|p| p.index())));
-        assert!(ids.iter().zip(&tris).all(|(&i, t)| *t == mesh.triangle(i)));
+        let b = build_mesh(&mesh, &params, &progress).unwrap();
+        assert!(b.nodes == nodes, "the mesh path's tree");
+        assert!(b.prim_ids.iter().copied().eq(a.iter().map(|p| p.index())));
+        assert!(b.prim_ids.iter().zip(&b.tris).all(|(&i, t)| *t == mesh.triangle(i)));
         // Every leaf holds at most 4, and each interior box is its children's union.
         for n in &nodes {
             if n.is_leaf() {

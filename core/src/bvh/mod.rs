@@ -15,6 +15,7 @@ pub mod lbvh;
 mod linear;
 mod node;
 pub mod packet;
+mod params;
 mod ploc;
 mod preset;
 pub mod reinsert;

@@ -1,0 +1,85 @@
+//! The build driver's tests: the parallel and sequential builds agree, progress adds up, a build
+//! can be cancelled while it runs.
+
+use super::*;
+use crate::mesh::generate::torus;
+
+#[test]
+fn the_parallel_build_lays_out_the_same_tree_as_the_sequential_one() {
+    // Big enough for several parallel levels (and parallel binning at the root).
+    let mesh = torus(2.0, 0.5, 256, 160);
+    assert!(mesh.triangle_count() > 16 * PARALLEL_MIN_PRIMS);
+    // (LBVH's own parallel build is compared with its one-thread build in `bvh::lbvh`.)
+    for strategy in SplitStrategy::ALL.into_iter().filter(|&s| s != SplitStrategy::SahSweep && s.splits_top_down()) {
+        let params = BuildParams::with_strategy(strategy).clamped();
+        let bvh = Bvh::build(&mesh, &params);
+        let mut prims: Vec<BuildPrim> = (0..mesh.triangle_count())
+            .map(|i| BuildPrim::new(Aabb::from_points(&mesh.triangle(i as u32)), i as u32))
+            .collect();
+        let progress = Progress { control: &WorkControl::new(), levels: 1 };
+        let (nodes, _) = build_sequential(&mut prims, 0, 0, &params, &progress).unwrap();
+        assert_eq!(bvh.nodes.len(), nodes.len(), "{strategy:?}");
+        assert!(bvh.nodes == nodes, "{strategy:?}: the same nodes in the same places");
+        assert!(bvh.prim_ids.iter().copied().eq(prims.iter().map(|p| p.index())), "{strategy:?}");
+    }
+}
+
+#[test]
+fn build_reports_progress_and_can_be_cancelled() {
+    let mesh = torus(2.0, 0.5, 64, 32);
+    for strategy in SplitStrategy::ALL {
+        for max_leaf_size in [1, 4, 16] {
+            let control = WorkControl::new();
+            let params = BuildParams { max_leaf_size, ..BuildParams::with_strategy(strategy) };
+            let bvh = Bvh::build_controlled(&mesh, &params, &control).unwrap();
+            let n = mesh.triangle_count() as u64;
+            assert!(control.total() >= n * 8, "4096 triangles pass at least 8 levels");
+            assert_eq!(control.done(), control.total(), "{strategy:?}/{max_leaf_size}: the work adds up");
+            assert_eq!(super::super::tree::distinct(&bvh.prim_ids), mesh.triangle_count(), "every triangle in a leaf");
+        }
+    }
+
+    let cancelled = WorkControl::new();
+    cancelled.cancel();
+    assert_eq!(Bvh::build_controlled(&mesh, &BuildParams::default(), &cancelled).unwrap_err(), Cancelled);
+}
+
+#[test]
+fn progress_moves_at_the_first_split_not_only_at_the_first_leaf() {
+    // The exact sweep's first splits of a million triangles are the slow part of its build;
+    // progress that counted only triangles placed in leaves stayed at 0 through them.
+    let mesh = torus(2.0, 0.5, 1024, 512);
+    let n = mesh.triangle_count() as u64;
+    let control = WorkControl::new();
+    let first_seen = std::thread::scope(|s| {
+        let build =
+            s.spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(SplitStrategy::SahSweep), &control));
+        let mut seen = 0;
+        while seen == 0 && !build.is_finished() {
+            seen = control.done();
+        }
+        control.cancel();
+        let _ = build.join().expect("the build thread does not panic");
+        seen
+    });
+    assert!(first_seen >= n, "the root's split counts its {n} triangles at once (first progress seen: {first_seen})");
+    assert!(first_seen < control.total(), "and is only part of the work");
+}
+
+#[test]
+fn a_build_cancelled_while_running_stops() {
+    // A million triangles: the build runs long enough to be cancelled once it has made leaves.
+    let mesh = torus(2.0, 0.5, 1024, 512);
+    let control = WorkControl::new();
+    let result = std::thread::scope(|s| {
+        let build =
+            s.spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(SplitStrategy::SahSweep), &control));
+        while control.done() == 0 && !build.is_finished() {
+            std::thread::yield_now();
+        }
+        control.cancel();
+        build.join().expect("the build thread does not panic")
+    });
+    assert_eq!(result.unwrap_err(), Cancelled, "cancelled part-way, after {} units", control.done());
+    assert!(control.done() < control.total());
+}
