@@ -17,6 +17,22 @@ pub struct SahCost {
     pub intersection: f32,
 }
 
+impl SahCost {
+    /// Bottom-up leaf gathering (PLOC's layout, reinsertion's collapse): a subtree over `count`
+    /// triangles in a box of `area`, whose two children cost `children` (their SAH costs summed,
+    /// in area units), costs the cheaper of a leaf (C_isect·n·A, only when `count` fits a leaf of
+    /// `max_leaf`) and a split (C_trav·A + children). Returns the cost and whether it is a leaf.
+    pub(super) fn leaf_or_split(&self, area: f64, count: u32, children: f64, max_leaf: u32) -> (f64, bool) {
+        let split = self.traversal as f64 * area + children;
+        let as_leaf = self.intersection as f64 * count as f64 * area;
+        if count <= max_leaf && as_leaf <= split {
+            (as_leaf, true)
+        } else {
+            (split, false)
+        }
+    }
+}
+
 impl Default for SahCost {
     fn default() -> Self {
         Self { traversal: TRAVERSAL_COST.default, intersection: 1.0 }

@@ -140,7 +140,7 @@ fn layout(
     progress: &Progress,
 ) -> Result<Vec<BvhNode>, Cancelled> {
     // Bottom-up (merged nodes come after their children): primitives and SAH cost per node.
-    let (ci, ct) = (params.cost.intersection as f64, params.cost.traversal as f64);
+    let ci = params.cost.intersection as f64;
     let mut count = vec![0u32; nodes.len()];
     let mut cost = vec![0f64; nodes.len()];
     let mut leaf = vec![false; nodes.len()];
@@ -152,13 +152,7 @@ fn layout(
         }
         let (l, r) = (c.left as usize, c.right as usize);
         count[k] = count[l] + count[r];
-        let split = ct * area + cost[l] + cost[r];
-        let as_leaf = ci * count[k] as f64 * area;
-        if count[k] <= params.max_leaf_size && as_leaf <= split {
-            (cost[k], leaf[k]) = (as_leaf, true);
-        } else {
-            cost[k] = split;
-        }
+        (cost[k], leaf[k]) = params.cost.leaf_or_split(area, count[k], cost[l] + cost[r], params.max_leaf_size);
     }
     // Top-down, depth first: the layout, and the leaves' primitives gathered in order.
     let mut out = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];

@@ -357,7 +357,7 @@ fn layout(t: &Tree, bvh: &mut Bvh, gather_leaves: bool) {
 /// leaf cost no more by the SAH than the subtree below them (decided bottom-up, as PLOC's layout
 /// does), so single-triangle leaves that reinsertion left side by side are gathered again.
 fn collapse(t: &Tree, params: &super::BuildParams) -> Vec<bool> {
-    let (ci, ct) = (params.cost.intersection as f64, params.cost.traversal as f64);
+    let ci = params.cost.intersection as f64;
     let n = t.kids.len();
     let (mut count, mut cost, mut gather) = (vec![0u32; n], vec![0f64; n], vec![false; n]);
     // Parents before children, then backwards: children before parents.
@@ -380,13 +380,7 @@ fn collapse(t: &Tree, params: &super::BuildParams) -> Vec<bool> {
         }
         let [l, r] = t.kids[i].map(|c| c as usize);
         count[i] = count[l] + count[r];
-        let split = ct * area + cost[l] + cost[r];
-        let as_leaf = ci * count[i] as f64 * area;
-        if count[i] <= params.max_leaf_size && as_leaf <= split {
-            (cost[i], gather[i]) = (as_leaf, true);
-        } else {
-            cost[i] = split;
-        }
+        (cost[i], gather[i]) = params.cost.leaf_or_split(area, count[i], cost[l] + cost[r], params.max_leaf_size);
     }
     gather
 }
