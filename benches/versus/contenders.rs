@@ -27,12 +27,16 @@ pub enum Family {
     ObvhsBvh2,
     ObvhsCwbvh,
     BvhCrate,
+    /// Embree with single rays (`rtcIntersect1`).
+    Embree,
+    /// Embree with packets or streams.
+    EmbreePackets,
 }
 
 pub struct Built {
     pub tracer: Box<dyn Tracer>,
     pub sah_cost: Option<f64>,
-    /// Nodes + primitive indices, bytes per triangle.
+    /// Bytes per triangle of what the traversal reads: nodes, indices, triangle leaves.
     pub bytes_per_tri: Option<f64>,
 }
 

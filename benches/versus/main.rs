@@ -8,6 +8,7 @@
 
 mod contenders;
 mod counts;
+mod embree;
 mod rays;
 mod scenes;
 
@@ -197,6 +198,12 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
             line(&format!("{label} {what}/obvhs-best-BVH2"), a, best(rows, is(Family::ObvhsBvh2), key), key);
             line(&format!("{label} {what}/obvhs-best-CWBVH"), a, best(rows, is(Family::ObvhsCwbvh), key), key);
         }
+        // Against Embree: single rays with rtcIntersect1, and our best path with Embree's best
+        // (packets and streams included).
+        let embree_single = best(rows, is(Family::Embree), key);
+        let embree_any = best(rows, |r| matches!(r.family, Some(Family::Embree | Family::EmbreePackets)), key);
+        line(&format!("{label} best single-ray/embree-rtcIntersect1"), our_single, embree_single, key);
+        line(&format!("{label} best/embree-best"), our_best, embree_any, key);
         for our in ["bvhscope sah (BVH2)", "bvhscope sah (BVH2, 8×8 packets)"] {
             let a = rows.iter().find(|r| r.name == our);
             let label = format!("{label} sah-BVH2{}/bvh-crate", if our.contains("packets") { "-packets" } else { "" });
@@ -207,6 +214,11 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
     let our_sah = rows.iter().find(|r| r.name == "bvhscope sah (BVH2)");
     let fastest = rows.iter().find(|r| r.name == "obvhs fastest (BVH2)");
     line("build NT triangles/s sah/obvhs-fastest", our_sah, fastest, &tris_per_s);
+    let embree_medium = rows.iter().find(|r| r.name == "embree medium (rtcIntersect1)");
+    for layout in ["BVH2", "BVH4", "BVH8"] {
+        let our = rows.iter().find(|r| r.name == format!("bvhscope sah ({layout})"));
+        line(&format!("build NT triangles/s sah-{layout}/embree-medium"), our, embree_medium, &tris_per_s);
+    }
     let medium = rows.iter().find(|r| r.name == "obvhs medium (BVH2)");
     if let (Some(a), Some(b)) = (our_sah, medium) {
         let _ = writeln!(
@@ -218,9 +230,11 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
             b.sah.unwrap_or(f64::NAN)
         );
     }
-    for r in rows.iter().filter(|r| ours(r) && !r.name.contains("packets")) {
+    let single_embree = |r: &Row| r.family == Some(Family::Embree);
+    for r in rows.iter().filter(|r| (ours(r) || single_embree(r)) && !r.name.contains("packets")) {
         if let Some(b) = r.bytes {
-            let _ = writeln!(o, "memory {name}: {} {:.1} bytes per triangle (nodes + indices)", r.name, b);
+            let what = if single_embree(r) { "what the device allocates" } else { "nodes + leaves" };
+            let _ = writeln!(o, "memory {name}: {} {:.1} bytes per triangle ({what})", r.name, b);
         }
     }
     o
@@ -411,6 +425,10 @@ fn main() {
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Counting));
     contenders.extend(contenders::obvhs_all());
     contenders.push(contenders::bvh_crate());
+    contenders.extend(embree::all());
+    if let Some(n) = embree::notice() {
+        eprintln!("notice: {n}");
+    }
     // BENCH_ONLY=a,b keeps contenders whose name contains one of the words (for quick iteration).
     if let Ok(only) = std::env::var("BENCH_ONLY") {
         let words: Vec<String> = only.split(',').map(|w| w.trim().to_lowercase()).collect();
@@ -422,6 +440,9 @@ fn main() {
     let mut meshes: Vec<Mesh> = Vec::new();
     meshes.extend(scenes::shared("stanford-bunny.obj"));
     meshes.extend(scenes::shared("beast.obj"));
+    meshes.extend(scenes::shared("spot.obj"));
+    meshes.extend(scenes::shared("cow.obj"));
+    meshes.push(scenes::knot_field());
     meshes.push(scenes::teapot_in_stadium());
     if !quick || app_only {
         meshes.push(scenes::big_knot());

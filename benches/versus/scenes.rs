@@ -32,6 +32,29 @@ pub fn big_knot() -> Mesh {
     m
 }
 
+/// About 500k triangles of uneven sizes: 64 torus knots (8k triangles each) scattered with
+/// different sizes, thicknesses and orientations through a box, some overlapping. Not one regular
+/// surface like the 2M knot: the builders meet clusters, gaps and long thin triangles.
+pub fn knot_field() -> Mesh {
+    let mut m = Mesh { name: "knot field 500k".into(), ..Default::default() };
+    let mut seed = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    for k in 0..64u32 {
+        let (p, q) = ([2, 3, 2, 3, 5][k as usize % 5], [3, 5, 5, 7, 2][k as usize % 5]);
+        let knot = generate::torus_knot(p, q, 0.05 + 0.3 * next(), 256, 16);
+        let scale = 0.2 + 2.0 * next() * next();
+        let at = Vec3::new(next(), next(), next()) * 20.0;
+        let rot = glam::Quat::from_euler(glam::EulerRot::XYZ, 6.3 * next(), 6.3 * next(), 6.3 * next());
+        merge(&mut m, &knot, |v| rot * v * scale + at);
+    }
+    m
+}
+
 pub fn shared(name: &str) -> Option<Mesh> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
     if !dir.is_dir() {

@@ -147,7 +147,11 @@ fn format_two_level(
         t.bottom_time.as_secs_f64() * 1e3,
         t.top_time.as_secs_f64() * 1e3
     );
-    let _ = writeln!(o, "memory          {} bytes (every node and index array, each mesh BVH once)", t.memory_bytes());
+    let _ = writeln!(
+        o,
+        "memory          {} bytes (every node, index and triangle array, each mesh BVH once)",
+        t.memory_bytes()
+    );
     let p = &t.top.params;
     let _ = writeln!(o, "top level       {}, max {} placements per leaf", p.strategy.label(), p.max_leaf_size);
     let _ = writeln!(
@@ -218,7 +222,7 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
     }
     let _ = writeln!(
         o,
-        "memory          {} bytes ({:.1} per triangle, nodes + indices)",
+        "memory          {} bytes ({:.1} per triangle: nodes, indices and the triangles in leaf order)",
         s.memory_bytes,
         s.memory_bytes as f64 / s.triangles.max(1) as f64
     );

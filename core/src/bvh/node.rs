@@ -79,9 +79,12 @@ impl Bvh {
         self.nodes[0].bounds()
     }
 
-    /// Bytes used by the nodes and the primitive index array.
+    /// Bytes a ray's walk reads from: the nodes, the primitive index array and the triangles,
+    /// which the BVH keeps in leaf order (its own copy, 36 bytes each).
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<BvhNode>() + self.prim_ids.len() * 4
+        self.nodes.len() * std::mem::size_of::<BvhNode>()
+            + self.prim_ids.len() * 4
+            + self.tris.len() * std::mem::size_of::<[Vec3; 3]>()
     }
 }
 

@@ -397,7 +397,10 @@ impl TreeView for WideBvh {
     }
 
     fn memory_bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<WideNode>() + self.prim_ids.len() * 4
+        // Nodes, primitive ids and the triangles in leaf order (the BVH's own copy).
+        self.nodes.len() * std::mem::size_of::<WideNode>()
+            + self.prim_ids.len() * 4
+            + self.tris.len() * std::mem::size_of::<[Vec3; 3]>()
     }
 
     fn params(&self) -> &BuildParams {
