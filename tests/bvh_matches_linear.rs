@@ -1,4 +1,6 @@
-//! Every strategy and both traversal orders give the linear scan's closest hit; any-hit agrees.
+//! Every strategy, layout and traversal order gives the linear scan's closest hit; any-hit agrees.
+//! The wide layouts also run with every SIMD kernel forced (`cpu::Simd`): each must find the same
+//! hit with the same counts as the kernel the CPU would choose.
 
 mod common;
 
@@ -6,6 +8,7 @@ use bvhscope::bvh::{
     Accelerator, AnyBvh, BuildParams, Layout, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions,
     TraversalOrder, TreeView,
 };
+use bvhscope::cpu::Simd;
 use bvhscope::geometry::{Ray, TriangleTest};
 use bvhscope::mesh::Mesh;
 use glam::Vec3;
@@ -26,12 +29,24 @@ fn check_ray(mesh: &Mesh, bvhs: &[AnyBvh], linear: &LinearScan, ray: Ray) {
     for opts in all_options() {
         let mut r = ray;
         let expected = linear.closest_hit(&mut r, opts, &mut NoStats);
+        // The first result of each tree, which the same tree with another kernel must repeat.
+        let mut by_tree = std::collections::HashMap::new();
         for bvh in bvhs {
             let mut r = ray;
             let mut counters = RayCounters::default();
             let got = bvh.closest_hit(&mut r, opts, &mut counters);
             let p = bvh.params();
-            let what = format!("{:?} {:?} leaf {} {:?} ray {:?}", p.strategy, p.layout, p.max_leaf_size, opts, ray);
+            let what = format!(
+                "{:?} {:?} leaf {} {:?} kernels {:?} ray {:?}",
+                p.strategy,
+                p.layout,
+                p.max_leaf_size,
+                opts,
+                simd_of(bvh),
+                ray
+            );
+            let first = by_tree.entry(format!("{p:?}")).or_insert((got, counters));
+            assert_eq!(*first, (got, counters), "another kernel, another result: {what}");
             match (expected, got) {
                 (None, None) => {}
                 (Some(e), Some(g)) => {
@@ -78,7 +93,27 @@ fn build_all(mesh: &Mesh) -> Vec<AnyBvh> {
         })
         .flat_map(|p| Layout::ALL.map(|layout| BuildParams { layout, ..p }))
         .map(|p| AnyBvh::build(mesh, &p))
+        .flat_map(with_every_kernel)
         .collect()
+}
+
+/// A wide tree as built, then the same tree with each more portable kernel forced.
+fn with_every_kernel(bvh: AnyBvh) -> Vec<AnyBvh> {
+    let forced = |simd: Simd| match &bvh {
+        AnyBvh::Binary(_) => None,
+        AnyBvh::Wide(w) => Some(AnyBvh::Wide(w.clone().with_simd(simd))),
+        AnyBvh::Wide8(w) => Some(AnyBvh::Wide8(w.clone().with_simd(simd))),
+    };
+    let lower: Vec<AnyBvh> = Simd::ALL.into_iter().filter(|&s| s < Simd::detected()).filter_map(forced).collect();
+    std::iter::once(bvh).chain(lower).collect()
+}
+
+fn simd_of(bvh: &AnyBvh) -> Option<Simd> {
+    match bvh {
+        AnyBvh::Binary(_) => None,
+        AnyBvh::Wide(w) => Some(w.simd),
+        AnyBvh::Wide8(w) => Some(w.simd),
+    }
 }
 
 fn vec3(range: f32) -> impl Strategy<Value = Vec3> {

@@ -120,7 +120,7 @@ fn check_mesh(name: &str, mesh: &Mesh, n: usize) {
                         assert_eq!(trace.last_hit(), hit.map(|h| (h.prim, h.t)), "{what}");
                         let axis = |k: u32| match &bvh {
                             AnyBvh::Binary(b) => b.nodes[k as usize].axis as usize,
-                            AnyBvh::Wide(_) => unreachable!(),
+                            AnyBvh::Wide(_) | AnyBvh::Wide8(_) => unreachable!(),
                         };
                         let axis_of: Option<&dyn Fn(u32) -> usize> =
                             matches!(bvh, AnyBvh::Binary(_)).then_some(&axis as &dyn Fn(u32) -> usize);

@@ -104,6 +104,7 @@ fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(bv
     match bvh {
         AnyBvh::Binary(accel) => Box::new(Ours::<_, S> { accel, opts, _stats: Default::default() }),
         AnyBvh::Wide(accel) => Box::new(Ours::<_, S> { accel, opts, _stats: Default::default() }),
+        AnyBvh::Wide8(accel) => Box::new(Ours::<_, S> { accel, opts, _stats: Default::default() }),
     }
 }
 
@@ -127,6 +128,7 @@ pub fn ours(strategy: SplitStrategy, layout: Layout, tracing: Tracing) -> Conten
     let layout_name = match layout {
         Layout::Binary => "BVH2",
         Layout::Wide4 => "BVH4",
+        Layout::Wide8 => "BVH8",
     };
     let name = match tracing {
         Tracing::Plain => format!("bvhscope {} ({layout_name})", strategy.name()),

@@ -251,7 +251,7 @@ fn counting_overhead(mesh: &Mesh, s: &Settings, one: &ThreadPool) -> String {
     let incoherent = rays::incoherent(mesh, s.incoherent, 0x5EED);
     let pairs = if s.quick || mesh.triangle_count() > 1_000_000 { 3 } else { 5 };
     let mut o = String::new();
-    for (layout, label) in [(Layout::Binary, "BVH2"), (Layout::Wide4, "BVH4")] {
+    for (layout, label) in [(Layout::Binary, "BVH2"), (Layout::Wide4, "BVH4"), (Layout::Wide8, "BVH8")] {
         let [plain, counting] = contenders::plain_and_counting(mesh, layout);
         let overhead = |rays: &[RaySpec]| {
             let ratios = (0..pairs)
@@ -421,8 +421,10 @@ fn main() {
     }
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Packets));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Packets));
+    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide8, Tracing::Packets));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Counting));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Counting));
+    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide8, Tracing::Counting));
     contenders.extend(contenders::obvhs_all());
     contenders.push(contenders::bvh_crate());
     contenders.extend(embree::all());

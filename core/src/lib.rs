@@ -7,6 +7,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bvh;
+pub mod cpu;
 pub mod geometry;
 pub mod mesh;
 pub mod options;

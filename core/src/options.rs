@@ -117,7 +117,7 @@ const STRATEGIES: [Named<SplitStrategy>; 7] = [
 ];
 choice!(SplitStrategy, STRATEGIES, 7);
 
-const LAYOUTS: [Named<Layout>; 2] = [
+const LAYOUTS: [Named<Layout>; 3] = [
     Named {
         value: Layout::Binary,
         name: "binary",
@@ -130,8 +130,14 @@ const LAYOUTS: [Named<Layout>; 2] = [
         label: "4-wide SIMD",
         help: "collapsed into 4-wide nodes whose boxes are tested together with SIMD: faster",
     },
+    Named {
+        value: Layout::Wide8,
+        name: "wide8",
+        label: "8-wide AVX2",
+        help: "collapsed into 8-wide nodes: eight boxes in one AVX2 pass where the CPU has it (chosen at run time), half as many levels again",
+    },
 ];
-choice!(Layout, LAYOUTS, 2);
+choice!(Layout, LAYOUTS, 3);
 
 const ORDERS: [Named<TraversalOrder>; 2] = [
     Named {

@@ -294,11 +294,11 @@ fn wide_slots(w: &WideBvh) -> Vec<Vec<Slot>> {
 fn both_layouts(mesh: &Mesh, params: BuildParams) -> (Bvh, WideBvh) {
     let binary = match AnyBvh::build(mesh, &BuildParams { layout: Layout::Binary, ..params }) {
         AnyBvh::Binary(b) => b,
-        AnyBvh::Wide(_) => panic!("asked for the binary layout"),
+        _ => panic!("asked for the binary layout"),
     };
     let wide = match AnyBvh::build(mesh, &BuildParams { layout: Layout::Wide4, ..params }) {
         AnyBvh::Wide(w) => w,
-        AnyBvh::Binary(_) => panic!("asked for the wide layout"),
+        _ => panic!("asked for the 4-wide layout"),
     };
     (binary, wide)
 }

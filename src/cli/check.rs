@@ -72,7 +72,7 @@ fn quality(
         sah_cost: s.sah_cost,
         epo: match bvh {
             AnyBvh::Binary(b) => Some(epo::of(b)),
-            AnyBvh::Wide(_) => None,
+            AnyBvh::Wide(_) | AnyBvh::Wide8(_) => None,
         },
         nodes_per_ray: r.mean_nodes_visited,
         tri_tests_per_ray: r.mean_triangle_tests,

@@ -5,8 +5,8 @@
 use super::args::{BuildArgs, ViewArgs};
 use super::{build_scene, load_mesh, CliError};
 use crate::bvh::inspect::{inspect, CurvePoint, Hierarchy, Inspection};
-use crate::bvh::wide::{wide_group_of, WideGroup};
-use crate::bvh::{epo, Layout, SceneBvh, TreeView};
+use crate::bvh::wide::{wide_group_in, WideGroup};
+use crate::bvh::{epo, SceneBvh, TreeView};
 use crate::options::Choice;
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
@@ -272,10 +272,8 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     let visits = crate::bvh::visits::frame_visits(&tree, &camera, a.build.trace(), &crate::work::WorkControl::new())
         .map_err(|_| CliError::Usage("cancelled".into()))?
         .counts[node as usize];
-    // A built 4-wide tree is collapsed from the binary one; an imported one is not.
-    let wide = (bvh.params().layout == Layout::Wide4 && names.is_none())
-        .then(|| wide_group_of(&tree.nodes, &h.parent, node))
-        .flatten();
+    // A built wide tree is collapsed from the binary one; an imported one is not.
+    let wide = names.is_none().then(|| wide_group_in(bvh.params().layout, &tree.nodes, &h.parent, node)).flatten();
     let dump_id = names.map(|n| n.dump_of_binary_node(node));
     Ok(match a.format {
         InspectFormat::Csv => csv(&ins),

@@ -32,6 +32,7 @@ pub fn check_any(bvh: &AnyBvh, mesh: &Mesh) {
     match bvh {
         AnyBvh::Binary(b) => check_invariants(b, mesh),
         AnyBvh::Wide(w) => check_wide(w, mesh),
+        AnyBvh::Wide8(w) => check_wide(w, mesh),
     }
 }
 
@@ -113,7 +114,7 @@ fn check_tiling(mut ranges: Vec<std::ops::Range<usize>>, n: usize) {
 
 /// The wide layout: every slot box inside its parent's, leaf ranges tiling the triangles, each
 /// node reached exactly once, valid masks matching the slots.
-pub fn check_wide(w: &WideBvh, mesh: &Mesh) {
+pub fn check_wide<const W: usize>(w: &WideBvh<W>, mesh: &Mesh) {
     let refs = check_prims(&w.prim_ids, &w.tris, mesh, &w.params);
     let mut ranges = Vec::new();
     let mut leaves = Vec::new();
@@ -122,7 +123,7 @@ pub fn check_wide(w: &WideBvh, mesh: &Mesh) {
     while let Some((i, parent)) = stack.pop() {
         reached[i] += 1;
         let node = &w.nodes[i];
-        for slot in 0..4 {
+        for slot in 0..W {
             let used = node.valid & (1 << slot) != 0;
             if !used {
                 assert!(node.slot_bounds(slot).is_empty(), "empty slot {slot} of node {i} must have an inverted box");

@@ -1,4 +1,4 @@
-//! A built BVH in either layout behind one type: what the app, the CLI and the tests hold.
+//! A built BVH in any layout behind one type: what the app, the CLI and the tests hold.
 
 use super::tree::{NodeView, TreeView};
 use super::wide::WideBvh;
@@ -11,6 +11,7 @@ use crate::work::{Cancelled, WorkControl};
 pub enum AnyBvh {
     Binary(Bvh),
     Wide(WideBvh),
+    Wide8(WideBvh<8>),
 }
 
 impl AnyBvh {
@@ -20,9 +21,10 @@ impl AnyBvh {
     pub fn binary_tree<'a>(&'a self, mesh: &Mesh) -> std::borrow::Cow<'a, Bvh> {
         match self {
             AnyBvh::Binary(b) => std::borrow::Cow::Borrowed(b),
-            AnyBvh::Wide(w) => {
-                std::borrow::Cow::Owned(Bvh::build(mesh, &BuildParams { layout: Layout::Binary, ..w.params }))
-            }
+            AnyBvh::Wide(_) | AnyBvh::Wide8(_) => std::borrow::Cow::Owned(Bvh::build(
+                mesh,
+                &BuildParams { layout: Layout::Binary, ..*self.tree().params() },
+            )),
         }
     }
 
@@ -46,6 +48,7 @@ impl AnyBvh {
         Ok(match params.layout {
             Layout::Binary => AnyBvh::Binary(bvh),
             Layout::Wide4 => AnyBvh::Wide(WideBvh::from_binary(bvh)),
+            Layout::Wide8 => AnyBvh::Wide8(WideBvh::collapse(bvh)),
         })
     }
 
@@ -53,6 +56,7 @@ impl AnyBvh {
         match self {
             AnyBvh::Binary(b) => b,
             AnyBvh::Wide(w) => w,
+            AnyBvh::Wide8(w) => w,
         }
     }
 }
@@ -67,6 +71,7 @@ impl Accelerator for AnyBvh {
         match self {
             AnyBvh::Binary(b) => b.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
             AnyBvh::Wide(w) => w.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
+            AnyBvh::Wide8(w) => w.trace::<T, BY_DISTANCE, ANY, S>(ray, stats),
         }
     }
 
@@ -79,6 +84,7 @@ impl Accelerator for AnyBvh {
         match self {
             AnyBvh::Binary(b) => b.closest_hits(rays, hits, opts),
             AnyBvh::Wide(w) => w.closest_hits(rays, hits, opts),
+            AnyBvh::Wide8(w) => w.closest_hits(rays, hits, opts),
         }
     }
 }

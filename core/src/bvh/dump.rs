@@ -236,11 +236,12 @@ impl BvhDump {
         o
     }
 
-    /// A tree of bvhscope's in either layout (`of_bvh`, `of_wide`).
+    /// A tree of bvhscope's in any layout (`of_bvh`, `of_wide`).
     pub fn of_any(bvh: &super::AnyBvh, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
         match bvh {
             super::AnyBvh::Binary(b) => Self::of_bvh(b, mesh, name),
             super::AnyBvh::Wide(w) => Self::of_wide(w, mesh, name),
+            super::AnyBvh::Wide8(w) => Self::of_wide(w, mesh, name),
         }
     }
 
@@ -275,9 +276,9 @@ impl BvhDump {
         BvhDump { format: FORMAT.into(), version: VERSION, mesh: name, primitives, nodes }
     }
 
-    /// A 4-wide tree of bvhscope's over `mesh`, as a dump: wide node i is dump node i (its box
-    /// is its slot's in its parent, the root's the tree's), and each leaf slot a dump leaf after them.
-    pub fn of_wide(w: &super::WideBvh, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
+    /// A 4- or 8-wide tree of bvhscope's over `mesh`, as a dump: wide node i is dump node i (its
+    /// box is its slot's in its parent, the root's the tree's), and each leaf slot a dump leaf after them.
+    pub fn of_wide<const W: usize>(w: &super::WideBvh<W>, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
         let arr = |v: glam::Vec3A| glam::Vec3::from(v).to_array();
         let mut boxes = vec![w.root_bounds; w.nodes.len()];
         let mut leaves = Vec::new();

@@ -264,7 +264,15 @@ fn to_wide(mut leaves: Leaves) -> Option<(WideBvh, Vec<u32>, Vec<u32>)> {
     }
     let (prim_ids, tris) = (leaves.prim_ids, leaves.tris);
     let params = Leaves::params(Layout::Wide4);
-    let wide = WideBvh { nodes, prim_ids, tris, root_bounds: root.bounds(), params, report: Default::default() };
+    let wide = WideBvh {
+        nodes,
+        prim_ids,
+        tris,
+        root_bounds: root.bounds(),
+        params,
+        report: Default::default(),
+        simd: crate::cpu::Simd::chosen(),
+    };
     Some((wide, ids, leaf_ids))
 }
 
@@ -287,6 +295,7 @@ mod tests {
             let dump = match &built {
                 AnyBvh::Binary(b) => BvhDump::of_bvh(b, &mesh, None),
                 AnyBvh::Wide(w) => BvhDump::of_wide(w, &mesh, None),
+                AnyBvh::Wide8(_) => unreachable!("not asked for"),
             };
             let (back, names) = import(&dump, &mesh, "t.json".as_ref()).unwrap();
             assert_eq!(back.params().layout, layout);

@@ -218,7 +218,7 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
     }
 }
 
-/// A BVH layout as the packet walk sees it: nodes whose children are boxes, up to four, with their
+/// A BVH layout as the packet walk sees it: nodes whose children are boxes, up to eight, with their
 /// planes in SoA order (`min[axis][slot]`), and child references (`u32`) the walk keeps on its
 /// stack.
 pub(super) trait PacketTree {
@@ -234,7 +234,7 @@ pub(super) trait PacketTree {
     fn slot_planes(&self, r: u32, slot: usize) -> ([f32; 3], [f32; 3]);
     /// Per slot, where its box's centre lies along `lead` (twice that, in fact: the order is all
     /// that counts).
-    fn keys(&self, r: u32, lead: Vec3) -> [f32; 4];
+    fn keys(&self, r: u32, lead: Vec3) -> [f32; 8];
     /// The slots of `missed` whose boxes some ray of the packet may still hit before `t_far`
     /// (the packet's interval test, `RayInterval`).
     fn may_hit(&self, r: u32, missed: u32, frustum: &RayInterval, t_far: f32) -> u32;
@@ -271,12 +271,12 @@ impl PacketTree for Bvh {
         (n.lo, n.hi)
     }
     #[inline(always)]
-    fn keys(&self, r: u32, lead: Vec3) -> [f32; 4] {
+    fn keys(&self, r: u32, lead: Vec3) -> [f32; 8] {
         let key = |s: usize| {
             let (lo, hi) = self.slot_planes(r, s);
             (Vec3::from_array(lo) + Vec3::from_array(hi)).dot(lead)
         };
-        [key(0), key(1), 0.0, 0.0]
+        [key(0), key(1), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
     }
     #[inline(always)]
     fn may_hit(&self, r: u32, missed: u32, frustum: &RayInterval, t_far: f32) -> u32 {
@@ -300,16 +300,16 @@ impl PacketTree for Bvh {
     }
 }
 
-/// Deepest stack a packet walk can need: at most three pushes per level (the build bounds the
-/// depth by `TRAVERSAL_STACK_SIZE`).
-const STACK: usize = 3 * TRAVERSAL_STACK_SIZE + 4;
+/// Deepest stack a packet walk can need: at most seven pushes per level of an 8-wide tree (the
+/// build bounds the depth by `TRAVERSAL_STACK_SIZE`). Not initialised: its size costs nothing.
+const STACK: usize = 7 * TRAVERSAL_STACK_SIZE + 8;
 
-/// The packet walk, written once for both layouts (Wald, Boulos & Shirley 2007, §4). For each
+/// The packet walk, written once for every layout (Wald, Boulos & Shirley 2007, §4). For each
 /// child of a node the packet finds the first group of four rays that hits its box, starting from
 /// the node's own first group; children no group hits are dropped, the others are visited nearest
 /// first along the packet's leading direction (their centres projected on it: for coherent rays
 /// that is front to back; the order only affects speed, never the result). Most children are hit
-/// by the node's first group; the others are first put to the packet's frustum, one SIMD test for
+/// by the node's first group; the others are first put to the packet's frustum, one SIMD test per
 /// four boxes, then to the following groups one by one. At a leaf every group from its first one
 /// tests the leaf's triangles with the four-ray triangle test (bit for bit the single-ray test), so
 /// each ray gets the hit it would get alone.
@@ -330,7 +330,7 @@ fn walk<B: PacketTree, T: TriangleIntersector>(bvh: &B, rays: &mut [Ray], hits: 
         if !bvh.is_leaf(cur) {
             let key = bvh.keys(cur, lead);
             // The hit children as (key, reference, first group), kept sorted far to near.
-            let mut hit = [(0f32, 0u32, 0u8); 4];
+            let mut hit = [(0f32, 0u32, 0u8); 8];
             let mut n = 0;
             let mut add = |s: usize, g: usize| {
                 let mut j = n;

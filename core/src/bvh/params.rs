@@ -47,6 +47,9 @@ pub enum Layout {
     /// The binary BVH collapsed into 4-wide nodes traversed with SIMD box tests (`bvh::wide`).
     #[default]
     Wide4,
+    /// Collapsed into 8-wide nodes: eight child boxes in one AVX2 pass where the CPU has it
+    /// (`crate::cpu`), two passes of four elsewhere.
+    Wide8,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -75,7 +75,7 @@ impl SceneBvh {
             SceneBvh::Single { bvh, imported: Some(i), .. } => match (&i.binary, bvh) {
                 (Some((b, _)), _) => Some(Cow::Borrowed(&**b)),
                 (None, AnyBvh::Binary(b)) => Some(Cow::Borrowed(b)),
-                (None, AnyBvh::Wide(_)) => None,
+                (None, AnyBvh::Wide(_) | AnyBvh::Wide8(_)) => None,
             },
             SceneBvh::Single { bvh, mesh, imported: None } => Some(bvh.binary_tree(mesh)),
             SceneBvh::TwoLevel { .. } => None,
@@ -179,6 +179,7 @@ impl SceneBvh {
         let in_tree = |bvh: &AnyBvh| match (bvh, node) {
             (AnyBvh::Binary(b), NodeId::Node(i)) => b.nodes.get(i as usize).map(|n| n.bounds()),
             (AnyBvh::Wide(w), id) => w.node_box(id),
+            (AnyBvh::Wide8(w), id) => w.node_box(id),
             (AnyBvh::Binary(_), NodeId::Leaf { .. }) => None,
         };
         match (self, level) {

@@ -3,6 +3,7 @@
 mod aabb;
 mod ray;
 pub mod slab;
+pub mod slab8;
 pub(crate) mod triangle;
 
 pub use aabb::Aabb;

@@ -137,17 +137,20 @@ pub fn box_once(lo: &[f32; 3], hi: &[f32; 3], ray: &Ray) -> (f32, f32) {
     (t_enter, widen(t_exit))
 }
 
-/// Four boxes' planes in SoA order (`min[axis][box]`), for one SIMD slab test of all four: a
-/// wide node's children, or a binary node's two with two empty slots.
+/// `W` boxes' planes in SoA order (`min[axis][box]`), for one SIMD slab test of all of them: a
+/// wide node's children (four, or eight in `slab8`), or a binary node's two with empty slots.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Boxes4 {
-    pub min: [[f32; 4]; 3],
-    pub max: [[f32; 4]; 3],
+pub struct Boxes<const W: usize> {
+    pub min: [[f32; W]; 3],
+    pub max: [[f32; W]; 3],
 }
 
-impl Boxes4 {
-    /// Four empty boxes (+inf..-inf), which every slab test misses.
-    pub const EMPTY: Boxes4 = Boxes4 { min: [[f32::INFINITY; 4]; 3], max: [[f32::NEG_INFINITY; 4]; 3] };
+/// Four boxes: the 4-wide node's children and the packet walk's nodes.
+pub type Boxes4 = Boxes<4>;
+
+impl<const W: usize> Boxes<W> {
+    /// Empty boxes (+inf..-inf), which every slab test misses.
+    pub const EMPTY: Self = Self { min: [[f32::INFINITY; W]; 3], max: [[f32::NEG_INFINITY; W]; 3] };
 
     /// Put box `b`'s planes in slot `k`.
     #[inline(always)]
@@ -196,7 +199,14 @@ impl RayX4 {
     /// (`t_max` the caller's limit, the closest hit widened); `valid` masks out empty slots.
     #[inline(always)]
     pub fn four_boxes(&self, boxes: &Boxes4, valid: u32, t_min: f32, t_max: f32) -> ([f32; 4], u32) {
-        let (min, max) = (&boxes.min, &boxes.max);
+        let (enter, exit) = self.lanes(&boxes.min, &boxes.max, t_min, t_max);
+        let mask = enter.simd_le(exit).to_bitmask() & valid;
+        (enter.to_array(), mask)
+    }
+
+    /// The entry and exit distances of four boxes given by their planes.
+    #[inline(always)]
+    pub(crate) fn lanes(&self, min: &[[f32; 4]; 3], max: &[[f32; 4]; 3], t_min: f32, t_max: f32) -> (f32x4, f32x4) {
         let mut enter = f32x4::splat(t_min);
         let mut exit = f32x4::splat(t_max);
         for axis in 0..3 {
@@ -206,8 +216,62 @@ impl RayX4 {
             enter = max_keep(t0, enter);
             exit = min_keep(t1, exit);
         }
-        let mask = enter.simd_le(exit).to_bitmask() & valid;
-        (enter.to_array(), mask)
+        (enter, exit)
+    }
+}
+
+/// One ray against the `W` child boxes of a wide node: what the wide walk asks of a kernel. Every
+/// kernel computes the same slab distances with the same operations (a subtraction and a product
+/// per plane, nothing fused, NaN skipped as in `max_keep`), so all of them return the same entries
+/// and masks bit for bit: the choice of kernel (`crate::cpu`) changes the speed, never a result
+/// or a count. Implemented here for four boxes (`Simd4`, `Scalar`) and in `slab8` for eight.
+pub trait SlabKernel<const W: usize>: Copy {
+    /// The ray as this kernel wants it, prepared once per ray.
+    type Ray;
+    fn prepare(self, ray: &Ray) -> Self::Ray;
+    /// Entry distances of the `W` boxes and the mask of those hit within `[t_min, t_max]`;
+    /// `valid` masks out empty slots.
+    fn test(self, ray: &Self::Ray, boxes: &Boxes<W>, valid: u32, t_min: f32, t_max: f32) -> ([f32; W], u32);
+}
+
+/// Four lanes of the `wide` crate: SSE on x86-64, NEON on aarch64, plain arrays elsewhere.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Simd4;
+
+impl SlabKernel<4> for Simd4 {
+    type Ray = RayX4;
+    #[inline(always)]
+    fn prepare(self, ray: &Ray) -> RayX4 {
+        RayX4::new(ray)
+    }
+    #[inline(always)]
+    fn test(self, ray: &RayX4, boxes: &Boxes4, valid: u32, t_min: f32, t_max: f32) -> ([f32; 4], u32) {
+        ray.four_boxes(boxes, valid, t_min, t_max)
+    }
+}
+
+/// One box at a time with `OneRay`'s scalar test: the reference the SIMD kernels are tested
+/// against, and the path for a CPU without SIMD.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Scalar;
+
+impl<const W: usize> SlabKernel<W> for Scalar {
+    type Ray = OneRay;
+    #[inline(always)]
+    fn prepare(self, ray: &Ray) -> OneRay {
+        OneRay::new(ray)
+    }
+    #[inline(always)]
+    fn test(self, ray: &OneRay, boxes: &Boxes<W>, valid: u32, t_min: f32, t_max: f32) -> ([f32; W], u32) {
+        let mut enter = [0.0; W];
+        let mut mask = 0;
+        for (k, e) in enter.iter_mut().enumerate() {
+            let (lo, hi) = boxes.planes(k);
+            let (t0, t1) = ray.one_box(&lo, &hi, t_min, t_max);
+            *e = t0;
+            mask |= ((t0 <= t1) as u32) << k;
+        }
+        (enter, mask & valid)
     }
 }
 

@@ -81,10 +81,11 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 ui.label(format!("Imported from {}: dump node {d}.", names.name))
                     .on_hover_text("The node's id in the dump; bvhscope inspect MESH --bvh DUMP --node ID takes that id");
             }
-            if e.bvh.build_params().bvh.layout == crate::bvh::Layout::Wide4 && imported.is_none() {
-                if let Some(g) = crate::bvh::wide::wide_group_of(&e.tree.nodes, &e.hierarchy.parent, node) {
+            let layout = e.bvh.build_params().bvh.layout;
+            if imported.is_none() {
+                if let Some(g) = crate::bvh::wide::wide_group_in(layout, &e.tree.nodes, &e.hierarchy.parent, node) {
                     ui.label(wide_group_text(node, &g)).on_hover_text(
-                        "The 4-wide layout collapses the binary tree: a wide node takes the children of a binary node and, while it has fewer than four, opens the largest interior one",
+                        "A wide layout collapses the binary tree: a wide node takes the children of a binary node and, while it has fewer than four (or eight), opens the largest interior one",
                     );
                 }
             }

@@ -1,7 +1,8 @@
-//! The wide BVH: the binary BVH collapsed into nodes of up to four children whose boxes are tested
-//! together with SIMD (`traverse.rs`).
+//! The wide BVHs: the binary BVH collapsed into nodes of up to four or eight children (`W`) whose
+//! boxes are tested together with SIMD (`traverse.rs`; the eight-wide one with AVX2 where the CPU
+//! has it, chosen at run time: `crate::cpu`).
 //!
-//! Collapse: starting from a binary node, its two children are taken; then, while fewer than four,
+//! Collapse: starting from a binary node, its two children are taken; then, while fewer than `W`,
 //! the interior child of largest surface area is replaced by its own two children. Opening the
 //! largest box first removes the most expected traversal cost under the SAH; the rule is the
 //! greedy collapse of Wald, Benthin & Boulos, "Getting Rid of Packets" (RT 2008), and Pinto,
@@ -25,33 +26,34 @@ mod traverse;
 use super::node::{Bvh, BvhNode};
 use super::tree::{NodeKind, NodeView, TreeView};
 use super::{BuildParams, BuildReport};
-use crate::geometry::slab::Boxes4;
+use crate::geometry::slab::Boxes;
 use crate::geometry::Aabb;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
 
+/// The width of the 4-wide layout (the app's default), and of the imported trees.
 pub const WIDTH: usize = 4;
 
 /// Children boxes in SoA order (`boxes`), then per slot: a child node index (interior,
 /// `count == 0`) or the first triangle of a leaf (`count > 0`). Empty slots have an inverted box
-/// (+inf..-inf), which every slab test misses, and are clear in `valid`.
+/// (+inf..-inf), which every slab test misses, and are clear in `valid`. Cache-line aligned: 128
+/// bytes for four children, 256 for eight (Embree's uncompressed BVH8 node is 256 bytes too).
 #[repr(C, align(64))]
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct WideNode {
-    pub boxes: Boxes4,
-    pub child: [u32; WIDTH],
-    pub count: [u8; WIDTH],
+pub struct WideNode<const W: usize = WIDTH> {
+    pub boxes: Boxes<W>,
+    pub child: [u32; W],
+    pub count: [u8; W],
     /// Bit k set when slot k holds a child.
     pub valid: u8,
-    pub _pad: [u8; 11],
 }
 
-const _: () = assert!(std::mem::size_of::<WideNode>() == 128);
+const _: () = assert!(std::mem::size_of::<WideNode<4>>() == 128);
+const _: () = assert!(std::mem::size_of::<WideNode<8>>() == 256);
 
-impl WideNode {
-    pub const EMPTY: WideNode =
-        WideNode { boxes: Boxes4::EMPTY, child: [u32::MAX; WIDTH], count: [0; WIDTH], valid: 0, _pad: [0; 11] };
+impl<const W: usize> WideNode<W> {
+    pub const EMPTY: Self = Self { boxes: Boxes::EMPTY, child: [u32::MAX; W], count: [0; W], valid: 0 };
 
     pub(crate) fn set(&mut self, slot: usize, b: Aabb, child: u32, count: u8) {
         let (lo, hi) = b.planes();
@@ -71,19 +73,18 @@ impl WideNode {
     }
 
     pub fn slots(&self) -> impl Iterator<Item = usize> + '_ {
-        (0..WIDTH).filter(|k| self.valid & (1 << k) != 0)
+        (0..W).filter(|k| self.valid & (1 << k) != 0)
     }
 }
 
 /// A reference to a wide node's child, as the single-ray and the packet walks carry it on their
-/// stacks, encoded here once: an interior child is its node index; a leaf is `LEAF | node·4 +
+/// stacks, encoded here once: an interior child is its node index; a leaf is `LEAF | node·W +
 /// slot`, the node and slot that hold it (its first triangle and count are read from that node,
 /// which is still in cache when the leaf is reached). The top bit is free: a tree of 2³¹ wide
-/// nodes would need 256 GB.
+/// nodes would need 256 GB; a leaf's node number has 28 bits left for eight slots (2²⁸ nodes of
+/// 256 bytes: 64 GB).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct ChildRef(u32);
-
-const _: () = assert!(WIDTH == 4, "child references pack the slot into two bits");
 
 impl ChildRef {
     const LEAF: u32 = 1 << 31;
@@ -92,9 +93,9 @@ impl ChildRef {
 
     /// Slot `slot` of node `index` (`node`).
     #[inline(always)]
-    pub(crate) fn of(node: &WideNode, index: u32, slot: usize) -> Self {
+    pub(crate) fn of<const W: usize>(node: &WideNode<W>, index: u32, slot: usize) -> Self {
         if node.count[slot] > 0 {
-            ChildRef(Self::LEAF | index << 2 | slot as u32)
+            ChildRef(Self::LEAF | index << W.trailing_zeros() | slot as u32)
         } else {
             ChildRef(node.child[slot])
         }
@@ -111,10 +112,10 @@ impl ChildRef {
         self.0
     }
 
-    /// The node and slot of a leaf.
+    /// The node and slot of a leaf in a `W`-wide tree.
     #[inline(always)]
-    pub(crate) fn leaf(self) -> (usize, usize) {
-        (((self.0 & !Self::LEAF) >> 2) as usize, (self.0 & 3) as usize)
+    pub(crate) fn leaf<const W: usize>(self) -> (usize, usize) {
+        (((self.0 & !Self::LEAF) >> W.trailing_zeros()) as usize, (self.0 as usize & (W - 1)))
     }
 
     /// The bits, for a stack entry.
@@ -129,20 +130,30 @@ impl ChildRef {
     }
 }
 
-/// A BVH with 4-wide nodes. Node 0 is the root.
+/// A BVH with `W`-wide nodes (4 or 8). Node 0 is the root.
 #[derive(Clone, Debug)]
-pub struct WideBvh {
-    pub nodes: Vec<WideNode>,
+pub struct WideBvh<const W: usize = WIDTH> {
+    pub nodes: Vec<WideNode<W>>,
     pub prim_ids: Vec<u32>,
     pub tris: Vec<[Vec3; 3]>,
     pub root_bounds: Aabb,
     pub params: BuildParams,
     pub report: BuildReport,
+    /// The box kernels this tree's walk uses (`crate::cpu`): the CPU's best unless a test or
+    /// `BVHSCOPE_SIMD` asks for a more portable one. Only the eight-wide walk has a choice.
+    pub simd: crate::cpu::Simd,
 }
 
-impl WideBvh {
-    /// Collapse a binary BVH (its triangle arrays are moved, not copied).
-    pub fn from_binary(bvh: Bvh) -> WideBvh {
+impl<const W: usize> WideBvh<W> {
+    /// This tree walked with the kernels of `simd` (or the best below it this CPU has).
+    pub fn with_simd(mut self, simd: crate::cpu::Simd) -> Self {
+        self.simd = simd.available();
+        self
+    }
+
+    /// Collapse a binary BVH into `W`-wide nodes (its triangle arrays are moved, not copied).
+    pub fn collapse(bvh: Bvh) -> WideBvh<W> {
+        const { assert!(W == 4 || W == 8, "four or eight children") };
         let start = Instant::now();
         let root_bounds = bvh.root_bounds();
         let b = &bvh.nodes;
@@ -159,19 +170,28 @@ impl WideBvh {
         };
         let mut report = bvh.report;
         report.collapse_time = start.elapsed();
-        let params = BuildParams { layout: super::Layout::Wide4, ..bvh.params };
-        WideBvh { nodes, prim_ids: bvh.prim_ids, tris: bvh.tris, root_bounds, params, report }
+        let layout = if W == 8 { super::Layout::Wide8 } else { super::Layout::Wide4 };
+        let params = BuildParams { layout, ..bvh.params };
+        let simd = crate::cpu::Simd::chosen();
+        WideBvh { nodes, prim_ids: bvh.prim_ids, tris: bvh.tris, root_bounds, params, report, simd }
     }
 }
 
 impl WideBvh {
+    /// Collapse a binary BVH into the 4-wide layout.
+    pub fn from_binary(bvh: Bvh) -> WideBvh {
+        Self::collapse(bvh)
+    }
+}
+
+impl<const W: usize> WideBvh<W> {
     /// The box of a node as a trace names it (`bvh::trace::NodeId`): a leaf's is its slot's in
     /// its parent; a wide node's is the slot that refers to it (the root's, the tree's bounds).
     pub fn node_box(&self, id: crate::bvh::NodeId) -> Option<crate::geometry::Aabb> {
         match id {
             crate::bvh::NodeId::Node(0) => Some(self.root_bounds),
             crate::bvh::NodeId::Node(i) => self.nodes.iter().find_map(|n| {
-                (0..WIDTH)
+                (0..W)
                     .find(|&s| n.valid & (1 << s) != 0 && n.count[s] == 0 && n.child[s] == i)
                     .map(|s| n.boxes.bounds(s))
             }),
@@ -184,7 +204,7 @@ impl WideBvh {
 
 /// How the collapse groups binary nodes into one wide node: the binary node at its top, the
 /// interior binary nodes it swallows (the top included), and its children, each a binary leaf or
-/// the top of another wide node. The node inspector says this of a node in the 4-wide layout.
+/// the top of another wide node. The node inspector says this of a node in a wide layout.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct WideGroup {
     pub top: u32,
@@ -195,7 +215,7 @@ pub struct WideGroup {
 /// The wide node that binary node `node` is collapsed into (for a leaf: the wide node holding it
 /// as a slot), found by walking the collapse (`wide_children`, the same choice `from_binary`
 /// makes) from the root; `parent` is each binary node's parent (`inspect::Hierarchy::parent`).
-pub fn wide_group_of(b: &[BvhNode], parent: &[u32], node: u32) -> Option<WideGroup> {
+pub fn wide_group_of<const W: usize>(b: &[BvhNode], parent: &[u32], node: u32) -> Option<WideGroup> {
     if b.get(node as usize)?.is_leaf() && node == 0 || b[0].is_leaf() {
         return None;
     }
@@ -207,7 +227,7 @@ pub fn wide_group_of(b: &[BvhNode], parent: &[u32], node: u32) -> Option<WideGro
     path.reverse();
     let mut top = 0usize;
     loop {
-        let (kids, n) = wide_children(b, top);
+        let (kids, n) = wide_children::<W>(b, top);
         let kids = &kids[..n];
         // The swallowed nodes: every binary node from the top down to (not including) a child.
         let mut collapsed = vec![top as u32];
@@ -229,15 +249,24 @@ pub fn wide_group_of(b: &[BvhNode], parent: &[u32], node: u32) -> Option<WideGro
     }
 }
 
+/// `wide_group_of` for a tree of `layout`'s width; `None` for the binary layout.
+pub fn wide_group_in(layout: super::Layout, b: &[BvhNode], parent: &[u32], node: u32) -> Option<WideGroup> {
+    match layout {
+        super::Layout::Binary => None,
+        super::Layout::Wide4 => wide_group_of::<4>(b, parent, node),
+        super::Layout::Wide8 => wide_group_of::<8>(b, parent, node),
+    }
+}
+
 /// The binary nodes a wide node over interior binary node `bin` takes as its children: its two
-/// children, then, while fewer than four, the interior one of largest surface area replaced by
+/// children, then, while fewer than `W`, the interior one of largest surface area replaced by
 /// its own two.
-fn wide_children(b: &[BvhNode], bin: usize) -> ([usize; WIDTH], usize) {
-    let mut kids = [0usize; WIDTH];
+fn wide_children<const W: usize>(b: &[BvhNode], bin: usize) -> ([usize; W], usize) {
+    let mut kids = [0usize; W];
     kids[0] = b[bin].index as usize;
     kids[1] = kids[0] + 1;
     let mut n = 2;
-    while n < WIDTH {
+    while n < W {
         let open = (0..n)
             .filter(|&k| !b[kids[k]].is_leaf())
             .max_by(|&x, &y| b[kids[x]].bounds().area().total_cmp(&b[kids[y]].bounds().area()));
@@ -252,14 +281,14 @@ fn wide_children(b: &[BvhNode], bin: usize) -> ([usize; WIDTH], usize) {
 
 /// Collapse the subtree under interior binary node `root` with an explicit stack; node 0 of the
 /// result is its wide root, child indices are local. `expected` binary nodes are under the root.
-fn collapse_sequential(b: &[BvhNode], root: usize, expected: usize) -> Vec<WideNode> {
-    // Each wide node takes the place of up to three binary interior nodes (half the nodes are
-    // interior); reserving that up front avoids regrowing a vector of 128-byte nodes.
-    let mut nodes = Vec::with_capacity(expected / 6 + 1);
+fn collapse_sequential<const W: usize>(b: &[BvhNode], root: usize, expected: usize) -> Vec<WideNode<W>> {
+    // Each wide node takes the place of up to W − 1 binary interior nodes (half the nodes are
+    // interior); reserving that up front avoids regrowing a vector of big nodes.
+    let mut nodes = Vec::with_capacity(expected / (2 * (W - 1)) + 1);
     nodes.push(WideNode::EMPTY);
     let mut stack = vec![(root, 0usize)]; // (binary node, wide node to fill)
     while let Some((bin, wide)) = stack.pop() {
-        let (kids, n) = wide_children(b, bin);
+        let (kids, n) = wide_children::<W>(b, bin);
         for (slot, &k) in kids[..n].iter().enumerate() {
             let node = &b[k];
             if node.is_leaf() {
@@ -277,25 +306,25 @@ fn collapse_sequential(b: &[BvhNode], root: usize, expected: usize) -> Vec<WideN
 
 /// Binary trees at least this big are collapsed in parallel ...
 const PARALLEL_MIN_NODES: usize = 1 << 15;
-/// ... their top wide levels one by one, the subtrees below (up to 4³) on rayon.
+/// ... their top wide levels one by one, the subtrees below (up to W³) on rayon.
 const PARALLEL_DEPTH: u32 = 3;
 
 /// A collapsed subtree as the parallel collapse returns it, written into one array at the end.
-enum WideTree {
+enum WideTree<const W: usize> {
     /// Node 0 is the root; child indices are local to the vector.
-    Flat(Vec<WideNode>),
+    Flat(Vec<WideNode<W>>),
     /// A wide node whose interior slots are filled in by `into_nodes`, and its interior children.
-    Node { node: WideNode, kids: Vec<(usize, WideTree)>, len: usize },
+    Node { node: WideNode<W>, kids: Vec<(usize, WideTree<W>)>, len: usize },
 }
 
-fn collapse_parallel(b: &[BvhNode], bin: usize, depth: u32) -> WideTree {
+fn collapse_parallel<const W: usize>(b: &[BvhNode], bin: usize, depth: u32) -> WideTree<W> {
     if depth >= PARALLEL_DEPTH {
-        // Binary nodes under this one, guessed: a near-balanced tree splits them about four ways
+        // Binary nodes under this one, guessed: a near-balanced tree splits them about W ways
         // per wide level. `collapse_sequential` reserves a wide node per six of them; if the guess
         // is short, its vector grows.
-        return WideTree::Flat(collapse_sequential(b, bin, b.len() >> (2 * depth)));
+        return WideTree::Flat(collapse_sequential(b, bin, b.len() >> (W.trailing_zeros() * depth)));
     }
-    let (kids, n) = wide_children(b, bin);
+    let (kids, n) = wide_children::<W>(b, bin);
     let mut node = WideNode::EMPTY;
     let mut interior = Vec::new();
     for (slot, &k) in kids[..n].iter().enumerate() {
@@ -306,13 +335,13 @@ fn collapse_parallel(b: &[BvhNode], bin: usize, depth: u32) -> WideTree {
             interior.push((slot, k));
         }
     }
-    let kids: Vec<(usize, WideTree)> =
+    let kids: Vec<(usize, WideTree<W>)> =
         interior.into_par_iter().map(|(slot, k)| (slot, collapse_parallel(b, k, depth + 1))).collect();
     let len = 1 + kids.iter().map(|(_, t)| t.len()).sum::<usize>();
     WideTree::Node { node, kids, len }
 }
 
-impl WideTree {
+impl<const W: usize> WideTree<W> {
     fn len(&self) -> usize {
         match self {
             WideTree::Flat(nodes) => nodes.len(),
@@ -321,7 +350,7 @@ impl WideTree {
     }
 
     /// One array, each subtree contiguous after its parent (child subtrees in slot order).
-    fn into_nodes(self) -> Vec<WideNode> {
+    fn into_nodes(self) -> Vec<WideNode<W>> {
         let mut nodes = Vec::with_capacity(self.len());
         // Filled in parallel: first touch of fresh pages is much of the cost of a big array.
         nodes.par_extend(rayon::iter::repeat_n(WideNode::EMPTY, self.len()));
@@ -330,12 +359,12 @@ impl WideTree {
     }
 
     /// Write into `out`, whose first node has global index `base`.
-    fn write(self, out: &mut [WideNode], base: u32) {
+    fn write(self, out: &mut [WideNode<W>], base: u32) {
         match self {
             WideTree::Flat(nodes) => {
                 for (to, from) in out.iter_mut().zip(nodes) {
                     *to = from;
-                    for slot in 0..WIDTH {
+                    for slot in 0..W {
                         if to.valid & (1 << slot) != 0 && to.count[slot] == 0 {
                             to.child[slot] += base;
                         }
@@ -361,9 +390,9 @@ impl WideTree {
     }
 }
 
-impl TreeView for WideBvh {
+impl<const W: usize> TreeView for WideBvh<W> {
     /// The root is node 0 with the whole box; each valid slot is a child: an interior wide node
-    /// (id = its index) or a leaf (id = nodes.len() + 4·parent + slot).
+    /// (id = its index) or a leaf (id = nodes.len() + W·parent + slot).
     fn walk(&self, f: &mut dyn FnMut(&NodeView) -> bool) {
         let root_kind = if self.prim_ids.is_empty() { NodeKind::Leaf { count: 0 } } else { NodeKind::Interior };
         if !f(&NodeView { id: 0, bounds: self.root_bounds, depth: 0, kind: root_kind }) || self.prim_ids.is_empty() {
@@ -376,7 +405,7 @@ impl TreeView for WideBvh {
                 let bounds = node.slot_bounds(slot);
                 let d = depth + 1;
                 if node.count[slot] > 0 {
-                    let id = self.nodes.len() + WIDTH * i + slot;
+                    let id = self.nodes.len() + W * i + slot;
                     f(&NodeView { id, bounds, depth: d, kind: NodeKind::Leaf { count: node.count[slot] as u32 } });
                 } else {
                     let c = node.child[slot] as usize;
@@ -398,7 +427,7 @@ impl TreeView for WideBvh {
 
     fn memory_bytes(&self) -> usize {
         // Nodes, primitive ids and the triangles in leaf order (the BVH's own copy).
-        self.nodes.len() * std::mem::size_of::<WideNode>()
+        self.nodes.len() * std::mem::size_of::<WideNode<W>>()
             + self.prim_ids.len() * 4
             + self.tris.len() * std::mem::size_of::<[Vec3; 3]>()
     }
@@ -428,7 +457,7 @@ mod tests {
         let mut tops = std::collections::HashSet::new();
         let mut swallowed = 0;
         for (i, n) in binary.nodes.iter().enumerate() {
-            let g = super::wide_group_of(&binary.nodes, &h.parent, i as u32).expect("a group");
+            let g = super::wide_group_of::<4>(&binary.nodes, &h.parent, i as u32).expect("a group");
             assert!((2..=WIDTH).contains(&g.children.len()));
             if n.is_leaf() {
                 assert!(g.children.contains(&(i as u32)));

@@ -1,7 +1,8 @@
-//! The 4-wide BVH's walk, written once: one SIMD slab test for the four child boxes of a node
-//! (`geometry::slab::RayX4`), hit children visited nearest first. The common cases take few
+//! The wide BVHs' walk, written once for four and eight children: one SIMD slab test for the child
+//! boxes of a node (a `geometry::slab::SlabKernel`: four lanes, or eight with AVX2 where the CPU
+//! has it, chosen per tree from `crate::cpu`), hit children visited nearest first. The common cases take few
 //! branches: one child hit is entered directly, two are ordered by one comparison; only three or
-//! four hits are sorted (on the stack). Leaves travel through the same path as nodes, as child
+//! more hits are sorted (on the stack). Leaves travel through the same path as nodes, as child
 //! references (`ChildRef`; the loop layout of Embree's BVH4 traversal, Wald et al., "Embree: A
 //! Kernel Framework for Efficient CPU Ray Tracing", SIGGRAPH 2014). What happens at a leaf is the
 //! caller's closure. Counters: a node visit counts once, its box tests count per valid child (so
@@ -15,17 +16,19 @@ use crate::bvh::stack::TraversalStack;
 use crate::bvh::trace::NodeId;
 use crate::bvh::traverse::test_triangles;
 use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
-use crate::geometry::slab::{widen, RayX4};
+use crate::cpu::Simd;
+use crate::geometry::slab::{widen, Scalar, Simd4, SlabKernel};
 use crate::geometry::{Ray, TriangleIntersector};
 
-/// Deepest stack a traversal can need: at most three pushes per level (the build bounds the depth
+/// Deepest stack a traversal can need: at most W − 1 pushes per level (the build bounds the depth
 /// by `TRAVERSAL_STACK_SIZE`).
 pub(super) const STACK: usize = 3 * crate::bvh::TRAVERSAL_STACK_SIZE + 4;
+const STACK8: usize = 7 * crate::bvh::TRAVERSAL_STACK_SIZE + 8;
 
-impl WideBvh {
+impl<const W: usize> WideBvh<W> {
     /// Start loading a child that goes on the stack: the node, or a leaf's first triangle.
     #[inline(always)]
-    fn prefetch_child(&self, node: &WideNode, slot: usize) {
+    fn prefetch_child(&self, node: &WideNode<W>, slot: usize) {
         let i = node.child[slot] as usize;
         if node.count[slot] > 0 {
             if let Some(t) = self.tris.get(i) {
@@ -39,9 +42,11 @@ impl WideBvh {
     /// Walk the tree nearest child first. `leaf(first, count, ray, stats)` is called for every
     /// leaf reached (its triangles `first..first + count` in leaf order); it may shrink
     /// `ray.t_max` and returns true to stop the walk.
+    /// `kernel` tests a node's child boxes; `N` is the stack's size (`STACK` for four children).
     #[inline(always)]
-    pub(crate) fn walk_ray<S: TraversalStats>(
+    pub(crate) fn walk_ray<S: TraversalStats, K: SlabKernel<W>, const N: usize>(
         &self,
+        kernel: K,
         ray: &mut Ray,
         stats: &mut S,
         mut leaf: impl FnMut(usize, usize, &mut Ray, &mut S) -> bool,
@@ -53,11 +58,11 @@ impl WideBvh {
         if self.prim_ids.is_empty() || self.root_bounds.intersect(ray).is_none() {
             return;
         }
-        let sray = RayX4::new(ray);
+        let sray = kernel.prepare(ray);
         // The closest hit so far, widened: what boxes and stack entries are compared with.
         let mut limit = widen(ray.t_max);
         let t_min = ray.t_min;
-        let mut stack = TraversalStack::<STACK>::new();
+        let mut stack = TraversalStack::<N>::new();
         let mut cur = ChildRef::ROOT;
         'traversal: loop {
             // Descend through interior nodes until a leaf is reached or nothing is hit.
@@ -69,7 +74,7 @@ impl WideBvh {
                 }
                 stats.node_visited();
                 stats.box_tests(node.valid.count_ones());
-                let (enter, mask) = sray.four_boxes(&node.boxes, node.valid as u32, t_min, limit);
+                let (enter, mask) = kernel.test(&sray, &node.boxes, node.valid as u32, t_min, limit);
                 if S::STEPS {
                     self.report_boxes(stats, node, index, mask, &enter, ray, limit);
                 }
@@ -104,11 +109,11 @@ impl WideBvh {
                         cur = r1;
                     }
                     if S::STEPS {
-                        report_stack(stats, &stack);
+                        report_stack::<S, W, N>(stats, &stack);
                     }
                     continue;
                 }
-                // Three or four children hit: push them all, nearest on top, and take it.
+                // Three or more children hit: push them all, nearest on top, and take it.
                 let mut m = mask;
                 let mut k = 0;
                 while m != 0 {
@@ -120,21 +125,21 @@ impl WideBvh {
                 }
                 stack.sort_top(k);
                 if S::STEPS {
-                    report_stack(stats, &stack);
+                    report_stack::<S, W, N>(stats, &stack);
                 }
                 cur = match stack.pop() {
                     Some((r, _)) => ChildRef::from_raw(r),
                     None => break 'traversal,
                 };
                 if S::STEPS {
-                    report_stack(stats, &stack);
+                    report_stack::<S, W, N>(stats, &stack);
                 }
             }
-            let (index, slot) = cur.leaf();
+            let (index, slot) = cur.leaf::<W>();
             let node = &self.nodes[index];
             stats.leaf_visited();
             if S::STEPS {
-                stats.step_leaf(node_id(cur));
+                stats.step_leaf(node_id::<W>(cur));
             }
             if leaf(node.child[slot] as usize, node.count[slot] as usize, ray, stats) {
                 break 'traversal;
@@ -148,17 +153,22 @@ impl WideBvh {
     }
 }
 
-impl WideBvh {
+impl<const W: usize> WideBvh<W> {
     /// `pop_nearer`, telling a tracing sink what it skips and what the stack then holds.
     #[inline(always)]
-    fn pop<S: TraversalStats>(&self, stack: &mut TraversalStack<STACK>, limit: f32, stats: &mut S) -> Option<u32> {
+    fn pop<S: TraversalStats, const N: usize>(
+        &self,
+        stack: &mut TraversalStack<N>,
+        limit: f32,
+        stats: &mut S,
+    ) -> Option<u32> {
         let next = stack.pop_nearer_or_skip(limit, |r, t| {
             if S::STEPS {
-                stats.step_skip(node_id(ChildRef::from_raw(r)), t);
+                stats.step_skip(node_id::<W>(ChildRef::from_raw(r)), t);
             }
         });
         if S::STEPS {
-            report_stack(stats, stack);
+            report_stack::<S, W, N>(stats, stack);
         }
         next
     }
@@ -170,15 +180,15 @@ impl WideBvh {
     fn report_boxes<S: TraversalStats>(
         &self,
         stats: &mut S,
-        node: &WideNode,
+        node: &WideNode<W>,
         index: u32,
         mask: u32,
-        enter: &[f32; 4],
+        enter: &[f32; W],
         ray: &Ray,
         limit: f32,
     ) {
-        for slot in (0..4).filter(|&s| node.valid & (1 << s) != 0) {
-            let child = node_id(ChildRef::of(node, index, slot));
+        for slot in node.slots() {
+            let child = node_id::<W>(ChildRef::of(node, index, slot));
             let hit = mask & (1 << slot) != 0;
             let mut r = *ray;
             r.t_max = limit;
@@ -189,9 +199,9 @@ impl WideBvh {
 }
 
 /// The trace's name of a child reference.
-fn node_id(r: ChildRef) -> NodeId {
+fn node_id<const W: usize>(r: ChildRef) -> NodeId {
     if r.is_leaf() {
-        let (node, slot) = r.leaf();
+        let (node, slot) = r.leaf::<W>();
         NodeId::Leaf { node: node as u32, slot: slot as u8 }
     } else {
         NodeId::Node(r.node())
@@ -199,21 +209,23 @@ fn node_id(r: ChildRef) -> NodeId {
 }
 
 /// Tell a tracing sink what the wide walk's stack holds.
-fn report_stack<S: TraversalStats>(stats: &mut S, stack: &TraversalStack<STACK>) {
+fn report_stack<S: TraversalStats, const W: usize, const N: usize>(stats: &mut S, stack: &TraversalStack<N>) {
     let entries: Vec<(NodeId, f32)> =
-        stack.entries().iter().map(|&(r, t)| (node_id(ChildRef::from_raw(r)), t)).collect();
+        stack.entries().iter().map(|&(r, t)| (node_id::<W>(ChildRef::from_raw(r)), t)).collect();
     stats.step_stack(&entries);
 }
 
-impl Accelerator for WideBvh {
-    /// Children are always taken nearest first here; `BY_DISTANCE` applies to the binary layout.
-    fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
+impl<const W: usize> WideBvh<W> {
+    /// One ray's closest (or, with `ANY`, first) hit with box kernel `kernel`.
+    #[inline(always)]
+    fn trace_with<T: TriangleIntersector, const ANY: bool, S: TraversalStats, K: SlabKernel<W>, const N: usize>(
         &self,
+        kernel: K,
         ray: &mut Ray,
         stats: &mut S,
     ) -> Option<Hit> {
         let (mut prepared, mut best) = (None, None);
-        self.walk_ray(ray, stats, |first, count, ray, stats| {
+        self.walk_ray::<S, K, N>(kernel, ray, stats, |first, count, ray, stats| {
             let ids = |i: usize| self.prim_ids[i];
             test_triangles::<T, ANY, S>(
                 &self.tris[first..first + count],
@@ -226,6 +238,67 @@ impl Accelerator for WideBvh {
             )
         });
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
+    }
+}
+
+impl Accelerator for WideBvh {
+    /// Children are always taken nearest first here; `BY_DISTANCE` applies to the binary layout.
+    fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
+        match self.simd {
+            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK>(Scalar, ray, stats),
+            Simd::Simd4 | Simd::Avx2 => self.trace_with::<T, ANY, S, _, STACK>(Simd4, ray, stats),
+        }
+    }
+
+    fn traces_packets(&self) -> bool {
+        true
+    }
+
+    fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
+        crate::bvh::packet::closest_hits_packet(self, rays, hits, opts)
+    }
+}
+
+impl WideBvh<8> {
+    /// The walk compiled for AVX2 and FMA, so the eight-lane kernel's intrinsics (and everything
+    /// else in the walk) are inlined as AVX code.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA: `kernel` proves it.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn trace_avx2<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
+        &self,
+        kernel: crate::geometry::slab8::Avx2,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
+        self.trace_with::<T, ANY, S, _, STACK8>(kernel, ray, stats)
+    }
+}
+
+impl Accelerator for WideBvh<8> {
+    /// Children are always taken nearest first here; `BY_DISTANCE` applies to the binary layout.
+    /// The box kernel is the tree's `simd` level, chosen once when it was built.
+    fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
+        &self,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
+        match self.simd {
+            #[cfg(target_arch = "x86_64")]
+            Simd::Avx2 => match crate::geometry::slab8::Avx2::detect() {
+                // SAFETY: `detect` found AVX2 and FMA.
+                Some(k) => unsafe { self.trace_avx2::<T, ANY, S>(k, ray, stats) },
+                None => self.trace_with::<T, ANY, S, _, STACK8>(Simd4, ray, stats),
+            },
+            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK8>(Scalar, ray, stats),
+            _ => self.trace_with::<T, ANY, S, _, STACK8>(Simd4, ray, stats),
+        }
     }
 
     fn traces_packets(&self) -> bool {
