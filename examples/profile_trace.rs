@@ -1,6 +1,7 @@
 //! A profiling driver: traces the bunny's primary and incoherent rays with the wide SAH BVH on
 //! one thread, many times over, for `perf record` / `valgrind --tool=callgrind`.
-//! `cargo run --release --example profile_trace -- [binary|wide4] [primary|incoherent|build|frame]`
+//! `cargo run --release --example profile_trace -- [binary|wide4|wide8] [primary|incoherent|build|frame]`
+//! (`TIME=n`: also the plain closest-hit traversal of all rays, n times, with its median)
 //! (`frame` with `PARTS=1` also splits the app's frame into counting, passes and snapshots;
 //! `primary` with `PACKET=1` also times 8×8 packets, with `PACKET=only` nothing else).
 
@@ -13,7 +14,11 @@ use std::time::Instant;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let layout = if args.get(1).is_some_and(|a| a == "binary") { Layout::Binary } else { Layout::Wide4 };
+    let layout = match args.get(1).map(|a| a.as_str()) {
+        Some("binary") => Layout::Binary,
+        Some("wide8") => Layout::Wide8,
+        _ => Layout::Wide4,
+    };
     let what = args.get(2).map_or("primary", |s| s.as_str());
     let path = args.get(3).map_or("../shared/models/stanford-bunny.obj", |s| s.as_str());
     let (mesh, _) = load_obj(path).unwrap_or_else(|e| panic!("{e}"));
@@ -119,6 +124,20 @@ fn main() {
             })
             .collect()
     };
+    if let Some(n) = std::env::var("TIME").ok().and_then(|n| n.parse::<usize>().ok()) {
+        let mut times: Vec<f64> = (0..n)
+            .map(|_| {
+                let t = Instant::now();
+                for r in &rays {
+                    let mut r = *r;
+                    std::hint::black_box(bvh.closest_hit(&mut r, TraceOptions::default(), &mut NoStats));
+                }
+                rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        println!("{layout:?} {what}: median {:.2} MRays/s of {n}", times[n / 2]);
+    }
     let mut c = bvhscope::bvh::RayCounters::default();
     for r in &rays {
         let mut r = *r;

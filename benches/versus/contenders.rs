@@ -141,7 +141,15 @@ pub fn ours(strategy: SplitStrategy, layout: Layout, tracing: Tracing) -> Conten
         slow_build: strategy == SplitStrategy::SahSweep,
         build: Box::new(move |mesh| {
             let t = Instant::now();
-            let bvh = AnyBvh::build(mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
+            let mut params = BuildParams { layout, ..BuildParams::with_strategy(strategy) };
+            // BENCH_TRAVERSAL_COST=c: the SAH's traversal cost (for tuning; default 1).
+            if let Some(c) = std::env::var("BENCH_TRAVERSAL_COST").ok().and_then(|c| c.parse().ok()) {
+                params.cost.traversal = c;
+            }
+            if let Some(l) = std::env::var("BENCH_MAX_LEAF").ok().and_then(|c| c.parse().ok()) {
+                params.max_leaf_size = l;
+            }
+            let bvh = AnyBvh::build(mesh, &params);
             let took = t.elapsed();
             let stats = TreeStats::of(&bvh);
             let built = Built {

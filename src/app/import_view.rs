@@ -19,7 +19,7 @@ pub struct ImportedTree {
     pub path: PathBuf,
     /// The scene it was read for (`BvhscopeApp::scene_id`).
     pub scene_id: u64,
-    /// The tree as traced; `None` when its structure has defects (or it has nodes of more than 4
+    /// The tree as traced; `None` when its structure has defects (or it has nodes of more than 8
     /// children), with the reason.
     pub bvh: Result<Arc<SceneBvh>, String>,
     pub findings: Vec<Finding>,

@@ -180,7 +180,7 @@ pub(crate) fn import_dump(scene: &crate::scene::Scene, path: &std::path::Path) -
 
 #[derive(Args, Debug)]
 pub struct ExportArgs {
-    /// The mesh (.obj). The tree written is the binary one unless --layout wide4 is given.
+    /// The mesh (.obj). The tree written is the binary one unless --layout wide4 or wide8 is given.
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
@@ -193,7 +193,7 @@ pub struct ExportArgs {
 pub fn export(a: &ExportArgs) -> Result<(), CliError> {
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
-    // The binary tree unless --layout wide4 asks for the 4-wide one.
+    // The binary tree unless --layout wide4 or wide8 asks for a wide one.
     let layout = a.build.layout.unwrap_or(Layout::Binary);
     let params = BuildParams { layout, ..a.build.params(scene.build.as_ref()) };
     let name = super::render::file_name(&a.mesh);

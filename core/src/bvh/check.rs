@@ -89,12 +89,12 @@ pub fn check_tree(dump: &BvhDump, mesh: &Mesh, tolerance: f32) -> Vec<Finding> {
             _ => {}
         }
         if let Some(kids) = &n.children {
-            if kids.len() < 2 || kids.len() > 4 {
+            if kids.len() < 2 || kids.len() > 8 {
                 out.push(defect(
                     Group::Structure,
                     id,
                     None,
-                    format!("node {i} has {} children; 2 to 4 are supported", kids.len()),
+                    format!("node {i} has {} children; 2 to 8 are supported", kids.len()),
                 ));
             }
             for &k in kids {

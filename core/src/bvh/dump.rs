@@ -4,7 +4,7 @@
 //! - JSON: `{"format": "bvhscope-bvh", "version": 1, "mesh": "monkey.obj", "primitives": [..],
 //!   "nodes": [{"min": [x,y,z], "max": [x,y,z], "children": [a, b], "axis": 0} |
 //!   {"min": .., "max": .., "first": f, "count": n}]}`; node 0 is the root, nodes in any order,
-//!   2 to 4 children, a leaf holds `primitives[first .. first + count]`, a primitive is a triangle
+//!   2 to 8 children, a leaf holds `primitives[first .. first + count]`, a primitive is a triangle
 //!   index of the mesh (faces in file order, fan-triangulated, degenerate ones included);
 //! - the same gzip-compressed (`.json.gz`);
 //! - a plain text form a C++ program prints without a JSON library, one line per item:

@@ -1,12 +1,12 @@
 //! A BVH another program wrote (`dump`), made into one of bvhscope's own layouts so that every
 //! view and command traces it with the same traversal as the built-in strategies: a binary dump
-//! becomes a `Bvh`, a dump with nodes of 3 or 4 children a `WideBvh` (each dump node one wide node,
-//! its children in the order written). Boxes are kept as written, so a wrong box misses rays as it
+//! becomes a `Bvh`, a dump with nodes of 3 or 4 children a 4-wide `WideBvh`, one with nodes of up
+//! to 8 children an 8-wide one (each dump node one wide node, its children in the order written). Boxes are kept as written, so a wrong box misses rays as it
 //! would in the student's renderer; nodes are renumbered, and `Imported` keeps the dump's id of
 //! each so that traces and the tree view name nodes as the student's program does.
 
 use super::dump::BvhDump;
-use super::wide::{WideNode, WIDTH};
+use super::wide::WideNode;
 use super::{AnyBvh, BuildParams, Bvh, BvhNode, Layout, NodeId, WideBvh};
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
@@ -20,9 +20,11 @@ pub struct Imported {
     pub path: std::path::PathBuf,
     /// For each node of the traced tree (binary node i, or wide node i), the dump's id.
     pub node_ids: Vec<u32>,
-    /// Wide layout: the dump's id of the leaf in slot s of wide node i, at `WIDTH·i + s`
+    /// Wide layout: the dump's id of the leaf in slot s of wide node i, at `width·i + s`
     /// (`u32::MAX` where the slot holds no leaf). Empty for the binary layout.
     pub leaf_ids: Vec<u32>,
+    /// Children per wide node (4 or 8; 2 for the binary layout).
+    pub width: usize,
     /// Wide layout: the binary tree the tree view and the node inspector show (as they show the
     /// binary tree a built 4-wide tree was collapsed from): each node of k > 2 children split
     /// into binary nodes over its children in the order written, the added nodes' boxes the union
@@ -41,7 +43,7 @@ impl Imported {
         match id {
             NodeId::Node(i) => self.node_ids.get(i as usize).copied(),
             NodeId::Leaf { node, slot } => {
-                self.leaf_ids.get(node as usize * WIDTH + slot as usize).copied().filter(|&d| d != u32::MAX)
+                self.leaf_ids.get(node as usize * self.width + slot as usize).copied().filter(|&d| d != u32::MAX)
             }
         }
     }
@@ -53,7 +55,7 @@ impl Imported {
             return Some(NodeId::Node(i as u32));
         }
         let k = self.leaf_ids.iter().position(|&d| d == dump)?;
-        Some(NodeId::Leaf { node: (k / WIDTH) as u32, slot: (k % WIDTH) as u8 })
+        Some(NodeId::Leaf { node: (k / self.width) as u32, slot: (k % self.width) as u8 })
     }
 
     /// The binary tree node that is the dump's node `dump`, in the binary tree the tree view shows
@@ -81,20 +83,20 @@ pub fn untraceable(dump: &BvhDump) -> Option<String> {
     let widest = kids.clone().max().unwrap_or(2);
     let binary = widest == 2;
     let (most, cap) = if binary { (u16::MAX as u32, "65,535") } else { (u8::MAX as u32, "255") };
-    if widest > WIDTH || kids.clone().any(|k| k < 2) {
-        return Some("its nodes have fewer than 2 or more than 4 children".into());
+    if widest > 8 || kids.clone().any(|k| k < 2) {
+        return Some("its nodes have fewer than 2 or more than 8 children".into());
     }
     let big = dump.nodes.iter().filter(|n| n.children.is_none()).filter_map(|n| n.count).max().unwrap_or(0);
     (big > most).then(|| {
         format!(
             "a leaf holds {big} triangles; a {} tree's leaves hold at most {cap}",
-            if binary { "binary" } else { "4-wide" }
+            if binary { "binary" } else { "wide" }
         )
     })
 }
 
-/// The dump as bvhscope traces it: binary when every interior node has two children, 4-wide
-/// otherwise. The dump's structure must be sound (`check::check_tree` finds no structure defect);
+/// The dump as bvhscope traces it: binary when every interior node has two children, 4-wide when
+/// none has more than four, 8-wide otherwise. The dump's structure must be sound (`check::check_tree` finds no structure defect);
 /// `Err` says why a tree cannot be traced when it cannot.
 pub fn import(dump: &BvhDump, mesh: &Mesh, path: &std::path::Path) -> Result<(AnyBvh, Imported), String> {
     let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
@@ -107,16 +109,24 @@ pub fn import(dump: &BvhDump, mesh: &Mesh, path: &std::path::Path) -> Result<(An
     let broken = || "its structure has defects (bvhscope check lists them)".to_string();
     if binary {
         let (bvh, ids) = to_binary(copy).ok_or_else(broken)?;
-        Ok((AnyBvh::Binary(bvh), Imported { name, path, node_ids: ids, leaf_ids: Vec::new(), binary: None }))
+        let imported = Imported { name, path, node_ids: ids, leaf_ids: Vec::new(), width: 2, binary: None };
+        Ok((AnyBvh::Binary(bvh), imported))
     } else {
-        let (wide, node_ids, leaf_ids) = to_wide(copy).ok_or_else(broken)?;
+        let widest = dump.nodes.iter().filter_map(|n| n.children.as_ref().map(|k| k.len())).max().unwrap_or(2);
+        let (wide, node_ids, leaf_ids, width) = if widest <= 4 {
+            let (w, n, l) = to_wide::<4>(copy).ok_or_else(broken)?;
+            (AnyBvh::Wide(w), n, l, 4)
+        } else {
+            let (w, n, l) = to_wide::<8>(copy).ok_or_else(broken)?;
+            (AnyBvh::Wide8(w), n, l, 8)
+        };
         let (split, added) = binarised(dump);
         let again =
             Leaves { dump: &split, by_file: mesh.triangles_by_file_number(), mesh, prim_ids: vec![], tris: vec![] };
         let (bvh, ids) = to_binary(again).ok_or_else(broken)?;
         let ids = ids.into_iter().map(|d| if d >= added { u32::MAX } else { d }).collect();
         let binary = Some((std::sync::Arc::new(bvh), ids));
-        Ok((AnyBvh::Wide(wide), Imported { name, path, node_ids, leaf_ids, binary }))
+        Ok((wide, Imported { name, path, node_ids, leaf_ids, width, binary }))
     }
 }
 
@@ -225,12 +235,12 @@ fn to_binary(mut leaves: Leaves) -> Option<(Bvh, Vec<u32>)> {
 }
 
 /// Each interior dump node one wide node (numbered depth first), each leaf a slot of its parent.
-fn to_wide(mut leaves: Leaves) -> Option<(WideBvh, Vec<u32>, Vec<u32>)> {
+fn to_wide<const W: usize>(mut leaves: Leaves) -> Option<(WideBvh<W>, Vec<u32>, Vec<u32>)> {
     let dump = leaves.dump;
     let root = dump.nodes.first()?;
-    let mut nodes = vec![WideNode::EMPTY];
+    let mut nodes = vec![WideNode::<W>::EMPTY];
     let mut ids = vec![0u32];
-    let mut leaf_ids = vec![u32::MAX; WIDTH];
+    let mut leaf_ids = vec![u32::MAX; W];
     // A tree of one leaf: the root wide node holds it in slot 0.
     if root.children.is_none() {
         let (start, kept) = leaves.copy(0)?;
@@ -250,20 +260,20 @@ fn to_wide(mut leaves: Leaves) -> Option<(WideBvh, Vec<u32>, Vec<u32>)> {
                 let index = nodes.len();
                 nodes.push(WideNode::EMPTY);
                 ids.push(k);
-                leaf_ids.extend([u32::MAX; WIDTH]);
+                leaf_ids.extend([u32::MAX; W]);
                 nodes[w].set(s, c.bounds(), index as u32, 0);
                 stack.push((k as usize, index));
             } else {
                 let (start, kept) = leaves.copy(k as usize)?;
                 if kept > 0 {
                     nodes[w].set(s, c.bounds(), start, kept as u8);
-                    leaf_ids[w * WIDTH + s] = k;
+                    leaf_ids[w * W + s] = k;
                 }
             }
         }
     }
     let (prim_ids, tris) = (leaves.prim_ids, leaves.tris);
-    let params = Leaves::params(Layout::Wide4);
+    let params = Leaves::params(if W == 8 { Layout::Wide8 } else { Layout::Wide4 });
     let wide = WideBvh {
         nodes,
         prim_ids,
@@ -290,12 +300,12 @@ mod tests {
         let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);
         let camera = crate::render::Camera::framing_up(&mesh.bounds(), 40, 30, crate::render::UpAxis::Y, 45.0);
         let rays = check_rays(&mesh, &camera, 500);
-        for layout in [Layout::Binary, Layout::Wide4] {
+        for layout in Layout::ALL {
             let built = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::default() });
             let dump = match &built {
                 AnyBvh::Binary(b) => BvhDump::of_bvh(b, &mesh, None),
                 AnyBvh::Wide(w) => BvhDump::of_wide(w, &mesh, None),
-                AnyBvh::Wide8(_) => unreachable!("not asked for"),
+                AnyBvh::Wide8(w) => BvhDump::of_wide(w, &mesh, None),
             };
             let (back, names) = import(&dump, &mesh, "t.json".as_ref()).unwrap();
             assert_eq!(back.params().layout, layout);
@@ -341,14 +351,14 @@ mod tests {
         }
     }
 
-    /// Nodes of 5 children, and leaves too large for the layout, are refused with the reason.
+    /// Nodes of 9 children, and leaves too large for the layout, are refused with the reason.
     #[test]
     fn untraceable_trees_say_why() {
         let mesh = generate::torus_knot(2, 3, 0.3, 16, 4);
         let b = Bvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..BuildParams::default() });
         let mut d = BvhDump::of_bvh(&b, &mesh, None);
-        d.nodes[0].children.as_mut().unwrap().extend([1, 1, 1]);
-        assert!(import(&d, &mesh, "x".as_ref()).unwrap_err().contains("more than 4 children"));
+        d.nodes[0].children.as_mut().unwrap().extend([1; 7]);
+        assert!(import(&d, &mesh, "x".as_ref()).unwrap_err().contains("more than 8 children"));
         let mut d = BvhDump::of_bvh(&b, &mesh, None);
         d.nodes[0].children.as_mut().unwrap().push(2);
         let leaf = d.nodes.iter_mut().find(|n| n.children.is_none()).unwrap();

@@ -188,6 +188,51 @@ pub(crate) fn test_triangles<T: TriangleIntersector, const ANY: bool, S: Travers
     false
 }
 
+/// `test_triangles` four triangles at a time, each group in one SIMD pass
+/// (`TriangleIntersector::intersect_group`). The lanes are then taken in order against the
+/// closest hit so far, as the one-by-one loop takes them, so the same hits are reported and the
+/// same closest hit kept, bit for bit. Counts: every triangle tested (an any-hit query stops after
+/// the group that hit, all of whose triangles were tested).
+#[inline(always)]
+pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
+    tris: &[[glam::Vec3; 3]],
+    first: usize,
+    ray: &mut Ray,
+    stats: &mut S,
+    prepared: &mut Option<T::Prepared>,
+    best: &mut Option<(usize, crate::geometry::TriangleHit)>,
+    prim_of: impl Fn(usize) -> u32,
+) -> bool {
+    let p = *prepared.get_or_insert_with(|| T::prepare(ray));
+    for (g, group) in tris.chunks(4).enumerate() {
+        let hits = T::intersect_group(&p, ray, group);
+        if hits.mask == 0 && !S::STEPS {
+            continue;
+        }
+        for k in 0..group.len() {
+            let hit = (hits.mask & (1 << k) != 0 && hits.t[k] < ray.t_max).then(|| crate::geometry::TriangleHit {
+                t: hits.t[k],
+                u: hits.u[k],
+                v: hits.v[k],
+            });
+            let i = first + 4 * g + k;
+            if S::STEPS {
+                stats.step_triangle(prim_of(i), hit);
+            }
+            if let Some(h) = hit {
+                ray.t_max = h.t;
+                *best = Some((i, h));
+                if ANY {
+                    stats.triangle_tests((4 * g + group.len()) as u32);
+                    return true;
+                }
+            }
+        }
+    }
+    stats.triangle_tests(tris.len() as u32);
+    false
+}
+
 impl Accelerator for Bvh {
     fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
         &self,

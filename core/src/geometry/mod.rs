@@ -5,6 +5,7 @@ mod ray;
 pub mod slab;
 pub mod slab8;
 pub(crate) mod triangle;
+mod triangle4;
 
 pub use aabb::Aabb;
 pub use ray::Ray;

@@ -38,15 +38,21 @@ mod avx2 {
     use super::{Boxes8, Ray, SlabKernel};
     use std::arch::x86_64::*;
 
-    /// Proof that this CPU has AVX2 and FMA: made only by `detect`, so a kernel holding it may
-    /// use their instructions. The walk that uses it is compiled for them (`#[target_feature]`)
+    /// Proof that this CPU has AVX2 and FMA, and the bit instructions every such CPU has (POPCNT,
+    /// BMI1/2, LZCNT): made only by `detect`, so a kernel holding it may use their instructions. The walk that uses it is compiled for them (`#[target_feature]`)
     /// and chosen at run time; nobody needs `-C target-cpu`.
     #[derive(Clone, Copy, Debug)]
     pub struct Avx2(());
 
     impl Avx2 {
         pub fn detect() -> Option<Avx2> {
-            (is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")).then_some(Avx2(()))
+            let all = is_x86_feature_detected!("avx2")
+                && is_x86_feature_detected!("fma")
+                && is_x86_feature_detected!("popcnt")
+                && is_x86_feature_detected!("bmi1")
+                && is_x86_feature_detected!("bmi2")
+                && is_x86_feature_detected!("lzcnt");
+            all.then_some(Avx2(()))
         }
     }
 

@@ -44,6 +44,21 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
     /// of the lanes in `lanes` that hit, and their hits. Lane by lane the same result as
     /// `intersect` (packets must find exactly what single rays find).
     fn intersect4(p: &Self::Prepared4, t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4;
+
+    /// One ray against up to four triangles (`tris.len() <= 4`): lane k of the result is
+    /// `intersect(p, ray, &tris[k])`, bit for bit. The watertight test does the four in one SIMD
+    /// pass (`triangle4.rs`, the wide BVHs' leaves); this default runs `intersect` lane by lane.
+    #[inline(always)]
+    fn intersect_group(p: &Self::Prepared, ray: &Ray, tris: &[[Vec3; 3]]) -> Hits4 {
+        let mut hits = Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+        for (k, tri) in tris.iter().enumerate() {
+            if let Some(h) = Self::intersect(p, ray, tri) {
+                hits.mask |= 1 << k;
+                (hits.t[k], hits.u[k], hits.v[k]) = (h.t, h.u, h.v);
+            }
+        }
+        hits
+    }
 }
 
 /// The hits of `intersect4`: lane k of each array is ray k's hit when bit k of `mask` is set.
@@ -68,9 +83,9 @@ pub struct Watertight;
 /// to the paper's indexed form, without indexing by a run-time axis in the inner loop.
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    rx: Vec3,
-    ry: Vec3,
-    rz: Vec3,
+    pub(super) rx: Vec3,
+    pub(super) ry: Vec3,
+    pub(super) rz: Vec3,
 }
 
 impl TriangleIntersector for Watertight {
@@ -133,6 +148,11 @@ impl TriangleIntersector for Watertight {
         }
         // u, v, w weight v0, v1, v2: in our convention u ↔ v1 and v ↔ v2.
         Some(TriangleHit { t, u: v * inv_det, v: w * inv_det })
+    }
+
+    #[inline(always)]
+    fn intersect_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]]) -> Hits4 {
+        super::triangle4::watertight_group(p, ray, tris)
     }
 
     type Prepared4 = WatertightRay4;

@@ -14,7 +14,7 @@ use super::{ChildRef, WideBvh, WideNode};
 use crate::bvh::simd::prefetch;
 use crate::bvh::stack::TraversalStack;
 use crate::bvh::trace::NodeId;
-use crate::bvh::traverse::test_triangles;
+use crate::bvh::traverse::{test_triangles, test_triangles_grouped};
 use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
 use crate::cpu::Simd;
 use crate::geometry::slab::{widen, Scalar, Simd4, SlabKernel};
@@ -216,9 +216,17 @@ fn report_stack<S: TraversalStats, const W: usize, const N: usize>(stats: &mut S
 }
 
 impl<const W: usize> WideBvh<W> {
-    /// One ray's closest (or, with `ANY`, first) hit with box kernel `kernel`.
+    /// One ray's closest (or, with `ANY`, first) hit with box kernel `kernel`; leaves tested
+    /// four triangles at a time in SIMD when `GROUPED`, one by one otherwise (the scalar path).
     #[inline(always)]
-    fn trace_with<T: TriangleIntersector, const ANY: bool, S: TraversalStats, K: SlabKernel<W>, const N: usize>(
+    fn trace_with<
+        T: TriangleIntersector,
+        const ANY: bool,
+        S: TraversalStats,
+        K: SlabKernel<W>,
+        const N: usize,
+        const GROUPED: bool,
+    >(
         &self,
         kernel: K,
         ray: &mut Ray,
@@ -227,15 +235,12 @@ impl<const W: usize> WideBvh<W> {
         let (mut prepared, mut best) = (None, None);
         self.walk_ray::<S, K, N>(kernel, ray, stats, |first, count, ray, stats| {
             let ids = |i: usize| self.prim_ids[i];
-            test_triangles::<T, ANY, S>(
-                &self.tris[first..first + count],
-                first,
-                ray,
-                stats,
-                &mut prepared,
-                &mut best,
-                ids,
-            )
+            let tris = &self.tris[first..first + count];
+            if GROUPED {
+                test_triangles_grouped::<T, ANY, S>(tris, first, ray, stats, &mut prepared, &mut best, ids)
+            } else {
+                test_triangles::<T, ANY, S>(tris, first, ray, stats, &mut prepared, &mut best, ids)
+            }
         });
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
     }
@@ -249,8 +254,8 @@ impl Accelerator for WideBvh {
         stats: &mut S,
     ) -> Option<Hit> {
         match self.simd {
-            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK>(Scalar, ray, stats),
-            Simd::Simd4 | Simd::Avx2 => self.trace_with::<T, ANY, S, _, STACK>(Simd4, ray, stats),
+            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK, false>(Scalar, ray, stats),
+            Simd::Simd4 | Simd::Avx2 => self.trace_with::<T, ANY, S, _, STACK, false>(Simd4, ray, stats),
         }
     }
 
@@ -264,20 +269,22 @@ impl Accelerator for WideBvh {
 }
 
 impl WideBvh<8> {
-    /// The walk compiled for AVX2 and FMA, so the eight-lane kernel's intrinsics (and everything
-    /// else in the walk) are inlined as AVX code.
+    /// The walk compiled for AVX2 (and the bit instructions that come with it: a loop over a
+    /// mask's bits becomes POPCNT, not a multiply trick), so the eight-lane kernel's intrinsics and
+    /// everything else in the walk are inlined as AVX code. FMA is enabled but never contracted
+    /// into (Rust does not fuse `a * b + c`), so results stay those of the other kernels.
     ///
     /// # Safety
-    /// The CPU must have AVX2 and FMA: `kernel` proves it.
+    /// The CPU must have these features: `kernel` proves it.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,lzcnt")]
     unsafe fn trace_avx2<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
         &self,
         kernel: crate::geometry::slab8::Avx2,
         ray: &mut Ray,
         stats: &mut S,
     ) -> Option<Hit> {
-        self.trace_with::<T, ANY, S, _, STACK8>(kernel, ray, stats)
+        self.trace_with::<T, ANY, S, _, STACK8, true>(kernel, ray, stats)
     }
 }
 
@@ -294,10 +301,10 @@ impl Accelerator for WideBvh<8> {
             Simd::Avx2 => match crate::geometry::slab8::Avx2::detect() {
                 // SAFETY: `detect` found AVX2 and FMA.
                 Some(k) => unsafe { self.trace_avx2::<T, ANY, S>(k, ray, stats) },
-                None => self.trace_with::<T, ANY, S, _, STACK8>(Simd4, ray, stats),
+                None => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, ray, stats),
             },
-            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK8>(Scalar, ray, stats),
-            _ => self.trace_with::<T, ANY, S, _, STACK8>(Simd4, ray, stats),
+            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK8, false>(Scalar, ray, stats),
+            _ => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, ray, stats),
         }
     }
 

@@ -1,0 +1,119 @@
+//! One ray against up to four triangles in one SIMD pass: the watertight test (Woop, Benthin &
+//! Wald 2013) with one lane per triangle, for the leaves of the wide BVHs. The arithmetic is
+//! `Watertight::intersect`'s in the same order (glam's dot is `(x·x' + y·y') + z·z'`), each
+//! operation rounded as the scalar one is and nothing fused, so lane k is the scalar test of
+//! triangle k bit for bit, the double-precision fallback for an exactly-zero edge function
+//! included. The triangles are read from the leaf's array (three vertices each, in leaf order)
+//! and turned into lanes here: nine loads of four lanes.
+
+use super::triangle::{Hits4, WatertightRay};
+use super::Ray;
+use glam::Vec3;
+use wide::f32x4;
+
+/// The watertight test of `tris` (at most four) against one ray: the mask of the triangles hit
+/// within `[ray.t_min, ray.t_max)` and, per lane, the hit's `t`, `u`, `v`.
+#[inline(always)]
+pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]]) -> Hits4 {
+    let n = tris.len().min(4);
+    let lanes = (1u32 << n) - 1;
+    // Vertex j's coordinate `axis` of each triangle relative to the origin; lanes past `n`
+    // repeat the first triangle (masked off below).
+    let o = ray.origin();
+    let rel = |j: usize, axis: usize| {
+        let at = |k: usize| tris[if k < n { k } else { 0 }][j][axis];
+        f32x4::from([at(0), at(1), at(2), at(3)]) - f32x4::splat(o[axis])
+    };
+    let vertex = |j: usize| [rel(j, 0), rel(j, 1), rel(j, 2)];
+    let (a, b, c) = (vertex(0), vertex(1), vertex(2));
+    let dot = |v: &[f32x4; 3], r: Vec3| v[0] * f32x4::splat(r.x) + v[1] * f32x4::splat(r.y) + v[2] * f32x4::splat(r.z);
+    let (ax, ay) = (dot(&a, p.rx), dot(&a, p.ry));
+    let (bx, by) = (dot(&b, p.rx), dot(&b, p.ry));
+    let (cx, cy) = (dot(&c, p.rx), dot(&c, p.ry));
+    let mut u = cx * by - cy * bx;
+    let mut v = ax * cy - ay * cx;
+    let mut w = bx * ay - by * ax;
+    let z = f32x4::ZERO;
+    let zero = (u.simd_eq(z) | v.simd_eq(z) | w.simd_eq(z)).to_bitmask() & lanes;
+    if zero != 0 {
+        // The paper's fallback, lane by lane: the edge functions again in double precision.
+        let (mut uu, mut vv, mut ww) = (u.to_array(), v.to_array(), w.to_array());
+        let f = |x: f32x4, k: usize| x.to_array()[k] as f64;
+        let mut m = zero;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let (ax, ay, bx, by, cx, cy) = (f(ax, k), f(ay, k), f(bx, k), f(by, k), f(cx, k), f(cy, k));
+            uu[k] = (cx * by - cy * bx) as f32;
+            vv[k] = (ax * cy - ay * cx) as f32;
+            ww[k] = (bx * ay - by * ax) as f32;
+        }
+        (u, v, w) = (f32x4::from(uu), f32x4::from(vv), f32x4::from(ww));
+    }
+    let outside = (u.simd_lt(z) | v.simd_lt(z) | w.simd_lt(z)) & (u.simd_gt(z) | v.simd_gt(z) | w.simd_gt(z));
+    let det = u + v + w;
+    let t_scaled = u * dot(&a, p.rz) + v * dot(&b, p.rz) + w * dot(&c, p.rz);
+    let inv_det = f32x4::ONE / det;
+    let t = t_scaled * inv_det;
+    let inside = det.simd_ne(z) & t.simd_ge(f32x4::splat(ray.t_min)) & t.simd_lt(f32x4::splat(ray.t_max));
+    let mask = inside.to_bitmask() & !outside.to_bitmask() & lanes;
+    Hits4 { mask, t: t.to_array(), u: (v * inv_det).to_array(), v: (w * inv_det).to_array() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::triangle::{TriangleIntersector, Watertight};
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Grid points: shared vertices and edges, axis-parallel rays and exactly-zero edge
+    /// functions come up often.
+    fn point() -> impl Strategy<Value = Vec3> {
+        [(-4i32..=4), (-4i32..=4), (-4i32..=4)].prop_map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32) * 0.5)
+    }
+
+    /// Up to four triangles (often sharing vertices) and one ray aimed at a vertex, an edge point
+    /// or an inner point of one of them, or anywhere, with an interval that may cut the hits.
+    fn case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ray)> {
+        let pool = proptest::collection::vec(point(), 6);
+        let picks = proptest::collection::vec([0usize..6, 0usize..6, 0usize..6], 1..=4);
+        let aim = (0usize..4, 0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..4);
+        (pool, picks, aim).prop_map(|(pool, picks, (target, i, j, k, d, s, interval))| {
+            let tris: Vec<[Vec3; 3]> = picks.iter().map(|p| p.map(|q| pool[q])).collect();
+            let t = &tris[target % tris.len()];
+            let w = (i + j + k).max(1) as f32;
+            let at = (t[0] * i as f32 + t[1] * j as f32 + t[2] * k as f32) / w;
+            let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
+            let mut ray = Ray::new(at - dir * s as f32, dir);
+            match interval {
+                0 => ray.t_max = s as f32, // a hit exactly at t_max is excluded
+                1 => ray.t_min = s as f32 + 0.25,
+                _ => {}
+            }
+            (tris, ray)
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(4000))]
+        /// Lane k is the scalar test of triangle k, bit for bit.
+        #[test]
+        fn four_triangles_at_once_are_four_scalar_tests((tris, ray) in case()) {
+            let p = Watertight::prepare(&ray);
+            let got = Watertight::intersect_group(&p, &ray, &tris);
+            prop_assert_eq!(got.mask >> tris.len(), 0, "no lane past the triangles");
+            for (k, tri) in tris.iter().enumerate() {
+                let want = Watertight::intersect(&p, &ray, tri);
+                prop_assert_eq!(got.mask & (1 << k) != 0, want.is_some(), "lane {}: hit or miss", k);
+                if let Some(h) = want {
+                    let bits = |x: f32| x.to_bits();
+                    prop_assert_eq!(
+                        (bits(got.t[k]), bits(got.u[k]), bits(got.v[k])),
+                        (bits(h.t), bits(h.u), bits(h.v)),
+                        "lane {}: bit for bit", k
+                    );
+                }
+            }
+        }
+    }
+}
