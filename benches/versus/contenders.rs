@@ -123,25 +123,31 @@ pub enum Tracing {
     Packets,
 }
 
-/// Our BVH with one strategy and layout, traced as `tracing` says.
+/// Our BVH with one strategy and layout (default parameters), traced as `tracing` says.
 pub fn ours(strategy: SplitStrategy, layout: Layout, tracing: Tracing) -> Contender {
-    let layout_name = match layout {
+    let params = BuildParams { layout, ..BuildParams::with_strategy(strategy) };
+    ours_with(strategy.name(), params, tracing)
+}
+
+/// Our BVH built with `params` (named `label` in the table), traced as `tracing` says.
+pub fn ours_with(label: &str, params: BuildParams, tracing: Tracing) -> Contender {
+    let layout_name = match params.layout {
         Layout::Binary => "BVH2",
         Layout::Wide4 => "BVH4",
         Layout::Wide8 => "BVH8",
     };
     let name = match tracing {
-        Tracing::Plain => format!("bvhscope {} ({layout_name})", strategy.name()),
-        Tracing::Counting => format!("bvhscope {} ({layout_name}), counting", strategy.name()),
-        Tracing::Packets => format!("bvhscope {} ({layout_name}, 8×8 packets)", strategy.name()),
+        Tracing::Plain => format!("bvhscope {label} ({layout_name})"),
+        Tracing::Counting => format!("bvhscope {label} ({layout_name}), counting"),
+        Tracing::Packets => format!("bvhscope {label} ({layout_name}, 8×8 packets)"),
     };
     Contender {
         name,
         family: Family::Ours,
-        slow_build: strategy == SplitStrategy::SahSweep,
+        slow_build: params.strategy == SplitStrategy::SahSweep,
         build: Box::new(move |mesh| {
             let t = Instant::now();
-            let mut params = BuildParams { layout, ..BuildParams::with_strategy(strategy) };
+            let mut params = params;
             // BENCH_TRAVERSAL_COST=c: the SAH's traversal cost (for tuning; default 1).
             if let Some(c) = std::env::var("BENCH_TRAVERSAL_COST").ok().and_then(|c| c.parse().ok()) {
                 params.cost.traversal = c;

@@ -212,7 +212,10 @@ mod linked {
     impl EmbreeScene {
         fn build(mesh: &Mesh, quality: Quality, trace: Trace) -> (EmbreeScene, std::time::Duration) {
             let threads = rayon::current_num_threads();
-            let config = CString::new(format!("threads={threads},set_affinity=0")).expect("no NUL");
+            // BENCH_EMBREE_ISA=avx2 (or sse4.2, avx512): the kernels Embree would pick on another CPU.
+            let isa = std::env::var("BENCH_EMBREE_ISA").ok().filter(|i| !i.is_empty());
+            let isa = isa.map(|i| format!(",isa={i}")).unwrap_or_default();
+            let config = CString::new(format!("threads={threads},set_affinity=0{isa}")).expect("no NUL");
             // Embree reads 16 bytes at the last vertex: four floats per vertex, stride 16.
             let vertices: Vec<[f32; 4]> = mesh.positions.iter().map(|p| [p.x, p.y, p.z, 0.0]).collect();
             let indices = mesh.triangles.clone();

@@ -5,6 +5,9 @@
 //! `BENCH_ONLY=sah,medium` keeps contenders whose names contain a word, `BENCH_MESH=bunny` one mesh,
 //! `BENCH_APP=1` prints only the app figures, `BENCH_OVERHEAD=1` only the counting overhead,
 //! `BENCH_COUNTS=1` only the work per ray (nodes, triangle tests) of our strategies' trees.
+//! Tuning: `BENCH_TRAVERSAL_COST=c` and `BENCH_MAX_LEAF=n` build our trees with that SAH traversal
+//! cost and leaf size; `BENCH_EMBREE_ISA=avx2` asks Embree for its kernels of another CPU.
+//! Embree 3 is raced when `build.rs` found it (Debian: libembree-dev).
 
 mod contenders;
 mod counts;
@@ -215,9 +218,10 @@ fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
     let fastest = rows.iter().find(|r| r.name == "obvhs fastest (BVH2)");
     line("build NT triangles/s sah/obvhs-fastest", our_sah, fastest, &tris_per_s);
     let embree_medium = rows.iter().find(|r| r.name == "embree medium (rtcIntersect1)");
-    for layout in ["BVH2", "BVH4", "BVH8"] {
-        let our = rows.iter().find(|r| r.name == format!("bvhscope sah ({layout})"));
-        line(&format!("build NT triangles/s sah-{layout}/embree-medium"), our, embree_medium, &tris_per_s);
+    for our_name in ["sah (BVH2)", "sah (BVH4)", "sah (BVH8)", "fastest (BVH8)"] {
+        let our = rows.iter().find(|r| r.name == format!("bvhscope {our_name}"));
+        let label = format!("build NT triangles/s {}/embree-medium", our_name.replace(" (", "-").replace(')', ""));
+        line(&label, our, embree_medium, &tris_per_s);
     }
     let medium = rows.iter().find(|r| r.name == "obvhs medium (BVH2)");
     if let (Some(a), Some(b)) = (our_sah, medium) {
@@ -422,6 +426,11 @@ fn main() {
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Packets));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Packets));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide8, Tracing::Packets));
+    // The fastest preset (8-wide, SAH traversal cost 3), as the app's and CLI's `--preset fastest`.
+    let fastest = bvhscope::bvh::Preset::Fastest.build();
+    contenders.push(contenders::ours_with("fastest", fastest, Tracing::Plain));
+    contenders.push(contenders::ours_with("fastest", fastest, Tracing::Packets));
+    contenders.push(contenders::ours_with("fastest", fastest, Tracing::Counting));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Counting));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Counting));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide8, Tracing::Counting));

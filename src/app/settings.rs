@@ -107,8 +107,13 @@ impl Settings {
     /// Set what `preset` sets (the rest stays).
     pub fn apply_preset(&mut self, preset: Preset) {
         let p = preset.build();
-        self.build =
-            BuildParams { strategy: p.strategy, layout: p.layout, max_leaf_size: p.max_leaf_size, ..self.build };
+        self.build = BuildParams {
+            strategy: p.strategy,
+            layout: p.layout,
+            max_leaf_size: p.max_leaf_size,
+            cost: p.cost,
+            ..self.build
+        };
         self.trace = preset.trace();
         self.two_level = preset.two_level();
     }

@@ -45,14 +45,20 @@ mod avx2 {
     pub struct Avx2(());
 
     impl Avx2 {
+        /// The proof, if this CPU has the features (asked once; each call after that is one load).
+        #[inline]
         pub fn detect() -> Option<Avx2> {
-            let all = is_x86_feature_detected!("avx2")
+            static HAS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+            HAS.get_or_init(Self::ask).then_some(Avx2(()))
+        }
+
+        fn ask() -> bool {
+            is_x86_feature_detected!("avx2")
                 && is_x86_feature_detected!("fma")
                 && is_x86_feature_detected!("popcnt")
                 && is_x86_feature_detected!("bmi1")
                 && is_x86_feature_detected!("bmi2")
-                && is_x86_feature_detected!("lzcnt");
-            all.then_some(Avx2(()))
+                && is_x86_feature_detected!("lzcnt")
         }
     }
 

@@ -36,10 +36,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         let text = if on { format!("{} (on)", preset.label()) } else { preset.label().to_string() };
         if ui
             .add_enabled(!on, egui::Button::new(text))
-            .on_hover_text(format!(
-                "One click to {}: the BVH a student writes in the lab, so the figures compare with yours",
-                preset.help()
-            ))
+            .on_hover_text(format!("One click to {}", preset.help()))
             .on_disabled_hover_text(format!("These are the settings of {}", preset.help()))
             .clicked()
         {
