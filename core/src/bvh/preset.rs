@@ -61,7 +61,8 @@ impl Preset {
     pub fn two_level(self) -> bool {
         match self {
             Preset::Handout => false,
-            Preset::Fastest => true,
+            // One tree over the flattened scene: a ray walks one hierarchy, not two.
+            Preset::Fastest => false,
         }
     }
 
