@@ -52,6 +52,7 @@ mod linked {
     const INVALID_ID: u32 = u32::MAX;
     const CONTEXT_INCOHERENT: u32 = 0;
     const CONTEXT_COHERENT: u32 = 1;
+    const SCENE_FLAG_ROBUST: u32 = 1 << 2;
 
     /// `RTCIntersectContext` as `rtcore_config.h` configures it here (one instance level, no
     /// minimum width); `rtcInitIntersectContext` is an inline function, written out in `context`.
@@ -127,6 +128,7 @@ mod linked {
         fn rtcNewScene(device: Device) -> Scene;
         fn rtcReleaseScene(scene: Scene);
         fn rtcSetSceneBuildQuality(scene: Scene, quality: u32);
+        fn rtcSetSceneFlags(scene: Scene, flags: u32);
         fn rtcNewGeometry(device: Device, kind: u32) -> Geometry;
         fn rtcSetGeometryBuildQuality(geometry: Geometry, quality: u32);
         fn rtcSetSharedGeometryBuffer(
@@ -228,6 +230,11 @@ mod linked {
                 rtcSetDeviceMemoryMonitorFunction(device, monitor, &*bytes as *const AtomicIsize as *mut c_void);
                 let scene = rtcNewScene(device);
                 rtcSetSceneBuildQuality(scene, quality as u32);
+                // BENCH_EMBREE_ROBUST=1: Embree's robust mode (avoids its optimisations that can
+                // miss rays through edges and vertices), as bvhscope always is.
+                if std::env::var("BENCH_EMBREE_ROBUST").is_ok_and(|v| v == "1") {
+                    rtcSetSceneFlags(scene, SCENE_FLAG_ROBUST);
+                }
                 let geometry = rtcNewGeometry(device, GEOMETRY_TYPE_TRIANGLE);
                 rtcSetGeometryBuildQuality(geometry, quality as u32);
                 rtcSetSharedGeometryBuffer(

@@ -6,7 +6,8 @@
 //! `BENCH_APP=1` prints only the app figures, `BENCH_OVERHEAD=1` only the counting overhead,
 //! `BENCH_COUNTS=1` only the work per ray (nodes, triangle tests) of our strategies' trees.
 //! Tuning: `BENCH_TRAVERSAL_COST=c` and `BENCH_MAX_LEAF=n` build our trees with that SAH traversal
-//! cost and leaf size; `BENCH_EMBREE_ISA=avx2` asks Embree for its kernels of another CPU.
+//! cost and leaf size; `BENCH_EMBREE_ISA=avx2` asks Embree for its kernels of another CPU,
+//! `BENCH_EMBREE_ROBUST=1` for its robust mode.
 //! Embree 3 is raced when `build.rs` found it (Debian: libembree-dev).
 
 mod contenders;

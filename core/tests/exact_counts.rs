@@ -193,8 +193,8 @@ fn any_hit_counts_only_the_triangle_tests_it_made() {
 /// The relation documented in `bvh::wide`: on the same tree, a ray that no hit prunes (it hits
 /// nothing, so both layouts reach every leaf whose box it meets) reaches the same leaves and makes
 /// the same triangle tests in both layouts; the wide layout visits at most as many nodes as the
-/// binary one visits interior nodes. In the binary layout, box tests = 1 + 2 × (nodes visited −
-/// leaves visited) for a ray that enters the root. (Box tests have no such bound between the
+/// binary one visits interior nodes (so does the 8-wide one, fewer in all than the 4-wide
+/// one). In the binary layout, box tests = 1 + 2 × (nodes visited − leaves visited) for a ray that enters the root. (Box tests have no such bound between the
 /// layouts: a wide node tests its grandchildren's boxes even where the binary walk culled them at
 /// the child's box.)
 #[test]
@@ -202,6 +202,7 @@ fn binary_and_wide_counts_relate_as_documented() {
     let mesh = generate::torus_knot(2, 3, 0.3, 256, 12);
     let binary = Bvh::build(&mesh, &BuildParams { max_leaf_size: 4, ..BuildParams::default() });
     let wide = WideBvh::from_binary(binary.clone());
+    let wide8 = WideBvh::<8>::collapse(binary.clone());
     let linear = LinearScan::new(&mesh);
     let b = mesh.bounds();
     let (c, r) = (b.center(), b.extent().length());
@@ -213,6 +214,7 @@ fn binary_and_wide_counts_relate_as_documented() {
         state as f32 / u32::MAX as f32
     };
     let (mut misses, mut crossing) = (0, 0);
+    let (mut visits4, mut visits8) = (0u64, 0u64);
     for _ in 0..20_000 {
         let from = c + Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5).normalize_or(Vec3::X) * r;
         let to = c + Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5) * b.extent();
@@ -230,6 +232,13 @@ fn binary_and_wide_counts_relate_as_documented() {
             assert_eq!(cb.leaves_visited, cw.leaves_visited, "{ray:?}");
             assert_eq!(cb.triangle_tests, cw.triangle_tests, "{ray:?}");
             assert!(cw.nodes_visited <= cb.nodes_visited - cb.leaves_visited || cb.nodes_visited == 0, "{ray:?}");
+            // Eight wide: the same leaves and triangles; each node visited is an interior binary
+            // node the ray enters, and in all fewer than four wide visits.
+            let mut c8 = RayCounters::ZERO;
+            assert!(wide8.closest_hit(&mut ray.clone(), opts, &mut c8).is_none());
+            assert_eq!((c8.leaves_visited, c8.triangle_tests), (cw.leaves_visited, cw.triangle_tests), "{ray:?}");
+            assert!(c8.nodes_visited <= cb.nodes_visited - cb.leaves_visited || cb.nodes_visited == 0, "{ray:?}");
+            (visits4, visits8) = (visits4 + u64::from(cw.nodes_visited), visits8 + u64::from(c8.nodes_visited));
             if cb.nodes_visited > 0 {
                 assert_eq!(cb.box_tests, 1 + 2 * (cb.nodes_visited - cb.leaves_visited), "{ray:?}");
             }
@@ -242,6 +251,7 @@ fn binary_and_wide_counts_relate_as_documented() {
         misses > 2_000 && crossing > 500,
         "the rays exercise the relation: {misses} misses, {crossing} reach leaves"
     );
+    assert!(visits8 < visits4, "eight wide visits fewer nodes: {visits8} vs {visits4}");
 }
 
 // ---- Deeper trees: several wide nodes, leaves of one and of two triangles, the far child

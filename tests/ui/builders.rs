@@ -165,3 +165,32 @@ fn the_lbvh_replay_names_each_split_by_its_morton_bit_as_replay_prints_it() {
     run_until(&mut h, "the step", |a| a.replay.k == k && idle(a));
     assert!(h.query_all_by_label_contains(&text).count() == 1, "the Replay window says {text}");
 }
+
+/// The fastest preset is one click: the 8-wide layout, the SAH told a step costs three triangle
+/// tests, one level; the tree's figures are `bvhscope stats --preset fastest`'s.
+#[test]
+fn fastest_traversal_is_one_click_and_stats_agrees() {
+    let (mut h, torus) = open_with("torus.obj", "SAH binned");
+    run_until(&mut h, "the SAH build", |a| {
+        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::SahBinned)
+    });
+    h.get_by_label("Fastest traversal").click();
+    run_until(&mut h, "the fastest build", |a| {
+        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.layout == bvhscope::bvh::Layout::Wide8)
+    });
+    let s = &h.state().settings;
+    assert!(s.is_preset(bvhscope::bvh::Preset::Fastest));
+    assert_eq!(s.build.cost.traversal, bvhscope::bvh::Preset::FASTEST_TRAVERSAL_COST);
+    assert!(!s.two_level);
+    h.get_by_label("Fastest traversal (on)");
+    h.get_by_label("SAH binned, wide8");
+    let stats = h.state().current_bvh().unwrap().stats.clone();
+    let words = ["bvhscope", "stats", torus.to_str().unwrap(), "--preset", "fastest", "--no-rays", "--format", "json"];
+    let Some(Command::Stats(args)) = Cli::from_words(words).unwrap().command else { panic!("stats") };
+    let v: serde_json::Value = serde_json::from_str(&bvhscope::cli::stats::output(&args).unwrap()).unwrap();
+    let cli = &v["stats"];
+    assert_eq!(cli["nodes"], stats.nodes);
+    assert_eq!(cli["leaves"], stats.leaves);
+    assert_eq!(cli["sah_cost"].as_f64().unwrap(), stats.sah_cost);
+    assert_eq!(cli["memory_bytes"], stats.memory_bytes);
+}
