@@ -17,12 +17,12 @@ use wide::f32x4;
 pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]]) -> Hits4 {
     let n = tris.len().min(4);
     let lanes = (1u32 << n) - 1;
-    // Vertex j's coordinate `axis` of each triangle relative to the origin; lanes past `n`
-    // repeat the first triangle (masked off below).
+    // Lane k reads triangle k; lanes past `n` repeat the first one (masked off below).
+    let t: [&[Vec3; 3]; 4] = [&tris[0], &tris[1.min(n - 1)], &tris[2.min(n - 1)], &tris[3.min(n - 1)]];
+    // Vertex j's coordinate `axis` of each triangle relative to the origin.
     let o = ray.origin();
     let rel = |j: usize, axis: usize| {
-        let at = |k: usize| tris[if k < n { k } else { 0 }][j][axis];
-        f32x4::from([at(0), at(1), at(2), at(3)]) - f32x4::splat(o[axis])
+        f32x4::new([t[0][j][axis], t[1][j][axis], t[2][j][axis], t[3][j][axis]]) - f32x4::splat(o[axis])
     };
     let vertex = |j: usize| [rel(j, 0), rel(j, 1), rel(j, 2)];
     let (a, b, c) = (vertex(0), vertex(1), vertex(2));
