@@ -199,12 +199,13 @@ pub fn sbvh_text(ins: &Inspection) -> Option<String> {
     ))
 }
 
-/// Which wide node of the 4-wide layout binary node `node` is collapsed into.
+/// Which wide node of a wide layout binary node `node` is collapsed into.
 pub fn wide_group_text(node: u32, g: &WideGroup) -> String {
     let list = |v: &[u32]| v.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ");
     let role = if g.collapsed.contains(&node) { "is collapsed into" } else { "is a leaf slot of" };
     format!(
-        "In the 4-wide layout, node {node} {role} the wide node over binary node {}, which swallows binary nodes {} and has children {}.",
+        "In the {}-wide layout, node {node} {role} the wide node over binary node {}, which swallows binary nodes {} and has children {}.",
+        g.width,
         g.top,
         list(&g.collapsed),
         list(&g.children)
@@ -286,7 +287,7 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
                 v["dump_node"] = serde_json::json!(d);
             }
             if let Some(g) = &wide {
-                v["wide_node"] = serde_json::json!({ "top": g.top, "collapsed": g.collapsed, "children": g.children });
+                v["wide_node"] = serde_json::json!({ "width": g.width, "top": g.top, "collapsed": g.collapsed, "children": g.children });
             }
             format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises"))
         }

@@ -207,6 +207,8 @@ impl<const W: usize> WideBvh<W> {
 /// the top of another wide node. The node inspector says this of a node in a wide layout.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct WideGroup {
+    /// Children per wide node of the layout (4 or 8).
+    pub width: usize,
     pub top: u32,
     pub collapsed: Vec<u32>,
     pub children: Vec<u32>,
@@ -242,7 +244,7 @@ pub fn wide_group_of<const W: usize>(b: &[BvhNode], parent: &[u32], node: u32) -
         let children: Vec<u32> = kids.iter().map(|&k| k as u32).collect();
         let is_slot = children.contains(&node) && b[node as usize].is_leaf();
         if collapsed.contains(&node) || is_slot {
-            return Some(WideGroup { top: top as u32, collapsed, children });
+            return Some(WideGroup { width: W, top: top as u32, collapsed, children });
         }
         // Go down to the child on the path to `node`.
         top = *kids.iter().find(|&&k| path.contains(&(k as u32)))?;
