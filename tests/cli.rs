@@ -108,14 +108,17 @@ fn stats_and_compare_print_their_tables() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     let rows = v["rows"].as_array().unwrap();
     let strategies = bvhscope::bvh::SplitStrategy::ALL.len();
-    assert_eq!(rows.len(), 2 * strategies + 1, "every strategy in two layouts, and the linear scan");
+    let layouts = bvhscope::bvh::Layout::ALL.len();
+    assert_eq!(rows.len(), layouts * strategies + 1, "every strategy in every layout, and the linear scan");
     assert_eq!(rows[0]["name"], "Midpoint (binary)");
     assert_eq!(rows[1]["name"], "Midpoint (wide4)");
-    assert_eq!(rows[8]["name"], "LBVH (Morton) (binary)");
-    assert_eq!(rows[10]["name"], "PLOC (binary)");
-    assert_eq!(rows[12]["name"], "SBVH (spatial splits) (binary)");
-    assert_eq!(rows[2 * strategies]["name"], "Linear scan");
-    assert_eq!(rows[2 * strategies]["tri_tests_per_ray"], 4.0);
+    assert_eq!(rows[2]["name"], "Midpoint (wide8)");
+    assert_eq!(rows[4 * layouts]["name"], "LBVH (Morton) (binary)");
+    assert_eq!(rows[5 * layouts]["name"], "PLOC (binary)");
+    assert_eq!(rows[6 * layouts]["name"], "SBVH (spatial splits) (binary)");
+    assert_eq!(rows[layouts * strategies]["name"], "Linear scan");
+    assert_eq!(rows[layouts * strategies]["tri_tests_per_ray"], 4.0);
+
     for r in rows {
         assert!(r["frame_ms"].as_f64().unwrap() > 0.0);
     }

@@ -13,6 +13,7 @@
 mod contenders;
 mod counts;
 mod embree;
+mod ratios;
 mod rays;
 mod scenes;
 
@@ -169,78 +170,6 @@ fn table(mesh: &Mesh, rows: &[Row], s: &Settings, threads: usize) -> String {
         let spread = (hi - lo) as f64 / hi.max(1) as f64;
         let verdict = if spread <= 1e-3 { "agree" } else { "DISAGREE" };
         let _ = writeln!(o, "\n{label} hit counts {verdict}: {lo}..{hi} ({:.3}% spread)", spread * 100.0);
-    }
-    o
-}
-
-fn best(rows: &[Row], pick: impl Fn(&Row) -> bool, key: impl Fn(&Row) -> f64) -> Option<&Row> {
-    rows.iter().filter(|r| pick(r)).max_by(|a, b| key(a).total_cmp(&key(b)))
-}
-
-fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
-    let mut o = String::new();
-    let name = mesh.name.split_whitespace().next().unwrap_or("mesh").to_lowercase();
-    let ours = |r: &Row| r.family == Some(Family::Ours) && !r.name.contains("counting");
-    let is = |f: Family| move |r: &Row| r.family == Some(f);
-    let mut line = |label: &str, a: Option<&Row>, b: Option<&Row>, key: &dyn Fn(&Row) -> f64| {
-        if let (Some(a), Some(b)) = (a, b) {
-            let _ = writeln!(o, "ratio {label} {name}: {} / {} = {:.2}", a.name, b.name, key(a) / key(b));
-        }
-    };
-    for (label, key) in [
-        ("primary 1T", &(|r: &Row| r.p1) as &dyn Fn(&Row) -> f64),
-        ("primary NT", &|r: &Row| r.pn),
-        ("incoherent 1T", &|r: &Row| r.i1),
-        ("incoherent NT", &|r: &Row| r.i_n),
-    ] {
-        // "best" may be a packet row; "best single-ray" leaves packets out, for comparing like
-        // with like (obvhs and the bvh crate trace one ray at a time).
-        let our_best = best(rows, ours, key);
-        let single = |r: &Row| ours(r) && !r.name.contains("packets");
-        let our_single = best(rows, single, key);
-        for (what, a) in [("best", our_best), ("best single-ray", our_single)] {
-            line(&format!("{label} {what}/obvhs-best-BVH2"), a, best(rows, is(Family::ObvhsBvh2), key), key);
-            line(&format!("{label} {what}/obvhs-best-CWBVH"), a, best(rows, is(Family::ObvhsCwbvh), key), key);
-        }
-        // Against Embree: single rays with rtcIntersect1, and our best path with Embree's best
-        // (packets and streams included).
-        let embree_single = best(rows, is(Family::Embree), key);
-        let embree_any = best(rows, |r| matches!(r.family, Some(Family::Embree | Family::EmbreePackets)), key);
-        line(&format!("{label} best single-ray/embree-rtcIntersect1"), our_single, embree_single, key);
-        line(&format!("{label} best/embree-best"), our_best, embree_any, key);
-        for our in ["bvhscope sah (BVH2)", "bvhscope sah (BVH2, 8×8 packets)"] {
-            let a = rows.iter().find(|r| r.name == our);
-            let label = format!("{label} sah-BVH2{}/bvh-crate", if our.contains("packets") { "-packets" } else { "" });
-            line(&label, a, best(rows, is(Family::BvhCrate), key), key);
-        }
-    }
-    let tris_per_s = |r: &Row| 1.0 / r.build_nt;
-    let our_sah = rows.iter().find(|r| r.name == "bvhscope sah (BVH2)");
-    let fastest = rows.iter().find(|r| r.name == "obvhs fastest (BVH2)");
-    line("build NT triangles/s sah/obvhs-fastest", our_sah, fastest, &tris_per_s);
-    let embree_medium = rows.iter().find(|r| r.name == "embree medium (rtcIntersect1)");
-    for our_name in ["sah (BVH2)", "sah (BVH4)", "sah (BVH8)", "fastest (BVH8)"] {
-        let our = rows.iter().find(|r| r.name == format!("bvhscope {our_name}"));
-        let label = format!("build NT triangles/s {}/embree-medium", our_name.replace(" (", "-").replace(')', ""));
-        line(&label, our, embree_medium, &tris_per_s);
-    }
-    let medium = rows.iter().find(|r| r.name == "obvhs medium (BVH2)");
-    if let (Some(a), Some(b)) = (our_sah, medium) {
-        let _ = writeln!(
-            o,
-            "SAH cost {name}: {} {:.2} vs {} {:.2}",
-            a.name,
-            a.sah.unwrap_or(f64::NAN),
-            b.name,
-            b.sah.unwrap_or(f64::NAN)
-        );
-    }
-    let single_embree = |r: &Row| r.family == Some(Family::Embree);
-    for r in rows.iter().filter(|r| (ours(r) || single_embree(r)) && !r.name.contains("packets")) {
-        if let Some(b) = r.bytes {
-            let what = if single_embree(r) { "what the device allocates" } else { "nodes + leaves" };
-            let _ = writeln!(o, "memory {name}: {} {:.1} bytes per triangle ({what})", r.name, b);
-        }
     }
     o
 }
@@ -496,7 +425,7 @@ fn main() {
         t += &all.install(|| counts::table(mesh, &p, &i));
         print!("{t}");
         out += &t;
-        closing += &ratios(mesh, &rows);
+        closing += &ratios::ratios(mesh, &rows);
         closing += &counting_overhead(mesh, &s, &one);
     }
     println!("\n{closing}");
