@@ -226,6 +226,10 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         s.memory_bytes,
         s.memory_bytes as f64 / s.triangles.max(1) as f64
     );
+    if let Some(k) = s.simd {
+        let _ =
+            writeln!(o, "SIMD kernels    {k} (the best this CPU has, unless BVHSCOPE_SIMD=simd4|scalar asks for less)");
+    }
     if s.fallback_splits > 0 || s.depth_limited_splits > 0 {
         let _ = writeln!(
             o,

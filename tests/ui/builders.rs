@@ -193,4 +193,8 @@ fn fastest_traversal_is_one_click_and_stats_agrees() {
     assert_eq!(cli["leaves"], stats.leaves);
     assert_eq!(cli["sah_cost"].as_f64().unwrap(), stats.sah_cost);
     assert_eq!(cli["memory_bytes"], stats.memory_bytes);
+    // The kernels the statistics panel names are the ones `stats` prints.
+    let simd = stats.simd.expect("a wide layout's kernels");
+    assert_eq!(cli["simd"], simd);
+    assert!(h.query_all_by_label(simd).count() >= 1, "the SIMD kernels row shows {simd}");
 }

@@ -103,6 +103,9 @@ impl TreeView for AnyBvh {
     fn memory_bytes(&self) -> usize {
         self.tree().memory_bytes()
     }
+    fn simd(&self) -> Option<crate::cpu::Simd> {
+        self.tree().simd()
+    }
     fn params(&self) -> &BuildParams {
         self.tree().params()
     }

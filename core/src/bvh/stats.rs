@@ -41,6 +41,8 @@ pub struct TreeStats {
     pub epo: Option<f64>,
     /// The reinsertion after the build, if one was asked for (its SAH cost before and after).
     pub reinsertion: Option<super::reinsert::Reinsertion>,
+    /// The SIMD kernels a wide layout's walk runs on this CPU ("avx2", "simd4", "scalar").
+    pub simd: Option<&'static str>,
 }
 
 /// A time in milliseconds as the statistics print it: two decimals under 10 ms, so a fast build
@@ -83,6 +85,7 @@ impl TreeStats {
             fallback_splits: report.fallback_splits,
             depth_limited_splits: report.depth_limited_splits,
             reinsertion: report.reinsertion,
+            simd: tree.simd().map(crate::cpu::Simd::name),
             ..Default::default()
         };
         let mut depth_sum = 0u64;

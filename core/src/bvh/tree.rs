@@ -30,8 +30,12 @@ pub trait TreeView {
     fn distinct_triangles(&self) -> usize {
         self.triangle_count()
     }
-    /// Bytes of nodes and primitive indices.
+    /// Bytes of nodes, primitive indices and the triangles the tree keeps.
     fn memory_bytes(&self) -> usize;
+    /// The SIMD kernels its walk runs (`crate::cpu`), for a wide layout; `None` for the binary one.
+    fn simd(&self) -> Option<crate::cpu::Simd> {
+        None
+    }
     fn params(&self) -> &BuildParams;
     fn report(&self) -> &BuildReport;
 

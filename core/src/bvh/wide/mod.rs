@@ -251,6 +251,12 @@ impl<const W: usize> TreeView for WideBvh<W> {
         &self.params
     }
 
+    /// The kernels the walk runs: for eight children the tree's choice (AVX2, two SSE/NEON passes or
+    /// scalar); four children are tested in one four-lane pass unless scalar is asked for.
+    fn simd(&self) -> Option<crate::cpu::Simd> {
+        Some(if W == 4 { self.simd.min(crate::cpu::Simd::Simd4) } else { self.simd })
+    }
+
     fn report(&self) -> &BuildReport {
         &self.report
     }
