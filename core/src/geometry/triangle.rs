@@ -188,33 +188,8 @@ impl TriangleIntersector for Watertight {
         let (ax, ay) = (dot(&a, &p.rx), dot(&a, &p.ry));
         let (bx, by) = (dot(&b, &p.rx), dot(&b, &p.ry));
         let (cx, cy) = (dot(&c, &p.rx), dot(&c, &p.ry));
-        let mut u = cx * by - cy * bx;
-        let mut v = ax * cy - ay * cx;
-        let mut w = bx * ay - by * ax;
-        let zero = (u.simd_eq(f32x4::ZERO) | v.simd_eq(f32x4::ZERO) | w.simd_eq(f32x4::ZERO)).to_bitmask() & lanes;
-        if zero != 0 {
-            let (mut uu, mut vv, mut ww) = (u.to_array(), v.to_array(), w.to_array());
-            let f = |x: f32x4, k: usize| x.to_array()[k] as f64;
-            let mut m = zero;
-            while m != 0 {
-                let k = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let (ax, ay, bx, by, cx, cy) = (f(ax, k), f(ay, k), f(bx, k), f(by, k), f(cx, k), f(cy, k));
-                uu[k] = (cx * by - cy * bx) as f32;
-                vv[k] = (ax * cy - ay * cx) as f32;
-                ww[k] = (bx * ay - by * ax) as f32;
-            }
-            (u, v, w) = (f32x4::from(uu), f32x4::from(vv), f32x4::from(ww));
-        }
-        let z = f32x4::ZERO;
-        let outside = (u.simd_lt(z) | v.simd_lt(z) | w.simd_lt(z)) & (u.simd_gt(z) | v.simd_gt(z) | w.simd_gt(z));
-        let det = u + v + w;
-        let t_scaled = u * dot(&a, &p.rz) + v * dot(&b, &p.rz) + w * dot(&c, &p.rz);
-        let inv_det = f32x4::ONE / det;
-        let t = t_scaled * inv_det;
-        let inside = det.simd_ne(z) & t.simd_ge(t_min) & t.simd_lt(t_max);
-        let mask = inside.to_bitmask() & !outside.to_bitmask() & lanes;
-        Hits4 { mask, t: t.to_array(), u: (v * inv_det).to_array(), v: (w * inv_det).to_array() }
+        let z = [dot(&a, &p.rz), dot(&b, &p.rz), dot(&c, &p.rz)];
+        super::triangle4::edge_test4([ax, ay, bx, by, cx, cy], z, t_min, t_max, lanes)
     }
 }
 

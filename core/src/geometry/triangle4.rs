@@ -30,13 +30,24 @@ pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]])
     let (ax, ay) = (dot(&a, p.rx), dot(&a, p.ry));
     let (bx, by) = (dot(&b, p.rx), dot(&b, p.ry));
     let (cx, cy) = (dot(&c, p.rx), dot(&c, p.ry));
+    let z = [dot(&a, p.rz), dot(&b, p.rz), dot(&c, p.rz)];
+    edge_test4([ax, ay, bx, by, cx, cy], z, f32x4::splat(ray.t_min), f32x4::splat(ray.t_max), lanes)
+}
+
+/// The watertight test's second half, four lanes at once (one ray and four triangles, or four
+/// rays and one triangle): from the vertices' sheared coordinates `[ax, ay, bx, by, cx, cy]` and
+/// their distances along the ray `z` (`a·rz`, `b·rz`, `c·rz`), the edge functions (redone in double
+/// precision in a lane where one is exactly zero, as the paper says), the inside test and the
+/// hit within `[t_min, t_max)`, for the lanes in `lanes`. Lane by lane the scalar test's arithmetic.
+#[inline(always)]
+pub(super) fn edge_test4(xy: [f32x4; 6], z: [f32x4; 3], t_min: f32x4, t_max: f32x4, lanes: u32) -> Hits4 {
+    let [ax, ay, bx, by, cx, cy] = xy;
     let mut u = cx * by - cy * bx;
     let mut v = ax * cy - ay * cx;
     let mut w = bx * ay - by * ax;
-    let z = f32x4::ZERO;
-    let zero = (u.simd_eq(z) | v.simd_eq(z) | w.simd_eq(z)).to_bitmask() & lanes;
+    let zero_f = f32x4::ZERO;
+    let zero = (u.simd_eq(zero_f) | v.simd_eq(zero_f) | w.simd_eq(zero_f)).to_bitmask() & lanes;
     if zero != 0 {
-        // The paper's fallback, lane by lane: the edge functions again in double precision.
         let (mut uu, mut vv, mut ww) = (u.to_array(), v.to_array(), w.to_array());
         let f = |x: f32x4, k: usize| x.to_array()[k] as f64;
         let mut m = zero;
@@ -50,12 +61,13 @@ pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]])
         }
         (u, v, w) = (f32x4::from(uu), f32x4::from(vv), f32x4::from(ww));
     }
-    let outside = (u.simd_lt(z) | v.simd_lt(z) | w.simd_lt(z)) & (u.simd_gt(z) | v.simd_gt(z) | w.simd_gt(z));
+    let o = zero_f;
+    let outside = (u.simd_lt(o) | v.simd_lt(o) | w.simd_lt(o)) & (u.simd_gt(o) | v.simd_gt(o) | w.simd_gt(o));
     let det = u + v + w;
-    let t_scaled = u * dot(&a, p.rz) + v * dot(&b, p.rz) + w * dot(&c, p.rz);
+    let t_scaled = u * z[0] + v * z[1] + w * z[2];
     let inv_det = f32x4::ONE / det;
     let t = t_scaled * inv_det;
-    let inside = det.simd_ne(z) & t.simd_ge(f32x4::splat(ray.t_min)) & t.simd_lt(f32x4::splat(ray.t_max));
+    let inside = det.simd_ne(o) & t.simd_ge(t_min) & t.simd_lt(t_max);
     let mask = inside.to_bitmask() & !outside.to_bitmask() & lanes;
     Hits4 { mask, t: t.to_array(), u: (v * inv_det).to_array(), v: (w * inv_det).to_array() }
 }
