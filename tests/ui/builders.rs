@@ -178,15 +178,16 @@ fn fastest_traversal_is_one_click_and_stats_agrees() {
     run_until(&mut h, "the fastest build", |a| {
         idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.layout == bvhscope::bvh::Layout::Wide8)
     });
-    let s = &h.state().settings;
-    assert!(s.is_preset(bvhscope::bvh::Preset::Fastest));
-    assert_eq!(s.build.cost.traversal, bvhscope::bvh::Preset::FASTEST_TRAVERSAL_COST);
-    assert!(!s.two_level);
+    let settings = &h.state().settings;
+    assert!(settings.is_preset(bvhscope::bvh::Preset::Fastest));
+    assert_eq!(settings.build.cost.traversal, bvhscope::bvh::Preset::FASTEST_TRAVERSAL_COST);
+    assert!(!settings.two_level);
     h.get_by_label("Fastest traversal (on)");
     h.get_by_label("SAH binned, wide8");
     let stats = h.state().current_bvh().unwrap().stats.clone();
-    let words = ["bvhscope", "stats", torus.to_str().unwrap(), "--preset", "fastest", "--no-rays", "--format", "json"];
-    let Some(Command::Stats(args)) = Cli::from_words(words).unwrap().command else { panic!("stats") };
+    let stats_words =
+        ["bvhscope", "stats", torus.to_str().unwrap(), "--preset", "fastest", "--no-rays", "--format", "json"];
+    let Some(Command::Stats(args)) = Cli::from_words(stats_words).unwrap().command else { panic!("stats") };
     let v: serde_json::Value = serde_json::from_str(&bvhscope::cli::stats::output(&args).unwrap()).unwrap();
     let cli = &v["stats"];
     assert_eq!(cli["nodes"], stats.nodes);
@@ -197,4 +198,16 @@ fn fastest_traversal_is_one_click_and_stats_agrees() {
     let simd = stats.simd.expect("a wide layout's kernels");
     assert_eq!(cli["simd"], simd);
     assert!(h.query_all_by_label(simd).count() >= 1, "the SIMD kernels row shows {simd}");
+
+    // The 8-wide heatmap's counts: `render --preset fastest` on the same camera gives them pixel for pixel.
+    h.state_mut().act(Action::View(2));
+    run_until(&mut h, "the visits heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+    let camera = h.state().shown.as_ref().unwrap().camera;
+    let csv = temp_file("fastest-counts.csv", "");
+    let mut args = vec![s("render"), s(torus.display()), s("--preset"), s("fastest"), s("--view"), s("visits")];
+    args.extend(camera_words(&camera));
+    args.extend([s("--counts"), s(csv.display()), s("-o"), s(temp_file("fastest.png", "").display())]);
+    bvhscope::cli::run(words(&args)).unwrap();
+    let app_counts = h.state().shown.as_ref().unwrap().frame.counts_csv().unwrap();
+    assert_eq!(app_counts, std::fs::read_to_string(&csv).unwrap(), "the app's 8-wide counts are render's");
 }

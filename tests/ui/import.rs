@@ -6,7 +6,7 @@ mod support;
 
 use bvhscope::app::{Action, BvhscopeApp, MessageKind, Pick, SceneSource};
 use bvhscope::bvh::check::Group;
-use bvhscope::cli::{Cli, Command};
+use bvhscope::cli::Command;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use std::path::{Path, PathBuf};
@@ -15,29 +15,6 @@ use support::*;
 
 fn torus() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj")
-}
-
-fn words(args: &[String]) -> Command {
-    let mut all = vec!["bvhscope".to_string()];
-    all.extend(args.iter().cloned());
-    Cli::from_words(&all).unwrap().command.unwrap()
-}
-
-fn s(x: impl ToString) -> String {
-    x.to_string()
-}
-
-/// `--camera … --fov … --size …`: the camera of the image on screen, for the command line.
-fn camera_words(c: &bvhscope::render::Camera) -> Vec<String> {
-    let v3 = |v: glam::Vec3| format!("{},{},{}", v.x, v.y, v.z);
-    vec![
-        s("--camera"),
-        format!("{}:{}:{}", v3(c.position), v3(c.look_at), v3(c.up)),
-        s("--fov"),
-        s(c.vfov_deg),
-        s("--size"),
-        format!("{}x{}", c.width, c.height),
-    ]
 }
 
 /// Export `strategy`'s tree of the torus in `layout` to `name` (through the command line).

@@ -63,3 +63,26 @@ pub fn type_keys(h: &mut Harness<'_, BvhscopeApp>, text: &str) {
         h.step();
     }
 }
+
+pub fn words(args: &[String]) -> bvhscope::cli::Command {
+    let mut all = vec!["bvhscope".to_string()];
+    all.extend(args.iter().cloned());
+    bvhscope::cli::Cli::from_words(&all).unwrap().command.unwrap()
+}
+
+pub fn s(x: impl ToString) -> String {
+    x.to_string()
+}
+
+/// `--camera … --fov … --size …`: the camera of the image on screen, for the command line.
+pub fn camera_words(c: &bvhscope::render::Camera) -> Vec<String> {
+    let v3 = |v: glam::Vec3| format!("{},{},{}", v.x, v.y, v.z);
+    vec![
+        s("--camera"),
+        format!("{}:{}:{}", v3(c.position), v3(c.look_at), v3(c.up)),
+        s("--fov"),
+        s(c.vfov_deg),
+        s("--size"),
+        format!("{}x{}", c.width, c.height),
+    ]
+}
