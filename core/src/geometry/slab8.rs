@@ -167,4 +167,38 @@ mod tests {
             }
         }
     }
+
+    /// A ray aimed exactly at a box's corner from far away touches the box at one point, where
+    /// rounding can put the entry above the exit: every kernel must still report it (the enlarged
+    /// far reciprocal, `slab.rs`). Without it this fails for some of these rays.
+    #[test]
+    fn rays_aimed_at_box_corners_from_afar_hit_in_every_kernel() {
+        let mut state = 0x2545_f491_u32;
+        let mut rand = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as f32 / u32::MAX as f32
+        };
+        for _ in 0..20_000 {
+            let lo = Vec3::new(rand(), rand(), rand()) * 10.0 - 5.0;
+            let hi = lo + Vec3::new(rand(), rand(), rand()) * 3.0 + 0.01;
+            let corner = Vec3::new(
+                if rand() < 0.5 { lo.x } else { hi.x },
+                if rand() < 0.5 { lo.y } else { hi.y },
+                if rand() < 0.5 { lo.z } else { hi.z },
+            );
+            let from =
+                corner + (Vec3::new(rand(), rand(), rand()) - 0.5).normalize_or(Vec3::X) * (100.0 + 900.0 * rand());
+            let ray = Ray::new(from, corner - from);
+            let b = boxes(&[(lo, hi)]);
+            let (_, scalar) = Scalar.test(&SlabKernel::<8>::prepare(Scalar, &ray), &b, 1, ray.t_min, ray.t_max);
+            let (_, simd4) = Simd4.test(&SlabKernel::<8>::prepare(Simd4, &ray), &b, 1, ray.t_min, ray.t_max);
+            assert_eq!((scalar, simd4), (1, 1), "{ray:?} at the corner {corner} of {lo}..{hi}");
+            #[cfg(target_arch = "x86_64")]
+            if let Some(k) = Avx2::detect() {
+                assert_eq!(k.test(&k.prepare(&ray), &b, 1, ray.t_min, ray.t_max).1, 1, "AVX2: {ray:?}");
+            }
+        }
+    }
 }

@@ -16,6 +16,9 @@ use wide::f32x4;
 #[inline(always)]
 pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]]) -> Hits4 {
     let n = tris.len().min(4);
+    if n == 0 {
+        return Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+    }
     let lanes = (1u32 << n) - 1;
     // Lane k reads triangle k; lanes past `n` repeat the first one (masked off below).
     let t: [&[Vec3; 3]; 4] = [&tris[0], &tris[1.min(n - 1)], &tris[2.min(n - 1)], &tris[3.min(n - 1)]];
@@ -127,5 +130,12 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// No triangles: no lanes, nothing hit (a leaf always has some, but the call must not panic).
+    #[test]
+    fn no_triangles_hit_nothing() {
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+        assert_eq!(Watertight::intersect_group(&Watertight::prepare(&ray), &ray, &[]).mask, 0);
     }
 }
