@@ -45,8 +45,11 @@ fn check_ray(mesh: &Mesh, bvhs: &[AnyBvh], linear: &LinearScan, ray: Ray) {
                 simd_of(bvh),
                 ray
             );
-            let first = by_tree.entry(format!("{p:?}")).or_insert((got, counters));
-            assert_eq!(*first, (got, counters), "another kernel, another result: {what}");
+            let mut any_counters = RayCounters::default();
+            let any_found = bvh.any_hit(&ray, opts, &mut any_counters);
+            let result = (got, counters, any_found, any_counters);
+            let first = by_tree.entry(format!("{p:?}")).or_insert(result);
+            assert_eq!(*first, result, "another kernel, another result or count: {what}");
             match (expected, got) {
                 (None, None) => {}
                 (Some(e), Some(g)) => {

@@ -117,6 +117,10 @@ mod linked {
         inst_id: [u32; 8],
     }
 
+    /// `rtcIntersect8`'s lane mask, aligned as it reads it.
+    #[repr(C, align(32))]
+    struct Valid([i32; 8]);
+
     type MemoryMonitor = extern "C" fn(user: *mut c_void, bytes: isize, post: bool) -> bool;
 
     #[link(name = "embree3")]
@@ -265,8 +269,10 @@ mod linked {
                 let start = Instant::now();
                 rtcCommitScene(scene);
                 let took = start.elapsed();
+                // Owned first, so a failed build releases the scene and device on its way out.
+                let built = EmbreeScene { device, scene, trace, _vertices: vertices, _indices: indices, _bytes: bytes };
                 assert_eq!(rtcGetDeviceError(device), 0, "Embree reported an error building the scene");
-                (EmbreeScene { device, scene, trace, _vertices: vertices, _indices: indices, _bytes: bytes }, took)
+                (built, took)
             }
         }
 
@@ -318,9 +324,15 @@ mod linked {
         fn packet8(&self, rays: &[RaySpec]) -> usize {
             // SAFETY: all-zero is a valid value of this plain-data struct.
             let mut p: RayHit8 = unsafe { std::mem::zeroed() };
-            let mut valid = [0i32; 8];
+            // Unused lanes get an empty interval too: a fallback path of Embree's that ignores
+            // `valid` treats a ray as active when tnear <= tfar.
+            p.tnear = [f32::INFINITY; 8];
+            p.tfar = [f32::NEG_INFINITY; 8];
+            // rtcIntersect8 reads the mask as one 32-byte vector.
+            let mut valid = Valid([0; 8]);
             for (k, r) in rays.iter().enumerate() {
-                valid[k] = -1;
+                valid.0[k] = -1;
+                p.tnear[k] = 0.0;
                 for a in 0..3 {
                     p.org[a][k] = r.origin[a];
                     p.dir[a][k] = r.dir[a];
@@ -333,7 +345,7 @@ mod linked {
             }
             let mut ctx = context(CONTEXT_COHERENT);
             // SAFETY: a committed scene, a 32-byte aligned packet, `valid` 8 lanes.
-            unsafe { rtcIntersect8(valid.as_ptr(), self.scene, &mut ctx, &mut p) };
+            unsafe { rtcIntersect8(valid.0.as_ptr(), self.scene, &mut ctx, &mut p) };
             (0..rays.len()).filter(|&k| p.geom_id[k] != INVALID_ID).count()
         }
     }

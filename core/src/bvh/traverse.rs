@@ -191,8 +191,9 @@ pub(crate) fn test_triangles<T: TriangleIntersector, const ANY: bool, S: Travers
 /// `test_triangles` four triangles at a time, each group in one SIMD pass
 /// (`TriangleIntersector::intersect_group`). The lanes are then taken in order against the
 /// closest hit so far, as the one-by-one loop takes them, so the same hits are reported and the
-/// same closest hit kept, bit for bit. Counts: every triangle tested (an any-hit query stops after
-/// the group that hit, all of whose triangles were tested).
+/// same closest hit kept, bit for bit. Counts are the one-by-one loop's too, so that no count
+/// depends on the CPU: every triangle of the leaf for a closest hit; for an any-hit query, the
+/// triangles up to the one that hit (the SIMD pass computed the rest of its group, unused).
 #[inline(always)]
 pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
     tris: &[[glam::Vec3; 3]],
@@ -223,7 +224,7 @@ pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S:
                 ray.t_max = h.t;
                 *best = Some((i, h));
                 if ANY {
-                    stats.triangle_tests((4 * g + group.len()) as u32);
+                    stats.triangle_tests((4 * g + k + 1) as u32);
                     return true;
                 }
             }

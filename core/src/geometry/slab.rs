@@ -65,11 +65,11 @@ fn far_inv(inv: Vec3) -> Vec3 {
 }
 
 /// `max(t, acc)` where a NaN `t` (0·inf: the ray lies in a slab plane) leaves `acc` unchanged, the
-/// scalar `f32::max` rule in SIMD. SSE's maxps returns its second operand on NaN; elsewhere the
-/// NaN-aware `max` is used.
+/// scalar `f32::max` rule in SIMD. SSE's maxps returns its second operand on NaN (the `wide` crate
+/// uses it when SSE is enabled, as on every x86-64); elsewhere the NaN-aware `max` is used.
 #[inline(always)]
 pub fn max_keep(t: f32x4, acc: f32x4) -> f32x4 {
-    if cfg!(any(target_arch = "x86", target_arch = "x86_64")) {
+    if cfg!(target_feature = "sse") {
         t.fast_max(acc)
     } else {
         t.max(acc)
@@ -79,7 +79,7 @@ pub fn max_keep(t: f32x4, acc: f32x4) -> f32x4 {
 /// `min(t, acc)` with the same NaN rule as `max_keep`.
 #[inline(always)]
 pub fn min_keep(t: f32x4, acc: f32x4) -> f32x4 {
-    if cfg!(any(target_arch = "x86", target_arch = "x86_64")) {
+    if cfg!(target_feature = "sse") {
         t.fast_min(acc)
     } else {
         t.min(acc)

@@ -53,7 +53,8 @@ mod avx2 {
         }
 
         fn ask() -> bool {
-            is_x86_feature_detected!("avx2")
+            is_x86_feature_detected!("avx")
+                && is_x86_feature_detected!("avx2")
                 && is_x86_feature_detected!("fma")
                 && is_x86_feature_detected!("popcnt")
                 && is_x86_feature_detected!("bmi1")

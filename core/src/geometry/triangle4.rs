@@ -20,7 +20,7 @@ pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]])
         return Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
     }
     let lanes = (1u32 << n) - 1;
-    // Lane k reads triangle k; lanes past `n` repeat the first one (masked off below).
+    // Lane k reads triangle k; lanes past `n` repeat the last one (masked off below).
     let t: [&[Vec3; 3]; 4] = [&tris[0], &tris[1.min(n - 1)], &tris[2.min(n - 1)], &tris[3.min(n - 1)]];
     // Vertex j's coordinate `axis` of each triangle relative to the origin.
     let o = ray.origin();
