@@ -1,8 +1,9 @@
 //! The command line as a user runs it: outputs, formats, and one-line errors with exit code 2.
 
+mod cli_support;
 mod common;
 
-use common::{bvhscope, tent, tmp};
+use cli_support::{bvhscope, tent, tmp};
 use std::process::Command;
 
 #[test]

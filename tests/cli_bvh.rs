@@ -2,9 +2,9 @@
 //! broken dumps, dumps that number triangles as the file does, the format's snippets, and
 //! `render --bvh` through an imported tree.
 
-mod common;
+mod cli_support;
 
-use common::{bvhscope, render_small_visits, tmp};
+use cli_support::{bvhscope, render_small_visits, tmp};
 use std::path::PathBuf;
 use std::process::Command;
 

@@ -2,9 +2,9 @@
 //! counts against `render --counts`), `inspect` (a node's curves), `render --against` (two builds'
 //! difference) and `replay` (a build step by step).
 
-mod common;
+mod cli_support;
 
-use common::{bvhscope, render_small_visits, tent, tmp};
+use cli_support::{bvhscope, render_small_visits, tent, tmp};
 use std::path::PathBuf;
 
 /// `trace` and `render --counts` tell the same story for the same pixel: the counts file's row is
