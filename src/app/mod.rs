@@ -6,6 +6,7 @@
 mod action;
 mod compare_view;
 mod derived;
+mod explain_overlay;
 mod export;
 mod import_view;
 mod jobs;

@@ -123,7 +123,7 @@ fn pinned_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
 
 /// What the viewport's colours mean, in those colours.
 fn legend(ui: &mut egui::Ui) {
-    let c = &crate::app::viewport::RAY_COLORS;
+    let c = &crate::app::explain_overlay::RAY_COLORS;
     ui.horizontal_wrapped(|ui| {
         ui.spacing_mut().item_spacing.x = 8.0;
         ui.weak("In the image:");
