@@ -6,8 +6,10 @@
 mod action;
 mod compare_view;
 mod derived;
+mod events;
 mod explain_overlay;
 mod export;
+mod figures;
 mod import_view;
 mod jobs;
 mod node_view;
@@ -15,11 +17,14 @@ mod orbit;
 mod overlay;
 mod panels;
 mod ray_view;
+mod reconcile;
 mod replay_view;
 mod scene;
 mod settings;
 mod shortcuts;
 mod viewport;
+
+pub use figures::{MeasuredRays, Message, MessageKind, PathWindow, Shown, StrategyFigures};
 
 pub use crate::scene::{Scene, SceneSource};
 pub use action::{Action, Actions};
@@ -65,80 +70,6 @@ pub fn run(options: AppOptions) -> Result<(), String> {
     };
     eframe::run_native("bvhscope", native, Box::new(move |cc| Ok(Box::new(BvhscopeApp::new(cc, options)))))
         .map_err(|e| format!("cannot open the window: {e}"))
-}
-
-/// The image on screen and what produced it.
-pub struct Shown {
-    pub texture: egui::TextureHandle,
-    pub frame: Arc<Frame>,
-    pub camera: Camera,
-    pub legend: Option<Legend>,
-    pub style: ViewStyle,
-    /// The build replay's partial tree that traced the image, if it was one.
-    pub partial: Option<Arc<crate::bvh::replay::PartialBvh>>,
-    /// Rays per second of the last pass.
-    pub rays_per_s: f64,
-    /// The build that traced it ("SAH binned, wide4"), for captions.
-    pub build_label: String,
-    /// The BVH and traversal that traced it: a pinned pixel is traced again through them.
-    pub bvh: Arc<SceneBvh>,
-    pub trace: TraceOptions,
-}
-
-/// Per-ray figures of a full frame, with what they depend on besides the BVH: the camera (and
-/// image size) and the traversal options. Figures measured under other ones are not comparable.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MeasuredRays {
-    pub summary: RaySummary,
-    pub camera: Camera,
-    pub trace: TraceOptions,
-}
-
-impl MeasuredRays {
-    /// Whether these figures and `other` come from the same rays (camera, image size, traversal).
-    pub fn comparable(&self, camera: &Camera, trace: &TraceOptions) -> bool {
-        self.camera == *camera && self.trace == *trace
-    }
-}
-
-/// One strategy's figures for the statistics panel (the current one and the one before).
-#[derive(Clone, Debug)]
-pub struct StrategyFigures {
-    pub label: String,
-    /// Of the tree the statistics rows describe (`BuiltBvh::stats`).
-    pub stats: TreeStats,
-    /// The whole build, every level.
-    pub build_ms: f64,
-    pub rays: Option<MeasuredRays>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MessageKind {
-    Info,
-    Warning,
-    Error,
-}
-
-#[derive(Clone, Debug)]
-pub struct Message {
-    pub kind: MessageKind,
-    pub text: String,
-    pub at: Instant,
-}
-
-/// The path-typing window: the way in when no file dialog is available, and always offered.
-pub struct PathWindow {
-    pub pick: Pick,
-    pub text: String,
-    pub note: Option<String>,
-    /// Its text field takes the keyboard when it first shows (then single-key shortcuts stop).
-    pub focus: bool,
-}
-
-impl PathWindow {
-    pub fn new(pick: Pick, text: String, note: Option<String>) -> Self {
-        Self { pick, text, note, focus: true }
-    }
 }
 
 pub struct BvhscopeApp {
@@ -396,162 +327,6 @@ impl BvhscopeApp {
         SceneBuild { bvh: self.settings.build, top }
     }
 
-    /// Bring the background work in line with the state: settings that depend on the BVH are
-    /// kept within it, a build starts when the settings or the scene differ from what was built
-    /// or is building, and a render when what the viewport would show differs from the last
-    /// render asked for. The one place that decides what to rebuild and re-render.
-    pub fn reconcile(&mut self) {
-        self.fit_settings_to_bvh();
-        self.fit_levels_to_scene();
-        self.ensure_build();
-        self.ensure_render();
-        self.ensure_explained();
-        self.ensure_compare();
-        self.ensure_wrong();
-    }
-
-    /// The red mask's pixels: once an image of the imported tree is done, the frame's primary
-    /// rays are traced against the linear scan (unless they were for this camera).
-    fn ensure_wrong(&mut self) {
-        if !self.import.on || self.jobs.is_busy() || self.jobs.wrong.is_some() {
-            return;
-        }
-        let Some(s) = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none()) else { return };
-        let Some(reference) = self.import.tree.as_ref().and_then(|t| t.reference.clone()) else { return };
-        if s.bvh.import().is_some() && self.import.wrong_for(&s.bvh, &s.camera, &s.trace).is_none() {
-            self.jobs.wrong(s.bvh.clone(), reference, s.camera, s.trace);
-        }
-    }
-
-    /// B of the side-by-side view: once A's image is done, B is built (or kept) and traced on the
-    /// same camera and traversal, unless it already was.
-    fn ensure_compare(&mut self) {
-        if !self.compare.on || self.jobs.is_busy() {
-            return;
-        }
-        let Some(shown) = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none()) else { return };
-        if !self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &shown.bvh)) {
-            return;
-        }
-        let build = self.compare.build_for(self.wanted_build());
-        let wanted = (build, self.scene_id, shown.camera, self.compare.trace);
-        let have = self.compare.b.as_ref().is_some_and(|b| (b.build, b.scene_id, b.camera, b.trace) == wanted);
-        if !have && self.jobs.last_compare != Some(wanted) {
-            let keep = self.compare.b.as_ref().filter(|b| b.scene_id == self.scene_id).map(|b| b.bvh.clone());
-            self.jobs.compare(self.scene.clone(), self.scene_id, build, keep, shown.camera, self.compare.trace);
-        }
-    }
-
-    /// The node explainer's background work, each started only when the image is done (it must
-    /// not slow a build or a render): the binary tree behind the current single BVH, the frame's
-    /// visits per node while the Tree window is open, and the selected node's inspection.
-    fn ensure_explained(&mut self) {
-        if self.jobs.is_busy() {
-            return;
-        }
-        let Some(bvh) = self.current_bvh().map(|b| b.bvh.clone()) else { return };
-        if !matches!(*bvh, SceneBvh::Single { .. }) {
-            return;
-        }
-        let Some(explained) = self.nodes.current(Some(&bvh)).cloned() else {
-            if self.jobs.explain.is_none() {
-                self.jobs.explain(bvh);
-            }
-            return;
-        };
-        if self.replay.window {
-            let before = self.replay.partial.clone();
-            self.replay.fit(&explained);
-            let changed = match (&before, &self.replay.partial) {
-                (Some(a), Some(b)) => !Arc::ptr_eq(a, b),
-                _ => true,
-            };
-            if changed {
-                self.ensure_render();
-            }
-        }
-        if let Some(node) = self.nodes.selected.filter(|_| self.nodes.inspection.is_none()) {
-            if self.jobs.inspect.as_ref().is_none_or(|(_, n)| *n != node) {
-                self.jobs.inspect(explained.clone(), node);
-            }
-        }
-        if self.nodes.window && self.jobs.visits.is_none() {
-            let Some(shown) = self.shown.as_ref().filter(|s| Arc::ptr_eq(&s.bvh, &bvh)) else { return };
-            let fresh = self.nodes.visits.as_ref().is_some_and(|v| {
-                Arc::ptr_eq(&v.explained, &explained) && v.camera == shown.camera && v.trace == shown.trace
-            });
-            if !fresh {
-                self.jobs.visits(explained, shown.camera, shown.trace);
-            }
-        }
-    }
-
-    /// Box depths within the tree's depth (once it is known: until a BVH is built the chosen
-    /// depth is kept), and no per-level view for a single BVH, which has no levels to tell apart.
-    fn fit_settings_to_bvh(&mut self) {
-        let Some(built) = self.current_bvh() else { return };
-        let (max, top) = (built.bottom_max_depth(), built.top_stats.as_ref().map(|s| s.max_depth));
-        let s = &mut self.settings;
-        s.box_depth = s.box_depth.min(max);
-        match top {
-            Some(top) => s.top_box_depth = s.top_box_depth.min(top),
-            None if s.view.is_per_level() => s.view = View::Visits,
-            None => {}
-        }
-    }
-
-    /// One level over a scene too large to flatten is not built: the app switches to two levels
-    /// and says why (the CLI refuses with the same sentence).
-    fn fit_levels_to_scene(&mut self) {
-        if self.settings.two_level || !self.has_instances() {
-            return;
-        }
-        if let Err(e) = self.scene.check_one_level() {
-            self.settings.two_level = true;
-            self.message(MessageKind::Warning, format!("{e}. Switched to two levels."));
-        }
-    }
-
-    /// Start a build when the settings or the scene differ from what was built or is building.
-    fn ensure_build(&mut self) {
-        // The imported tree, when it is chosen, is the current BVH: nothing to build.
-        if let Some(bvh) = self.import.shown(self.scene_id).cloned() {
-            self.jobs.cancel_build();
-            self.jobs.last_build = None;
-            if !self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &bvh)) {
-                self.set_built(bvh);
-            }
-            return;
-        }
-        let build = self.wanted_build();
-        let wanted = (build, self.scene_id);
-        let have = self.current_bvh().is_some_and(|b| b.bvh.import().is_none() && b.bvh.build_params() == build);
-        if have {
-            // Switched back to what is built while another build ran: that build is not wanted.
-            self.jobs.cancel_build();
-        } else if self.jobs.last_build != Some(wanted) {
-            self.jobs.build(self.scene.clone(), build, self.scene_id);
-        }
-    }
-
-    /// Start a render when what the viewport would show (camera, image size, BVH, view)
-    /// differs from the last render asked for.
-    fn ensure_render(&mut self) {
-        let (w, h) = self.viewport_pixels;
-        let Some(built) = self.current_bvh().filter(|_| w > 0 && h > 0) else { return };
-        let req = jobs::RenderRequest {
-            bvh: built.bvh.clone(),
-            camera: self.orbit.camera(w, h),
-            trace: self.settings.trace,
-            style: self.view_style(),
-            progressive: self.settings.progressive,
-            partial: self.replay_partial(),
-        };
-        if req.camera.validate().is_ok() && !self.jobs.last_render.as_ref().is_some_and(|last| last.same_as(&req)) {
-            self.jobs.render(req);
-        }
-    }
-
     /// The boxes of the overlay for the current BVH and settings (cached): the single BVH's at
     /// the box depth, or for two levels the top level's and/or the bottom level's, each at its
     /// own depth.
@@ -648,161 +423,6 @@ impl BvhscopeApp {
 
     fn reset_view(&mut self) {
         self.orbit = OrbitCamera::home(&self.scene.bounds(), self.viewport_aspect, self.settings.up_axis);
-    }
-
-    fn apply(&mut self, ctx: &egui::Context, event: JobEvent) {
-        match event {
-            JobEvent::Loaded(Ok(scene)) => {
-                if let SceneSource::File(p) = &scene.source {
-                    self.settings.remember(p.clone());
-                }
-                let r = &scene.report;
-                let mut text = format!("Opened {}: {} triangles", scene.title(), r.triangles);
-                if r.degenerate_skipped > 0 {
-                    text += &format!(" ({} degenerate triangles skipped)", r.degenerate_skipped);
-                }
-                self.message(MessageKind::Info, text);
-                self.set_scene(scene);
-                if let Some(dump) = self.pending_import.take() {
-                    self.import_file(dump);
-                }
-            }
-            JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
-            JobEvent::Explained(e) => {
-                // A new tree: keep the selection where the id still exists, and its open rows.
-                let n = e.tree.nodes.len() as u32;
-                self.nodes.selected = self.nodes.selected.filter(|&s| s < n);
-                self.nodes.open.retain(|&o| o < n);
-                self.nodes.inspection = None;
-                self.nodes.explained = Some(e);
-                if let Some(s) = self.nodes.selected {
-                    self.nodes.select(s);
-                }
-            }
-            JobEvent::Visits(v) => self.nodes.visits = Some(v),
-            JobEvent::Compared(b) => {
-                if b.scene_id == self.scene_id {
-                    self.compare.b = Some(*b);
-                }
-            }
-            JobEvent::Inspected { node, explained, inspection } => {
-                let current = self.nodes.explained.as_ref().is_some_and(|e| Arc::ptr_eq(e, &explained));
-                if current && self.nodes.selected == Some(node) {
-                    self.nodes.inspection = Some(inspection);
-                }
-            }
-            JobEvent::Built { scene_id, result: Ok(bvh), .. }
-                if scene_id == self.scene_id && self.import.shown(scene_id).is_none() =>
-            {
-                self.set_built(bvh)
-            }
-            JobEvent::Imported(Err(e)) => self.message(MessageKind::Error, e),
-            JobEvent::Imported(Ok(tree)) if tree.scene_id == self.scene_id => {
-                let (d, w) = (tree.defects(), tree.findings.len() - tree.defects());
-                let kind = if d > 0 { MessageKind::Warning } else { MessageKind::Info };
-                let shown = match &tree.bvh {
-                    Ok(_) => "shown as \"imported\" in the strategy list".to_string(),
-                    Err(why) => format!("not traced: {why}"),
-                };
-                self.message(kind, format!("Checked {}: {d} defects, {w} warnings; {shown}", tree.name()));
-                self.import.on = tree.bvh.is_ok();
-                self.import.window = true;
-                self.import.wrong = None;
-                self.import.tree = Some(*tree);
-            }
-            JobEvent::Imported(_) => {}
-            JobEvent::Wrong(w) => self.import.wrong = Some(w),
-            JobEvent::Built { scene_id, result: Err(SceneBuildError::Scene(e)), .. } if scene_id == self.scene_id => {
-                self.message(MessageKind::Error, e.to_string());
-            }
-            JobEvent::Built { .. } => {}
-            JobEvent::Pass(pass) => self.show_pass(ctx, pass),
-            JobEvent::Picked { pick, path: Some(path), .. } => self.act(Action::Picked(pick, path)),
-            JobEvent::Picked { pick, path: None, took } => {
-                // rfd answers None at once when it has no portal or zenity to ask; a person who
-                // cancels a real dialog takes longer than that.
-                if took < Duration::from_millis(300) {
-                    let note = "No file dialog is available on this system (no desktop portal or zenity). Type the path instead.";
-                    self.path_window = Some(PathWindow::new(pick, String::new(), Some(note.into())));
-                }
-            }
-        }
-    }
-
-    /// Act on a chosen file.
-    fn picked(&mut self, pick: Pick, path: PathBuf) {
-        let result = match pick {
-            Pick::Open => {
-                self.jobs.load(path);
-                return;
-            }
-            Pick::SavePng => export::save_png(self, &path),
-            Pick::SaveStatsCsv => export::save_stats(self, &path, export::StatsFormat::Csv),
-            Pick::SaveStatsJson => export::save_stats(self, &path, export::StatsFormat::Json),
-            Pick::SaveCounts => export::save_counts(self, &path),
-            Pick::OpenBvh => {
-                self.import_file(path);
-                return;
-            }
-            Pick::SaveBvh => export::save_bvh(self, &path),
-            Pick::SaveScene => self
-                .scene_file_text()
-                .and_then(|t| std::fs::write(&path, t).map_err(|e| format!("{}: cannot write: {e}", path.display()))),
-        };
-        match result {
-            Ok(()) => self.message(MessageKind::Info, format!("Saved {}", path.display())),
-            Err(e) => self.message(MessageKind::Error, e),
-        }
-    }
-
-    fn show_pass(&mut self, ctx: &egui::Context, p: PassOutput) {
-        let options = egui::TextureOptions::NEAREST;
-        let rays_per_s = p.info.rays as f64 / p.info.pass_time.as_secs_f64().max(1e-9);
-        if p.info.stride == 1 {
-            self.last_full_frame = Some(p.info.elapsed);
-            // Per-ray figures belong to the BVH that traced them; a pass of an older BVH that
-            // arrives after a rebuild must not be shown (or remembered) under the new strategy.
-            // A replay's partial tree is not the strategy's tree: its figures are not recorded.
-            if p.partial.is_none() && self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
-                self.rays = Some(MeasuredRays { summary: p.frame.ray_summary(), camera: p.camera, trace: p.trace });
-            }
-        }
-        let texture = match self.shown.take() {
-            Some(mut s) => {
-                s.texture.set(p.image, options);
-                s.texture
-            }
-            None => ctx.load_texture("bvhscope-view", p.image, options),
-        };
-        let build_label = p.bvh.label();
-        self.shown = Some(Shown {
-            texture,
-            frame: p.frame,
-            camera: p.camera,
-            legend: p.legend,
-            style: p.style,
-            rays_per_s,
-            build_label,
-            bvh: p.bvh,
-            trace: p.trace,
-            partial: p.partial,
-        });
-    }
-
-    /// Job results, and the actions of input outside the panels: dropped files and keys.
-    fn handle_input(&mut self, ctx: &egui::Context, actions: &mut Actions) {
-        for event in self.jobs.poll() {
-            self.apply(ctx, event);
-        }
-        let dropped: Vec<PathBuf> = ctx.input(|i| {
-            i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
-        });
-        // A dump dropped is imported for the current mesh; anything else is opened.
-        let open = |p: PathBuf| if BvhDump::sniff(&p) { Action::ImportFile(p) } else { Action::OpenFile(p) };
-        actions.extend(dropped.into_iter().take(1).map(open));
-        actions.extend(shortcuts::pressed(ctx));
-        // Info messages fade out; errors stay until dismissed.
-        self.messages.retain(|m| m.kind != MessageKind::Info || m.at.elapsed() < Duration::from_secs(6));
     }
 }
 

@@ -1,0 +1,161 @@
+//! What arrives from outside the panels: background jobs' results (a loaded scene, a build, a
+//! render pass, …), files picked in a dialog, dropped files and keys.
+
+use super::*;
+
+impl BvhscopeApp {
+    pub(super) fn apply(&mut self, ctx: &egui::Context, event: JobEvent) {
+        match event {
+            JobEvent::Loaded(Ok(scene)) => {
+                if let SceneSource::File(p) = &scene.source {
+                    self.settings.remember(p.clone());
+                }
+                let r = &scene.report;
+                let mut text = format!("Opened {}: {} triangles", scene.title(), r.triangles);
+                if r.degenerate_skipped > 0 {
+                    text += &format!(" ({} degenerate triangles skipped)", r.degenerate_skipped);
+                }
+                self.message(MessageKind::Info, text);
+                self.set_scene(scene);
+                if let Some(dump) = self.pending_import.take() {
+                    self.import_file(dump);
+                }
+            }
+            JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
+            JobEvent::Explained(e) => {
+                // A new tree: keep the selection where the id still exists, and its open rows.
+                let n = e.tree.nodes.len() as u32;
+                self.nodes.selected = self.nodes.selected.filter(|&s| s < n);
+                self.nodes.open.retain(|&o| o < n);
+                self.nodes.inspection = None;
+                self.nodes.explained = Some(e);
+                if let Some(s) = self.nodes.selected {
+                    self.nodes.select(s);
+                }
+            }
+            JobEvent::Visits(v) => self.nodes.visits = Some(v),
+            JobEvent::Compared(b) => {
+                if b.scene_id == self.scene_id {
+                    self.compare.b = Some(*b);
+                }
+            }
+            JobEvent::Inspected { node, explained, inspection } => {
+                let current = self.nodes.explained.as_ref().is_some_and(|e| Arc::ptr_eq(e, &explained));
+                if current && self.nodes.selected == Some(node) {
+                    self.nodes.inspection = Some(inspection);
+                }
+            }
+            JobEvent::Built { scene_id, result: Ok(bvh), .. }
+                if scene_id == self.scene_id && self.import.shown(scene_id).is_none() =>
+            {
+                self.set_built(bvh)
+            }
+            JobEvent::Imported(Err(e)) => self.message(MessageKind::Error, e),
+            JobEvent::Imported(Ok(tree)) if tree.scene_id == self.scene_id => {
+                let (d, w) = (tree.defects(), tree.findings.len() - tree.defects());
+                let kind = if d > 0 { MessageKind::Warning } else { MessageKind::Info };
+                let shown = match &tree.bvh {
+                    Ok(_) => "shown as \"imported\" in the strategy list".to_string(),
+                    Err(why) => format!("not traced: {why}"),
+                };
+                self.message(kind, format!("Checked {}: {d} defects, {w} warnings; {shown}", tree.name()));
+                self.import.on = tree.bvh.is_ok();
+                self.import.window = true;
+                self.import.wrong = None;
+                self.import.tree = Some(*tree);
+            }
+            JobEvent::Imported(_) => {}
+            JobEvent::Wrong(w) => self.import.wrong = Some(w),
+            JobEvent::Built { scene_id, result: Err(SceneBuildError::Scene(e)), .. } if scene_id == self.scene_id => {
+                self.message(MessageKind::Error, e.to_string());
+            }
+            JobEvent::Built { .. } => {}
+            JobEvent::Pass(pass) => self.show_pass(ctx, pass),
+            JobEvent::Picked { pick, path: Some(path), .. } => self.act(Action::Picked(pick, path)),
+            JobEvent::Picked { pick, path: None, took } => {
+                // rfd answers None at once when it has no portal or zenity to ask; a person who
+                // cancels a real dialog takes longer than that.
+                if took < Duration::from_millis(300) {
+                    let note = "No file dialog is available on this system (no desktop portal or zenity). Type the path instead.";
+                    self.path_window = Some(PathWindow::new(pick, String::new(), Some(note.into())));
+                }
+            }
+        }
+    }
+
+    /// Act on a chosen file.
+    pub(super) fn picked(&mut self, pick: Pick, path: PathBuf) {
+        let result = match pick {
+            Pick::Open => {
+                self.jobs.load(path);
+                return;
+            }
+            Pick::SavePng => export::save_png(self, &path),
+            Pick::SaveStatsCsv => export::save_stats(self, &path, export::StatsFormat::Csv),
+            Pick::SaveStatsJson => export::save_stats(self, &path, export::StatsFormat::Json),
+            Pick::SaveCounts => export::save_counts(self, &path),
+            Pick::OpenBvh => {
+                self.import_file(path);
+                return;
+            }
+            Pick::SaveBvh => export::save_bvh(self, &path),
+            Pick::SaveScene => self
+                .scene_file_text()
+                .and_then(|t| std::fs::write(&path, t).map_err(|e| format!("{}: cannot write: {e}", path.display()))),
+        };
+        match result {
+            Ok(()) => self.message(MessageKind::Info, format!("Saved {}", path.display())),
+            Err(e) => self.message(MessageKind::Error, e),
+        }
+    }
+
+    pub(super) fn show_pass(&mut self, ctx: &egui::Context, p: PassOutput) {
+        let options = egui::TextureOptions::NEAREST;
+        let rays_per_s = p.info.rays as f64 / p.info.pass_time.as_secs_f64().max(1e-9);
+        if p.info.stride == 1 {
+            self.last_full_frame = Some(p.info.elapsed);
+            // Per-ray figures belong to the BVH that traced them; a pass of an older BVH that
+            // arrives after a rebuild must not be shown (or remembered) under the new strategy.
+            // A replay's partial tree is not the strategy's tree: its figures are not recorded.
+            if p.partial.is_none() && self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
+                self.rays = Some(MeasuredRays { summary: p.frame.ray_summary(), camera: p.camera, trace: p.trace });
+            }
+        }
+        let texture = match self.shown.take() {
+            Some(mut s) => {
+                s.texture.set(p.image, options);
+                s.texture
+            }
+            None => ctx.load_texture("bvhscope-view", p.image, options),
+        };
+        let build_label = p.bvh.label();
+        self.shown = Some(Shown {
+            texture,
+            frame: p.frame,
+            camera: p.camera,
+            legend: p.legend,
+            style: p.style,
+            rays_per_s,
+            build_label,
+            bvh: p.bvh,
+            trace: p.trace,
+            partial: p.partial,
+        });
+    }
+
+    /// Job results, and the actions of input outside the panels: dropped files and keys.
+    pub(super) fn handle_input(&mut self, ctx: &egui::Context, actions: &mut Actions) {
+        for event in self.jobs.poll() {
+            self.apply(ctx, event);
+        }
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
+        });
+        // A dump dropped is imported for the current mesh; anything else is opened.
+        let open = |p: PathBuf| if BvhDump::sniff(&p) { Action::ImportFile(p) } else { Action::OpenFile(p) };
+        actions.extend(dropped.into_iter().take(1).map(open));
+        actions.extend(shortcuts::pressed(ctx));
+        // Info messages fade out; errors stay until dismissed.
+        self.messages.retain(|m| m.kind != MessageKind::Info || m.at.elapsed() < Duration::from_secs(6));
+    }
+}

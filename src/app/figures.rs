@@ -1,0 +1,79 @@
+//! The plain data the app's state is made of: the image on screen and what produced it, the
+//! per-ray figures and what they depend on, a strategy's figures for the statistics panel, the
+//! messages, the path-typing window.
+
+use super::*;
+
+/// The image on screen and what produced it.
+pub struct Shown {
+    pub texture: egui::TextureHandle,
+    pub frame: Arc<Frame>,
+    pub camera: Camera,
+    pub legend: Option<Legend>,
+    pub style: ViewStyle,
+    /// The build replay's partial tree that traced the image, if it was one.
+    pub partial: Option<Arc<crate::bvh::replay::PartialBvh>>,
+    /// Rays per second of the last pass.
+    pub rays_per_s: f64,
+    /// The build that traced it ("SAH binned, wide4"), for captions.
+    pub build_label: String,
+    /// The BVH and traversal that traced it: a pinned pixel is traced again through them.
+    pub bvh: Arc<SceneBvh>,
+    pub trace: TraceOptions,
+}
+
+/// Per-ray figures of a full frame, with what they depend on besides the BVH: the camera (and
+/// image size) and the traversal options. Figures measured under other ones are not comparable.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeasuredRays {
+    pub summary: RaySummary,
+    pub camera: Camera,
+    pub trace: TraceOptions,
+}
+
+impl MeasuredRays {
+    /// Whether these figures and `other` come from the same rays (camera, image size, traversal).
+    pub fn comparable(&self, camera: &Camera, trace: &TraceOptions) -> bool {
+        self.camera == *camera && self.trace == *trace
+    }
+}
+
+/// One strategy's figures for the statistics panel (the current one and the one before).
+#[derive(Clone, Debug)]
+pub struct StrategyFigures {
+    pub label: String,
+    /// Of the tree the statistics rows describe (`BuiltBvh::stats`).
+    pub stats: TreeStats,
+    /// The whole build, every level.
+    pub build_ms: f64,
+    pub rays: Option<MeasuredRays>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MessageKind {
+    Info,
+    Warning,
+    Error,
+}
+
+#[derive(Clone, Debug)]
+pub struct Message {
+    pub kind: MessageKind,
+    pub text: String,
+    pub at: Instant,
+}
+
+/// The path-typing window: the way in when no file dialog is available, and always offered.
+pub struct PathWindow {
+    pub pick: Pick,
+    pub text: String,
+    pub note: Option<String>,
+    /// Its text field takes the keyboard when it first shows (then single-key shortcuts stop).
+    pub focus: bool,
+}
+
+impl PathWindow {
+    pub fn new(pick: Pick, text: String, note: Option<String>) -> Self {
+        Self { pick, text, note, focus: true }
+    }
+}
