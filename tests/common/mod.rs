@@ -115,7 +115,8 @@ fn check_tiling(mut ranges: Vec<std::ops::Range<usize>>, n: usize) {
 /// The wide layout: every slot box inside its parent's, leaf ranges tiling the triangles, each
 /// node reached exactly once, valid masks matching the slots.
 pub fn check_wide<const W: usize>(w: &WideBvh<W>, mesh: &Mesh) {
-    let refs = check_prims(&w.prim_ids, &w.tris, mesh, &w.params);
+    let tris = w.leaf_order_triangles();
+    let refs = check_prims(&w.prim_ids, &tris, mesh, &w.params);
     let mut ranges = Vec::new();
     let mut leaves = Vec::new();
     let mut reached = vec![0u32; w.nodes.len()];
@@ -145,7 +146,7 @@ pub fn check_wide<const W: usize>(w: &WideBvh<W>, mesh: &Mesh) {
     if !w.prim_ids.is_empty() {
         assert!(reached.iter().all(|&c| c == 1), "every wide node is reached exactly once");
     }
-    check_leaves_hold(&leaves, &w.prim_ids, &w.tris, &refs);
+    check_leaves_hold(&leaves, &w.prim_ids, &tris, &refs);
     check_tiling(ranges, w.prim_ids.len());
 }
 

@@ -274,7 +274,7 @@ fn to_wide<const W: usize>(mut leaves: Leaves) -> Option<(WideBvh<W>, Vec<u32>, 
     }
     let (prim_ids, tris) = (leaves.prim_ids, leaves.tris);
     let params = Leaves::params(if W == 8 { Layout::Wide8 } else { Layout::Wide4 });
-    let wide = WideBvh {
+    let mut wide = WideBvh {
         nodes,
         prim_ids,
         tris,
@@ -283,6 +283,7 @@ fn to_wide<const W: usize>(mut leaves: Leaves) -> Option<(WideBvh<W>, Vec<u32>, 
         report: Default::default(),
         simd: crate::cpu::Simd::chosen(),
     };
+    wide.store_leaves_by_coordinate();
     Some((wide, ids, leaf_ids))
 }
 

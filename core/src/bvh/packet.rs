@@ -223,8 +223,8 @@ impl<'r, T: TriangleIntersector> Packet<'r, T> {
 /// stack.
 pub(super) trait PacketTree {
     fn prim_ids(&self) -> &[u32];
-    /// Triangles in leaf order.
-    fn tris(&self) -> &[[glam::Vec3; 3]];
+    /// `f` of the triangles `start..start + count` of a leaf, in leaf order.
+    fn with_leaf<R>(&self, start: usize, count: usize, f: impl FnOnce(&[[glam::Vec3; 3]]) -> R) -> R;
     fn root_bounds(&self) -> Aabb;
     fn root(&self) -> u32;
     fn is_leaf(&self, r: u32) -> bool;
@@ -248,8 +248,9 @@ impl PacketTree for Bvh {
     fn prim_ids(&self) -> &[u32] {
         &self.prim_ids
     }
-    fn tris(&self) -> &[[glam::Vec3; 3]] {
-        &self.tris
+    #[inline(always)]
+    fn with_leaf<R>(&self, start: usize, count: usize, f: impl FnOnce(&[[glam::Vec3; 3]]) -> R) -> R {
+        f(&self.tris[start..start + count])
     }
     fn root_bounds(&self) -> Aabb {
         self.root_bounds()
@@ -377,7 +378,7 @@ fn walk<B: PacketTree, T: TriangleIntersector>(bvh: &B, rays: &mut [Ray], hits: 
             }
         } else {
             let (lo, hi, start, count) = bvh.leaf(cur);
-            if packet.leaf_groups(first, lo, hi, &bvh.tris()[start..start + count], start) {
+            if bvh.with_leaf(start, count, |tris| packet.leaf_groups(first, lo, hi, tris, start)) {
                 t_far = packet.t_far();
             }
         }

@@ -194,9 +194,13 @@ pub(crate) fn test_triangles<T: TriangleIntersector, const ANY: bool, S: Travers
 /// same closest hit kept, bit for bit. Counts are the one-by-one loop's too, so that no count
 /// depends on the CPU: every triangle of the leaf for a closest hit; for an any-hit query, the
 /// triangles up to the one that hit (the SIMD pass computed the rest of its group, unused).
+/// The `count` triangles come from the 8-wide layout's leaf storage: `coords` are the floats from
+/// the leaf's first one on, coordinate by coordinate (`wide::leaves`).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
-    tris: &[[glam::Vec3; 3]],
+    coords: &[f32],
+    count: usize,
     first: usize,
     ray: &mut Ray,
     stats: &mut S,
@@ -205,12 +209,12 @@ pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S:
     prim_of: impl Fn(usize) -> u32,
 ) -> bool {
     let p = *prepared.get_or_insert_with(|| T::prepare(ray));
-    for (g, group) in tris.chunks(4).enumerate() {
-        let hits = T::intersect_group(&p, ray, group);
+    for g in 0..count.div_ceil(4) {
+        let hits = T::intersect_group_coords(&p, ray, coords, count, g);
         if hits.mask == 0 && !S::STEPS {
             continue;
         }
-        for k in 0..group.len() {
+        for k in 0..(count - 4 * g).min(4) {
             let hit = (hits.mask & (1 << k) != 0 && hits.t[k] < ray.t_max).then(|| crate::geometry::TriangleHit {
                 t: hits.t[k],
                 u: hits.u[k],
@@ -230,7 +234,7 @@ pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S:
             }
         }
     }
-    stats.triangle_tests(tris.len() as u32);
+    stats.triangle_tests(count as u32);
     false
 }
 

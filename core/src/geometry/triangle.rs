@@ -59,6 +59,25 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
         }
         hits
     }
+
+    /// `intersect_group` of triangles `4g..4g + 4` (those below `count`) of a leaf stored
+    /// coordinate by coordinate (`coords`: the `count` values of v0.x, then of v0.y, …, v2.z; the
+    /// 8-wide layout's leaves). The watertight test loads its lanes straight from there; this
+    /// default gathers the triangles and runs `intersect_group`.
+    #[inline(always)]
+    fn intersect_group_coords(p: &Self::Prepared, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits4 {
+        let n = (count - 4 * g).min(4);
+        let c = |j: usize, k: usize| coords[j * count + 4 * g + k];
+        let tri = |k: usize| {
+            [
+                Vec3::new(c(0, k), c(1, k), c(2, k)),
+                Vec3::new(c(3, k), c(4, k), c(5, k)),
+                Vec3::new(c(6, k), c(7, k), c(8, k)),
+            ]
+        };
+        let tris = [tri(0), tri(1.min(n - 1)), tri(2.min(n - 1)), tri(3.min(n - 1))];
+        Self::intersect_group(p, ray, &tris[..n])
+    }
 }
 
 /// The hits of `intersect4`: lane k of each array is ray k's hit when bit k of `mask` is set.
@@ -153,6 +172,11 @@ impl TriangleIntersector for Watertight {
     #[inline(always)]
     fn intersect_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]]) -> Hits4 {
         super::triangle4::watertight_group(p, ray, tris)
+    }
+
+    #[inline(always)]
+    fn intersect_group_coords(p: &WatertightRay, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits4 {
+        super::triangle4::watertight_group_coords(p, ray, coords, count, g)
     }
 
     type Prepared4 = WatertightRay4;

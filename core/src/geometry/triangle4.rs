@@ -37,6 +37,37 @@ pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]])
     edge_test4([ax, ay, bx, by, cx, cy], z, f32x4::splat(ray.t_min), f32x4::splat(ray.t_max), lanes)
 }
 
+/// `watertight_group` of triangles `4g..4g + 4` (those below `count`) of a leaf stored coordinate
+/// by coordinate (`coords`, the 8-wide layout's leaves): each of the nine lanes is one load of four
+/// consecutive floats (past the leaf's last triangle they belong to the next coordinate or leaf,
+/// or are zero at the array's end, and are masked off). The same arithmetic as `watertight_group`.
+#[inline(always)]
+pub(super) fn watertight_group_coords(p: &WatertightRay, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits4 {
+    let n = count.saturating_sub(4 * g).min(4);
+    if n == 0 {
+        return Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+    }
+    let lanes = (1u32 << n) - 1;
+    let o = ray.origin();
+    let load = |j: usize| {
+        let at = j * count + 4 * g;
+        match coords.get(at..at + 4) {
+            Some(four) => f32x4::new([four[0], four[1], four[2], four[3]]),
+            None => f32x4::new(std::array::from_fn(|k| coords.get(at + k).copied().unwrap_or(0.0))),
+        }
+    };
+    let vertex = |v: usize| {
+        [load(3 * v) - f32x4::splat(o.x), load(3 * v + 1) - f32x4::splat(o.y), load(3 * v + 2) - f32x4::splat(o.z)]
+    };
+    let (a, b, c) = (vertex(0), vertex(1), vertex(2));
+    let dot = |v: &[f32x4; 3], r: Vec3| v[0] * f32x4::splat(r.x) + v[1] * f32x4::splat(r.y) + v[2] * f32x4::splat(r.z);
+    let (ax, ay) = (dot(&a, p.rx), dot(&a, p.ry));
+    let (bx, by) = (dot(&b, p.rx), dot(&b, p.ry));
+    let (cx, cy) = (dot(&c, p.rx), dot(&c, p.ry));
+    let z = [dot(&a, p.rz), dot(&b, p.rz), dot(&c, p.rz)];
+    edge_test4([ax, ay, bx, by, cx, cy], z, f32x4::splat(ray.t_min), f32x4::splat(ray.t_max), lanes)
+}
+
 /// The watertight test's second half, four lanes at once (one ray and four triangles, or four
 /// rays and one triangle): from the vertices' sheared coordinates `[ax, ay, bx, by, cx, cy]` and
 /// their distances along the ray `z` (`a·rz`, `b·rz`, `c·rz`), the edge functions (redone in double
@@ -127,6 +158,50 @@ mod tests {
                         (bits(h.t), bits(h.u), bits(h.v)),
                         "lane {}: bit for bit", k
                     );
+                }
+            }
+        }
+    }
+
+    /// A leaf of up to seven triangles stored coordinate by coordinate, as the 8-wide layout keeps
+    /// it, and a ray aimed into it.
+    fn leaf_case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ray, bool)> {
+        let pool = proptest::collection::vec(point(), 6);
+        let picks = proptest::collection::vec([0usize..6, 0usize..6, 0usize..6], 1..=7);
+        let aim = (0usize..7, 0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4);
+        (pool, picks, aim, proptest::bool::ANY).prop_map(|(pool, picks, (target, i, j, k, d, s), more)| {
+            let tris: Vec<[Vec3; 3]> = picks.iter().map(|p| p.map(|q| pool[q])).collect();
+            let t = &tris[target % tris.len()];
+            let w = (i + j + k).max(1) as f32;
+            let at = (t[0] * i as f32 + t[1] * j as f32 + t[2] * k as f32) / w;
+            let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
+            (tris, Ray::new(at - dir * s as f32, dir), more)
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3000))]
+        /// Each group of a leaf stored coordinate by coordinate is the scalar test of its
+        /// triangles, bit for bit, whether more data follows the leaf or the array ends there.
+        #[test]
+        fn a_leaf_stored_by_coordinate_tests_as_its_triangles((tris, ray, more) in leaf_case()) {
+            let count = tris.len();
+            let mut coords: Vec<f32> = (0..9).flat_map(|j| tris.iter().map(move |t| t[j / 3][j % 3])).collect();
+            if more {
+                coords.extend([7.0, -3.5, 1e9, f32::NAN]);
+            }
+            let p = Watertight::prepare(&ray);
+            for g in 0..count.div_ceil(4) {
+                let got = Watertight::intersect_group_coords(&p, &ray, &coords, count, g);
+                let n = (count - 4 * g).min(4);
+                prop_assert_eq!(got.mask >> n, 0, "no lane past the leaf");
+                for k in 0..n {
+                    let want = Watertight::intersect(&p, &ray, &tris[4 * g + k]);
+                    prop_assert_eq!(got.mask & (1 << k) != 0, want.is_some(), "group {} lane {}", g, k);
+                    if let Some(h) = want {
+                        let bits = |x: f32| x.to_bits();
+                        prop_assert_eq!((bits(got.t[k]), bits(got.u[k]), bits(got.v[k])), (bits(h.t), bits(h.u), bits(h.v)));
+                    }
                 }
             }
         }

@@ -21,6 +21,7 @@
 //! lose the guarantee that rays through shared edges hit.
 
 mod collapse;
+mod leaves;
 mod packet;
 mod traverse;
 
@@ -138,6 +139,8 @@ impl ChildRef {
 pub struct WideBvh<const W: usize = WIDTH> {
     pub nodes: Vec<WideNode<W>>,
     pub prim_ids: Vec<u32>,
+    /// The triangles in leaf order, 36 bytes each. In the 8-wide layout each leaf's bytes hold its
+    /// triangles coordinate by coordinate (`leaves.rs`); read them through `leaf_order_triangles`.
     pub tris: Vec<[Vec3; 3]>,
     pub root_bounds: Aabb,
     pub params: BuildParams,
@@ -171,12 +174,14 @@ impl<const W: usize> WideBvh<W> {
         } else {
             collapse_parallel(b, 0, 0).into_nodes()
         };
-        let mut report = bvh.report;
-        report.collapse_time = start.elapsed();
         let layout = if W == 8 { super::Layout::Wide8 } else { super::Layout::Wide4 };
         let params = BuildParams { layout, ..bvh.params };
         let simd = crate::cpu::Simd::chosen();
-        WideBvh { nodes, prim_ids: bvh.prim_ids, tris: bvh.tris, root_bounds, params, report, simd }
+        let (prim_ids, tris, report) = (bvh.prim_ids, bvh.tris, bvh.report);
+        let mut wide = WideBvh { nodes, prim_ids, tris, root_bounds, params, report, simd };
+        wide.store_leaves_by_coordinate();
+        wide.report.collapse_time = start.elapsed();
+        wide
     }
 }
 

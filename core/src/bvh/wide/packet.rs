@@ -14,8 +14,9 @@ impl<const W: usize> PacketTree for WideBvh<W> {
     fn prim_ids(&self) -> &[u32] {
         &self.prim_ids
     }
-    fn tris(&self) -> &[[glam::Vec3; 3]] {
-        &self.tris
+    #[inline(always)]
+    fn with_leaf<R>(&self, start: usize, count: usize, f: impl FnOnce(&[[glam::Vec3; 3]]) -> R) -> R {
+        WideBvh::with_leaf(self, start, count, f)
     }
     fn root_bounds(&self) -> Aabb {
         self.root_bounds

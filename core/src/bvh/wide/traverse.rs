@@ -235,11 +235,14 @@ impl<const W: usize> WideBvh<W> {
         let (mut prepared, mut best) = (None, None);
         self.walk_ray::<S, K, N>(kernel, ray, stats, |first, count, ray, stats| {
             let ids = |i: usize| self.prim_ids[i];
-            let tris = &self.tris[first..first + count];
             if GROUPED {
-                test_triangles_grouped::<T, ANY, S>(tris, first, ray, stats, &mut prepared, &mut best, ids)
+                // The 8-wide layout's leaves, coordinate by coordinate (`leaves.rs`).
+                let coords = &super::leaves::floats(&self.tris)[9 * first..];
+                test_triangles_grouped::<T, ANY, S>(coords, count, first, ray, stats, &mut prepared, &mut best, ids)
             } else {
-                test_triangles::<T, ANY, S>(tris, first, ray, stats, &mut prepared, &mut best, ids)
+                self.with_leaf(first, count, |tris| {
+                    test_triangles::<T, ANY, S>(tris, first, ray, stats, &mut prepared, &mut best, ids)
+                })
             }
         });
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })

@@ -1,0 +1,96 @@
+//! The 8-wide layout's leaves, stored for the four-triangle SIMD test: a leaf of `c` triangles
+//! keeps its 36·c bytes in the triangle array, but coordinate by coordinate — the `c` values of v0.x,
+//! then of v0.y, …, then of v2.z — so the test's nine lanes of a group of four are nine plain loads
+//! instead of thirty-six gathered floats. No padding: memory is the same as the other layouts'.
+//! Everything else that reads a leaf's triangles (the one-at-a-time test, packets, checks) goes
+//! through `with_leaf`, which hands it the triangles in leaf order, as the other layouts store them.
+
+use super::WideBvh;
+use glam::Vec3;
+
+const _: () = assert!(std::mem::size_of::<[Vec3; 3]>() == 36, "nine floats per triangle, no padding");
+
+/// The triangles' floats as one slice, nine per triangle.
+#[inline(always)]
+pub(crate) fn floats(tris: &[[Vec3; 3]]) -> &[f32] {
+    // SAFETY: `Vec3` is `repr(C)` of three `f32`s (asserted above: 36 bytes per triangle), so the
+    // array is `9 · len` floats, aligned for `f32`.
+    unsafe { std::slice::from_raw_parts(tris.as_ptr().cast::<f32>(), tris.len() * 9) }
+}
+
+fn floats_mut(tris: &mut [[Vec3; 3]]) -> &mut [f32] {
+    // SAFETY: as in `floats`, with the unique borrow of `tris`.
+    unsafe { std::slice::from_raw_parts_mut(tris.as_mut_ptr().cast::<f32>(), tris.len() * 9) }
+}
+
+/// Triangle `k` of a leaf of `count` triangles whose coordinates are `coords` (its `9·count`
+/// floats, coordinate by coordinate).
+#[inline(always)]
+pub(crate) fn triangle_of(coords: &[f32], count: usize, k: usize) -> [Vec3; 3] {
+    let c = |j: usize| coords[j * count + k];
+    [Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)), Vec3::new(c(6), c(7), c(8))]
+}
+
+impl<const W: usize> WideBvh<W> {
+    /// Rewrite every leaf's triangles coordinate by coordinate (8-wide trees only; done once,
+    /// after the collapse or an import).
+    pub(crate) fn store_leaves_by_coordinate(&mut self) {
+        if W != 8 {
+            return;
+        }
+        let leaves: Vec<(usize, usize)> = self
+            .nodes
+            .iter()
+            .flat_map(|n| n.slots().filter(|&s| n.count[s] > 0).map(|s| (n.child[s] as usize, n.count[s] as usize)))
+            .collect();
+        let all = floats_mut(&mut self.tris);
+        for (first, count) in leaves {
+            let leaf = &mut all[9 * first..9 * (first + count)];
+            let aos: Vec<f32> = leaf.to_vec();
+            for k in 0..count {
+                for j in 0..9 {
+                    leaf[j * count + k] = aos[9 * k + j];
+                }
+            }
+        }
+    }
+
+    /// The `9·count` floats of the leaf at `first` (8-wide trees: coordinate by coordinate).
+    #[inline(always)]
+    pub(crate) fn leaf_coords(&self, first: usize, count: usize) -> &[f32] {
+        &floats(&self.tris)[9 * first..9 * (first + count)]
+    }
+
+    /// `f` of the leaf's triangles in leaf order, whatever this layout stores.
+    #[inline(always)]
+    pub(crate) fn with_leaf<R>(&self, first: usize, count: usize, f: impl FnOnce(&[[Vec3; 3]]) -> R) -> R {
+        if W != 8 {
+            return f(&self.tris[first..first + count]);
+        }
+        let coords = self.leaf_coords(first, count);
+        if count <= 16 {
+            let mut buf = [[Vec3::ZERO; 3]; 16];
+            for (k, t) in buf[..count].iter_mut().enumerate() {
+                *t = triangle_of(coords, count, k);
+            }
+            f(&buf[..count])
+        } else {
+            f(&(0..count).map(|k| triangle_of(coords, count, k)).collect::<Vec<_>>())
+        }
+    }
+
+    /// Every triangle in leaf order, as the binary and 4-wide layouts store them (for checks).
+    pub fn leaf_order_triangles(&self) -> Vec<[Vec3; 3]> {
+        if W != 8 {
+            return self.tris.clone();
+        }
+        let mut out = self.tris.clone();
+        for n in &self.nodes {
+            for s in n.slots().filter(|&s| n.count[s] > 0) {
+                let (first, count) = (n.child[s] as usize, n.count[s] as usize);
+                self.with_leaf(first, count, |t| out[first..first + count].copy_from_slice(t));
+            }
+        }
+        out
+    }
+}
