@@ -22,19 +22,8 @@ pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]])
     let lanes = (1u32 << n) - 1;
     // Lane k reads triangle k; lanes past `n` repeat the last one (masked off below).
     let t: [&[Vec3; 3]; 4] = [&tris[0], &tris[1.min(n - 1)], &tris[2.min(n - 1)], &tris[3.min(n - 1)]];
-    // Vertex j's coordinate `axis` of each triangle relative to the origin.
-    let o = ray.origin();
-    let rel = |j: usize, axis: usize| {
-        f32x4::new([t[0][j][axis], t[1][j][axis], t[2][j][axis], t[3][j][axis]]) - f32x4::splat(o[axis])
-    };
-    let vertex = |j: usize| [rel(j, 0), rel(j, 1), rel(j, 2)];
-    let (a, b, c) = (vertex(0), vertex(1), vertex(2));
-    let dot = |v: &[f32x4; 3], r: Vec3| v[0] * f32x4::splat(r.x) + v[1] * f32x4::splat(r.y) + v[2] * f32x4::splat(r.z);
-    let (ax, ay) = (dot(&a, p.rx), dot(&a, p.ry));
-    let (bx, by) = (dot(&b, p.rx), dot(&b, p.ry));
-    let (cx, cy) = (dot(&c, p.rx), dot(&c, p.ry));
-    let z = [dot(&a, p.rz), dot(&b, p.rz), dot(&c, p.rz)];
-    edge_test4([ax, ay, bx, by, cx, cy], z, f32x4::splat(ray.t_min), f32x4::splat(ray.t_max), lanes)
+    let coord = |j: usize| f32x4::new(t.map(|t| t[j / 3][j % 3]));
+    one_ray_four(p, ray, coord, lanes)
 }
 
 /// `watertight_group` of triangles `4g..4g + 4` (those below `count`) of a leaf stored coordinate
@@ -48,7 +37,6 @@ pub(super) fn watertight_group_coords(p: &WatertightRay, ray: &Ray, coords: &[f3
         return Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
     }
     let lanes = (1u32 << n) - 1;
-    let o = ray.origin();
     let load = |j: usize| {
         let at = j * count + 4 * g;
         match coords.get(at..at + 4) {
@@ -56,8 +44,17 @@ pub(super) fn watertight_group_coords(p: &WatertightRay, ray: &Ray, coords: &[f3
             None => f32x4::new(std::array::from_fn(|k| coords.get(at + k).copied().unwrap_or(0.0))),
         }
     };
+    one_ray_four(p, ray, load, lanes)
+}
+
+/// The watertight test of four triangles against one ray, given `coord(j)`: coordinate j of each
+/// triangle (v0.x, v0.y, v0.z, v1.x, …, v2.z; lane k for triangle k). The vertices relative to the
+/// origin, sheared, then `edge_test4`: `Watertight::intersect`'s arithmetic, lane by lane.
+#[inline(always)]
+fn one_ray_four(p: &WatertightRay, ray: &Ray, coord: impl Fn(usize) -> f32x4, lanes: u32) -> Hits4 {
+    let o = ray.origin();
     let vertex = |v: usize| {
-        [load(3 * v) - f32x4::splat(o.x), load(3 * v + 1) - f32x4::splat(o.y), load(3 * v + 2) - f32x4::splat(o.z)]
+        [coord(3 * v) - f32x4::splat(o.x), coord(3 * v + 1) - f32x4::splat(o.y), coord(3 * v + 2) - f32x4::splat(o.z)]
     };
     let (a, b, c) = (vertex(0), vertex(1), vertex(2));
     let dot = |v: &[f32x4; 3], r: Vec3| v[0] * f32x4::splat(r.x) + v[1] * f32x4::splat(r.y) + v[2] * f32x4::splat(r.z);
