@@ -7,6 +7,7 @@
 
 use super::WideBvh;
 use glam::Vec3;
+use rayon::prelude::*;
 
 const _: () = assert!(std::mem::size_of::<[Vec3; 3]>() == 36, "nine floats per triangle, no padding");
 
@@ -38,21 +39,40 @@ impl<const W: usize> WideBvh<W> {
         if W != 8 {
             return;
         }
-        let leaves: Vec<(usize, usize)> = self
-            .nodes
-            .iter()
-            .flat_map(|n| n.slots().filter(|&s| n.count[s] > 0).map(|s| (n.child[s] as usize, n.count[s] as usize)))
-            .collect();
-        let all = floats_mut(&mut self.tris);
-        for (first, count) in leaves {
-            let leaf = &mut all[9 * first..9 * (first + count)];
-            let aos: Vec<f32> = leaf.to_vec();
+        // The leaves tile the array: each slot's count at its leaf's first triangle, then the array
+        // cut into the leaves' floats in one pass, and the leaves transposed on all threads.
+        let mut count_at = vec![0u8; self.tris.len()];
+        for n in &self.nodes {
+            for s in n.slots().filter(|&s| n.count[s] > 0) {
+                count_at[n.child[s] as usize] = n.count[s];
+            }
+        }
+        let mut rest = floats_mut(&mut self.tris);
+        let mut parts = Vec::new();
+        let mut i = 0;
+        while i < count_at.len() {
+            let count = count_at[i] as usize;
+            if count == 0 {
+                // Not a leaf's first triangle: cannot happen in a tiled array, but stay in step.
+                rest = &mut std::mem::take(&mut rest)[9..];
+                i += 1;
+                continue;
+            }
+            let (leaf, tail) = std::mem::take(&mut rest).split_at_mut(9 * count);
+            parts.push((leaf, count));
+            rest = tail;
+            i += count;
+        }
+        parts.into_par_iter().for_each(|(leaf, count)| {
+            let mut aos = [0f32; 9 * 16];
+            let aos: &mut [f32] = if count <= 16 { &mut aos[..9 * count] } else { &mut vec![0f32; 9 * count] };
+            aos.copy_from_slice(leaf);
             for k in 0..count {
                 for j in 0..9 {
                     leaf[j * count + k] = aos[9 * k + j];
                 }
             }
-        }
+        });
     }
 
     /// The `9·count` floats of the leaf at `first` (8-wide trees: coordinate by coordinate).
