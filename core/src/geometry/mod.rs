@@ -7,6 +7,8 @@ pub mod slab8;
 pub(crate) mod triangle;
 mod triangle4;
 
+pub(crate) use triangle4::leaf_triangle;
+
 pub use aabb::Aabb;
 pub use ray::Ray;
 pub use triangle::{

@@ -67,14 +67,7 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
     #[inline(always)]
     fn intersect_group_coords(p: &Self::Prepared, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits4 {
         let n = (count - 4 * g).min(4);
-        let c = |j: usize, k: usize| coords[j * count + 4 * g + k];
-        let tri = |k: usize| {
-            [
-                Vec3::new(c(0, k), c(1, k), c(2, k)),
-                Vec3::new(c(3, k), c(4, k), c(5, k)),
-                Vec3::new(c(6, k), c(7, k), c(8, k)),
-            ]
-        };
+        let tri = |k: usize| super::leaf_triangle(coords, count, 4 * g + k);
         let tris = [tri(0), tri(1.min(n - 1)), tri(2.min(n - 1)), tri(3.min(n - 1))];
         Self::intersect_group(p, ray, &tris[..n])
     }

@@ -11,6 +11,14 @@ use super::Ray;
 use glam::Vec3;
 use wide::f32x4;
 
+/// Triangle `k` of a leaf of `count` triangles whose coordinates are `coords` (its `9·count`
+/// floats, coordinate by coordinate).
+#[inline(always)]
+pub(crate) fn leaf_triangle(coords: &[f32], count: usize, k: usize) -> [Vec3; 3] {
+    let c = |j: usize| coords[j * count + k];
+    [Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)), Vec3::new(c(6), c(7), c(8))]
+}
+
 /// The watertight test of `tris` (at most four) against one ray: the mask of the triangles hit
 /// within `[ray.t_min, ray.t_max)` and, per lane, the hit's `t`, `u`, `v`.
 #[inline(always)]

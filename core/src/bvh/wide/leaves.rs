@@ -6,6 +6,7 @@
 //! through `with_leaf`, which hands it the triangles in leaf order, as the other layouts store them.
 
 use super::WideBvh;
+use crate::geometry::leaf_triangle;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -22,14 +23,6 @@ pub(crate) fn floats(tris: &[[Vec3; 3]]) -> &[f32] {
 fn floats_mut(tris: &mut [[Vec3; 3]]) -> &mut [f32] {
     // SAFETY: as in `floats`, with the unique borrow of `tris`.
     unsafe { std::slice::from_raw_parts_mut(tris.as_mut_ptr().cast::<f32>(), tris.len() * 9) }
-}
-
-/// Triangle `k` of a leaf of `count` triangles whose coordinates are `coords` (its `9·count`
-/// floats, coordinate by coordinate).
-#[inline(always)]
-pub(crate) fn triangle_of(coords: &[f32], count: usize, k: usize) -> [Vec3; 3] {
-    let c = |j: usize| coords[j * count + k];
-    [Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)), Vec3::new(c(6), c(7), c(8))]
 }
 
 impl<const W: usize> WideBvh<W> {
@@ -91,11 +84,11 @@ impl<const W: usize> WideBvh<W> {
         if count <= 16 {
             let mut buf = [[Vec3::ZERO; 3]; 16];
             for (k, t) in buf[..count].iter_mut().enumerate() {
-                *t = triangle_of(coords, count, k);
+                *t = leaf_triangle(coords, count, k);
             }
             f(&buf[..count])
         } else {
-            f(&(0..count).map(|k| triangle_of(coords, count, k)).collect::<Vec<_>>())
+            f(&(0..count).map(|k| leaf_triangle(coords, count, k)).collect::<Vec<_>>())
         }
     }
 
