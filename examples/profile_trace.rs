@@ -124,51 +124,6 @@ fn main() {
             })
             .collect()
     };
-    if let (Ok(n), AnyBvh::Wide8(w)) = (std::env::var("QUANT"), &bvh) {
-        // The quantised-node experiment: the same walk and leaves with 128-byte nodes, runs
-        // alternated with the plain walk; hits compared first.
-        use bvhscope::bvh::wide::quantised::quantise;
-        let n: usize = n.parse().expect("QUANT is a number of runs");
-        let q = quantise(w);
-        let mut differ = 0;
-        let (mut cq, mut cf) = (bvhscope::bvh::RayCounters::default(), bvhscope::bvh::RayCounters::default());
-        for r in &rays {
-            let (mut a, mut b) = (*r, *r);
-            let want = w.trace::<bvhscope::geometry::Watertight, true, false, _>(&mut a, &mut cf);
-            // SAFETY: the experiment runs on AVX2 machines only.
-            let got = unsafe { w.trace_quantised(&q, &mut b, &mut cq) };
-            differ += (want.map(|h| (h.t, h.prim)) != got.map(|h| (h.t, h.prim))) as usize;
-        }
-        let per = |c: &bvhscope::bvh::RayCounters| c.nodes_visited as f64 / rays.len() as f64;
-        println!(
-            "quantised: {differ} hits differ; nodes/ray {:.2} (plain {:.2}); node bytes {} (plain {})",
-            per(&cq),
-            per(&cf),
-            q.len() * 128,
-            w.nodes.len() * 256
-        );
-        let (mut tq, mut tf) = (Vec::new(), Vec::new());
-        for _ in 0..n {
-            let t = Instant::now();
-            for r in &rays {
-                let mut r = *r;
-                std::hint::black_box(w.trace::<bvhscope::geometry::Watertight, true, false, _>(&mut r, &mut NoStats));
-            }
-            tf.push(rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6);
-            let t = Instant::now();
-            for r in &rays {
-                let mut r = *r;
-                // SAFETY: as above.
-                std::hint::black_box(unsafe { w.trace_quantised(&q, &mut r, &mut NoStats) });
-            }
-            tq.push(rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6);
-        }
-        tf.sort_by(f64::total_cmp);
-        tq.sort_by(f64::total_cmp);
-        let (f, qq) = (tf[n / 2], tq[n / 2]);
-        println!("{what}: plain 256-byte nodes median {f:.2} MRays/s, quantised {qq:.2} ({:.3}x), {n} runs each", qq / f);
-        return;
-    }
     if let Some(n) = std::env::var("TIME").ok().and_then(|n| n.parse::<usize>().ok()) {
         let mut times: Vec<f64> = (0..n)
             .map(|_| {

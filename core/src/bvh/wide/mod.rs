@@ -23,7 +23,6 @@
 mod collapse;
 mod leaves;
 mod packet;
-pub mod quantised;
 mod traverse;
 
 use collapse::{collapse_parallel, collapse_sequential, PARALLEL_MIN_NODES};

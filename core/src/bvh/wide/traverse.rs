@@ -23,7 +23,7 @@ use crate::geometry::{Ray, TriangleIntersector};
 /// Deepest stack a traversal can need: at most W − 1 pushes per level (the build bounds the depth
 /// by `TRAVERSAL_STACK_SIZE`).
 pub(super) const STACK: usize = 3 * crate::bvh::TRAVERSAL_STACK_SIZE + 4;
-pub(super) const STACK8: usize = 7 * crate::bvh::TRAVERSAL_STACK_SIZE + 8;
+const STACK8: usize = 7 * crate::bvh::TRAVERSAL_STACK_SIZE + 8;
 
 impl<const W: usize> WideBvh<W> {
     /// Start loading a child that goes on the stack: the node, or a leaf's first triangle.
