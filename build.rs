@@ -15,9 +15,13 @@ fn main() {
         return;
     }
     let mut dirs: Vec<PathBuf> = std::env::var_os("EMBREE_DIR").map(PathBuf::from).into_iter().collect();
-    dirs.extend(
-        ["/usr/lib/x86_64-linux-gnu", "/usr/lib/aarch64-linux-gnu", "/usr/lib", "/usr/local/lib"].map(PathBuf::from),
-    );
+    // Only a library built for the target: cross-compiling (to aarch64 on an x86-64 machine, say)
+    // must not pick up the machine's own Embree.
+    let arch = std::env::var("CARGO_CFG_TARGET_ARCH").unwrap_or_default();
+    dirs.push(PathBuf::from(format!("/usr/lib/{arch}-linux-gnu")));
+    if std::env::var("HOST").ok() == std::env::var("TARGET").ok() {
+        dirs.extend(["/usr/lib", "/usr/local/lib"].map(PathBuf::from));
+    }
     if let Some(dir) = dirs.iter().find(|d| d.join("libembree3.so").exists()) {
         println!("cargo::rustc-cfg=embree");
         println!("cargo::rustc-link-search=native={}", dir.display());
