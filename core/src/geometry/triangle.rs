@@ -105,25 +105,21 @@ impl TriangleIntersector for Watertight {
 
     #[inline(always)]
     fn prepare(ray: &Ray) -> WatertightRay {
+        // kz: the axis of the direction's largest component; kx, ky the next two, swapped when
+        // that component is negative, to keep the winding of the sheared triangle independent
+        // of the direction's sign. Chosen without branches (random directions would mispredict
+        // them on every ray) from a table of the six cases.
+        const AXES: [[usize; 3]; 6] = [[1, 2, 0], [2, 1, 0], [2, 0, 1], [0, 2, 1], [0, 1, 2], [1, 0, 2]];
+        const UNIT: [Vec3; 4] = [Vec3::X, Vec3::Y, Vec3::Z, Vec3::ZERO];
         let d = ray.dir();
         let a = d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Keep the winding of the sheared triangle independent of the direction's sign.
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
-        let unit = |k: usize| Vec3::from_array(std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 }));
-        let rz_axis = unit(kz);
-        WatertightRay { rx: unit(kx) - rz_axis * sx, ry: unit(ky) - rz_axis * sy, rz: rz_axis * sz }
+        let x_largest = (a.x >= a.y) & (a.x >= a.z);
+        let kz = if x_largest { 0 } else { 2 - (a.y >= a.z) as usize };
+        let dd = d.extend(0.0).to_array();
+        let [kx, ky, kz] = AXES[2 * kz + (dd[kz & 3] < 0.0) as usize].map(|k| k & 3);
+        let (sx, sy, sz) = (dd[kx] / dd[kz], dd[ky] / dd[kz], 1.0 / dd[kz]);
+        let rz_axis = UNIT[kz];
+        WatertightRay { rx: UNIT[kx] - rz_axis * sx, ry: UNIT[ky] - rz_axis * sy, rz: rz_axis * sz }
     }
 
     #[inline(always)]
@@ -417,6 +413,49 @@ mod tests {
             let hit2 = intersect_triangle(TriangleTest::Watertight, &r, &t2).is_some();
             assert!(hit1 || hit2, "gap at s = {s}");
         }
+    }
+
+    /// The branch-free choice of axes in `prepare` against the paper's rule written out (Woop,
+    /// Benthin & Wald 2013, §3: kz the largest component, kx and ky the next two, swapped when
+    /// that component is negative), bit for bit, on directions with ties, zeros of both signs and
+    /// every sign pattern.
+    #[test]
+    fn the_shear_axes_follow_the_papers_rule_in_every_case() {
+        let reference = |d: Vec3| {
+            let a = d.abs();
+            let kz = if a.x >= a.y && a.x >= a.z {
+                0
+            } else if a.y >= a.z {
+                1
+            } else {
+                2
+            };
+            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if d[kz] < 0.0 {
+                std::mem::swap(&mut kx, &mut ky);
+            }
+            let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+            let unit = |k: usize| Vec3::from_array(std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 }));
+            [unit(kx) - unit(kz) * sx, unit(ky) - unit(kz) * sy, unit(kz) * sz]
+        };
+        let values = [-2.0f32, -1.0, -0.5, -0.0, 0.0, 0.5, 1.0, 2.0];
+        let mut tested = 0;
+        for x in values {
+            for y in values {
+                for z in values {
+                    let d = Vec3::new(x, y, z);
+                    if d == Vec3::ZERO {
+                        continue;
+                    }
+                    let ray = Ray::new(Vec3::ZERO, d);
+                    let p = Watertight::prepare(&ray);
+                    let bits = |v: [Vec3; 3]| v.map(|r| r.to_array().map(f32::to_bits));
+                    assert_eq!(bits([p.rx, p.ry, p.rz]), bits(reference(ray.dir())), "direction {d}");
+                    tested += 1;
+                }
+            }
+        }
+        assert_eq!(tested, 8 * 8 * 8 - 8, "all but the zero directions (both signs of zero)");
     }
 
     #[test]
