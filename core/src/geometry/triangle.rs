@@ -116,6 +116,7 @@ impl WatertightRay {
             2
         };
         let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        // Keep the winding of the sheared triangle independent of the direction's sign.
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
