@@ -210,4 +210,40 @@ fn replay_writes_an_animated_png_and_the_sah_cost_per_step() {
     let text = String::from_utf8_lossy(&stats.stdout);
     let sah = text.lines().find(|l| l.starts_with("SAH cost")).unwrap().split_whitespace().nth(2).unwrap().to_string();
     assert_eq!(format!("{:.3}", rows.last().unwrap()[1]), sah, "the last step is the finished tree");
+    assert_eq!(rows.len(), 6, "the frames asked for");
+
+    // A .gif is a real GIF (slide software plays it), with the frames asked for; another name is
+    // refused before anything is rendered, and nothing is written.
+    for frames in ["20", "24"] {
+        let gif = tmp(&format!("replay-{frames}.gif"));
+        let args = [
+            "replay",
+            torus,
+            "--strategy",
+            "midpoint",
+            "--size",
+            "48x32",
+            "--frames",
+            frames,
+            "-o",
+            gif.to_str().unwrap(),
+        ];
+        let out = bvhscope(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let table = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(table.lines().skip(1).count(), frames.parse::<usize>().unwrap(), "{table}");
+        let bytes = std::fs::read(&gif).unwrap();
+        assert!(bytes.starts_with(b"GIF89a"), "a GIF, not a PNG under a .gif name");
+        let mut d = gif::DecodeOptions::new().read_info(&bytes[..]).unwrap();
+        let mut n = 0;
+        while d.read_next_frame().unwrap().is_some() {
+            n += 1;
+        }
+        assert_eq!(n.to_string(), frames);
+    }
+    let mp4 = tmp("replay.mp4");
+    let out = bvhscope(&["replay", torus, "--size", "48x32", "-o", mp4.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("must end in .gif or .png"));
+    assert!(!mp4.exists());
 }

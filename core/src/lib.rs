@@ -8,9 +8,13 @@
 
 pub mod bvh;
 pub mod cpu;
+pub mod dump;
+pub mod explain;
+pub mod files;
 pub mod geometry;
 pub mod mesh;
 pub mod options;
+pub mod random;
 pub mod render;
 pub mod scene;
 pub mod work;

@@ -22,6 +22,7 @@ impl BvhscopeApp {
                 }
             }
             JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
+            JobEvent::Failed(e) => self.message(MessageKind::Error, e),
             JobEvent::Explained(e) => {
                 // A new tree: keep the selection where the id still exists, and its open rows.
                 let n = e.tree.nodes.len() as u32;
@@ -85,6 +86,9 @@ impl BvhscopeApp {
 
     /// Act on a chosen file.
     pub(super) fn picked(&mut self, pick: Pick, path: PathBuf) {
+        if let Err(e) = export::check_output(self, pick, &path) {
+            return self.message(MessageKind::Error, e);
+        }
         let result = match pick {
             Pick::Open => {
                 self.jobs.load(path);
@@ -101,7 +105,7 @@ impl BvhscopeApp {
             Pick::SaveBvh => export::save_bvh(self, &path),
             Pick::SaveScene => self
                 .scene_file_text()
-                .and_then(|t| std::fs::write(&path, t).map_err(|e| format!("{}: cannot write: {e}", path.display()))),
+                .and_then(|t| crate::files::write_bytes(&path, t.as_bytes()).map_err(|e| e.to_string())),
         };
         match result {
             Ok(()) => self.message(MessageKind::Info, format!("Saved {}", path.display())),

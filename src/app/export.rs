@@ -1,9 +1,10 @@
 //! Saving what the app shows: the view as PNG (heatmaps with their legend), the statistics as CSV
 //! or JSON (current strategy and the one before).
 
+use super::jobs::Pick;
 use super::{BvhscopeApp, StrategyFigures};
 use crate::render::{draw_legend, full_size, view_image};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StatsFormat {
@@ -23,6 +24,32 @@ pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
     }
 }
 
+/// Before anything is written: the file named for what it will hold, and none of the files the
+/// app has open (the scene, its meshes, the imported dump).
+pub fn check_output(app: &BvhscopeApp, pick: Pick, path: &Path) -> Result<(), String> {
+    use crate::files::{CSV, JSON, PNG};
+    let kind = match pick {
+        Pick::Open | Pick::OpenBvh => return Ok(()),
+        Pick::SavePng => PNG,
+        Pick::SaveStatsCsv | Pick::SaveCounts => CSV,
+        Pick::SaveStatsJson | Pick::SaveScene => JSON,
+        Pick::SaveBvh => return crate::dump::BvhDump::written_as(path).map(|_| ()),
+    };
+    kind.check(path).map_err(|e| e.to_string())?;
+    let mut inputs: Vec<(PathBuf, &str)> = Vec::new();
+    if let crate::scene::SceneSource::File(p) = &app.scene.source {
+        inputs.push((p.clone(), "the scene or mesh open"));
+    }
+    for m in app.scene.desc.iter().flat_map(|d| &d.meshes) {
+        inputs.push((m.file.clone(), "a mesh of the scene open"));
+    }
+    if let Some(t) = &app.import.tree {
+        inputs.push((t.path.clone(), "the imported BVH dump"));
+    }
+    let inputs: Vec<(&Path, &str)> = inputs.iter().map(|(p, w)| (p.as_path(), *w)).collect();
+    crate::files::refuse_inputs(path, &inputs).map_err(|e| e.to_string())
+}
+
 pub fn save_png(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
     let shown = app.shown.as_ref().ok_or("nothing rendered yet")?;
     let s = shown.style;
@@ -36,7 +63,7 @@ pub fn save_png(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
         Some(l) => draw_legend(&img, l),
         None => img,
     };
-    img.save(path).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+    crate::files::write_png(path, &img).map_err(|e| e.to_string())
 }
 
 fn rows(app: &BvhscopeApp) -> Vec<(&'static str, StrategyFigures)> {
@@ -137,7 +164,7 @@ pub fn stats_text(app: &BvhscopeApp, format: StatsFormat) -> Result<String, Stri
 pub fn save_counts(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
     let shown = app.shown.as_ref().ok_or("nothing rendered yet")?;
     let text = shown.frame.counts_csv().ok_or("the frame is still refining; export once it is complete")?;
-    std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+    crate::files::write_bytes(path, text.as_bytes()).map_err(|e| e.to_string())
 }
 
 /// The current single BVH as a bvhscope-bvh dump (`bvhscope export-bvh` writes the same), JSON or
@@ -151,13 +178,13 @@ pub fn save_bvh(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
         crate::scene::SceneSource::File(p) => p.file_name().map(|n| n.to_string_lossy().into_owned()),
         crate::scene::SceneSource::Builtin => None,
     };
-    let dump = crate::bvh::dump::BvhDump::of_any(bvh, mesh, name);
-    dump.write(path).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+    let dump = crate::dump::BvhDump::of_any(bvh, mesh, name);
+    dump.write(path).map_err(|e| e.to_string())
 }
 
 pub fn save_stats(app: &BvhscopeApp, path: &Path, format: StatsFormat) -> Result<(), String> {
     let text = stats_text(app, format)?;
-    std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+    crate::files::write_bytes(path, text.as_bytes()).map_err(|e| e.to_string())
 }
 
 #[cfg(test)]

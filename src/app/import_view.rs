@@ -1,18 +1,18 @@
 //! Bring your own BVH, in the app: a dump read for the current scene's mesh and checked
-//! (`bvh::check`, as `bvhscope check` does), one more entry in the strategy list ("imported:
+//! (`explain::check`, as `bvhscope check` does), one more entry in the strategy list ("imported:
 //! FILE") that every view traces like a built tree, the checker's findings (the Imported BVH
 //! window), and the pixels of the frame on screen whose hit differs from the linear scan's (a red
-//! mask, `bvh::check::wrong_rays` over the frame's primary rays).
+//! mask, `explain::check::wrong_rays` over the frame's primary rays).
 
-use crate::bvh::check::Finding;
 use crate::bvh::{SceneBvh, TraceOptions};
+use crate::explain::check::Finding;
 use crate::render::Camera;
 use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Random rays the app's check traces besides the frame's (the CLI's default is a million; the
 /// app keeps the wait short and says how many it traced).
-pub const CHECK_RAYS: usize = 100_000;
+pub const CHECK_RAYS: u64 = 100_000;
 
 /// A dump read and checked for one scene.
 pub struct ImportedTree {
@@ -24,9 +24,9 @@ pub struct ImportedTree {
     pub bvh: Result<Arc<SceneBvh>, String>,
     pub findings: Vec<Finding>,
     /// Random rays traced against the linear scan, besides the frame's.
-    pub rays: usize,
+    pub rays: u64,
     /// What the rays were checked against (kept for the wrong pixels of every view).
-    pub reference: Option<Arc<crate::bvh::check::Reference>>,
+    pub reference: Option<Arc<crate::explain::check::Reference>>,
 }
 
 impl ImportedTree {

@@ -113,6 +113,8 @@ pub enum JobEvent {
         path: Option<PathBuf>,
         took: Duration,
     },
+    /// The job panicked (`Jobs::spawn`): what to tell the user.
+    Failed(String),
 }
 
 /// A job in flight.
@@ -192,6 +194,24 @@ impl Jobs {
         }
     }
 
+    /// Run `work` for `job` on a thread of its own. A panic there (a bug) must not leave the job
+    /// running forever in the status bar: it is caught and reported as the job's failure.
+    fn spawn(&self, job: &Running, work: impl FnOnce() + Send + 'static) {
+        let (fail, label) = (self.sender(job.id), job.label.clone());
+        std::thread::spawn(move || {
+            if let Err(panic) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)) {
+                let why = panic
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "a panic".into());
+                fail(JobEvent::Failed(format!(
+                    "{label} failed: {why} (an internal error of bvhscope; please report it)"
+                )));
+            }
+        });
+    }
+
     pub fn is_busy(&self) -> bool {
         self.load.is_some() || self.build.is_some() || self.render.is_some()
     }
@@ -201,7 +221,7 @@ impl Jobs {
     pub fn load(&mut self, path: PathBuf) {
         let job = self.start(format!("Loading {}", path.display()));
         let send = self.sender(job.id);
-        std::thread::spawn(move || {
+        self.spawn(&job, move || {
             let result = Scene::open(&path).map(Arc::new).map_err(|e| e.to_string());
             send(JobEvent::Loaded(result));
         });
@@ -219,7 +239,7 @@ impl Jobs {
         };
         let job = self.start(label);
         let (send, control) = (self.sender(job.id), job.control.clone());
-        std::thread::spawn(move || {
+        self.spawn(&job, move || {
             let result = scene.build(&params, &control).map(Arc::new);
             send(JobEvent::Built { scene_id, params, result });
         });
@@ -243,7 +263,7 @@ impl Jobs {
         let job = self.start("Rendering".to_string());
         let (send, control) = (self.sender(job.id), job.control.clone());
         let (r, frames) = (req.clone(), self.frames.clone());
-        std::thread::spawn(move || {
+        self.spawn(&job, move || {
             // Always count: the heatmaps and the hover read-out need the counters, and counting
             // costs little next to shading.
             let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive };
@@ -271,7 +291,7 @@ impl Jobs {
     pub fn explain(&mut self, bvh: Arc<SceneBvh>) {
         let job = self.start("Preparing the tree view".to_string());
         let send = self.sender(job.id);
-        std::thread::spawn(move || {
+        self.spawn(&job, move || {
             if let Some(tree) = bvh.binary_tree() {
                 let tree = Arc::new(tree.into_owned());
                 send(JobEvent::Explained(Arc::new(Explained::new(bvh.clone(), tree))));
@@ -297,7 +317,7 @@ impl Jobs {
         }
         let job = self.start(format!("Building and tracing B ({})", build.bvh.strategy.label()));
         let (send, control, frames) = (self.sender(job.id), job.control.clone(), self.frames.clone());
-        std::thread::spawn(move || {
+        self.spawn(&job, move || {
             let bvh = match have.filter(|b| b.build_params() == build) {
                 Some(b) => b,
                 None => match scene.build(&build, &control) {
@@ -326,7 +346,7 @@ impl Jobs {
         }
         let job = self.start("Counting visits per node".to_string());
         let (send, control) = (self.sender(job.id), job.control.clone());
-        std::thread::spawn(move || {
+        self.spawn(&job, move || {
             if let Ok(v) = crate::bvh::visits::frame_visits(&explained.tree, &camera, trace, &control) {
                 send(JobEvent::Visits(FrameVisits { explained, camera, trace, counts: v.counts }));
             }
@@ -338,9 +358,9 @@ impl Jobs {
     /// `CHECK_RAYS` random rays and `camera`'s primary rays.
     pub fn import(&mut self, path: PathBuf, scene: Arc<Scene>, scene_id: u64, camera: Camera, trace: TraceOptions) {
         let job = self.start(format!("Checking {}", path.display()));
-        let send = self.sender(job.id);
-        std::thread::spawn(move || {
-            let tree = import_tree(path, &scene, scene_id, &camera, trace);
+        let (send, control) = (self.sender(job.id), job.control.clone());
+        self.spawn(&job, move || {
+            let tree = import_tree(path, &scene, scene_id, &camera, trace, &control);
             send(JobEvent::Imported(tree.map(Box::new)));
         });
         self.import = Some(job);
@@ -351,18 +371,19 @@ impl Jobs {
     pub fn wrong(
         &mut self,
         bvh: Arc<SceneBvh>,
-        reference: Arc<crate::bvh::check::Reference>,
+        reference: Arc<crate::explain::check::Reference>,
         camera: Camera,
         trace: TraceOptions,
     ) {
         let job = self.start("Finding wrong pixels".to_string());
-        let send = self.sender(job.id);
-        std::thread::spawn(move || {
+        let (send, control) = (self.sender(job.id), job.control.clone());
+        self.spawn(&job, move || {
             let SceneBvh::Single { mesh, .. } = &*bvh else { return };
-            let rays = crate::bvh::check::check_rays(mesh, &camera, 0);
-            let wrong = crate::bvh::check::wrong_rays(&*bvh, mesh, &reference, &rays, trace);
-            let pixels = wrong.iter().filter_map(|w| w.pixel).collect();
-            send(JobEvent::Wrong(WrongPixels { bvh, camera, trace, pixels }));
+            let rays = crate::explain::check::RaySet::new(mesh, &camera, 0);
+            let Ok(wrong) = crate::explain::check::wrong_rays(&*bvh, mesh, &reference, &rays, trace, &control) else {
+                return;
+            };
+            send(JobEvent::Wrong(WrongPixels { bvh, camera, trace, pixels: wrong.pixels }));
         });
         self.wrong = Some(job);
     }
@@ -371,7 +392,7 @@ impl Jobs {
     pub fn inspect(&mut self, explained: Arc<Explained>, node: u32) {
         let job = self.start(format!("Inspecting node {node}"));
         let send = self.sender(job.id);
-        std::thread::spawn(move || {
+        self.spawn(&job, move || {
             if let Some(ins) = crate::bvh::inspect::inspect(&explained.tree, &explained.hierarchy, node) {
                 send(JobEvent::Inspected { node, explained, inspection: Arc::new(ins) });
             }
@@ -419,6 +440,28 @@ impl Jobs {
         let mut out = Vec::new();
         while let Ok((id, event)) = self.rx.try_recv() {
             let current = |slot: &Option<Running>| slot.as_ref().is_some_and(|r| r.id == id);
+            if let JobEvent::Failed(_) = &event {
+                // Whichever job it was is over.
+                for slot in [
+                    &mut self.load,
+                    &mut self.build,
+                    &mut self.render,
+                    &mut self.explain,
+                    &mut self.visits,
+                    &mut self.compare,
+                    &mut self.import,
+                    &mut self.wrong,
+                ] {
+                    if slot.as_ref().is_some_and(|r| r.id == id) {
+                        *slot = None;
+                    }
+                }
+                if self.inspect.as_ref().is_some_and(|(r, _)| r.id == id) {
+                    self.inspect = None;
+                }
+                out.push(event);
+                continue;
+            }
             match &event {
                 JobEvent::Loaded(_) if current(&self.load) => self.load = None,
                 JobEvent::Built { .. } if current(&self.build) => self.build = None,
@@ -444,7 +487,7 @@ impl Jobs {
     }
 }
 
-/// A dump read and checked (`bvh::check::check`) for `scene`, as the Imported BVH window shows it,
+/// A dump read and checked (`explain::check::check`) for `scene`, as the Imported BVH window shows it,
 /// or one line naming the file and why it cannot be read.
 fn import_tree(
     path: PathBuf,
@@ -452,18 +495,26 @@ fn import_tree(
     scene_id: u64,
     camera: &Camera,
     trace: TraceOptions,
+    control: &WorkControl,
 ) -> Result<ImportedTree, String> {
-    use crate::bvh::check::{check, Group};
-    let dump = crate::bvh::dump::BvhDump::read(&path).map_err(|e| e.to_string())?;
+    use crate::explain::check::{check, Group, Subject};
     let mesh = scene.flat_mesh().map_err(|e| format!("{}: {e}", scene.title()))?;
-    let checked = check(&dump, &path, &mesh, camera, CHECK_RAYS, trace);
+    let limit = crate::dump::max_bytes(mesh.file_triangle_count());
+    let dump = crate::dump::BvhDump::read(&path, limit).map_err(|e| e.to_string())?;
+    let mesh_path = match &scene.source {
+        crate::scene::SceneSource::File(p) => p.clone(),
+        crate::scene::SceneSource::Builtin => PathBuf::from(scene.title()),
+    };
+    let subject = Subject { dump: &dump, dump_path: &path, mesh: &mesh, mesh_path: &mesh_path };
+    let checked =
+        check(&subject, camera, CHECK_RAYS, trace, control).map_err(|_| "the check was cancelled".to_string())?;
     let (findings, traced, reference) = (checked.findings, checked.tree, checked.reference.map(Arc::new));
     let bvh = match traced {
         Some((bvh, names)) => Ok(Arc::new(SceneBvh::imported(bvh, mesh, names))),
         None => Err(findings
             .iter()
             .find(|f| f.group == Group::Rays || f.group == Group::Structure)
-            .map_or("it cannot be traced".into(), |f| f.text.clone())),
+            .map_or("it cannot be traced".into(), |f| f.line(crate::explain::check::LISTED))),
     };
     Ok(ImportedTree { path, scene_id, bvh, findings, rays: CHECK_RAYS, reference })
 }

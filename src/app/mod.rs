@@ -39,8 +39,8 @@ pub use replay_view::ReplayView;
 pub use scene::BuiltBvh;
 pub use settings::{BoxLevel, Settings};
 
-use crate::bvh::dump::BvhDump;
 use crate::bvh::{SceneBuild, SceneBvh, TraceOptions, TreeStats};
+use crate::dump::BvhDump;
 use crate::render::{Camera, Frame, Legend, RaySummary, UpAxis, View};
 use crate::scene::SceneBuildError;
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};

@@ -169,6 +169,23 @@ pub fn shell_word(s: &str) -> String {
     }
 }
 
+/// How much of a BVH dump is read (`--bvh`): a dump decompressed past the limit is refused while
+/// it is read (a gzip bomb, a device).
+#[derive(Args, Debug, Clone, Default)]
+pub struct DumpLimit {
+    /// Largest BVH dump read, in MB after decompression [default: what a dump of the mesh can
+    /// need: 64 MB and 6.5 kB per triangle].
+    #[arg(long, value_name = "MB", value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    pub max_dump_mb: Option<u64>,
+}
+
+impl DumpLimit {
+    /// The limit in bytes for a dump of `mesh`.
+    pub fn bytes(&self, mesh: &crate::mesh::Mesh) -> u64 {
+        self.max_dump_mb.map_or_else(|| crate::dump::max_bytes(mesh.file_triangle_count()), |mb| mb << 20)
+    }
+}
+
 /// The camera and image size of a render.
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
@@ -179,7 +196,7 @@ pub struct ViewArgs {
     /// Default: frames the mesh from the front.
     #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     pub camera: Option<(Vec3, Vec3, Option<Vec3>)>,
-    /// Vertical field of view in degrees (between 0 and 180).
+    /// Vertical field of view in degrees (0.01 to 179.9).
     #[arg(long, default_value_t = 45.0, value_parser = parse_fov)]
     pub fov: f32,
     /// Which axis of the mesh points up: the default camera frames it from the front with this
@@ -206,11 +223,12 @@ impl ViewArgs {
     }
 }
 
-/// A vertical field of view strictly between 0 and 180 degrees.
+/// A vertical field of view within the camera's limits.
 pub fn parse_fov(s: &str) -> Result<f32, String> {
+    let (lo, hi) = (Camera::MIN_VFOV_DEG, Camera::MAX_VFOV_DEG);
     match s.trim().parse::<f32>() {
-        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
-        _ => Err(format!("'{s}' is not an angle between 0 and 180 degrees")),
+        Ok(v) if (lo..=hi).contains(&v) => Ok(v),
+        _ => Err(format!("'{s}' is not an angle from {lo} to {hi} degrees")),
     }
 }
 

@@ -1,13 +1,13 @@
 //! `bvhscope check MESH --bvh FILE`: a BVH written by another program, checked against the mesh
-//! and the linear scan (`bvh::check`), then set next to bvhscope's strategies on the same mesh.
+//! and the linear scan (`explain::check`), then set next to bvhscope's strategies on the same mesh.
 //! Exit 0: correct (warnings allowed); 1: defects; 2: the input cannot be read.
 //! `bvhscope export-bvh MESH -o FILE`: a built-in strategy's tree in the same format.
 
-use super::args::{BuildArgs, ViewArgs};
+use super::args::{BuildArgs, DumpLimit, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::check::{check, Finding, Group};
-use crate::bvh::dump::BvhDump;
 use crate::bvh::{epo, AnyBvh, BuildParams, Layout, SceneBvh, SplitStrategy, TreeStats, TreeView};
+use crate::dump::BvhDump;
+use crate::explain::check::{check, Finding, Group, Subject, LISTED, MAX_RAYS};
 use crate::render::{render, RenderSettings};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
@@ -26,9 +26,12 @@ pub struct CheckArgs {
     /// The BVH: bvhscope-bvh JSON, .json.gz, or the text form (see the README).
     #[arg(long)]
     pub bvh: PathBuf,
-    /// Random rays traced against the linear scan, besides the frame's primary rays.
-    #[arg(long, default_value_t = 1_000_000)]
-    pub rays: usize,
+    /// Random rays traced against the linear scan, besides the frame's primary rays (at most
+    /// 100,000,000; they are traced in batches, memory does not grow with their count).
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(0..=MAX_RAYS))]
+    pub rays: u64,
+    #[command(flatten)]
+    pub dump_limit: DumpLimit,
     /// The frame whose primary rays are traced and counted.
     #[command(flatten)]
     pub view_args: ViewArgs,
@@ -40,6 +43,10 @@ pub struct CheckArgs {
     /// of the time on a big mesh).
     #[arg(long)]
     pub no_compare: bool,
+    /// List every case of each finding (by default a finding lists its first few and how many
+    /// there are in all).
+    #[arg(long)]
+    pub all: bool,
 }
 
 /// One row of the quality table.
@@ -91,12 +98,16 @@ pub fn run(a: &CheckArgs) -> Result<(), CliError> {
 /// What `run` prints, and the number of defects (the app's tests compare it with the Imported BVH
 /// window).
 pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
-    let dump = BvhDump::read(&a.bvh).map_err(|e| CliError::Usage(e.to_string()))?;
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
+    let dump = BvhDump::read(&a.bvh, a.dump_limit.bytes(&mesh)).map_err(|e| CliError::Usage(e.to_string()))?;
     let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
     let trace = a.build.trace();
-    let checked = progress::with_spinner("checking the BVH", || check(&dump, &a.bvh, &mesh, &camera, a.rays, trace));
+    let subject = Subject { dump: &dump, dump_path: &a.bvh, mesh: &mesh, mesh_path: &a.mesh };
+    let control = crate::work::WorkControl::new();
+    let checked =
+        progress::with_bar("checking the BVH", &control, || check(&subject, &camera, a.rays, trace, &control))
+            .map_err(|_| CliError::Usage("check cancelled".into()))?;
     let (findings, imported) = (checked.findings, checked.tree);
     let defects = findings.iter().filter(|f| f.defect).count();
     // The imported tree next to bvhscope's strategies, on the same mesh, frame and constants.
@@ -122,12 +133,12 @@ pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
             });
             let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
-        CheckFormat::Text => o = text(&a.bvh, &findings, &table),
+        CheckFormat::Text => o = text(&a.bvh, &findings, &table, if a.all { usize::MAX } else { LISTED }),
     }
     Ok((o, defects))
 }
 
-fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality]) -> String {
+fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality], list: usize) -> String {
     let mut o = String::new();
     let defects = findings.iter().filter(|f| f.defect).count();
     let warnings = findings.len() - defects;
@@ -140,7 +151,7 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality]) -> Stri
         let d = here.iter().filter(|f| f.defect).count();
         let _ = writeln!(o, "\n{} ({d} defects, {} warnings)", g.label(), here.len() - d);
         for f in here {
-            let _ = writeln!(o, "  {} {}", if f.defect { "defect: " } else { "warning:" }, f.text);
+            let _ = writeln!(o, "  {} {}", if f.defect { "defect: " } else { "warning:" }, f.line(list));
         }
     }
     if !table.is_empty() {
@@ -169,11 +180,15 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality]) -> Stri
 
 /// A dump read and made into bvhscope's tree over the scene's mesh, as every command traces it
 /// (its structure must be sound: `check` says what is wrong otherwise).
-pub(crate) fn import_dump(scene: &crate::scene::Scene, path: &std::path::Path) -> Result<SceneBvh, CliError> {
-    let dump = BvhDump::read(path).map_err(|e| CliError::Usage(e.to_string()))?;
+pub(crate) fn import_dump(
+    scene: &crate::scene::Scene,
+    path: &std::path::Path,
+    limit: &DumpLimit,
+) -> Result<SceneBvh, CliError> {
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
-    let structure = crate::bvh::check::check_tree(&dump, &mesh, crate::bvh::check::tolerance(&mesh));
-    let (bvh, imported) = crate::bvh::check::traceable(&structure, &dump, &mesh, path)
+    let dump = BvhDump::read(path, limit.bytes(&mesh)).map_err(|e| CliError::Usage(e.to_string()))?;
+    let structure = crate::explain::check::check_tree(&dump, &mesh);
+    let (bvh, imported) = crate::explain::check::traceable(&structure, &dump, &mesh, path)
         .map_err(|why| CliError::Usage(format!("{}: {why}; bvhscope check lists what is wrong", path.display())))?;
     Ok(SceneBvh::imported(bvh, mesh, imported))
 }
@@ -184,13 +199,16 @@ pub struct ExportArgs {
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
-    /// The file to write: JSON, or the text form when it ends in .txt.
+    /// The file to write: .json (JSON), .json.gz (gzip-compressed JSON) or .txt (the text form).
     #[arg(long, short)]
     pub output: PathBuf,
 }
 
 /// `export-bvh`: the binary tree as built, in the bvhscope-bvh format.
 pub fn export(a: &ExportArgs) -> Result<(), CliError> {
+    // Before anything is built: a name that says no dump format, an output that is the mesh.
+    BvhDump::written_as(&a.output).map_err(CliError::Usage)?;
+    crate::files::refuse_inputs(&a.output, &[(&a.mesh, "the mesh")])?;
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
     // The binary tree unless --layout wide4 or wide8 asks for a wide one.
@@ -198,7 +216,7 @@ pub fn export(a: &ExportArgs) -> Result<(), CliError> {
     let params = BuildParams { layout, ..a.build.params(scene.build.as_ref()) };
     let name = super::render::file_name(&a.mesh);
     let dump = BvhDump::of_any(&AnyBvh::build(&mesh, &params), &mesh, Some(name));
-    dump.write(&a.output).map_err(|source| CliError::Write { path: a.output.clone(), source })?;
+    dump.write(&a.output).map_err(|e| CliError::Usage(e.to_string()))?;
     eprintln!("wrote {} ({} nodes, {} primitives)", a.output.display(), dump.nodes.len(), dump.primitives.len());
     Ok(())
 }

@@ -33,6 +33,8 @@ pub struct InspectArgs {
     #[arg(long, value_name = "DUMP")]
     pub bvh: Option<PathBuf>,
     #[command(flatten)]
+    pub dump_limit: super::args::DumpLimit,
+    #[command(flatten)]
     pub build: BuildArgs,
     /// The frame whose primary rays are counted per node (the Tree window's visits; camera and
     /// size as `render` takes them).
@@ -245,7 +247,7 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
     let built = match &a.bvh {
-        Some(path) => super::check::import_dump(&scene, path)?,
+        Some(path) => super::check::import_dump(&scene, path, &a.dump_limit)?,
         None => build_scene(&scene, &a.build.scene_build(params))?,
     };
     let SceneBvh::Single { bvh, .. } = &built else { unreachable!("one level was asked for") };
@@ -254,8 +256,18 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     // An imported tree's node by the dump's id.
     let names = built.import();
     let node = match names {
+        Some(n) if a.node as usize >= n.dump_nodes => {
+            let last = n.dump_nodes.saturating_sub(1);
+            return Err(CliError::Usage(format!(
+                "--node {}: the dump has {} nodes (0 to {last})",
+                a.node, n.dump_nodes
+            )));
+        }
         Some(n) => n.binary_node_of_dump(a.node).ok_or_else(|| {
-            CliError::Usage(format!("--node {}: the dump's node {} is not reached from its root", a.node, a.node))
+            CliError::Usage(format!(
+                "--node {}: the dump's node {} is not reached from its root (or is an empty leaf, which no ray enters)",
+                a.node, a.node
+            ))
         })?,
         None => a.node,
     };

@@ -89,6 +89,8 @@ pub enum CliError {
     Usage(String),
     #[error("{}: cannot write: {source}", .path.display())]
     Write { path: PathBuf, source: std::io::Error },
+    #[error(transparent)]
+    File(#[from] crate::files::FileError),
     /// `check` found defects (reported on stdout): exit code 1.
     #[error("{0} defects")]
     Defects(usize),

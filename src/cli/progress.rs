@@ -19,6 +19,16 @@ pub fn with_spinner<T: Send>(label: &str, work: impl FnOnce() -> T + Send) -> T 
     watch(label, None, work)
 }
 
+/// Sets `finished` when dropped: when the work returns, and when it panics (the scope then waits
+/// for the display thread, which must stop, before the panic goes on to end the process).
+struct Finish<'a>(&'a AtomicBool);
+
+impl Drop for Finish<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Release);
+    }
+}
+
 fn watch<T: Send>(label: &str, bar: Option<&WorkControl>, work: impl FnOnce() -> T + Send) -> T {
     let finished = AtomicBool::new(false);
     std::thread::scope(|s| {
@@ -53,8 +63,26 @@ fn watch<T: Send>(label: &str, bar: Option<&WorkControl>, work: impl FnOnce() ->
                 p.finish_and_clear();
             }
         });
-        let out = work();
-        finished.store(true, Ordering::Release);
-        out
+        let _finish = Finish(&finished);
+        work()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A panic in the work ends the wrapped call with that panic, and does not leave the display
+    /// thread waiting forever (it used to: the scope waited for a spinner nobody stopped).
+    #[test]
+    fn a_panic_in_the_work_is_passed_on_not_waited_for() {
+        let (done, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let r = std::panic::catch_unwind(|| with_spinner("failing", || -> u32 { panic!("the work failed") }));
+            let _ = done.send(r.is_err());
+        });
+        let panicked = rx.recv_timeout(Duration::from_secs(20)).expect("with_spinner returned within 20 s");
+        assert!(panicked);
+        assert_eq!(with_spinner("fine", || 7), 7);
+    }
 }

@@ -24,8 +24,9 @@ pub struct RenderArgs {
     /// Colour map of heatmaps.
     #[arg(long, value_parser = super::args::choice::<ColorMap>(), default_value = "viridis")]
     pub colormap: ColorMap,
-    /// Fixed heatmap range MIN:MAX (default: the frame's own min and max).
-    #[arg(long, value_parser = parse_range)]
+    /// Fixed heatmap range MIN:MAX (default: the frame's own min and max); negative numbers as
+    /// they are (`--range -5:5`).
+    #[arg(long, value_parser = parse_range, allow_hyphen_values = true)]
     pub range: Option<(f32, f32)>,
     /// Also write the counts behind the heatmap, one CSV row per pixel: x, y (0-based, from the
     /// top left), nodes_visited, box_tests, leaves_visited, triangle_tests, hit_triangle (-1: miss).
@@ -44,6 +45,8 @@ pub struct RenderArgs {
     /// of building one; with --against, it is A.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,
+    #[command(flatten)]
+    pub dump_limit: super::args::DumpLimit,
     /// With --against: also write the difference as CSV, one row per pixel: x, y, a, b, b_minus_a.
     #[arg(long, value_name = "FILE.csv", requires = "against")]
     pub difference: Option<PathBuf>,
@@ -58,14 +61,29 @@ fn parse_range(s: &str) -> Result<(f32, f32), String> {
     }
 }
 
-fn write_png(img: &image::RgbImage, path: &std::path::Path) -> Result<(), CliError> {
-    img.save(path).map_err(|e| CliError::Write {
-        path: path.to_path_buf(),
-        source: match e {
-            image::ImageError::IoError(io) => io,
-            other => std::io::Error::other(other.to_string()),
-        },
-    })
+/// Before anything is loaded or traced: every output named for what it holds, none of them an
+/// input (the mesh, the dump) or another output.
+fn check_outputs(a: &RenderArgs) -> Result<(), CliError> {
+    use crate::files::{refuse_inputs, refuse_same_outputs, CSV, PNG};
+    PNG.check(&a.output)?;
+    let mut outputs = vec![(a.output.as_path(), "the image (-o)")];
+    if let Some(c) = &a.counts {
+        CSV.check(c)?;
+        outputs.push((c, "the counts (--counts)"));
+    }
+    if let Some(d) = &a.difference {
+        CSV.check(d)?;
+        outputs.push((d, "the difference (--difference)"));
+    }
+    refuse_same_outputs(&outputs)?;
+    let mut inputs = vec![(a.mesh.as_path(), "the mesh")];
+    if let Some(b) = &a.bvh {
+        inputs.push((b, "the BVH dump (--bvh)"));
+    }
+    for (o, _) in outputs {
+        refuse_inputs(o, &inputs)?;
+    }
+    Ok(())
 }
 
 /// `render --against`: render the second build on the same camera and write B − A.
@@ -106,13 +124,13 @@ fn run_against(
             let _ = w.write_record([x.to_string(), y.to_string(), va.to_string(), vb.to_string(), v.to_string()]);
         }
         let bytes = w.into_inner().expect("writing to memory");
-        std::fs::write(path, bytes).map_err(|source| CliError::Write { path: path.clone(), source })?;
+        crate::files::write_bytes(path, &bytes)?;
     }
     let range = a.range.map(|(lo, hi)| lo.abs().max(hi.abs()));
     let (img, mut legend) = difference_image(camera.width, &d, a.view, range);
     legend.subject = format!("{}: A {label_a}, B {}", file_name(&a.mesh), params_b.label());
     let img = draw_legend(&img, &legend);
-    write_png(&img, &a.output)?;
+    crate::files::write_png(&a.output, &img)?;
     let (less, same, more) = tally(&d);
     eprintln!(
         "wrote {} ({}x{} difference of {}, B {} minus A {}: B does less work at {less} pixels, the same at {same}, more at {more}; mean {:.3})",
@@ -133,11 +151,12 @@ pub(crate) fn file_name(p: &std::path::Path) -> String {
 }
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
+    check_outputs(a)?;
     let loaded = load_mesh(&a.mesh)?;
     let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
     let params = a.build.params(loaded.build.as_ref());
     let bvh = match &a.bvh {
-        Some(path) => super::check::import_dump(&loaded, path)?,
+        Some(path) => super::check::import_dump(&loaded, path, &a.dump_limit)?,
         None => build_scene(&loaded, &a.build.scene_build(params))?,
     };
     let count = a.view.is_heatmap() || a.counts.is_some();
@@ -152,7 +171,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let label_a = bvh.label();
     if let Some(path) = &a.counts {
         let text = frame.counts_csv().expect("the frame was counted and is complete");
-        std::fs::write(path, text).map_err(|source| CliError::Write { path: path.clone(), source })?;
+        crate::files::write_bytes(path, text.as_bytes())?;
     }
     if let Some(against) = a.against {
         return run_against(a, &loaded, &camera, &settings, &frame, &bvh.build_params(), &label_a, against);
@@ -164,11 +183,11 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     if let (Some(bins), Some(l)) = (a.histogram, &legend) {
         let counts = crate::render::histogram(&frame, a.view, params.cost, l.range_min, l.range_max, bins as usize);
-        let width = (l.range_max - l.range_min) / bins as f32;
+        let (lo, hi) = (l.range_min as f64, l.range_max as f64);
+        let edge = |i: usize| (lo + (hi - lo) * i as f64 / bins as f64) as f32;
         let mut o = String::from("bin_low,bin_high,pixels\n");
         for (i, c) in counts.iter().enumerate() {
-            let lo = l.range_min + width * i as f32;
-            o += &format!("{lo},{},{c}\n", lo + width);
+            o += &format!("{},{},{c}\n", edge(i), edge(i + 1));
         }
         super::out(&o);
     } else if a.histogram.is_some() {
@@ -178,13 +197,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         Some(l) => draw_legend(&img, l),
         None => img,
     };
-    img.save(&a.output).map_err(|e| CliError::Write {
-        path: a.output.clone(),
-        source: match e {
-            image::ImageError::IoError(io) => io,
-            other => std::io::Error::other(other.to_string()),
-        },
-    })?;
+    crate::files::write_png(&a.output, &img)?;
     let hits = frame.traced().filter(|(s, _)| s.is_hit()).count();
     let legend_note = if legend.is_some() { " with the legend below" } else { "" };
     eprint!(

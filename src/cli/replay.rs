@@ -34,20 +34,25 @@ pub struct ReplayArgs {
     /// How long each frame shows, in milliseconds.
     #[arg(long, default_value_t = 400, value_parser = clap::value_parser!(u16).range(20..))]
     pub delay_ms: u16,
-    /// The animated PNG to write.
+    /// The animation to write: .gif (a GIF, for slides) or .png (an animated PNG, every colour
+    /// exact).
     #[arg(long, short, default_value = "build.png")]
     pub output: PathBuf,
 }
 
-/// `frames` split counts from 0 to `n` on a log scale of k + 1, without repeats.
+/// `frames` split counts from 0 to `n`, as near a log scale of k + 1 as distinct counts allow
+/// (where the scale's steps round to the same count, the next counts are taken: the first
+/// splits are shown one by one). Fewer only when the tree has fewer steps: `n + 1`.
 pub fn steps(n: usize, frames: u32) -> Vec<usize> {
+    let frames = (frames as usize).min(n + 1).max(1);
     let top = ((n + 1) as f64).ln();
-    let mut ks: Vec<usize> = (0..frames)
-        .map(|i| ((top * i as f64 / (frames - 1).max(1) as f64).exp().round() as usize).saturating_sub(1).min(n))
-        .collect();
-    ks.dedup();
-    if ks.last() != Some(&n) {
-        ks.push(n);
+    let mut ks: Vec<usize> = Vec::with_capacity(frames);
+    for i in 0..frames {
+        let on_scale = ((top * i as f64 / (frames - 1).max(1) as f64).exp().round() as usize).saturating_sub(1);
+        // Distinct and increasing, and room left for the frames still to come.
+        let lowest = ks.last().map_or(0, |&k| k + 1);
+        let highest = n - (frames - 1 - i);
+        ks.push(on_scale.clamp(lowest, highest));
     }
     ks
 }
@@ -65,6 +70,8 @@ pub fn output(a: &ReplayArgs) -> Result<String, CliError> {
     if !a.view.is_heatmap() {
         return Err(CliError::Usage("replay shows a heatmap: --view visits, tri-tests or cost".into()));
     }
+    crate::render::animation::ANIMATION.check(&a.output)?;
+    crate::files::refuse_inputs(&a.output, &[(&a.mesh, "the mesh")])?;
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
     let SceneBvh::Single { bvh, mesh, .. } = build_scene(&scene, &a.build.scene_build(params))? else {
@@ -77,6 +84,14 @@ pub fn output(a: &ReplayArgs) -> Result<String, CliError> {
     let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
     let settings = RenderSettings { trace: a.build.trace(), count: true, progressive: false };
     let ks = steps(replay.splits(), a.frames);
+    if ks.len() < a.frames as usize {
+        eprintln!(
+            "note: the tree has {} splits, so {} frames (one per step from the root alone to the finished tree), not {}",
+            replay.splits(),
+            ks.len(),
+            a.frames
+        );
+    }
     let cost = params.cost;
     // Each step's metric per pixel; then one colour scale for all of them.
     let values: Vec<Vec<f32>> = progress::with_spinner("rendering the steps", || {
@@ -128,7 +143,7 @@ pub fn output(a: &ReplayArgs) -> Result<String, CliError> {
         };
         images.push(draw_legend(&img, &legend));
     }
-    write_apng(&images, a.delay_ms, &a.output)?;
+    crate::render::animation::write_animation(&a.output, &images, a.delay_ms)?;
     eprintln!("wrote {} ({} frames, {}x{})", a.output.display(), images.len(), images[0].width(), images[0].height());
     Ok(table)
 }
@@ -150,22 +165,22 @@ pub fn morton_text(order: &crate::bvh::lbvh::MortonOrder, r: &Replay, node: u32)
     ))
 }
 
-/// Frames of one size as an animated PNG that loops.
-fn write_apng(frames: &[image::RgbImage], delay_ms: u16, path: &std::path::Path) -> Result<(), CliError> {
-    let err = |e: png::EncodingError| CliError::Write {
-        path: path.to_path_buf(),
-        source: std::io::Error::other(e.to_string()),
-    };
-    let file = std::fs::File::create(path).map_err(|source| CliError::Write { path: path.to_path_buf(), source })?;
-    let (w, h) = frames[0].dimensions();
-    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), w, h);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.set_animated(frames.len() as u32, 0).map_err(err)?;
-    let mut writer = enc.write_header().map_err(err)?;
-    for f in frames {
-        writer.set_frame_delay(delay_ms, 1000).map_err(err)?;
-        writer.write_image_data(f.as_raw()).map_err(err)?;
+#[cfg(test)]
+mod tests {
+    use super::steps;
+
+    /// The frames asked for, distinct, from the root alone to the finished tree, near a log scale;
+    /// fewer only when the tree has fewer steps.
+    #[test]
+    fn steps_are_as_many_as_asked_and_distinct() {
+        for (n, frames) in [(1000, 24), (1000, 20), (30, 24), (200_000, 400), (5, 2)] {
+            let ks = steps(n, frames);
+            assert_eq!(ks.len(), frames as usize, "{n} {frames}");
+            assert_eq!((ks[0], *ks.last().unwrap()), (0, n));
+            assert!(ks.windows(2).all(|w| w[0] < w[1]), "{ks:?}");
+        }
+        assert_eq!(steps(3, 24), [0, 1, 2, 3], "a tree of three splits has four steps");
+        // Far along, the log scale itself: the middle frame of 1,000 splits in 21 is near √1001.
+        assert!((25..=40).contains(&steps(1000, 21)[10]));
     }
-    writer.finish().map_err(err)
 }

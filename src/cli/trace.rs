@@ -38,6 +38,8 @@ pub struct TraceArgs {
     /// of building one.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,
+    #[command(flatten)]
+    pub dump_limit: super::args::DumpLimit,
 }
 
 fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
@@ -105,7 +107,7 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
     let bvh = match &a.bvh {
-        Some(path) => super::check::import_dump(&scene, path)?,
+        Some(path) => super::check::import_dump(&scene, path, &a.dump_limit)?,
         None => build_scene(&scene, &a.build.scene_build(params))?,
     };
     let (ray, source) = match (a.pixel, a.ray) {
@@ -168,7 +170,7 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
                 }
                 let depth = depth.unwrap_or(entered + 1);
                 let level = if levels { format!("{:<10}", level_text(s.level)) } else { String::new() };
-                let _ = writeln!(o, "{:>5}  {level}{}{text}", i + 1, "  ".repeat(depth as usize));
+                let _ = writeln!(o, "{:>5}  {level}{}{text}", i + 1, crate::bvh::trace::indent(depth));
             }
             let _ = writeln!(o);
             match hit {

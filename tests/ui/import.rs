@@ -5,8 +5,8 @@
 mod support;
 
 use bvhscope::app::{Action, BvhscopeApp, MessageKind, Pick, SceneSource};
-use bvhscope::bvh::check::Group;
 use bvhscope::cli::Command;
+use bvhscope::explain::check::Group;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use std::path::{Path, PathBuf};
@@ -82,7 +82,7 @@ fn a_dropped_dump_is_checked_and_traced_by_every_view() {
     let Command::Check(check_args) = words(&args) else { panic!("check") };
     let (json, defects) = bvhscope::cli::check::output(&check_args).unwrap();
     let cli: serde_json::Value = serde_json::from_str(&json).unwrap();
-    let tree_findings = |f: &[bvhscope::bvh::check::Finding]| {
+    let tree_findings = |f: &[bvhscope::explain::check::Finding]| {
         f.iter().filter(|f| f.group != Group::Rays).map(|f| serde_json::to_value(f).unwrap()).collect::<Vec<_>>()
     };
     let cli_tree: Vec<serde_json::Value> =
@@ -113,7 +113,7 @@ fn a_dropped_dump_is_checked_and_traced_by_every_view() {
     // A finding that names a node selects it in the tree view (by the dump's id).
     h.get_by_role_and_label(
         egui::accesskit::Role::Link,
-        &format!("defect: {}", findings.iter().find(|f| f.group == Group::Bounds).unwrap().text),
+        &format!("defect: {}", findings.iter().find(|f| f.group == Group::Bounds).unwrap().line(8)),
     )
     .click();
     run_until(&mut h, "the node selected", |a| {
@@ -152,7 +152,7 @@ fn a_dropped_dump_is_checked_and_traced_by_every_view() {
     assert_eq!(h.state().boxes_drawn(), 8, "a binary tree has 8 nodes at depth 3 here");
     let written = temp_file("written.json", "");
     h.state_mut().act(Action::Picked(Pick::SaveBvh, written.clone()));
-    let back = bvhscope::bvh::dump::BvhDump::read(&written).unwrap();
+    let back = bvhscope::dump::BvhDump::read(&written, 1 << 30).unwrap();
     assert_eq!(back.nodes.len(), v["nodes"].as_array().unwrap().len());
 
     // Back to the built strategy: chosen in the list (the one built before, SAH).
@@ -216,7 +216,7 @@ fn unreadable_and_broken_dumps_say_why() {
     });
     let t = h.state().import.tree.as_ref().unwrap();
     assert!(t.bvh.is_err() && !h.state().import.on);
-    assert!(t.findings.iter().any(|f| f.text.contains("a cycle")));
+    assert!(t.findings.iter().any(|f| f.line(usize::MAX).contains("a cycle")));
     h.get_by_label_contains("Not traced");
 }
 

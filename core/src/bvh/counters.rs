@@ -7,6 +7,10 @@
 use super::trace::NodeId;
 use crate::geometry::TriangleHit;
 
+/// How many of the stack's top entries a walk reports with each change (`step_stack`): more than
+/// one step changes (an 8-wide node pushes at most seven, then sorts them).
+pub const REPORTED_STACK: usize = 32;
+
 /// Where the traversal reports its work. Implementations must be cheap: these run per node.
 pub trait TraversalStats {
     fn node_visited(&mut self);
@@ -46,9 +50,12 @@ pub trait TraversalStats {
     /// The walk reached the leaf `node`.
     #[inline(always)]
     fn step_leaf(&mut self, _node: NodeId) {}
-    /// The stack after a push, a pop or a sort: (node, entry parameter), bottom first.
+    /// The stack after a push, a pop or a sort: its `len` entries in all, and the top ones
+    /// (`REPORTED_STACK` of them, or all when fewer), bottom first: (node, entry parameter).
+    /// Entries below the reported ones are as they were at the last report (a walk changes only
+    /// the top of its stack between reports), so a deep tree's trace costs no more per step.
     #[inline(always)]
-    fn step_stack(&mut self, _entries: &[(NodeId, f32)]) {}
+    fn step_stack(&mut self, _len: usize, _top: &[(NodeId, f32)]) {}
     /// `node` was popped and dropped: the ray enters it at `t`, beyond the closest hit so far.
     #[inline(always)]
     fn step_skip(&mut self, _node: NodeId, _t: f32) {}

@@ -5,9 +5,7 @@
 mod accel;
 mod any;
 mod build;
-pub mod check;
 mod counters;
-pub mod dump;
 pub mod epo;
 pub mod imported;
 pub mod inspect;

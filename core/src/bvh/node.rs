@@ -5,8 +5,9 @@ use super::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use glam::Vec3;
 
-/// Depth of the traversal stack. The builder guarantees the tree is shallower than this
-/// (see `build::HEURISTIC_DEPTH_LIMIT`), so the fixed-size stack cannot overflow.
+/// Depth of the traversal stack's fixed part. The builder keeps the trees it makes shallower than
+/// this (see `build::HEURISTIC_DEPTH_LIMIT`), so their walks never leave it; an imported tree of
+/// any depth spills onto the heap (`stack::TraversalStack`).
 pub const TRAVERSAL_STACK_SIZE: usize = 128;
 
 /// One node: 24 bytes of bounds (the box's lower and upper planes), then either the first of two

@@ -301,8 +301,9 @@ impl PacketTree for Bvh {
     }
 }
 
-/// Deepest stack a packet walk can need: at most seven pushes per level of an 8-wide tree (the
-/// build bounds the depth by `TRAVERSAL_STACK_SIZE`). Not initialised: its size costs nothing.
+/// The fixed part of a packet walk's stack: at most seven pushes per level of an 8-wide tree built
+/// by bvhscope (the build bounds the depth by `TRAVERSAL_STACK_SIZE`; a deeper imported tree
+/// spills onto the heap). Not initialised: its size costs nothing.
 const STACK: usize = 7 * TRAVERSAL_STACK_SIZE + 8;
 
 /// The packet walk, written once for every layout (Wald, Boulos & Shirley 2007, §4). For each

@@ -413,8 +413,9 @@ mod tests {
             assert_eq!(n.bounds(), l.union(r));
         }
         let linear = LinearScan::new(&mesh);
-        let camera = crate::render::Camera::framing_up(&mesh.bounds(), 40, 30, crate::render::UpAxis::Y, 45.0);
-        for (ray, _) in crate::bvh::check::check_rays(&mesh, &camera, 2000) {
+        let b = mesh.bounds();
+        for (o, d) in crate::random::Rng::rays_at(3, 3000, (b.min.into(), b.max.into())) {
+            let ray = crate::geometry::Ray::new(o, d);
             let t = |h: Option<crate::bvh::Hit>| h.map(|h| h.t);
             let a = bvh.closest_hit(&mut ray.clone(), TraceOptions::default(), &mut NoStats);
             let b = linear.closest_hit(&mut ray.clone(), TraceOptions::default(), &mut NoStats);

@@ -53,7 +53,7 @@ impl SceneBvh {
         Ok(SceneBvh::Single { bvh: AnyBvh::build_controlled(&mesh, params, control)?, mesh, imported: None })
     }
 
-    /// A tree imported from a dump over `mesh` (`bvh::imported::import`).
+    /// A tree imported from a dump over `mesh` (`dump::import`).
     pub fn imported(bvh: AnyBvh, mesh: Arc<Mesh>, imported: Imported) -> SceneBvh {
         SceneBvh::Single { bvh, mesh, imported: Some(Arc::new(imported)) }
     }

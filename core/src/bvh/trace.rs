@@ -52,13 +52,14 @@ pub enum StepKind {
     Enter { node: NodeId, depth: u32, t_entry: f32, t_exit: f32 },
     /// The walk reached a leaf (its triangle tests follow).
     Leaf { node: NodeId, depth: u32 },
-    /// `node` went on the stack, to be visited at `t_entry`; `stack` is the stack after it.
-    Push { node: NodeId, t_entry: f32, stack: Vec<(NodeId, f32)> },
+    /// `node` went on the stack, to be visited at `t_entry`; `stack` is the stack after it (its
+    /// top `SHOWN_STACK` entries; `below` more under them, in a tree deeper than that).
+    Push { node: NodeId, t_entry: f32, stack: Vec<(NodeId, f32)>, below: u32 },
     /// `node` came off the stack to be visited next.
-    Pop { node: NodeId, t_entry: f32, stack: Vec<(NodeId, f32)> },
+    Pop { node: NodeId, t_entry: f32, stack: Vec<(NodeId, f32)>, below: u32 },
     /// `node` came off the stack and was dropped: the ray enters it at `t_entry`, beyond the
     /// closest hit so far (`closest_t`).
-    Skip { node: NodeId, t_entry: f32, closest_t: f32, stack: Vec<(NodeId, f32)> },
+    Skip { node: NodeId, t_entry: f32, closest_t: f32, stack: Vec<(NodeId, f32)>, below: u32 },
     /// A ray–triangle test (`triangle`: the mesh's or the scene's triangle id).
     Triangle { triangle: u32, hit: bool, t: Option<f32>, u: Option<f32>, v: Option<f32> },
     /// The triangle just hit is the closest hit so far.
@@ -90,15 +91,19 @@ impl Step {
                 StepKind::Enter { node: n(*node), depth: *depth, t_entry: *t_entry, t_exit: *t_exit }
             }
             StepKind::Leaf { node, depth } => StepKind::Leaf { node: n(*node), depth: *depth },
-            StepKind::Push { node, t_entry, stack } => {
-                StepKind::Push { node: n(*node), t_entry: *t_entry, stack: st(stack) }
+            StepKind::Push { node, t_entry, stack, below } => {
+                StepKind::Push { node: n(*node), t_entry: *t_entry, stack: st(stack), below: *below }
             }
-            StepKind::Pop { node, t_entry, stack } => {
-                StepKind::Pop { node: n(*node), t_entry: *t_entry, stack: st(stack) }
+            StepKind::Pop { node, t_entry, stack, below } => {
+                StepKind::Pop { node: n(*node), t_entry: *t_entry, stack: st(stack), below: *below }
             }
-            StepKind::Skip { node, t_entry, closest_t, stack } => {
-                StepKind::Skip { node: n(*node), t_entry: *t_entry, closest_t: *closest_t, stack: st(stack) }
-            }
+            StepKind::Skip { node, t_entry, closest_t, stack, below } => StepKind::Skip {
+                node: n(*node),
+                t_entry: *t_entry,
+                closest_t: *closest_t,
+                stack: st(stack),
+                below: *below,
+            },
             StepKind::Triangle { triangle: tri, hit, t, u, v } => {
                 StepKind::Triangle { triangle: triangle(*tri), hit: *hit, t: *t, u: *u, v: *v }
             }
@@ -127,8 +132,11 @@ impl Step {
 
     /// The step in words, as `bvhscope trace` and the app's Ray panel list it.
     pub fn text(&self) -> String {
-        let stack = |st: &[(NodeId, f32)]| {
-            let items: Vec<String> = st.iter().map(|(n, t)| format!("{n}@{t:.3}")).collect();
+        let stack = |st: &[(NodeId, f32)], below: &u32| {
+            let mut items: Vec<String> = st.iter().map(|(n, t)| format!("{n}@{t:.3}")).collect();
+            if *below > 0 {
+                items.insert(0, format!("… {below} below"));
+            }
             format!("[{}]", items.join(", "))
         };
         match &self.kind {
@@ -140,16 +148,16 @@ impl Step {
                 format!("enter {node} (depth {depth}, t {t_entry:.4}..{t_exit:.4})")
             }
             StepKind::Leaf { node, .. } => format!("leaf {node}: test its triangles"),
-            StepKind::Push { node, t_entry, stack: st } => {
-                format!("push {node} (enters at {t_entry:.4})  stack {}", stack(st))
+            StepKind::Push { node, t_entry, stack: st, below } => {
+                format!("push {node} (enters at {t_entry:.4})  stack {}", stack(st, below))
             }
-            StepKind::Pop { node, t_entry, stack: st } => {
-                format!("pop {node} (enters at {t_entry:.4})  stack {}", stack(st))
+            StepKind::Pop { node, t_entry, stack: st, below } => {
+                format!("pop {node} (enters at {t_entry:.4})  stack {}", stack(st, below))
             }
-            StepKind::Skip { node, t_entry, closest_t, stack: st } => {
+            StepKind::Skip { node, t_entry, closest_t, stack: st, below } => {
                 format!(
                     "skip {node}: enters at {t_entry:.4}, beyond the closest hit {closest_t:.4}  stack {}",
-                    stack(st)
+                    stack(st, below)
                 )
             }
             StepKind::Triangle { triangle, hit: true, t, u, v } => format!(
@@ -168,10 +176,13 @@ impl Step {
         }
     }
 
-    /// The stack as it stands after this step, for steps that change it.
-    pub fn stack(&self) -> Option<&[(NodeId, f32)]> {
+    /// The stack as it stands after this step, for steps that change it: its top entries (bottom
+    /// first) and how many more are under them.
+    pub fn stack(&self) -> Option<(&[(NodeId, f32)], u32)> {
         match &self.kind {
-            StepKind::Push { stack, .. } | StepKind::Pop { stack, .. } | StepKind::Skip { stack, .. } => Some(stack),
+            StepKind::Push { stack, below, .. }
+            | StepKind::Pop { stack, below, .. }
+            | StepKind::Skip { stack, below, .. } => Some((stack, *below)),
             _ => None,
         }
     }
@@ -285,20 +296,25 @@ impl TraversalStats for Trace {
         self.push(StepKind::Leaf { node, depth });
     }
 
-    fn step_stack(&mut self, entries: &[(NodeId, f32)]) {
-        let kept = self.stack.iter().zip(entries).take_while(|(a, b)| a == b).count();
+    fn step_stack(&mut self, len: usize, top: &[(NodeId, f32)]) {
+        // The entries below the reported top are as they were: compare from there up.
+        let base = len - top.len();
+        let same = self.stack.get(base..).unwrap_or(&[]).iter().zip(top).take_while(|(a, b)| a == b).count();
+        let kept = (base + same).min(self.stack.len());
         // Entries beyond what both share were popped (from the old stack), then pushed (from
         // the new one), in that order.
         for k in (kept..self.stack.len()).rev() {
             let (node, t_entry) = self.stack[k];
-            let stack = self.stack[..k].to_vec();
-            self.push(StepKind::Pop { node, t_entry, stack });
+            let (stack, below) = shown(&self.stack[..k]);
+            self.push(StepKind::Pop { node, t_entry, stack, below });
         }
-        for k in kept..entries.len() {
-            let (node, t_entry) = entries[k];
-            self.push(StepKind::Push { node, t_entry, stack: entries[..=k].to_vec() });
+        self.stack.truncate(kept);
+        // (The mirror holds at least `base` entries when every change was reported.)
+        for &e in &top[kept.saturating_sub(base)..] {
+            self.stack.push(e);
+            let (stack, below) = shown(&self.stack);
+            self.push(StepKind::Push { node: e.0, t_entry: e.1, stack, below });
         }
-        self.stack = entries.to_vec();
     }
 
     fn step_skip(&mut self, node: NodeId, t: f32) {
@@ -306,8 +322,8 @@ impl TraversalStats for Trace {
         if self.stack.last().is_some_and(|e| e.0 == node) {
             self.stack.pop();
         }
-        let stack = self.stack.clone();
-        self.push(StepKind::Skip { node, t_entry: t, closest_t: self.closest_t, stack });
+        let (stack, below) = shown(&self.stack);
+        self.push(StepKind::Skip { node, t_entry: t, closest_t: self.closest_t, stack, below });
     }
 
     fn step_triangle(&mut self, prim: u32, hit: Option<TriangleHit>) {
@@ -337,6 +353,29 @@ impl TraversalStats for Trace {
             (self.stack, self.entered_depth) = std::mem::take(&mut self.outer);
         }
     }
+}
+
+/// Levels a listing of the steps indents by; deeper steps are indented as far and marked with
+/// their depth, so a tree thousands deep lists in lines of a readable width.
+pub const MAX_INDENT: u32 = 16;
+
+/// The indent of a step at `depth` in a listing (`bvhscope trace`, the app's Ray window).
+pub fn indent(depth: u32) -> String {
+    if depth <= MAX_INDENT {
+        "  ".repeat(depth as usize)
+    } else {
+        format!("{}[depth {depth}] ", "  ".repeat(MAX_INDENT as usize))
+    }
+}
+
+/// Entries of the stack a step keeps: its top ones (a trace of a tree thousands deep would
+/// otherwise keep thousands per step).
+pub const SHOWN_STACK: usize = 16;
+
+/// The top `SHOWN_STACK` entries of `stack`, bottom first, and how many are under them.
+fn shown(stack: &[(NodeId, f32)]) -> (Vec<(NodeId, f32)>, u32) {
+    let below = stack.len().saturating_sub(SHOWN_STACK);
+    (stack[below..].to_vec(), below as u32)
 }
 
 /// Trace `ray`'s closest hit through `accel` with `opts`, recording every step.

@@ -150,8 +150,9 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
 
 /// Tell a tracing sink what the binary walk's stack holds.
 fn report_stack<S: TraversalStats, const N: usize>(stats: &mut S, stack: &TraversalStack<N>) {
-    let entries: Vec<(NodeId, f32)> = stack.entries().iter().map(|&(n, t)| (NodeId::Node(n), t)).collect();
-    stats.step_stack(&entries);
+    let top: Vec<(NodeId, f32)> =
+        stack.top(super::counters::REPORTED_STACK).iter().map(|&(n, t)| (NodeId::Node(n), t)).collect();
+    stats.step_stack(stack.len(), &top);
 }
 
 /// Test a leaf's triangles `tris` (slot `first` onwards in leaf order) against the ray: each

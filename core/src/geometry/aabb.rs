@@ -41,6 +41,18 @@ impl Aabb {
         Self { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
+    /// The part of both boxes; empty (some `min` above its `max`) where they do not meet.
+    #[inline(always)]
+    pub fn intersection(self, o: Aabb) -> Self {
+        Self { min: self.min.max(o.min), max: self.max.min(o.max) }
+    }
+
+    /// The box grown by `d` on every side.
+    #[inline]
+    pub fn grown(self, d: f32) -> Self {
+        Self { min: self.min - Vec3A::splat(d), max: self.max + Vec3A::splat(d) }
+    }
+
     #[inline]
     pub fn is_empty(&self) -> bool {
         !(self.min.x <= self.max.x && self.min.y <= self.max.y && self.min.z <= self.max.z)

@@ -25,6 +25,9 @@ pub struct Mesh {
     /// order, fan-triangulated, zero-area ones included (the loader drops those): what a BVH dump's
     /// primitives refer to. Empty otherwise (a triangle's number is its index).
     pub file_numbers: Vec<u32>,
+    /// How many triangles the file has, zero-area ones included (0: as many as `triangles`). A
+    /// file may end with zero-area faces, so this is not the largest of `file_numbers` plus one.
+    pub file_triangles: usize,
 }
 
 /// Everything a shading step needs about a hit, in world space.
@@ -52,6 +55,7 @@ impl Mesh {
             triangles,
             groups: vec![MeshGroup { name: name.to_string(), triangles: 0..n }],
             file_numbers: Vec::new(),
+            file_triangles: 0,
         }
     }
 
@@ -60,14 +64,22 @@ impl Mesh {
         self.file_numbers.get(t as usize).copied().unwrap_or(t)
     }
 
+    /// How many triangles the file has (`file_triangles`), zero-area ones included: what a BVH
+    /// dump's primitives may number.
+    pub fn file_triangle_count(&self) -> usize {
+        let last = self.file_numbers.iter().copied().max().map_or(0, |m| m as usize + 1);
+        self.file_triangles.max(last).max(if self.file_numbers.is_empty() { self.triangles.len() } else { 0 })
+    }
+
     /// For each file number, the triangle it became, or `None` for a zero-area triangle the loader
-    /// dropped; `len` covers the file's triangles.
+    /// dropped; `len` is the file's triangle count (`file_triangle_count`).
     pub fn triangles_by_file_number(&self) -> Vec<Option<u32>> {
         if self.file_numbers.is_empty() {
-            return (0..self.triangles.len() as u32).map(Some).collect();
+            let mut out: Vec<Option<u32>> = (0..self.triangles.len() as u32).map(Some).collect();
+            out.resize(self.file_triangle_count(), None);
+            return out;
         }
-        let n = self.file_numbers.iter().copied().max().map_or(0, |m| m as usize + 1);
-        let mut out = vec![None; n];
+        let mut out = vec![None; self.file_triangle_count()];
         for (t, &f) in self.file_numbers.iter().enumerate() {
             out[f as usize] = Some(t as u32);
         }

@@ -325,6 +325,7 @@ fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport
     if mesh.triangles.is_empty() {
         return Err(Problem::NoTriangles { degenerate });
     }
+    mesh.file_triangles = file_base as usize;
     let report = LoadReport {
         path: path.into(),
         vertices: mesh.positions.len(),

@@ -2,6 +2,7 @@
 //! Pixel (0, 0) is the top-left corner; a pixel's ray passes through its centre.
 
 use crate::geometry::{Aabb, Ray};
+use crate::mesh::MAX_COORDINATE;
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -23,8 +24,10 @@ pub enum CameraError {
     NoDirection,
     #[error("camera up vector is zero or parallel to the viewing direction")]
     BadUp,
-    #[error("vertical field of view must be between 0 and 180 degrees (got {0})")]
+    #[error("vertical field of view must be between {lo} and {hi} degrees (got {0})", lo = Camera::MIN_VFOV_DEG, hi = Camera::MAX_VFOV_DEG)]
     BadFov(f32),
+    #[error("the camera is {0:e} from {1}, farther than {MAX_COORDINATE:e}: rays from so far cannot be traced in single precision")]
+    TooFar(f32, &'static str),
     #[error("image size must be at least 1x1, at most 16384 on a side and 40 megapixels (got {0}x{1})")]
     BadSize(u32, u32),
 }
@@ -94,19 +97,30 @@ impl RayGen {
 }
 
 impl Camera {
+    /// The narrowest and widest vertical field of view (a narrower one would frame a mesh from
+    /// farther than single precision traces; 180 degrees sees nothing).
+    pub const MIN_VFOV_DEG: f32 = 0.01;
+    pub const MAX_VFOV_DEG: f32 = 179.9;
+
     pub fn validate(&self) -> Result<(), CameraError> {
         if !(self.position.is_finite() && self.look_at.is_finite() && self.up.is_finite()) {
             return Err(CameraError::NotFinite);
+        }
+        if !(self.vfov_deg >= Self::MIN_VFOV_DEG && self.vfov_deg <= Self::MAX_VFOV_DEG) {
+            return Err(CameraError::BadFov(self.vfov_deg));
+        }
+        for (p, what) in [(self.position, "the origin"), (self.look_at, "the origin (its look-at point)")] {
+            let d = p.abs().max_element();
+            if d > MAX_COORDINATE {
+                return Err(CameraError::TooFar(d, what));
+            }
         }
         let f = self.look_at - self.position;
         if f.length_squared() == 0.0 {
             return Err(CameraError::NoDirection);
         }
-        if f.normalize().cross(self.up).length_squared() < 1e-12 {
+        if f.normalize().cross(self.up.normalize_or_zero()).length_squared() < 1e-12 {
             return Err(CameraError::BadUp);
-        }
-        if !(self.vfov_deg > 0.0 && self.vfov_deg < 180.0) {
-            return Err(CameraError::BadFov(self.vfov_deg));
         }
         let pixels = self.width as u64 * self.height as u64;
         if self.width == 0 || self.height == 0 || self.width > 16384 || self.height > 16384 || pixels > Self::MAX_PIXELS
@@ -175,7 +189,11 @@ impl Camera {
         vfov_deg: f32,
         up_axis: UpAxis,
     ) -> Camera {
-        let vfov_deg = if vfov_deg > 0.0 && vfov_deg < 180.0 { vfov_deg } else { Self::DEFAULT_VFOV_DEG };
+        let vfov_deg = if (Self::MIN_VFOV_DEG..=Self::MAX_VFOV_DEG).contains(&vfov_deg) {
+            vfov_deg
+        } else {
+            Self::DEFAULT_VFOV_DEG
+        };
         let (width, height) = (width.max(1), height.max(1));
         let b = if bounds.is_empty() { Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0)) } else { *bounds };
         let center = b.center();

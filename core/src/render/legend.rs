@@ -43,9 +43,18 @@ fn draw_line(img: &mut RgbImage, x: u32, y: u32, s: &str, color: Rgb<u8>, width:
     draw_text(img, x, y + (LINE - 8 * scale) / 2, s, color, scale);
 }
 
-/// Format a legend number compactly: integers as integers, others with one decimal.
+/// Format a legend number compactly: integers as integers, others with one decimal, and very
+/// large or very small ones in scientific notation (`-1e8`, `3.4e38`), so that any finite range
+/// has labels a few characters long.
 pub fn fmt_value(v: f64) -> String {
-    if (v - v.round()).abs() < 1e-9 && v.abs() < 1e9 {
+    if v != 0.0 && !(1e-2..1e6).contains(&v.abs()) {
+        // Three significant digits, trailing zeros dropped: 1e20, 2.5e-3, -3.4e38.
+        let s = format!("{v:.2e}");
+        let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        return format!("{mantissa}e{exp}");
+    }
+    if (v - v.round()).abs() < 1e-9 {
         format!("{}", v.round() as i64)
     } else {
         format!("{v:.1}")
@@ -62,7 +71,11 @@ pub fn legend_height(legend: &Legend) -> u32 {
 /// strategy, layout), the colour bar with its range, and the frame's min / mean / max.
 pub fn draw_legend(img: &RgbImage, legend: &Legend) -> RgbImage {
     let strip = legend_height(legend);
-    let (w, h) = (img.width().max(2 * PAD + 10 * LINE), img.height());
+    let lo = fmt_value(legend.range_min as f64);
+    let hi = fmt_value(legend.range_max as f64);
+    // Wide enough for both range labels and a bar between them, whatever the image's width.
+    let labels = PAD + text_width(&lo, TEXT_SCALE) + PAD + 4 * LINE + PAD + text_width(&hi, TEXT_SCALE) + PAD;
+    let (w, h) = (img.width().max(2 * PAD + 10 * LINE).max(labels), img.height());
     let mut out = RgbImage::from_pixel(w, h + strip, Rgb([24, 24, 24]));
     image::imageops::replace(&mut out, img, 0, 0);
     let white = Rgb([235, 235, 235]);
@@ -74,8 +87,6 @@ pub fn draw_legend(img: &RgbImage, legend: &Legend) -> RgbImage {
         draw_line(&mut out, PAD, y, &legend.subject, grey, w - 2 * PAD);
     }
     // Colour bar between the two range labels.
-    let lo = fmt_value(legend.range_min as f64);
-    let hi = fmt_value(legend.range_max as f64);
     let bar_y = y + LINE + PAD;
     let bar_x0 = PAD + text_width(&lo, TEXT_SCALE) + PAD;
     let bar_x1 = w.saturating_sub(PAD + text_width(&hi, TEXT_SCALE) + PAD).max(bar_x0 + 1);
@@ -117,6 +128,24 @@ mod tests {
     /// Rows of the strip that have any light pixel (text or bar).
     fn inked_rows(img: &RgbImage, from: u32) -> Vec<u32> {
         (from..img.height()).filter(|&y| (0..img.width()).any(|x| img.get_pixel(x, y).0[0] > 100)).collect()
+    }
+
+    /// Any finite range draws, however large its numbers and however small the image (it
+    /// used to index past the image's right edge).
+    #[test]
+    fn any_finite_range_draws_on_any_image() {
+        for (lo, hi) in [(-1e8, 1.0), (0.0, 1e20), (-3e38, 3e38), (-f32::MAX, f32::MAX), (1e-30, 2e-30)] {
+            for w in [1, 8, 32, 300] {
+                let l = Legend { range_min: lo, range_max: hi, min: lo, max: hi, mean: 0.0, ..legend("x") };
+                let out = draw_legend(&RgbImage::new(w, 4), &l);
+                assert!(out.width() >= w);
+            }
+        }
+        assert_eq!(fmt_value(-1e8), "-1e8");
+        assert_eq!(fmt_value(3.4e38), "3.4e38");
+        assert_eq!(fmt_value(12.0), "12");
+        assert_eq!(fmt_value(2.5), "2.5");
+        assert_eq!(fmt_value(0.0025), "2.5e-3");
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! progressive passes over tiles (rayon), per-pixel counters, and conversion of the result into
 //! images: normals, depth, and heatmaps of traversal work with a legend.
 
+pub mod animation;
 mod camera;
 mod colormap;
 pub mod diff;
@@ -10,7 +11,7 @@ pub mod legend;
 mod raycast;
 mod views;
 
-pub use camera::{Camera, CameraError, UpAxis};
+pub use camera::{Camera, CameraError, RayGen, UpAxis};
 pub use colormap::ColorMap;
 pub use frame::{Frame, FramePool, PixelSample, RaySummary};
 pub use legend::{draw_legend, legend_height};

@@ -98,9 +98,11 @@ pub fn metric_stats(frame: &Frame, view: View, cost: SahCost) -> (f32, f32, f64)
 pub fn histogram(frame: &Frame, view: View, cost: SahCost, lo: f32, hi: f32, bins: usize) -> Vec<u32> {
     let n = bins.max(1);
     let mut out = vec![0u32; n];
-    let scale = if hi > lo { n as f32 / (hi - lo) } else { 0.0 };
+    // In f64: a range of ±3e38 spans more than an f32 holds.
+    let (lo, hi) = (lo as f64, hi as f64);
+    let scale = if hi > lo { n as f64 / (hi - lo) } else { 0.0 };
     for (_, c) in frame.traced() {
-        let b = ((view.metric(&c, cost) - lo) * scale).floor();
+        let b = ((view.metric(&c, cost) as f64 - lo) * scale).floor();
         out[(b.max(0.0) as usize).min(n - 1)] += 1;
     }
     out

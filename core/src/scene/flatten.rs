@@ -118,6 +118,11 @@ pub fn flatten(scene_path: &Path, scene: &SceneInstances) -> Result<Mesh, SceneE
             out.uvs.extend(&mesh.uvs);
         }
         out.triangles.extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
+        // Triangles numbered as in the files, one after the other (zero-area ones counted), as a
+        // dump of the flattened scene numbers them.
+        let numbered = out.file_triangles as u32;
+        out.file_numbers.extend((0..mesh.triangle_count() as u32).map(|t| numbered + mesh.file_number(t)));
+        out.file_triangles += mesh.file_triangle_count();
         let name = if mesh.name.is_empty() { format!("mesh {i}") } else { mesh.name.clone() };
         out.groups.push(MeshGroup { name, triangles: first..out.triangles.len() as u32 });
     }

@@ -7,6 +7,7 @@ mod flatten;
 mod moer_lite;
 mod open;
 mod scene_file;
+mod strict_json;
 
 pub use flatten::{flatten, load_instances, SceneInstances};
 pub use open::{load_any, Geometry, Scene, SceneBuildError, SceneSource, MAX_FLAT_TRIANGLES};
@@ -82,7 +83,7 @@ fn read_json(path: &Path) -> Result<serde_json::Value, SceneError> {
         other => SceneError::Mesh(other),
     })?;
     let text = crate::mesh::decode_text(path, &bytes)?;
-    serde_json::from_str(&text).map_err(|e| SceneError::Json {
+    strict_json::parse(&text).map_err(|e| SceneError::Json {
         path: path.into(),
         line: e.line(),
         message: e.to_string(),

@@ -93,7 +93,12 @@ fn transform(t: &serde_json::Value, field: &str, f: &Fields) -> Result<Affine3A,
             return Err(f.err(&format!("{mf}[3]"), "the last row must be [0, 0, 0, 1] (no projection)"));
         }
         let m = Mat4::from_cols_array_2d(&v).transpose();
-        if !(m.determinant().abs() > 1e-12) {
+        // Singular relative to its own scale: |det| against the product of its columns' lengths
+        // (Hadamard's bound, 1 for any rotation and scale, 0 for a matrix that flattens), so a
+        // matrix scaling by 1e-4 (det 1e-12) loads as `"scale": 0.0001` does.
+        let m3 = glam::Mat3::from_mat4(m).as_dmat3();
+        let lengths = m3.x_axis.length() * m3.y_axis.length() * m3.z_axis.length();
+        if !(lengths > 0.0 && m3.determinant().abs() / lengths > 1e-6) {
             return Err(f.err(&mf, "the matrix is singular (it flattens the mesh)"));
         }
         return Ok(Affine3A::from_mat4(m));
@@ -182,7 +187,7 @@ fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
 
 /// Parse a scene file's text (for tests and tools; `path` names it in errors and anchors paths).
 pub fn parse_scene_file(path: &Path, text: &str) -> Result<SceneDesc, SceneError> {
-    let json: serde_json::Value = serde_json::from_str(text).map_err(|e| SceneError::Json {
+    let json: serde_json::Value = super::strict_json::parse(text).map_err(|e| SceneError::Json {
         path: path.into(),
         line: e.line(),
         message: e.to_string(),

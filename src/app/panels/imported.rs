@@ -1,10 +1,10 @@
 //! The Imported BVH window: what the checker found in the imported dump (as `bvhscope check`
-//! prints it: grouped, all of them, defects and warnings counted), each finding that names a node
-//! or a triangle a link that selects it; the wrong pixels of the view on screen; and the switch
-//! between the imported tree and the built strategy.
+//! prints it: grouped, each finding its root cause and its first cases, defects and warnings
+//! counted), each finding that names a node or a triangle a link that selects it; the wrong pixels
+//! of the view on screen; and the switch between the imported tree and the built strategy.
 
 use crate::app::{Action, Actions, BvhscopeApp};
-use crate::bvh::check::Group;
+use crate::explain::check::Group;
 
 /// Findings listed per group before "… and N more" (a broken dump of a million nodes can have a
 /// million findings; the CLI lists them all).
@@ -60,7 +60,8 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                             } else {
                                 egui::Color32::from_rgb(220, 190, 90)
                             };
-                            let text = egui::RichText::new(format!("{} {}", if f.defect { "defect:" } else { "warning:" }, f.text)).color(color);
+                            let line = f.line(crate::explain::check::LISTED);
+                            let text = egui::RichText::new(format!("{} {line}", if f.defect { "defect:" } else { "warning:" })).color(color);
                             let action = f.node.map(Action::SelectDumpNode).or(f.triangle.map(Action::SelectTriangle));
                             match action {
                                 Some(a) => {

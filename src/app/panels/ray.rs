@@ -78,8 +78,11 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             }
             let stack = r.trace.steps[..=k.min(n.saturating_sub(1))].iter().rev().find_map(|s| s.stack());
             let stack_text = match stack {
-                Some([]) | None => "empty".to_string(),
-                Some(st) => st.iter().map(|(n, t)| format!("{n} @ {t:.3}")).collect::<Vec<_>>().join(", "),
+                Some(([], _)) | None => "empty".to_string(),
+                Some((st, below)) => {
+                    let under = if below > 0 { format!("… {below} more, ") } else { String::new() };
+                    under + &st.iter().map(|(n, t)| format!("{n} @ {t:.3}")).collect::<Vec<_>>().join(", ")
+                }
             };
             command_line(r, ui);
             ui.label(format!("Stack (bottom first): {stack_text}"))
@@ -221,7 +224,7 @@ fn steps_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions, k: usize)
                 (true, TraceLevel::Top) => "top  ".into(),
                 (true, TraceLevel::Bottom { instance }) => format!("#{instance:<4}"),
             };
-            let text = format!("{:>4}  {level}{}{}", i + 1, "  ".repeat(depths[i] as usize), s.text());
+            let text = format!("{:>4}  {level}{}{}", i + 1, crate::bvh::trace::indent(depths[i]), s.text());
             let mut rich = RichText::new(text).monospace();
             if let Some(c) = step_color(&s.kind) {
                 rich = rich.color(c);

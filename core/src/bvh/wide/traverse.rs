@@ -20,8 +20,8 @@ use crate::cpu::Simd;
 use crate::geometry::slab::{widen, Scalar, Simd4, SlabKernel};
 use crate::geometry::{Ray, TriangleIntersector};
 
-/// Deepest stack a traversal can need: at most W − 1 pushes per level (the build bounds the depth
-/// by `TRAVERSAL_STACK_SIZE`).
+/// The fixed part of the stack: at most W − 1 pushes per level of a tree built by bvhscope (the
+/// build bounds the depth by `TRAVERSAL_STACK_SIZE`); a deeper imported tree spills onto the heap.
 pub(super) const STACK: usize = 3 * crate::bvh::TRAVERSAL_STACK_SIZE + 4;
 const STACK8: usize = 7 * crate::bvh::TRAVERSAL_STACK_SIZE + 8;
 
@@ -210,9 +210,12 @@ fn node_id<const W: usize>(r: ChildRef) -> NodeId {
 
 /// Tell a tracing sink what the wide walk's stack holds.
 fn report_stack<S: TraversalStats, const W: usize, const N: usize>(stats: &mut S, stack: &TraversalStack<N>) {
-    let entries: Vec<(NodeId, f32)> =
-        stack.entries().iter().map(|&(r, t)| (node_id::<W>(ChildRef::from_raw(r)), t)).collect();
-    stats.step_stack(&entries);
+    let top: Vec<(NodeId, f32)> = stack
+        .top(crate::bvh::counters::REPORTED_STACK)
+        .iter()
+        .map(|&(r, t)| (node_id::<W>(ChildRef::from_raw(r)), t))
+        .collect();
+    stats.step_stack(stack.len(), &top);
 }
 
 impl<const W: usize> WideBvh<W> {

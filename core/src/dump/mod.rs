@@ -13,7 +13,12 @@
 //!   `node MINX MINY MINZ MAXX MAXY MAXZ children C1 C2 [C3 C4] [axis A]` or
 //!   `node MINX MINY MINZ MAXX MAXY MAXZ leaf FIRST COUNT`; `#` starts a comment.
 
-use super::Bvh;
+mod import;
+
+pub use import::{import, oversized_leaves, untraceable};
+
+use crate::bvh::{AnyBvh, Bvh, WideBvh};
+use crate::files::FileError;
 use crate::geometry::Aabb;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -57,41 +62,76 @@ pub struct BvhDump {
 /// Why a dump cannot be read (the checker's exit code 2).
 #[derive(Debug, thiserror::Error)]
 pub enum DumpError {
-    #[error("{path}: cannot read: {source}")]
-    Io { path: String, source: std::io::Error },
+    #[error(transparent)]
+    File(#[from] FileError),
     #[error("{path}: not a bvhscope-bvh file: {why}")]
     NotTheFormat { path: String, why: String },
     #[error("{path}: version {found} of the bvhscope-bvh format; this bvhscope reads version {VERSION}")]
     FutureVersion { path: String, found: u32 },
     #[error("{path}: line {line}: {why}")]
     Text { path: String, line: usize, why: String },
+    #[error("{path}: {what} more than {} MB, the limit (by default what a BVH dump of this mesh can need; --max-dump-mb sets it)", .limit.div_ceil(1 << 20))]
+    TooBig { path: String, what: &'static str, limit: u64 },
+}
+
+/// Bytes a dump of a mesh of `triangles` triangles may take, decompressed: what its largest tree
+/// can need written generously (`explain::check::max_references`'s eight references per
+/// triangle, two nodes per reference of a few hundred bytes each, as pretty-printed JSON writes
+/// them), and 64 MB for small meshes. A dump past it is refused while it is read, so a gzip bomb
+/// or a device stops there.
+pub fn max_bytes(triangles: usize) -> u64 {
+    (64 << 20) + triangles as u64 * 8 * (2 * 400 + 16)
+}
+
+/// The forms a dump is written in, by the file's name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DumpFile {
+    Json,
+    JsonGz,
+    Text,
 }
 
 impl BvhDump {
     /// Whether `path` looks like a dump rather than a mesh or a scene (what a file dropped on the
-    /// app is taken for): gzip, or the format's name in its first kilobytes.
+    /// app is taken for): gzip, or the format's name in its first kilobytes. Only regular files
+    /// are opened (a FIFO would block).
     pub fn sniff(path: &Path) -> bool {
-        let mut head = [0u8; 4096];
-        let Ok(n) = std::fs::File::open(path).and_then(|mut f| f.read(&mut head)) else { return false };
-        let head = &head[..n];
+        let Ok((file, _)) = crate::files::open_regular(path) else { return false };
+        let mut head = Vec::new();
+        if file.take(4096).read_to_end(&mut head).is_err() {
+            return false;
+        }
         head.starts_with(&[0x1f, 0x8b]) || head.windows(FORMAT.len()).any(|w| w == FORMAT.as_bytes())
     }
 
-    /// Read a dump: JSON, gzip-compressed JSON (`.gz`), or the text form (anything whose first
-    /// word is `bvhscope-bvh`).
-    pub fn read(path: &Path) -> Result<BvhDump, DumpError> {
+    /// Read a dump: JSON, gzip-compressed JSON (`.gz`, one member or several), or the text form
+    /// (anything whose first word is `bvhscope-bvh`). At most `limit` bytes are read, counted
+    /// after decompression (`max_bytes`).
+    pub fn read(path: &Path, limit: u64) -> Result<BvhDump, DumpError> {
         let name = path.display().to_string();
-        let io = |source| DumpError::Io { path: name.clone(), source };
-        let mut bytes = std::fs::read(path).map_err(io)?;
-        if bytes.starts_with(&[0x1f, 0x8b]) {
-            let mut out = Vec::new();
-            flate2::read::GzDecoder::new(&bytes[..]).read_to_end(&mut out).map_err(io)?;
-            bytes = out;
-        }
-        let text = String::from_utf8(bytes)
-            .map_err(|_| DumpError::NotTheFormat { path: name.clone(), why: "not text (nor gzip)".into() })?;
-        let dump = if text.trim_start().starts_with('{') {
-            Self::from_json(&text, &name)?
+        let io = |source| DumpError::File(FileError::Read { path: path.into(), source });
+        let too_big = |what| DumpError::TooBig { path: name.clone(), what, limit };
+        let (mut file, _) = crate::files::open_regular(path)?;
+        let mut magic = [0u8; 2];
+        let n = file.read(&mut magic).map_err(io)?;
+        let head = std::io::Cursor::new(magic[..n].to_vec());
+        let bytes = if magic[..n] == [0x1f, 0x8b] {
+            // Every member of a multi-member gzip file, and bytes after the last member are an
+            // error (MultiGzDecoder reads them as a broken member), not silently ignored.
+            let gz = flate2::read::MultiGzDecoder::new(head.chain(file));
+            crate::files::read_limited(gz, limit)
+                .map_err(|e| DumpError::NotTheFormat { path: name.clone(), why: format!("broken gzip data: {e}") })?
+                .ok_or_else(|| too_big("decompresses to"))?
+        } else {
+            crate::files::read_limited(head.chain(file), limit).map_err(io)?.ok_or_else(|| too_big("is"))?
+        };
+        let text = decode(&bytes).ok_or_else(|| DumpError::NotTheFormat {
+            path: name.clone(),
+            why: "not text (a NUL byte: binary data, nor gzip)".into(),
+        })?;
+        let start = text.trim_start();
+        let dump = if start.starts_with('{') || start.starts_with('[') || start.starts_with("null") {
+            Self::from_json(start, &name)?
         } else {
             Self::from_text(&text, &name)?
         };
@@ -105,25 +145,39 @@ impl BvhDump {
     }
 
     fn from_json(text: &str, name: &str) -> Result<BvhDump, DumpError> {
+        let not = |why: String| DumpError::NotTheFormat { path: name.into(), why };
         // The format and version first, so a future version is named as such, not as broken JSON.
         #[derive(Deserialize)]
         struct Head {
             format: Option<String>,
-            version: Option<u32>,
+            version: Option<serde_json::Value>,
         }
-        let head: Head = serde_json::from_str(text)
-            .map_err(|e| DumpError::NotTheFormat { path: name.into(), why: format!("broken JSON: {e}") })?;
-        match (head.format.as_deref(), head.version) {
-            (Some(FORMAT), Some(v)) if v != VERSION => {
-                return Err(DumpError::FutureVersion { path: name.into(), found: v })
-            }
-            (Some(FORMAT), Some(_)) => {}
-            (f, _) => {
-                let why = f.map_or("no \"format\" field".to_string(), |f| format!("its format is \"{f}\""));
-                return Err(DumpError::NotTheFormat { path: name.into(), why });
-            }
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| not(format!("broken JSON: {e}")))?;
+        if !value.is_object() {
+            let kind = match &value {
+                serde_json::Value::Null => "null",
+                serde_json::Value::Array(_) => "an array",
+                serde_json::Value::String(_) => "a string",
+                serde_json::Value::Number(_) => "a number",
+                _ => "a boolean",
+            };
+            return Err(not(format!("the JSON is {kind}, not an object with \"format\": \"{FORMAT}\"")));
         }
-        serde_json::from_str(text).map_err(|e| DumpError::NotTheFormat { path: name.into(), why: e.to_string() })
+        let head = Head::deserialize(&value).map_err(|e| not(e.to_string()))?;
+        match head.format.as_deref() {
+            Some(FORMAT) => {}
+            Some(f) => return Err(not(format!("its format is \"{f}\""))),
+            None => return Err(not("no \"format\" field".into())),
+        }
+        match head.version.as_ref().map(|v| v.as_u64()) {
+            None => return Err(not(format!("no \"version\" field (this bvhscope reads version {VERSION})"))),
+            Some(Some(v)) if v != VERSION as u64 => {
+                return Err(DumpError::FutureVersion { path: name.into(), found: v.min(u32::MAX as u64) as u32 })
+            }
+            Some(Some(_)) => {}
+            Some(None) => return Err(not("\"version\" is not a whole number".into())),
+        }
+        BvhDump::deserialize(value).map_err(|e| not(e.to_string()))
     }
 
     fn from_text(text: &str, name: &str) -> Result<BvhDump, DumpError> {
@@ -144,6 +198,12 @@ impl BvhDump {
                     dump.version = int(rest.first().copied().unwrap_or("?"))?;
                     if dump.version != VERSION {
                         return Err(DumpError::FutureVersion { path: name.into(), found: dump.version });
+                    }
+                    if let Some(extra) = rest.get(1) {
+                        return Err(err(
+                            n,
+                            format!("'{extra}' after 'bvhscope-bvh 1': the first line holds nothing else"),
+                        ));
                     }
                 }
                 _ if dump.format.is_empty() => {
@@ -179,6 +239,12 @@ impl BvhDump {
                             node.first = Some(int(rest[7])?);
                             node.count = Some(int(rest[8])?);
                         }
+                        "leaf" => {
+                            return Err(err(
+                                n,
+                                format!("'leaf' takes FIRST COUNT: two numbers, not {}", rest.len() - 7),
+                            ))
+                        }
                         "children" => {
                             let mut kids = Vec::new();
                             let mut k = 7;
@@ -188,7 +254,12 @@ impl BvhDump {
                             }
                             if k < rest.len() {
                                 let a = rest.get(k + 1).ok_or_else(|| err(n, "'axis' without a value".into()))?;
-                                node.axis = Some(int(a)? as u8);
+                                let axis = a.parse::<u8>().ok().filter(|&a| a <= 2);
+                                node.axis =
+                                    Some(axis.ok_or_else(|| err(n, format!("axis '{a}' is not 0, 1 or 2 (x, y, z)")))?);
+                                if let Some(extra) = rest.get(k + 2) {
+                                    return Err(err(n, format!("'{extra}' after the axis: a node line ends with it")));
+                                }
                             }
                             node.children = Some(kids);
                         }
@@ -237,22 +308,53 @@ impl BvhDump {
     }
 
     /// A tree of bvhscope's in any layout (`of_bvh`, `of_wide`).
-    pub fn of_any(bvh: &super::AnyBvh, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
+    pub fn of_any(bvh: &AnyBvh, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
         match bvh {
-            super::AnyBvh::Binary(b) => Self::of_bvh(b, mesh, name),
-            super::AnyBvh::Wide(w) => Self::of_wide(w, mesh, name),
-            super::AnyBvh::Wide8(w) => Self::of_wide(w, mesh, name),
+            AnyBvh::Binary(b) => Self::of_bvh(b, mesh, name),
+            AnyBvh::Wide(w) => Self::of_wide(w, mesh, name),
+            AnyBvh::Wide8(w) => Self::of_wide(w, mesh, name),
         }
     }
 
-    /// Write the dump to `path`: the text form when its name ends in `.txt`, else JSON.
-    pub fn write(&self, path: &Path) -> std::io::Result<()> {
-        let text = if path.extension().is_some_and(|e| e == "txt") {
-            self.to_text()
+    /// The file names a dump can be written to, by what they hold.
+    pub const WRITTEN_AS: &'static str = ".json (JSON), .json.gz (gzip-compressed JSON) or .txt (the text form)";
+
+    /// What `path`'s name says the dump is written as, or why it names no dump format.
+    pub fn written_as(path: &Path) -> Result<DumpFile, String> {
+        let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
+        if name.ends_with(".json.gz") {
+            Ok(DumpFile::JsonGz)
+        } else if name.ends_with(".json") {
+            Ok(DumpFile::Json)
+        } else if name.ends_with(".txt") {
+            Ok(DumpFile::Text)
         } else {
-            serde_json::to_string(self).expect("plain data serialises")
-        };
-        std::fs::write(path, text)
+            Err(format!("{}: a dump is written as {}", path.display(), Self::WRITTEN_AS))
+        }
+    }
+
+    /// Write the dump to `path` in the form its name says (`written_as`), through a temporary file
+    /// renamed over `path` when complete.
+    pub fn write(&self, path: &Path) -> Result<(), DumpError> {
+        use std::io::Write;
+        let form =
+            Self::written_as(path).map_err(|why| DumpError::NotTheFormat { path: path.display().to_string(), why })?;
+        let werr = |source| DumpError::File(FileError::Write { path: path.into(), source });
+        crate::files::write_atomically(path, |w| {
+            let text = match form {
+                DumpFile::Text => self.to_text(),
+                DumpFile::Json | DumpFile::JsonGz => serde_json::to_string(self).expect("plain data serialises"),
+            };
+            match form {
+                DumpFile::JsonGz => {
+                    let mut gz = flate2::write::GzEncoder::new(w, flate2::Compression::default());
+                    gz.write_all(text.as_bytes()).map_err(werr)?;
+                    gz.finish().map_err(werr)?;
+                }
+                _ => w.write_all(text.as_bytes()).map_err(werr)?,
+            }
+            Ok(())
+        })
     }
 
     /// A binary tree of bvhscope's over `mesh`, as a dump (its leaf order is the primitives'
@@ -278,7 +380,7 @@ impl BvhDump {
 
     /// A 4- or 8-wide tree of bvhscope's over `mesh`, as a dump: wide node i is dump node i (its
     /// box is its slot's in its parent, the root's the tree's), and each leaf slot a dump leaf after them.
-    pub fn of_wide<const W: usize>(w: &super::WideBvh<W>, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
+    pub fn of_wide<const W: usize>(w: &WideBvh<W>, mesh: &crate::mesh::Mesh, name: Option<String>) -> BvhDump {
         let arr = |v: glam::Vec3A| glam::Vec3::from(v).to_array();
         let mut boxes = vec![w.root_bounds; w.nodes.len()];
         let mut leaves = Vec::new();
@@ -320,4 +422,18 @@ impl BvhDump {
         nodes.extend(leaves);
         BvhDump { format: FORMAT.into(), version: VERSION, mesh: name, primitives, nodes }
     }
+}
+
+/// A dump's bytes as text: a UTF-8 byte-order mark dropped, bytes that are not UTF-8 decoded as
+/// Latin-1 (as meshes and scenes are: an exporter's comment or mesh name may be written so; the
+/// numbers and words of the format are ASCII). `None` for binary data (a NUL byte).
+fn decode(bytes: &[u8]) -> Option<std::borrow::Cow<'_, str>> {
+    let bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
+    if bytes.contains(&0) {
+        return None;
+    }
+    Some(match std::str::from_utf8(bytes) {
+        Ok(s) => std::borrow::Cow::Borrowed(s),
+        Err(_) => std::borrow::Cow::Owned(bytes.iter().map(|&b| b as char).collect()),
+    })
 }

@@ -1,0 +1,246 @@
+//! The checker's coverage and bounds groups: every triangle in a leaf, and every triangle inside
+//! what a ray can reach of its leaf: the leaf's box inside every ancestor's box (a ray enters a
+//! node only through its parent). Found exactly:
+//!
+//! - a triangle in one leaf is inside that region when its three vertices are (the region is a
+//!   box, the triangle the convex hull of its vertices); when it is not, the highest node on its
+//!   path whose box leaves it out is the root cause, found by a binary search (the region only
+//!   shrinks going down), and the finding is that node's: "node 3's box does not contain its child
+//!   node 6 (by 0.5 on +x): 144 triangles below node 6 stick out of it";
+//! - a triangle cut among several leaves (spatial splits) must be covered by the union of their
+//!   regions: the triangle is clipped against them (`cover`), nothing sampled.
+//!
+//! One walk from the root without recursion, carrying the path: time linear in the nodes and the
+//! references, plus a logarithm of the depth per triangle that sticks out.
+
+use super::structure::Walk;
+use super::{count, cover, defect, tolerance, Finding, Group, Tally};
+use crate::dump::BvhDump;
+use crate::geometry::Aabb;
+use crate::mesh::Mesh;
+use glam::Vec3;
+use std::collections::BTreeMap;
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// How far `t` sticks out of `b`, and where: (distance, axis, beyond the max side). Distance 0
+/// when inside.
+fn excess(b: &Aabb, t: &[Vec3]) -> (f32, usize, bool) {
+    let (lo, hi) = (Vec3::from(b.min), Vec3::from(b.max));
+    let mut worst = (0.0f32, 0usize, false);
+    for p in t {
+        for a in 0..3 {
+            let (below, above) = (lo[a] - p[a], p[a] - hi[a]);
+            // NaN boxes (a structure defect) stick out by infinity.
+            let (below, above) = (
+                if below.is_nan() { f32::INFINITY } else { below },
+                if above.is_nan() { f32::INFINITY } else { above },
+            );
+            if below > worst.0 {
+                worst = (below, a, false);
+            }
+            if above > worst.0 {
+                worst = (above, a, true);
+            }
+        }
+    }
+    worst
+}
+
+fn by(e: (f32, usize, bool)) -> String {
+    format!("by {} on {}{}", e.0, if e.2 { "+" } else { "-" }, AXES[e.1])
+}
+
+/// Whether `t` lies in `b` grown by `tol`.
+fn holds(b: &Aabb, t: &[Vec3; 3], tol: f32) -> bool {
+    excess(b, t).0 <= tol
+}
+
+/// Triangles sticking out for one root cause, keyed by (node `worst`, its child on their way
+/// down, `None` when `worst` is their own leaf).
+#[derive(Default)]
+struct Cause {
+    examples: Vec<String>,
+    first: Option<u32>,
+}
+
+pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Finding>) {
+    let (nodes, prims) = (&dump.nodes, &dump.primitives);
+    let by_file = mesh.triangles_by_file_number();
+    let tris = by_file.len();
+    let leaf_prims = |i: usize| -> Option<&[u32]> {
+        let n = &nodes[i];
+        let (Some(f), Some(c), None) = (n.first, n.count, &n.children) else { return None };
+        prims.get(f as usize..f as usize + c as usize)
+    };
+    // First pass: how many distinct leaves hold each triangle; a triangle twice in one leaf.
+    let mut leaves_of = vec![0u32; tris];
+    let mut last = vec![u32::MAX; tris];
+    let mut twice = Tally::new(
+        Group::Coverage,
+        false,
+        "triangle is referenced twice in one leaf (tested twice by every ray that reaches it)",
+        "triangles are referenced twice in one leaf (tested twice by every ray that reaches it)",
+    );
+    for i in (0..nodes.len()).filter(|&i| walk.reached[i]) {
+        for &p in leaf_prims(i).into_iter().flatten() {
+            let Some(l) = last.get_mut(p as usize) else { continue };
+            if *l == i as u32 {
+                twice.add(Some(i as u32), Some(p), format!("triangle {p} (leaf node {i})"));
+            } else {
+                *l = i as u32;
+                leaves_of[p as usize] += 1;
+            }
+        }
+    }
+    // Second pass: the walk from the root with the path and each node's reachable region.
+    let mut reach = vec![Aabb::EMPTY; nodes.len()];
+    let mut path: Vec<usize> = Vec::new();
+    let mut stack = vec![(0usize, 0usize)];
+    let mut causes: BTreeMap<(u32, Option<u32>), Cause> = BTreeMap::new();
+    let mut shared: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
+    let mut degenerate_in = Tally::new(
+        Group::Coverage,
+        false,
+        "degenerate (zero-area) triangle is in a leaf: harmless, no ray can hit it",
+        "degenerate (zero-area) triangles are in leaves: harmless, no ray can hit them",
+    );
+    let mut covered = vec![false; tris];
+    last.fill(u32::MAX);
+    while let Some((i, depth)) = stack.pop() {
+        path.truncate(depth);
+        path.push(i);
+        let b = nodes[i].bounds();
+        reach[i] = if depth == 0 { b } else { reach[path[depth - 1]].intersection(b) };
+        for &k in nodes[i].children.iter().flatten().rev() {
+            let k = k as usize;
+            if k < nodes.len() && k != 0 && walk.parent[k] == i as u32 {
+                stack.push((k, depth + 1));
+            }
+        }
+        let Some(leaf) = leaf_prims(i) else { continue };
+        for &p in leaf {
+            let Some(l) = last.get_mut(p as usize) else { continue };
+            if std::mem::replace(l, i as u32) == i as u32 {
+                continue; // the second reference in this leaf: already looked at
+            }
+            covered[p as usize] = true;
+            let Some(m) = by_file[p as usize] else {
+                degenerate_in.add(Some(i as u32), Some(p), format!("triangle {p} (leaf node {i})"));
+                continue;
+            };
+            let t = mesh.triangle(m);
+            if leaves_of[p as usize] > 1 {
+                shared.entry(p).or_default().push(i);
+                continue;
+            }
+            let tol = tolerance(&t);
+            if holds(&reach[i], &t, tol) {
+                continue;
+            }
+            // The highest node on the path whose region leaves the triangle out: each side of
+            // the region only moves inwards going down, so each side's first failure is found
+            // by a binary search, and the earliest of the six is the one.
+            let (lo, hi) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+            let mut k = depth;
+            for a in 0..3 {
+                let low = path.partition_point(|&q| !(reach[q].min[a] - lo[a] > tol));
+                let high = path.partition_point(|&q| !(hi[a] - reach[q].max[a] > tol));
+                k = k.min(low).min(high);
+            }
+            // NaN in a box (a structure defect) breaks the order the search relies on.
+            let k = k.min(depth);
+            let worst = path[k];
+            let e = excess(&nodes[worst].bounds(), &t);
+            let child = (k < depth).then(|| path[k + 1] as u32);
+            let cause = causes.entry((worst as u32, child)).or_default();
+            cause.first.get_or_insert(p);
+            cause.examples.push(match child {
+                Some(_) => format!("triangle {p} {} (leaf node {i})", by(e)),
+                None => format!("triangle {p} {}", by(e)),
+            });
+        }
+    }
+    // Leaves whose own box is wrong: one finding, a leaf each; a wrong box above the leaves: one
+    // finding per box, the triangles it leaves out listed.
+    let mut leaves = Tally::new(
+        Group::Bounds,
+        true,
+        "leaf's box does not hold all its triangles",
+        "leaves' boxes do not hold all their triangles",
+    );
+    for ((worst, child), cause) in causes {
+        let n = cause.examples.len();
+        let Some(c) = child else {
+            let more = if n > 1 { format!(", and {} more", n - 1) } else { String::new() };
+            leaves.add(Some(worst), cause.first, format!("leaf node {worst} ({}{more})", cause.examples[0]));
+            continue;
+        };
+        let child_box = nodes[c as usize].bounds();
+        let e = excess(&nodes[worst as usize].bounds(), &[child_box.min.into(), child_box.max.into()]);
+        let text = if e.0 > 0.0 && !child_box.is_empty() {
+            format!(
+                "node {worst}'s box does not contain its child node {c} ({}): {} below node {c} stick{} out of node {worst}'s box",
+                by(e),
+                count(n, "triangle", "triangles"),
+                if n == 1 { "s" } else { "" }
+            )
+        } else {
+            format!("node {worst}'s box leaves out {} below its child node {c}", count(n, "triangle", "triangles"))
+        };
+        let mut f = defect(Group::Bounds, Some(worst), cause.first, text);
+        f.examples = cause.examples;
+        out.push(f);
+    }
+    leaves.finish(out);
+    let mut cut = Tally::new(
+        Group::Bounds,
+        true,
+        "triangle cut among several leaves has a part in none of their boxes (within their ancestors')",
+        "triangles cut among several leaves have parts in none of their boxes (within their ancestors')",
+    );
+    let mut complex = Tally::new(
+        Group::Bounds,
+        false,
+        "triangle is cut among too many leaves to clip exactly (its rays are still checked)",
+        "triangles are cut among too many leaves to clip exactly (their rays are still checked)",
+    );
+    for (p, leaves) in shared {
+        let Some(Some(m)) = by_file.get(p as usize) else { continue };
+        let t = mesh.triangle(*m);
+        let regions: Vec<Aabb> = leaves.iter().map(|&i| reach[i]).collect();
+        let list = |k: usize| {
+            let names: Vec<String> = leaves.iter().take(k).map(|i| format!("node {i}")).collect();
+            format!("{}{}", names.join(", "), if leaves.len() > k { ", …" } else { "" })
+        };
+        match cover::uncovered(&t, &regions, tolerance(&t)) {
+            cover::Coverage::Covered => {}
+            cover::Coverage::Uncovered(q) => cut.add(
+                Some(leaves[0] as u32),
+                Some(p),
+                format!("triangle {p} around ({}, {}, {}) (leaves {})", q.x, q.y, q.z, list(4)),
+            ),
+            cover::Coverage::TooComplex => {
+                complex.add(Some(leaves[0] as u32), Some(p), format!("triangle {p} ({} leaves)", leaves.len()))
+            }
+        }
+    }
+    cut.finish(out);
+    complex.finish(out);
+    let mut missing = Tally::new(Group::Coverage, true, "triangle is in no leaf", "triangles are in no leaf");
+    let mut degenerate_out = Tally::new(
+        Group::Coverage,
+        false,
+        "degenerate (zero-area) triangle is in no leaf: harmless, no ray can hit it",
+        "degenerate (zero-area) triangles are in no leaf: harmless, no ray can hit them",
+    );
+    for t in (0..tris).filter(|&t| !covered[t]) {
+        let degenerate = by_file[t].is_none_or(|m| crate::geometry::triangle_double_area(&mesh.triangle(m)) <= 0.0);
+        let tally = if degenerate { &mut degenerate_out } else { &mut missing };
+        tally.add(None, Some(t as u32), format!("triangle {t}"));
+    }
+    missing.finish(out);
+    degenerate_out.finish(out);
+    degenerate_in.finish(out);
+    twice.finish(out);
+}

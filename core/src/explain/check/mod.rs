@@ -1,0 +1,270 @@
+//! The checker of an imported BVH (`dump`): everything wrong with it, in four groups: structure
+//! (indices, ranges, kinds, nodes reached twice, boxes), coverage (triangles in no leaf, nodes
+//! never reached), bounds (a triangle outside its leaf's box or an ancestor's, found exactly) and
+//! rays (the tree traced by bvhscope's own traversal against the linear scan). Each finding names
+//! its root cause once (a node, a triangle) and lists what follows from it, so one wrong box is
+//! one line, not a hundred.
+//!
+//! A checker that passes a wrong tree is worse than none, so the bounds are exact: a triangle is
+//! checked against what a ray can reach of its leaf (the leaf's box inside every ancestor's), with
+//! a tolerance of a few ulps of the triangle's own coordinates (`tolerance`), never of the scene's
+//! size; a triangle cut among several leaves is clipped against their boxes (`cover`). And the
+//! checker is bounded: references are counted before any is followed (`max_references`), rays
+//! are traced in batches (`rays`), deep trees are walked without recursion.
+
+mod bounds;
+mod cover;
+mod rays;
+mod structure;
+#[cfg(test)]
+mod tests;
+
+pub use rays::{check_rays, wrong_rays, RaySet, Reference, WrongRay, WrongRays, LINEAR_REFERENCE_MAX, MAX_RAYS};
+
+use crate::bvh::imported::Imported;
+use crate::bvh::{AnyBvh, TraceOptions};
+use crate::dump::{import, BvhDump};
+use crate::mesh::Mesh;
+use crate::work::{Cancelled, WorkControl};
+use glam::Vec3;
+use serde::Serialize;
+use std::path::Path;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+pub enum Group {
+    Structure,
+    Coverage,
+    Bounds,
+    Rays,
+}
+
+impl Group {
+    pub const ALL: [Group; 4] = [Group::Structure, Group::Coverage, Group::Bounds, Group::Rays];
+    pub fn label(self) -> &'static str {
+        match self {
+            Group::Structure => "structure",
+            Group::Coverage => "coverage",
+            Group::Bounds => "bounds",
+            Group::Rays => "rays",
+        }
+    }
+}
+
+/// One thing found: its cause (`text`, naming the node or triangle), and the cases it covers
+/// (`examples`: the triangles a wrong box leaves out, the nodes of one kind of defect…).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Finding {
+    pub group: Group,
+    /// A defect (the tree is wrong) or a warning (worth a look, not wrong).
+    pub defect: bool,
+    pub text: String,
+    /// The node the finding is about (the first, for a finding of several).
+    pub node: Option<u32>,
+    /// The triangle it is about (the first, for a finding of several).
+    pub triangle: Option<u32>,
+    /// Every case, in order (empty for a finding that is one case).
+    pub examples: Vec<String>,
+}
+
+/// Examples listed after a finding unless all are asked for (`check --all`).
+pub const LISTED: usize = 8;
+
+impl Finding {
+    /// The finding as one line: its text, then up to `list` of its examples and how many there
+    /// are in all when some are left out.
+    pub fn line(&self, list: usize) -> String {
+        if self.examples.is_empty() {
+            return self.text.clone();
+        }
+        let shown: Vec<&str> = self.examples.iter().take(list).map(String::as_str).collect();
+        let more = self.examples.len() > shown.len();
+        let tail = if more { format!(", … ({} in all)", self.examples.len()) } else { String::new() };
+        format!("{}: {}{tail}", self.text, shown.join(", "))
+    }
+}
+
+pub(crate) fn defect(group: Group, node: Option<u32>, triangle: Option<u32>, text: String) -> Finding {
+    Finding { group, defect: true, text, node, triangle, examples: Vec::new() }
+}
+
+pub(crate) fn warning(group: Group, node: Option<u32>, triangle: Option<u32>, text: String) -> Finding {
+    Finding { group, defect: false, text, node, triangle, examples: Vec::new() }
+}
+
+/// "1 node is" / "3 nodes are": a count with its noun and verb agreeing.
+pub(crate) fn count(n: usize, one: &str, many: &str) -> String {
+    if n == 1 {
+        format!("1 {one}")
+    } else {
+        format!("{n} {many}")
+    }
+}
+
+/// Findings of one kind gathered as they are met, made into one finding at the end: "3 nodes
+/// are …: node 1, node 4, node 9".
+pub(crate) struct Tally {
+    group: Group,
+    defect: bool,
+    one: &'static str,
+    many: &'static str,
+    node: Option<u32>,
+    triangle: Option<u32>,
+    examples: Vec<String>,
+}
+
+impl Tally {
+    pub fn new(group: Group, defect: bool, one: &'static str, many: &'static str) -> Self {
+        Tally { group, defect, one, many, node: None, triangle: None, examples: Vec::new() }
+    }
+
+    pub fn add(&mut self, node: Option<u32>, triangle: Option<u32>, example: String) {
+        if self.examples.is_empty() {
+            (self.node, self.triangle) = (node, triangle);
+        }
+        self.examples.push(example);
+    }
+
+    pub fn finish(self, out: &mut Vec<Finding>) {
+        if self.examples.is_empty() {
+            return;
+        }
+        let text = count(self.examples.len(), self.one, self.many);
+        out.push(Finding {
+            group: self.group,
+            defect: self.defect,
+            text,
+            node: self.node,
+            triangle: self.triangle,
+            examples: self.examples,
+        });
+    }
+}
+
+/// How far a dump's box may miss a triangle `t` and still hold it: four ulps of its largest
+/// coordinate (a box written with nine significant digits, or computed in another order of
+/// floating-point operations, is that close), never a fraction of the scene (a far triangle must
+/// not excuse a wrong box near the origin).
+pub fn tolerance(t: &[Vec3; 3]) -> f32 {
+    let m = t.iter().map(|v| v.abs().max_element()).fold(0.0f32, f32::max);
+    (4.0 * f32::EPSILON * m).max(f32::MIN_POSITIVE)
+}
+
+/// The most triangle references the leaves of a dump of `mesh` may hold: eight per triangle (a
+/// tree needs one; spatial splits add some, bvhscope's SBVH at most three more), and a few
+/// thousand for tiny meshes. Counted before any reference is followed, so a small dump cannot
+/// ask for gigabytes.
+pub fn max_references(mesh: &Mesh) -> u64 {
+    8 * mesh.file_triangle_count() as u64 + 4096
+}
+
+/// What is checked: a dump read from `dump_path`, over the mesh read from `mesh_path`.
+pub struct Subject<'a> {
+    pub dump: &'a BvhDump,
+    pub dump_path: &'a Path,
+    pub mesh: &'a Mesh,
+    pub mesh_path: &'a Path,
+}
+
+/// The structure, coverage and bounds of `dump` over `mesh` (no rays).
+pub fn check_tree(dump: &BvhDump, mesh: &Mesh) -> Vec<Finding> {
+    let mut out = Vec::new();
+    let Some(walk) = structure::check(dump, mesh, &mut out) else { return out };
+    bounds::check(dump, mesh, &walk, &mut out);
+    out
+}
+
+/// When the dump names another mesh than the one given, or numbers more triangles than it has:
+/// one line saying so, before the defects that follow from it.
+pub fn wrong_mesh(s: &Subject) -> Option<Finding> {
+    let given = s.mesh_path.file_name().map(|n| n.to_string_lossy().into_owned())?;
+    let named = s.dump.mesh.as_deref().map(|m| m.rsplit(['/', '\\']).next().unwrap_or(m).to_string());
+    let tris = s.mesh.file_triangle_count();
+    let highest = s.dump.primitives.iter().copied().max();
+    let past = highest.filter(|&h| h as usize >= tris);
+    let other_name = named.as_ref().filter(|n| !n.eq_ignore_ascii_case(&given));
+    if other_name.is_none() && past.is_none() {
+        return None;
+    }
+    let mut text = match other_name {
+        Some(n) => format!("the dump was written for {n}, but is checked against {given} ({tris} triangles)"),
+        None => format!("the dump is checked against {given} ({tris} triangles)"),
+    };
+    if let Some(h) = past {
+        text += &format!(", and its primitives number triangles up to {h}");
+    }
+    text += ": is this the mesh it was built over?";
+    Some(warning(Group::Structure, None, None, text))
+}
+
+/// Why a dump cannot be traced as it is, or `Ok` with the tree every view traces.
+pub fn traceable(findings: &[Finding], dump: &BvhDump, mesh: &Mesh, path: &Path) -> Result<(AnyBvh, Imported), String> {
+    if findings.iter().any(|f| f.group == Group::Structure && f.defect) {
+        return Err("its structure has defects".into());
+    }
+    import(dump, mesh, path)
+}
+
+/// What `check` found.
+pub struct Checked {
+    pub findings: Vec<Finding>,
+    /// The tree as traced, when its structure is sound.
+    pub tree: Option<(AnyBvh, Imported)>,
+    /// The camera's pixels whose hit through the tree differs from the linear scan's (the app's
+    /// red mask).
+    pub wrong_pixels: Vec<(u32, u32)>,
+    /// What the rays were checked against, when they were traced.
+    pub reference: Option<Reference>,
+    /// Rays traced.
+    pub rays: u64,
+}
+
+/// Findings of every group for `s`: the tree's, then, when its structure is sound, the rays'
+/// (the camera's primary rays and `rays` random ones, `control` told of each batch).
+pub fn check(
+    s: &Subject,
+    camera: &crate::render::Camera,
+    rays: u64,
+    opts: TraceOptions,
+    control: &WorkControl,
+) -> Result<Checked, Cancelled> {
+    let mut out: Vec<Finding> = wrong_mesh(s).into_iter().collect();
+    out.extend(check_tree(s.dump, s.mesh));
+    let nothing = |findings| Checked { findings, tree: None, wrong_pixels: Vec::new(), reference: None, rays: 0 };
+    if out.iter().any(|f| f.group == Group::Structure && f.defect) {
+        return Ok(nothing(out));
+    }
+    let (bvh, imported) = match import(s.dump, s.mesh, s.dump_path) {
+        Ok(b) => b,
+        Err(why) => {
+            // Not a warning: a tree bvhscope cannot trace is a tree nobody can see is right.
+            out.push(defect(Group::Rays, None, None, format!("the tree cannot be traced: {why}")));
+            return Ok(nothing(out));
+        }
+    };
+    let (cap, big) = crate::dump::oversized_leaves(s.dump);
+    if let Some(&first) = big.first() {
+        let text = format!(
+            "{} more than {cap} triangles, the most a leaf of the layout it is traced in holds: each is traced as a subtree of leaves with its box (the same hits; its counts include the added boxes)",
+            count(big.len(), "leaf holds", "leaves hold")
+        );
+        let mut f = warning(Group::Rays, Some(first), None, text);
+        f.examples = big
+            .iter()
+            .map(|&i| format!("node {i} ({} triangles)", s.dump.nodes[i as usize].count.unwrap_or(0)))
+            .collect();
+        out.push(f);
+    }
+    let set = RaySet::new(s.mesh, camera, rays);
+    let reference = Reference::of(s.mesh);
+    let wrong = wrong_rays(&bvh, s.mesh, &reference, &set, opts, control)?;
+    if let Some(f) = wrong.finding(set.len()) {
+        out.push(f);
+    }
+    Ok(Checked {
+        findings: out,
+        tree: Some((bvh, imported)),
+        wrong_pixels: wrong.pixels,
+        reference: Some(reference),
+        rays: set.len(),
+    })
+}
