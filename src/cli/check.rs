@@ -138,6 +138,9 @@ pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
     Ok((o, defects))
 }
 
+/// Findings printed per group unless `--all`.
+const FINDINGS_LISTED: usize = 12;
+
 fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality], list: usize) -> String {
     let mut o = String::new();
     let defects = findings.iter().filter(|f| f.defect).count();
@@ -150,8 +153,14 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality], list: u
         }
         let d = here.iter().filter(|f| f.defect).count();
         let _ = writeln!(o, "\n{} ({d} defects, {} warnings)", g.label(), here.len() - d);
-        for f in here {
+        // A tree whose every box is wrong has a root cause per box: the first few say what is
+        // wrong, `--all` lists every one.
+        let shown = if list == usize::MAX { here.len() } else { FINDINGS_LISTED };
+        for f in here.iter().take(shown) {
             let _ = writeln!(o, "  {} {}", if f.defect { "defect: " } else { "warning:" }, f.line(list));
+        }
+        if here.len() > shown {
+            let _ = writeln!(o, "  … {} more in this group (--all lists every one)", here.len() - shown);
         }
     }
     if !table.is_empty() {

@@ -67,7 +67,7 @@ pub struct Finding {
 }
 
 /// Examples listed after a finding unless all are asked for (`check --all`).
-pub const LISTED: usize = 8;
+pub const LISTED: usize = 4;
 
 impl Finding {
     /// The finding as one line: its text, then up to `list` of its examples and how many there
