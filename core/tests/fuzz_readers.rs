@@ -258,3 +258,42 @@ fn random_trees_correct_or_broken_are_never_passed_when_wrong() {
     eprintln!("{passed} passed, {failed} with defects, in {:.1?}: {kinds:?}", start.elapsed());
     assert!(passed > 0 && failed > 0, "both kinds were tried");
 }
+
+/// Every tree the checker passes or traces can be walked by every view: its statistics, its
+/// hierarchy and the inspector of each node end (an empty leaf used to make the binary tree point
+/// back at its root, and `inspect` ran out of memory).
+#[test]
+fn every_traced_tree_can_be_inspected_node_by_node() {
+    use bvhscope_core::bvh::{inspect, AnyBvh, TreeStats};
+    let mesh = mesh();
+    let mut rng = Rng::new(777);
+    for _ in 0..cases(60) {
+        let mut d = random_tree(&mesh, &mut rng);
+        // Some leaves emptied (count 0), some triangles so made unreferenced.
+        for _ in 0..rng.below(4) {
+            let leaves: Vec<usize> = (0..d.nodes.len()).filter(|&i| d.nodes[i].count.is_some()).collect();
+            let k = leaves[rng.below(leaves.len() as u64) as usize];
+            d.nodes[k].count = Some(0);
+        }
+        let findings = check_tree(&d, &mesh);
+        let Ok((bvh, names)) = bvhscope_core::explain::check::traceable(&findings, &d, &mesh, "e.json".as_ref()) else {
+            continue;
+        };
+        let tree = match &bvh {
+            AnyBvh::Binary(b) => b.clone(),
+            _ => (*names.binary.clone().unwrap().0).clone(),
+        };
+        let stats = bounded(Duration::from_secs(20), {
+            let bvh = bvh.clone();
+            move || TreeStats::of(&bvh)
+        });
+        assert!(stats.nodes >= 1);
+        bounded(Duration::from_secs(60), move || {
+            let h = inspect::Hierarchy::of(&tree);
+            for node in 0..tree.nodes.len() as u32 {
+                assert!(h.path(node).len() <= tree.nodes.len());
+                let _ = inspect::inspect(&tree, &h, node);
+            }
+        });
+    }
+}

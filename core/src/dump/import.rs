@@ -88,7 +88,8 @@ pub fn import(dump: &BvhDump, mesh: &Mesh, path: &std::path::Path) -> Result<(An
         |ids: Vec<u32>| -> Vec<u32> { ids.into_iter().map(|d| if d >= added { u32::MAX } else { d }).collect() };
     let by_file = mesh.triangles_by_file_number();
     let copy = Leaves { dump, by_file: by_file.clone(), mesh, prim_ids: Vec::new(), tris: Vec::new() };
-    let broken = || "its structure has defects (bvhscope check lists them)".to_string();
+    let broken =
+        || "its structure has defects, or its leaves hold no triangle (bvhscope check lists what is wrong)".to_string();
     if widest(dump) == 2 {
         let (bvh, ids) = to_binary(copy).ok_or_else(broken)?;
         let node_ids = named(ids);
@@ -180,6 +181,8 @@ fn to_binary(mut leaves: Leaves) -> Option<(Bvh, Vec<u32>)> {
     let dump = leaves.dump;
     let mut ids = vec![0u32];
     let mut nodes = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
+    // Slots of leaves that hold nothing to trace.
+    let mut empty = Vec::new();
     // (dump node, its slot in `nodes`)
     let mut stack = vec![(0usize, 0usize)];
     while let Some((d, slot)) = stack.pop() {
@@ -198,16 +201,71 @@ fn to_binary(mut leaves: Leaves) -> Option<(Bvh, Vec<u32>)> {
                 stack.push((kids[0] as usize, first));
             }
             None => {
-                // An empty leaf's empty box is never entered.
                 let (start, kept) = leaves.copy(d)?;
                 if kept > 0 {
                     nodes[slot] = BvhNode::leaf(n.bounds(), start, kept as u16);
+                } else {
+                    empty.push(slot);
                 }
             }
         }
     }
+    let (nodes, ids) = without_empty(nodes, ids, &empty)?;
     let params = Leaves::params(Layout::Binary);
     Some((Bvh { nodes, prim_ids: leaves.prim_ids, tris: leaves.tris, params, report: Default::default() }, ids))
+}
+
+/// The binary tree without its empty leaves (a leaf of count 0, or of zero-area triangles only,
+/// which no ray can hit): a node whose one child is empty is replaced by its other child. A binary
+/// node of no triangles cannot be written (a count of 0 means interior), and a walk that took it
+/// for one would follow children that are not there. `None` when nothing is left.
+fn without_empty(nodes: Vec<BvhNode>, ids: Vec<u32>, empty: &[usize]) -> Option<(Vec<BvhNode>, Vec<u32>)> {
+    if empty.is_empty() {
+        return Some((nodes, ids));
+    }
+    let mut is_empty = vec![false; nodes.len()];
+    for &e in empty {
+        is_empty[e] = true;
+    }
+    let interior = |i: usize, is_empty: &[bool]| !is_empty[i] && !nodes[i].is_leaf();
+    // Children come after their parents (numbered depth first): one pass back up.
+    for i in (0..nodes.len()).rev() {
+        if interior(i, &is_empty) {
+            let l = nodes[i].index as usize;
+            is_empty[i] = is_empty[l] && is_empty[l + 1];
+        }
+    }
+    if is_empty[0] {
+        return None;
+    }
+    // Past a node with one empty child, to the first node worth keeping.
+    let keep = |mut i: usize| {
+        while interior(i, &is_empty) {
+            let l = nodes[i].index as usize;
+            match (is_empty[l], is_empty[l + 1]) {
+                (true, false) => i = l + 1,
+                (false, true) => i = l,
+                _ => break,
+            }
+        }
+        i
+    };
+    let (mut out, mut out_ids) = (vec![nodes[0]], vec![ids[0]]);
+    let mut stack = vec![(keep(0), 0usize)];
+    while let Some((i, slot)) = stack.pop() {
+        out[slot] = nodes[i];
+        out_ids[slot] = ids[i];
+        if interior(i, &is_empty) {
+            let l = nodes[i].index as usize;
+            let first = out.len();
+            out.extend([nodes[l], nodes[l + 1]]);
+            out_ids.extend([ids[l], ids[l + 1]]);
+            out[slot].index = first as u32;
+            stack.push((keep(l + 1), first + 1));
+            stack.push((keep(l), first));
+        }
+    }
+    Some((out, out_ids))
 }
 
 /// Each interior dump node one wide node (numbered depth first), each leaf a slot of its parent.

@@ -161,6 +161,19 @@ fn walk(dump: &BvhDump, out: &mut Vec<Finding>) -> Walk {
         stack.push((k, 0));
     }
     twice.finish(out);
+    // Reached leaves of no triangle: harmless, but a binary node cannot hold nothing.
+    let mut empty = Tally::new(
+        Group::Structure,
+        false,
+        "leaf holds no triangle: no ray finds anything in it, and bvhscope traces its parent as its other child",
+        "leaves hold no triangle: no ray finds anything in them, and bvhscope traces each one's parent as its other child",
+    );
+    let hold_nothing =
+        |(i, n): &(usize, &crate::dump::DumpNode)| reached[*i] && n.children.is_none() && n.count == Some(0);
+    for (i, _) in nodes.iter().enumerate().filter(hold_nothing) {
+        empty.add(Some(i as u32), None, format!("node {i}"));
+    }
+    empty.finish(out);
     let unreached: Vec<usize> = (0..nodes.len()).filter(|&i| !reached[i]).collect();
     if let Some(&first) = unreached.first() {
         let text =
