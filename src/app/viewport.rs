@@ -282,6 +282,9 @@ fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, hi
             egui::Frame::popup(ui.style()).show(ui, |ui| {
                 ui.set_max_width(330.0);
                 ui.label(egui::RichText::new(format!("Legend: {}", legend.title)).strong());
+                if !legend.note.is_empty() {
+                    ui.weak(&legend.note);
+                }
                 let mut bar_x = 0.0..=0.0;
                 ui.horizontal(|ui| {
                     ui.label(fmt_value(legend.range_min as f64));

@@ -47,9 +47,21 @@ pub struct RenderArgs {
     pub bvh: Option<PathBuf>,
     #[command(flatten)]
     pub dump_limit: super::args::DumpLimit,
+    /// With --against and no --range: the colour scale's ends at ± this percentile of |B − A| over
+    /// the pixels where the builds differ (100: the largest difference; one outlier pixel would
+    /// leave the rest nearly white) [default: 99].
+    #[arg(long, value_parser = parse_percentile, requires = "against", conflicts_with = "range")]
+    pub percentile: Option<f32>,
     /// With --against: also write the difference as CSV, one row per pixel: x, y, a, b, b_minus_a.
     #[arg(long, value_name = "FILE.csv", requires = "against")]
     pub difference: Option<PathBuf>,
+}
+
+fn parse_percentile(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(p) if p > 0.0 && p <= 100.0 => Ok(p),
+        _ => Err(format!("'{s}' is not a percentile above 0, at most 100")),
+    }
 }
 
 fn parse_range(s: &str) -> Result<(f32, f32), String> {
@@ -98,7 +110,7 @@ fn run_against(
     label_a: &str,
     against: crate::bvh::SplitStrategy,
 ) -> Result<(), CliError> {
-    use crate::render::diff::{difference, difference_image, tally};
+    use crate::render::diff::{difference, difference_image, tally, DiffRange};
     if !a.view.is_heatmap() {
         return Err(CliError::Usage(
             "--against compares two builds' heatmaps: add --view visits, tri-tests or cost".into(),
@@ -126,7 +138,10 @@ fn run_against(
         let bytes = w.into_inner().expect("writing to memory");
         crate::files::write_bytes(path, &bytes)?;
     }
-    let range = a.range.map(|(lo, hi)| lo.abs().max(hi.abs()));
+    let range = match (a.range, a.percentile) {
+        (Some((lo, hi)), _) => DiffRange::Fixed(lo.abs().max(hi.abs())),
+        (None, p) => DiffRange::Percentile(p.unwrap_or(crate::render::diff::DEFAULT_PERCENTILE)),
+    };
     let (img, mut legend) = difference_image(camera.width, &d, a.view, range);
     legend.subject = format!("{}: A {label_a}, B {}", file_name(&a.mesh), params_b.label());
     let img = draw_legend(&img, &legend);

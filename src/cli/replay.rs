@@ -134,6 +134,7 @@ pub fn output(a: &ReplayArgs) -> Result<String, CliError> {
                 replay.sah[k]
             ),
             subject: subject.clone(),
+            note: String::new(),
             colormap: a.colormap,
             range_min: 0.0,
             range_max: max,

@@ -22,9 +22,40 @@ pub fn difference(a: &Frame, b: &Frame, view: View, cost: SahCost) -> Option<Vec
     )
 }
 
-/// The difference as an image and its legend: the range is ±`range` if given, else ± the largest
-/// difference; the legend's min, mean and max are the differences'.
-pub fn difference_image(width: u32, d: &[f32], view: View, range: Option<f32>) -> (RgbImage, Legend) {
+/// The range of a difference image, symmetric about zero.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DiffRange {
+    /// ±this.
+    Fixed(f32),
+    /// ± this percentile of |B − A| over the pixels where B and A differ (100: the largest
+    /// difference). One outlier pixel would otherwise set the scale and leave the rest white.
+    Percentile(f32),
+}
+
+/// The default: the 99th percentile.
+pub const DEFAULT_PERCENTILE: f32 = 99.0;
+
+impl From<Option<f32>> for DiffRange {
+    /// A fixed range if given, else the default percentile.
+    fn from(r: Option<f32>) -> Self {
+        r.map_or(DiffRange::Percentile(DEFAULT_PERCENTILE), DiffRange::Fixed)
+    }
+}
+
+/// The `p`th percentile of |v| over the nonzero values of `d` (0 when all are zero).
+pub fn percentile_of_abs(d: &[f32], p: f32) -> f32 {
+    let mut a: Vec<f32> = d.iter().map(|v| v.abs()).filter(|&v| v > 0.0).collect();
+    if a.is_empty() {
+        return 0.0;
+    }
+    let k = (((p.clamp(0.0, 100.0) / 100.0) * a.len() as f32).ceil() as usize).clamp(1, a.len()) - 1;
+    *a.select_nth_unstable_by(k, f32::total_cmp).1
+}
+
+/// The difference as an image and its legend: the range is ± a fixed value or a percentile of
+/// the differences (the legend's title says which, and how many pixels lie beyond it, drawn at
+/// the ends of the scale); the legend's min, mean and max are the differences'.
+pub fn difference_image(width: u32, d: &[f32], view: View, range: impl Into<DiffRange>) -> (RgbImage, Legend) {
     let height = (d.len() as u32).checked_div(width).unwrap_or(0);
     let (mut lo, mut hi, mut sum) = (f32::INFINITY, f32::NEG_INFINITY, 0f64);
     for &v in d {
@@ -35,12 +66,20 @@ pub fn difference_image(width: u32, d: &[f32], view: View, range: Option<f32>) -
     if d.is_empty() {
         (lo, hi) = (0.0, 0.0);
     }
-    let m = range.unwrap_or(lo.abs().max(hi.abs())).max(1e-20);
+    let (m, how) = match range.into() {
+        DiffRange::Fixed(r) => (r, "fixed".to_string()),
+        DiffRange::Percentile(p) if p >= 100.0 => (lo.abs().max(hi.abs()), "the largest |B - A|".to_string()),
+        DiffRange::Percentile(p) => (percentile_of_abs(d, p), format!("{p}th percentile of |B - A|")),
+    };
+    let m = m.max(1e-20);
+    let beyond = d.iter().filter(|v| v.abs() > m).count();
+    let clamped = if beyond > 0 { format!(", {beyond} pixels beyond") } else { String::new() };
     let map = ColorMap::Diverging;
     let img = RgbImage::from_fn(width, height, |x, y| image::Rgb(map.map(0.5 + 0.5 * d[(y * width + x) as usize] / m)));
     let legend = Legend {
         title: format!("{} per ray: B - A", view.label().to_lowercase()),
         subject: String::new(),
+        note: format!("range: {how}{clamped}"),
         colormap: map,
         range_min: -m,
         range_max: m,
@@ -78,6 +117,22 @@ mod tests {
         render(&bvh, &mesh, &camera, &RenderSettings { count: true, ..Default::default() })
     }
 
+    /// One outlier does not set the scale: the 99th percentile of the differing pixels does.
+    #[test]
+    fn a_percentile_range_ignores_an_outlier() {
+        let mut d = vec![0.0f32; 1000];
+        for (i, v) in d.iter_mut().enumerate().take(500) {
+            *v = if i % 2 == 0 { 1.0 + (i % 3) as f32 } else { -2.0 };
+        }
+        d[999] = -47.0;
+        assert_eq!(percentile_of_abs(&d, 100.0), 47.0);
+        assert_eq!(percentile_of_abs(&d, 99.0), 3.0);
+        let (_, l) = difference_image(100, &d, View::Visits, None);
+        assert_eq!((l.range_min, l.range_max), (-3.0, 3.0));
+        assert_eq!(l.note, "range: 99th percentile of |B - A|, 1 pixels beyond");
+        assert_eq!(percentile_of_abs(&[0.0; 4], 99.0), 0.0);
+    }
+
     /// Two separate builds with the same settings differ nowhere; different strategies do, and
     /// each pixel's difference is B's count minus A's.
     #[test]
@@ -98,8 +153,12 @@ mod tests {
             let (x, y) = (i as u32 % a.width(), i as u32 / a.width());
             assert_eq!(v, b.counters(x, y).nodes_visited as f32 - a.counters(x, y).nodes_visited as f32);
         }
-        let (img, legend) = difference_image(a.width(), &d, View::Visits, None);
+        let (img, legend) = difference_image(a.width(), &d, View::Visits, DiffRange::Percentile(100.0));
         assert_eq!(legend.range_max, legend.min.abs().max(legend.max));
+        // The default: the 99th percentile of the pixels that differ, named in the title.
+        let (_, p99) = difference_image(a.width(), &d, View::Visits, None);
+        assert_eq!(p99.range_max, percentile_of_abs(&d, 99.0));
+        assert!(p99.note.contains("99th percentile"), "{}", p99.note);
         // A pixel where B does less is bluer than red, one where it does more redder than blue.
         let at = |i: usize| img.get_pixel(i as u32 % a.width(), i as u32 / a.width()).0;
         if let Some(i) = d.iter().position(|&v| v < 0.0) {

@@ -63,7 +63,7 @@ pub fn fmt_value(v: f64) -> String {
 
 /// Height of the strip `draw_legend` appends for `legend`.
 pub fn legend_height(legend: &Legend) -> u32 {
-    let lines = if legend.subject.is_empty() { 3 } else { 4 };
+    let lines = 3 + u32::from(!legend.subject.is_empty()) + u32::from(!legend.note.is_empty());
     PAD * (lines + 1) + LINE * lines
 }
 
@@ -82,9 +82,9 @@ pub fn draw_legend(img: &RgbImage, legend: &Legend) -> RgbImage {
     let grey = Rgb([170, 170, 170]);
     let mut y = h + PAD;
     draw_line(&mut out, PAD, y, &legend.title, white, w - 2 * PAD);
-    if !legend.subject.is_empty() {
+    for line in [&legend.subject, &legend.note].into_iter().filter(|l| !l.is_empty()) {
         y += LINE + PAD;
-        draw_line(&mut out, PAD, y, &legend.subject, grey, w - 2 * PAD);
+        draw_line(&mut out, PAD, y, line, grey, w - 2 * PAD);
     }
     // Colour bar between the two range labels.
     let bar_y = y + LINE + PAD;
@@ -116,6 +116,7 @@ mod tests {
         Legend {
             title: "nodes visited per ray".into(),
             subject: subject.into(),
+            note: String::new(),
             colormap: super::super::ColorMap::Viridis,
             range_min: 0.0,
             range_max: 60.0,

@@ -67,6 +67,9 @@ pub struct Legend {
     /// What the image is of: mesh, strategy, layout (set by whoever knows them; drawn into an
     /// exported PNG's legend strip, so a file says what it shows). Empty when unknown.
     pub subject: String,
+    /// How the range was chosen, when that needs saying (a difference's percentile); empty
+    /// otherwise. Drawn on a line of its own.
+    pub note: String,
     pub colormap: ColorMap,
     pub range_min: f32,
     pub range_max: f32,
@@ -159,7 +162,17 @@ pub fn view_image(
             let title = format!("{} per ray", view.label().to_lowercase());
             (
                 img,
-                Some(Legend { title, subject: String::new(), colormap, range_min: lo, range_max: hi, min, max, mean }),
+                Some(Legend {
+                    title,
+                    subject: String::new(),
+                    note: String::new(),
+                    colormap,
+                    range_min: lo,
+                    range_max: hi,
+                    min,
+                    max,
+                    mean,
+                }),
             )
         }
     }
