@@ -1,0 +1,127 @@
+// The binary BVH's walk: core's bvh::traverse::walk, step by step and count by count. Ordered
+// stack traversal (pbrt-v4 §7.3.5): both children's boxes tested at an interior node, the near
+// one entered, the far one pushed with its entry distance and dropped when popped beyond the
+// closest hit so far. Near is the smaller entry distance (BY_DISTANCE) or the handout's rule, the
+// direction's sign on the node's split axis.
+
+override BY_DISTANCE: bool = true;
+
+// core's BvhNode, 32 bytes: the box's planes, then the left child (interior) or first triangle
+// (leaf), then the triangle count (0: interior) in the low 16 bits and the split axis above.
+struct Node {
+    lo_x: f32, lo_y: f32, lo_z: f32,
+    hi_x: f32, hi_y: f32, hi_z: f32,
+    index: u32,
+    info: u32,
+}
+
+// A triangle's three vertices in leaf order, 36 bytes (core's Bvh::tris).
+struct Tri { v: array<f32, 9> }
+
+@group(0) @binding(5) var<storage, read> nodes: array<Node>;
+@group(0) @binding(6) var<storage, read> tris: array<Tri>;
+@group(0) @binding(7) var<storage, read> prim_ids: array<u32>;
+
+// The mesh's number of the triangle in leaf slot i.
+fn prim_of(i: u32) -> u32 {
+    return prim_ids[i];
+}
+
+fn node_slab(i: u32, t_min: f32, limit: f32) -> vec2<f32> {
+    let n = nodes[i];
+    return slab(vec3<f32>(n.lo_x, n.lo_y, n.lo_z), vec3<f32>(n.hi_x, n.hi_y, n.hi_z), t_min, limit);
+}
+
+// core's test_triangles: every triangle of the leaf in order, each nearer hit shrinking t_max.
+fn test_leaf(first: u32, count: u32) {
+    for (var k = 0u; k < count; k++) {
+        let i = first + k;
+        let t = tris[i].v;
+        let h = intersect(vec3<f32>(t[0], t[1], t[2]), vec3<f32>(t[3], t[4], t[5]), vec3<f32>(t[6], t[7], t[8]));
+        if h.w != 0.0 {
+            R_t_max = h.x;
+            best = i;
+            best_u = h.y;
+            best_v = h.z;
+        }
+    }
+    count_tris(count);
+}
+
+fn walk() {
+    best = MISS;
+    C = vec4<u32>(0u);
+    overflow = false;
+    // The closest hit so far, widened: what boxes and stack entries are compared with.
+    var limit = widen(R_t_max);
+    count_boxes(1u);
+    let root = node_slab(0u, R_t_min, limit);
+    if !(root.x <= root.y) {
+        return;
+    }
+    prepare_shear();
+    var len = 0u;
+    var current = 0u;
+    loop {
+        let node = nodes[current];
+        count_nodes(1u);
+        let leaf_count = node.info & 0xffffu;
+        if leaf_count != 0u {
+            count_leaves(1u);
+            test_leaf(node.index, leaf_count);
+            limit = widen(R_t_max);
+        } else {
+            let left = node.index;
+            count_boxes(2u);
+            let l = node_slab(left, R_t_min, limit);
+            let r = node_slab(left + 1u, R_t_min, limit);
+            let lh = l.x <= l.y;
+            let rh = r.x <= r.y;
+            if lh && rh {
+                var right_first: bool;
+                if BY_DISTANCE {
+                    right_first = r.x < l.x;
+                } else {
+                    right_first = ((R_neg >> ((node.info >> 16u) & 3u)) & 1u) != 0u;
+                }
+                let near = select(left, left + 1u, right_first);
+                let far = select(left + 1u, left, right_first);
+                let far_t = select(r.x, l.x, right_first);
+                if len >= STACK_SIZE {
+                    overflow = true;
+                    return;
+                }
+                stack_set(len, vec2<u32>(far, bitcast<u32>(far_t)));
+                len += 1u;
+                current = near;
+                continue;
+            }
+            if lh {
+                current = left;
+                continue;
+            }
+            if rh {
+                current = left + 1u;
+                continue;
+            }
+        }
+        // The next entry that can still hold a hit nearer than the best so far.
+        var found = false;
+        loop {
+            if len == 0u {
+                break;
+            }
+            len -= 1u;
+            let e = stack_get(len);
+            if bitcast<f32>(e.y) <= limit {
+                current = e.x;
+                found = true;
+                break;
+            }
+        }
+        if !found {
+            break;
+        }
+    }
+}
+

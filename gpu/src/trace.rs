@@ -1,0 +1,343 @@
+//! What every GPU walk shares: the options, where rays come from (a camera's pixels, generated on
+//! the GPU as core's `RayGen::pixel_ray` makes them, or a list), the traversal stack's variant, the
+//! kernels compiled per variant, and the run in batches that fit the adapter's buffer limit, with
+//! hits and counts read back in core's types.
+
+use crate::device::{Gpu, GpuError};
+use crate::kernel::{Bind, Kernel};
+use bvhscope_core::bvh::{Hit, RayCounters, TraversalOrder};
+use bvhscope_core::geometry::Ray;
+use bvhscope_core::render::Camera;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// How a GPU walk runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct GpuTraceOptions {
+    /// The near child's rule (binary nodes; CWBVH orders its children by octant instead).
+    pub order: TraversalOrder,
+    /// Keep and read back per-ray counts (core's `RayCounters`: nodes, box tests, leaves, triangles).
+    pub counted: bool,
+    /// Round every product on its own as the CPU does (see `xm` in shaders/common.wgsl); off, the
+    /// compiler may fuse them (faster on some GPUs, results may differ in the last place).
+    pub exact: bool,
+}
+
+impl Default for GpuTraceOptions {
+    fn default() -> Self {
+        Self { order: TraversalOrder::EntryDistance, counted: true, exact: true }
+    }
+}
+
+/// The rays of a GPU walk.
+#[derive(Clone, Copy, Debug)]
+pub enum Rays<'a> {
+    /// One ray through each pixel's centre, row by row from the top (`Camera::ray_gen().pixel_ray`).
+    Camera(&'a Camera),
+    /// Any rays, each with its own interval.
+    List(&'a [Ray]),
+}
+
+impl Rays<'_> {
+    pub fn len(&self) -> usize {
+        match self {
+            Rays::Camera(c) => c.width as usize * c.height as usize,
+            Rays::List(r) => r.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// What a GPU walk found: per ray (per pixel, row by row, for a camera) its closest hit and,
+/// when counted, its work.
+#[derive(Clone, Debug, Default)]
+pub struct GpuTrace {
+    pub hits: Vec<Option<Hit>>,
+    /// Empty unless the walk was counted.
+    pub counters: Vec<RayCounters>,
+    /// From submitting the walks to their end, read-backs left out (summed over batches).
+    pub gpu_time: Duration,
+    /// How many dispatches the rays took (more than one where a buffer would pass the limit).
+    pub batches: u32,
+}
+
+/// The uniform block of shaders/common.wgsl (`Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct Params {
+    origin: [f32; 4],
+    forward: [f32; 4],
+    right: [f32; 4],
+    up: [f32; 4],
+    inv_w: f32,
+    inv_h: f32,
+    width: u32,
+    height: u32,
+    count: u32,
+    offset: u32,
+    stack_stride: u32,
+    never: u32,
+}
+
+/// The camera's ray generator as core's `Camera::ray_gen` computes it (its fields are private
+/// there: INTEGRATION.md), for the GPU to finish per pixel.
+fn camera_params(cam: &Camera) -> Result<Params, GpuError> {
+    cam.validate().map_err(|e| GpuError::Input(e.to_string()))?;
+    let (forward, right, up) = cam.basis();
+    let tan_half = (cam.vfov_deg.to_radians() * 0.5).tan();
+    let right = right * tan_half * cam.aspect();
+    let up = up * tan_half;
+    let v = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
+    Ok(Params {
+        origin: v(cam.position),
+        forward: v(forward),
+        right: v(right),
+        up: v(up),
+        inv_w: 1.0 / cam.width as f32,
+        inv_h: 1.0 / cam.height as f32,
+        width: cam.width,
+        height: cam.height,
+        ..Params::default()
+    })
+}
+
+/// The GPU form of a ray (shaders/common.wgsl's `RayIn`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct RayIn {
+    o: [f32; 3],
+    t_min: f32,
+    d: [f32; 3],
+    t_max: f32,
+}
+
+/// Where a walk keeps its stack: in private memory of a fixed size, or `stride` entries per
+/// invocation in a global buffer (a tree deeper than any private stack here).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Stack {
+    Private(u32),
+    Global(u32),
+}
+
+/// Private stacks up to this many entries (1 KB per invocation); deeper walks use global memory.
+const PRIVATE_MAX: u32 = 128;
+
+impl Stack {
+    /// The stack for walks that hold at most `entries` at once.
+    pub(crate) fn for_entries(entries: u32) -> Stack {
+        match entries {
+            0..=32 => Stack::Private(32),
+            33..=64 => Stack::Private(64),
+            65..=PRIVATE_MAX => Stack::Private(PRIVATE_MAX),
+            n => Stack::Global(n),
+        }
+    }
+
+    fn stride(self) -> u32 {
+        match self {
+            Stack::Private(_) => 0,
+            Stack::Global(n) => n,
+        }
+    }
+}
+
+/// A node format's kernels: its WGSL walk (defining `walk` and `prim_of`) compiled per stack
+/// variant and options, once each.
+pub(crate) struct Kernels {
+    format: &'static str,
+    walk_source: &'static str,
+}
+
+impl Kernels {
+    pub(crate) const fn new(format: &'static str, walk_source: &'static str) -> Kernels {
+        Kernels { format, walk_source }
+    }
+
+    /// The whole module: shared parts, the adapter's edge fallback, the stack, the walk, the entries.
+    fn source(&self, gpu: &Gpu, stack: Stack) -> String {
+        let edge =
+            if gpu.has_f64() { include_str!("shaders/edge_f64.wgsl") } else { include_str!("shaders/edge_f32.wgsl") };
+        let stack_src = match stack {
+            Stack::Private(n) => include_str!("shaders/stack_private.wgsl").replace("{STACK_SIZE}", &n.to_string()),
+            Stack::Global(_) => include_str!("shaders/stack_global.wgsl").to_string(),
+        };
+        [
+            include_str!("shaders/common.wgsl"),
+            include_str!("shaders/triangle.wgsl"),
+            edge,
+            &stack_src,
+            self.walk_source,
+            include_str!("shaders/entry.wgsl"),
+        ]
+        .join("\n")
+    }
+
+    fn get(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Arc<Kernel>, GpuError> {
+        let key = format!("{} {stack:?} camera={camera} {opts:?}", self.format);
+        gpu.kernel(key, || self.compile(gpu, stack, camera, opts))
+    }
+
+    fn compile(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Kernel, GpuError> {
+        let source = self.source(gpu, stack);
+        let binds = [Bind::Uniform, Bind::Read, Bind::ReadWrite, Bind::ReadWrite, Bind::ReadWrite];
+        let mut binds = binds.to_vec();
+        binds.extend(std::iter::repeat_n(Bind::Read, self.tree_buffers()));
+        let by_distance = (opts.order == TraversalOrder::EntryDistance) as u8 as f64;
+        let mut constants = vec![("COUNTED", opts.counted as u8 as f64), ("EXACT", opts.exact as u8 as f64)];
+        if self.format == "binary" {
+            constants.push(("BY_DISTANCE", by_distance));
+        }
+        let entry = if camera { "trace_camera" } else { "trace_list" };
+        Kernel::new(gpu, &format!("{} {entry}", self.format), &source, entry, &binds, &constants)
+    }
+
+    fn tree_buffers(&self) -> usize {
+        if self.format == "binary" {
+            3
+        } else {
+            4
+        }
+    }
+
+    /// Trace `rays` against the tree in `tree` (bound from binding 5 on) with the stack `stack`.
+    pub(crate) fn run(
+        &self,
+        gpu: &Gpu,
+        tree: &[&wgpu::Buffer],
+        stack: Stack,
+        rays: Rays,
+        opts: GpuTraceOptions,
+    ) -> Result<GpuTrace, GpuError> {
+        let camera = matches!(rays, Rays::Camera(_));
+        let kernel = self.get(gpu, stack, camera, opts)?;
+        let n = rays.len();
+        let mut out = GpuTrace {
+            hits: Vec::with_capacity(n),
+            counters: Vec::with_capacity(if opts.counted { n } else { 0 }),
+            ..GpuTrace::default()
+        };
+        // Bytes per ray in each buffer the batch allocates; the largest decides the batch.
+        let stride = stack.stride() as u64;
+        let per_ray = [16u64, 32, if opts.counted { 16 } else { 0 }, stride * 8];
+        let worst = per_ray.iter().copied().max().unwrap_or(16);
+        let max_rays = gpu.max_buffer_bytes() / worst;
+        if max_rays == 0 {
+            return Err(match stack {
+                Stack::Global(depth) => GpuError::TooDeep { depth, bytes: stride * 8, limit: gpu.max_buffer_bytes() },
+                Stack::Private(_) => {
+                    gpu.check_size("one ray's results", worst).err().unwrap_or(GpuError::Input("no room".into()))
+                }
+            });
+        }
+        let dummy = gpu.storage("unused", 16)?;
+        match rays {
+            Rays::Camera(cam) => {
+                let base = camera_params(cam)?;
+                let rows_per = (max_rays / cam.width as u64).min(cam.height as u64);
+                if rows_per == 0 {
+                    gpu.check_size("one row of the frame's results", cam.width as u64 * worst)?;
+                }
+                let mut row = 0;
+                while row < cam.height {
+                    let rows = (rows_per as u32).min(cam.height - row);
+                    let p = Params { count: rows, offset: row, stack_stride: stack.stride(), ..base };
+                    let groups = (cam.width.div_ceil(8), rows.div_ceil(8));
+                    self.batch(
+                        gpu,
+                        &kernel,
+                        tree,
+                        &dummy,
+                        p,
+                        groups,
+                        (cam.width * rows) as usize,
+                        stack,
+                        opts,
+                        &mut out,
+                    )?;
+                    row += rows;
+                }
+            }
+            Rays::List(list) => {
+                for chunk in list.chunks(max_rays.min(u32::MAX as u64 / 2) as usize) {
+                    let up: Vec<RayIn> = chunk
+                        .iter()
+                        .map(|r| RayIn { o: r.origin().into(), t_min: r.t_min, d: r.dir().into(), t_max: r.t_max })
+                        .collect();
+                    let rays_buf = gpu.upload("rays", &up)?;
+                    let p = Params { count: chunk.len() as u32, stack_stride: stack.stride(), ..Params::default() };
+                    let groups = gpu.grid(chunk.len() as u32, 64);
+                    self.batch(gpu, &kernel, tree, &rays_buf, p, groups, chunk.len(), stack, opts, &mut out)?;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// One dispatch over `n` rays and the read-back of its results into `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn batch(
+        &self,
+        gpu: &Gpu,
+        kernel: &Kernel,
+        tree: &[&wgpu::Buffer],
+        rays: &wgpu::Buffer,
+        p: Params,
+        groups: (u32, u32),
+        n: usize,
+        stack: Stack,
+        opts: GpuTraceOptions,
+        out: &mut GpuTrace,
+    ) -> Result<(), GpuError> {
+        let params = gpu.uniform("trace parameters", &p);
+        let hits = gpu.storage("hits", n as u64 * 16)?;
+        let counts =
+            if opts.counted { gpu.storage("counts", n as u64 * 16)? } else { gpu.storage("counts (unused)", 16)? };
+        let gstack = match stack {
+            Stack::Global(stride) => gpu.storage("traversal stack", n as u64 * stride as u64 * 8)?,
+            Stack::Private(_) => gpu.storage("traversal stack (unused)", 16)?,
+        };
+        let mut buffers = vec![&params, rays, &hits, &counts, &gstack];
+        buffers.extend_from_slice(tree);
+        let bind = kernel.bind(gpu, &buffers);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        kernel.dispatch(&mut encoder, &bind, groups);
+        let start = Instant::now();
+        gpu.queue.submit([encoder.finish()]);
+        gpu.wait()?;
+        out.gpu_time += start.elapsed();
+        out.batches += 1;
+        let mut parts = vec![(&hits, n as u64 * 16)];
+        if opts.counted {
+            parts.push((&counts, n as u64 * 16));
+        }
+        let data = gpu.download_bytes(&parts)?;
+        let h: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&data[0]);
+        for [t, u, v, prim] in h {
+            match prim {
+                u32::MAX => out.hits.push(None),
+                0xffff_fffe => {
+                    return Err(GpuError::Rejected(
+                        "a ray's walk passed the end of its stack (a bug: please report)".into(),
+                    ))
+                }
+                _ => {
+                    out.hits.push(Some(Hit { t: f32::from_bits(t), u: f32::from_bits(u), v: f32::from_bits(v), prim }))
+                }
+            }
+        }
+        if opts.counted {
+            let c: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&data[1]);
+            out.counters.extend(c.into_iter().map(|[nodes, boxes, leaves, tris]| RayCounters {
+                nodes_visited: nodes,
+                box_tests: boxes,
+                leaves_visited: leaves,
+                triangle_tests: tris,
+                ..RayCounters::ZERO
+            }));
+        }
+        Ok(())
+    }
+}
