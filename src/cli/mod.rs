@@ -4,6 +4,7 @@
 mod args;
 pub mod check;
 mod compare;
+mod grade;
 pub mod inspect;
 mod progress;
 mod render;
@@ -76,6 +77,9 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Write a built-in strategy's binary tree in the bvhscope-bvh format.
     ExportBvh(check::ExportArgs),
+    /// Grade a class: check every student's BVH dump, measure it next to bvhscope's trees, rank
+    /// them, and write a report folder (HTML, CSV, JSON).
+    Grade(grade::GradeArgs),
 }
 
 /// An error the CLI reports in one line before exiting with code 2.
@@ -149,6 +153,7 @@ pub fn run(command: Command) -> Result<(), CliError> {
         Command::Replay(a) => replay::run(&a),
         Command::Check(a) => check::run(&a),
         Command::ExportBvh(a) => check::export(&a),
+        Command::Grade(a) => grade::run(&a),
         Command::Stats(a) => stats::run(&a),
         Command::Compare(a) => compare::run(&a),
     }

@@ -3,3 +3,4 @@
 //! build and traversal code that renders.
 
 pub mod check;
+pub mod grade;

@@ -1,0 +1,200 @@
+//! One submission graded: its dump read (bounded), checked (`check::check`: the rays on every
+//! thread), its tree measured and timed, its two images written, its row made; then all of it
+//! dropped but the row. Nothing about a submission stops the class: an unreadable file, a
+//! missing folder, a tree that takes too long (`Setup::max_seconds`, enforced through the
+//! checker's and the renderer's cancel points) and even a panic become the row's verdict.
+
+use super::measure::{measure, timed};
+use super::{FindingLine, Images, References, ReportDir, Row, Setup, Submission, Verdict, VersusSah};
+use crate::bvh::imported::Imported;
+use crate::bvh::{AnyBvh, Bvh, TreeView};
+use crate::dump::BvhDump;
+use crate::explain::check::{check, wrong_mesh, Subject};
+use crate::render::diff::{difference, difference_image};
+use crate::render::{draw_legend, view_image, ColorMap, HeatRange, View};
+use crate::work::{Cancelled, WorkControl};
+use std::panic::AssertUnwindSafe;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Cases of a finding listed in its line (the report's rows stay short; the count says how many).
+const LISTED: usize = 4;
+
+/// Grade one submission: never fails, never panics out (a panic becomes the row's reason).
+pub fn evaluate(sub: &Submission, setup: &Setup, refs: &mut References, out: &ReportDir) -> Row {
+    let start = Instant::now();
+    let limit = Duration::from_secs_f64(setup.max_seconds.max(0.001));
+    let graded = std::panic::catch_unwind(AssertUnwindSafe(|| {
+        let (row, traced) = match with_deadline(limit, |control| checked(sub, setup, control))? {
+            Checked::Row(row) => return Ok(row),
+            Checked::Traced(row, tree) => (row, tree),
+        };
+        // Outside the submission's time: references of a layout the class had not met yet.
+        let layout = traced.0.params().layout;
+        let spent = start.elapsed();
+        refs.ensure(layout, setup);
+        let left = limit.saturating_sub(spent).max(Duration::from_millis(1));
+        with_deadline(left, |control| measured(row, sub, &traced, setup, refs, out, control))
+    }));
+    let mut row = match graded {
+        Ok(Ok(row)) => row,
+        Ok(Err(Cancelled)) => Row::not_checked(
+            sub,
+            Verdict::TimedOut,
+            format!(
+                "grading it took over {} s, the limit (--max-seconds): a tree whose boxes overlap makes every ray visit most nodes",
+                setup.max_seconds
+            ),
+        ),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "a panic".into());
+            let reason = format!("bvhscope failed while grading it ({what}); please report this with the file");
+            Row::not_checked(sub, Verdict::Unreadable, reason)
+        }
+    };
+    row.seconds = start.elapsed().as_secs_f64();
+    row
+}
+
+/// Run `work` with a control that is cancelled once `limit` has passed.
+fn with_deadline<T>(limit: Duration, work: impl FnOnce(&WorkControl) -> T) -> T {
+    let control = WorkControl::new();
+    let finished = AtomicBool::new(false);
+    // Set when `work` returns or panics, so the watcher never outlives it.
+    struct Finish<'a>(&'a AtomicBool);
+    impl Drop for Finish<'_> {
+        fn drop(&mut self) {
+            self.0.store(true, Ordering::Release);
+        }
+    }
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            let start = Instant::now();
+            while !finished.load(Ordering::Acquire) {
+                if start.elapsed() >= limit {
+                    control.cancel();
+                    return;
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        });
+        let _finish = Finish(&finished);
+        work(&control)
+    })
+}
+
+/// What the check left: a finished row, or a row and the tree to measure.
+enum Checked {
+    Row(Row),
+    Traced(Row, (AnyBvh, Imported)),
+}
+
+/// The dump read and checked: the row's verdict, reason and findings.
+fn checked(sub: &Submission, setup: &Setup, control: &WorkControl) -> Result<Checked, Cancelled> {
+    let Some(path) = &sub.dump else {
+        let why = sub.problem.clone().unwrap_or_else(|| "no dump".into());
+        return Ok(Checked::Row(Row::not_checked(sub, Verdict::NoDump, format!("{}: {why}", sub.path.display()))));
+    };
+    let dump = match BvhDump::read(path, setup.dump_limit) {
+        Ok(d) => d,
+        Err(e) => return Ok(Checked::Row(Row::not_checked(sub, Verdict::Unreadable, e.to_string()))),
+    };
+    let subject = Subject { dump: &dump, dump_path: path, mesh: setup.mesh, mesh_path: setup.mesh_path };
+    let checked = check(&subject, &setup.camera, setup.rays, setup.trace, control)?;
+    let required = &setup.rubric.required;
+    let findings: Vec<FindingLine> = checked
+        .findings
+        .iter()
+        .map(|f| FindingLine {
+            group: f.group,
+            defect: f.defect,
+            required: required.contains(&f.group),
+            node: f.node,
+            triangle: f.triangle,
+            line: f.line(LISTED),
+            cases: f.examples.len().max(1),
+        })
+        .collect();
+    let mut row = Row::not_checked(sub, Verdict::Correct, String::new());
+    row.defects = findings.iter().filter(|f| f.defect).count();
+    row.warnings = findings.len() - row.defects;
+    row.rays_checked = checked.rays;
+    let first_required = findings.iter().find(|f| f.defect && f.required);
+    if let (Some(w), true) = (wrong_mesh(&subject), row.defects > 0) {
+        (row.verdict, row.reason) = (Verdict::WrongMesh, w.text);
+    } else if let Some(f) = first_required {
+        (row.verdict, row.reason) = (Verdict::Defects, format!("{}: {}", f.group.label(), f.line));
+    }
+    row.findings = findings;
+    // A tree over another mesh is not measured: its figures would say nothing of the student's work.
+    Ok(match checked.tree {
+        Some(tree) if row.verdict != Verdict::WrongMesh => Checked::Traced(row, tree),
+        _ => Checked::Row(row),
+    })
+}
+
+/// The traced tree measured, timed and drawn into `row`.
+fn measured(
+    mut row: Row,
+    sub: &Submission,
+    (tree, imported): &(AnyBvh, Imported),
+    setup: &Setup,
+    refs: &References,
+    out: &ReportDir,
+    control: &WorkControl,
+) -> Result<Row, Cancelled> {
+    let layout = tree.params().layout;
+    // The EPO is of a binary tree: the dump's own, or a wide dump binarised as the tree view shows it.
+    let binary: Option<&Bvh> = match tree {
+        AnyBvh::Binary(b) => Some(b),
+        AnyBvh::Wide(_) | AnyBvh::Wide8(_) => imported.binary.as_ref().map(|(b, _)| b.as_ref()),
+    };
+    let (q, frame) = measure(tree, binary, setup.mesh, &setup.camera, setup.trace, control)?;
+    control.check()?;
+    let q = timed(q, tree, &setup.camera, setup.trace, &refs.timing);
+    let sah = &refs.sah(layout).expect("ensured above").quality;
+    let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { f64::NAN };
+    let versus = VersusSah {
+        sah_cost: ratio(q.sah_cost, sah.sah_cost),
+        nodes_per_ray: ratio(q.nodes_per_ray, sah.nodes_per_ray),
+        tri_tests_per_ray: ratio(q.tri_tests_per_ray, sah.tri_tests_per_ray),
+        trace_time: ratio(q.trace_ns_per_ray, sah.trace_ns_per_ray),
+    };
+    if row.verdict == Verdict::Correct && setup.rubric.good.any() {
+        row.misses = setup.rubric.good.misses(&q, &versus);
+        row.good = Some(row.misses.is_empty());
+    }
+    // The images: nodes visited on the class's scale for this layout, and the difference from the
+    // SAH tree (B, the student, minus A, bvhscope) on a fixed symmetric scale of half of it.
+    let cost = tree.params().cost;
+    let top = refs.visits_max(layout);
+    let (img, legend) =
+        view_image(&frame, View::Visits, ColorMap::Viridis, HeatRange::Fixed { min: 0.0, max: top }, cost);
+    let visits = legend.map(|mut l| {
+        l.subject = format!("{}: {}", sub.name, imported.label());
+        draw_legend(&img, &l)
+    });
+    let sah_frame = refs.sah_frame(layout).expect("ensured above");
+    let diff = difference(sah_frame, &frame, View::Visits, cost).map(|d| {
+        let (img, mut l) = difference_image(frame.width(), &d, View::Visits, Some((top / 2.0).ceil().max(1.0)));
+        l.subject = format!("A: bvhscope SAH ({}), B: {}", layout.name(), sub.name);
+        draw_legend(&img, &l)
+    });
+    if let (Some(v), Some(d)) = (visits, diff) {
+        let names = Images {
+            visits: ReportDir::image_name(&sub.slug, "visits"),
+            difference: ReportDir::image_name(&sub.slug, "difference"),
+        };
+        match out.write_png(&names.visits, &v).and_then(|_| out.write_png(&names.difference, &d)) {
+            Ok(()) => row.images = Some(names),
+            Err(e) => row.notes.push(format!("images not written: {e}")),
+        }
+    }
+    row.quality = Some(q);
+    row.versus_sah = Some(versus);
+    Ok(row)
+}

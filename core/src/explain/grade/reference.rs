@@ -1,0 +1,135 @@
+//! bvhscope's own trees on the class's mesh and camera: what every submission is measured
+//! against. Built and measured once per layout the class uses (binary from the start; a 4- or
+//! 8-wide layout when a dump of that width first comes), then dropped: the figures stay, and of
+//! the SAH tree its counted frame, for the students' difference images.
+
+use super::measure::{measure, time_linear, timed, Quality, Timing, RUNS};
+use super::Setup;
+use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SplitStrategy};
+use crate::dump::{import, BvhDump};
+use crate::mesh::Mesh;
+use crate::render::Frame;
+use crate::work::WorkControl;
+use serde::Serialize;
+use std::sync::Arc;
+
+/// One of bvhscope's trees, measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReferenceTree {
+    /// The strategy's name on the command line and in rubrics (`sah`, `midpoint`).
+    pub strategy: &'static str,
+    /// "SAH binned, binary".
+    pub name: String,
+    pub quality: Quality,
+}
+
+/// The references of one layout.
+struct LayoutRefs {
+    layout: Layout,
+    /// SAH binned first.
+    trees: Vec<ReferenceTree>,
+    /// The SAH tree's counted frame.
+    sah_frame: Frame,
+    /// The most nodes any reference visits for a pixel: the top of the class's heatmap scale.
+    visits_max: f32,
+}
+
+/// The reference trees of every layout met so far, and how trees are timed.
+pub struct References {
+    pub timing: Timing,
+    layouts: Vec<LayoutRefs>,
+}
+
+impl References {
+    /// The strategies built: SAH binned (the ratios and differences are against it), then the
+    /// rubric's others in its order.
+    pub fn strategies(setup: &Setup) -> Vec<SplitStrategy> {
+        let mut s = vec![SplitStrategy::SahBinned];
+        s.extend(setup.rubric.references.iter().copied().filter(|&r| r != SplitStrategy::SahBinned));
+        s
+    }
+
+    /// The linear scan timed and the binary layout's references built: what any class needs.
+    pub fn new(setup: &Setup) -> References {
+        let rays = setup.time_rays.clamp(1, setup.camera.width as usize * setup.camera.height as usize);
+        let (linear_ns_per_ray, linear_rays) = time_linear(setup.mesh, &setup.camera, setup.trace, rays);
+        let timing = Timing { rays, runs: RUNS, linear_rays, linear_ns_per_ray };
+        let mut r = References { timing, layouts: Vec::new() };
+        r.ensure(Layout::Binary, setup);
+        r
+    }
+
+    /// Build the references of `layout` unless they are there.
+    pub fn ensure(&mut self, layout: Layout, setup: &Setup) {
+        if self.layouts.iter().any(|l| l.layout == layout) {
+            return;
+        }
+        let mut trees = Vec::new();
+        let mut sah_frame = None;
+        let mut visits_max = 1f32;
+        // Nobody cancels the references: they are what the whole class is measured against.
+        let control = WorkControl::new();
+        for strategy in Self::strategies(setup) {
+            let params = BuildParams { strategy, layout, ..setup.params };
+            let tree = AnyBvh::build(setup.mesh, &params);
+            let binarised = binarised(&tree, setup.mesh);
+            let binary: Option<&Bvh> = match &tree {
+                AnyBvh::Binary(b) => Some(b),
+                AnyBvh::Wide(_) | AnyBvh::Wide8(_) => binarised.as_deref(),
+            };
+            let Ok((q, frame)) = measure(&tree, binary, setup.mesh, &setup.camera, setup.trace, &control) else {
+                unreachable!("nobody else holds this control")
+            };
+            let q = timed(q, &tree, &setup.camera, setup.trace, &self.timing);
+            visits_max = visits_max.max(frame.ray_summary().max_nodes_visited as f32);
+            if strategy == SplitStrategy::SahBinned {
+                sah_frame = Some(frame);
+            }
+            let name = format!("{}, {}", strategy.label(), layout.name());
+            trees.push(ReferenceTree { strategy: strategy.name(), name, quality: q });
+        }
+        let sah_frame = sah_frame.expect("SAH binned is always among the references");
+        self.layouts.push(LayoutRefs { layout, trees, sah_frame, visits_max });
+    }
+
+    fn of(&self, layout: Layout) -> Option<&LayoutRefs> {
+        self.layouts.iter().find(|l| l.layout == layout)
+    }
+
+    /// The SAH tree of `layout`, once built.
+    pub fn sah(&self, layout: Layout) -> Option<&ReferenceTree> {
+        self.of(layout).map(|l| &l.trees[0])
+    }
+
+    /// The SAH tree's counted frame in `layout`.
+    pub fn sah_frame(&self, layout: Layout) -> Option<&Frame> {
+        self.of(layout).map(|l| &l.sah_frame)
+    }
+
+    /// The top of `layout`'s heatmap scale (nodes visited per pixel; at least 1).
+    pub fn visits_max(&self, layout: Layout) -> f32 {
+        self.of(layout).map_or(1.0, |l| l.visits_max)
+    }
+
+    /// Every reference tree, layout by layout in the order they were built.
+    pub fn trees(&self) -> impl Iterator<Item = &ReferenceTree> {
+        self.layouts.iter().flat_map(|l| l.trees.iter())
+    }
+
+    /// The heatmap scales, by layout name (for the report's captions).
+    pub fn scales(&self) -> Vec<(&'static str, f32)> {
+        self.layouts.iter().map(|l| (l.layout.name(), l.visits_max)).collect()
+    }
+}
+
+/// A wide tree binarised as a wide student dump is (`Imported::binary`: each node of k children
+/// split over its children in order), so the EPO of a wide reference and of a wide dump are
+/// measured alike. `None` for a binary tree, which is its own.
+fn binarised(tree: &AnyBvh, mesh: &Mesh) -> Option<Arc<Bvh>> {
+    if let AnyBvh::Binary(_) = tree {
+        return None;
+    }
+    let dump = BvhDump::of_any(tree, mesh, None);
+    let (_, imported) = import(&dump, mesh, std::path::Path::new("reference")).ok()?;
+    imported.binary.map(|(b, _)| b)
+}
