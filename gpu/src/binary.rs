@@ -101,13 +101,13 @@ impl GpuBinaryBvh {
 
     /// Closest hits of `rays` (and their counts when `opts.counted`).
     pub fn trace(&self, gpu: &Gpu, rays: Rays, opts: GpuTraceOptions) -> Result<GpuTrace, GpuError> {
-        KERNELS.run(gpu, &[&self.nodes, &self.tris, &self.prim_ids], self.stack, rays, opts)
+        KERNELS.run(gpu, &[&self.nodes, &self.tris, &self.prim_ids], None, self.stack, rays, opts)
     }
 
     /// `trace` with the walk's stack forced into global memory (tests of the deep-tree path on a
     /// shallow tree).
     pub fn trace_with_global_stack(&self, gpu: &Gpu, rays: Rays, opts: GpuTraceOptions) -> Result<GpuTrace, GpuError> {
         let stack = Stack::Global(self.depth.max(1));
-        KERNELS.run(gpu, &[&self.nodes, &self.tris, &self.prim_ids], stack, rays, opts)
+        KERNELS.run(gpu, &[&self.nodes, &self.tris, &self.prim_ids], None, stack, rays, opts)
     }
 }

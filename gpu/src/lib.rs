@@ -1,12 +1,17 @@
 //! bvhscope's GPU path on wgpu (WGSL compute shaders, headless): the BVHs bvhscope builds or
 //! imports traced on the GPU with the CPU's per-ray counts, and built there. See INTEGRATION.md.
 
+// `!(a <= b)` on floats is deliberate, as in core: true when either side is NaN, the safe side.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod binary;
 mod buffers;
+mod cwbvh;
 mod device;
 mod kernel;
 mod trace;
 
 pub use binary::{checked_depth, GpuBinaryBvh};
+pub use cwbvh::{Cwbvh, CwbvhNode, GpuCwbvh, META_INTERIOR, META_LEAF};
 pub use device::{gpu_for_tests, Gpu, GpuError, GpuOptions};
 pub use trace::{GpuTrace, GpuTraceOptions, Rays};

@@ -72,6 +72,8 @@ pub(crate) struct Params {
     forward: [f32; 4],
     right: [f32; 4],
     up: [f32; 4],
+    pub(crate) root_lo: [f32; 4],
+    pub(crate) root_hi: [f32; 4],
     inv_w: f32,
     inv_h: f32,
     width: u32,
@@ -202,15 +204,24 @@ impl Kernels {
         }
     }
 
-    /// Trace `rays` against the tree in `tree` (bound from binding 5 on) with the stack `stack`.
+    /// Trace `rays` against the tree in `tree` (bound from binding 5 on) with the stack `stack`;
+    /// `root` is the tree's box for the formats whose walk tests it from the parameters.
     pub(crate) fn run(
         &self,
         gpu: &Gpu,
         tree: &[&wgpu::Buffer],
+        root: Option<bvhscope_core::geometry::Aabb>,
         stack: Stack,
         rays: Rays,
         opts: GpuTraceOptions,
     ) -> Result<GpuTrace, GpuError> {
+        let (root_lo, root_hi) = match root {
+            Some(b) if !b.is_empty() => {
+                let (lo, hi) = b.planes();
+                ([lo[0], lo[1], lo[2], 1.0], [hi[0], hi[1], hi[2], 0.0])
+            }
+            _ => ([f32::INFINITY, f32::INFINITY, f32::INFINITY, 0.0], [f32::NEG_INFINITY; 4]),
+        };
         let camera = matches!(rays, Rays::Camera(_));
         let kernel = self.get(gpu, stack, camera, opts)?;
         let n = rays.len();
@@ -243,7 +254,7 @@ impl Kernels {
                 let mut row = 0;
                 while row < cam.height {
                     let rows = (rows_per as u32).min(cam.height - row);
-                    let p = Params { count: rows, offset: row, stack_stride: stack.stride(), ..base };
+                    let p = Params { count: rows, offset: row, stack_stride: stack.stride(), root_lo, root_hi, ..base };
                     let groups = (cam.width.div_ceil(8), rows.div_ceil(8));
                     self.batch(
                         gpu,
@@ -267,7 +278,13 @@ impl Kernels {
                         .map(|r| RayIn { o: r.origin().into(), t_min: r.t_min, d: r.dir().into(), t_max: r.t_max })
                         .collect();
                     let rays_buf = gpu.upload("rays", &up)?;
-                    let p = Params { count: chunk.len() as u32, stack_stride: stack.stride(), ..Params::default() };
+                    let p = Params {
+                        count: chunk.len() as u32,
+                        stack_stride: stack.stride(),
+                        root_lo,
+                        root_hi,
+                        ..Params::default()
+                    };
                     let groups = gpu.grid(chunk.len() as u32, 64);
                     self.batch(gpu, &kernel, tree, &rays_buf, p, groups, chunk.len(), stack, opts, &mut out)?;
                 }

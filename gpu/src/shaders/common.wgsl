@@ -11,6 +11,9 @@ struct Params {
     forward: vec4<f32>,
     right: vec4<f32>,
     up: vec4<f32>,
+    // The tree's bounds (CWBVH: its first box test); root_lo.w = 1 when it holds triangles.
+    root_lo: vec4<f32>,
+    root_hi: vec4<f32>,
     inv_w: f32,
     inv_h: f32,
     width: u32,
