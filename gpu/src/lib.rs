@@ -10,8 +10,10 @@ mod cwbvh;
 mod device;
 mod kernel;
 mod trace;
+mod warp;
 
 pub use binary::{checked_depth, GpuBinaryBvh};
 pub use cwbvh::{Cwbvh, CwbvhNode, GpuCwbvh, META_INTERIOR, META_LEAF};
 pub use device::{gpu_for_tests, Gpu, GpuError, GpuOptions};
 pub use trace::{GpuTrace, GpuTraceOptions, Rays};
+pub use warp::{WarpGroup, WarpSize, WarpSummary, WarpView, WarpWork};
