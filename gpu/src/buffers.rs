@@ -4,7 +4,6 @@
 
 use crate::device::{Gpu, GpuError};
 use bytemuck::Pod;
-use wgpu::util::DeviceExt;
 
 /// Storage buffers are never empty: a binding of zero bytes is invalid, and an empty mesh or ray
 /// list still binds its arrays, and a binding must hold one element of its array (80 bytes for a
@@ -22,20 +21,27 @@ impl Gpu {
         let bytes: &[u8] = bytemuck::cast_slice(data);
         self.check_size(what, bytes.len() as u64)?;
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        if (bytes.len() as u64) < MIN_BYTES || !bytes.len().is_multiple_of(4) {
-            let mut v = bytes.to_vec();
-            v.resize(padded(bytes.len() as u64) as usize, 0);
-            return Ok(self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(what),
-                contents: &v,
-                usage,
-            }));
-        }
-        Ok(self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        Ok(self.filled(what, bytes, usage))
+    }
+
+    /// A buffer of `bytes` (padded), written through the queue: a buffer mapped at creation
+    /// panics in wgpu when the device is lost, a queued write reports an error.
+    fn filled(&self, what: &str, bytes: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        let size = padded(bytes.len() as u64);
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(what),
-            contents: bytes,
+            size,
             usage,
-        }))
+            mapped_at_creation: false,
+        });
+        if bytes.len() as u64 == size {
+            self.queue.write_buffer(&buffer, 0, bytes);
+        } else {
+            let mut v = bytes.to_vec();
+            v.resize(size as usize, 0);
+            self.queue.write_buffer(&buffer, 0, &v);
+        }
+        buffer
     }
 
     /// A zero-filled storage buffer of `bytes` (kernels write it; it can be read back).
@@ -51,11 +57,7 @@ impl Gpu {
 
     /// A uniform buffer holding `value`.
     pub fn uniform<T: Pod>(&self, what: &str, value: &T) -> wgpu::Buffer {
-        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(what),
-            contents: bytemuck::bytes_of(value),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        })
+        self.filled(what, bytemuck::bytes_of(value), wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)
     }
 
     /// The first `count` elements of `buffer`, read back (waits for the queue's work).

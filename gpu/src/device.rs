@@ -213,6 +213,13 @@ impl Gpu {
         self.check()
     }
 
+    /// Give the device up now (as the driver does when it loses it): every later call on this
+    /// `Gpu` fails with an error, and the caller keeps its CPU results. For shutting down early,
+    /// and for testing that a lost device never takes the program down.
+    pub fn destroy(&self) {
+        self.device.destroy();
+    }
+
     /// The kernel compiled for `key`, made by `make` the first time.
     pub(crate) fn kernel(
         &self,

@@ -28,6 +28,21 @@ impl Kernel {
         binds: &[Bind],
         constants: &[(&str, f64)],
     ) -> Result<Kernel, GpuError> {
+        let numbered: Vec<(u32, Bind)> = binds.iter().enumerate().map(|(i, &b)| (i as u32, b)).collect();
+        Self::with_bindings(gpu, label, source, entry, &numbered, constants)
+    }
+
+    /// A kernel whose entry point uses the bindings `binds` (number, kind) of a module that
+    /// declares more (a module of several kernels, each binding what it uses: a layout of all of
+    /// them could pass the adapter's storage-buffer count).
+    pub(crate) fn with_bindings(
+        gpu: &Gpu,
+        label: &str,
+        source: &str,
+        entry: &str,
+        binds: &[(u32, Bind)],
+        constants: &[(&str, f64)],
+    ) -> Result<Kernel, GpuError> {
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(label),
@@ -35,9 +50,8 @@ impl Kernel {
         });
         let entries: Vec<wgpu::BindGroupLayoutEntry> = binds
             .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupLayoutEntry {
-                binding: i as u32,
+            .map(|&(i, b)| wgpu::BindGroupLayoutEntry {
+                binding: i,
                 visibility: wgpu::ShaderStages::COMPUTE,
                 ty: wgpu::BindingType::Buffer {
                     ty: match b {
@@ -75,10 +89,15 @@ impl Kernel {
 
     /// A bind group of `buffers` (binding i = `buffers[i]`, whole buffers).
     pub(crate) fn bind(&self, gpu: &Gpu, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+        let numbered: Vec<(u32, &wgpu::Buffer)> = buffers.iter().enumerate().map(|(i, &b)| (i as u32, b)).collect();
+        self.bind_numbered(gpu, &numbered)
+    }
+
+    /// A bind group of (binding, buffer) pairs, whole buffers.
+    pub(crate) fn bind_numbered(&self, gpu: &Gpu, buffers: &[(u32, &wgpu::Buffer)]) -> wgpu::BindGroup {
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .map(|&(i, b)| wgpu::BindGroupEntry { binding: i, resource: b.as_entire_binding() })
             .collect();
         gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(&self.label),

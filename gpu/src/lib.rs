@@ -9,11 +9,15 @@ mod buffers;
 mod cwbvh;
 mod device;
 mod kernel;
+mod lbvh;
+mod scan;
+mod sort;
 mod trace;
 mod warp;
 
 pub use binary::{checked_depth, GpuBinaryBvh};
 pub use cwbvh::{Cwbvh, CwbvhNode, GpuCwbvh, META_INTERIOR, META_LEAF};
 pub use device::{gpu_for_tests, Gpu, GpuError, GpuOptions};
+pub use lbvh::{GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
 pub use trace::{GpuTrace, GpuTraceOptions, Rays};
 pub use warp::{WarpGroup, WarpSize, WarpSummary, WarpView, WarpWork};
