@@ -9,7 +9,7 @@ use super::{FindingLine, Images, References, ReportDir, Row, Setup, Submission, 
 use crate::bvh::imported::Imported;
 use crate::bvh::{AnyBvh, Bvh, TreeView};
 use crate::dump::BvhDump;
-use crate::explain::check::{check, wrong_mesh, Subject};
+use crate::explain::check::{check, wrong_mesh, Group, Subject};
 use crate::render::diff::{difference, difference_image};
 use crate::render::{draw_legend, view_image, ColorMap, HeatRange, View};
 use crate::work::{Cancelled, WorkControl};
@@ -19,6 +19,9 @@ use std::time::{Duration, Instant};
 
 /// Cases of a finding listed in its line (the report's rows stay short; the count says how many).
 const LISTED: usize = 4;
+
+/// Findings kept per group, as `check` prints them without `--all`.
+const FINDINGS_KEPT: usize = 12;
 
 /// Grade one submission: never fails, never panics out (a panic becomes the row's reason).
 pub fn evaluate(sub: &Submission, setup: &Setup, refs: &mut References, out: &ReportDir) -> Row {
@@ -90,7 +93,8 @@ fn with_deadline<T>(limit: Duration, work: impl FnOnce(&WorkControl) -> T) -> T 
 /// What the check left: a finished row, or a row and the tree to measure.
 enum Checked {
     Row(Row),
-    Traced(Row, (AnyBvh, Imported)),
+    /// Boxed: the tree is large beside a row, and most rows have none.
+    Traced(Row, Box<(AnyBvh, Imported)>),
 }
 
 /// The dump read and checked: the row's verdict, reason and findings.
@@ -129,10 +133,21 @@ fn checked(sub: &Submission, setup: &Setup, control: &WorkControl) -> Result<Che
     } else if let Some(f) = first_required {
         (row.verdict, row.reason) = (Verdict::Defects, format!("{}: {}", f.group.label(), f.line));
     }
-    row.findings = findings;
+    // The first few of each group are kept (a dump for another mesh has thousands), as `check`
+    // prints them; the count says how many there are in all.
+    row.findings_total = findings.len();
+    let mut kept = [0usize; 4];
+    row.findings = findings
+        .into_iter()
+        .filter(|f| {
+            let k = &mut kept[Group::ALL.iter().position(|g| *g == f.group).unwrap_or(0)];
+            *k += 1;
+            *k <= FINDINGS_KEPT
+        })
+        .collect();
     // A tree over another mesh is not measured: its figures would say nothing of the student's work.
     Ok(match checked.tree {
-        Some(tree) if row.verdict != Verdict::WrongMesh => Checked::Traced(row, tree),
+        Some(tree) if row.verdict != Verdict::WrongMesh => Checked::Traced(row, Box::new(tree)),
         _ => Checked::Row(row),
     })
 }
@@ -168,8 +183,10 @@ fn measured(
         row.misses = setup.rubric.good.misses(&q, &versus);
         row.good = Some(row.misses.is_empty());
     }
-    // The images: nodes visited on the class's scale for this layout, and the difference from the
-    // SAH tree (B, the student, minus A, bvhscope) on a fixed symmetric scale of half of it.
+    // The images: nodes visited on the class's scale for this layout (so they compare from student
+    // to student), and the difference from the SAH tree (B, the student, minus A, bvhscope) on
+    // ± the 99th percentile of its own differences, as `render --against` draws it: most
+    // differences are a few nodes, and a class-wide scale left them white.
     let cost = tree.params().cost;
     let top = refs.visits_max(layout);
     let (img, legend) =
@@ -180,7 +197,7 @@ fn measured(
     });
     let sah_frame = refs.sah_frame(layout).expect("ensured above");
     let diff = difference(sah_frame, &frame, View::Visits, cost).map(|d| {
-        let (img, mut l) = difference_image(frame.width(), &d, View::Visits, Some((top / 2.0).ceil().max(1.0)));
+        let (img, mut l) = difference_image(frame.width(), &d, View::Visits, None);
         l.subject = format!("A: bvhscope SAH ({}), B: {}", layout.name(), sub.name);
         draw_legend(&img, &l)
     });

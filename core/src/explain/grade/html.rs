@@ -200,7 +200,7 @@ fn class_table(graded: &Graded) -> String {
         let vs = r.versus_sah.map(|v| v.sah_cost);
         let _ = writeln!(
             o,
-            "<tr>{rank}<td data-v=\"{name}\"><a href=\"#s-{slug}\">{name}</a></td><td data-v=\"{verdict}\">{badge}</td>{good}{}{}{}{}{}{}{}{}{}<td class=\"reason\" title=\"{reason}\">{reason_short}</td></tr>",
+            "<tr>{rank}<td class=\"name\" data-v=\"{name}\"><a href=\"#s-{slug}\">{name}</a></td><td data-v=\"{verdict}\">{badge}</td>{good}{}{}{}{}{}{}{}{}{}<td class=\"reason\" title=\"{reason}\">{reason_short}</td></tr>",
             cell(q.map(|q| q.sah_cost), q.map_or(String::new(), |q| num(q.sah_cost, 2))),
             cell(vs, vs.map_or(String::new(), |v| format!("{:+.1} %", (v - 1.0) * 100.0))),
             cell(q.and_then(|q| q.epo), q.and_then(|q| q.epo).map_or(String::new(), |e| num(e, 3))),
@@ -294,7 +294,7 @@ fn student(w: &mut impl Write, row: &Row, out: &ReportDir) -> std::io::Result<()
             format!("<span class=\"key\" style=\"background:#{r:02x}{g:02x}{b:02x}\"></span>")
         };
         let difference = format!(
-            "This tree minus bvhscope's SAH tree, nodes visited per pixel: {} blue where it visits fewer, {} red where it visits more, white where they agree.",
+            "This tree minus bvhscope's SAH tree, nodes visited per pixel: {} blue where it visits fewer, {} red where it visits more, white where they agree; the scale is ± the 99th percentile of this tree's differences (in the legend).",
             key(0.15),
             key(0.85)
         );
@@ -340,6 +340,13 @@ fn student(w: &mut impl Write, row: &Row, out: &ReportDir) -> std::io::Result<()
             );
         }
         o += "</tbody></table>\n";
+        if row.findings_total > row.findings.len() {
+            let _ = writeln!(
+                o,
+                "<p class=\"setup\">… {} more findings (the first twelve of each check are listed; <code>bvhscope check MESH --bvh FILE --all</code> lists every one).</p>",
+                row.findings_total - row.findings.len()
+            );
+        }
     } else if row.verdict == Verdict::Correct {
         let _ = writeln!(o, "<p>No findings: {} rays hit what the linear scan hits.</p>", row.rays_checked);
     }

@@ -176,7 +176,10 @@ pub struct Row {
     pub reason: String,
     pub defects: usize,
     pub warnings: usize,
+    /// The checker's findings, the first twelve of each group.
     pub findings: Vec<FindingLine>,
+    /// Findings in all (`findings` leaves the rest of a long group out).
+    pub findings_total: usize,
     /// Rays the checker traced.
     pub rays_checked: u64,
     pub quality: Option<Quality>,
@@ -208,6 +211,7 @@ impl Row {
             defects: 0,
             warnings: 0,
             findings: Vec::new(),
+            findings_total: 0,
             rays_checked: 0,
             quality: None,
             versus_sah: None,
