@@ -99,9 +99,9 @@ pub fn run(a: &GradeArgs) -> Result<(), CliError> {
         inputs.push((r.clone(), "the rubric".into()));
     }
     for s in &subs {
-        inputs.push((s.path.clone(), format!("{}'s submission", s.name)));
+        inputs.push((s.path.clone(), format!("the submission '{}'", s.name)));
         if let Some(d) = s.dump.as_ref().filter(|d| **d != s.path) {
-            inputs.push((d.clone(), format!("{}'s dump", s.name)));
+            inputs.push((d.clone(), format!("the dump of '{}'", s.name)));
         }
     }
     let dir = ReportDir::prepare(&a.out, inputs).map_err(grade_err)?;
