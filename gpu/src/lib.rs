@@ -11,6 +11,7 @@ mod device;
 mod kernel;
 mod lbvh;
 mod scan;
+mod shaders_valid;
 mod sort;
 mod trace;
 mod warp;

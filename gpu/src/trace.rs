@@ -158,10 +158,10 @@ impl Kernels {
         Kernels { format, walk_source }
     }
 
-    /// The whole module: shared parts, the adapter's edge fallback, the stack, the walk, the entries.
-    fn source(&self, gpu: &Gpu, stack: Stack) -> String {
-        let edge =
-            if gpu.has_f64() { include_str!("shaders/edge_f64.wgsl") } else { include_str!("shaders/edge_f32.wgsl") };
+    /// The whole module: shared parts, the adapter's edge fallback (doubles or not), the stack,
+    /// the walk, the entries.
+    pub(crate) fn source(&self, f64: bool, stack: Stack) -> String {
+        let edge = if f64 { include_str!("shaders/edge_f64.wgsl") } else { include_str!("shaders/edge_f32.wgsl") };
         let stack_src = match stack {
             Stack::Private(n) => include_str!("shaders/stack_private.wgsl").replace("{STACK_SIZE}", &n.to_string()),
             Stack::Global(_) => include_str!("shaders/stack_global.wgsl").to_string(),
@@ -183,7 +183,7 @@ impl Kernels {
     }
 
     fn compile(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Kernel, GpuError> {
-        let source = self.source(gpu, stack);
+        let source = self.source(gpu.has_f64(), stack);
         let binds = [Bind::Uniform, Bind::Read, Bind::ReadWrite, Bind::ReadWrite, Bind::ReadWrite];
         let mut binds = binds.to_vec();
         binds.extend(std::iter::repeat_n(Bind::Read, self.tree_buffers()));

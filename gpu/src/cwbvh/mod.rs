@@ -12,7 +12,7 @@
 //! array, so that trees with larger leaves (bvhscope's default is four, an import may hold any
 //! number) keep their leaves and triangle order. See `CwbvhNode` for the bytes.
 
-mod gpu;
+pub(crate) mod gpu;
 mod walk;
 
 pub use gpu::GpuCwbvh;
