@@ -321,6 +321,10 @@ impl Kernels {
         let bind = kernel.bind(gpu, &buffers);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         kernel.dispatch(&mut encoder, &bind, groups);
+        // The rays' and parameters' writes go with the next submission: flush them first, so the
+        // time is the walk's.
+        gpu.queue.submit([]);
+        gpu.wait()?;
         let start = Instant::now();
         gpu.queue.submit([encoder.finish()]);
         gpu.wait()?;
