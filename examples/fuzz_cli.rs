@@ -31,8 +31,22 @@ impl Rng {
     }
 }
 
-const EXTREMES: [&str; 14] =
-    ["0", "-1", "1e400", "-1e400", "NaN", "inf", "4294967295", "4294967296", "65536", "256", "1e-45", "3.4e38", "", "99999999999999999999"];
+const EXTREMES: [&str; 14] = [
+    "0",
+    "-1",
+    "1e400",
+    "-1e400",
+    "NaN",
+    "inf",
+    "4294967295",
+    "4294967296",
+    "65536",
+    "256",
+    "1e-45",
+    "3.4e38",
+    "",
+    "99999999999999999999",
+];
 
 /// One mutation of `bytes`.
 fn mutate(bytes: &mut Vec<u8>, r: &mut Rng) {
@@ -153,7 +167,16 @@ fn main() {
     for (layout, ext) in [("binary", "json"), ("wide4", "txt"), ("wide8", "json"), ("binary", "txt")] {
         let p = work.join(format!("seed-{layout}.{ext}"));
         let s = Command::new(&bin)
-            .args(["export-bvh", torus.to_str().unwrap(), "--layout", layout, "--max-leaf-size", "3", "-o", p.to_str().unwrap()])
+            .args([
+                "export-bvh",
+                torus.to_str().unwrap(),
+                "--layout",
+                layout,
+                "--max-leaf-size",
+                "3",
+                "-o",
+                p.to_str().unwrap(),
+            ])
             .output()
             .unwrap();
         assert!(s.status.success());
@@ -196,10 +219,7 @@ fn main() {
                 s(&["inspect", &t, "--bvh", &f, "--node", &node, "--size", "16x12"]),
             ]
         } else {
-            vec![
-                s(&["stats", &f, "--no-rays"]),
-                s(&["render", &f, "--size", "16x12", "--view", "cost", "-o", &png]),
-            ]
+            vec![s(&["stats", &f, "--no-rays"]), s(&["render", &f, "--size", "16x12", "--view", "cost", "-o", &png])]
         };
         let mut kept = false;
         for c in commands {

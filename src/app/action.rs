@@ -64,9 +64,11 @@ pub enum Action {
     Zoom(f32),
     FrameMesh,
     ResetView,
-    /// The viewport's rectangle this frame and the image size it renders at.
+    /// The viewport's rectangle this frame, the image's within it (the film letterboxed, or the
+    /// whole viewport) and the image size it renders at.
     Viewport {
         rect: egui::Rect,
+        image: egui::Rect,
         pixels: (u32, u32),
     },
 
@@ -141,6 +143,10 @@ pub enum Action {
     SetHelp(bool),
     /// Dismiss message `i` of the viewport's messages.
     Dismiss(usize),
+    /// Dismiss the `n` oldest messages (those folded out of sight).
+    DismissEarlier(usize),
+    /// The Node window's cost curves on one scale for the three axes, or each on its own.
+    SharedCostScale(bool),
 }
 
 /// Where panels put the actions they emit during one frame.
@@ -197,9 +203,10 @@ impl BvhscopeApp {
             A::Zoom(amount) => self.orbit.zoom(amount),
             A::FrameMesh => self.orbit.frame(&self.scene.bounds(), self.viewport_aspect),
             A::ResetView => self.reset_view(),
-            A::Viewport { rect, pixels } => {
+            A::Viewport { rect, image, pixels } => {
                 self.viewport_rect = rect;
-                self.viewport_aspect = rect.width() / rect.height().max(1.0);
+                self.image_rect = image;
+                self.viewport_aspect = image.width() / image.height().max(1.0);
                 self.viewport_pixels = pixels;
             }
             A::View(i) => {
@@ -367,6 +374,10 @@ impl BvhscopeApp {
                 if i < self.messages.len() {
                     self.messages.remove(i);
                 }
+            }
+            A::SharedCostScale(on) => self.nodes.shared_scale = on,
+            A::DismissEarlier(n) => {
+                self.messages.drain(..n.min(self.messages.len()));
             }
         }
     }

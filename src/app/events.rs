@@ -133,6 +133,13 @@ impl BvhscopeApp {
             None => ctx.load_texture("bvhscope-view", p.image, options),
         };
         let build_label = p.bvh.label();
+        // A threshold belongs to the scale it was set on: another view, or a range that no longer
+        // holds it, clears it (it used to say "pixels above 125.1" over a 0..1 scale).
+        let same_view = self.shown.as_ref().is_some_and(|s| s.style.view == p.style.view);
+        let holds = |t: f32| p.legend.as_ref().is_some_and(|l| (l.range_min..=l.range_max).contains(&t));
+        if self.threshold.is_some_and(|t| !same_view || !holds(t)) {
+            self.threshold = None;
+        }
         self.shown = Some(Shown {
             texture,
             frame: p.frame,

@@ -152,6 +152,26 @@ pub struct Jobs {
     pub last_build: Option<(SceneBuild, u64)>,
     /// The render jobs' frame storage, reused from one render to the next (`FramePool`).
     frames: FramePool,
+    /// Jobs other than builds and loads running now: a build waits for them to end before it
+    /// starts its clock, so its time is the build's alone (as `bvhscope stats` measures it), not
+    /// the build's and a render's sharing the cores.
+    others: Arc<std::sync::atomic::AtomicUsize>,
+}
+
+/// Counts a job among `Jobs::others` while it lives.
+struct Other(Arc<std::sync::atomic::AtomicUsize>);
+
+impl Other {
+    fn new(count: &Arc<std::sync::atomic::AtomicUsize>) -> Self {
+        count.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        Other(count.clone())
+    }
+}
+
+impl Drop for Other {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
+    }
 }
 
 impl Jobs {
@@ -176,6 +196,7 @@ impl Jobs {
             last_render: None,
             last_build: None,
             frames: FramePool::default(),
+            others: Default::default(),
         }
     }
 
@@ -194,9 +215,19 @@ impl Jobs {
         }
     }
 
-    /// Run `work` for `job` on a thread of its own. A panic there (a bug) must not leave the job
-    /// running forever in the status bar: it is caught and reported as the job's failure.
+    /// Run `work` for `job` on a thread of its own, counted among the jobs a build waits for
+    /// (`others`). A panic there (a bug) must not leave the job running forever in the status bar:
+    /// it is caught and reported as the job's failure.
     fn spawn(&self, job: &Running, work: impl FnOnce() + Send + 'static) {
+        let other = Other::new(&self.others);
+        self.spawn_uncounted(job, move || {
+            let _counted = other;
+            work()
+        });
+    }
+
+    /// `spawn` for builds and loads, which no build waits for.
+    fn spawn_uncounted(&self, job: &Running, work: impl FnOnce() + Send + 'static) {
         let (fail, label) = (self.sender(job.id), job.label.clone());
         std::thread::spawn(move || {
             if let Err(panic) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)) {
@@ -221,25 +252,38 @@ impl Jobs {
     pub fn load(&mut self, path: PathBuf) {
         let job = self.start(format!("Loading {}", path.display()));
         let send = self.sender(job.id);
-        self.spawn(&job, move || {
+        self.spawn_uncounted(&job, move || {
             let result = Scene::open(&path).map(Arc::new).map_err(|e| e.to_string());
             send(JobEvent::Loaded(result));
         });
         self.load = Some(job);
     }
 
-    /// Build a BVH (or two levels) over `scene` in the background; a running build is cancelled.
+    /// Build a BVH (or two levels) over `scene` in the background; a running build is cancelled,
+    /// and so are the render, the comparison, the visit count and the wrong pixels (they are of
+    /// the BVH being replaced). The build starts its clock once every other job has ended.
     pub fn build(&mut self, scene: Arc<Scene>, params: SceneBuild, scene_id: u64) {
         if let Some(old) = self.build.take() {
             old.control.cancel();
         }
+        for old in
+            [self.render.take(), self.compare.take(), self.visits.take(), self.wrong.take()].into_iter().flatten()
+        {
+            old.control.cancel();
+        }
+        // The cancelled render is redrawn once the build is done (or for the BVH kept, if not).
+        self.last_render = None;
+        self.last_compare = None;
         let label = match params.top {
             Some(top) => format!("Building two levels ({} over {})", top.strategy.label(), params.bvh.strategy.label()),
             None => format!("Building ({})", params.bvh.strategy.label()),
         };
         let job = self.start(label);
-        let (send, control) = (self.sender(job.id), job.control.clone());
-        self.spawn(&job, move || {
+        let (send, control, others) = (self.sender(job.id), job.control.clone(), self.others.clone());
+        self.spawn_uncounted(&job, move || {
+            while others.load(std::sync::atomic::Ordering::SeqCst) > 0 && !control.is_cancelled() {
+                std::thread::sleep(Duration::from_millis(1));
+            }
             let result = scene.build(&params, &control).map(Arc::new);
             send(JobEvent::Built { scene_id, params, result });
         });
@@ -329,7 +373,9 @@ impl Jobs {
             let mut last = None;
             let _ = render_passes(&*bvh, &*bvh, &camera, &settings, &frames, &control, |frame, _| last = Some(frame));
             if let Some(frame) = last.filter(|f| f.is_complete()) {
-                let stats = crate::bvh::TreeStats::of(bvh.tree());
+                // B's end-point overlap, of its binary tree as A's is (the statistics' EPO row).
+                let epo = bvh.binary_tree().map(|t| crate::bvh::epo::of(&t));
+                let stats = crate::bvh::TreeStats { epo, ..crate::bvh::TreeStats::of(bvh.tree()) };
                 let summary = frame.ray_summary();
                 let b = CompareB { scene_id, build, bvh, stats, frame: Arc::new(frame), camera, trace, summary };
                 send(JobEvent::Compared(Box::new(b)));

@@ -37,7 +37,7 @@ pub use overlay::OverlayBox;
 pub use ray_view::{PinnedRay, RayView};
 pub use replay_view::ReplayView;
 pub use scene::BuiltBvh;
-pub use settings::{BoxLevel, Settings};
+pub use settings::{BoxLevel, Film, Settings};
 
 use crate::bvh::{SceneBuild, SceneBvh, TraceOptions, TreeStats};
 use crate::dump::BvhDump;
@@ -47,6 +47,9 @@ use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+/// Messages kept; the viewport shows the newest `viewport::MESSAGES_SHOWN` of them.
+const MESSAGES_KEPT: usize = 8;
 
 /// How the app starts.
 #[derive(Clone, Debug, Default)]
@@ -119,8 +122,10 @@ pub struct BvhscopeApp {
     wrong_cache: std::cell::RefCell<Option<WrongCache>>,
     /// Aspect of the viewport, for framing the camera.
     viewport_aspect: f32,
-    /// Where the viewport was drawn in the last frame (its size is the rendered image's).
+    /// Where the viewport was drawn in the last frame.
     pub viewport_rect: egui::Rect,
+    /// Where the image was drawn in it: all of it, or a scene's film letterboxed.
+    pub image_rect: egui::Rect,
     /// The image size the viewport asks for (0 × 0 before it is first laid out).
     viewport_pixels: (u32, u32),
 }
@@ -202,6 +207,7 @@ impl BvhscopeApp {
             wrong_cache: Default::default(),
             viewport_aspect: aspect,
             viewport_rect: egui::Rect::NOTHING,
+            image_rect: egui::Rect::NOTHING,
             viewport_pixels: (0, 0),
         };
         match (options.file, app.pending_import.take()) {
@@ -218,7 +224,7 @@ impl BvhscopeApp {
 
     pub fn message(&mut self, kind: MessageKind, text: impl Into<String>) {
         self.messages.push(Message { kind, text: text.into(), at: Instant::now() });
-        if self.messages.len() > 5 {
+        if self.messages.len() > MESSAGES_KEPT {
             self.messages.remove(0);
         }
     }
@@ -234,7 +240,7 @@ impl BvhscopeApp {
             self.settings.up_axis = up_axis_of(c);
         }
         self.orbit = match &scene.camera {
-            Some(c) => OrbitCamera::from_camera(c, self.settings.up_axis),
+            Some(c) => OrbitCamera::exactly(c, self.settings.up_axis),
             None => OrbitCamera::home(&scene.bounds(), self.viewport_aspect, self.settings.up_axis),
         };
         if let Some(b) = scene.build {
@@ -252,6 +258,8 @@ impl BvhscopeApp {
         self.scene_id += 1;
         self.previous = None;
         self.rays = None;
+        // Node ids are the old tree's: a selection kept would dim the new heatmap for nothing.
+        self.nodes.deselect();
         // A dump numbers the triangles of the mesh it was written for.
         self.import = ImportView { mask: self.import.mask, ..Default::default() };
     }
@@ -278,6 +286,16 @@ impl BvhscopeApp {
         }
         let names: Vec<String> =
             self.scene.instances().iter().flat_map(|i| &i.meshes).map(|m| m.name.clone()).collect();
+        // Node ids are the old binary tree's: kept only where the new BVH has the same one (the
+        // same build in another layout, which is collapsed from it).
+        let binary = |b: &SceneBvh| {
+            let mut p = b.build_params();
+            p.bvh.layout = crate::bvh::Layout::Binary;
+            (p, b.import().map(|i| i.path.clone()))
+        };
+        if self.current_bvh().is_none_or(|b| binary(&b.bvh) != binary(&bvh)) {
+            self.nodes.deselect();
+        }
         self.built = Some(BuiltBvh::new(bvh, &names, self.scene_id));
         self.rays = None;
     }
@@ -419,6 +437,13 @@ impl BvhscopeApp {
     /// The image size the viewport renders at.
     pub fn viewport_pixels(&self) -> (u32, u32) {
         self.viewport_pixels
+    }
+
+    /// The film the image is rendered at, when it is a scene file's (its camera's size): the
+    /// statistics are then of the scene's frame, as `bvhscope stats SCENE` counts them.
+    pub fn film(&self) -> Option<(u32, u32)> {
+        let c = self.scene.camera.as_ref().filter(|_| self.settings.film == Film::Scene)?;
+        Some((c.width, c.height))
     }
 
     fn reset_view(&mut self) {

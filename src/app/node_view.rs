@@ -123,6 +123,8 @@ pub struct NodeView {
     /// The Tree and Node windows are shown.
     pub window: bool,
     pub metric: Metric,
+    /// The Node window draws its three axes' cost curves on one cost range.
+    pub shared_scale: bool,
 }
 
 impl NodeView {
@@ -146,6 +148,13 @@ impl NodeView {
             self.inspection = None;
         }
         self.selected = Some(node);
+    }
+
+    /// No node selected (a new scene or another tree: its ids are not the old tree's).
+    pub fn deselect(&mut self) {
+        self.selected = None;
+        self.inspection = None;
+        self.open.clear();
     }
 
     /// The node one step from the selected one, if there is one.

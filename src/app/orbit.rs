@@ -17,6 +17,9 @@ pub struct OrbitCamera {
     pub pitch: f32,
     pub distance: f32,
     pub vfov_deg: f32,
+    /// The camera the orbit was made from, while it has not moved: a scene file's camera is
+    /// then used as written (its rays the CLI's, bit for bit), not as rebuilt from yaw and pitch.
+    pub exact: Option<Camera>,
 }
 
 const MAX_PITCH: f32 = 89.0 * std::f32::consts::PI / 180.0;
@@ -40,7 +43,13 @@ impl OrbitCamera {
             pitch: d.y.clamp(-1.0, 1.0).asin().clamp(-MAX_PITCH, MAX_PITCH),
             distance,
             vfov_deg: c.vfov_deg,
+            exact: None,
         }
+    }
+
+    /// `from_camera`, keeping `c` itself while the orbit does not move (`exact`).
+    pub fn exactly(c: &Camera, up: UpAxis) -> Self {
+        Self { exact: Some(*c), ..Self::from_camera(c, up) }
     }
 
     /// Unit vector from the target to the eye (world coordinates).
@@ -50,6 +59,9 @@ impl OrbitCamera {
     }
 
     pub fn camera(&self, width: u32, height: u32) -> Camera {
+        if let Some(c) = self.exact {
+            return Camera { width, height, ..c };
+        }
         Camera {
             position: self.target + self.direction() * self.distance,
             look_at: self.target,
@@ -62,12 +74,14 @@ impl OrbitCamera {
 
     /// Rotate by a mouse drag of (dx, dy) pixels.
     pub fn orbit(&mut self, dx: f32, dy: f32) {
+        self.exact = None;
         self.yaw -= dx * 0.008;
         self.pitch = (self.pitch + dy * 0.008).clamp(-MAX_PITCH, MAX_PITCH);
     }
 
     /// Move the target so the scene follows a drag of (dx, dy) pixels in a view `height` high.
     pub fn pan(&mut self, dx: f32, dy: f32, height: f32) {
+        self.exact = None;
         let forward = -self.direction();
         let right = forward.cross(self.up.vector()).normalize_or(Vec3::X);
         let up = right.cross(forward);
@@ -77,6 +91,7 @@ impl OrbitCamera {
 
     /// Zoom by mouse-wheel steps (positive: closer).
     pub fn zoom(&mut self, steps: f32) {
+        self.exact = None;
         self.distance = (self.distance * (-steps * 0.0015).exp()).clamp(1e-6, 1e9);
     }
 

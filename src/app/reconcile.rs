@@ -147,6 +147,11 @@ impl BvhscopeApp {
     /// differs from the last render asked for.
     pub(super) fn ensure_render(&mut self) {
         let (w, h) = self.viewport_pixels;
+        // Nothing renders while a build runs: it would share the cores with it and lengthen the
+        // build time the statistics show; the new BVH is rendered when it is there.
+        if self.jobs.build.is_some() {
+            return;
+        }
         let Some(built) = self.current_bvh().filter(|_| w > 0 && h > 0) else { return };
         let req = jobs::RenderRequest {
             bvh: built.bvh.clone(),

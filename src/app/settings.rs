@@ -40,6 +40,9 @@ pub struct Settings {
     pub boxes_in_front: bool,
     /// Coarse passes first (off: each frame at full resolution at once).
     pub progressive: bool,
+    /// What the image is rendered at: the viewport's size, or a scene file's film (its camera's
+    /// size and aspect, letterboxed in the viewport), so the figures are the scene's frame's.
+    pub film: Film,
     pub recent_files: Vec<PathBuf>,
 }
 
@@ -61,9 +64,20 @@ impl Default for Settings {
             boxes_leaves_above: false,
             boxes_in_front: false,
             progressive: true,
+            film: Film::Scene,
             recent_files: Vec::new(),
         }
     }
+}
+
+/// What the image is rendered at.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Film {
+    /// The viewport's own size and aspect.
+    Viewport,
+    /// A scene file's camera size (the viewport's when the scene has none), letterboxed.
+    #[default]
+    Scene,
 }
 
 /// The overlay's choice of level for a two-level BVH.

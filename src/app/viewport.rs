@@ -11,9 +11,34 @@ use std::sync::Arc;
 /// Largest image the viewport renders (pixels), so huge windows stay interactive.
 const MAX_PIXELS: f32 = 2560.0 * 1440.0;
 
+/// Where the image goes in the viewport `full` and the size it is rendered at: the whole viewport
+/// at its pixel size, or, for a scene's film, the largest rectangle of the film's aspect centred
+/// in it (letterboxed) at the film's size.
+fn image_area(app: &BvhscopeApp, full: Rect, ppp: f32) -> (Rect, (u32, u32)) {
+    let (rect, mut size) = match app.film() {
+        Some((w, h)) => {
+            let aspect = w as f32 / h as f32;
+            let fit = if full.width() / full.height().max(1.0) > aspect {
+                Vec2::new(full.height() * aspect, full.height())
+            } else {
+                Vec2::new(full.width(), full.width() / aspect)
+            };
+            (Rect::from_center_size(full.center(), fit), Vec2::new(w as f32, h as f32))
+        }
+        None => (full, full.size() * ppp),
+    };
+    let area = size.x * size.y;
+    if area > MAX_PIXELS {
+        size *= (MAX_PIXELS / area).sqrt();
+    }
+    (rect, (size.x.round().max(1.0) as u32, size.y.round().max(1.0) as u32))
+}
+
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
-    let rect = ui.available_rect_before_wrap();
-    let response = ui.allocate_rect(rect, Sense::click_and_drag());
+    let full = ui.available_rect_before_wrap();
+    let response = ui.allocate_rect(full, Sense::click_and_drag());
+    // The image's rectangle: the viewport, or the film letterboxed in it.
+    let (rect, pixels) = image_area(app, full, ui.ctx().pixels_per_point());
 
     // Camera input.
     if response.dragged_by(PointerButton::Primary) {
@@ -47,20 +72,22 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
     }
 
-    // Render at the viewport's pixel size.
-    let ppp = ui.ctx().pixels_per_point();
-    let mut size = rect.size() * ppp;
-    let area = size.x * size.y;
-    if area > MAX_PIXELS {
-        size *= (MAX_PIXELS / area).sqrt();
-    }
-    let pixels = (size.x.round().max(1.0) as u32, size.y.round().max(1.0) as u32);
-    if rect != app.viewport_rect || pixels != app.viewport_pixels() {
-        out.push(Action::Viewport { rect, pixels });
+    if full != app.viewport_rect || rect != app.image_rect || pixels != app.viewport_pixels() {
+        out.push(Action::Viewport { rect: full, image: rect, pixels });
     }
 
     // The image, stretched to the viewport while a new size is on its way.
+    // Drawing over the image is clipped to it; the film's outline and its size around it.
     let painter = ui.painter_at(rect);
+    let around = ui.painter_at(full);
+    if let Some((w, h)) = app.film() {
+        around.rect_stroke(rect.expand(1.0), 0.0, Stroke::new(1.0, Color32::from_gray(110)), egui::StrokeKind::Outside);
+        let text = egui::RichText::new(format!("film {w}×{h}")).small().color(Color32::from_gray(150));
+        let at =
+            Rect::from_min_max(rect.left_bottom() + Vec2::new(0.0, 2.0), rect.right_bottom() + Vec2::new(0.0, 18.0));
+        ui.put(at, egui::Label::new(text))
+            .on_hover_text("The scene's film: the image is its camera's size, letterboxed (View panel: Film)");
+    }
     if let Some(shown) = &app.shown {
         // A coarse pass's image has a texel per traced pixel; its last row and column may cover
         // pixels past the frame's edge, which the uv range leaves out.
@@ -110,9 +137,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
 
     // Files dragged over the window.
     if ui.ctx().input(|i| !i.raw.hovered_files.is_empty()) {
-        painter.rect_filled(rect, 0.0, Color32::from_black_alpha(160));
-        painter.text(
-            rect.center(),
+        around.rect_filled(full, 0.0, Color32::from_black_alpha(160));
+        around.text(
+            full.center(),
             egui::Align2::CENTER_CENTER,
             "Drop a mesh or scene to open it, or a BVH dump to import it",
             egui::FontId::proportional(22.0),
@@ -120,7 +147,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         );
     }
 
-    messages(app, ui, rect, out);
+    messages(app, ui, full, out);
     if let Some(shown) = &app.shown {
         let compare_legend = compared.as_ref().and_then(|c| match app.compare.mode {
             super::CompareMode::Difference => c.diff.as_ref().map(|d| d.2.clone()),
@@ -128,9 +155,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         });
         // The histogram is of the image's own values: not drawn for a side-by-side pair.
         if let Some(legend) = compare_legend.as_ref() {
-            legend_area(app, ui, rect, legend, false, out);
+            legend_area(app, ui, full, legend, false, out);
         } else if let Some(legend) = shown.legend.as_ref() {
-            legend_area(app, ui, rect, legend, true, out);
+            legend_area(app, ui, full, legend, true, out);
         }
         if let Some(pos) = response.hover_pos() {
             let frame = shown.frame.clone();
@@ -368,37 +395,51 @@ fn histogram_bars(
         .on_hover_text("The same bins as `bvhscope render --histogram 32`");
 }
 
-/// Errors (until dismissed) and notes (for a few seconds) across the top of the viewport. Each
-/// wraps inside the viewport, however long (a scene's note can be a paragraph), with its Dismiss
+/// Messages shown at once; older ones fold into one line.
+pub const MESSAGES_SHOWN: usize = 3;
+
+/// Errors (until dismissed) and notes (for a few seconds) across the top of the viewport, the
+/// newest `MESSAGES_SHOWN`. They are part of the viewport itself, drawn over the image but under
+/// every window, so they never hide a window; each wraps inside the viewport with its Dismiss
 /// button below the text, so the button stays on screen.
-fn messages(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, out: &mut Actions) {
+fn messages(app: &BvhscopeApp, ui: &mut egui::Ui, rect: Rect, out: &mut Actions) {
     if app.messages.is_empty() {
         return;
     }
     let mut dismiss = None;
     let margin = 8.0;
-    let width = (rect.width() - 24.0 - 2.0 * margin).max(60.0);
-    egui::Area::new(ui.scope_id().with("messages"))
-        .fixed_pos(rect.left_top() + Vec2::new(12.0, 12.0))
-        .order(egui::Order::Foreground)
-        .constrain_to(rect)
-        .show(ui.ctx(), |ui| {
-            ui.set_max_width(width + 2.0 * margin);
-            for (i, m) in app.messages.iter().enumerate() {
-                let (fill, title) = match m.kind {
-                    MessageKind::Error => (Color32::from_rgb(110, 24, 24), "Error"),
-                    MessageKind::Warning => (Color32::from_rgb(110, 80, 10), "Warning"),
-                    MessageKind::Info => (Color32::from_rgb(24, 60, 100), "Note"),
-                };
-                egui::Frame::new().fill(fill).inner_margin(margin).corner_radius(4.0).show(ui, |ui| {
-                    ui.set_max_width(width);
-                    let text = egui::RichText::new(format!("{title}: {}", m.text)).color(Color32::WHITE);
-                    ui.add(egui::Label::new(text).wrap());
-                    if ui.small_button("Dismiss").clicked() {
-                        dismiss = Some(i);
-                    }
-                });
+    let width = (rect.width().min(560.0) - 24.0 - 2.0 * margin).max(60.0);
+    let area = Rect::from_min_max(rect.left_top() + Vec2::new(12.0, 12.0), rect.right_bottom());
+    let mut child =
+        ui.new_child(egui::UiBuilder::new().max_rect(area).layout(egui::Layout::top_down(egui::Align::LEFT)));
+    let ui = &mut child;
+    ui.set_max_width(width + 2.0 * margin);
+    let first = app.messages.len().saturating_sub(MESSAGES_SHOWN);
+    if first > 0 {
+        egui::Frame::new().fill(Color32::from_black_alpha(170)).inner_margin(4.0).corner_radius(4.0).show(ui, |ui| {
+            ui.horizontal(|ui| {
+                ui.label(egui::RichText::new(format!("{first} earlier")).color(Color32::LIGHT_GRAY));
+                if ui.small_button("Dismiss them").clicked() {
+                    out.push(Action::DismissEarlier(first));
+                }
+            });
+        });
+    }
+    for (i, m) in app.messages.iter().enumerate().skip(first) {
+        let (fill, title) = match m.kind {
+            MessageKind::Error => (Color32::from_rgb(110, 24, 24), "Error"),
+            MessageKind::Warning => (Color32::from_rgb(110, 80, 10), "Warning"),
+            MessageKind::Info => (Color32::from_rgb(24, 60, 100), "Note"),
+        };
+        egui::Frame::new().fill(fill).inner_margin(margin).corner_radius(4.0).show(ui, |ui| {
+            ui.set_max_width(width);
+            let text = egui::RichText::new(format!("{title}: {}", m.text)).color(Color32::WHITE);
+            ui.add(egui::Label::new(text).wrap());
+            if ui.small_button("Dismiss").clicked() {
+                dismiss = Some(i);
             }
         });
+        ui.add_space(4.0);
+    }
     out.extend(dismiss.map(Action::Dismiss));
 }

@@ -46,18 +46,29 @@ pub struct InspectArgs {
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
-fn points_json(points: &[CurvePoint]) -> serde_json::Value {
+/// A split's cost term by term, as JSON fields.
+fn terms_json(t: &crate::bvh::inspect::CostTerms) -> serde_json::Value {
+    serde_json::json!({ "left_count": t.left, "right_count": t.right, "area_left_ratio": t.area_left,
+        "area_right_ratio": t.area_right, "traversal_term": t.traversal, "left_term": t.left_term,
+        "right_term": t.right_term, "cost": t.cost })
+}
+
+fn points_json(points: &[CurvePoint], sah: crate::bvh::SahCost) -> serde_json::Value {
     points
         .iter()
-        .map(|p| serde_json::json!({ "position": p.position, "left_count": p.left, "right_count": p.right, "cost": p.cost }))
+        .map(|p| {
+            let mut v = terms_json(&p.terms(sah));
+            v["position"] = p.position.into();
+            v
+        })
         .collect()
 }
 
 fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
     let curves: serde_json::Map<String, serde_json::Value> = (0..3)
         .map(|a| {
-            let v = serde_json::json!({ "sweep": points_json(&ins.sweep[a]), "binned": points_json(&ins.binned[a]),
-                "spatial": points_json(&ins.spatial[a]) });
+            let v = serde_json::json!({ "sweep": points_json(&ins.sweep[a], ins.sah),
+                "binned": points_json(&ins.binned[a], ins.sah), "spatial": points_json(&ins.spatial[a], ins.sah) });
             (AXES[a].to_string(), v)
         })
         .collect();
@@ -66,8 +77,10 @@ fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
         .iter()
         .map(|(s, m)| {
             let v = m.map_or(serde_json::Value::Null, |m| {
-                serde_json::json!({ "axis": AXES[m.axis as usize], "position": m.position, "cost": m.cost,
-                    "left_count": m.left, "right_count": m.right })
+                let mut v = terms_json(&m.terms(ins.sah));
+                v["axis"] = AXES[m.axis as usize].into();
+                v["position"] = m.position.into();
+                v
             });
             (s.named().name.to_string(), v)
         })
@@ -128,6 +141,7 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
                     m.right,
                     m.cost
                 );
+                let _ = writeln!(o, "  {:<12}  {}", "", m.terms(ins.sah).text());
             }
             None if *s == crate::bvh::SplitStrategy::Sbvh => {
                 let _ = writeln!(o, "  {:<12}  makes a leaf here", s.named().name);
@@ -217,14 +231,29 @@ pub fn wide_group_text(node: u32, g: &WideGroup) -> String {
 /// The exact sweep's curves as CSV.
 pub fn csv(ins: &Inspection) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let _ = w.write_record(["axis", "position", "left_count", "right_count", "cost"]);
+    let _ = w.write_record([
+        "axis",
+        "position",
+        "left_count",
+        "right_count",
+        "area_left_ratio",
+        "area_right_ratio",
+        "left_term",
+        "right_term",
+        "cost",
+    ]);
     for (a, points) in ins.sweep.iter().enumerate() {
         for p in points {
+            let t = p.terms(ins.sah);
             let _ = w.write_record([
                 AXES[a].to_string(),
                 p.position.to_string(),
                 p.left.to_string(),
                 p.right.to_string(),
+                t.area_left.to_string(),
+                t.area_right.to_string(),
+                t.left_term.to_string(),
+                t.right_term.to_string(),
                 p.cost.to_string(),
             ]);
         }

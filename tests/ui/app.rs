@@ -9,8 +9,10 @@ use support::*;
 // The explaining views (pinned rays, the tree and the node inspector, the histogram, the replay,
 // two strategies side by side): the same binary, another file.
 mod app_explain;
+mod app_look;
 mod app_replay;
 mod app_scenes;
+mod app_truth;
 
 use bvhscope::app::{Action, AppOptions, BvhscopeApp, MessageKind, SceneSource};
 use bvhscope::bvh::SplitStrategy;

@@ -23,7 +23,7 @@ fn click_at(h: &mut Harness<'_, BvhscopeApp>, pos: egui::Pos2) {
 
 /// The frame pixel under a screen position of the viewport (as the viewport maps it).
 fn pixel_under(app: &BvhscopeApp, pos: egui::Pos2) -> (u32, u32) {
-    let (r, f) = (app.viewport_rect, &app.shown.as_ref().unwrap().frame);
+    let (r, f) = (app.image_rect, &app.shown.as_ref().unwrap().frame);
     let (u, v) = ((pos.x - r.min.x) / r.width(), (pos.y - r.min.y) / r.height());
     ((u * f.width() as f32) as u32, (v * f.height() as f32) as u32)
 }
@@ -39,7 +39,7 @@ fn clicking_a_pixel_pins_its_ray_and_the_ray_window_steps_through_it() {
     // The hottest pixel of the heatmap (the knot's view has a hole in its middle).
     let pos = {
         let app = h.state();
-        let (r, f) = (app.viewport_rect, &app.shown.as_ref().unwrap().frame);
+        let (r, f) = (app.image_rect, &app.shown.as_ref().unwrap().frame);
         let (w, hh) = (f.width(), f.height());
         let (x, y) = (0..hh)
             .flat_map(|y| (0..w).map(move |x| (x, y)))
@@ -261,7 +261,7 @@ fn a_node_is_selected_from_the_tree_the_icicle_and_the_viewport() {
     // The viewport: shift-click a hit pixel selects the leaf holding its triangle.
     let (pos, leaf) = {
         let app = h.state();
-        let (r, f) = (app.viewport_rect, &app.shown.as_ref().unwrap().frame);
+        let (r, f) = (app.image_rect, &app.shown.as_ref().unwrap().frame);
         let (x, y) = (f.width() / 2, (0..f.height()).find(|&y| f.sample(f.width() / 2, y).is_hit()).unwrap());
         let pos = r.min
             + egui::vec2(

@@ -150,6 +150,52 @@ pub struct CurvePoint {
     pub right: u32,
     /// C_trav + C_isect·(A_L·n_L + A_R·n_R)/A.
     pub cost: f32,
+    /// A_L / A and A_R / A: the chances that a ray entering the node enters each side.
+    pub area_left: f32,
+    pub area_right: f32,
+}
+
+/// A split's cost term by term, as a student checks it: C_trav + C_isect·(A_L/A)·n_L +
+/// C_isect·(A_R/A)·n_R.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CostTerms {
+    pub left: u32,
+    pub right: u32,
+    pub area_left: f32,
+    pub area_right: f32,
+    pub traversal: f32,
+    pub left_term: f32,
+    pub right_term: f32,
+    pub cost: f32,
+}
+
+impl CostTerms {
+    pub fn of(c: SahCost, left: u32, right: u32, area_left: f32, area_right: f32, cost: f32) -> CostTerms {
+        CostTerms {
+            left,
+            right,
+            area_left,
+            area_right,
+            traversal: c.traversal,
+            left_term: c.intersection * area_left * left as f32,
+            right_term: c.intersection * area_right * right as f32,
+            cost,
+        }
+    }
+
+    /// "n_L 34, n_R 62; A_L/A 0.412, A_R/A 0.730; cost 1.000 + 14.008 + 45.260 = 60.268".
+    pub fn text(&self) -> String {
+        format!(
+            "n_L {}, n_R {}; A_L/A {:.3}, A_R/A {:.3}; cost = C_trav {:.3} + C_isect·A_L/A·n_L {:.3} + C_isect·A_R/A·n_R {:.3} = {:.3}",
+            self.left, self.right, self.area_left, self.area_right, self.traversal, self.left_term, self.right_term, self.cost
+        )
+    }
+}
+
+impl CurvePoint {
+    pub fn terms(&self, c: SahCost) -> CostTerms {
+        CostTerms::of(c, self.left, self.right, self.area_left, self.area_right, self.cost)
+    }
 }
 
 /// Where a strategy puts its plane at this node, and what that split costs.
@@ -161,6 +207,15 @@ pub struct Marker {
     pub left: u32,
     pub right: u32,
     pub cost: f32,
+    /// A_L / A and A_R / A of the children it makes.
+    pub area_left: f32,
+    pub area_right: f32,
+}
+
+impl Marker {
+    pub fn terms(&self, c: SahCost) -> CostTerms {
+        CostTerms::of(c, self.left, self.right, self.area_left, self.area_right, self.cost)
+    }
 }
 
 /// A node of the binary tree, explained.
@@ -206,6 +261,8 @@ pub struct Inspection {
     /// stored and their triangle counts: where an imported tree's split stands against the curves
     /// (a built tree's children's boxes are tight, so this is its strategy's marker cost).
     pub own_cost: Option<f32>,
+    /// The SAH constants the costs are priced with (for their terms: `CostTerms`).
+    pub sah: SahCost,
 }
 
 /// Collects a sweep's planes as curve points.
@@ -216,9 +273,10 @@ struct Curves<'a> {
 }
 
 impl PlaneSink for Curves<'_> {
-    fn plane(&mut self, axis: usize, position: f32, left: u32, right: u32, weighted: f32) {
+    fn plane(&mut self, axis: usize, position: f32, left: u32, right: u32, weighted: f32, areas: [f32; 2]) {
         let cost = split_cost(self.cost, weighted, self.area);
-        self.out[axis].push(CurvePoint { position, left, right, cost });
+        let (area_left, area_right) = (areas[0] / self.area, areas[1] / self.area);
+        self.out[axis].push(CurvePoint { position, left, right, cost, area_left, area_right });
     }
 }
 
@@ -328,6 +386,8 @@ fn marker(
                 left: mid as u32,
                 right: (p.len() - mid) as u32,
                 cost: split_cost(params.cost, weighted, area),
+                area_left: l.area() / area,
+                area_right: r.area() / area,
             })
         }
         _ => None,
@@ -373,6 +433,8 @@ fn sbvh_marker(e: &super::sbvh::Explained, params: &super::BuildParams, area: f3
         left: s.left,
         right: s.right,
         cost: split_cost(params.cost, s.weighted, area),
+        area_left: s.areas[0] / area,
+        area_right: s.areas[1] / area,
     })
 }
 
@@ -447,6 +509,7 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         sbvh,
         markers,
         own_cost,
+        sah: params.cost,
     })
 }
 

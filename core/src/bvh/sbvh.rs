@@ -403,6 +403,7 @@ pub(super) fn explain(
             left: left.refs.len() as u32,
             right: right.refs.len() as u32,
             weighted: [&left.refs, &right.refs].iter().map(|s| area_of(s) * s.len() as f32).sum(),
+            areas: [area_of(&left.refs), area_of(&right.refs)],
         }),
         Outcome::Leaf(_) => None,
     };
@@ -441,6 +442,8 @@ pub struct ExplainedSplit {
     pub right: u32,
     /// A_L·n_L + A_R·n_R of the children made.
     pub weighted: f32,
+    /// [A_L, A_R].
+    pub areas: [f32; 2],
 }
 
 #[cfg(test)]

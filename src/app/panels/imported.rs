@@ -22,7 +22,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         .show(ctx, |ui| {
             let d = t.defects();
             ui.label(egui::RichText::new(t.path.display().to_string()).strong());
-            let verdict = if d == 0 { "correct" } else { "has defects" };
+            let verdict = if d == 0 { "is correct" } else { "has defects" };
             ui.label(format!("{d} defects, {} warnings: the BVH {verdict}.", t.findings.len() - d));
             match &t.bvh {
                 Ok(_) => {

@@ -7,7 +7,7 @@ use crate::app::{Action, Actions, BvhscopeApp, NodeStep};
 use crate::bvh::inspect::{CurvePoint, Inspection};
 use crate::bvh::SplitStrategy;
 use egui::Color32;
-use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints, VLine};
+use egui_plot::{HLine, Line, LineStyle, Plot, PlotPoints, VLine};
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -74,7 +74,8 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 return;
             };
             let visits = nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
-            figures(ui, ins, e.epo_terms[node as usize], visits.map(|v| v.counts[node as usize]));
+            let visits = visits.map(|v| (v.counts[node as usize], v.camera.width, v.camera.height));
+            figures(ui, ins, e.epo_terms[node as usize], visits);
             let imported = e.bvh.import();
             if let Some(names) = imported {
                 let d = crate::cli::inspect::dump_text(names.dump_of_binary_node(node));
@@ -109,8 +110,17 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                         "Stich et al. 2009: the SBVH prices spatial splits (which cut triangles straddling the plane) only where the object split's two boxes overlap by more than α of the root's area, while its budget of extra references lasts",
                     );
                 }
+                let mut shared = app.nodes.shared_scale;
+                if ui
+                    .checkbox(&mut shared, "One cost scale for the three axes")
+                    .on_hover_text("Draw x, y and z on the same cost range, so their costs compare across plots")
+                    .changed()
+                {
+                    out.push(Action::SharedCostScale(shared));
+                }
+                let range = shared.then(|| cost_range(ins));
                 for axis in 0..3 {
-                    curve_plot(ui, ins, axis, own);
+                    curve_plot(ui, ins, axis, own, range);
                 }
             }
         });
@@ -124,7 +134,7 @@ pub fn wide_group_text(node: u32, g: &crate::bvh::wide::WideGroup) -> String {
     crate::cli::inspect::wide_group_text(node, g)
 }
 
-fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<u32>) {
+fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<(u32, u32, u32)>) {
     egui::Grid::new("node-figures").num_columns(2).striped(true).show(ui, |ui| {
         let mut row = |k: &str, v: String, tip: &str| {
             ui.label(k).on_hover_text(tip);
@@ -146,7 +156,8 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<u32>) {
         }
         row("EPO share", format!("{epo:.4}"), "Its term of the tree's end-point overlap (Aila, Karras & Laine 2013): the surface of other subtrees' triangles inside its box, weighted by its cost and over the total surface");
         row("As a leaf", format!("{:.3}", ins.leaf_cost), "What making it a leaf would cost: C_isect × triangles");
-        row("Visits", visits.map_or("…".into(), |v| v.to_string()), "Primary rays of the last frame that entered it (a binary traversal of the same rays)");
+        let visits = visits.map_or("…".into(), |(v, w, h)| format!("{v} of the {w}×{h} frame's primary rays"));
+        row("Visits", visits, "Primary rays of the frame on screen that entered it (a binary traversal of the same rays; `bvhscope inspect --size WxH` counts the same frame)");
         for (s, m) in &ins.markers {
             let text = match m {
                 Some(m) => format!("{} = {:.4}: {} | {}, cost {:.3}", AXES[m.axis as usize], m.position, m.left, m.right, m.cost),
@@ -154,7 +165,10 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<u32>) {
                 None => "no split (the builder falls back to equal count)".into(),
             };
             ui.label(egui::RichText::new(s.label()).color(strategy_color(*s)));
-            ui.label(text);
+            match m {
+                Some(m) => ui.label(text).on_hover_text(m.terms(ins.sah).text()),
+                None => ui.label(text),
+            };
             ui.end_row();
         }
     });
@@ -199,62 +213,142 @@ fn steps(points: &[CurvePoint]) -> Vec<[f64; 2]> {
     out
 }
 
-/// `own`: the tree's strategy, whose marker is "(this tree)"; `None` for an imported tree, whose
-/// own split is drawn as a line at its cost.
-fn curve_plot(ui: &mut egui::Ui, ins: &Inspection, axis: usize, own: Option<SplitStrategy>) {
+/// Height of each axis's plot: tall enough for tick labels on both axes at the default window size.
+const PLOT_HEIGHT: f32 = 170.0;
+/// Width of the legend beside each plot (the curves stay uncovered).
+const LEGEND_WIDTH: f32 = 150.0;
+
+/// The lowest and highest cost drawn on any axis's plot: the shared scale.
+fn cost_range(ins: &Inspection) -> (f32, f32) {
+    let mut lo = ins.leaf_cost.min(ins.own_cost.unwrap_or(f32::INFINITY));
+    let mut hi = ins.leaf_cost.max(ins.own_cost.unwrap_or(f32::NEG_INFINITY));
+    for a in 0..3 {
+        for p in ins.sweep[a].iter().chain(&ins.binned[a]).chain(&ins.spatial[a]) {
+            lo = lo.min(p.cost);
+            hi = hi.max(p.cost);
+        }
+    }
+    (lo, hi)
+}
+
+/// The plane nearest `x` on a curve.
+fn nearest(points: &[CurvePoint], x: f64) -> Option<&CurvePoint> {
+    points.iter().min_by(|a, b| (a.position as f64 - x).abs().total_cmp(&(b.position as f64 - x).abs()))
+}
+
+/// One axis: the curves (each named by its strategy, as the options table names it), where each
+/// strategy puts its plane, the cost of a leaf; the legend beside the plot; below it the cost of
+/// the plane under the pointer (or of this tree's own split) term by term. `own`: the tree's
+/// strategy, whose marker is "(this tree)"; `None` for an imported tree, whose own split is drawn
+/// as a line at its cost. `shared`: the cost range all three axes are drawn on, when one scale is
+/// asked for.
+fn curve_plot(
+    ui: &mut egui::Ui,
+    ins: &Inspection,
+    axis: usize,
+    own: Option<SplitStrategy>,
+    shared: Option<(f32, f32)>,
+) {
     let (sweep, binned, spatial) = (&ins.sweep[axis], &ins.binned[axis], &ins.spatial[axis]);
     let cuts = if spatial.is_empty() { String::new() } else { format!(", {} spatial planes", spatial.len()) };
-    ui.label(format!("Axis {}: {} candidate planes, {} bins' planes{cuts}", AXES[axis], sweep.len(), binned.len()));
+    ui.label(format!(
+        "Axis {}: {} candidate planes, {} bins' planes ({} bins){cuts}",
+        AXES[axis],
+        sweep.len(),
+        binned.len(),
+        ins.bins
+    ));
     if sweep.is_empty() {
         ui.weak("The centroids do not spread along this axis.");
         return;
     }
-    Plot::new(("node-curve", axis))
-        .height(105.0)
-        .legend(Legend::default())
-        .allow_scroll(false)
-        .x_axis_label(AXES[axis])
-        .y_axis_label("cost")
-        .show(ui, |p| {
+    let (sweep_name, binned_name, spatial_name) =
+        (SplitStrategy::SahSweep.label(), SplitStrategy::SahBinned.label(), SplitStrategy::Sbvh.label());
+    let markers: Vec<(SplitStrategy, crate::bvh::inspect::Marker)> =
+        ins.markers.iter().filter_map(|(s, m)| m.filter(|m| m.axis as usize == axis).map(|m| (*s, m))).collect();
+    let mut hovered = None;
+    ui.horizontal(|ui| {
+        let width = (ui.available_width() - LEGEND_WIDTH - 8.0).max(160.0);
+        let mut plot = Plot::new(("node-curve", axis))
+            .height(PLOT_HEIGHT)
+            .width(width)
+            .allow_scroll(false)
+            .show_axes(true)
+            .y_axis_min_width(40.0)
+            .x_axis_label(AXES[axis])
+            .y_axis_label("cost");
+        if let Some((lo, hi)) = shared {
+            plot = plot.include_y(lo).include_y(hi);
+        }
+        plot.show(ui, |p| {
             let line: PlotPoints = thinned(sweep).into_iter().map(|q| [q.position as f64, q.cost as f64]).collect();
-            p.line(Line::new("exact sweep", line).color(Color32::from_gray(220)).width(1.5));
+            p.line(Line::new(sweep_name, line).color(strategy_color(SplitStrategy::SahSweep)).width(1.5));
             if !binned.is_empty() {
-                let stairs = PlotPoints::from(steps(binned));
                 p.line(
-                    Line::new(format!("binned SAH ({} bins)", ins.bins), stairs)
-                        .color(Color32::from_rgb(90, 200, 250))
+                    Line::new(binned_name, PlotPoints::from(steps(binned)))
+                        .color(strategy_color(SplitStrategy::SahBinned))
                         .width(1.0)
                         .style(LineStyle::dashed_loose()),
                 );
             }
             if !spatial.is_empty() {
                 p.line(
-                    Line::new("SBVH spatial split", PlotPoints::from(steps(spatial)))
+                    Line::new(spatial_name, PlotPoints::from(steps(spatial)))
                         .color(strategy_color(SplitStrategy::Sbvh))
                         .width(1.0)
                         .style(LineStyle::dashed_dense()),
                 );
             }
-            p.hline(
-                HLine::new("as a leaf", ins.leaf_cost as f64)
-                    .color(Color32::from_rgb(230, 200, 80))
-                    .style(LineStyle::dotted_dense()),
-            );
+            p.hline(HLine::new("as a leaf", ins.leaf_cost as f64).color(LEAF_COLOR).style(LineStyle::dotted_dense()));
             if let (None, Some(c)) = (own, ins.own_cost) {
-                p.hline(HLine::new("this tree's split", c as f64).color(Color32::from_rgb(240, 80, 70)).width(2.0));
+                p.hline(HLine::new("this tree's split", c as f64).color(OWN_COLOR).width(2.0));
             }
-            for (s, m) in &ins.markers {
-                if let Some(m) = m.filter(|m| m.axis as usize == axis) {
-                    let chosen = if Some(*s) == own { " (this tree)" } else { "" };
-                    p.vline(
-                        VLine::new(format!("{}{chosen}", s.label()), m.position as f64)
-                            .color(strategy_color(*s))
-                            .width(if Some(*s) == own { 2.5 } else { 1.5 }),
-                    );
-                }
+            for (s, m) in &markers {
+                let width = if Some(*s) == own { 2.5 } else { 1.5 };
+                p.vline(VLine::new(s.label(), m.position as f64).color(strategy_color(*s)).width(width));
+            }
+            hovered = p.pointer_coordinate().and_then(|c| nearest(sweep, c.x).copied());
+        });
+        // The legend beside the plot, one line per name.
+        ui.vertical(|ui| {
+            ui.set_width(LEGEND_WIDTH);
+            let swatch = |ui: &mut egui::Ui, color: Color32, text: String| {
+                ui.horizontal(|ui| {
+                    let (r, _) = ui.allocate_exact_size(egui::vec2(14.0, 10.0), egui::Sense::hover());
+                    ui.painter().rect_filled(r, 2.0, color);
+                    ui.label(egui::RichText::new(text).small());
+                });
+            };
+            swatch(ui, strategy_color(SplitStrategy::SahSweep), format!("{sweep_name}: every plane"));
+            if !binned.is_empty() {
+                swatch(ui, strategy_color(SplitStrategy::SahBinned), format!("{binned_name}: its bins"));
+            }
+            if !spatial.is_empty() {
+                swatch(ui, strategy_color(SplitStrategy::Sbvh), format!("{spatial_name}: spatial"));
+            }
+            swatch(ui, LEAF_COLOR, "as a leaf".into());
+            if let (None, Some(_)) = (own, ins.own_cost) {
+                swatch(ui, OWN_COLOR, "this tree's split".into());
+            }
+            for (s, _) in &markers {
+                let chosen = if Some(*s) == own { " (this tree)" } else { "" };
+                swatch(ui, strategy_color(*s), format!("| {}{chosen}", s.label()));
             }
         });
+    });
+    // The cost term by term: of the plane under the pointer, else of this tree's split here.
+    let chosen = markers.iter().find(|(s, _)| Some(*s) == own).map(|(_, m)| (m.position, m.terms(ins.sah)));
+    let shown = hovered
+        .map(|p| (p.position, p.terms(ins.sah), "the plane under the pointer"))
+        .or(chosen.map(|(x, t)| (x, t, "this tree's split")));
+    if let Some((x, t, what)) = shown {
+        ui.label(egui::RichText::new(format!("At {} = {x:.4} ({what}): {}", AXES[axis], t.text())).small())
+            .on_hover_text("C_trav + C_isect·(A_L/A)·n_L + C_isect·(A_R/A)·n_R: the traversal step, then each side's triangle tests weighted by the chance a ray entering the node enters that side");
+    }
 }
+
+const LEAF_COLOR: Color32 = Color32::from_rgb(200, 200, 200);
+const OWN_COLOR: Color32 = Color32::from_rgb(240, 80, 70);
 
 #[cfg(test)]
 mod tests {
@@ -265,7 +359,8 @@ mod tests {
         let points: Vec<CurvePoint> = (0..100_000)
             .map(|i| {
                 let x = i as f32 / 1000.0;
-                CurvePoint { position: x, left: i, right: 100_000 - i, cost: (x - 37.123).powi(2) + (x * 7.0).sin() }
+                let cost = (x - 37.123).powi(2) + (x * 7.0).sin();
+                CurvePoint { position: x, left: i, right: 100_000 - i, cost, area_left: 0.5, area_right: 0.5 }
             })
             .collect();
         let t = thinned(&points);

@@ -34,7 +34,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 ui.weak(why);
                 return;
             };
-            let cut = e.hierarchy.other_slots.len();
+            let (cut, twice) = references(e);
             let refs = if cut > 0 {
                 format!(" (references: spatial splits cut {cut} triangles among several leaves, and the counts below count each part)")
             } else {
@@ -45,6 +45,14 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 e.tree.nodes.len(),
                 e.tree.prim_ids.len()
             ));
+            if !twice.is_empty() {
+                let shown: Vec<String> = twice.iter().take(4).cloned().collect();
+                let more = if twice.len() > 4 { format!(", … ({} in all)", twice.len()) } else { String::new() };
+                ui.colored_label(
+                    egui::Color32::from_rgb(220, 190, 90),
+                    format!("Warning: {}{more}: each is tested twice by every ray that reaches its leaf.", shown.join(", ")),
+                );
+            }
             let visits = app.nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
             ui.horizontal(|ui| {
                 ui.label("Colour by");
@@ -204,4 +212,39 @@ fn rows(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u32]
             });
         }
     });
+}
+
+/// How many triangles spatial splits cut among several leaves, and the triangles referenced twice
+/// in one leaf ("triangle 928 is referenced twice (leaf 17)", by the file's triangle numbers and,
+/// for an imported tree, the dump's node ids), which is no split but a duplicate.
+pub fn references(e: &crate::app::node_view::Explained) -> (usize, Vec<String>) {
+    let h = &e.hierarchy;
+    let (mut cut, mut twice) = (0, Vec::new());
+    let names = e.bvh.import();
+    let file_number = |t: u32| match &*e.bvh {
+        crate::bvh::SceneBvh::Single { mesh, .. } => mesh.file_number(t),
+        _ => t,
+    };
+    let mut prims: Vec<u32> = h.other_slots.keys().copied().collect();
+    prims.sort_unstable();
+    for prim in prims {
+        let mut leaves: Vec<u32> =
+            h.slots_of_prim(prim).filter_map(|s| h.leaf_of_slot.get(s as usize).copied()).collect();
+        leaves.sort_unstable();
+        let n = leaves.len();
+        leaves.dedup();
+        if leaves.len() > 1 {
+            cut += 1;
+        }
+        if leaves.len() < n {
+            // The leaf that holds it more than once.
+            let mut all: Vec<u32> =
+                h.slots_of_prim(prim).filter_map(|s| h.leaf_of_slot.get(s as usize).copied()).collect();
+            all.sort_unstable();
+            let leaf = all.windows(2).find(|w| w[0] == w[1]).map_or(all[0], |w| w[0]);
+            let leaf = names.and_then(|i| i.dump_of_binary_node(leaf)).unwrap_or(leaf);
+            twice.push(format!("triangle {} is referenced twice (leaf {leaf})", file_number(prim)));
+        }
+    }
+    (cut, twice)
 }

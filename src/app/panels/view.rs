@@ -81,6 +81,15 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.checkbox(&mut s.progressive, "Progressive refinement")
         .on_hover_text("Coarse passes first (1/8, 1/4, 1/2, full)");
     ui.horizontal(|ui| {
+        let scene = app.scene.camera.map(|c| (c.width, c.height));
+        ui.label("Film").on_hover_text(
+            "The image's size: the viewport's, or the scene file's camera size (letterboxed), so the statistics are those of the scene's frame, as bvhscope stats SCENE counts them",
+        );
+        ui.radio_value(&mut s.film, crate::app::Film::Viewport, "viewport");
+        let label = scene.map_or("the scene's (none)".to_string(), |(w, h)| format!("the scene's {w}×{h}"));
+        ui.add_enabled_ui(scene.is_some(), |ui| ui.radio_value(&mut s.film, crate::app::Film::Scene, label));
+    });
+    ui.horizontal(|ui| {
         ui.label("Up axis").on_hover_text(
             "Which axis of the mesh points up. Meshes exported Z-up (CAD, scans) look as if seen from underneath with Y up. Changing it resets the camera to the front view.",
         );

@@ -150,9 +150,10 @@ pub enum Proposal {
 /// whose `ACTIVE = false` compiles the reports away.
 pub trait PlaneSink {
     const ACTIVE: bool = true;
-    /// A candidate plane at `position` on `axis`, with `left` and `right` triangles on its sides
-    /// and `weighted` = A_L·n_L + A_R·n_R.
-    fn plane(&mut self, axis: usize, position: f32, left: u32, right: u32, weighted: f32);
+    /// A candidate plane at `position` on `axis`, with `left` and `right` triangles on its sides,
+    /// `weighted` = A_L·n_L + A_R·n_R, and `areas` = [A_L, A_R] (what a student checks the cost
+    /// against, term by term).
+    fn plane(&mut self, axis: usize, position: f32, left: u32, right: u32, weighted: f32, areas: [f32; 2]);
 }
 
 /// Whether `sink` records (a constant: the build's `()` compiles the reports away).
@@ -164,7 +165,7 @@ pub(crate) fn is_active<P: PlaneSink>(_: &P) -> bool {
 impl PlaneSink for () {
     const ACTIVE: bool = false;
     #[inline(always)]
-    fn plane(&mut self, _: usize, _: f32, _: u32, _: u32, _: f32) {}
+    fn plane(&mut self, _: usize, _: f32, _: u32, _: u32, _: f32, _: [f32; 2]) {}
 }
 
 /// Move the elements satisfying `left` to the front; returns how many there are. Unstable.

@@ -175,11 +175,13 @@ fn binned<P: PlaneSink>(
         }
         let right = left.map(|l| n as u32 - l);
         let counts = |c: [u32; 3]| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, 0.0);
-        let cost = areas3(&acc) * counts(left) + right_area * counts(right);
+        let left_area = areas3(&acc);
+        let cost = left_area * counts(left) + right_area * counts(right);
         let usable = |a: usize| left[a] != 0 && right[a] != 0 && splittable[a];
         if is_active(sink) {
             for a in (0..3).filter(|&a| usable(a)) {
-                sink.plane(a, cb.min[a] + i as f32 / scale[a], left[a], right[a], cost[a]);
+                let areas = [left_area[a], right_area[a]];
+                sink.plane(a, cb.min[a] + i as f32 / scale[a], left[a], right[a], cost[a], areas);
             }
         }
         let better = cost.cmplt(lane_cost) & BVec4A::new(usable(0), usable(1), usable(2), false);

@@ -67,7 +67,7 @@ fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>, si
             let cost = acc.area() * i as f32 + right_area[i] * (n - i) as f32;
             if is_active(sink) {
                 let plane = (prims[i - 1].centroid()[axis] + prims[i].centroid()[axis]) * 0.5;
-                sink.plane(axis, plane, i as u32, (n - i) as u32, cost);
+                sink.plane(axis, plane, i as u32, (n - i) as u32, cost, [acc.area(), right_area[i]]);
             }
             if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, axis, i));

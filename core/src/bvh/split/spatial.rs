@@ -152,10 +152,11 @@ pub fn spatial_planes(
             if left == 0 || right == 0 {
                 continue;
             }
-            let weighted = area(&acc) * left as f32 + right_area[k] * right as f32;
+            let areas = [area(&acc), right_area[k]];
+            let weighted = areas[0] * left as f32 + areas[1] * right as f32;
             let position = plane(lo, width, k);
             if is_active(sink) {
-                sink.plane(axis, position, left, right, weighted);
+                sink.plane(axis, position, left, right, weighted, areas);
             }
             if best.is_none_or(|b| weighted < b.weighted) {
                 best = Some(SpatialSplit { axis: axis as u8, position, weighted, left, right });
@@ -322,7 +323,7 @@ mod tests {
         let mut seen = Vec::new();
         struct Seen<'a>(&'a mut Vec<(usize, f32, u32, u32)>);
         impl PlaneSink for Seen<'_> {
-            fn plane(&mut self, axis: usize, position: f32, left: u32, right: u32, _: f32) {
+            fn plane(&mut self, axis: usize, position: f32, left: u32, right: u32, _: f32, _: [f32; 2]) {
                 self.0.push((axis, position, left, right));
             }
         }

@@ -1,0 +1,62 @@
+//! The README's pictures of the app, made from the app itself: each sets the app up as the
+//! picture shows it and writes a PNG rendered on the software GPU. Not a check (a picture must be
+//! looked at): `BVHSCOPE_LOOK=DIR cargo test -p bvhscope-ui-tests --test app_ui look_ -- --ignored
+//! --test-threads 1` writes them into DIR, to be looked at and copied to assets/screenshots/.
+
+use super::support::*;
+use bvhscope::app::{Action, AppOptions, BvhscopeApp, SceneSource};
+use egui_kittest::Harness;
+use std::path::{Path, PathBuf};
+
+fn out_dir() -> PathBuf {
+    let dir =
+        PathBuf::from(std::env::var("BVHSCOPE_LOOK").unwrap_or_else(|_| std::env::temp_dir().display().to_string()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The app at the README's window size, drawn by wgpu.
+fn looking() -> Harness<'static, BvhscopeApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1400.0, 860.0))
+        .wgpu()
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()))
+}
+
+fn save(h: &mut Harness<'_, BvhscopeApp>, name: &str) {
+    for _ in 0..4 {
+        h.step();
+    }
+    let img = h.render().expect("a wgpu adapter (Mesa's lavapipe)");
+    let path = out_dir().join(format!("{name}.png"));
+    img.save(&path).unwrap();
+    eprintln!("wrote {}", path.display());
+}
+
+fn open(h: &mut Harness<'_, BvhscopeApp>, file: &Path) {
+    run_until(h, "the first frame", idle);
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, file.to_path_buf()));
+    let f = file.to_path_buf();
+    run_until(h, "the file", move |a| a.scene.source == SceneSource::File(f.clone()) && idle(a));
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The Node window on the monkey's root: the three axes' curves, the legend beside them, the cost
+/// of this tree's split term by term.
+#[test]
+#[ignore]
+fn look_node_inspector() {
+    let mut h = looking();
+    open(&mut h, &root().join("scenes/monkey.json"));
+    h.state_mut().act(Action::ShowTree(true));
+    h.state_mut().act(Action::SelectNode(0));
+    run_until(&mut h, "the root's inspection", |a| {
+        a.nodes.inspection.as_ref().is_some_and(|i| i.node == 0) && a.nodes.visits.is_some()
+    });
+    save(&mut h, "app-node-inspector");
+    h.state_mut().act(Action::SharedCostScale(true));
+    save(&mut h, "app-node-inspector-shared");
+}
