@@ -14,7 +14,7 @@ td.n, th.n { text-align: right; font-variant-numeric: tabular-nums; white-space:
 #class th { cursor: pointer; user-select: none; }
 #class th:hover { background: #e6eaf2; }
 #class th.asc::after { content: " \25B2"; font-size: 10px; } #class th.desc::after { content: " \25BC"; font-size: 10px; }
-#class td.reason { max-width: 380px; color: #4a5263; font-size: 13px; }
+#class td.reason { min-width: 240px; max-width: 380px; color: #4a5263; font-size: 13px; }
 #class td.name { white-space: nowrap; }
 .badge { display: inline-block; padding: 1px 8px; border-radius: 10px; font-size: 12px; font-weight: 600; white-space: nowrap; }
 .correct { background: #d9f2e0; color: #17602d; } .defects { background: #fbdcdc; color: #8b1a1a; }
