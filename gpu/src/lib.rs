@@ -22,3 +22,12 @@ pub use device::{gpu_for_tests, Gpu, GpuError, GpuOptions};
 pub use lbvh::{GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
 pub use trace::{GpuTrace, GpuTraceOptions, Rays};
 pub use warp::{WarpGroup, WarpSize, WarpSummary, WarpView, WarpWork};
+
+// The app keeps these in an `Arc` and uses them from its jobs' threads.
+const _: () = {
+    const fn shared<T: Send + Sync>() {}
+    shared::<Gpu>();
+    shared::<GpuBinaryBvh>();
+    shared::<GpuCwbvh>();
+    shared::<GpuLbvh>();
+};
