@@ -1,7 +1,7 @@
 //! GPU throughput, for a run on a real GPU (lavapipe runs it too, but a software adapter's figures
 //! say nothing about a GPU): MRays/s of primary and incoherent rays per node format (binary,
 //! CWBVH), counted and plain, exact and fused arithmetic; the warp view's SIMT efficiency; the
-//! GPU LBVH's build phases against core's LBVH on this machine's CPU. The adapter is named first.
+//! GPU LBVH's and PLOC's build phases against core's on this machine's CPU. The adapter is named first.
 //!
 //! ```sh
 //! cargo run --release -p bvhscope-gpu --example gpu_bench -- [MESH.obj ...] [--size 1920x1080]
@@ -18,7 +18,7 @@ use bvhscope_core::geometry::Ray;
 use bvhscope_core::mesh::{generate, load_obj, Mesh};
 use bvhscope_core::render::Camera;
 use bvhscope_gpu::{
-    Cwbvh, Gpu, GpuBinaryBvh, GpuCwbvh, GpuLbvh, GpuTrace, GpuTraceOptions, Rays, WarpSize, WarpView, WarpWork,
+    Cwbvh, Gpu, GpuBinaryBvh, GpuCwbvh, GpuLbvh, GpuPloc, GpuTrace, GpuTraceOptions, Rays, WarpSize, WarpView, WarpWork,
 };
 use glam::Vec3;
 use std::time::{Duration, Instant};
@@ -200,6 +200,28 @@ fn run() -> Result<(), String> {
             std::thread::available_parallelism().map_or(1, |n| n.get()),
             cpu_time,
             cpu.nodes.len()
+        );
+        let ploc = GpuPloc::new(&gpu).map_err(|e| e.to_string())?;
+        let params = BuildParams { strategy: SplitStrategy::Ploc, ..params };
+        ploc.build(&gpu, mesh, &params).map_err(|e| e.to_string())?;
+        let (g, t) = ploc.build(&gpu, mesh, &params).map_err(|e| e.to_string())?;
+        let start = Instant::now();
+        let cpu = Bvh::build(mesh, &params);
+        let cpu_time = start.elapsed();
+        let sah = |b: &Bvh| bvhscope_core::bvh::TreeStats::of(b).sah_cost;
+        println!(
+            "GPU PLOC, {name}: {:?} (upload {:?}, codes {:?}, sort {:?}, {} clustering rounds {:?}, layout on the host {:?}, download {:?}), SAH {:.3}; CPU PLOC: {:?}, SAH {:.3}",
+            t.total(),
+            t.upload,
+            t.codes,
+            t.sort,
+            t.rounds,
+            t.emission,
+            t.boxes,
+            t.download,
+            sah(&g),
+            cpu_time,
+            sah(&cpu)
         );
     }
     Ok(())

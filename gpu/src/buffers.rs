@@ -67,9 +67,20 @@ impl Gpu {
         Ok(bytemuck::pod_collect_to_vec(&out.remove(0)))
     }
 
+    /// `bytes` of `buffer` from `offset` (both multiples of 4), read back.
+    pub fn download_at(&self, buffer: &wgpu::Buffer, offset: u64, bytes: u64) -> Result<Vec<u8>, GpuError> {
+        Ok(self.read_back(&[(buffer, offset, bytes)])?.remove(0))
+    }
+
     /// Several buffers' first bytes read back through one staging buffer and one submission.
     pub fn download_bytes(&self, parts: &[(&wgpu::Buffer, u64)]) -> Result<Vec<Vec<u8>>, GpuError> {
-        let sizes: Vec<u64> = parts.iter().map(|&(_, b)| b.next_multiple_of(4)).collect();
+        let parts: Vec<(&wgpu::Buffer, u64, u64)> = parts.iter().map(|&(b, n)| (b, 0, n)).collect();
+        self.read_back(&parts)
+    }
+
+    /// (buffer, offset, bytes) parts read back through one staging buffer and one submission.
+    fn read_back(&self, parts: &[(&wgpu::Buffer, u64, u64)]) -> Result<Vec<Vec<u8>>, GpuError> {
+        let sizes: Vec<u64> = parts.iter().map(|&(_, _, b)| b.next_multiple_of(4)).collect();
         let total: u64 = sizes.iter().sum();
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("read-back"),
@@ -79,9 +90,9 @@ impl Gpu {
         });
         let mut encoder = self.device.create_command_encoder(&Default::default());
         let mut offset = 0;
-        for (&(buf, _), &size) in parts.iter().zip(&sizes) {
+        for (&(buf, from, _), &size) in parts.iter().zip(&sizes) {
             if size > 0 {
-                encoder.copy_buffer_to_buffer(buf, 0, &staging, offset, size);
+                encoder.copy_buffer_to_buffer(buf, from, &staging, offset, size);
             }
             offset += size;
         }
@@ -100,7 +111,7 @@ impl Gpu {
         let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
         let mut out = Vec::with_capacity(parts.len());
         let mut offset = 0usize;
-        for (&(_, bytes), &size) in parts.iter().zip(&sizes) {
+        for (&(_, _, bytes), &size) in parts.iter().zip(&sizes) {
             out.push(data[offset..offset + bytes as usize].to_vec());
             offset += size as usize;
         }

@@ -32,8 +32,10 @@ pub struct GpuBuildTimings {
     pub boxes: Duration,
     /// Nodes and ids back, triangles gathered into leaf order.
     pub download: Duration,
-    /// Passes of the box check (1 when no parent read a sibling's box early).
+    /// LBVH: passes of the box check (1 when no parent read a sibling's box early).
     pub verify_passes: u32,
+    /// PLOC: clustering rounds.
+    pub rounds: u32,
 }
 
 impl GpuBuildTimings {
@@ -76,16 +78,28 @@ const KERNELS: [(&str, &[u32]); 9] = [
 /// pass runs in one workgroup.
 pub const MAX_TRIANGLES: usize = 1 << 28;
 
-/// The buffers of a build over `n` triangles: (what, bytes), binding number where it has one.
-fn buffer_sizes(n: u64) -> Vec<(Option<u32>, &'static str, u64)> {
-    let nodes = 2 * n.max(1) - 1;
+/// The buffers of the Morton order (upload, codes, sort) over `n` triangles: (binding, what,
+/// bytes); shared by the LBVH and PLOC builds.
+pub(crate) fn morton_sizes(n: u64) -> Vec<(Option<u32>, &'static str, u64)> {
     let mut v = vec![
-        (Some(1), "the LBVH's triangles", 36 * n),
-        (Some(2), "the LBVH's Morton codes", 4 * n),
-        (Some(3), "the LBVH's primitive order", 4 * n),
+        (Some(1), "the build's triangles", 36 * n),
+        (Some(2), "the build's Morton codes", 4 * n),
+        (Some(3), "the build's primitive order", 4 * n),
         (None, "the sort's second code buffer", 4 * n),
         (None, "the sort's second order buffer", 4 * n),
-        (Some(4), "the LBVH's counters", 32),
+        (Some(4), "the build's counters", 32),
+    ];
+    for (what, bytes) in RadixSort::scratch_sizes(n as u32) {
+        v.push((None, what, bytes));
+    }
+    v
+}
+
+/// The buffers of an LBVH build over `n` triangles.
+fn buffer_sizes(n: u64) -> Vec<(Option<u32>, &'static str, u64)> {
+    let nodes = 2 * n.max(1) - 1;
+    let mut v = morton_sizes(n);
+    v.extend([
         (Some(5), "the LBVH's runs of equal codes", 4 * (n + 1)),
         (Some(6), "the LBVH's run starts", 4 * (n + 1)),
         (Some(7), "the LBVH's run codes", 4 * n),
@@ -95,11 +109,23 @@ fn buffer_sizes(n: u64) -> Vec<(Option<u32>, &'static str, u64)> {
         (Some(11), "the LBVH's leaf starts", 4 * (n + 1)),
         (Some(12), "the LBVH's output nodes", 32 * nodes),
         (None, "the scans' sums", Scan::scratch_bytes(n as u32 + 1)),
-    ];
-    for (what, bytes) in RadixSort::scratch_sizes(n as u32) {
-        v.push((None, what, bytes));
-    }
+    ]);
     v
+}
+
+/// The mesh's triangles as nine floats each, in mesh order.
+pub(crate) fn triangle_floats(mesh: &Mesh) -> Vec<[f32; 9]> {
+    (0..mesh.triangle_count() as u32)
+        .map(|i| {
+            let [a, b, c] = mesh.triangle(i);
+            [a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z]
+        })
+        .collect()
+}
+
+/// The LBVH's WGSL module: the builders' boxes, then its kernels.
+pub(crate) fn source() -> String {
+    [include_str!("shaders/boxes.wgsl"), include_str!("shaders/lbvh.wgsl")].join("\n")
 }
 
 /// Decode `lbvh.wgsl`'s `ordered` words.
@@ -109,7 +135,7 @@ fn unordered(u: u32) -> f32 {
 
 impl GpuLbvh {
     pub fn new(gpu: &Gpu) -> Result<GpuLbvh, GpuError> {
-        let src = include_str!("shaders/lbvh.wgsl");
+        let src = &source();
         let mut kernels = Vec::new();
         for (entry, binds) in KERNELS {
             let binds: Vec<(u32, Bind)> = binds
@@ -160,45 +186,29 @@ impl GpuLbvh {
         k.dispatch(enc, &bind, gpu.grid(threads, 64));
     }
 
-    /// Build core's LBVH of `mesh` with `params` (its `max_leaf_size`; reinsertion is left to the
-    /// caller, as `Bvh::build` runs it after any builder).
-    pub fn build(&self, gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<(Bvh, GpuBuildTimings), GpuError> {
-        let params = BuildParams {
-            strategy: SplitStrategy::Lbvh,
-            max_leaf_size: MAX_LEAF_SIZE.clamp(params.max_leaf_size),
-            ..*params
-        };
-        let n = mesh.triangle_count();
-        let mut t = GpuBuildTimings::default();
-        if n == 0 {
-            // core's tree of an empty mesh: one empty leaf.
-            let nodes = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
-            return Ok((Bvh { nodes, prim_ids: vec![], tris: vec![], params, report: BuildReport::default() }, t));
-        }
-        Self::check_size(gpu, n)?;
-        let n32 = n as u32;
+    /// Upload `mesh`'s triangles and sort them by Morton code as core's LBVH does (phases upload,
+    /// codes, sort): the buffers at bindings 0 (parameters), 1 (triangles), 2 (sorted codes), 3
+    /// (triangle order) and 4 (counters); the caller has checked the sizes.
+    pub(crate) fn morton_order(
+        &self,
+        gpu: &Gpu,
+        mesh: &Mesh,
+        max_leaf: u32,
+        t: &mut GpuBuildTimings,
+    ) -> Result<Vec<Option<wgpu::Buffer>>, GpuError> {
+        let n32 = mesh.triangle_count() as u32;
         let start = Instant::now();
-        let tris: Vec<[f32; 9]> = (0..n32)
-            .map(|i| {
-                let [a, b, c] = mesh.triangle(i);
-                [a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z]
-            })
-            .collect();
-        let sizes = buffer_sizes(n as u64);
+        let sizes = morton_sizes(n32 as u64);
         let mut bufs: Vec<Option<wgpu::Buffer>> = (0..13).map(|_| None).collect();
-        bufs[1] = Some(gpu.upload(sizes[0].1, &tris)?);
-        for &(b, what, bytes) in &sizes[1..] {
-            if let Some(b) = b {
-                bufs[b as usize] = Some(gpu.storage(what, bytes)?);
-            }
-        }
+        bufs[1] = Some(gpu.upload(sizes[0].1, &triangle_floats(mesh))?);
+        bufs[2] = Some(gpu.storage(sizes[1].1, sizes[1].2)?);
+        bufs[3] = Some(gpu.storage(sizes[2].1, sizes[2].2)?);
         let stats = [u32::MAX, u32::MAX, u32::MAX, 0, 0, 0, 0, 0];
-        bufs[4] = Some(gpu.upload("the LBVH's counters", &stats)?);
+        bufs[4] = Some(gpu.upload(sizes[5].1, &stats)?);
         let tmp_keys = gpu.storage(sizes[3].1, sizes[3].2)?;
         let tmp_vals = gpu.storage(sizes[4].1, sizes[4].2)?;
-        let scan_scratch = gpu.storage("the scans' sums", Scan::scratch_bytes(n32 + 1))?;
         let sort_scratch = RadixSort::scratch(gpu, n32)?;
-        let mut p = LParams { lo: [0.0; 4], scale: [0.0; 4], n: n32, max_leaf: params.max_leaf_size, pad: [0; 2] };
+        let mut p = LParams { lo: [0.0; 4], scale: [0.0; 4], n: n32, max_leaf, pad: [0; 2] };
         bufs[0] = Some(gpu.uniform("LBVH parameters", &p));
         gpu.wait()?;
         t.upload = start.elapsed();
@@ -230,6 +240,34 @@ impl GpuLbvh {
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         t.sort = start.elapsed();
+        Ok(bufs)
+    }
+
+    /// Build core's LBVH of `mesh` with `params` (its `max_leaf_size`; reinsertion is left to the
+    /// caller, as `Bvh::build` runs it after any builder).
+    pub fn build(&self, gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<(Bvh, GpuBuildTimings), GpuError> {
+        let params = BuildParams {
+            strategy: SplitStrategy::Lbvh,
+            max_leaf_size: MAX_LEAF_SIZE.clamp(params.max_leaf_size),
+            ..*params
+        };
+        let n = mesh.triangle_count();
+        let mut t = GpuBuildTimings::default();
+        if n == 0 {
+            // core's tree of an empty mesh: one empty leaf.
+            let nodes = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
+            return Ok((Bvh { nodes, prim_ids: vec![], tris: vec![], params, report: BuildReport::default() }, t));
+        }
+        Self::check_size(gpu, n)?;
+        let n32 = n as u32;
+        let mut bufs = self.morton_order(gpu, mesh, params.max_leaf_size, &mut t)?;
+        for &(b, what, bytes) in &buffer_sizes(n as u64) {
+            if let Some(b) = b.filter(|&b| b > 4) {
+                bufs[b as usize] = Some(gpu.storage(what, bytes)?);
+            }
+        }
+        let scan_scratch = gpu.storage("the scans' sums", Scan::scratch_bytes(n32 + 1))?;
+        let buf = |bufs: &[Option<wgpu::Buffer>], i: usize| bufs[i].as_ref().expect("made above").clone();
 
         let start = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());

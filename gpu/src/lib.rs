@@ -10,6 +10,7 @@ mod cwbvh;
 mod device;
 mod kernel;
 mod lbvh;
+mod ploc;
 mod scan;
 mod shaders_valid;
 mod sort;
@@ -20,6 +21,7 @@ pub use binary::{checked_depth, GpuBinaryBvh};
 pub use cwbvh::{Cwbvh, CwbvhNode, GpuCwbvh, META_INTERIOR, META_LEAF};
 pub use device::{gpu_for_tests, Gpu, GpuError, GpuOptions};
 pub use lbvh::{GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
+pub use ploc::GpuPloc;
 pub use trace::{GpuTrace, GpuTraceOptions, Rays};
 pub use warp::{WarpGroup, WarpSize, WarpSummary, WarpView, WarpWork};
 
@@ -30,4 +32,5 @@ const _: () = {
     shared::<GpuBinaryBvh>();
     shared::<GpuCwbvh>();
     shared::<GpuLbvh>();
+    shared::<GpuPloc>();
 };

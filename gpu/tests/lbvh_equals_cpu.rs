@@ -152,7 +152,7 @@ fn a_mesh_beyond_a_buffer_limit_is_refused_before_upload() {
         GpuError::TooLarge { what, bytes, limit, .. } => {
             assert_eq!(*limit, 64 * 1024);
             assert!(*bytes > *limit);
-            assert_eq!(what, "the LBVH's triangles", "the first buffer too large is named");
+            assert_eq!(what, "the build's triangles", "the first buffer too large is named");
         }
         other => panic!("{other}"),
     }

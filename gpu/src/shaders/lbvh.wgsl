@@ -14,8 +14,6 @@ struct LParams {
     _pad1: u32,
 }
 
-struct Tri { v: array<f32, 9> }
-
 // A node of the Karras tree: internal nodes 0..m-1, then the m runs of equal codes as its leaves.
 // `parent` is the parent's index + 1 (0: the root); a range of sorted primitives [start, end).
 struct KNode {
@@ -26,8 +24,6 @@ struct KNode {
     right: u32,
     axis: u32,
 }
-
-struct KBox { lo: array<f32, 3>, hi: array<f32, 3> }
 
 @group(0) @binding(0) var<uniform> LP: LParams;
 @group(0) @binding(1) var<storage, read> tris: array<Tri>;
@@ -56,31 +52,6 @@ fn index(wg: vec3<u32>, nwg: vec3<u32>, lid: u32) -> u32 {
 fn ordered(f: f32) -> u32 {
     let b = bitcast<u32>(f);
     return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
-}
-
-// Min and max that pick the same operand every time (-0 and +0 compare equal): the verify pass
-// compares boxes bit for bit and must see a repeated union unchanged.
-fn fmin(a: f32, b: f32) -> f32 { return select(b, a, a < b); }
-fn fmax(a: f32, b: f32) -> f32 { return select(b, a, a > b); }
-
-fn tri_box(t: Tri) -> KBox {
-    let v = t.v;
-    return KBox(
-        array<f32, 3>(fmin(fmin(v[0], v[3]), v[6]), fmin(fmin(v[1], v[4]), v[7]), fmin(fmin(v[2], v[5]), v[8])),
-        array<f32, 3>(fmax(fmax(v[0], v[3]), v[6]), fmax(fmax(v[1], v[4]), v[7]), fmax(fmax(v[2], v[5]), v[8])),
-    );
-}
-
-fn box_union(a: KBox, b: KBox) -> KBox {
-    return KBox(
-        array<f32, 3>(fmin(a.lo[0], b.lo[0]), fmin(a.lo[1], b.lo[1]), fmin(a.lo[2], b.lo[2])),
-        array<f32, 3>(fmax(a.hi[0], b.hi[0]), fmax(a.hi[1], b.hi[1]), fmax(a.hi[2], b.hi[2])),
-    );
-}
-
-fn empty_box() -> KBox {
-    let inf = bitcast<f32>(0x7f800000u);
-    return KBox(array<f32, 3>(inf, inf, inf), array<f32, 3>(-inf, -inf, -inf));
 }
 
 // core's Aabb::from_points(tri).center(): (min + max) · 0.5.
