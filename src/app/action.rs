@@ -147,6 +147,13 @@ pub enum Action {
     DismissEarlier(usize),
     /// The Node window's cost curves on one scale for the three axes, or each on its own.
     SharedCostScale(bool),
+    /// Time the current BVH against the linear scan on the frame on screen (or stop timing).
+    TimeLinear(bool),
+    /// Pin the ray of the pixel with the most work in the heatmap on screen (`false`), or of the
+    /// next one after the last pinned so (`true`), as `bvhscope trace --hottest K` traces it.
+    Hottest {
+        next: bool,
+    },
 }
 
 /// Where panels put the actions they emit during one frame.
@@ -376,6 +383,33 @@ impl BvhscopeApp {
                 }
             }
             A::SharedCostScale(on) => self.nodes.shared_scale = on,
+            A::Hottest { next } => {
+                let Some(s) = self.shown.as_ref() else { return };
+                let k = if next { self.hottest.map_or(0, |k| k + 1) } else { 0 };
+                match crate::render::hottest(&s.frame, s.style.view, s.style.cost, k) {
+                    Some((x, y, v)) => {
+                        self.hottest = Some(k);
+                        let what = s.style.view.label().to_lowercase();
+                        let text = format!(
+                            "Pixel {x},{y}: the {} most {what} ({}), pinned in the Ray window",
+                            crate::explain::words::ordinal(k as u32 + 1),
+                            crate::render::legend::fmt_value(v as f64)
+                        );
+                        self.message(MessageKind::Info, text);
+                        self.act(A::PinPixel(x, y));
+                    }
+                    None => self.message(
+                        MessageKind::Info,
+                        "The hottest pixels are of a finished heatmap: choose a heatmap view",
+                    ),
+                }
+            }
+            A::TimeLinear(false) => self.jobs.cancel_speedup(),
+            A::TimeLinear(true) => {
+                if let Some(s) = &self.shown {
+                    self.jobs.speedup(s.bvh.clone(), s.camera, s.trace);
+                }
+            }
             A::DismissEarlier(n) => {
                 self.messages.drain(..n.min(self.messages.len()));
             }

@@ -23,6 +23,7 @@ impl BvhscopeApp {
             }
             JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
             JobEvent::Failed(e) => self.message(MessageKind::Error, e),
+            JobEvent::Speedup(t) => self.speedup = Some(*t),
             JobEvent::Explained(e) => {
                 // A new tree: keep the selection where the id still exists, and its open rows.
                 let n = e.tree.nodes.len() as u32;

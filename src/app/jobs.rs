@@ -115,6 +115,19 @@ pub enum JobEvent {
     },
     /// The job panicked (`Jobs::spawn`): what to tell the user.
     Failed(String),
+    /// The BVH timed against the linear scan.
+    Speedup(Box<Timed>),
+}
+
+/// The linear scan's time budget for a frame: past it, a spread sample is timed (as `compare`).
+pub const LINEAR_BUDGET: Duration = Duration::from_secs(10);
+
+/// A speed-up over the linear scan, for the BVH, camera and traversal it was timed with.
+pub struct Timed {
+    pub bvh: Arc<SceneBvh>,
+    pub camera: Camera,
+    pub trace: TraceOptions,
+    pub speedup: crate::explain::timing::Speedup,
 }
 
 /// A job in flight.
@@ -143,6 +156,8 @@ pub struct Jobs {
     /// Reading and checking a dump; finding the frame's wrong pixels of an imported tree.
     pub import: Option<Running>,
     pub wrong: Option<Running>,
+    /// Timing the BVH against the linear scan (the statistics panel's speed-up).
+    pub speedup: Option<Running>,
     /// What the last compare job was asked for.
     pub last_compare: Option<(SceneBuild, u64, Camera, TraceOptions)>,
     pub picking: Option<Pick>,
@@ -191,6 +206,7 @@ impl Jobs {
             compare: None,
             import: None,
             wrong: None,
+            speedup: None,
             last_compare: None,
             picking: None,
             last_render: None,
@@ -266,9 +282,9 @@ impl Jobs {
         if let Some(old) = self.build.take() {
             old.control.cancel();
         }
-        for old in
-            [self.render.take(), self.compare.take(), self.visits.take(), self.wrong.take()].into_iter().flatten()
-        {
+        let others =
+            [self.render.take(), self.compare.take(), self.visits.take(), self.wrong.take(), self.speedup.take()];
+        for old in others.into_iter().flatten() {
             old.control.cancel();
         }
         // The cancelled render is redrawn once the build is done (or for the BVH kept, if not).
@@ -412,6 +428,33 @@ impl Jobs {
         self.import = Some(job);
     }
 
+    /// Time `bvh` (a single BVH) against the linear scan on `camera`'s frame, single rays on one
+    /// thread (`explain::timing`, as `compare`'s trace column); a running timing is cancelled.
+    pub fn speedup(&mut self, bvh: Arc<SceneBvh>, camera: Camera, trace: TraceOptions) {
+        if let Some(old) = self.speedup.take() {
+            old.control.cancel();
+        }
+        let job = self.start("Timing against the linear scan".to_string());
+        let (send, control) = (self.sender(job.id), job.control.clone());
+        self.spawn(&job, move || {
+            let SceneBvh::Single { mesh, .. } = &*bvh else { return };
+            let linear = crate::bvh::LinearScan::new(mesh);
+            let budget = LINEAR_BUDGET;
+            if let Ok(s) = crate::explain::timing::speedup_one_thread(&*bvh, &linear, &camera, trace, budget, &control)
+            {
+                send(JobEvent::Speedup(Box::new(Timed { bvh, camera, trace, speedup: s })));
+            }
+        });
+        self.speedup = Some(job);
+    }
+
+    /// Stop the speed-up's timing.
+    pub fn cancel_speedup(&mut self) {
+        if let Some(old) = self.speedup.take() {
+            old.control.cancel();
+        }
+    }
+
     /// The pixels of `camera`'s frame whose hit through `bvh` (an imported tree) differs from the
     /// linear scan's.
     pub fn wrong(
@@ -497,6 +540,7 @@ impl Jobs {
                     &mut self.compare,
                     &mut self.import,
                     &mut self.wrong,
+                    &mut self.speedup,
                 ] {
                     if slot.as_ref().is_some_and(|r| r.id == id) {
                         *slot = None;
@@ -522,6 +566,7 @@ impl Jobs {
                 JobEvent::Visits(_) if current(&self.visits) => self.visits = None,
                 JobEvent::Imported(_) if current(&self.import) => self.import = None,
                 JobEvent::Wrong(_) if current(&self.wrong) => self.wrong = None,
+                JobEvent::Speedup(_) if current(&self.speedup) => self.speedup = None,
                 JobEvent::Inspected { .. } if self.inspect.as_ref().is_some_and(|(r, _)| r.id == id) => {
                     self.inspect = None
                 }

@@ -43,6 +43,7 @@ use crate::bvh::{SceneBuild, SceneBvh, TraceOptions, TreeStats};
 use crate::dump::BvhDump;
 use crate::render::{Camera, Frame, Legend, RaySummary, UpAxis, View};
 use crate::scene::SceneBuildError;
+pub use jobs::Timed;
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -106,6 +107,10 @@ pub struct BvhscopeApp {
     pub compare: CompareView,
     /// Bring your own BVH: the imported dump, its findings, the wrong pixels.
     pub import: ImportView,
+    /// The current BVH timed against the linear scan (the statistics panel, on demand).
+    pub speedup: Option<jobs::Timed>,
+    /// The rank of the last hottest pixel pinned (0: the hottest), for "Next".
+    pub hottest: Option<usize>,
     /// A dump to import once the scene being loaded is there.
     pending_import: Option<PathBuf>,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
@@ -197,6 +202,8 @@ impl BvhscopeApp {
             replay: ReplayView::default(),
             compare: CompareView::default(),
             import: ImportView { mask: true, ..Default::default() },
+            speedup: None,
+            hottest: None,
             pending_import: options.bvh.clone(),
             box_cache: Default::default(),
             overlay_cache: Default::default(),
@@ -260,6 +267,7 @@ impl BvhscopeApp {
         self.rays = None;
         // Node ids are the old tree's: a selection kept would dim the new heatmap for nothing.
         self.nodes.deselect();
+        self.hottest = None;
         // A dump numbers the triangles of the mesh it was written for.
         self.import = ImportView { mask: self.import.mask, ..Default::default() };
     }
@@ -478,7 +486,7 @@ impl eframe::App for BvhscopeApp {
             .resizable(true)
             .default_size(340.0)
             .size_range(220.0..=720.0)
-            .show(ui, |ui| panels::fixed_width(ui, |ui| panels::stats::show(self, ui)));
+            .show(ui, |ui| panels::fixed_width(ui, |ui| panels::stats::show(self, ui, out)));
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(12)))
             .show(ui, |ui| viewport::show(self, ui, out));

@@ -334,6 +334,15 @@ fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, hi
                 });
                 if histogram {
                     histogram_bars(app, ui, legend, bar_x, out);
+                    ui.horizontal(|ui| {
+                        if ui.small_button("Hottest pixel").on_hover_text("Pin the ray with the most work in this heatmap in the Ray window (bvhscope trace --hottest 1)").clicked() {
+                            out.push(Action::Hottest { next: false });
+                        }
+                        let next = ui.add_enabled(app.hottest.is_some(), egui::Button::new("Next").small());
+                        if next.on_hover_text("The pixel with the next most work (bvhscope trace --hottest K)").clicked() {
+                            out.push(Action::Hottest { next: true });
+                        }
+                    });
                 }
                 ui.label(format!(
                     "min {}   mean {:.2}   max {}   (all traced rays)",

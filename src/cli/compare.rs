@@ -15,12 +15,9 @@
 
 use super::args::{BuildArgs, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{
-    epo, Accelerator, AnyBvh, BuildParams, LinearScan, NoStats, SplitStrategy, TraceOptions, TreeStats, TreeView,
-};
+use crate::bvh::{epo, AnyBvh, BuildParams, LinearScan, SplitStrategy, TreeStats, TreeView};
 use crate::render::{render, Camera, RenderSettings};
 use clap::{Args, ValueEnum};
-use rayon::prelude::*;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -99,41 +96,7 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
-/// Trace `n` of the camera's pixels (evenly spread; all of them when `n` is the pixel count) one
-/// ray at a time, closest hit only, on the current thread pool: the work of a renderer's
-/// intersection loop and nothing else.
-fn trace_rays<A: Accelerator>(accel: &A, camera: &Camera, trace: TraceOptions, n: usize) -> Duration {
-    let gen = camera.ray_gen();
-    let total = camera.width as usize * camera.height as usize;
-    let start = Instant::now();
-    (0..n).into_par_iter().with_min_len(256).for_each(|i| {
-        let p = (i * total / n) as u32;
-        let mut ray = gen.pixel_ray(p % camera.width, p / camera.width);
-        std::hint::black_box(accel.closest_hit(&mut ray, trace, &mut NoStats));
-    });
-    start.elapsed()
-}
-
-/// Time the linear scan's trace: on the whole frame if that is cheap enough, else on a spread
-/// sample, scaled to the frame. Returns (ms, rays timed if sampled).
-fn time_linear(linear: &LinearScan, camera: &Camera, trace: TraceOptions, budget: Duration) -> (f64, Option<usize>) {
-    let total = camera.width as usize * camera.height as usize;
-    let probe = 256.min(total);
-    let t = trace_rays(linear, camera, trace, probe);
-    let projected = t.as_secs_f64() * total as f64 / probe as f64;
-    if projected <= budget.as_secs_f64() {
-        return (ms(trace_rays(linear, camera, trace, total)), None);
-    }
-    // About a fifth of the budget on the sample.
-    let n = ((budget.as_secs_f64() / 5.0 / t.as_secs_f64().max(1e-9)) * probe as f64) as usize;
-    let n = n.clamp(probe, total);
-    let t = trace_rays(linear, camera, trace, n);
-    (ms(t) * total as f64 / n as f64, Some(n))
-}
+use crate::explain::timing::{ms, time_linear, trace_rays};
 
 /// Builds of one strategy stop once they have taken this long in all (at least one is made).
 const BUILD_BUDGET_MS: f64 = 1000.0;
@@ -235,8 +198,12 @@ pub fn compare_rows(
     let linear = LinearScan::new(mesh);
     let ((linear_ms, sampled), (frame_ms, _)) = progress::with_spinner("timing the linear scan", || {
         // The scan has no packets: its "frame" is its trace on the frame's threads.
-        let trace_ms = traces.install(|| time_linear(&linear, camera, trace, linear_budget));
-        (trace_ms, frames.install(|| time_linear(&linear, camera, trace, linear_budget)))
+        let control = crate::work::WorkControl::new();
+        let timed = |pool: &rayon::ThreadPool| {
+            pool.install(|| time_linear(&linear, camera, trace, linear_budget, &control))
+                .expect("nobody else holds this control")
+        };
+        (timed(&traces), timed(&frames))
     });
     let n = mesh.triangle_count() as f64;
     rows.push(CompareRow {

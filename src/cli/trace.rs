@@ -22,8 +22,15 @@ pub struct TraceArgs {
     /// The mesh (.obj) or scene (.json: bvhscope's or Moer-lite's).
     pub mesh: PathBuf,
     /// The pixel X,Y of the camera's image (0-based, x from the left, y from the top).
-    #[arg(long, value_parser = parse_pixel, conflicts_with = "ray", required_unless_present = "ray")]
+    #[arg(long, value_parser = parse_pixel, conflicts_with_all = ["ray", "hottest"], required_unless_present_any = ["ray", "hottest"])]
     pub pixel: Option<(u32, u32)>,
+    /// The pixel with the K-th most work of --view's heatmap (1: the hottest; ties in reading
+    /// order), as the app's "Hottest pixel" and "Next" pin it.
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(1..), conflicts_with = "ray")]
+    pub hottest: Option<u32>,
+    /// The heatmap whose work --hottest ranks.
+    #[arg(long, value_parser = super::args::choice::<crate::render::View>(), default_value = "visits")]
+    pub view: crate::render::View,
     /// A ray typed as OX,OY,OZ:DX,DY,DZ (origin and direction, world space).
     #[arg(long, value_parser = parse_ray, allow_hyphen_values = true)]
     pub ray: Option<(Vec3, Vec3)>,
@@ -110,7 +117,27 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
         Some(path) => super::check::import_dump(&scene, path, &a.dump_limit)?,
         None => build_scene(&scene, &a.build.scene_build(params))?,
     };
-    let (ray, source) = match (a.pixel, a.ray) {
+    // The K-th hottest pixel: the frame traced and counted, as the app's heatmap is.
+    let hot = match a.hottest {
+        Some(k) => {
+            let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
+            if !a.view.is_heatmap() {
+                return Err(CliError::Usage(
+                    "--hottest ranks a heatmap's work: --view visits, tri-tests or cost".into(),
+                ));
+            }
+            let settings = crate::render::RenderSettings { trace: a.build.trace(), count: true, progressive: false };
+            let frame = super::progress::with_spinner("tracing the frame", || {
+                crate::render::render(&bvh, &bvh, &camera, &settings)
+            });
+            let (x, y, _) = crate::render::hottest(&frame, a.view, params.cost, k as usize - 1).ok_or_else(|| {
+                CliError::Usage(format!("--hottest {k}: the {}x{} frame has fewer pixels", camera.width, camera.height))
+            })?;
+            Some((x, y))
+        }
+        None => None,
+    };
+    let (ray, source) = match (a.pixel.or(hot), a.ray) {
         (_, Some((o, d))) => (Ray::new(o, d), serde_json::json!({ "typed": true })),
         (Some((x, y)), None) => {
             let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
@@ -155,8 +182,15 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
                 "ray             origin ({}, {}, {}), direction ({}, {}, {})",
                 o3.x, o3.y, o3.z, d3.x, d3.y, d3.z
             );
-            if let Some((x, y)) = a.pixel.filter(|_| a.ray.is_none()) {
-                let _ = writeln!(o, "pixel           {x},{y}");
+            if let Some((x, y)) = a.pixel.or(hot).filter(|_| a.ray.is_none()) {
+                let rank = a.hottest.map_or(String::new(), |k| {
+                    format!(
+                        " (the pixel with the {} most work of {})",
+                        crate::explain::words::ordinal(k),
+                        a.view.label().to_lowercase()
+                    )
+                });
+                let _ = writeln!(o, "pixel           {x},{y}{rank}");
             }
             let _ = writeln!(o, "build           {build_label}");
             let _ = writeln!(o, "traversal       {} order, {} test", opts.order.label(), opts.test.label());

@@ -55,43 +55,6 @@ fn the_scenes_film_gives_the_command_lines_figures() {
     assert_ne!(h.state().rays.unwrap().summary.rays, rays.rays);
 }
 
-/// A build started while the previous frame still renders waits for the render to stop: its time
-/// is the build's alone, as `stats` measures it (it used to be several times more, and the
-/// Compare window once showed a negative difference). Generous bounds: timings are noisy, but
-/// contention made it 6 to 9 times the CLI's.
-#[test]
-fn the_build_time_is_the_builds_alone() {
-    let mut h = harness();
-    open(&mut h, &root().join("scenes/knot-on-floor.json"));
-    // A render starts (a new camera), then, at once, a new build.
-    h.state_mut().act(Action::Orbit(40.0, 0.0));
-    h.step();
-    assert!(h.state().jobs.render.is_some(), "a render runs");
-    assert_ne!(h.state().settings.build.strategy, SplitStrategy::EqualCount);
-    with_strategy(&mut h, SplitStrategy::EqualCount);
-    // The render stops for the build, and nothing renders while it runs.
-    h.state_mut().reconcile();
-    assert!(h.state().jobs.build.is_some() && h.state().jobs.render.is_none(), "the render was stopped for the build");
-    while h.state().jobs.build.is_some() {
-        assert!(h.state().jobs.render.is_none(), "no render while the build runs");
-        h.step();
-    }
-    run_until(&mut h, "the equal-count build", |a| {
-        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::EqualCount) && idle(a)
-    });
-    let app_ms = h.state().current_bvh().unwrap().bvh.build_time().as_secs_f64() * 1e3;
-    // The same build, alone, three times.
-    let scene = h.state().scene.clone();
-    let params = h.state().wanted_build();
-    let alone = (0..3)
-        .map(|_| {
-            let b = scene.build(&params, &bvhscope::work::WorkControl::new()).unwrap();
-            b.build_time().as_secs_f64() * 1e3
-        })
-        .fold(f64::INFINITY, f64::min);
-    assert!(app_ms <= 3.0 * alone + 5.0, "the app's build took {app_ms:.2} ms, alone it takes {alone:.2} ms");
-}
-
 /// B of the side-by-side view has its EPO in the statistics, as A has.
 #[test]
 fn bs_epo_is_shown() {
@@ -157,4 +120,49 @@ fn messages_are_few_and_under_the_windows() {
     h.step();
     assert_eq!(h.state().messages.len(), 3);
     h.get_by_label_contains("message number 3");
+}
+
+/// "Hottest pixel" pins the ray with the most work of the heatmap on screen, "Next" the next one:
+/// the pixels `bvhscope trace --hottest 1` and `--hottest 2` trace on the same camera.
+#[test]
+fn the_hottest_pixels_are_the_command_lines() {
+    let mut h = harness();
+    let torus = root().join("assets/torus.obj");
+    open(&mut h, &torus);
+    h.state_mut().act(Action::View(2));
+    run_until(&mut h, "the visits heatmap", |a| idle(a) && a.shown.as_ref().unwrap().legend.is_some());
+    let camera = h.state().shown.as_ref().unwrap().camera;
+    h.get_by_label("Hottest pixel").click();
+    h.step();
+    let pinned = |h: &Harness<'_, BvhscopeApp>| h.state().pins.current().and_then(|r| r.pixel);
+    let first = pinned(&h).expect("a pinned pixel");
+    h.get_by_label("Next").click();
+    h.step();
+    let second = pinned(&h).unwrap();
+    assert_ne!(first, second);
+    for (k, want) in [(1, first), (2, second)] {
+        let mut args = vec![s("trace"), s(torus.display()), s("--hottest"), s(k), s("--format"), s("json")];
+        args.extend(camera_words(&camera));
+        let bvhscope::cli::Command::Trace(a) = words(&args) else { panic!("trace") };
+        let v: serde_json::Value = serde_json::from_str(&bvhscope::cli::trace::output(&a).unwrap()).unwrap();
+        let p = &v["ray"]["from"]["pixel"];
+        assert_eq!((p[0].as_u64().unwrap() as u32, p[1].as_u64().unwrap() as u32), want, "--hottest {k}");
+    }
+}
+
+/// The statistics panel times the BVH against the linear scan on demand, single rays on one
+/// thread, with a progress bar; the result is of the frame on screen.
+#[test]
+fn the_speedup_over_linear_search_is_timed_on_demand() {
+    let mut h = harness();
+    open(&mut h, &root().join("assets/torus.obj"));
+    h.get_by_label("Time against the linear scan").click();
+    h.step();
+    assert!(h.state().jobs.speedup.is_some(), "timing");
+    run_until(&mut h, "the speed-up", |a| a.speedup.is_some() && a.jobs.speedup.is_none());
+    let t = h.state().speedup.as_ref().unwrap();
+    let shown = h.state().shown.as_ref().unwrap();
+    assert_eq!(t.speedup.rays, (shown.camera.width * shown.camera.height) as usize);
+    assert!(t.speedup.speedup > 1.0, "{:?}", t.speedup);
+    h.get_by_label_contains("× faster: this BVH");
 }

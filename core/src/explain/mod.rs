@@ -4,3 +4,5 @@
 
 pub mod check;
 pub mod grade;
+pub mod timing;
+pub mod words;

@@ -16,4 +16,4 @@ pub use colormap::ColorMap;
 pub use frame::{Frame, FramePool, PixelSample, RaySummary};
 pub use legend::{draw_legend, legend_height};
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
-pub use views::{full_size, histogram, metric_stats, view_image, HeatRange, Legend, View};
+pub use views::{full_size, histogram, hottest, metric_stats, view_image, HeatRange, Legend, View};

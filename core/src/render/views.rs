@@ -78,6 +78,24 @@ pub struct Legend {
     pub mean: f64,
 }
 
+/// The pixel with the `k`-th most work (0: the hottest) of `view`'s metric in a complete counted
+/// frame, with its value: ties by row, then column, so the order is the same every time. `None`
+/// when the frame is not complete and counted, the view is no heatmap, or `k` is past the pixels.
+pub fn hottest(frame: &Frame, view: View, cost: SahCost, k: usize) -> Option<(u32, u32, f32)> {
+    if !frame.is_complete() || !frame.counted() || !view.is_heatmap() {
+        return None;
+    }
+    let (w, h) = (frame.width(), frame.height());
+    let mut all: Vec<(f32, u32)> = (0..w * h).map(|i| (view.metric(&frame.counters(i % w, i / w), cost), i)).collect();
+    if k >= all.len() {
+        return None;
+    }
+    // Most work first; of equal work, the first pixel in reading order.
+    let order = |a: &(f32, u32), b: &(f32, u32)| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1));
+    let (_, &mut (v, i), _) = all.select_nth_unstable_by(k, order);
+    Some((i % w, i / w, v))
+}
+
 /// Min, max and mean of a heatmap metric over the traced rays.
 pub fn metric_stats(frame: &Frame, view: View, cost: SahCost) -> (f32, f32, f64) {
     let (mut lo, mut hi, mut sum, mut n) = (f32::INFINITY, f32::NEG_INFINITY, 0f64, 0u64);

@@ -193,7 +193,7 @@ pub fn combined_cost_text(c: SahCost) -> String {
     )
 }
 
-pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
+pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions) {
     ui.heading("Statistics");
     if let Some(note) = app.scene.desc.as_ref().and_then(|d| d.note.as_ref()) {
         ui.label(egui::RichText::new(note).italics());
@@ -295,6 +295,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
     if let Some(built) = app.current_bvh().filter(|b| b.bvh.two_level().is_some()) {
         two_level(ui, built, rays(&current));
     }
+    speedup(app, ui, out);
 
     ui.add_space(6.0);
     ui.label("Leaf sizes (triangles per leaf)").on_hover_text("How many leaves hold each number of triangles");
@@ -309,4 +310,62 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
     Plot::new("leaf-histogram").height(140.0).allow_drag(false).allow_zoom(false).allow_scroll(false).show(ui, |p| {
         p.bar_chart(BarChart::new("leaves", bars));
     });
+}
+
+/// The speed-up over linear search the lab asks for: on demand (the scan of a big mesh takes
+/// seconds), single rays on one thread, as `bvhscope compare`'s trace column times them.
+fn speedup(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions) {
+    use crate::app::Action;
+    ui.add_space(6.0);
+    ui.label("Speed-up over linear search").on_hover_text(
+        "The frame's primary rays traced one at a time on one thread, closest hit, no shading: through this BVH, and through a linear scan of every triangle (on a spread sample when the whole frame would take over 10 s). bvhscope compare prints the same column",
+    );
+    let Some(shown) = app.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none()) else {
+        ui.weak("After the frame is done.");
+        return;
+    };
+    if !matches!(*shown.bvh, crate::bvh::SceneBvh::Single { .. }) {
+        ui.weak("Of one BVH: uncheck Two levels.");
+        return;
+    }
+    if let Some(job) = &app.jobs.speedup {
+        ui.horizontal(|ui| {
+            let bar = egui::ProgressBar::new(job.control.fraction())
+                .desired_width((ui.available_width() - 70.0).max(60.0))
+                .show_percentage();
+            ui.add(bar);
+            if ui.button("Cancel").clicked() {
+                out.push(Action::TimeLinear(false));
+            }
+        });
+        ui.ctx().request_repaint_after(std::time::Duration::from_millis(100));
+        return;
+    }
+    let fresh = app
+        .speedup
+        .as_ref()
+        .filter(|t| std::sync::Arc::ptr_eq(&t.bvh, &shown.bvh) && t.camera == shown.camera && t.trace == shown.trace);
+    match fresh {
+        Some(t) => {
+            let s = &t.speedup;
+            let sampled = s.linear_sampled.map_or(String::new(), |n| format!(" (projected from {n} rays)"));
+            ui.label(format!(
+                "{:.0}× faster: this BVH {} ms, the linear scan {} ms{sampled}, for the {} rays of the {}×{} frame on one thread.",
+                s.speedup,
+                fmt_ms(s.tree_ms),
+                fmt_ms(s.linear_ms),
+                s.rays,
+                t.camera.width,
+                t.camera.height
+            ));
+            if ui.small_button("Time again").on_hover_text("Timings vary from run to run on a busy machine").clicked() {
+                out.push(Action::TimeLinear(true));
+            }
+        }
+        None => {
+            if ui.button("Time against the linear scan").clicked() {
+                out.push(Action::TimeLinear(true));
+            }
+        }
+    }
 }
