@@ -5,6 +5,7 @@
 
 use crate::bvh::{Layout, Preset, SplitStrategy, TraversalOrder};
 use crate::geometry::TriangleTest;
+use crate::render::warp::WarpSize;
 use crate::render::{ColorMap, UpAxis, View};
 
 /// One value of a choice: what it is called where.
@@ -171,7 +172,7 @@ const TESTS: [Named<TriangleTest>; 2] = [
 ];
 choice!(TriangleTest, TESTS, 2);
 
-const VIEWS: [Named<View>; 8] = [
+const VIEWS: [Named<View>; 12] = [
     Named {
         value: View::Normals,
         name: "normals",
@@ -203,6 +204,30 @@ const VIEWS: [Named<View>; 8] = [
         help: "heatmap of C_trav × nodes visited + C_isect × triangle tests, with the build's SAH constants",
     },
     Named {
+        value: View::WarpCost(WarpSize::W32),
+        name: "warp-cost",
+        label: "Warp cost (32 lanes)",
+        help: "heatmap of what each GPU warp of 32 rays (an 8×4 pixel block) pays: the most nodes visited + triangle tests of its rays, as its lanes step together",
+    },
+    Named {
+        value: View::SimtEfficiency(WarpSize::W32),
+        name: "simt-efficiency",
+        label: "SIMT efficiency (32 lanes)",
+        help: "heatmap of each 8×4 block's SIMT efficiency: its rays' mean work over the most work (1: no lane of the warp sits idle)",
+    },
+    Named {
+        value: View::WarpCost(WarpSize::W64),
+        name: "warp-cost-64",
+        label: "Warp cost (64 lanes)",
+        help: "warp cost for GPUs that run 64 rays together (AMD's wave64): the most work in each 8×8 pixel block",
+    },
+    Named {
+        value: View::SimtEfficiency(WarpSize::W64),
+        name: "simt-efficiency-64",
+        label: "SIMT efficiency (64 lanes)",
+        help: "SIMT efficiency of 64-lane groups (8×8 pixel blocks): mean work over the most work",
+    },
+    Named {
         value: View::TopVisits,
         name: "top-visits",
         label: "Top-level nodes visited",
@@ -221,7 +246,7 @@ const VIEWS: [Named<View>; 8] = [
         help: "placements whose mesh BVH the ray entered (moved into object space)",
     },
 ];
-choice!(View, VIEWS, 8);
+choice!(View, VIEWS, 12);
 
 const COLOR_MAPS: [Named<ColorMap>; 5] = [
     Named { value: ColorMap::Viridis, name: "viridis", label: "viridis", help: "perceptually uniform, blue to yellow" },

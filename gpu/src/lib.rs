@@ -15,7 +15,6 @@ mod scan;
 mod shaders_valid;
 mod sort;
 mod trace;
-mod warp;
 
 pub use binary::{checked_depth, GpuBinaryBvh};
 pub use cwbvh::{Cwbvh, CwbvhNode, GpuCwbvh, META_INTERIOR, META_LEAF};
@@ -23,7 +22,8 @@ pub use device::{gpu_for_tests, Gpu, GpuError, GpuOptions};
 pub use lbvh::{GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
 pub use ploc::GpuPloc;
 pub use trace::{GpuTrace, GpuTraceOptions, Rays};
-pub use warp::{WarpGroup, WarpSize, WarpSummary, WarpView, WarpWork};
+// The warp view needs no GPU: it moved to core, where the heatmaps use it on either path.
+pub use bvhscope_core::render::warp::{WarpGroup, WarpSize, WarpSummary, WarpView, WarpWork};
 
 // The app keeps these in an `Arc` and uses them from its jobs' threads.
 const _: () = {

@@ -84,22 +84,19 @@ pub(crate) struct Params {
     never: u32,
 }
 
-/// The camera's ray generator as core's `Camera::ray_gen` computes it (its fields are private
-/// there: INTEGRATION.md), for the GPU to finish per pixel.
+/// The camera's ray generator as core's `Camera::ray_gen` makes it (`RayGen::parts`), for the GPU
+/// to finish per pixel as `RayGen::pixel_ray` does.
 fn camera_params(cam: &Camera) -> Result<Params, GpuError> {
     cam.validate().map_err(|e| GpuError::Input(e.to_string()))?;
-    let (forward, right, up) = cam.basis();
-    let tan_half = (cam.vfov_deg.to_radians() * 0.5).tan();
-    let right = right * tan_half * cam.aspect();
-    let up = up * tan_half;
+    let g = cam.ray_gen().parts();
     let v = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
     Ok(Params {
-        origin: v(cam.position),
-        forward: v(forward),
-        right: v(right),
-        up: v(up),
-        inv_w: 1.0 / cam.width as f32,
-        inv_h: 1.0 / cam.height as f32,
+        origin: v(g.origin),
+        forward: v(g.forward),
+        right: v(g.right),
+        up: v(g.up),
+        inv_w: g.inv_w,
+        inv_h: g.inv_h,
         width: cam.width,
         height: cam.height,
         ..Params::default()

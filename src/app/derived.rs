@@ -138,15 +138,10 @@ impl BvhscopeApp {
             }
         }
         let (w, h) = (f.width(), f.height());
-        let pixels = (0..h)
-            .flat_map(|y| (0..w).map(move |x| (x, y)))
-            .map(|(x, y)| {
-                if view.metric(&f.counters(x, y), shown.style.cost) > t {
-                    egui::Color32::TRANSPARENT
-                } else {
-                    egui::Color32::from_black_alpha(170)
-                }
-            })
+        // A complete frame's values, pixel by pixel (a warp view's are its groups').
+        let pixels = crate::render::grid_values(f, view, shown.style.cost)
+            .into_iter()
+            .map(|v| if v > t { egui::Color32::TRANSPARENT } else { egui::Color32::from_black_alpha(170) })
             .collect();
         let tex = ctx.load_texture(
             "threshold-mask",

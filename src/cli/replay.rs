@@ -99,10 +99,8 @@ pub fn output(a: &ReplayArgs) -> Result<String, CliError> {
             .map(|&k| {
                 let partial = replay.partial(k);
                 let f = render(&partial, &*mesh, &camera, &settings);
-                (0..camera.height)
-                    .flat_map(|y| (0..camera.width).map(move |x| (x, y)))
-                    .map(|(x, y)| a.view.metric(&f.counters(x, y), cost))
-                    .collect()
+                // Every pixel of the complete frame (a warp view's are its groups' values).
+                crate::render::grid_values(&f, a.view, cost)
             })
             .collect()
     });

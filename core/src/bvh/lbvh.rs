@@ -62,12 +62,26 @@ impl Keyed {
 }
 
 impl rdst::RadixKey for Keyed {
-    /// Only the code's bytes are sorted on.
+    /// Only the code's bytes are sorted on (`in_triangle_order` then orders equal codes).
     const LEVELS: usize = 4;
     #[inline]
     fn get_level(&self, level: usize) -> u8 {
         (self.0 >> (32 + level * 8)) as u8
     }
+}
+
+/// Records sorted by code, with each run of equal codes put in triangle (slot) order. The radix
+/// sort is unstable and multi-threaded: on its own it left equal codes in an order that could
+/// change with the thread count, and the tree with it. With this the tree is the same on any
+/// machine, and it is the GPU's LBVH's (a stable sort) node for node. Sorting on all eight bytes
+/// instead did the same at 15 % more build time on a 2M-triangle mesh; runs of equal codes are
+/// short, so this pass costs little next to the sort.
+fn in_triangle_order(keyed: &mut [Keyed]) {
+    keyed.par_chunk_by_mut(|a, b| a.code() == b.code()).for_each(|run| {
+        if run.len() > 1 {
+            run.sort_unstable_by_key(|k| k.0);
+        }
+    });
 }
 
 /// Where a range of sorted codes is split, and on which axis: `None` when all codes are equal.
@@ -131,6 +145,7 @@ pub(super) fn build_mesh(
         .collect();
     drop(centroids);
     rdst::RadixSort::radix_sort_unstable(&mut keyed);
+    in_triangle_order(&mut keyed);
     let codes: Vec<u64> = keyed.par_iter().with_min_len(4096).map(|k| k.code()).collect();
     let prim_ids: Vec<u32> = keyed.par_iter().with_min_len(4096).map(|k| k.slot() as u32).collect();
     drop(keyed);
@@ -167,6 +182,7 @@ pub(super) fn sort(prims: &mut Vec<BuildPrim>) -> Vec<u64> {
         .map(|(i, p)| Keyed(morton(p.centroid(), lo, scale) << 32 | i as u64))
         .collect();
     rdst::RadixSort::radix_sort_unstable(&mut keyed);
+    in_triangle_order(&mut keyed);
     // The sorted records replace the vector (a copy back into it cost a pass over all of them).
     *prims = keyed.par_iter().with_min_len(4096).map(|k| prims[k.slot()]).collect();
     keyed.par_iter().with_min_len(4096).map(|k| k.code()).collect()
@@ -433,6 +449,39 @@ mod tests {
                 let (l, r) = (nodes[n.index as usize].bounds(), nodes[n.index as usize + 1].bounds());
                 assert_eq!(n.bounds(), l.union(r));
             }
+        }
+    }
+
+    /// Many triangles on few centroids, interleaved (a cloud of copies): the radix sort alone,
+    /// on all threads, left equal codes out of triangle order; both sorts keep it.
+    #[test]
+    fn equal_codes_stay_in_triangle_order() {
+        use glam::Vec3;
+        let (n, spots) = (300_000u32, 7u32);
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for i in 0..n {
+            let c = Vec3::new((i % spots) as f32, ((i % spots) * 3 % spots) as f32, 0.5 * (i % 3) as f32);
+            let k = positions.len() as u32;
+            positions.extend([c, c + Vec3::X * 0.01, c + Vec3::Y * 0.01]);
+            triangles.push([k, k + 1, k + 2]);
+        }
+        let mesh = crate::mesh::Mesh::from_triangles("copies", positions, triangles);
+        let control = crate::work::WorkControl::new();
+        let progress = Progress::new(&control, 1);
+        let bvh = build_mesh(&mesh, &BuildParams { max_leaf_size: 4, ..BuildParams::default() }, &progress).unwrap();
+        let mut prims: Vec<BuildPrim> =
+            (0..n).map(|i| BuildPrim::new(Aabb::from_points(&mesh.triangle(i)), i)).collect();
+        let codes = sort(&mut prims);
+        let ids: Vec<u32> = prims.iter().map(|p| p.index()).collect();
+        assert_eq!(bvh.prim_ids, ids, "the mesh path and the records' sort agree");
+        let runs = codes.chunk_by(|a, b| a == b).count();
+        assert!(runs <= 21 && runs > 1, "{runs} runs of equal codes");
+        let mut start = 0;
+        for run in codes.chunk_by(|a, b| a == b) {
+            let run_ids = &ids[start..start + run.len()];
+            assert!(run_ids.windows(2).all(|w| w[0] < w[1]), "code {:#x}: triangles out of order", run[0]);
+            start += run.len();
         }
     }
 

@@ -79,7 +79,28 @@ pub struct RayGen {
     inv_h: f32,
 }
 
+/// What a `RayGen` is made of, for code that makes the same rays elsewhere (the GPU path finishes
+/// each pixel's ray in a shader from these, so its rays follow any change to `Camera::ray_gen`).
+/// A pixel's ray is `normalize(forward + right·sx + up·sy)` from `origin`, with
+/// `sx = 2·x·inv_w − 1` and `sy = 1 − 2·y·inv_h` at the pixel's centre (x + 0.5, y + 0.5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayGenParts {
+    pub origin: Vec3,
+    pub forward: Vec3,
+    /// Scaled by the tangent of half the field of view and the aspect.
+    pub right: Vec3,
+    /// Scaled by the tangent of half the field of view.
+    pub up: Vec3,
+    pub inv_w: f32,
+    pub inv_h: f32,
+}
+
 impl RayGen {
+    pub fn parts(&self) -> RayGenParts {
+        let RayGen { origin, forward, right, up, inv_w, inv_h } = *self;
+        RayGenParts { origin, forward, right, up, inv_w, inv_h }
+    }
+
     /// The ray through continuous pixel coordinates (x right, y down; pixel centres at +0.5).
     #[inline]
     pub fn ray(&self, x: f32, y: f32) -> Ray {

@@ -13,13 +13,10 @@ pub fn difference(a: &Frame, b: &Frame, view: View, cost: SahCost) -> Option<Vec
     if !ready(a) || !ready(b) || (a.width(), a.height()) != (b.width(), b.height()) || !view.is_heatmap() {
         return None;
     }
-    let (w, h) = (a.width(), a.height());
-    Some(
-        (0..h)
-            .flat_map(|y| (0..w).map(move |x| (x, y)))
-            .map(|(x, y)| view.metric(&b.counters(x, y), cost) - view.metric(&a.counters(x, y), cost))
-            .collect(),
-    )
+    // Complete frames: the traced grid is every pixel, row by row. A warp view's pixel is its
+    // group's value, which `grid_values` computes from the neighbours' counts.
+    let (va, vb) = (super::views::grid_values(a, view, cost), super::views::grid_values(b, view, cost));
+    Some(vb.iter().zip(&va).map(|(b, a)| b - a).collect())
 }
 
 /// The range of a difference image, symmetric about zero.

@@ -246,6 +246,61 @@ impl Frame {
     }
 }
 
+/// Why per-pixel results cannot make a frame (`Frame::from_hits`).
+#[derive(Debug, PartialEq, thiserror::Error)]
+pub enum FromHitsError {
+    #[error("{what}: {got} given for a {width}x{height} frame of {pixels} pixels")]
+    Length { what: &'static str, got: usize, width: u32, height: u32, pixels: usize },
+    #[error("pixel ({x}, {y}) hit triangle {prim}, but the mesh has {triangles} triangles")]
+    NoSuchTriangle { x: u32, y: u32, prim: u32, triangles: usize },
+    #[error(transparent)]
+    Camera(#[from] super::CameraError),
+}
+
+impl Frame {
+    /// A complete frame of `camera` from hits and counts traced elsewhere (the GPU path): `hits`
+    /// per pixel row by row from the top left, and `counters` likewise or empty (then the frame
+    /// is uncounted). Each sample is made as the renderer makes it, from the hit and the pixel's
+    /// ray (`Camera::ray_gen().pixel_ray`), so every view, legend, histogram and `counts_csv` of
+    /// the frame is what a render with these hits and counts gives.
+    pub fn from_hits(
+        mesh: &crate::mesh::Mesh,
+        camera: &super::Camera,
+        hits: &[Option<crate::bvh::Hit>],
+        counters: &[RayCounters],
+    ) -> Result<Frame, FromHitsError> {
+        camera.validate()?;
+        let (width, height) = (camera.width, camera.height);
+        let pixels = width as usize * height as usize;
+        let length = |what, got| FromHitsError::Length { what, got, width, height, pixels };
+        if hits.len() != pixels {
+            return Err(length("hits", hits.len()));
+        }
+        if !counters.is_empty() && counters.len() != pixels {
+            return Err(length("counters", counters.len()));
+        }
+        let triangles = mesh.triangle_count();
+        if let Some(i) = hits.iter().position(|h| h.is_some_and(|h| h.prim as usize >= triangles)) {
+            let prim = hits[i].map_or(0, |h| h.prim);
+            let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
+            return Err(FromHitsError::NoSuchTriangle { x, y, prim, triangles });
+        }
+        let mut frame = Frame::new(width, height, !counters.is_empty());
+        let gen = camera.ray_gen();
+        let (samples, slots) = frame.slots_mut();
+        samples.par_chunks_mut(width as usize).zip(hits.par_chunks(width as usize)).enumerate().for_each(
+            |(y, (row, hits))| {
+                for (x, (s, hit)) in row.iter_mut().zip(hits).enumerate() {
+                    *s = super::raycast::sample(mesh, &gen.pixel_ray(x as u32, y as u32), *hit);
+                }
+            },
+        );
+        slots.copy_from_slice(counters);
+        frame.stride = 1;
+        Ok(frame)
+    }
+}
+
 impl Drop for Frame {
     fn drop(&mut self) {
         self.pool.keep(std::mem::take(&mut self.samples), std::mem::take(&mut self.counters));

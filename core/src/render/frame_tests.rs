@@ -124,3 +124,45 @@ fn an_untraced_frame_has_no_samples_to_show() {
     assert!(f.full_samples().is_none());
     assert!(!Frame::new(5, 3, false).counted());
 }
+
+/// Hits and counts traced outside the renderer (as the GPU path returns them) make the frame the
+/// renderer makes: the same samples, normals included, and the same counts CSV.
+#[test]
+fn a_frame_from_hits_and_counts_is_the_rendered_frame() {
+    use crate::bvh::{Accelerator, BuildParams, Bvh, TraceOptions};
+    use crate::render::{render, Camera, RenderSettings};
+    let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 64, 8);
+    let bvh = Bvh::build(&mesh, &BuildParams::default());
+    let camera = Camera::framing_from(&mesh.bounds(), 29, 17, Vec3::new(0.3, 0.5, 1.0), 45.0);
+    let rendered = render(&bvh, &mesh, &camera, &RenderSettings { count: true, ..Default::default() });
+    let gen = camera.ray_gen();
+    let (mut hits, mut counters) = (Vec::new(), Vec::new());
+    for y in 0..camera.height {
+        for x in 0..camera.width {
+            let mut c = RayCounters::ZERO;
+            hits.push(bvh.closest_hit(&mut gen.pixel_ray(x, y), TraceOptions::default(), &mut c));
+            counters.push(c);
+        }
+    }
+    assert!(hits.iter().any(|h| h.is_some()) && hits.iter().any(|h| h.is_none()));
+    let made = Frame::from_hits(&mesh, &camera, &hits, &counters).unwrap();
+    assert!(made.is_complete() && made.counted());
+    assert_eq!(made.full_samples(), rendered.full_samples());
+    assert_eq!(made.counts_csv(), rendered.counts_csv());
+    let plain = Frame::from_hits(&mesh, &camera, &hits, &[]).unwrap();
+    assert!(!plain.counted() && plain.full_samples() == rendered.full_samples());
+
+    // Wrong lengths and triangles the mesh lacks are errors naming them, not panics.
+    let short = Frame::from_hits(&mesh, &camera, &hits[1..], &counters).unwrap_err();
+    assert!(short.to_string().contains("hits: 492 given for a 29x17 frame of 493 pixels"), "{short}");
+    let e = Frame::from_hits(&mesh, &camera, &hits, &counters[..3]).unwrap_err();
+    assert!(e.to_string().starts_with("counters: 3 given"), "{e}");
+    let mut bad = hits.clone();
+    let i = bad.iter().position(|h| h.is_some()).unwrap();
+    bad[i].as_mut().unwrap().prim = 1 << 30;
+    let e = Frame::from_hits(&mesh, &camera, &bad, &counters).unwrap_err();
+    assert!(e.to_string().contains(&format!("hit triangle {}, but the mesh has", 1 << 30)), "{e}");
+    let wrong_camera = Camera { vfov_deg: 0.0, ..camera };
+    assert!(Frame::from_hits(&mesh, &camera, &hits, &counters).is_ok());
+    assert!(matches!(Frame::from_hits(&mesh, &wrong_camera, &hits, &counters), Err(FromHitsError::Camera(_))));
+}

@@ -10,10 +10,11 @@ mod frame;
 pub mod legend;
 mod raycast;
 mod views;
+pub mod warp;
 
-pub use camera::{Camera, CameraError, RayGen, UpAxis};
+pub use camera::{Camera, CameraError, RayGen, RayGenParts, UpAxis};
 pub use colormap::ColorMap;
-pub use frame::{Frame, FramePool, PixelSample, RaySummary};
+pub use frame::{Frame, FramePool, FromHitsError, PixelSample, RaySummary};
 pub use legend::{draw_legend, legend_height};
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
-pub use views::{full_size, histogram, hottest, metric_stats, view_image, HeatRange, Legend, View};
+pub use views::{full_size, grid_values, histogram, hottest, metric_stats, view_image, HeatRange, Legend, View};

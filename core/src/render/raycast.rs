@@ -189,8 +189,9 @@ fn for_each_band(
         .sum()
 }
 
-/// The pixel a ray's closest hit (or miss) shows.
-fn sample(surface: &(impl Surface + ?Sized), ray: &Ray, hit: Option<Hit>) -> PixelSample {
+/// The pixel a ray's closest hit (or miss) shows (also what `Frame::from_hits` makes of hits
+/// traced elsewhere).
+pub(super) fn sample(surface: &(impl Surface + ?Sized), ray: &Ray, hit: Option<Hit>) -> PixelSample {
     match hit {
         Some(hit) => {
             let normal = surface.shading_normal(ray, hit.prim, hit.triangle_hit());

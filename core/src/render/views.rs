@@ -1,6 +1,7 @@
 //! Turning a frame into pixels: the normal view (n·0.5+0.5, as the handout's normal integrator),
 //! depth, and heatmaps of per-ray work through a perceptual colour map.
 
+use super::warp::{WarpSize, WarpView, WarpWork};
 use super::{ColorMap, Frame};
 use crate::bvh::{RayCounters, SahCost};
 use image::RgbImage;
@@ -17,6 +18,11 @@ pub enum View {
     TriTests,
     /// traversal-cost·nodes + intersection-cost·triangle tests, with the SAH constants.
     Cost,
+    /// Per block of a GPU warp's pixels (8×4 for 32 lanes, 8×8 for 64): the most work (nodes
+    /// visited + triangle tests) of its rays, which is what the warp takes (`render::warp`).
+    WarpCost(WarpSize),
+    /// Per block: its rays' mean work over the most work, the share of lane-steps that work.
+    SimtEfficiency(WarpSize),
     /// Nodes visited per ray in the top level of a two-level BVH.
     TopVisits,
     /// Nodes visited per ray in the bottom level (the meshes' BVHs).
@@ -35,9 +41,33 @@ impl View {
         !matches!(self, View::Normals | View::Depth)
     }
 
-    /// The heatmap's value for one ray.
+    /// The warp size of a view whose pixels show their warp group's value, not their own ray's:
+    /// such a value needs the neighbours' counts (`grid_values`), never `metric` alone.
+    pub fn warp(self) -> Option<WarpSize> {
+        match self {
+            View::WarpCost(w) | View::SimtEfficiency(w) => Some(w),
+            _ => None,
+        }
+    }
+
+    /// What a heatmap's legend calls its values.
+    pub fn legend_title(self) -> String {
+        match self {
+            View::WarpCost(w) | View::SimtEfficiency(w) => {
+                let (bw, bh) = w.block();
+                let what = if matches!(self, View::WarpCost(_)) { "warp cost" } else { "SIMT efficiency" };
+                format!("{what} per {bw}×{bh} block ({} lanes)", w.lanes())
+            }
+            _ => format!("{} per ray", self.label().to_lowercase()),
+        }
+    }
+
+    /// The heatmap's value for one ray. For the warp views (`warp`), a ray alone: its own work
+    /// (warp cost) or 1 (a lane of its own never idles); their pixels come from `grid_values`.
     pub fn metric(self, c: &RayCounters, cost: SahCost) -> f32 {
         match self {
+            View::WarpCost(_) => WarpWork::Steps.of(c) as f32,
+            View::SimtEfficiency(_) => 1.0,
             View::Visits => c.nodes_visited as f32,
             View::TriTests => c.triangle_tests as f32,
             View::Cost => c.cost(cost),
@@ -85,8 +115,8 @@ pub fn hottest(frame: &Frame, view: View, cost: SahCost, k: usize) -> Option<(u3
     if !frame.is_complete() || !frame.counted() || !view.is_heatmap() {
         return None;
     }
-    let (w, h) = (frame.width(), frame.height());
-    let mut all: Vec<(f32, u32)> = (0..w * h).map(|i| (view.metric(&frame.counters(i % w, i / w), cost), i)).collect();
+    let w = frame.width();
+    let mut all: Vec<(f32, u32)> = grid_values(frame, view, cost).into_iter().zip(0..).collect();
     if k >= all.len() {
         return None;
     }
@@ -99,8 +129,7 @@ pub fn hottest(frame: &Frame, view: View, cost: SahCost, k: usize) -> Option<(u3
 /// Min, max and mean of a heatmap metric over the traced rays.
 pub fn metric_stats(frame: &Frame, view: View, cost: SahCost) -> (f32, f32, f64) {
     let (mut lo, mut hi, mut sum, mut n) = (f32::INFINITY, f32::NEG_INFINITY, 0f64, 0u64);
-    for (_, c) in frame.traced() {
-        let v = view.metric(&c, cost);
+    for v in values(frame, view, cost) {
         lo = lo.min(v);
         hi = hi.max(v);
         sum += v as f64;
@@ -122,8 +151,8 @@ pub fn histogram(frame: &Frame, view: View, cost: SahCost, lo: f32, hi: f32, bin
     // In f64: a range of ±3e38 spans more than an f32 holds.
     let (lo, hi) = (lo as f64, hi as f64);
     let scale = if hi > lo { n as f64 / (hi - lo) } else { 0.0 };
-    for (_, c) in frame.traced() {
-        let b = ((view.metric(&c, cost) as f64 - lo) * scale).floor();
+    for v in values(frame, view, cost) {
+        let b = ((v as f64 - lo) * scale).floor();
         out[(b.max(0.0) as usize).min(n - 1)] += 1;
     }
     out
@@ -176,8 +205,16 @@ pub fn view_image(
                 HeatRange::Fixed { min, max } => (min, max),
             };
             let scale = if hi > lo { 1.0 / (hi - lo) } else { 0.0 };
-            let img = grid_image(frame, |_, c| colormap.map((view.metric(&c, cost) - lo) * scale));
-            let title = format!("{} per ray", view.label().to_lowercase());
+            let colour = |v: f32| colormap.map((v - lo) * scale);
+            let img = match view.warp() {
+                None => grid_image(frame, |_, c| colour(view.metric(&c, cost))),
+                Some(_) => {
+                    let (w, h) = traced_size(frame);
+                    let rgb = grid_values(frame, view, cost).into_iter().flat_map(colour).collect();
+                    RgbImage::from_raw(w, h, rgb).expect("one value per traced pixel")
+                }
+            };
+            let title = view.legend_title();
             (
                 img,
                 Some(Legend {
@@ -194,6 +231,40 @@ pub fn view_image(
             )
         }
     }
+}
+
+/// Columns and rows of the pixels traced so far (none before the first pass).
+fn traced_size(frame: &Frame) -> (u32, u32) {
+    if frame.stride() == 0 {
+        (0, 0)
+    } else {
+        frame.grid_size()
+    }
+}
+
+/// The heatmap's value at each traced pixel, row by row of the traced grid (every pixel of a
+/// complete frame). A warp view groups the traced grid's pixels: exactly the GPU's warps once the
+/// frame is complete; during a coarse pass, blocks of traced pixels stand for them.
+pub fn grid_values(frame: &Frame, view: View, cost: SahCost) -> Vec<f32> {
+    match view {
+        View::WarpCost(size) | View::SimtEfficiency(size) => {
+            let (w, h) = traced_size(frame);
+            let counters: Vec<RayCounters> = frame.traced().map(|(_, c)| c).collect();
+            let groups = WarpView::frame(w, h, &counters, size, WarpWork::Steps);
+            match view {
+                View::WarpCost(_) => groups.cost_image(),
+                _ => groups.efficiency_image(),
+            }
+        }
+        _ => frame.traced().map(|(_, c)| view.metric(&c, cost)).collect(),
+    }
+}
+
+/// `grid_values` one by one; a per-ray view's without collecting them.
+fn values(frame: &Frame, view: View, cost: SahCost) -> impl Iterator<Item = f32> + '_ {
+    let grouped = view.warp().map(|_| grid_values(frame, view, cost));
+    let per_ray = grouped.is_none().then(|| frame.traced().map(move |(_, c)| view.metric(&c, cost)));
+    grouped.into_iter().flatten().chain(per_ray.into_iter().flatten())
 }
 
 /// `view_image`'s image at the frame's full size: a coarse pass's pixels repeated over the blocks
@@ -287,5 +358,86 @@ mod tests {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod warp_tests {
+    use super::*;
+    use crate::bvh::{AnyBvh, BuildParams};
+    use crate::render::{render, render_passes, Camera, RenderSettings};
+    use crate::work::WorkControl;
+
+    /// The warp views show each pixel's group: its cost (most steps) or efficiency (mean/max), the
+    /// numbers `WarpView` gives from the frame's counts; legend, histogram and hottest pixel agree.
+    #[test]
+    fn warp_views_show_each_pixels_group_from_the_frames_counts() {
+        let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 64, 8);
+        let bvh = AnyBvh::build(&mesh, &BuildParams::default());
+        // 37×21: partial blocks on the right and at the bottom.
+        let camera = Camera::framing_from(&mesh.bounds(), 37, 21, glam::Vec3::new(0.3, 0.5, 1.0), 45.0);
+        let f = render(&bvh, &mesh, &camera, &RenderSettings { count: true, ..Default::default() });
+        let counters: Vec<RayCounters> = f.traced().map(|(_, c)| c).collect();
+        let cost = SahCost::default();
+        for size in WarpSize::ALL {
+            let groups = WarpView::frame(37, 21, &counters, size, WarpWork::Steps);
+            let values = grid_values(&f, View::WarpCost(size), cost);
+            assert_eq!(values, groups.cost_image());
+            let (bw, bh) = size.block();
+            // Every pixel of a block shows the block's most steps, which one of its rays took.
+            for (i, &v) in values.iter().enumerate() {
+                let (x, y) = (i as u32 % 37, i as u32 / 37);
+                let block = (0..37 * 21).filter(|j| (j % 37) / bw == x / bw && (j / 37) / bh == y / bh);
+                let most = block.map(|j| WarpWork::Steps.of(&counters[j as usize])).max().unwrap();
+                assert_eq!(v, most as f32, "{size:?} pixel ({x}, {y})");
+            }
+            let eff = grid_values(&f, View::SimtEfficiency(size), cost);
+            assert_eq!(eff, groups.efficiency_image());
+            assert!(eff.iter().all(|&e| e > 0.0 && e <= 1.0));
+            assert!(eff.iter().any(|&e| e < 1.0), "some lanes idle on the knot's silhouette");
+
+            let view = View::WarpCost(size);
+            let (lo, hi, mean) = metric_stats(&f, view, cost);
+            assert_eq!(hi, groups.summary().max_cost as f32);
+            assert_eq!(lo, values.iter().copied().fold(f32::INFINITY, f32::min));
+            assert!((mean - values.iter().map(|&v| v as f64).sum::<f64>() / values.len() as f64).abs() < 1e-9);
+            let (img, legend) = view_image(&f, view, ColorMap::Viridis, HeatRange::Auto, cost);
+            let legend = legend.unwrap();
+            assert_eq!(legend.title, format!("warp cost per {bw}×{bh} block ({} lanes)", size.lanes()));
+            for (x, y, p) in img.enumerate_pixels() {
+                let v = values[(y * 37 + x) as usize];
+                assert_eq!(p.0, ColorMap::Viridis.map((v - lo) / (hi - lo)), "({x}, {y})");
+            }
+            assert_eq!(histogram(&f, view, cost, lo, hi, 5).iter().sum::<u32>(), 37 * 21);
+            // The hottest pixel: the first one, in reading order, of a costliest block.
+            let first = values.iter().position(|&v| v == hi).unwrap() as u32;
+            assert_eq!(hottest(&f, view, cost, 0), Some((first % 37, first / 37, hi)));
+            let same = crate::render::diff::difference(&f, &f, view, cost).unwrap();
+            assert!(same.iter().all(|&d| d == 0.0));
+        }
+        assert_eq!(View::WarpCost(WarpSize::W64).warp(), Some(WarpSize::W64));
+        assert_eq!(View::Cost.warp(), None);
+    }
+
+    /// During a coarse pass, a warp view groups the traced pixels: one image pixel per traced one.
+    #[test]
+    fn a_coarse_pass_of_a_warp_view_has_one_value_per_traced_pixel() {
+        let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 64, 8);
+        let cam = Camera::framing_from(&mesh.bounds(), 45, 29, glam::Vec3::new(0.3, 0.5, 1.0), 45.0);
+        let bvh = AnyBvh::build(&mesh, &BuildParams::default());
+        let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
+        let mut passes = Vec::new();
+        render_passes(&bvh, &mesh, &cam, &settings, &Default::default(), &WorkControl::new(), |f, _| passes.push(f))
+            .unwrap();
+        for f in &passes {
+            let s = f.stride();
+            for view in [View::WarpCost(WarpSize::W32), View::SimtEfficiency(WarpSize::W64)] {
+                let (img, _) = view_image(f, view, ColorMap::Viridis, HeatRange::Auto, SahCost::default());
+                assert_eq!(img.dimensions(), (45u32.div_ceil(s), 29u32.div_ceil(s)), "{view:?} 1/{s}");
+                assert_eq!(grid_values(f, view, SahCost::default()).len(), img.len() / 3);
+            }
+        }
+        let empty = Frame::new(8, 8, true);
+        assert!(grid_values(&empty, View::WarpCost(WarpSize::W32), SahCost::default()).is_empty());
     }
 }

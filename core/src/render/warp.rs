@@ -4,14 +4,18 @@
 //! From per-ray counts (the GPU's or the CPU's, which are equal) this computes each group's cost,
 //! the most work of its rays, and its SIMT efficiency, mean over max.
 //!
-//! Groups are the lanes the trace kernels give a warp: for a frame, blocks of 8×4 pixels (32) or
-//! 8×8 (64), as the 8×8 workgroups of `trace_camera` are split into warps; for a ray list, runs of
-//! consecutive rays. Pixels past the frame's edge are no lanes of their group.
+//! Groups are the lanes the GPU crate's trace kernels give a warp: for a frame, blocks of 8×4
+//! pixels (32) or 8×8 (64), as the 8×8 workgroups of `trace_camera` are split into warps; for a
+//! ray list, runs of consecutive rays. Pixels past the frame's edge are no lanes of their group.
+//!
+//! It lives in core, not in the GPU crate that first needed it, because it needs no GPU: the
+//! heatmap views `warp-cost` and `simt-efficiency` compute it from any frame's counts, so they
+//! work on the CPU path too (`bvhscope-gpu` re-exports it).
 
-use bvhscope_core::bvh::RayCounters;
+use crate::bvh::RayCounters;
 
 /// Lanes per group.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum WarpSize {
     /// NVIDIA's warp, and most GPUs'.
     #[default]
@@ -21,6 +25,13 @@ pub enum WarpSize {
 }
 
 impl WarpSize {
+    pub const ALL: [WarpSize; 2] = [WarpSize::W32, WarpSize::W64];
+
+    /// The size of `lanes` lanes (32 or 64), for a command line's `--warp`.
+    pub fn from_lanes(lanes: u32) -> Option<WarpSize> {
+        WarpSize::ALL.into_iter().find(|w| w.lanes() == lanes)
+    }
+
     pub fn lanes(self) -> u32 {
         match self {
             WarpSize::W32 => 32,
@@ -90,7 +101,7 @@ pub struct WarpView {
 }
 
 /// The figures `stats` prints.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct WarpSummary {
     /// Σ work over Σ (lanes × group cost): the share of lane-steps that do work.
     pub simt_efficiency: f64,
