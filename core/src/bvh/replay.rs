@@ -9,8 +9,8 @@
 
 use super::counters::TraversalStats;
 use super::inspect::Hierarchy;
-use super::traverse::{test_triangles, walk, MeshLevel};
-use super::{Accelerator, Bvh, BvhNode, Hit};
+use super::traverse::{test_triangles, walk, walk_from, MeshLevel};
+use super::{Accelerator, Bvh, BvhNode, Hit, NoStats};
 use crate::geometry::{Ray, TriangleIntersector};
 use std::sync::Arc;
 
@@ -71,7 +71,7 @@ impl Replay {
         // The finished tree's nodes, so ids stay the same; the ones reached become leaves unless
         // split, each leaf naming its entry of `ranges`. Nodes below the frontier are not reached.
         let mut nodes = self.tree.nodes.clone();
-        let mut ranges = Vec::new();
+        let (mut ranges, mut frontier_node) = (Vec::new(), Vec::new());
         let mut stack = vec![0usize];
         while let Some(n) = stack.pop() {
             if split[n] {
@@ -81,9 +81,10 @@ impl Replay {
                 let b = nodes[n].bounds();
                 nodes[n] = BvhNode::leaf(b, ranges.len() as u32, 1);
                 ranges.push((self.hierarchy.first[n], self.hierarchy.count[n]));
+                frontier_node.push(n as u32);
             }
         }
-        PartialBvh { tree: self.tree.clone(), nodes, ranges, splits: k }
+        PartialBvh { tree: self.tree.clone(), nodes, ranges, frontier_node, splits: k }
     }
 }
 
@@ -95,6 +96,8 @@ pub struct PartialBvh {
     pub nodes: Vec<BvhNode>,
     /// Per leaf: the first slot of its triangles in the leaf order, and how many.
     pub ranges: Vec<(u32, u32)>,
+    /// Per leaf: its node in the finished tree (whose subtree holds the same triangles).
+    pub frontier_node: Vec<u32>,
     pub splits: usize,
 }
 
@@ -116,7 +119,14 @@ impl PartialBvh {
 }
 
 impl Accelerator for PartialBvh {
-    /// The binary walk of the finished tree (`traverse::walk`), over the partial nodes.
+    /// The binary walk of the finished tree (`traverse::walk`), over the partial nodes. A frontier
+    /// leaf tests every one of its triangles, and is counted so; but for a closest hit it need not
+    /// pay for them: the nearest of its triangles is found by walking the finished tree's subtree
+    /// under it (the same triangles), and its tests are counted as the leaf's. The counts and the
+    /// hit's distance are those of testing them all (a test holds them equal); early frames of a
+    /// big mesh, whose frontier leaves hold tens of thousands of triangles, trace as fast as the
+    /// finished tree. A trace (`Trace`, which lists each triangle test) and an any-hit query test
+    /// them one by one.
     fn trace<T: TriangleIntersector, const BY_DISTANCE: bool, const ANY: bool, S: TraversalStats>(
         &self,
         ray: &mut Ray,
@@ -128,11 +138,33 @@ impl Accelerator for PartialBvh {
             let (first, count) = self.ranges[entry.start];
             let range = first as usize..(first + count) as usize;
             let ids = |i: usize| t.prim_ids[i];
-            test_triangles::<T, ANY, S>(&t.tris[range.clone()], range.start, ray, stats, &mut prepared, &mut best, ids)
+            if ANY || S::STEPS || count <= FAST_FRONTIER {
+                return test_triangles::<T, ANY, S>(
+                    &t.tris[range.clone()],
+                    range.start,
+                    ray,
+                    stats,
+                    &mut prepared,
+                    &mut best,
+                    ids,
+                );
+            }
+            stats.triangle_tests(count);
+            // The finished subtree under the frontier node, without counting.
+            let node = self.frontier_node[entry.start] as usize;
+            walk_from::<MeshLevel, BY_DISTANCE, NoStats>(&t.nodes, node, ray, &mut NoStats, |r, ray, _| {
+                let first = r.start;
+                test_triangles::<T, false, NoStats>(&t.tris[r], first, ray, &mut NoStats, &mut prepared, &mut best, ids)
+            });
+            false
         });
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: t.prim_ids[i] })
     }
 }
+
+/// Frontier leaves of at most this many triangles are tested one by one (as fast as walking
+/// their subtree).
+const FAST_FRONTIER: u32 = 8;
 
 #[cfg(test)]
 mod tests {
@@ -156,6 +188,47 @@ mod tests {
                 Ray::new(o, target - o)
             })
             .collect()
+    }
+
+    /// The partial tree as a plain `Bvh` whose frontier leaves hold their triangles (what a build
+    /// stopped after k splits is): the reference the fast frontier is held to.
+    fn as_plain_bvh(p: &PartialBvh) -> Bvh {
+        let mut nodes = p.nodes.clone();
+        // The frontier: the reached leaves (the nodes below it are the finished tree's, unreached).
+        for i in p.frontier() {
+            let n = &p.nodes[i as usize];
+            let (first, count) = p.ranges[n.index as usize];
+            nodes[i as usize] = BvhNode::leaf(n.bounds(), first, count as u16);
+        }
+        let t = &*p.tree;
+        Bvh { nodes, prim_ids: t.prim_ids.clone(), tris: t.tris.clone(), params: t.params, report: Default::default() }
+    }
+
+    /// A frontier leaf's triangles found through the finished subtree under it give the counts and
+    /// the hit distance of testing them all, for every ray, at every step, in both orders.
+    #[test]
+    fn the_fast_frontier_counts_and_hits_as_testing_every_triangle() {
+        let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);
+        for strategy in [SplitStrategy::SahBinned, SplitStrategy::Midpoint, SplitStrategy::Sbvh] {
+            let params = BuildParams { strategy, layout: Layout::Binary, ..BuildParams::default() };
+            let tree = Arc::new(Bvh::build(&mesh, &params));
+            let replay = Replay::of(tree.clone());
+            let rays = rays(&tree.root_bounds(), 400);
+            for k in [0, 1, 3, 10, 40, replay.splits() / 2] {
+                let p = replay.partial(k);
+                let plain = as_plain_bvh(&p);
+                for order in [crate::bvh::TraversalOrder::EntryDistance, crate::bvh::TraversalOrder::SplitAxisSign] {
+                    let opts = TraceOptions { order, ..TraceOptions::default() };
+                    for r in &rays {
+                        let (mut a, mut b) = (RayCounters::default(), RayCounters::default());
+                        let fast = p.closest_hit(&mut r.clone(), opts, &mut a);
+                        let all = plain.closest_hit(&mut r.clone(), opts, &mut b);
+                        assert_eq!(a, b, "{strategy:?} after {k} splits, {order:?}");
+                        assert_eq!(fast.map(|h| h.t), all.map(|h| h.t), "{strategy:?} after {k} splits");
+                    }
+                }
+            }
+        }
     }
 
     /// At every step the partial tree finds the linear scan's hits (it is a correct BVH); at its

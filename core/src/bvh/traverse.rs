@@ -67,6 +67,18 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
     nodes: &[BvhNode],
     ray: &mut Ray,
     stats: &mut S,
+    leaf: impl FnMut(Range<usize>, &mut Ray, &mut S) -> bool,
+) {
+    walk_from::<L, BY_DISTANCE, S>(nodes, 0, ray, stats, leaf)
+}
+
+/// `walk` of the subtree under node `root` (its box tested first, as the root's is).
+#[inline(always)]
+pub(crate) fn walk_from<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
+    nodes: &[BvhNode],
+    root: usize,
+    ray: &mut Ray,
+    stats: &mut S,
     mut leaf: impl FnMut(Range<usize>, &mut Ray, &mut S) -> bool,
 ) {
     let inv_dir = ray.inv_dir();
@@ -77,15 +89,15 @@ pub(crate) fn walk<L: Level, const BY_DISTANCE: bool, S: TraversalStats>(
     // (including -0) means the right child (larger coordinates) is met first.
     let dir_neg = [inv_dir.x.is_sign_negative(), inv_dir.y.is_sign_negative(), inv_dir.z.is_sign_negative()];
     L::box_tests(stats, 1);
-    let (t0, t1) = nodes[0].slab(&slab_ray, ray.t_min, limit);
+    let (t0, t1) = nodes[root].slab(&slab_ray, ray.t_min, limit);
     if S::STEPS {
-        stats.step_box(NodeId::Node(0), (t0 <= t1).then_some((t0, t1)));
+        stats.step_box(NodeId::Node(root as u32), (t0 <= t1).then_some((t0, t1)));
     }
     if !(t0 <= t1) {
         return;
     }
     let mut stack = TraversalStack::<TRAVERSAL_STACK_SIZE>::new();
-    let mut current = 0usize;
+    let mut current = root;
     loop {
         let node = &nodes[current];
         L::node_visited(stats);
