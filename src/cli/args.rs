@@ -169,6 +169,62 @@ pub fn shell_word(s: &str) -> String {
     }
 }
 
+/// Where rays are traced: the CPU (the renderer of `core`) or the GPU (`bvhscope-gpu`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Device {
+    #[default]
+    Cpu,
+    Gpu,
+}
+
+/// The node format the GPU walks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GpuNodes {
+    /// The binary tree as built: core's 32-byte nodes, byte for byte.
+    #[default]
+    Binary,
+    /// Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree.
+    Cwbvh,
+}
+
+/// `--device` and the GPU's node format: the one declaration `render`, `stats`, `compare` and
+/// `trace` take (the GPU path's rules are in `cli::device`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct DeviceArgs {
+    /// Trace the rays on the CPU or on the GPU (wgpu compute shaders: Vulkan, Metal, DX12; Mesa's
+    /// lavapipe too). On the GPU the per-pixel counts are the CPU's for the binary layout, the
+    /// strategies lbvh and ploc are built there too, and only the watertight test and one level
+    /// run; with no GPU adapter the command fails (it never falls back to the CPU).
+    #[arg(long, value_enum, default_value = "cpu")]
+    pub device: Device,
+    /// With --device gpu: the node format walked, the binary tree as built or its compressed
+    /// 8-wide form (CWBVH) [default: binary].
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub gpu_nodes: Option<GpuNodes>,
+}
+
+impl GpuNodes {
+    /// How messages and tables name the format.
+    pub fn name(self) -> &'static str {
+        match self {
+            GpuNodes::Binary => "binary",
+            GpuNodes::Cwbvh => "CWBVH",
+        }
+    }
+}
+
+impl DeviceArgs {
+    pub fn gpu(&self) -> bool {
+        self.device == Device::Gpu
+    }
+
+    pub fn nodes(&self) -> GpuNodes {
+        self.gpu_nodes.unwrap_or_default()
+    }
+}
+
 /// How much of a BVH dump is read (`--bvh`): a dump decompressed past the limit is refused while
 /// it is read (a gzip bomb, a device).
 #[derive(Args, Debug, Clone, Default)]

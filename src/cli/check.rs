@@ -208,6 +208,10 @@ pub struct ExportArgs {
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
+    /// With --device gpu the strategies lbvh and ploc are built on the GPU (the same tree as the
+    /// CPU's, node for node); the others are built on the CPU either way.
+    #[command(flatten)]
+    pub device: super::args::DeviceArgs,
     /// The file to write: .json (JSON), .json.gz (gzip-compressed JSON) or .txt (the text form).
     #[arg(long, short)]
     pub output: PathBuf,
@@ -218,13 +222,25 @@ pub fn export(a: &ExportArgs) -> Result<(), CliError> {
     // Before anything is built: a name that says no dump format, an output that is the mesh.
     BvhDump::written_as(&a.output).map_err(CliError::Usage)?;
     crate::files::refuse_inputs(&a.output, &[(&a.mesh, "the mesh")])?;
+    if a.device.gpu_nodes.is_some() {
+        return Err(CliError::Usage("--gpu-nodes is the format the GPU traces; export-bvh writes no GPU nodes".into()));
+    }
+    let gpu = super::device::open(&a.device)?;
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
     // The binary tree unless --layout wide4 or wide8 asks for a wide one.
     let layout = a.build.layout.unwrap_or(Layout::Binary);
     let params = BuildParams { layout, ..a.build.params(scene.build.as_ref()) };
     let name = super::render::file_name(&a.mesh);
-    let dump = BvhDump::of_any(&AnyBvh::build(&mesh, &params), &mesh, Some(name));
+    let built = match &gpu {
+        Some(g) => super::device::gpu_build(g, &mesh, &params)?.map(|(bvh, _)| bvh),
+        None => None,
+    };
+    if gpu.is_some() && built.is_none() {
+        eprintln!("note: the GPU builds lbvh and ploc; {} is built on the CPU", params.strategy.name());
+    }
+    let bvh = built.unwrap_or_else(|| AnyBvh::build(&mesh, &params));
+    let dump = BvhDump::of_any(&bvh, &mesh, Some(name));
     dump.write(&a.output).map_err(|e| CliError::Usage(e.to_string()))?;
     eprintln!("wrote {} ({} nodes, {} primitives)", a.output.display(), dump.nodes.len(), dump.primitives.len());
     Ok(())

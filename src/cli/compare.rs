@@ -13,7 +13,7 @@
 //! busy machine. The linear scan is timed on the full frame when that is projected to take at most
 //! ~10 s, else on an evenly spread sample of its rays, and the table says so.
 
-use super::args::{BuildArgs, ViewArgs};
+use super::args::{BuildArgs, DeviceArgs, GpuNodes, ViewArgs};
 use super::{load_mesh, progress, CliError};
 use crate::bvh::{epo, AnyBvh, BuildParams, LinearScan, SplitStrategy, TreeStats, TreeView};
 use crate::render::{render, Camera, RenderSettings};
@@ -35,6 +35,10 @@ pub struct CompareArgs {
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
+    /// With --device gpu, GPU rows follow the table: every strategy's binary tree traced on the
+    /// GPU in both node formats (or --gpu-nodes'), counted and plain, primary and incoherent rays.
+    #[command(flatten)]
+    pub device: DeviceArgs,
     #[command(flatten)]
     pub view_args: ViewArgs,
     #[arg(long, value_enum, default_value = "markdown")]
@@ -241,61 +245,107 @@ fn opt(v: Option<f64>, digits: usize) -> String {
     v.map_or(String::new(), |v| format!("{v:.digits$}"))
 }
 
-/// The rows as CSV (RFC 4180, by the `csv` crate): one header, one record per row; values not
-/// measured (a linear scan's build time) are empty fields.
-pub fn rows_csv(rows: &[CompareRow]) -> String {
+const CSV_HEADER: [&str; 16] = [
+    "strategy",
+    "build_ms",
+    "nodes",
+    "max_depth",
+    "mean_leaf_depth",
+    "sah_cost",
+    "epo",
+    "nodes_per_ray",
+    "tri_tests_per_ray",
+    "root_box_nodes_per_ray",
+    "root_box_tri_tests_per_ray",
+    "trace_ms",
+    "frame_ms",
+    "mrays_per_s",
+    "speedup_over_linear",
+    "sampled_rays",
+];
+
+/// One row's CSV fields, in `CSV_HEADER`'s order.
+fn csv_record(r: &CompareRow) -> Vec<String> {
+    vec![
+        r.name.clone(),
+        opt(r.build_ms, 2),
+        r.nodes.to_string(),
+        r.max_depth.to_string(),
+        format!("{:.2}", r.mean_leaf_depth),
+        opt(r.sah_cost, 3),
+        opt(r.epo, 3),
+        format!("{:.3}", r.nodes_per_ray),
+        format!("{:.3}", r.tri_tests_per_ray),
+        format!("{:.3}", r.root_nodes_per_ray),
+        format!("{:.3}", r.root_tri_tests_per_ray),
+        format!("{:.2}", r.trace_ms),
+        format!("{:.2}", r.frame_ms),
+        format!("{:.3}", r.mrays_per_s),
+        format!("{:.1}", r.speedup_over_linear),
+        r.sampled_rays.map_or(String::new(), |n| n.to_string()),
+    ]
+}
+
+fn write_csv(records: Vec<Vec<String>>) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let header = [
-        "strategy",
-        "build_ms",
-        "nodes",
-        "max_depth",
-        "mean_leaf_depth",
-        "sah_cost",
-        "epo",
-        "nodes_per_ray",
-        "tri_tests_per_ray",
-        "root_box_nodes_per_ray",
-        "root_box_tri_tests_per_ray",
-        "trace_ms",
-        "frame_ms",
-        "mrays_per_s",
-        "speedup_over_linear",
-        "sampled_rays",
-    ];
-    let mut records = vec![header.map(String::from).to_vec()];
-    for r in rows {
-        records.push(vec![
-            r.name.clone(),
-            opt(r.build_ms, 2),
-            r.nodes.to_string(),
-            r.max_depth.to_string(),
-            format!("{:.2}", r.mean_leaf_depth),
-            opt(r.sah_cost, 3),
-            opt(r.epo, 3),
-            format!("{:.3}", r.nodes_per_ray),
-            format!("{:.3}", r.tri_tests_per_ray),
-            format!("{:.3}", r.root_nodes_per_ray),
-            format!("{:.3}", r.root_tri_tests_per_ray),
-            format!("{:.2}", r.trace_ms),
-            format!("{:.2}", r.frame_ms),
-            format!("{:.3}", r.mrays_per_s),
-            format!("{:.1}", r.speedup_over_linear),
-            r.sampled_rays.map_or(String::new(), |n| n.to_string()),
-        ]);
-    }
     for rec in records {
         w.write_record(&rec).expect("writing CSV to memory");
     }
     String::from_utf8(w.into_inner().expect("writing CSV to memory")).expect("CSV of UTF-8 fields")
 }
 
+/// The rows as CSV (RFC 4180, by the `csv` crate): one header, one record per row; values not
+/// measured (a linear scan's build time) are empty fields.
+pub fn rows_csv(rows: &[CompareRow]) -> String {
+    let mut records = vec![CSV_HEADER.map(String::from).to_vec()];
+    records.extend(rows.iter().map(csv_record));
+    write_csv(records)
+}
+
+/// `rows_csv` with the GPU's rows after the CPU's, in one table: five more columns say where a
+/// row ran (device, node format, counted) and give its incoherent rays' time and MRays/s (empty
+/// on the CPU's rows); a GPU row's trace and frame ms are its primary frame's GPU time.
+pub fn rows_csv_with_gpu(rows: &[CompareRow], gpu: &[super::compare_gpu::GpuRow]) -> String {
+    let extra = ["device", "gpu_nodes", "counted", "incoherent_ms", "incoherent_mrays_per_s"];
+    let mut records = vec![CSV_HEADER.iter().chain(&extra).map(|s| s.to_string()).collect::<Vec<_>>()];
+    for r in rows {
+        records.push(
+            [csv_record(r), vec!["cpu".into(), String::new(), String::new(), String::new(), String::new()]].concat(),
+        );
+    }
+    for g in gpu {
+        let more = vec![
+            "gpu".into(),
+            g.gpu_nodes.name().to_lowercase(),
+            g.counted.to_string(),
+            format!("{:.3}", g.incoherent_ms),
+            format!("{:.3}", g.incoherent_mrays_per_s),
+        ];
+        records.push([csv_record(&g.row), more].concat());
+    }
+    write_csv(records)
+}
+
 pub fn run(a: &CompareArgs) -> Result<(), CliError> {
+    let gpu = super::device::open(&a.device)?;
     let loaded = load_mesh(&a.mesh)?;
-    let mesh = &*loaded.flat_mesh()?;
+    let mesh_arc = loaded.flat_mesh()?;
+    let mesh = &*mesh_arc;
     let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
     let scene = loaded.build.as_ref();
+    if gpu.is_some() {
+        // Refused before the CPU rows are measured, not after.
+        super::device::check_traceable(&a.build.scene_build(a.build.params(scene)), a.build.trace())?;
+    }
     let (rows, setup) = compare_rows(mesh, &camera, &a.build, scene, a.runs, a.threads, Duration::from_secs(10));
+    let linear_ms = rows.last().map_or(0.0, |r| r.trace_ms);
+    let formats = a.device.gpu_nodes.map_or(vec![GpuNodes::Binary, GpuNodes::Cwbvh], |n| vec![n]);
+    let gpu_rows = match &gpu {
+        Some(g) => {
+            Some(super::compare_gpu::gpu_rows(g, &mesh_arc, &camera, &a.build, scene, a.runs, &formats, linear_ms)?)
+        }
+        None => None,
+    };
     let rays = setup.rays;
     let trace = a.build.trace();
     let mut o = String::new();
@@ -304,10 +354,18 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
             let v = serde_json::json!({
                 "mesh": a.mesh, "triangles": mesh.triangle_count(), "width": camera.width, "height": camera.height,
                 "setup": setup, "trace": trace, "preset": a.build.preset, "rows": rows,
+                "gpu": gpu.as_ref().zip(gpu_rows.as_ref()).map(|(g, (r, n))| serde_json::json!({
+                    "adapter": g.name(), "software": g.is_software(), "incoherent_rays": n, "rows": r,
+                })),
             });
             let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
-        CompareFormat::Csv => o = rows_csv(&rows),
+        CompareFormat::Csv => {
+            o = match &gpu_rows {
+                Some((g, _)) => rows_csv_with_gpu(&rows, g),
+                None => rows_csv(&rows),
+            }
+        }
         CompareFormat::Markdown => {
             let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | EPO | nodes / ray: all / in root box | tri tests / ray: all / in root box | trace ms | frame ms | speedup vs linear |");
             let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
@@ -357,6 +415,9 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
                 .collect();
             if !fallbacks.is_empty() {
                 let _ = writeln!(o, "Equal-count fallback splits (no useful split found): {}.", fallbacks.join(", "));
+            }
+            if let (Some(g), Some((r, n))) = (&gpu, &gpu_rows) {
+                o += &super::compare_gpu::markdown(g, r, &camera, *n, a.runs, trace);
             }
         }
     }

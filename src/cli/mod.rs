@@ -4,6 +4,8 @@
 mod args;
 pub mod check;
 mod compare;
+mod compare_gpu;
+pub mod device;
 mod grade;
 pub mod inspect;
 mod progress;

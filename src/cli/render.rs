@@ -1,8 +1,12 @@
 //! `bvhscope render`: ray-cast a mesh to a PNG.
 
-use super::args::{BuildArgs, ViewArgs};
-use super::{build_scene, load_mesh, progress, CliError};
-use crate::render::{draw_legend, render_progressive, view_image, ColorMap, HeatRange, RenderSettings, View};
+use super::args::{BuildArgs, DeviceArgs, ViewArgs};
+use super::device::{self, GpuTree};
+use super::{load_mesh, progress, CliError};
+use crate::bvh::SceneBvh;
+use crate::render::{
+    draw_legend, render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, RenderSettings, View,
+};
 use crate::work::WorkControl;
 use clap::Args;
 use std::path::PathBuf;
@@ -13,6 +17,8 @@ pub struct RenderArgs {
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
+    #[command(flatten)]
+    pub device: DeviceArgs,
     /// What to show.
     #[arg(long, value_parser = super::args::choice::<View>(), default_value = "normals")]
     pub view: View,
@@ -98,10 +104,36 @@ fn check_outputs(a: &RenderArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The frame of `bvh` on `camera`: rendered on the CPU, or traced on the GPU when there is one
+/// (in `a`'s node format).
+fn frame_of(
+    a: &RenderArgs,
+    gpu: Option<&bvhscope_gpu::Gpu>,
+    bvh: &SceneBvh,
+    camera: &Camera,
+    settings: &RenderSettings,
+    label: &str,
+) -> Result<Frame, CliError> {
+    match gpu {
+        Some(gpu) => {
+            let (tree, mesh) = GpuTree::upload(gpu, bvh, a.device.nodes())?;
+            Ok(tree.frame(gpu, &mesh, camera, settings.trace, settings.count)?.0)
+        }
+        None => {
+            let control = WorkControl::new();
+            progress::with_bar(label, &control, || {
+                render_progressive(bvh, bvh, camera, settings, &Default::default(), &control, |_, _| {})
+            })
+            .map_err(|_| CliError::Usage("render cancelled".into()))
+        }
+    }
+}
+
 /// `render --against`: render the second build on the same camera and write B − A.
 #[allow(clippy::too_many_arguments)]
 fn run_against(
     a: &RenderArgs,
+    gpu: Option<&bvhscope_gpu::Gpu>,
     loaded: &crate::scene::Scene,
     camera: &crate::render::Camera,
     settings: &RenderSettings,
@@ -119,20 +151,19 @@ fn run_against(
     let params_a = *params_a;
     let params_b =
         crate::bvh::SceneBuild { bvh: crate::bvh::BuildParams { strategy: against, ..params_a.bvh }, ..params_a };
-    let bvh_b = build_scene(loaded, &params_b)?;
-    let control = WorkControl::new();
-    let frame_b = progress::with_bar("rendering the second build", &control, || {
-        render_progressive(&bvh_b, &bvh_b, camera, settings, &Default::default(), &control, |_, _| {})
-    })
-    .map_err(|_| CliError::Usage("render cancelled".into()))?;
+    let (bvh_b, _) = device::build_scene(gpu, loaded, &params_b)?;
+    let frame_b = frame_of(a, gpu, &bvh_b, camera, settings, "rendering the second build")?;
     let cost = params_a.bvh.cost;
     let d = difference(frame_a, &frame_b, a.view, cost).expect("two complete counted frames of one camera");
     if let Some(path) = &a.difference {
+        // Each pixel's value (a warp view's is its group's), as the difference has them.
+        let values_a = crate::render::grid_values(frame_a, a.view, cost);
+        let values_b = crate::render::grid_values(&frame_b, a.view, cost);
         let mut w = csv::Writer::from_writer(Vec::new());
         let _ = w.write_record(["x", "y", "a", "b", "b_minus_a"]);
         for (i, v) in d.iter().enumerate() {
             let (x, y) = (i as u32 % camera.width, i as u32 / camera.width);
-            let (va, vb) = (a.view.metric(&frame_a.counters(x, y), cost), a.view.metric(&frame_b.counters(x, y), cost));
+            let (va, vb) = (values_a[i], values_b[i]);
             let _ = w.write_record([x.to_string(), y.to_string(), va.to_string(), vb.to_string(), v.to_string()]);
         }
         let bytes = w.into_inner().expect("writing to memory");
@@ -167,21 +198,22 @@ pub(crate) fn file_name(p: &std::path::Path) -> String {
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     check_outputs(a)?;
+    let gpu = device::open(&a.device)?;
     let loaded = load_mesh(&a.mesh)?;
     let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
-    let params = a.build.params(loaded.build.as_ref());
+    let mut params = a.build.params(loaded.build.as_ref());
+    if gpu.is_some() {
+        params = device::gpu_params(&a.build, loaded.build.as_ref(), params)?;
+        device::check_traceable(&a.build.scene_build(params), a.build.trace())?;
+    }
     let bvh = match &a.bvh {
         Some(path) => super::check::import_dump(&loaded, path, &a.dump_limit)?,
-        None => build_scene(&loaded, &a.build.scene_build(params))?,
+        None => device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
     };
     let count = a.view.is_heatmap() || a.counts.is_some();
     let settings = RenderSettings { trace: a.build.trace(), count, progressive: false };
     let total = camera.width as u64 * camera.height as u64;
-    let control = WorkControl::new();
-    let frame = progress::with_bar("rendering", &control, || {
-        render_progressive(&bvh, &bvh, &camera, &settings, &Default::default(), &control, |_, _| {})
-    })
-    .map_err(|_| CliError::Usage("render cancelled".into()))?;
+    let frame = frame_of(a, gpu.as_ref(), &bvh, &camera, &settings, "rendering")?;
     // What A is called in captions: the build, or the imported file.
     let label_a = bvh.label();
     if let Some(path) = &a.counts {
@@ -189,7 +221,17 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         crate::files::write_bytes(path, text.as_bytes())?;
     }
     if let Some(against) = a.against {
-        return run_against(a, &loaded, &camera, &settings, &frame, &bvh.build_params(), &label_a, against);
+        return run_against(
+            a,
+            gpu.as_ref(),
+            &loaded,
+            &camera,
+            &settings,
+            &frame,
+            &bvh.build_params(),
+            &label_a,
+            against,
+        );
     }
     let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
     let (img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
@@ -227,6 +269,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     );
     if let Some(l) = legend {
         eprint!("; {}: min {} mean {:.2} max {}", l.title, l.min, l.mean, l.max);
+    }
+    if let Some(gpu) = &gpu {
+        eprint!("; traced on the GPU, {} nodes: {}", a.device.nodes().name(), gpu.name());
     }
     eprintln!(")");
     Ok(())

@@ -1,9 +1,11 @@
 //! `bvhscope stats`: the statistics of one BVH, and the work per primary ray of one frame (the
 //! figures of the app's statistics panel, from the same camera and size when given the same).
 
-use super::args::{BuildArgs, ViewArgs};
-use super::{build_scene, load_mesh, progress, CliError};
-use crate::bvh::{epo, SceneBvh, TreeStats, TreeView};
+use super::args::{BuildArgs, DeviceArgs, ViewArgs};
+use super::device::{self, GpuBuild, GpuTree};
+use super::{load_mesh, progress, CliError};
+use crate::bvh::{epo, RayCounters, SceneBvh, TreeStats, TreeView};
+use crate::render::warp::{WarpSize, WarpSummary, WarpView, WarpWork};
 use crate::render::{render, Camera, RaySummary, RenderSettings};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
@@ -21,6 +23,11 @@ pub struct StatsArgs {
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+    /// Lanes of a GPU warp for the warp figures: 32 (NVIDIA, most GPUs) or 64 (AMD's wave64).
+    #[arg(long, value_name = "LANES", default_value = "32", value_parser = parse_warp)]
+    pub warp: WarpSize,
     /// The frame whose primary rays are counted (camera and size as `render` takes them).
     #[command(flatten)]
     pub view_args: ViewArgs,
@@ -29,6 +36,45 @@ pub struct StatsArgs {
     pub no_rays: bool,
     #[arg(long, value_enum, default_value = "text")]
     pub format: StatsFormat,
+}
+
+fn parse_warp(s: &str) -> Result<WarpSize, String> {
+    s.trim().parse().ok().and_then(WarpSize::from_lanes).ok_or_else(|| format!("'{s}' is not 32 or 64 lanes"))
+}
+
+/// The warp view's figures from per-pixel counts (row by row), the GPU's and the CPU's.
+struct Warp {
+    size: WarpSize,
+    gpu: Option<WarpSummary>,
+    cpu: WarpSummary,
+}
+
+impl Warp {
+    fn of(camera: &Camera, size: WarpSize, counts: &[RayCounters]) -> WarpSummary {
+        WarpView::frame(camera.width, camera.height, counts, size, WarpWork::Steps).summary()
+    }
+
+    fn text(&self) -> String {
+        let (bw, bh) = self.size.block();
+        let mut o = format!(
+            "warp            {} lanes: groups of {bw}×{bh} pixels; a group costs its rays' most steps (nodes visited + triangle tests)\n",
+            self.size.lanes()
+        );
+        let line = |who: &str, s: &WarpSummary| {
+            format!(
+                "  {who:<14}SIMT efficiency {:.4} (mean of groups {:.4}), group cost mean {:.2}, max {}, total {} steps\n",
+                s.simt_efficiency, s.mean_group_efficiency, s.mean_cost, s.max_cost, s.total_cost
+            )
+        };
+        if let Some(g) = &self.gpu {
+            o += &line("GPU's counts", g);
+        }
+        o + &line("CPU's counts", &self.cpu)
+    }
+
+    fn json(&self) -> serde_json::Value {
+        serde_json::json!({ "lanes": self.size.lanes(), "gpu_counts": self.gpu, "cpu_counts": self.cpu })
+    }
 }
 
 /// The per-ray block of the text output.
@@ -64,28 +110,47 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
 
 /// What `run` prints (the app's tests compare it with the build panel and statistics).
 pub fn output(a: &StatsArgs) -> Result<String, CliError> {
+    let gpu = device::open(&a.device)?;
     let loaded = load_mesh(&a.mesh)?;
-    let params = a.build.params(loaded.build.as_ref());
-    let bvh = build_scene(&loaded, &a.build.scene_build(params))?;
+    let mut params = a.build.params(loaded.build.as_ref());
+    let trace = a.build.trace();
+    if gpu.is_some() {
+        params = device::gpu_params(&a.build, loaded.build.as_ref(), params)?;
+        device::check_traceable(&a.build.scene_build(params), trace)?;
+    }
+    let (bvh, gpu_build) = device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?;
     let report = &loaded.report;
     let rays = if a.no_rays {
         None
     } else {
         let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
-        let settings = RenderSettings { trace: a.build.trace(), count: true, progressive: false };
-        let summary =
-            progress::with_spinner("tracing the frame", || render(&bvh, &bvh, &camera, &settings)).ray_summary();
-        Some((camera, summary))
+        Some(trace_rays(a, gpu.as_ref(), &bvh, &camera)?)
     };
-    let rays_json = rays
-        .map(|(camera, summary)| serde_json::json!({ "camera": camera, "trace": a.build.trace(), "summary": summary }));
-    let rays_text = rays.map_or(String::new(), |(camera, r)| format_rays(&camera, &a.build.trace(), &r));
+    let rays_json = rays.as_ref().map(|(camera, summary, warp)| {
+        let device = gpu.as_ref().map(|g| serde_json::json!({ "adapter": g.name(), "nodes": a.device.nodes() }));
+        serde_json::json!({
+            "camera": camera, "trace": trace, "summary": summary, "device": a.device.device, "gpu": device,
+            "warp": warp.json(),
+        })
+    });
+    let mut rays_text = rays.as_ref().map_or(String::new(), |(camera, r, warp)| {
+        let on = gpu.as_ref().map_or(String::new(), |g| {
+            format!("device          GPU, {} nodes: {}\n", a.device.nodes().name(), g.name())
+        });
+        format!("{on}{}{}", format_rays(camera, &trace, r), warp.text())
+    });
+    if let Some(b) = &gpu_build {
+        rays_text = format!("GPU build       {}\n{rays_text}", b.text());
+    }
+    let gpu_build_json = gpu_build.as_ref().map(GpuBuild::json);
     Ok(match (&bvh, a.format) {
         (SceneBvh::Single { bvh: b, mesh, .. }, format) => {
             let epo = progress::with_spinner("measuring the end-point overlap", || epo::of(&b.binary_tree(mesh)));
             let stats = TreeStats { epo: Some(epo), ..TreeStats::of(b) };
             if let StatsFormat::Json = format {
-                let v = serde_json::json!({ "mesh": report, "params": params, "stats": stats, "rays": rays_json });
+                let v = serde_json::json!({
+                    "mesh": report, "params": params, "stats": stats, "gpu_build": gpu_build_json, "rays": rays_json,
+                });
                 format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises"))
             } else {
                 format!("{}{rays_text}", format_text(report, &params, &stats))
@@ -119,6 +184,38 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
             } else {
                 format!("{}{rays_text}", format_two_level(report, t, &top, &bottom))
             }
+        }
+    })
+}
+
+/// The frame's per-ray work (on the GPU when there is one) and the warp figures, from the GPU's
+/// counts and from the CPU's walk of the same tree.
+fn trace_rays(
+    a: &StatsArgs,
+    gpu: Option<&bvhscope_gpu::Gpu>,
+    bvh: &SceneBvh,
+    camera: &Camera,
+) -> Result<(Camera, RaySummary, Warp), CliError> {
+    let trace = a.build.trace();
+    let counts = |f: &crate::render::Frame| f.traced().map(|(_, c)| c).collect::<Vec<_>>();
+    Ok(match gpu {
+        Some(gpu) => {
+            let (tree, mesh) = GpuTree::upload(gpu, bvh, a.device.nodes())?;
+            let (frame, _) = tree.frame(gpu, &mesh, camera, trace, true)?;
+            let cpu =
+                progress::with_spinner("counting the same walk on the CPU", || tree.cpu_counts(bvh, camera, trace));
+            let warp = Warp {
+                size: a.warp,
+                gpu: Some(Warp::of(camera, a.warp, &counts(&frame))),
+                cpu: Warp::of(camera, a.warp, &cpu),
+            };
+            (*camera, frame.ray_summary(), warp)
+        }
+        None => {
+            let settings = RenderSettings { trace, count: true, progressive: false };
+            let frame = progress::with_spinner("tracing the frame", || render(bvh, bvh, camera, &settings));
+            let warp = Warp { size: a.warp, gpu: None, cpu: Warp::of(camera, a.warp, &counts(&frame)) };
+            (*camera, frame.ray_summary(), warp)
         }
     })
 }

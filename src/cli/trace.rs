@@ -2,8 +2,9 @@
 //! lists, from the same traversal (`bvh::trace`). The ray is a pixel of the camera (0-based, x from
 //! the left, y from the top, as everywhere) or typed as an origin and a direction.
 
-use super::args::{build_flags, shell_word, BuildArgs, ViewArgs};
-use super::{build_scene, load_mesh, CliError};
+use super::args::{build_flags, shell_word, BuildArgs, DeviceArgs, ViewArgs};
+use super::device::{self, GpuTree};
+use super::{load_mesh, CliError};
 use crate::bvh::{trace_ray, RayCounters, SceneBuild, SceneBvh, StepKind, TraceLevel, TraceOptions};
 use crate::geometry::Ray;
 use clap::{Args, ValueEnum};
@@ -36,6 +37,10 @@ pub struct TraceArgs {
     pub ray: Option<(Vec3, Vec3)>,
     #[command(flatten)]
     pub build: BuildArgs,
+    /// With --device gpu the ray (and --hottest's frame) is traced on the GPU: its hit and counts
+    /// are printed, without steps, which the GPU walk does not record.
+    #[command(flatten)]
+    pub device: DeviceArgs,
     /// The camera whose pixel is traced (as `render` takes it).
     #[command(flatten)]
     pub view_args: ViewArgs,
@@ -111,11 +116,20 @@ pub fn run(a: &TraceArgs) -> Result<(), CliError> {
 
 /// What `run` prints: the text table or the JSON (the app's tests compare it with the Ray window).
 pub fn output(a: &TraceArgs) -> Result<String, CliError> {
+    let gpu = device::open(&a.device)?;
     let scene = load_mesh(&a.mesh)?;
-    let params = a.build.params(scene.build.as_ref());
+    let mut params = a.build.params(scene.build.as_ref());
+    if gpu.is_some() {
+        params = device::gpu_params(&a.build, scene.build.as_ref(), params)?;
+        device::check_traceable(&a.build.scene_build(params), a.build.trace())?;
+    }
     let bvh = match &a.bvh {
         Some(path) => super::check::import_dump(&scene, path, &a.dump_limit)?,
-        None => build_scene(&scene, &a.build.scene_build(params))?,
+        None => device::build_scene(gpu.as_ref(), &scene, &a.build.scene_build(params))?.0,
+    };
+    let on_gpu = match &gpu {
+        Some(g) => Some((g, GpuTree::upload(g, &bvh, a.device.nodes())?)),
+        None => None,
     };
     // The K-th hottest pixel: the frame traced and counted, as the app's heatmap is.
     let hot = match a.hottest {
@@ -127,9 +141,12 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
                 ));
             }
             let settings = crate::render::RenderSettings { trace: a.build.trace(), count: true, progressive: false };
-            let frame = super::progress::with_spinner("tracing the frame", || {
-                crate::render::render(&bvh, &bvh, &camera, &settings)
-            });
+            let frame = match &on_gpu {
+                Some((g, (tree, mesh))) => tree.frame(g, mesh, &camera, settings.trace, true)?.0,
+                None => super::progress::with_spinner("tracing the frame", || {
+                    crate::render::render(&bvh, &bvh, &camera, &settings)
+                }),
+            };
             let (x, y, _) = crate::render::hottest(&frame, a.view, params.cost, k as usize - 1).ok_or_else(|| {
                 CliError::Usage(format!("--hottest {k}: the {}x{} frame has fewer pixels", camera.width, camera.height))
             })?;
@@ -152,7 +169,18 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
         (None, None) => unreachable!("clap requires --pixel or --ray"),
     };
     let opts = a.build.trace();
-    let (mut hit, mut trace) = trace_ray(&bvh, &ray, opts);
+    // On the GPU: its hit and counts, and no steps (an empty trace).
+    let (mut hit, mut trace, gpu_counts) = match &on_gpu {
+        Some((g, (tree, _))) => {
+            let t = tree.trace(g, bvhscope_gpu::Rays::List(&[ray]), opts, true)?;
+            let counts = t.counters.first().copied().unwrap_or_default();
+            (t.hits.first().copied().flatten(), crate::bvh::Trace::new(), Some(counts))
+        }
+        None => {
+            let (hit, trace) = trace_ray(&bvh, &ray, opts);
+            (hit, trace, None)
+        }
+    };
     // An imported tree's nodes by the dump's ids, its triangles by the file's numbers.
     if let (SceneBvh::Single { mesh, imported: Some(names), .. }, true) = (&bvh, a.bvh.is_some()) {
         trace.steps = trace.steps.iter().map(|s| names.rename(s, mesh)).collect();
@@ -161,7 +189,14 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
         }
     }
     let build_label = bvh.label();
-    let counts = trace.counts();
+    let counts = gpu_counts.unwrap_or_else(|| trace.counts());
+    let gpu_note = on_gpu.as_ref().map(|(g, (tree, _))| {
+        format!(
+            "traced on the GPU ({} nodes, {}): the GPU walk records no steps (its kernels keep each ray's hit and counts only); for the walk step by step, run this with --device cpu",
+            tree.nodes().name(),
+            g.name()
+        )
+    });
     let mut o = String::new();
     match a.format {
         TraceFormat::Json => {
@@ -171,7 +206,9 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
                 "trace": opts,
                 "hit": hit.map(|h| serde_json::json!({ "triangle": h.prim, "t": h.t })),
                 "counts": counts_json(&counts),
-                "steps": trace.steps,
+                "steps": if gpu_note.is_some() { serde_json::Value::Null } else { serde_json::json!(trace.steps) },
+                "device": a.device.device,
+                "note": gpu_note,
             });
             let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
         }
@@ -195,6 +232,9 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
             let _ = writeln!(o, "build           {build_label}");
             let _ = writeln!(o, "traversal       {} order, {} test", opts.order.label(), opts.test.label());
             let _ = writeln!(o);
+            if let Some(note) = &gpu_note {
+                let _ = writeln!(o, "steps           {note}");
+            }
             let levels = trace.steps.iter().any(|s| s.level != TraceLevel::Mesh);
             let mut entered = 0;
             for (i, s) in trace.steps.iter().enumerate() {
