@@ -60,3 +60,20 @@ fn look_node_inspector() {
     h.state_mut().act(Action::SharedCostScale(true));
     save(&mut h, "app-node-inspector-shared");
 }
+
+/// The Ray window on a deep walk: the knot on the floor, a pixel on the knot, midpoint's binary
+/// tree (deep), at the last step.
+#[test]
+#[ignore]
+fn look_ray_window() {
+    let mut h = looking();
+    open(&mut h, &root().join("scenes/knot-on-floor.json"));
+    let (w, hgt) = h.state().viewport_pixels();
+    h.state_mut().act(Action::PinPixel(w / 2, hgt / 3));
+    for _ in 0..10 {
+        h.step();
+    }
+    let n = h.state().pins.current().map_or(0, |r| r.trace.steps.len());
+    h.state_mut().act(Action::RayStep(n.saturating_sub(1)));
+    save(&mut h, "app-ray-trace");
+}

@@ -166,3 +166,88 @@ fn the_speedup_over_linear_search_is_timed_on_demand() {
     assert!(t.speedup.speedup > 1.0, "{:?}", t.speedup);
     h.get_by_label_contains("× faster: this BVH");
 }
+
+/// A chain of `n` stacked triangles and a correct chain-shaped dump (depth n - 1), in files.
+fn chain(n: u32, name: &str) -> (PathBuf, PathBuf) {
+    let (obj, json) = (temp_file(&format!("{name}.obj"), ""), temp_file(&format!("{name}.json"), ""));
+    let mut o = String::new();
+    for k in 0..n {
+        o += &format!("v 0 0 {k}\nv 1 0 {k}\nv 0 1 {k}\n");
+    }
+    for k in 0..n {
+        o += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+    }
+    std::fs::write(&obj, o).unwrap();
+    let inner = n - 1;
+    let mut nodes = Vec::new();
+    for k in 0..inner {
+        let next = if k + 1 < inner { k + 1 } else { inner + n - 1 };
+        nodes.push(
+            serde_json::json!({"min": [0, 0, k], "max": [1, 1, n - 1], "children": [inner + k, next], "axis": 2}),
+        );
+    }
+    for k in 0..n {
+        // Triangle 7 twice in its leaf: the Tree window says so.
+        let (first, count) = if k == 7 { (n, 2) } else { (k, 1) };
+        nodes.push(serde_json::json!({"min": [0, 0, k], "max": [1, 1, k], "first": first, "count": count}));
+    }
+    let mut prims: Vec<u32> = (0..n).collect();
+    prims.extend([7, 7]);
+    let v = serde_json::json!({"format": "bvhscope-bvh", "version": 1, "primitives": prims, "nodes": nodes});
+    std::fs::write(&json, v.to_string()).unwrap();
+    (obj, json)
+}
+
+/// A deep walk in the Ray window: its steps' indent is capped (the depth written out past it),
+/// a line keeps the step without its stack, and the step chosen is shown whole above the list.
+/// The Tree window names a triangle referenced twice in one leaf, not as a spatial split.
+#[test]
+fn a_deep_walk_is_readable_and_a_duplicate_is_named() {
+    let (obj, dump) = chain(120, "deep-chain");
+    let mut h = harness();
+    open(&mut h, &obj);
+    h.state_mut().act(Action::ImportFile(dump));
+    run_until(&mut h, "the chain imported", |a| a.import.shown(a.scene_id).is_some() && idle(a));
+    // A typed ray down the stack: through every level to the top triangle.
+    h.state_mut().pins.origin_text = "0.25,0.25,130".into();
+    h.state_mut().pins.dir_text = "0,0,-1".into();
+    h.state_mut().act(Action::PinTyped);
+    h.step();
+    let steps = h.state().pins.current().unwrap().named.clone();
+    let deep = steps.iter().position(|s| matches!(s.kind, bvhscope::bvh::StepKind::Enter { depth: 100, .. })).unwrap();
+    h.state_mut().act(Action::RayStep(deep));
+    // The list scrolls to the step chosen.
+    for _ in 0..6 {
+        h.step();
+    }
+    let whole = format!("Step {}: {}", deep + 1, steps[deep].brief());
+    h.get_by_label(&whole);
+    h.get_by_label_contains("[depth 100] enter");
+    assert!(h.query_by_label_contains(&" ".repeat(40)).is_none(), "no line is indented past the cap");
+    // The Tree window.
+    h.state_mut().act(Action::ShowTree(true));
+    run_until(&mut h, "the tree view", |a| a.nodes.explained.is_some());
+    h.run_steps(3);
+    assert!(h.query_all_by_label_contains("Warning: triangle 7 is referenced twice (leaf 126)").count() >= 1);
+    assert!(h.query_by_label_contains("spatial splits cut").is_none());
+}
+
+/// The Node window gives this tree's split term by term (the terms `inspect` prints), and draws
+/// the three axes on one cost scale when asked.
+#[test]
+fn the_node_window_gives_the_split_cost_term_by_term() {
+    let mut h = harness();
+    open(&mut h, &root().join("assets/torus.obj"));
+    h.state_mut().act(Action::ShowTree(true));
+    h.state_mut().act(Action::SelectNode(0));
+    run_until(&mut h, "the root's inspection", |a| a.nodes.inspection.as_ref().is_some_and(|i| i.node == 0));
+    h.run_steps(3);
+    let ins = h.state().nodes.inspection.clone().unwrap();
+    let own = h.state().settings.build.strategy;
+    let m = ins.markers.iter().find(|(s, _)| *s == own).and_then(|(_, m)| *m).expect("this tree's split");
+    let terms = m.terms(ins.sah).text();
+    assert!(h.query_all_by_label_contains(&format!("(this tree's split): {terms}")).count() >= 1, "{terms}");
+    h.get_by_label("One cost scale for the three axes").click();
+    h.step();
+    assert!(h.state().nodes.shared_scale);
+}

@@ -213,3 +213,31 @@ fn curves_and_markers_match_a_brute_force_sah() {
         assert!(sweep.cost <= binned.cost && sweep.cost <= mid.cost);
     }
 }
+
+/// Every plane's and every marker's cost, term by term: C_trav + C_isect·(A_L/A)·n_L +
+/// C_isect·(A_R/A)·n_R adds up to the cost the curve and the marker give, and each side's chance
+/// of being entered is at most one.
+#[test]
+fn each_split_cost_adds_up_term_by_term() {
+    let mesh = generate::torus_knot(2, 3, 0.3, 64, 8);
+    for cost in [SahCost::default(), SahCost { traversal: 2.5, intersection: 1.0 }] {
+        let params = BuildParams { layout: Layout::Binary, cost, ..BuildParams::default() };
+        let bvh = Bvh::build(&mesh, &params);
+        let h = Hierarchy::of(&bvh);
+        for node in [0u32, 1, 2, 5] {
+            let ins = inspect(&bvh, &h, node).unwrap();
+            let check = |t: CostTerms| {
+                assert!(t.area_left <= 1.0 + 1e-5 && t.area_right <= 1.0 + 1e-5, "{t:?}");
+                let sum = t.traversal + t.left_term + t.right_term;
+                assert!((sum - t.cost).abs() <= 1e-4 * t.cost.max(1.0), "{sum} vs {t:?}");
+                assert_eq!(t.traversal, cost.traversal);
+            };
+            for p in ins.sweep.iter().chain(&ins.binned).chain(&ins.spatial).flatten() {
+                check(p.terms(ins.sah));
+            }
+            for m in ins.markers.iter().filter_map(|(_, m)| *m) {
+                check(m.terms(ins.sah));
+            }
+        }
+    }
+}

@@ -130,6 +130,16 @@ impl Step {
         }
     }
 
+    /// The step in words without the stack it leaves (`text` adds it): what a list of steps shows
+    /// on one line, the stack shown apart.
+    pub fn brief(&self) -> String {
+        let full = self.text();
+        match full.split_once("  stack [") {
+            Some((head, _)) => head.to_string(),
+            None => full,
+        }
+    }
+
     /// The step in words, as `bvhscope trace` and the app's Ray panel list it.
     pub fn text(&self) -> String {
         let stack = |st: &[(NodeId, f32)], below: &u32| {
@@ -359,12 +369,18 @@ impl TraversalStats for Trace {
 /// their depth, so a tree thousands deep lists in lines of a readable width.
 pub const MAX_INDENT: u32 = 16;
 
-/// The indent of a step at `depth` in a listing (`bvhscope trace`, the app's Ray window).
+/// The indent of a step at `depth` in a listing (`bvhscope trace`): two spaces a level.
 pub fn indent(depth: u32) -> String {
+    indent_by(depth, 2)
+}
+
+/// The indent of a step at `depth`, `width` spaces a level (the app's Ray window uses one: its
+/// lines share a window's width with the numbers).
+pub fn indent_by(depth: u32, width: usize) -> String {
     if depth <= MAX_INDENT {
-        "  ".repeat(depth as usize)
+        " ".repeat(depth as usize * width)
     } else {
-        format!("{}[depth {depth}] ", "  ".repeat(MAX_INDENT as usize))
+        format!("{}[depth {depth}] ", " ".repeat(MAX_INDENT as usize * width))
     }
 }
 

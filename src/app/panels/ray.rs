@@ -33,7 +33,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
     egui::Window::new("Ray")
         .open(&mut open)
         // Over the statistics panel, so the image and the ray drawn on it stay in view.
-        .default_size([440.0, 520.0])
+        .default_size([640.0, 560.0])
         .default_pos(ctx.content_rect().right_top() + egui::vec2(-450.0, 40.0))
         .show(ctx, |ui| {
             pinned_list(app, ui, out);
@@ -85,7 +85,11 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 }
             };
             command_line(r, ui);
-            ui.label(format!("Stack (bottom first): {stack_text}"))
+            // The step shown, whole and wrapped (the list below keeps one line a step).
+            if let Some(s) = r.named.get(k) {
+                ui.add(egui::Label::new(egui::RichText::new(format!("Step {}: {}", k + 1, s.brief())).strong()).wrap());
+            }
+            ui.add(egui::Label::new(format!("Stack (bottom first): {stack_text}")).wrap())
                 .on_hover_text("What the traversal stack holds after this step: each node with the distance at which the ray enters its box");
             legend(ui);
             steps_list(app, ui, out, k);
@@ -224,12 +228,14 @@ fn steps_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions, k: usize)
                 (true, TraceLevel::Top) => "top  ".into(),
                 (true, TraceLevel::Bottom { instance }) => format!("#{instance:<4}"),
             };
-            let text = format!("{:>4}  {level}{}{}", i + 1, crate::bvh::trace::indent(depths[i]), s.text());
+            // The stack each push, pop and skip leaves is shown above for the step chosen: the
+            // list keeps its lines short, and a whole line is the row's tooltip.
+            let text = format!("{:>4}  {level}{}{}", i + 1, crate::bvh::trace::indent_by(depths[i], 1), s.brief());
             let mut rich = RichText::new(text).monospace();
             if let Some(c) = step_color(&s.kind) {
                 rich = rich.color(c);
             }
-            if ui.selectable_label(i == k, rich).clicked() {
+            if ui.selectable_label(i == k, rich).on_hover_text(s.text()).clicked() {
                 out.push(Action::RayStep(i));
             }
         }
