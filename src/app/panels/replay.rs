@@ -71,7 +71,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                     let node = &r.tree.nodes[newest as usize];
                     let (l, rr) = (node.index, node.index + 1);
                     let axis = ["x", "y", "z"][node.axis as usize];
-                    let morton = view.morton.as_ref().and_then(|m| crate::cli::replay::morton_text(m, r, newest));
+                    let morton = view.morton.as_ref().and_then(|m| crate::explain::replay_film::morton_text(m, r, newest));
                     let plane = match (view.newest.as_ref().filter(|(n, _, _)| *n == newest), &morton) {
                         (_, Some(t)) => format!(" at {t},"),
                         (Some((_, Some(m), _)), _) => format!(" on {axis} at {axis} = {:.4} (split cost {:.2})", m.position, m.cost),
