@@ -214,7 +214,7 @@ impl GpuLbvh {
         t.upload = start.elapsed();
         let buf = |bufs: &[Option<wgpu::Buffer>], i: usize| bufs[i].as_ref().expect("made above").clone();
 
-        // Codes: the centroids' bounds, the grid as core's lbvh::grid makes it, the codes.
+        // Codes: the centroids' bounds, the grid as core's morton::grid makes it, the codes.
         let start = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         self.record(gpu, &mut enc, "bounds", &bufs, n32);

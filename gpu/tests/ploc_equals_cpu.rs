@@ -4,7 +4,7 @@
 
 mod common;
 
-use bvhscope_core::bvh::lbvh::MortonOrder;
+use bvhscope_core::bvh::morton::MortonOrder;
 use bvhscope_core::bvh::{BuildParams, Bvh, Layout, SplitStrategy, TreeStats};
 use bvhscope_core::dump::BvhDump;
 use bvhscope_core::explain::check::check_tree;

@@ -56,7 +56,7 @@ pub(super) fn draw_replay(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect
 /// coloured from its start (blue) to its end (yellow). After one split it is two points, after
 /// seven the eight octant-like cells in Z order, and it refines as the tree is split.
 fn morton_lines(
-    m: &crate::bvh::lbvh::MortonOrder,
+    m: &crate::bvh::morton::MortonOrder,
     p: &crate::bvh::replay::PartialBvh,
     h: &crate::bvh::inspect::Hierarchy,
     out: &mut Vec<super::overlay::Line3>,

@@ -4,7 +4,7 @@
 
 use super::node_view::Explained;
 use crate::bvh::inspect::{CurvePoint, Marker};
-use crate::bvh::lbvh::MortonOrder;
+use crate::bvh::morton::MortonOrder;
 use crate::bvh::replay::{PartialBvh, Replay};
 use std::sync::Arc;
 use std::time::Instant;

@@ -1,9 +1,11 @@
 //! The interface shared by every acceleration structure (BVH, linear scan), so the renderer, the
 //! tests and the CLI can swap one for another.
 
-use super::packet::PACKET;
 use super::TraversalStats;
 use crate::geometry::{Ray, TriangleIntersector, TriangleTest};
+
+/// Most rays in one packet (`Accelerator::closest_hits`): an 8×8 pixel tile.
+pub const PACKET: usize = 64;
 
 /// A closest hit: distance, barycentrics and the mesh's triangle index.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -30,8 +30,7 @@ use glam::Vec3;
 use std::mem::MaybeUninit;
 use wide::f32x4;
 
-/// Most rays in one packet: an 8×8 pixel tile.
-pub const PACKET: usize = 64;
+pub use super::accel::PACKET;
 /// Side of the square pixel block a packet covers.
 pub const PACKET_SIDE: u32 = 8;
 pub(super) const GROUPS: usize = PACKET / 4;

@@ -3,7 +3,7 @@
 //! the table of each step's SAH cost and mean cost per ray. One implementation for `bvhscope
 //! replay` and the app's Replay window, which write the same files.
 
-use crate::bvh::lbvh::MortonOrder;
+use crate::bvh::morton::MortonOrder;
 use crate::bvh::replay::Replay;
 use crate::bvh::{SahCost, TraceOptions};
 use crate::mesh::Mesh;

@@ -2,6 +2,7 @@
 
 mod aabb;
 mod ray;
+mod shear;
 pub mod slab;
 pub mod slab8;
 pub(crate) mod triangle;

@@ -6,7 +6,7 @@
 //! included. The triangles are read from the leaf's array (three vertices each, in leaf order)
 //! and turned into lanes here: nine loads of four lanes.
 
-use super::triangle::{Hits4, WatertightRay};
+use super::shear::{Hits4, WatertightRay};
 use super::Ray;
 use glam::Vec3;
 use wide::f32x4;

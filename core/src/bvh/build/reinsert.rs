@@ -17,7 +17,8 @@
 //! interior area: C_trav × (the area freed by the removal − the area the insertion adds), over
 //! the root's area, which never changes.
 
-use super::node::{Bvh, BvhNode};
+use crate::bvh::node::{Bvh, BvhNode};
+use crate::bvh::{BuildParams, SplitStrategy, TreeStats};
 use crate::geometry::Aabb;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -266,7 +267,7 @@ fn reinsert(t: &mut Tree, x: u32, heap: &mut BinaryHeap<Candidate>) -> bool {
 /// Improve `bvh`'s tree by at most `passes` passes of reinsertion.
 pub fn optimise(bvh: &mut Bvh, passes: u32) -> Reinsertion {
     let start = Instant::now();
-    let sah = |b: &Bvh| super::TreeStats::of(b).sah_cost;
+    let sah = |b: &Bvh| TreeStats::of(b).sah_cost;
     let mut report = Reinsertion { sah_before: sah(bvh), sah_after: 0.0, ..Default::default() };
     if bvh.nodes.len() < 5 || passes == 0 {
         report.sah_after = report.sah_before;
@@ -275,7 +276,7 @@ pub fn optimise(bvh: &mut Bvh, passes: u32) -> Reinsertion {
     // Single triangles move, not only whole leaves (Bittner et al. optimise trees of one triangle
     // per leaf); an SBVH's leaves hold clipped parts of triangles, whose boxes are not the
     // triangles', so they stay whole.
-    let split_leaves = bvh.params.strategy != super::SplitStrategy::Sbvh;
+    let split_leaves = bvh.params.strategy != SplitStrategy::Sbvh;
     let mut t = Tree::of(bvh, split_leaves);
     let mut heap = BinaryHeap::new();
     let mut order: Vec<u32> = Vec::with_capacity(t.kids.len());
@@ -356,7 +357,7 @@ fn layout(t: &Tree, bvh: &mut Bvh, gather_leaves: bool) {
 /// Which interior nodes become leaves: those of at most the leaf size whose triangles as one
 /// leaf cost no more by the SAH than the subtree below them (decided bottom-up, as PLOC's layout
 /// does), so single-triangle leaves that reinsertion left side by side are gathered again.
-fn collapse(t: &Tree, params: &super::BuildParams) -> Vec<bool> {
+fn collapse(t: &Tree, params: &BuildParams) -> Vec<bool> {
     let ci = params.cost.intersection as f64;
     let n = t.kids.len();
     let (mut count, mut cost, mut gather) = (vec![0u32; n], vec![0f64; n], vec![false; n]);

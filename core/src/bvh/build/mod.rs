@@ -4,22 +4,26 @@
 //! identical triangles cannot overflow the call stack. Nodes are allocated in pairs when a node is
 //! split, so the two children of a node are adjacent and an interior node needs only one index.
 
-use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
-use super::split::{BuildPrim, EqualCount, NodeInfo, Proposal, SplitStrategy, Splitter};
-use super::subtree::Subtree;
+pub(crate) mod common;
+pub mod lbvh;
+pub mod morton;
+pub(crate) mod ploc;
+pub mod reinsert;
+pub mod sbvh;
+pub mod split;
+mod subtree;
+
+use crate::bvh::node::{Bvh, BvhNode};
+use crate::bvh::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
 use crate::work::{Cancelled, WorkControl};
+pub use common::{build_work, HEURISTIC_DEPTH_LIMIT};
+use common::{leaf_is_cheaper, node_info, progress_levels, Overrides, Progress, PARALLEL_MIN_PRIMS};
 use rayon::prelude::*;
+use split::{BuildPrim, EqualCount, NodeInfo, Proposal, SplitStrategy, Splitter};
 use std::time::Instant;
-
-pub use super::params::{BuildParams, BuildReport, Layout, SahCost};
-
-/// Below this depth a node is always split by equal count, whatever the strategy says. Equal
-/// count halves the range, so the tree depth stays under `HEURISTIC_DEPTH_LIMIT + 32`, inside the
-/// traversal's fixed stack, even for adversarial inputs where midpoint splits peel off one
-/// triangle at a time.
-pub const HEURISTIC_DEPTH_LIMIT: u32 = (TRAVERSAL_STACK_SIZE as u32) - 33;
+use subtree::Subtree;
 
 struct Task {
     node: u32,
@@ -53,7 +57,7 @@ impl Bvh {
         let n = mesh.triangle_count();
         if params.strategy == SplitStrategy::Lbvh {
             let progress = Progress { control, levels: progress_levels(n, &params) };
-            return Self::finish(super::lbvh::build_mesh(mesh, &params, &progress)?, control);
+            return Self::finish(lbvh::build_mesh(mesh, &params, &progress)?, control);
         }
         let make = |i: usize| {
             let tri = mesh.triangle(i as u32);
@@ -81,76 +85,9 @@ impl Bvh {
         let passes = bvh.params.reinsert_passes;
         if passes > 0 {
             control.check()?;
-            bvh.report.reinsertion = Some(super::reinsert::optimise(&mut bvh, passes));
+            bvh.report.reinsertion = Some(reinsert::optimise(&mut bvh, passes));
         }
         Ok(bvh)
-    }
-}
-
-/// The work units of building over `n` primitives, the total a build's progress reaches.
-///
-/// Progress counts primitives partitioned at every level, not only primitives placed in leaves:
-/// counting leaves alone left the progress at 0 % while the top levels were split, half of an
-/// exact-sweep build of 2M triangles. A build over n primitives is taken to have
-/// L = ⌈log2(n / max leaf size)⌉ + 1 levels, and each primitive is worth L units: one for each of
-/// the first L levels it is partitioned at, and the levels it skips when it reaches a leaf
-/// earlier. So the progress is exact at the end (n·L), moves with every split, and a tree deeper
-/// than L (midpoint on uneven meshes) only spends its last levels at the full count.
-pub fn build_work(n: usize, params: &BuildParams) -> u64 {
-    n as u64 * progress_levels(n, params) as u64
-}
-
-fn progress_levels(n: usize, params: &BuildParams) -> u32 {
-    let leaf = params.clamped().max_leaf_size as usize;
-    let leaves = n.div_ceil(leaf).max(1);
-    leaves.next_power_of_two().trailing_zeros() + 1
-}
-
-/// The build's progress: a control and the levels its primitives are counted over.
-pub(super) struct Progress<'a> {
-    control: &'a WorkControl,
-    levels: u32,
-}
-
-impl<'a> Progress<'a> {
-    #[cfg(test)]
-    pub(super) fn new(control: &'a WorkControl, levels: u32) -> Self {
-        Progress { control, levels }
-    }
-
-    pub(super) fn check(&self) -> Result<(), Cancelled> {
-        self.control.check()
-    }
-
-    /// The units of a split of `n` primitives at `depth` (`split`), for a caller that adds many
-    /// at once (`add`): one shared counter bumped per node costs a builder whose nodes are cheap.
-    pub(super) fn split_units(&self, n: usize, depth: u32) -> u64 {
-        if depth < self.levels {
-            n as u64
-        } else {
-            0
-        }
-    }
-
-    /// The units of a leaf of `n` primitives at `depth` (`leaf`).
-    pub(super) fn leaf_units(&self, n: usize, depth: u32) -> u64 {
-        n as u64 * self.levels.saturating_sub(depth) as u64
-    }
-
-    pub(super) fn add(&self, units: u64) {
-        self.control.add_done(units);
-    }
-
-    /// A node of `n` primitives at `depth` was partitioned.
-    pub(super) fn split(&self, n: usize, depth: u32) {
-        if depth < self.levels {
-            self.control.add_done(n as u64);
-        }
-    }
-
-    /// A leaf of `n` primitives was made at `depth`: the levels its primitives will not pass.
-    pub(super) fn leaf(&self, n: usize, depth: u32) {
-        self.control.add_done(n as u64 * self.levels.saturating_sub(depth) as u64);
     }
 }
 
@@ -178,14 +115,14 @@ pub fn build_over_boxes(
 /// `tri`).
 fn build_nodes(
     prims: &mut Vec<BuildPrim>,
-    tri: Option<super::sbvh::Triangles>,
+    tri: Option<sbvh::Triangles>,
     params: &BuildParams,
     control: &WorkControl,
 ) -> Result<(Vec<BvhNode>, BuildReport), Cancelled> {
     let t1 = Instant::now();
     let progress = Progress { control, levels: progress_levels(prims.len(), params) };
     if params.strategy == SplitStrategy::Sbvh {
-        let (nodes, refs, kinds) = super::sbvh::build(std::mem::take(prims), tri, params, &progress)?;
+        let (nodes, refs, kinds) = sbvh::build(std::mem::take(prims), tri, params, &progress)?;
         *prims = refs;
         let report = BuildReport {
             split_time: t1.elapsed(),
@@ -198,11 +135,11 @@ fn build_nodes(
     }
     let (tree, over) = match params.strategy {
         SplitStrategy::Lbvh => {
-            let (tree, fallback) = super::lbvh::build(prims, params, &progress)?;
+            let (tree, fallback) = lbvh::build(prims, params, &progress)?;
             (tree, Overrides { fallback, depth_limited: 0 })
         }
         SplitStrategy::Ploc => {
-            let (tree, _) = super::ploc::build(prims, params, params.ploc_radius as usize, &progress)?;
+            let (tree, _) = ploc::build(prims, params, params.ploc_radius as usize, &progress)?;
             (tree, Overrides::default())
         }
         _ => build_subtree(prims, 0, 0, params, &progress)?,
@@ -219,38 +156,6 @@ fn build_nodes(
     ))
 }
 
-/// The node's bounds and centroid bounds (in parallel for big ranges).
-pub(super) fn node_info(prims: &[BuildPrim]) -> NodeInfo {
-    const EMPTY: NodeInfo = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY };
-    let add = |i: NodeInfo, p: &BuildPrim| NodeInfo {
-        bounds: i.bounds.union(p.bounds()),
-        centroid_bounds: i.centroid_bounds.grow(p.centroid()),
-    };
-    let merge = |a: NodeInfo, b: NodeInfo| NodeInfo {
-        bounds: a.bounds.union(b.bounds),
-        centroid_bounds: a.centroid_bounds.union(b.centroid_bounds),
-    };
-    if prims.len() >= PARALLEL_MIN_PRIMS {
-        prims.par_chunks(4096).map(|c| c.iter().fold(EMPTY, add)).reduce(|| EMPTY, merge)
-    } else {
-        prims.iter().fold(EMPTY, add)
-    }
-}
-
-/// Nodes where the driver overrode or replaced the strategy's answer.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Overrides {
-    pub fallback: u32,
-    pub depth_limited: u32,
-}
-
-impl std::ops::AddAssign for Overrides {
-    fn add_assign(&mut self, o: Overrides) {
-        self.fallback += o.fallback;
-        self.depth_limited += o.depth_limited;
-    }
-}
-
 /// What becomes of a node.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Decision {
@@ -260,15 +165,6 @@ enum Decision {
         axis: u8,
         mid: usize,
     },
-}
-
-/// The SAH's comparison of a leaf with the best split (Goldsmith & Salmon 1987; pbrt-v4 §7.3.2): a
-/// leaf costs C_isect·n; the split costs C_trav + C_isect·(A_L·n_L + A_R·n_R)/A, where `weighted`
-/// is the sum in parentheses.
-pub(super) fn leaf_is_cheaper(n: usize, weighted: f32, node: &NodeInfo, params: &BuildParams) -> bool {
-    let split_cost = params.cost.traversal + params.cost.intersection * weighted / node.bounds.area();
-    let leaf_cost = params.cost.intersection * n as f32;
-    leaf_cost <= split_cost
 }
 
 /// Leaf or split, for every strategy, decided here and nowhere else: a single triangle is a leaf;
@@ -318,13 +214,12 @@ fn decide(
     }
 }
 
-/// Subtrees at least this big are split in parallel (`rayon::join`) ...
-const PARALLEL_MIN_PRIMS: usize = 4096;
-/// ... down to this depth, which bounds the recursion; deeper work uses the explicit stack.
+/// Subtrees at least `PARALLEL_MIN_PRIMS` big are split in parallel (`rayon::join`) down to this
+/// depth, which bounds the recursion; deeper work uses the explicit stack.
 const PARALLEL_MAX_DEPTH: u32 = 16;
 
 /// The splitter of a top-down strategy (`build_nodes` sends the others to their own builders).
-fn top_down(params: &BuildParams) -> Box<dyn super::split::Splitter> {
+fn top_down(params: &BuildParams) -> Box<dyn split::Splitter> {
     params.strategy.splitter(params).expect("build_nodes builds only top-down strategies with the driver")
 }
 
@@ -411,5 +306,4 @@ fn build_sequential(
 }
 
 #[cfg(test)]
-#[path = "build_tests.rs"]
 mod tests;

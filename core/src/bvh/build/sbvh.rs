@@ -17,12 +17,13 @@
 //! (`refs_at`, which walks from the root to a node through the same decisions) both call it, so
 //! the curves the inspector draws are the ones the builder priced.
 
-use super::build::{leaf_is_cheaper, node_info, BuildParams, Overrides, Progress, HEURISTIC_DEPTH_LIMIT};
-use super::node::BvhNode;
+use super::common::{leaf_is_cheaper, node_info, Overrides, Progress, HEURISTIC_DEPTH_LIMIT};
 use super::split::{
     binned_planes, spatial_partition, spatial_planes, BuildPrim, EqualCount, NodeInfo, PlaneSink, Proposal,
 };
 use super::subtree::Subtree;
+use crate::bvh::node::BvhNode;
+use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 use crate::work::Cancelled;
 use glam::Vec3;
@@ -52,7 +53,7 @@ impl<'a> Ctx<'a> {
 
 /// A node's work: its references, the duplicates its subtree may still add, its share of the
 /// build's progress units, its depth.
-pub(super) struct Work {
+pub(crate) struct Work {
     pub refs: Vec<BuildPrim>,
     pub budget: u64,
     weight: u64,
@@ -362,7 +363,7 @@ fn build_sequential(
 /// child) as the build had it, found by walking down through the build's own `split_node` from
 /// `refs`, the root's references in the build's order (triangle i's bounds at place i). `None`
 /// when the path runs past a leaf.
-pub(super) fn descend(refs: Vec<BuildPrim>, tri: Triangles, params: &BuildParams, path: &[bool]) -> Option<Work> {
+pub(crate) fn descend(refs: Vec<BuildPrim>, tri: Triangles, params: &BuildParams, path: &[bool]) -> Option<Work> {
     let root = node_info(&refs);
     let ctx = Ctx::new(Some(tri), params, &root.bounds);
     let mut work = Work::root(refs, params);
@@ -378,13 +379,13 @@ pub(super) fn descend(refs: Vec<BuildPrim>, tri: Triangles, params: &BuildParams
 
 /// A node's references, the duplicates it may still add and its depth: for a tree of another
 /// strategy, its triangles whole with a fresh budget (what the SBVH would do with them).
-pub(super) fn work_of(refs: Vec<BuildPrim>, params: &BuildParams, depth: u32) -> Work {
+pub(crate) fn work_of(refs: Vec<BuildPrim>, params: &BuildParams, depth: u32) -> Work {
     Work { depth, ..Work::root(refs, params) }
 }
 
 /// What the SBVH builder decides at `work` (a tree whose root box is `root`), with the spatial
 /// split's planes reported to `spatials`: the node inspector's explanation.
-pub(super) fn explain(
+pub(crate) fn explain(
     work: Work,
     tri: Triangles,
     params: &BuildParams,

@@ -35,7 +35,7 @@ fn build_reports_progress_and_can_be_cancelled() {
             let n = mesh.triangle_count() as u64;
             assert!(control.total() >= n * 8, "4096 triangles pass at least 8 levels");
             assert_eq!(control.done(), control.total(), "{strategy:?}/{max_leaf_size}: the work adds up");
-            assert_eq!(super::super::tree::distinct(&bvh.prim_ids), mesh.triangle_count(), "every triangle in a leaf");
+            assert_eq!(crate::bvh::tree::distinct(&bvh.prim_ids), mesh.triangle_count(), "every triangle in a leaf");
         }
     }
 

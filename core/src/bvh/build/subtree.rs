@@ -1,6 +1,6 @@
 //! The parallel build's subtrees and their placement in the final node array (`bvh::build`).
 
-use super::node::BvhNode;
+use crate::bvh::node::BvhNode;
 use crate::geometry::Aabb;
 use rayon::prelude::*;
 

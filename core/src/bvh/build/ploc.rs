@@ -1,5 +1,5 @@
 //! PLOC: Meister & Bittner, "Parallel Locally-Ordered Clustering for Bounding Volume Hierarchy
-//! Construction" (IEEE TVCG 2018). The primitives, sorted by Morton code (`lbvh::sort`), start as
+//! Construction" (IEEE TVCG 2018). The primitives, sorted by Morton code (`morton::sort`), start as
 //! one cluster each; every round, each cluster finds its nearest neighbour among the `radius`
 //! clusters before and after it in that order (the one whose union with it has the smallest
 //! surface area), mutual nearest neighbours merge, and the clusters are compacted, keeping the
@@ -11,10 +11,11 @@
 //! cannot be cut off at a leaf size before it is built: the clusters do not know their size
 //! when they meet.
 
-use super::build::{BuildParams, Progress};
-use super::node::BvhNode;
+use super::common::Progress;
 use super::split::BuildPrim;
 use super::subtree::Subtree;
+use crate::bvh::node::BvhNode;
+use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
 use crate::work::Cancelled;
 use rayon::prelude::*;
@@ -41,7 +42,7 @@ pub(super) fn build(
     if n == 0 {
         return Ok((Subtree::Flat(vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)]), 0));
     }
-    super::lbvh::sort(prims);
+    super::morton::sort(prims);
     progress.check()?;
     let mut nodes: Vec<Cluster> = prims
         .par_iter()
