@@ -3,7 +3,7 @@
 //! build and traversal code that renders.
 
 pub mod check;
-pub mod replay_film;
 pub mod grade;
+pub mod replay_film;
 pub mod timing;
 pub mod words;
