@@ -24,6 +24,7 @@ impl BvhscopeApp {
             JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
             JobEvent::Failed(e) => self.message(MessageKind::Error, e),
             JobEvent::Speedup(t) => self.speedup = Some(*t),
+            e @ (JobEvent::GpuProbed(_) | JobEvent::GpuFailed(_)) => self.gpu_event(e),
             JobEvent::Explained(e) => {
                 // A new tree: keep the selection where the id still exists, and its open rows.
                 let n = e.tree.nodes.len() as u32;
@@ -152,6 +153,7 @@ impl BvhscopeApp {
             bvh: p.bvh,
             trace: p.trace,
             partial: p.partial,
+            gpu: p.gpu,
         });
     }
 

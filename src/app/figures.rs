@@ -20,6 +20,8 @@ pub struct Shown {
     /// The BVH and traversal that traced it: a pinned pixel is traced again through them.
     pub bvh: Arc<SceneBvh>,
     pub trace: TraceOptions,
+    /// The GPU that traced it, if one did (`app::gpu`).
+    pub gpu: Option<super::gpu::GpuRender>,
 }
 
 /// Per-ray figures of a full frame, with what they depend on besides the BVH: the camera (and

@@ -39,6 +39,8 @@ pub struct RenderRequest {
     pub progressive: bool,
     /// The build replay's partial tree of `bvh` (a single BVH) to trace instead of it.
     pub partial: Option<Arc<PartialBvh>>,
+    /// Trace on this GPU instead of the CPU (`app::gpu`).
+    pub gpu: Option<super::gpu::GpuRender>,
 }
 
 impl RenderRequest {
@@ -51,6 +53,11 @@ impl RenderRequest {
             && self.progressive == o.progressive
             && match (&self.partial, &o.partial) {
                 (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (None, None) => true,
+                _ => false,
+            }
+            && match (&self.gpu, &o.gpu) {
+                (Some(a), Some(b)) => a.same_as(b),
                 (None, None) => true,
                 _ => false,
             }
@@ -70,6 +77,8 @@ pub struct PassOutput {
     pub style: ViewStyle,
     /// The partial tree of a build replay that traced the frame, if it was one.
     pub partial: Option<Arc<PartialBvh>>,
+    /// The GPU that traced it, if one did.
+    pub gpu: Option<super::gpu::GpuRender>,
 }
 
 /// What a file dialog was opened for.
@@ -117,6 +126,10 @@ pub enum JobEvent {
     Failed(String),
     /// The BVH timed against the linear scan.
     Speedup(Box<Timed>),
+    /// The look for a GPU adapter at start: the GPU, or why there is none.
+    GpuProbed(Result<Arc<bvhscope_gpu::Gpu>, String>),
+    /// A GPU render or build failed: what to tell the user (the app goes back to the CPU).
+    GpuFailed(String),
 }
 
 /// The linear scan's time budget for a frame: past it, a spread sample is timed (as `compare`).
@@ -171,6 +184,8 @@ pub struct Jobs {
     /// starts its clock, so its time is the build's alone (as `bvhscope stats` measures it), not
     /// the build's and a render's sharing the cores.
     others: Arc<std::sync::atomic::AtomicUsize>,
+    /// The GPU the render and build jobs may use, and what they keep on it (`app::gpu`).
+    pub gpu: super::gpu::GpuJobs,
 }
 
 /// Counts a job among `Jobs::others` while it lives.
@@ -213,7 +228,13 @@ impl Jobs {
             last_build: None,
             frames: FramePool::default(),
             others: Default::default(),
+            gpu: Default::default(),
         }
+    }
+
+    /// Look for a GPU adapter in the background (once, at start).
+    pub fn probe_gpu(&self) {
+        super::gpu::probe(self.sender(0));
     }
 
     fn start(&mut self, label: String) -> Running {
@@ -278,7 +299,8 @@ impl Jobs {
     /// Build a BVH (or two levels) over `scene` in the background; a running build is cancelled,
     /// and so are the render, the comparison, the visit count and the wrong pixels (they are of
     /// the BVH being replaced). The build starts its clock once every other job has ended.
-    pub fn build(&mut self, scene: Arc<Scene>, params: SceneBuild, scene_id: u64) {
+    /// With `gpu`, lbvh and ploc are built on it (`GpuJobs::build`).
+    pub fn build(&mut self, scene: Arc<Scene>, params: SceneBuild, scene_id: u64, gpu: Option<Arc<bvhscope_gpu::Gpu>>) {
         if let Some(old) = self.build.take() {
             old.control.cancel();
         }
@@ -294,13 +316,19 @@ impl Jobs {
             Some(top) => format!("Building two levels ({} over {})", top.strategy.label(), params.bvh.strategy.label()),
             None => format!("Building ({})", params.bvh.strategy.label()),
         };
+        let label = if gpu.is_some() { format!("{label} on the GPU") } else { label };
         let job = self.start(label);
         let (send, control, others) = (self.sender(job.id), job.control.clone(), self.others.clone());
+        let gpu_jobs = self.gpu.clone();
+        self.gpu.last_build_on_gpu = gpu.is_some();
         self.spawn_uncounted(&job, move || {
             while others.load(std::sync::atomic::Ordering::SeqCst) > 0 && !control.is_cancelled() {
                 std::thread::sleep(Duration::from_millis(1));
             }
-            let result = scene.build(&params, &control).map(Arc::new);
+            let (result, gpu_failed) = gpu_jobs.build(&scene, &params, &control, gpu.as_deref());
+            if let Some(why) = gpu_failed {
+                send(JobEvent::GpuFailed(why));
+            }
             send(JobEvent::Built { scene_id, params, result });
         });
         self.build = Some(job);
@@ -320,10 +348,19 @@ impl Jobs {
         if let Some(old) = self.render.take() {
             old.control.cancel();
         }
-        let job = self.start("Rendering".to_string());
+        let label = if req.gpu.is_some() && req.partial.is_none() { "Rendering on the GPU" } else { "Rendering" };
+        let job = self.start(label.to_string());
         let (send, control) = (self.sender(job.id), job.control.clone());
-        let (r, frames) = (req.clone(), self.frames.clone());
+        let (r, frames, gpu_jobs) = (req.clone(), self.frames.clone(), self.gpu.clone());
         self.spawn(&job, move || {
+            if let (Some(g), None) = (&r.gpu, &r.partial) {
+                match gpu_jobs.render(&r, g, &control) {
+                    Ok(Some(pass)) => send(JobEvent::Pass(pass)),
+                    Ok(None) => {}
+                    Err(why) => send(JobEvent::GpuFailed(format!("Tracing on the GPU failed: {why}"))),
+                }
+                return;
+            }
             // Always count: the heatmaps and the hover read-out need the counters, and counting
             // costs little next to shading.
             let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive };
@@ -332,8 +369,9 @@ impl Jobs {
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
                 let (bvh, camera, style, trace, partial) =
                     (r.bvh.clone(), r.camera, r.style, r.trace, r.partial.clone());
-                let frame = Arc::new(frame);
-                send(JobEvent::Pass(PassOutput { bvh, frame, image, legend, info, camera, trace, style, partial }));
+                let (frame, gpu) = (Arc::new(frame), None);
+                let pass = PassOutput { bvh, frame, image, legend, info, camera, trace, style, partial, gpu };
+                send(JobEvent::Pass(pass));
             };
             // A replay's partial tree traces in place of the BVH it is part of; the mesh shades.
             let _ = match (&r.partial, &*r.bvh) {
@@ -561,6 +599,8 @@ impl Jobs {
                     }
                 }
                 JobEvent::Picked { .. } => self.picking = None,
+                JobEvent::GpuProbed(_) => {}
+                JobEvent::GpuFailed(_) => self.render = None,
                 JobEvent::Explained(_) if current(&self.explain) => self.explain = None,
                 JobEvent::Compared(_) if current(&self.compare) => self.compare = None,
                 JobEvent::Visits(_) if current(&self.visits) => self.visits = None,

@@ -10,6 +10,7 @@ mod events;
 mod explain_overlay;
 mod export;
 mod figures;
+pub mod gpu;
 mod import_view;
 mod jobs;
 mod node_view;
@@ -225,6 +226,7 @@ impl BvhscopeApp {
             (None, Some(bvh)) => app.act(Action::ImportFile(bvh)),
             (None, None) => {}
         }
+        app.jobs.probe_gpu();
         app.reconcile();
         app
     }
@@ -350,7 +352,12 @@ impl BvhscopeApp {
     pub fn wanted_build(&self) -> SceneBuild {
         let top = (self.settings.two_level && self.has_instances())
             .then_some(crate::bvh::BuildParams { layout: crate::bvh::Layout::Binary, ..self.settings.top_build });
-        SceneBuild { bvh: self.settings.build, top }
+        let mut bvh = self.settings.build;
+        if self.gpu_for_frames().is_some() {
+            // The GPU walks binary nodes (or CWBVH nodes made from them), as `--device gpu` does.
+            bvh.layout = crate::bvh::Layout::Binary;
+        }
+        SceneBuild { bvh, top }
     }
 
     /// The boxes of the overlay for the current BVH and settings (cached): the single BVH's at

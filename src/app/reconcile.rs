@@ -134,12 +134,16 @@ impl BvhscopeApp {
         }
         let build = self.wanted_build();
         let wanted = (build, self.scene_id);
-        let have = self.current_bvh().is_some_and(|b| b.bvh.import().is_none() && b.bvh.build_params() == build);
+        // Built where it should be too: lbvh and ploc on the GPU when it traces the frames.
+        let gpu = self.gpu_for_building(&build);
+        let have = self.current_bvh().is_some_and(|b| {
+            b.bvh.import().is_none() && b.bvh.build_params() == build && self.built_where_wanted(&b.bvh, &build)
+        });
         if have {
             // Switched back to what is built while another build ran: that build is not wanted.
             self.jobs.cancel_build();
-        } else if self.jobs.last_build != Some(wanted) {
-            self.jobs.build(self.scene.clone(), build, self.scene_id);
+        } else if self.jobs.last_build != Some(wanted) || self.jobs.gpu.last_build_on_gpu != gpu.is_some() {
+            self.jobs.build(self.scene.clone(), build, self.scene_id, gpu);
         }
     }
 
@@ -160,6 +164,7 @@ impl BvhscopeApp {
             style: self.view_style(),
             progressive: self.settings.progressive,
             partial: self.replay_partial(),
+            gpu: self.gpu_for_frames(),
         };
         if req.camera.validate().is_ok() && !self.jobs.last_render.as_ref().is_some_and(|last| last.same_as(&req)) {
             self.jobs.render(req);

@@ -1,6 +1,7 @@
 //! What the user chose, remembered across runs (eframe persistence).
 
 use crate::bvh::{BuildParams, Layout, Preset, TraceOptions};
+use crate::cli::{Device, GpuNodes};
 use crate::render::{ColorMap, HeatRange, UpAxis, View};
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -43,6 +44,10 @@ pub struct Settings {
     /// What the image is rendered at: the viewport's size, or a scene file's film (its camera's
     /// size and aspect, letterboxed in the viewport), so the figures are the scene's frame's.
     pub film: Film,
+    /// Where frames are traced (and lbvh, ploc built): the CPU or the GPU (`app::gpu`).
+    pub device: Device,
+    /// The node format the GPU walks.
+    pub gpu_nodes: GpuNodes,
     pub recent_files: Vec<PathBuf>,
 }
 
@@ -65,6 +70,8 @@ impl Default for Settings {
             boxes_in_front: false,
             progressive: true,
             film: Film::Scene,
+            device: Device::Cpu,
+            gpu_nodes: GpuNodes::Binary,
             recent_files: Vec::new(),
         }
     }

@@ -170,7 +170,7 @@ pub fn shell_word(s: &str) -> String {
 }
 
 /// Where rays are traced: the CPU (the renderer of `core`) or the GPU (`bvhscope-gpu`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Device {
     #[default]
@@ -179,7 +179,7 @@ pub enum Device {
 }
 
 /// The node format the GPU walks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum GpuNodes {
     /// The binary tree as built: core's 32-byte nodes, byte for byte.

@@ -130,24 +130,33 @@ fn lay_out(bvh: Bvh, layout: Layout) -> AnyBvh {
     }
 }
 
-/// Build `build` over `mesh` with lbvh or ploc on the GPU (reinsertion, if asked for, then on the
-/// CPU, as `Bvh::build` runs it after any builder); `None` for the other strategies, which only
-/// the CPU builds.
-pub fn gpu_build(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<(AnyBvh, GpuBuild)>, CliError> {
+/// Whether the GPU builds `strategy` (lbvh and ploc; the others are built on the CPU).
+pub fn builds_on_gpu(strategy: SplitStrategy) -> bool {
+    matches!(strategy, SplitStrategy::Lbvh | SplitStrategy::Ploc)
+}
+
+/// `gpu_build` without a spinner (the app's build job).
+pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<(AnyBvh, GpuBuild)>, GpuError> {
     let strategy = params.strategy;
-    let label = format!("building the BVH ({} on the GPU)", strategy.label());
-    let built = progress::with_spinner(&label, || match strategy {
+    let built = match strategy {
         SplitStrategy::Lbvh => GpuLbvh::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
         SplitStrategy::Ploc => GpuPloc::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
         _ => Ok(None),
-    })
-    .map_err(gpu_error)?;
+    }?;
     Ok(built.map(|(mut bvh, timings)| {
         if params.reinsert_passes > 0 {
             bvh.report.reinsertion = Some(crate::bvh::reinsert::optimise(&mut bvh, params.reinsert_passes));
         }
         (lay_out(bvh, params.layout), GpuBuild { strategy, timings })
     }))
+}
+
+/// Build `params` over `mesh` with lbvh or ploc on the GPU (reinsertion, if asked for, then on the
+/// CPU, as `Bvh::build` runs it after any builder); `None` for the other strategies, which only
+/// the CPU builds.
+pub fn gpu_build(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<(AnyBvh, GpuBuild)>, CliError> {
+    let label = format!("building the BVH ({} on the GPU)", params.strategy.label());
+    progress::with_spinner(&label, || build_on_gpu(gpu, mesh, params)).map_err(gpu_error)
 }
 
 /// Build what `build` asks for: lbvh and ploc of one level on the GPU when there is one, anything
@@ -175,23 +184,27 @@ pub enum GpuTree {
 
 impl GpuTree {
     /// Upload the binary tree of `bvh` (one level: as built, or an imported dump's) as `nodes`.
-    pub fn upload(gpu: &Gpu, bvh: &SceneBvh, nodes: GpuNodes) -> Result<(GpuTree, Arc<Mesh>), CliError> {
+    pub fn new(gpu: &Gpu, bvh: &SceneBvh, nodes: GpuNodes) -> Result<(GpuTree, Arc<Mesh>), GpuError> {
         let SceneBvh::Single { mesh, .. } = bvh else {
-            return Err(CliError::Usage("the GPU traces one BVH, not two levels".into()));
+            return Err(GpuError::Input("the GPU traces one BVH, not two levels".into()));
         };
         let tree = bvh.binary_tree().ok_or_else(|| {
-            CliError::Usage("this imported wide tree has no binary form the GPU could walk; use --device cpu".into())
+            GpuError::Input("this imported wide tree has no binary form the GPU could walk; trace it on the CPU".into())
         })?;
-        let uploaded = progress::with_spinner("uploading the tree to the GPU", || match nodes {
-            GpuNodes::Binary => GpuBinaryBvh::upload(gpu, &tree).map(GpuTree::Binary),
+        let uploaded = match nodes {
+            GpuNodes::Binary => GpuTree::Binary(GpuBinaryBvh::upload(gpu, &tree)?),
             GpuNodes::Cwbvh => {
                 let cw = Cwbvh::from_bvh(&tree)?;
                 let on_gpu = GpuCwbvh::upload(gpu, &cw)?;
-                Ok(GpuTree::Cwbvh(Box::new(cw), on_gpu))
+                GpuTree::Cwbvh(Box::new(cw), on_gpu)
             }
-        })
-        .map_err(gpu_error)?;
+        };
         Ok((uploaded, mesh.clone()))
+    }
+
+    /// `new`, with a spinner while it takes long and the command line's error.
+    pub fn upload(gpu: &Gpu, bvh: &SceneBvh, nodes: GpuNodes) -> Result<(GpuTree, Arc<Mesh>), CliError> {
+        progress::with_spinner("uploading the tree to the GPU", || Self::new(gpu, bvh, nodes)).map_err(gpu_error)
     }
 
     pub fn nodes(&self) -> GpuNodes {
@@ -203,13 +216,17 @@ impl GpuTree {
 
     /// Trace `rays` (closest hits), counting when `counted`, in `trace`'s order (binary nodes;
     /// CWBVH orders its children by octant).
-    pub fn trace(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, CliError> {
+    pub fn walk(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, GpuError> {
         let opts = bvhscope_gpu::GpuTraceOptions { order: trace.order, counted, exact: true };
         match self {
             GpuTree::Binary(t) => t.trace(gpu, rays, opts),
             GpuTree::Cwbvh(_, t) => t.trace(gpu, rays, opts),
         }
-        .map_err(gpu_error)
+    }
+
+    /// `walk`, with the command line's error.
+    pub fn trace(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, CliError> {
+        self.walk(gpu, rays, trace, counted).map_err(gpu_error)
     }
 
     /// `camera`'s frame traced on the GPU, as a frame the views, legends and CSVs read.

@@ -14,7 +14,7 @@ pub mod replay;
 pub mod stats;
 pub mod trace;
 
-pub use args::{parse_camera, parse_size, BuildArgs};
+pub use args::{parse_camera, parse_size, BuildArgs, Device, GpuNodes};
 pub use compare::{compare_rows, CompareRow};
 
 use crate::mesh::MeshError;

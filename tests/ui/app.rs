@@ -9,6 +9,7 @@ use support::*;
 // The explaining views (pinned rays, the tree and the node inspector, the histogram, the replay,
 // two strategies side by side): the same binary, another file.
 mod app_explain;
+mod app_gpu;
 mod app_look;
 mod app_replay;
 mod app_scenes;

@@ -224,6 +224,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions)
         });
         return;
     };
+    crate::app::gpu::show_in_statistics(app, ui);
     // Side by side, the second column is B and a third gives B − A; otherwise it is the strategy
     // shown before this one.
     let b = app.compare_figures();

@@ -1,7 +1,10 @@
 //! The view panel: what the image shows, heatmap colours and range, the up axis, and the node-box
 //! overlay.
 
+use crate::app::gpu::Probe;
 use crate::app::{Action, Actions, BoxLevel, BvhscopeApp};
+use crate::cli::{Device, GpuNodes};
+use crate::render::warp::WarpSize;
 use crate::render::{ColorMap, UpAxis, View};
 
 /// What a view shows, for its tooltip: its help, and for combined cost the constants in use.
@@ -13,16 +16,48 @@ fn view_tip(v: View, cost: &str) -> String {
 }
 
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
-    ui.heading("View");
+    let mut edited = app.settings.clone();
+    // "Trace on" shares the heading's row: the panel is tall already, and what follows must stay
+    // on screen.
+    ui.horizontal(|ui| {
+        ui.heading("View");
+        ui.add_space(12.0);
+        trace_on(app, ui, &mut edited);
+    });
     let max_depth = app.current_bvh().map_or(0, |b| b.bottom_max_depth());
     // The top level's depth, when two levels are built.
     let top_depth = app.current_bvh().and_then(|b| b.top_stats.as_ref()).map(|s| s.max_depth);
     let legend_range = app.shown.as_ref().and_then(|s| s.legend.as_ref()).map(|l| (l.range_min, l.range_max));
     let cost = super::stats::combined_cost_text(app.settings.build.cost);
-    let mut edited = app.settings.clone();
     let s = &mut edited;
-    for v in View::ALL.into_iter().filter(|v| !v.is_per_level()) {
-        ui.radio_value(&mut s.view, v, v.label()).on_hover_text(view_tip(v, &cost));
+    gpu_choices(app, ui, s);
+    // The warp views are listed once, at 32 lanes; "64 lanes" below switches the one shown.
+    let listed = |v: &View| !v.is_per_level() && v.warp() != Some(WarpSize::W64);
+    let shown = match s.view {
+        View::WarpCost(_) => View::WarpCost(WarpSize::W32),
+        View::SimtEfficiency(_) => View::SimtEfficiency(WarpSize::W32),
+        v => v,
+    };
+    // In two columns, to keep the panel short.
+    egui::Grid::new("views").num_columns(2).show(ui, |ui| {
+        for (i, v) in View::ALL.into_iter().filter(listed).enumerate() {
+            if ui.radio(shown == v, v.label().replace(" (32 lanes)", "")).on_hover_text(view_tip(v, &cost)).clicked() {
+                s.view = v;
+            }
+            if i % 2 == 1 {
+                ui.end_row();
+            }
+        }
+    });
+    if let Some(lanes) = s.view.warp() {
+        let mut wide = lanes == WarpSize::W64;
+        ui.checkbox(&mut wide, "64 lanes per warp (AMD wave64)")
+            .on_hover_text("Groups of 64 rays (8×8 pixels) instead of 32 (8×4, NVIDIA's warp and most GPUs')");
+        let size = if wide { WarpSize::W64 } else { WarpSize::W32 };
+        s.view = match s.view {
+            View::WarpCost(_) => View::WarpCost(size),
+            _ => View::SimtEfficiency(size),
+        };
     }
     if top_depth.is_some() {
         ui.label("Two-level work (Nodes visited counts both levels)");
@@ -138,5 +173,44 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     }
     if edited != app.settings {
         out.push(Action::Edit(Box::new(edited)));
+    }
+}
+
+/// "Trace on: CPU / GPU": the GPU greyed, with the reason on hover, until an adapter is found.
+fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut crate::app::Settings) {
+    let probe = &app.jobs.gpu.probe;
+    ui.label("Trace on").on_hover_text(
+        "Where the frames are traced: the CPU, or the GPU (wgpu compute shaders) at full resolution in one pass, with the same per-pixel counts as the CPU's binary layout (bvhscope render --device gpu). With the GPU, the tree is built in the binary layout and lbvh and ploc are built on the GPU too.",
+    );
+    ui.radio_value(&mut s.device, Device::Cpu, "CPU");
+    let why = match probe {
+        Probe::Looking => "Looking for a GPU adapter…".to_string(),
+        Probe::Missing(why) => format!("No GPU: {why}"),
+        Probe::Found(g) if g.is_software() => {
+            format!("{} (a software adapter: its counts are right, its times are no GPU's)", g.name())
+        }
+        Probe::Found(g) => g.name(),
+    };
+    ui.add_enabled_ui(matches!(probe, Probe::Found(_)), |ui| ui.radio_value(&mut s.device, Device::Gpu, "GPU"))
+        .inner
+        .on_hover_text(&why)
+        .on_disabled_hover_text(&why);
+}
+
+/// With the GPU chosen: its node format, and why it does not trace now if it does not.
+fn gpu_choices(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut crate::app::Settings) {
+    if s.device != Device::Gpu {
+        return;
+    }
+    ui.horizontal(|ui| {
+        ui.label("GPU nodes");
+        ui.radio_value(&mut s.gpu_nodes, GpuNodes::Binary, "binary")
+            .on_hover_text("The binary tree as built: core's 32-byte nodes, byte for byte");
+        ui.radio_value(&mut s.gpu_nodes, GpuNodes::Cwbvh, "CWBVH").on_hover_text(
+            "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree; its counts are those of its own walk",
+        );
+    });
+    if let Some(why) = app.gpu_blocked() {
+        ui.label(format!("Traced on the CPU: {why}"));
     }
 }
