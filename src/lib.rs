@@ -6,3 +6,4 @@ pub use bvhscope_core::{bvh, cpu, dump, explain, files, geometry, mesh, options,
 #[cfg(feature = "gui")]
 pub mod app;
 pub mod cli;
+pub mod gpu_path;

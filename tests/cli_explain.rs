@@ -117,9 +117,25 @@ fn inspect_prints_a_nodes_curves_and_each_strategys_plane() {
 
     let out = bvhscope(&["inspect", torus, "--node", "1", "--format", "csv"]);
     let mut reader = csv::Reader::from_reader(&out.stdout[..]);
-    assert_eq!(reader.headers().unwrap(), vec!["axis", "position", "left_count", "right_count", "cost"]);
+    assert_eq!(
+        reader.headers().unwrap(),
+        vec![
+            "axis",
+            "position",
+            "left_count",
+            "right_count",
+            "area_left_ratio",
+            "area_right_ratio",
+            "left_term",
+            "right_term",
+            "cost"
+        ]
+    );
     let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
-    assert!(rows.len() > 100 && rows.iter().all(|r| r[4].parse::<f32>().unwrap() > 1.0));
+    let cost = |r: &csv::StringRecord, i: usize| r[i].parse::<f32>().unwrap();
+    assert!(rows.len() > 100 && rows.iter().all(|r| cost(r, 8) > 1.0));
+    // The cost is the traversal step plus the two terms the columns name.
+    assert!(rows.iter().all(|r| (cost(r, 8) - (1.0 + cost(r, 6) + cost(r, 7))).abs() < 1e-3 * cost(r, 8)));
 
     let out = bvhscope(&["inspect", torus, "--node", "999999"]);
     assert_eq!(out.status.code(), Some(2));

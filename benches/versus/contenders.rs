@@ -29,7 +29,8 @@ pub enum Family {
     BvhCrate,
     /// Embree with single rays (`rtcIntersect1`).
     Embree,
-    /// Embree with packets or streams.
+    /// Embree with packets or streams (built only where Embree is found).
+    #[cfg_attr(not(embree), allow(dead_code))]
     EmbreePackets,
 }
 

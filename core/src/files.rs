@@ -64,6 +64,11 @@ impl OutputKind {
     }
 }
 
+/// A path's file name as messages and titles show it (the whole path where it has none).
+pub fn file_name(p: &Path) -> String {
+    p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
 /// An image written as PNG to `path` (named `.png`: `PNG.check`), atomically.
 pub fn write_png(path: &Path, img: &image::RgbImage) -> Result<(), FileError> {
     PNG.check(path)?;

@@ -264,7 +264,8 @@ fn random_trees_correct_or_broken_are_never_passed_when_wrong() {
 /// back at its root, and `inspect` ran out of memory).
 #[test]
 fn every_traced_tree_can_be_inspected_node_by_node() {
-    use bvhscope_core::bvh::{inspect, AnyBvh, TreeStats};
+    use bvhscope_core::bvh::{AnyBvh, Hierarchy, TreeStats};
+    use bvhscope_core::explain::inspect;
     let mesh = mesh();
     let mut rng = Rng::new(777);
     for _ in 0..cases(60) {
@@ -289,7 +290,7 @@ fn every_traced_tree_can_be_inspected_node_by_node() {
         });
         assert!(stats.nodes >= 1);
         bounded(Duration::from_secs(60), move || {
-            let h = inspect::Hierarchy::of(&tree);
+            let h = Hierarchy::of(&tree);
             for node in 0..tree.nodes.len() as u32 {
                 assert!(h.path(node).len() <= tree.nodes.len());
                 let _ = inspect::inspect(&tree, &h, node);

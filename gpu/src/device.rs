@@ -7,7 +7,7 @@
 //! integrated, virtual or software one (Mesa's lavapipe is `Cpu`), and within a kind Vulkan
 //! first (it is what the tests and the benchmarks were checked on).
 
-use crate::kernel::Kernel;
+use std::any::Any;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
@@ -66,9 +66,10 @@ pub struct Gpu {
     /// the next `check` instead of the default handler's panic.
     errors: Arc<Mutex<Vec<String>>>,
     lost: Arc<Mutex<Option<String>>>,
-    /// Kernels compiled on this device, by what they were compiled for (compiling is slow on a
-    /// software adapter, and every tree of a format shares them).
-    kernels: Mutex<HashMap<String, Arc<Kernel>>>,
+    /// What was compiled on this device (the kernels), by what it was compiled for: compiling is
+    /// slow on a software adapter, and every tree of a format shares them. Typed loosely so the
+    /// device knows nothing of what a kernel is.
+    compiled: Mutex<HashMap<String, Arc<dyn Any + Send + Sync>>>,
 }
 
 impl std::fmt::Debug for Gpu {
@@ -137,7 +138,7 @@ impl Gpu {
         });
         let binding = limits.max_storage_buffer_binding_size as u64;
         let max_buffer = binding.min(limits.max_buffer_size).min(opts.max_buffer_bytes.unwrap_or(u64::MAX));
-        Ok(Gpu { device, queue, info, limits, max_buffer, f64, errors, lost, kernels: Mutex::new(HashMap::new()) })
+        Ok(Gpu { device, queue, info, limits, max_buffer, f64, errors, lost, compiled: Mutex::new(HashMap::new()) })
     }
 
     /// The adapter's name, its backend and driver, e.g. "NVIDIA H200 (Vulkan, NVIDIA 580.159)":
@@ -220,17 +221,18 @@ impl Gpu {
         self.device.destroy();
     }
 
-    /// The kernel compiled for `key`, made by `make` the first time.
-    pub(crate) fn kernel(
+    /// What was compiled for `key` (a kernel), made by `make` the first time.
+    pub(crate) fn compiled<T: Any + Send + Sync>(
         &self,
         key: String,
-        make: impl FnOnce() -> Result<Kernel, GpuError>,
-    ) -> Result<Arc<Kernel>, GpuError> {
-        if let Some(k) = self.kernels.lock().unwrap_or_else(|p| p.into_inner()).get(&key) {
-            return Ok(k.clone());
+        make: impl FnOnce() -> Result<T, GpuError>,
+    ) -> Result<Arc<T>, GpuError> {
+        let found = self.compiled.lock().unwrap_or_else(|p| p.into_inner()).get(&key).cloned();
+        if let Some(k) = found.and_then(|k| k.downcast::<T>().ok()) {
+            return Ok(k);
         }
         let k = Arc::new(make()?);
-        self.kernels.lock().unwrap_or_else(|p| p.into_inner()).insert(key, k.clone());
+        self.compiled.lock().unwrap_or_else(|p| p.into_inner()).insert(key, k.clone());
         Ok(k)
     }
 

@@ -14,10 +14,10 @@ use crate::device::{Gpu, GpuError};
 use crate::kernel::{Bind, Kernel};
 use crate::scan::Scan;
 use crate::sort::RadixSort;
+use bvhscope_core::bvh::params::MAX_LEAF_SIZE;
 use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, SplitStrategy};
 use bvhscope_core::geometry::Aabb;
 use bvhscope_core::mesh::Mesh;
-use bvhscope_core::options::MAX_LEAF_SIZE;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -154,7 +154,7 @@ impl GpuLbvh {
                 })
                 .collect();
             let k =
-                gpu.kernel(format!("lbvh {entry}"), || Kernel::with_bindings(gpu, entry, src, entry, &binds, &[]))?;
+                gpu.compiled(format!("lbvh {entry}"), || Kernel::with_bindings(gpu, entry, src, entry, &binds, &[]))?;
             kernels.push((entry, k));
         }
         Ok(GpuLbvh { kernels, sort: RadixSort::new(gpu)?, scan: Scan::new(gpu)? })

@@ -9,10 +9,10 @@ use crate::device::{Gpu, GpuError};
 use crate::kernel::{Bind, Kernel};
 use crate::lbvh::{morton_sizes, GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
 use crate::scan::Scan;
+use bvhscope_core::bvh::params::{MAX_LEAF_SIZE, PLOC_RADIUS, TRAVERSAL_COST};
 use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, SahCost, SplitStrategy};
 use bvhscope_core::geometry::Aabb;
 use bvhscope_core::mesh::Mesh;
-use bvhscope_core::options::{MAX_LEAF_SIZE, PLOC_RADIUS, TRAVERSAL_COST};
 use glam::Vec3;
 use std::sync::Arc;
 use std::time::Instant;
@@ -158,7 +158,7 @@ impl GpuPloc {
                 })
                 .collect();
             let k =
-                gpu.kernel(format!("ploc {entry}"), || Kernel::with_bindings(gpu, entry, src, entry, &binds, &[]))?;
+                gpu.compiled(format!("ploc {entry}"), || Kernel::with_bindings(gpu, entry, src, entry, &binds, &[]))?;
             kernels.push((entry, k));
         }
         Ok(GpuPloc { lbvh: GpuLbvh::new(gpu)?, kernels, scan: Scan::new(gpu)? })

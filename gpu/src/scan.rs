@@ -27,7 +27,7 @@ impl Scan {
         let src = include_str!("shaders/scan.wgsl");
         let binds = [Bind::Uniform, Bind::ReadWrite, Bind::ReadWrite];
         let k = |entry: &'static str| {
-            gpu.kernel(format!("scan {entry}"), || Kernel::new(gpu, entry, src, entry, &binds, &[]))
+            gpu.compiled(format!("scan {entry}"), || Kernel::new(gpu, entry, src, entry, &binds, &[]))
         };
         Ok(Scan { blocks: k("scan_blocks")?, sums: k("scan_sums")?, add: k("add_sums")? })
     }

@@ -36,7 +36,7 @@ impl RadixSort {
         let src = include_str!("shaders/radix_sort.wgsl");
         let binds = [Bind::Uniform, Bind::Read, Bind::Read, Bind::ReadWrite, Bind::ReadWrite, Bind::ReadWrite];
         let k = |entry: &'static str| {
-            gpu.kernel(format!("sort {entry}"), || Kernel::new(gpu, entry, src, entry, &binds, &[]))
+            gpu.compiled(format!("sort {entry}"), || Kernel::new(gpu, entry, src, entry, &binds, &[]))
         };
         Ok(RadixSort { histogram: k("histogram")?, scatter: k("scatter")?, scan: Scan::new(gpu)? })
     }

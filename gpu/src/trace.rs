@@ -176,7 +176,7 @@ impl Kernels {
 
     fn get(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Arc<Kernel>, GpuError> {
         let key = format!("{} {stack:?} camera={camera} {opts:?}", self.format);
-        gpu.kernel(key, || self.compile(gpu, stack, camera, opts))
+        gpu.compiled(key, || self.compile(gpu, stack, camera, opts))
     }
 
     fn compile(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Kernel, GpuError> {

@@ -233,8 +233,7 @@ impl BvhscopeApp {
             }
             A::CompareStrategy(st) => self.compare.strategy = st,
             A::CompareB { max_leaf_size, layout, trace } => {
-                let n = &crate::options::MAX_LEAF_SIZE;
-                self.compare.max_leaf_size = max_leaf_size.clamp(n.min, n.max);
+                self.compare.max_leaf_size = crate::bvh::params::MAX_LEAF_SIZE.clamp(max_leaf_size);
                 self.compare.layout = layout;
                 self.compare.trace = trace;
             }

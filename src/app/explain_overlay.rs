@@ -57,8 +57,8 @@ pub(super) fn draw_replay(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect
 /// seven the eight octant-like cells in Z order, and it refines as the tree is split.
 fn morton_lines(
     m: &crate::bvh::morton::MortonOrder,
-    p: &crate::bvh::replay::PartialBvh,
-    h: &crate::bvh::inspect::Hierarchy,
+    p: &crate::explain::replay::PartialBvh,
+    h: &crate::bvh::Hierarchy,
     out: &mut Vec<super::overlay::Line3>,
 ) {
     let mut pieces: Vec<(u32, u32)> =
@@ -114,7 +114,7 @@ fn draw_plane(
     rect: Rect,
     camera: &crate::render::Camera,
     b: &crate::geometry::Aabb,
-    m: &crate::bvh::inspect::Marker,
+    m: &crate::explain::inspect::Marker,
     lines: &mut Vec<super::overlay::Line3>,
 ) {
     use super::overlay::{project, Line3};

@@ -12,7 +12,7 @@ pub struct Shown {
     pub legend: Option<Legend>,
     pub style: ViewStyle,
     /// The build replay's partial tree that traced the image, if it was one.
-    pub partial: Option<Arc<crate::bvh::replay::PartialBvh>>,
+    pub partial: Option<Arc<crate::explain::replay::PartialBvh>>,
     /// Rays per second of the last pass.
     pub rays_per_s: f64,
     /// The build that traced it ("SAH binned, wide4"), for captions.
@@ -21,7 +21,7 @@ pub struct Shown {
     pub bvh: Arc<SceneBvh>,
     pub trace: TraceOptions,
     /// The GPU that traced it, if one did (`app::gpu`).
-    pub gpu: Option<super::gpu::GpuRender>,
+    pub gpu: Option<super::jobs::GpuRender>,
 }
 
 /// Per-ray figures of a full frame, with what they depend on besides the BVH: the camera (and

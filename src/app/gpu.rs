@@ -8,11 +8,10 @@
 //! Möller–Trumbore test, the build replay's partial trees) the CPU does and the View panel says
 //! why; a GPU error (device lost, a command rejected) switches back to the CPU with a message.
 
-use super::jobs::{JobEvent, PassOutput, RenderRequest};
+use super::jobs::messages::{GpuRender, JobEvent, PassOutput, RenderRequest};
 use super::{BvhscopeApp, MessageKind};
 use crate::bvh::{SceneBuild, SceneBvh};
-use crate::cli::device::{build_on_gpu, builds_on_gpu, GpuBuild, GpuTree};
-use crate::cli::{Device, GpuNodes};
+use crate::gpu_path::{build_on_gpu, builds_on_gpu, Device, GpuBuild, GpuNodes, GpuTree};
 use crate::mesh::Mesh;
 use crate::render::{view_image, Frame, PassInfo};
 use crate::scene::{Scene, SceneBuildError};
@@ -28,19 +27,6 @@ pub enum Probe {
     Found(Arc<Gpu>),
     /// Why there is no GPU (the GPU crate's message: what to install).
     Missing(String),
-}
-
-/// The GPU to trace a frame on, and in which node format (part of a render request).
-#[derive(Clone)]
-pub struct GpuRender {
-    pub gpu: Arc<Gpu>,
-    pub nodes: GpuNodes,
-}
-
-impl GpuRender {
-    pub fn same_as(&self, o: &GpuRender) -> bool {
-        Arc::ptr_eq(&self.gpu, &o.gpu) && self.nodes == o.nodes
-    }
 }
 
 /// The tree last uploaded: for which BVH and format (one at a time; a new one replaces it).
@@ -107,6 +93,10 @@ impl GpuJobs {
             return Ok(None);
         }
         let t = tree.walk(&g.gpu, Rays::Camera(&r.camera), r.trace, true).map_err(|e| e.to_string())?;
+        // While orbiting, a newer request has usually cancelled this one by now: skip its shading.
+        if control.is_cancelled() {
+            return Ok(None);
+        }
         let frame = Frame::from_hits(&mesh, &r.camera, &t.hits, &t.counters).map_err(|e| e.to_string())?;
         let rays = t.hits.len() as u64;
         let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);

@@ -31,7 +31,7 @@ pub struct ImportedTree {
 
 impl ImportedTree {
     pub fn name(&self) -> String {
-        self.path.file_name().map_or_else(|| self.path.display().to_string(), |n| n.to_string_lossy().into_owned())
+        crate::files::file_name(&self.path)
     }
 
     pub fn defects(&self) -> usize {

@@ -378,7 +378,7 @@ impl BvhscopeApp {
     }
 
     /// The partial tree the viewport shows while the Replay window is open (of the current BVH).
-    pub fn replay_partial(&self) -> Option<Arc<crate::bvh::replay::PartialBvh>> {
+    pub fn replay_partial(&self) -> Option<Arc<crate::explain::replay::PartialBvh>> {
         let bvh = self.current_bvh()?.bvh.clone();
         let e = self.nodes.current(Some(&bvh))?;
         let p = self.replay.partial.as_ref().filter(|_| self.replay.window)?;
@@ -476,34 +476,7 @@ impl eframe::App for BvhscopeApp {
             self.act(action);
         }
         self.reconcile();
-        let out = &mut actions;
-        egui::Panel::top("menu").show(ui, |ui| panels::menu::show(self, ui, out));
-        egui::Panel::bottom("status").show(ui, |ui| panels::status::show(self, ui));
-        // The side panels keep the width they have (the user's, remembered by egui's memory):
-        // their contents wrap, scroll or clip inside it and never widen them, so the viewport,
-        // and with it the camera's aspect, stays as it is when the figures change.
-        egui::Panel::left("controls").resizable(true).default_size(290.0).size_range(200.0..=640.0).show(ui, |ui| {
-            panels::fixed_width(ui, |ui| {
-                panels::build::show(self, ui, out);
-                ui.separator();
-                panels::view::show(self, ui, out);
-            })
-        });
-        egui::Panel::right("statistics")
-            .resizable(true)
-            .default_size(340.0)
-            .size_range(220.0..=720.0)
-            .show(ui, |ui| panels::fixed_width(ui, |ui| panels::stats::show(self, ui, out)));
-        egui::CentralPanel::default()
-            .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(12)))
-            .show(ui, |ui| viewport::show(self, ui, out));
-        panels::windows::show(self, &ctx, out);
-        panels::ray::show(self, &ctx, out);
-        panels::tree::show(self, &ctx, out);
-        panels::node::show(self, &ctx, out);
-        panels::replay::show(self, &ctx, out);
-        panels::compare::show(self, &ctx, out);
-        panels::imported::show(self, &ctx, out);
+        panels::show_all(self, ui, &mut actions);
         // What the panels asked for takes effect now, and shows in the next frame.
         if !actions.is_empty() {
             for action in actions {

@@ -2,11 +2,12 @@
 //! tree as built (`AnyBvh::binary_tree`), its hierarchy and each node's end-point overlap are
 //! prepared in the background (`Explained`); with the Tree window open, the visits of the frame's
 //! rays per node too. The node selected here is the one the tree view, the icicle, the viewport
-//! and the inspector show; its inspection (`bvh::inspect`) is computed in the background too,
+//! and the inspector show; its inspection (`explain::inspect`) is computed in the background too,
 //! since a node of millions of triangles takes a moment to sweep.
 
-use crate::bvh::inspect::{Hierarchy, Inspection};
+use crate::bvh::Hierarchy;
 use crate::bvh::{Bvh, SceneBvh, TraceOptions};
+use crate::explain::inspect::Inspection;
 use crate::render::Camera;
 use std::collections::HashSet;
 use std::sync::Arc;
@@ -53,7 +54,7 @@ impl Explained {
             return 0.0;
         }
         let (l, r) = (&self.tree.nodes[n.index as usize], &self.tree.nodes[n.index as usize + 1]);
-        crate::bvh::inspect::Overlap::of(&l.bounds(), &r.bounds()).area as f64 / n.bounds().area() as f64
+        crate::explain::inspect::Overlap::of(&l.bounds(), &r.bounds()).area as f64 / n.bounds().area() as f64
     }
 }
 

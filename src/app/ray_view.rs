@@ -49,7 +49,7 @@ impl PinnedRay {
         let command = match source {
             SceneSource::File(path) => {
                 let dump = bvh.import().map(|i| i.path.as_path());
-                Some(crate::cli::trace::command(path, &ray, &bvh.build_params(), opts, dump))
+                Some(crate::explain::words::trace_command(path, &ray, &bvh.build_params(), opts, dump))
             }
             SceneSource::Builtin => None,
         };

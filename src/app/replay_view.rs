@@ -1,11 +1,11 @@
 //! The build replay's state behind the Replay window: the replay of the current single BVH's
-//! binary tree (`bvh::replay`, prepared with the tree view's `Explained`), the step shown and
+//! binary tree (`explain::replay`, prepared with the tree view's `Explained`), the step shown and
 //! whether it plays. While the window is open the viewport shows the tree after `k` splits.
 
 use super::node_view::Explained;
-use crate::bvh::inspect::{CurvePoint, Marker};
 use crate::bvh::morton::MortonOrder;
-use crate::bvh::replay::{PartialBvh, Replay};
+use crate::explain::inspect::{CurvePoint, Marker};
+use crate::explain::replay::{PartialBvh, Replay};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -47,7 +47,7 @@ impl ReplayView {
             self.newest = self.k.checked_sub(1).map(|i| r.order[i]).map(|n| {
                 // An imported tree has no strategy of bvhscope's to find its plane with.
                 if e.hierarchy.count[n as usize] <= MAX_PLANE_TRIANGLES && e.bvh.import().is_none() {
-                    let (m, bins) = crate::bvh::inspect::own_split(&e.tree, &e.hierarchy, n);
+                    let (m, bins) = crate::explain::inspect::own_split(&e.tree, &e.hierarchy, n);
                     (n, m, bins)
                 } else {
                     (n, None, Default::default())

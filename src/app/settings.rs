@@ -1,7 +1,7 @@
 //! What the user chose, remembered across runs (eframe persistence).
 
 use crate::bvh::{BuildParams, Layout, Preset, TraceOptions};
-use crate::cli::{Device, GpuNodes};
+use crate::gpu_path::{Device, GpuNodes};
 use crate::render::{ColorMap, HeatRange, UpAxis, View};
 use std::collections::HashMap;
 use std::path::PathBuf;

@@ -1,15 +1,15 @@
 //! Arguments shared by the subcommands. Every value list, help line, limit and default comes from
 //! the core's option tables (`crate::options`), which the app's panels and scene files read too.
 
-use crate::bvh::{BuildParams, Layout, Preset, SahCost, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder};
-use crate::geometry::{Aabb, TriangleTest};
-use crate::options::{
-    Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TOP_MAX_LEAF_SIZE,
-    TRAVERSAL_COST,
+use crate::bvh::{
+    BuildParams, Layout, Param, ParamValue, Preset, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder,
 };
+use crate::geometry::{Aabb, TriangleTest};
+use crate::gpu_path::{Device, GpuNodes};
+use crate::options::{Choice, Number, BUILD_PARAMS, TOP_MAX_LEAF_SIZE};
 use crate::render::{Camera, UpAxis};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-use clap::Args;
+use clap::{Arg, ArgMatches, Args, Command, FromArgMatches};
 use glam::Vec3;
 
 /// clap's parser for a choice: the names of its table, each with its help in `--help`.
@@ -18,14 +18,37 @@ pub fn choice<T: Choice + Clone>() -> impl TypedValueParser<Value = T> {
         .map(|s| T::from_name(&s).expect("clap passes only the listed names"))
 }
 
-/// A whole number within a table's limits.
+/// A whole number within a number's limits.
 fn whole(n: &'static Number<u32>) -> impl TypedValueParser<Value = u32> {
-    clap::value_parser!(u32).range(n.min as i64..=n.max as i64)
+    clap::value_parser!(u32).range(n.limits.min as i64..=n.limits.max as i64)
 }
 
-/// A number's help line with its limits and default, for `--help`.
-fn number_help<T: std::fmt::Display + PartialOrd + Copy>(n: &Number<T>) -> String {
-    format!("{} ({}) [default: {}]", n.help, n.range_text(), n.default)
+/// The build parameters given on the command line: one option per row of the core's table
+/// (`--max-leaf-size`, `--bins`, …), its name, help, limits and default read from there.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ParamArgs(pub Vec<(Param, ParamValue)>);
+
+impl Args for ParamArgs {
+    fn augment_args(cmd: Command) -> Command {
+        BUILD_PARAMS.iter().fold(cmd, |cmd, o| {
+            let arg = Arg::new(o.name).long(o.name).value_name(o.name.to_uppercase().replace('-', "_"));
+            cmd.arg(arg.help(o.help_line()).value_parser(move |s: &str| o.parse(s)))
+        })
+    }
+    fn augment_args_for_update(cmd: Command) -> Command {
+        Self::augment_args(cmd)
+    }
+}
+
+impl FromArgMatches for ParamArgs {
+    fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
+        let given = BUILD_PARAMS.iter().filter_map(|o| Some((o.param, *m.get_one::<ParamValue>(o.name)?)));
+        Ok(ParamArgs(given.collect()))
+    }
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
 }
 
 /// How to build and traverse the BVH. Each option left out comes from `--preset` if given, else
@@ -38,20 +61,8 @@ pub struct BuildArgs {
     /// Split strategy [default: sah].
     #[arg(long, short, value_parser = choice::<SplitStrategy>())]
     pub strategy: Option<SplitStrategy>,
-    #[arg(long, value_parser = whole(&MAX_LEAF_SIZE), help = number_help(&MAX_LEAF_SIZE))]
-    pub max_leaf_size: Option<u32>,
-    #[arg(long, value_parser = whole(&SAH_BINS), help = number_help(&SAH_BINS))]
-    pub bins: Option<u32>,
-    #[arg(long, value_parser = whole(&PLOC_RADIUS), help = number_help(&PLOC_RADIUS))]
-    pub ploc_radius: Option<u32>,
-    #[arg(long, value_parser = whole(&REINSERT_PASSES), help = number_help(&REINSERT_PASSES))]
-    pub reinsert_passes: Option<u32>,
-    #[arg(long, value_parser = parse_sbvh_alpha, help = number_help(&SBVH_ALPHA))]
-    pub sbvh_alpha: Option<f32>,
-    #[arg(long, value_parser = whole(&SBVH_GROWTH), help = number_help(&SBVH_GROWTH))]
-    pub sbvh_growth: Option<u32>,
-    #[arg(long, value_parser = parse_traversal_cost, help = number_help(&TRAVERSAL_COST))]
-    pub traversal_cost: Option<f32>,
+    #[command(flatten)]
+    pub numbers: ParamArgs,
     /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
     #[arg(long, value_parser = choice::<Layout>())]
     pub layout: Option<Layout>,
@@ -69,7 +80,7 @@ pub struct BuildArgs {
     /// Split strategy of the top level [default: --strategy].
     #[arg(long, value_parser = choice::<SplitStrategy>(), requires = "two_level")]
     pub top_strategy: Option<SplitStrategy>,
-    #[arg(long, default_value_t = TOP_MAX_LEAF_SIZE.default, value_parser = whole(&TOP_MAX_LEAF_SIZE), help = number_help(&TOP_MAX_LEAF_SIZE), requires = "two_level")]
+    #[arg(long, default_value_t = TOP_MAX_LEAF_SIZE.limits.default, value_parser = whole(&TOP_MAX_LEAF_SIZE), help = format!("{} ({})", TOP_MAX_LEAF_SIZE.help, TOP_MAX_LEAF_SIZE.limits.range_text()), requires = "two_level")]
     pub top_max_leaf_size: u32,
 }
 
@@ -93,18 +104,11 @@ impl BuildArgs {
 
     /// `params` with the strategy and layout given (`compare` goes through them all).
     pub fn params_with(&self, scene: Option<&BuildParams>, strategy: SplitStrategy, layout: Layout) -> BuildParams {
-        let base = self.base(scene);
-        BuildParams {
-            strategy,
-            layout,
-            max_leaf_size: self.max_leaf_size.unwrap_or(base.max_leaf_size),
-            sah_bins: self.bins.unwrap_or(base.sah_bins),
-            ploc_radius: self.ploc_radius.unwrap_or(base.ploc_radius),
-            reinsert_passes: self.reinsert_passes.unwrap_or(base.reinsert_passes),
-            sbvh_alpha: self.sbvh_alpha.unwrap_or(base.sbvh_alpha),
-            sbvh_growth: self.sbvh_growth.unwrap_or(base.sbvh_growth),
-            cost: SahCost { traversal: self.traversal_cost.unwrap_or(base.cost.traversal), ..base.cost },
+        let mut p = BuildParams { strategy, layout, ..self.base(scene) };
+        for &(param, v) in &self.numbers.0 {
+            param.set(&mut p, v);
         }
+        p
     }
 
     /// The layouts `compare` shows: the one given or the preset's, else both.
@@ -134,61 +138,6 @@ impl BuildArgs {
     }
 }
 
-/// The options that rebuild `build` and trace with `opts`, every one given (so neither a preset
-/// nor a scene file's settings change them): what the app writes when it names the command line
-/// that reproduces what it shows. `BuildArgs` parses them back to the same values.
-pub fn build_flags(build: &SceneBuild, opts: TraceOptions) -> Vec<String> {
-    let p = &build.bvh;
-    let mut out = vec![
-        format!("--strategy {}", p.strategy.named().name),
-        format!("--max-leaf-size {}", p.max_leaf_size),
-        format!("--bins {}", p.sah_bins),
-        format!("--ploc-radius {}", p.ploc_radius),
-        format!("--reinsert-passes {}", p.reinsert_passes),
-        format!("--sbvh-alpha {}", p.sbvh_alpha),
-        format!("--sbvh-growth {}", p.sbvh_growth),
-        format!("--traversal-cost {}", p.cost.traversal),
-        format!("--layout {}", p.layout.named().name),
-        format!("--order {}", opts.order.named().name),
-        format!("--triangle-test {}", opts.test.named().name),
-    ];
-    if let Some(top) = &build.top {
-        out.push("--two-level".into());
-        out.push(format!("--top-strategy {}", top.strategy.named().name));
-        out.push(format!("--top-max-leaf-size {}", top.max_leaf_size));
-    }
-    out
-}
-
-/// A path as one shell word: as it is when it needs no quoting, else in single quotes.
-pub fn shell_word(s: &str) -> String {
-    if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "/._-+,:=@%".contains(c)) {
-        s.to_string()
-    } else {
-        format!("'{}'", s.replace('\'', r"'\''"))
-    }
-}
-
-/// Where rays are traced: the CPU (the renderer of `core`) or the GPU (`bvhscope-gpu`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Device {
-    #[default]
-    Cpu,
-    Gpu,
-}
-
-/// The node format the GPU walks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum GpuNodes {
-    /// The binary tree as built: core's 32-byte nodes, byte for byte.
-    #[default]
-    Binary,
-    /// Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree.
-    Cwbvh,
-}
-
 /// `--device` and the GPU's node format: the one declaration `render`, `stats`, `compare` and
 /// `trace` take (the GPU path's rules are in `cli::device`).
 #[derive(Args, Debug, Clone, Default)]
@@ -203,16 +152,6 @@ pub struct DeviceArgs {
     /// 8-wide form (CWBVH) [default: binary].
     #[arg(long, value_enum, value_name = "FORMAT")]
     pub gpu_nodes: Option<GpuNodes>,
-}
-
-impl GpuNodes {
-    /// How messages and tables name the format.
-    pub fn name(self) -> &'static str {
-        match self {
-            GpuNodes::Binary => "binary",
-            GpuNodes::Cwbvh => "CWBVH",
-        }
-    }
 }
 
 impl DeviceArgs {
@@ -239,6 +178,22 @@ impl DumpLimit {
     /// The limit in bytes for a dump of `mesh`.
     pub fn bytes(&self, mesh: &crate::mesh::Mesh) -> u64 {
         self.max_dump_mb.map_or_else(|| crate::dump::max_bytes(mesh.file_triangle_count()), |mb| mb << 20)
+    }
+
+    /// The dump at `path` (`--bvh`) read and made into bvhscope's tree over the scene's mesh, as
+    /// every command traces it (its structure must be sound: `check` says what is wrong otherwise).
+    pub fn import(
+        &self,
+        scene: &crate::scene::Scene,
+        path: &std::path::Path,
+    ) -> Result<crate::bvh::SceneBvh, super::CliError> {
+        use super::CliError;
+        let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
+        let dump = crate::dump::BvhDump::read(path, self.bytes(&mesh)).map_err(|e| CliError::Usage(e.to_string()))?;
+        let structure = crate::explain::check::check_tree(&dump, &mesh);
+        let (bvh, imported) = crate::explain::check::traceable(&structure, &dump, &mesh, path)
+            .map_err(|why| CliError::Usage(format!("{}: {why}; bvhscope check lists what is wrong", path.display())))?;
+        Ok(crate::bvh::SceneBvh::imported(bvh, mesh, imported))
     }
 }
 
@@ -288,23 +243,6 @@ pub fn parse_fov(s: &str) -> Result<f32, String> {
     }
 }
 
-/// A traversal cost within its limits.
-pub fn parse_traversal_cost(s: &str) -> Result<f32, String> {
-    real(s, &TRAVERSAL_COST)
-}
-
-fn parse_sbvh_alpha(s: &str) -> Result<f32, String> {
-    real(s, &SBVH_ALPHA)
-}
-
-/// A number within a table's limits.
-fn real(s: &str, n: &Number<f32>) -> Result<f32, String> {
-    match s.trim().parse::<f32>() {
-        Ok(v) if n.contains(v) => Ok(v),
-        _ => Err(format!("'{s}' is not a number {}", n.range_text())),
-    }
-}
-
 /// `1280x720` → (1280, 720).
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT"))?;
@@ -350,9 +288,9 @@ mod tests {
         assert_eq!((e, t, u), (Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, None));
         assert_eq!(parse_camera("1,2,3:4,5,6:0,0,1").unwrap().2, Some(Vec3::Z));
         assert!(parse_camera("1,2:0,0,0").is_err() && parse_camera("nan,0,0:0,0,0").is_err());
-        assert_eq!(parse_traversal_cost("2.5"), Ok(2.5));
-        assert!(parse_traversal_cost("nan").is_err() && parse_traversal_cost("inf").is_err());
-        assert!(parse_traversal_cost("-1").is_err() && parse_traversal_cost("0").is_err());
+        let cost = |s: &str| Param::TraversalCost.option().parse(s);
+        assert_eq!(cost("2.5"), Ok(ParamValue::Real(2.5)));
+        assert!(cost("nan").is_err() && cost("inf").is_err() && cost("-1").is_err() && cost("0").is_err());
     }
 
     #[test]
@@ -379,5 +317,59 @@ mod tests {
         assert_eq!(mine.trace(), TraceOptions { test: TriangleTest::Watertight, ..Preset::Handout.trace() });
         assert_eq!(parse(&["-s", "sah-sweep"]).params(Some(&scene)).strategy, SplitStrategy::SahSweep);
         assert_eq!(parse(&[]).compare_layouts(), Layout::ALL.to_vec());
+    }
+
+    /// Every row of the option tables is an option of every subcommand that builds, the flags the
+    /// app writes parse back to the build they came from, and a scene file keeps every number.
+    #[test]
+    fn every_build_parameter_is_a_flag_and_a_scene_key_and_reads_back() {
+        use crate::options::{ParamOption, BUILD_PARAMS};
+        use clap::{CommandFactory, Parser};
+        let cli = super::super::Cli::command();
+        let builds: Vec<&clap::Command> =
+            cli.get_subcommands().filter(|c| c.get_arguments().any(|a| a.get_long() == Some("strategy"))).collect();
+        assert!(builds.len() >= 5, "render, stats, compare, trace, inspect… take the build options");
+        for c in &builds {
+            for o in &BUILD_PARAMS {
+                assert!(
+                    c.get_arguments().any(|a| a.get_long() == Some(o.name)),
+                    "{} has no --{}",
+                    c.get_name(),
+                    o.name
+                );
+            }
+        }
+        // Every number away from its default, each within its limits.
+        let mut p = BuildParams { strategy: SplitStrategy::Sbvh, layout: Layout::Binary, ..BuildParams::default() };
+        for o in &BUILD_PARAMS {
+            let v = match o.limits() {
+                crate::bvh::ParamLimits::Whole(l) => ParamValue::Whole(if l.default == l.max { l.min } else { l.max }),
+                crate::bvh::ParamLimits::Real(l) => ParamValue::Real((l.default + l.max) * 0.5),
+            };
+            o.param.set(&mut p, v);
+            assert_ne!(o.param.get(&p), o.limits().default_value(), "{}", o.name);
+        }
+        let build = SceneBuild { bvh: p, top: None };
+        let words: Vec<String> = crate::explain::words::build_flags(&build, TraceOptions::default())
+            .iter()
+            .flat_map(|w| w.split(' ').map(str::to_string).collect::<Vec<_>>())
+            .collect();
+        #[derive(Parser)]
+        struct T {
+            #[command(flatten)]
+            b: BuildArgs,
+        }
+        let back = T::parse_from(std::iter::once("t".to_string()).chain(words)).b;
+        assert_eq!(back.params(None), p, "the flags read back to the build");
+        let camera = Camera::framing_up(&Aabb::from_points(&[Vec3::ZERO, Vec3::ONE]), 64, 48, UpAxis::Y, 45.0);
+        let text = crate::scene::write_scene_file(&camera, &[], &p);
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        for o in &BUILD_PARAMS {
+            assert_eq!(json["bvh"][o.key], ParamOption::to_json(o.param.get(&p)), "the scene file's {}", o.key);
+        }
+        let mut scene = json.clone();
+        scene["meshes"] = serde_json::json!([{ "file": "x.obj" }]);
+        let desc = crate::scene::parse_scene_file(std::path::Path::new("s.json"), &scene.to_string()).unwrap();
+        assert_eq!(desc.build, Some(p), "a scene file reads back every number");
     }
 }

@@ -5,7 +5,7 @@
 
 use super::args::{BuildArgs, DumpLimit, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{epo, AnyBvh, BuildParams, Layout, SceneBvh, SplitStrategy, TreeStats, TreeView};
+use crate::bvh::{epo, AnyBvh, BuildParams, Layout, SplitStrategy, TreeStats, TreeView};
 use crate::dump::BvhDump;
 use crate::explain::check::{check, Finding, Group, Subject, LISTED, MAX_RAYS};
 use crate::render::{render, RenderSettings};
@@ -187,21 +187,6 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality], list: u
     o
 }
 
-/// A dump read and made into bvhscope's tree over the scene's mesh, as every command traces it
-/// (its structure must be sound: `check` says what is wrong otherwise).
-pub(crate) fn import_dump(
-    scene: &crate::scene::Scene,
-    path: &std::path::Path,
-    limit: &DumpLimit,
-) -> Result<SceneBvh, CliError> {
-    let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
-    let dump = BvhDump::read(path, limit.bytes(&mesh)).map_err(|e| CliError::Usage(e.to_string()))?;
-    let structure = crate::explain::check::check_tree(&dump, &mesh);
-    let (bvh, imported) = crate::explain::check::traceable(&structure, &dump, &mesh, path)
-        .map_err(|why| CliError::Usage(format!("{}: {why}; bvhscope check lists what is wrong", path.display())))?;
-    Ok(SceneBvh::imported(bvh, mesh, imported))
-}
-
 #[derive(Args, Debug)]
 pub struct ExportArgs {
     /// The mesh (.obj). The tree written is the binary one unless --layout wide4 or wide8 is given.
@@ -231,7 +216,7 @@ pub fn export(a: &ExportArgs) -> Result<(), CliError> {
     // The binary tree unless --layout wide4 or wide8 asks for a wide one.
     let layout = a.build.layout.unwrap_or(Layout::Binary);
     let params = BuildParams { layout, ..a.build.params(scene.build.as_ref()) };
-    let name = super::render::file_name(&a.mesh);
+    let name = crate::files::file_name(&a.mesh);
     let built = match &gpu {
         Some(g) => super::device::gpu_build(g, &mesh, &params)?.map(|(bvh, _)| bvh),
         None => None,

@@ -5,15 +5,15 @@
 //! are the CPU's for the binary layout. The strategies lbvh and ploc are built on the GPU too
 //! (core's trees node for node), with the build's phases timed.
 
-use super::args::{BuildArgs, DeviceArgs, GpuNodes};
+use super::args::{BuildArgs, DeviceArgs};
 use super::{progress, CliError};
-use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, RayCounters, SceneBuild, SceneBvh, SplitStrategy, TraceOptions};
+use crate::bvh::{AnyBvh, BuildParams, Layout, SceneBuild, SceneBvh, TraceOptions};
 use crate::geometry::{Ray, TriangleTest};
+pub use crate::gpu_path::{build_on_gpu, builds_on_gpu, GpuBuild, GpuNodes, GpuTree};
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame};
 use crate::scene::Scene;
-use bvhscope_gpu::{Cwbvh, Gpu, GpuBinaryBvh, GpuBuildTimings, GpuCwbvh, GpuError, GpuLbvh, GpuPloc, GpuTrace, Rays};
-use rayon::prelude::*;
+use bvhscope_gpu::{Gpu, GpuError, GpuTrace, Rays};
 use std::sync::Arc;
 
 /// A GPU error as the command line reports it: one line, exit 2.
@@ -80,77 +80,6 @@ pub fn check_traceable(build: &SceneBuild, trace: TraceOptions) -> Result<(), Cl
     Ok(())
 }
 
-/// A build made on the GPU: which builder, and how long each phase took.
-#[derive(Clone, Copy, Debug)]
-pub struct GpuBuild {
-    pub strategy: SplitStrategy,
-    pub timings: GpuBuildTimings,
-}
-
-impl GpuBuild {
-    /// The phases as `stats` prints them (PLOC's emission is its clustering, its boxes the host's
-    /// layout of the leaves).
-    pub fn text(&self) -> String {
-        let t = &self.timings;
-        let ms = |d: std::time::Duration| format!("{:.2}", d.as_secs_f64() * 1e3);
-        let (emission, boxes) = match self.strategy {
-            SplitStrategy::Ploc => {
-                (format!("clustering {} ({} rounds)", ms(t.emission), t.rounds), "layout on the host")
-            }
-            _ => (format!("emission {}", ms(t.emission)), "boxes"),
-        };
-        format!(
-            "{} ms (upload {}, codes {}, sort {}, {emission}, {boxes} {}, download {})",
-            ms(t.total()),
-            ms(t.upload),
-            ms(t.codes),
-            ms(t.sort),
-            ms(t.boxes),
-            ms(t.download)
-        )
-    }
-
-    pub fn json(&self) -> serde_json::Value {
-        let t = &self.timings;
-        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-        serde_json::json!({
-            "strategy": self.strategy.name(), "total_ms": ms(t.total()), "upload_ms": ms(t.upload),
-            "codes_ms": ms(t.codes), "sort_ms": ms(t.sort), "emission_ms": ms(t.emission), "boxes_ms": ms(t.boxes),
-            "download_ms": ms(t.download), "ploc_rounds": t.rounds,
-        })
-    }
-}
-
-/// Lay a built binary tree out as `layout` asks (as `AnyBvh::build` does after its build).
-fn lay_out(bvh: Bvh, layout: Layout) -> AnyBvh {
-    match layout {
-        Layout::Binary => AnyBvh::Binary(bvh),
-        Layout::Wide4 => AnyBvh::Wide(crate::bvh::WideBvh::from_binary(bvh)),
-        Layout::Wide8 => AnyBvh::Wide8(crate::bvh::WideBvh::collapse(bvh)),
-    }
-}
-
-/// Whether the GPU builds `strategy` (lbvh and ploc; the others are built on the CPU).
-pub fn builds_on_gpu(strategy: SplitStrategy) -> bool {
-    matches!(strategy, SplitStrategy::Lbvh | SplitStrategy::Ploc)
-}
-
-/// `gpu_build` without a spinner (the app's build job).
-pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<(AnyBvh, GpuBuild)>, GpuError> {
-    let strategy = params.strategy;
-    let built = match strategy {
-        SplitStrategy::Lbvh => GpuLbvh::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
-        SplitStrategy::Ploc => GpuPloc::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
-        _ => Ok(None),
-    }?;
-    Ok(built.map(|(mut bvh, timings)| {
-        if params.reinsert_passes > 0 {
-            bvh.report.reinsertion = Some(crate::bvh::reinsert::optimise(&mut bvh, params.reinsert_passes));
-        }
-        (lay_out(bvh, params.layout), GpuBuild { strategy, timings })
-    }))
-}
-
 /// Build `params` over `mesh` with lbvh or ploc on the GPU (reinsertion, if asked for, then on the
 /// CPU, as `Bvh::build` runs it after any builder); `None` for the other strategies, which only
 /// the CPU builds.
@@ -173,96 +102,6 @@ pub fn build_scene(
         }
     }
     Ok((super::build_scene(scene, build)?, None))
-}
-
-/// A tree on the GPU in the node format asked for, with the mesh its hits are on.
-pub enum GpuTree {
-    Binary(GpuBinaryBvh),
-    /// The CWBVH's CPU form too: its CPU walk is the reference for the GPU's counts.
-    Cwbvh(Box<Cwbvh>, GpuCwbvh),
-}
-
-impl GpuTree {
-    /// Upload the binary tree of `bvh` (one level: as built, or an imported dump's) as `nodes`.
-    pub fn new(gpu: &Gpu, bvh: &SceneBvh, nodes: GpuNodes) -> Result<(GpuTree, Arc<Mesh>), GpuError> {
-        let SceneBvh::Single { mesh, .. } = bvh else {
-            return Err(GpuError::Input("the GPU traces one BVH, not two levels".into()));
-        };
-        let tree = bvh.binary_tree().ok_or_else(|| {
-            GpuError::Input("this imported wide tree has no binary form the GPU could walk; trace it on the CPU".into())
-        })?;
-        let uploaded = match nodes {
-            GpuNodes::Binary => GpuTree::Binary(GpuBinaryBvh::upload(gpu, &tree)?),
-            GpuNodes::Cwbvh => {
-                let cw = Cwbvh::from_bvh(&tree)?;
-                let on_gpu = GpuCwbvh::upload(gpu, &cw)?;
-                GpuTree::Cwbvh(Box::new(cw), on_gpu)
-            }
-        };
-        Ok((uploaded, mesh.clone()))
-    }
-
-    /// `new`, with a spinner while it takes long and the command line's error.
-    pub fn upload(gpu: &Gpu, bvh: &SceneBvh, nodes: GpuNodes) -> Result<(GpuTree, Arc<Mesh>), CliError> {
-        progress::with_spinner("uploading the tree to the GPU", || Self::new(gpu, bvh, nodes)).map_err(gpu_error)
-    }
-
-    pub fn nodes(&self) -> GpuNodes {
-        match self {
-            GpuTree::Binary(_) => GpuNodes::Binary,
-            GpuTree::Cwbvh(..) => GpuNodes::Cwbvh,
-        }
-    }
-
-    /// Trace `rays` (closest hits), counting when `counted`, in `trace`'s order (binary nodes;
-    /// CWBVH orders its children by octant).
-    pub fn walk(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, GpuError> {
-        let opts = bvhscope_gpu::GpuTraceOptions { order: trace.order, counted, exact: true };
-        match self {
-            GpuTree::Binary(t) => t.trace(gpu, rays, opts),
-            GpuTree::Cwbvh(_, t) => t.trace(gpu, rays, opts),
-        }
-    }
-
-    /// `walk`, with the command line's error.
-    pub fn trace(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, CliError> {
-        self.walk(gpu, rays, trace, counted).map_err(gpu_error)
-    }
-
-    /// `camera`'s frame traced on the GPU, as a frame the views, legends and CSVs read.
-    pub fn frame(
-        &self,
-        gpu: &Gpu,
-        mesh: &Mesh,
-        camera: &Camera,
-        trace: TraceOptions,
-        counted: bool,
-    ) -> Result<(Frame, GpuTrace), CliError> {
-        let label = format!("tracing the {}x{} frame on the GPU", camera.width, camera.height);
-        let t = progress::with_spinner(&label, || self.trace(gpu, Rays::Camera(camera), trace, counted))?;
-        let frame = Frame::from_hits(mesh, camera, &t.hits, &t.counters)
-            .map_err(|e| CliError::Usage(format!("--device gpu: {e}")))?;
-        Ok((frame, t))
-    }
-
-    /// The per-pixel counts of the same walk on the CPU (row by row): core's renderer for binary
-    /// nodes (`cpu` is the binary tree's `SceneBvh`), the CWBVH's own CPU walk for CWBVH nodes.
-    pub fn cpu_counts(&self, cpu: &SceneBvh, camera: &Camera, trace: TraceOptions) -> Vec<RayCounters> {
-        match self {
-            GpuTree::Binary(_) => {
-                let settings = crate::render::RenderSettings { trace, count: true, progressive: false };
-                let frame = crate::render::render(cpu, cpu, camera, &settings);
-                frame.traced().map(|(_, c)| c).collect()
-            }
-            GpuTree::Cwbvh(cw, _) => {
-                let gen = camera.ray_gen();
-                (0..camera.width * camera.height)
-                    .into_par_iter()
-                    .map(|i| cw.trace_cpu(&mut gen.pixel_ray(i % camera.width, i / camera.width)).1)
-                    .collect()
-            }
-        }
-    }
 }
 
 /// `n` incoherent rays: from random points on random triangles of `mesh` in random directions, a
@@ -289,4 +128,33 @@ pub fn incoherent_rays(mesh: &Mesh, n: usize) -> Vec<Ray> {
             Ray::new(p + dir * eps, dir)
         })
         .collect()
+}
+
+/// The command line's spinners and errors over the GPU path's tree.
+impl GpuTree {
+    /// `new`, with a spinner while it takes long and the command line's error.
+    pub fn upload(gpu: &Gpu, bvh: &SceneBvh, nodes: GpuNodes) -> Result<(GpuTree, Arc<Mesh>), CliError> {
+        progress::with_spinner("uploading the tree to the GPU", || Self::new(gpu, bvh, nodes)).map_err(gpu_error)
+    }
+
+    /// `walk`, with the command line's error.
+    pub fn trace(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, CliError> {
+        self.walk(gpu, rays, trace, counted).map_err(gpu_error)
+    }
+
+    /// `camera`'s frame traced on the GPU, as a frame the views, legends and CSVs read.
+    pub fn frame(
+        &self,
+        gpu: &Gpu,
+        mesh: &Mesh,
+        camera: &Camera,
+        trace: TraceOptions,
+        counted: bool,
+    ) -> Result<(Frame, GpuTrace), CliError> {
+        let label = format!("tracing the {}x{} frame on the GPU", camera.width, camera.height);
+        let t = progress::with_spinner(&label, || self.trace(gpu, Rays::Camera(camera), trace, counted))?;
+        let frame = Frame::from_hits(mesh, camera, &t.hits, &t.counters)
+            .map_err(|e| CliError::Usage(format!("--device gpu: {e}")))?;
+        Ok((frame, t))
+    }
 }

@@ -1,12 +1,14 @@
 //! `bvhscope inspect MESH --node N`: one node of the binary tree as built, explained (the app's
 //! node inspector): its figures, its children, and per axis the SAH cost of splitting its
-//! triangles at every candidate plane with each strategy's choice marked (`bvh::inspect`).
+//! triangles at every candidate plane with each strategy's choice marked (`explain::inspect`).
 
 use super::args::{BuildArgs, ViewArgs};
 use super::{build_scene, load_mesh, CliError};
-use crate::bvh::inspect::{inspect, CurvePoint, Hierarchy, Inspection};
-use crate::bvh::wide::{wide_group_in, WideGroup};
+use crate::bvh::wide::wide_group_in;
+use crate::bvh::Hierarchy;
 use crate::bvh::{epo, SceneBvh, TreeView};
+use crate::explain::inspect::text::{dump_text, no_split_text, sbvh_text, wide_group_text};
+use crate::explain::inspect::{inspect, CurvePoint, Inspection};
 use crate::options::Choice;
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
@@ -47,7 +49,7 @@ pub struct InspectArgs {
 const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// A split's cost term by term, as JSON fields.
-fn terms_json(t: &crate::bvh::inspect::CostTerms) -> serde_json::Value {
+fn terms_json(t: &crate::explain::inspect::CostTerms) -> serde_json::Value {
     serde_json::json!({ "left_count": t.left, "right_count": t.right, "area_left_ratio": t.area_left,
         "area_right_ratio": t.area_right, "traversal_term": t.traversal, "left_term": t.left_term,
         "right_term": t.right_term, "cost": t.cost })
@@ -143,14 +145,8 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
                 );
                 let _ = writeln!(o, "  {:<12}  {}", "", m.terms(ins.sah).text());
             }
-            None if *s == crate::bvh::SplitStrategy::Sbvh => {
-                let _ = writeln!(o, "  {:<12}  makes a leaf here", s.named().name);
-            }
-            None if !s.splits_top_down() => {
-                let _ = writeln!(o, "  {:<12}  no plane priced here: it builds from the Morton order", s.named().name);
-            }
             None => {
-                let _ = writeln!(o, "  {:<12}  no split (the builder falls back to equal count)", s.named().name);
+                let _ = writeln!(o, "  {:<12}  {}", s.named().name, no_split_text(*s));
             }
         }
     }
@@ -184,48 +180,6 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
         );
     }
     o
-}
-
-/// What the SBVH does at the node, in a line (the app's Node window shows the same line).
-pub fn sbvh_text(ins: &Inspection) -> Option<String> {
-    let e = ins.sbvh?;
-    let what = match e.split.map(|s| s.kind) {
-        None => "makes a leaf".to_string(),
-        Some(k) => format!(
-            "splits by {}",
-            match k {
-                crate::bvh::sbvh::SplitKind::Object => "an object split",
-                crate::bvh::sbvh::SplitKind::Spatial => "a spatial split (cutting triangles)",
-                crate::bvh::sbvh::SplitKind::EqualCount => "equal count (fallback)",
-            }
-        ),
-    };
-    let priced = if let Some(d) = e.over_budget {
-        format!("the cheaper spatial split would add {d} references, over the budget")
-    } else if e.spatial_priced {
-        "spatial planes priced".to_string()
-    } else if e.budget == 0 {
-        "no spatial planes: no reference budget left".to_string()
-    } else {
-        "no spatial planes: overlap not above α".to_string()
-    };
-    Some(format!(
-        "SBVH here        {what}; object split's overlap {:.2e} of the root's area; {priced}; {} extra references left",
-        e.overlap_ratio, e.budget
-    ))
-}
-
-/// Which wide node of a wide layout binary node `node` is collapsed into.
-pub fn wide_group_text(node: u32, g: &WideGroup) -> String {
-    let list = |v: &[u32]| v.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ");
-    let role = if g.collapsed.contains(&node) { "is collapsed into" } else { "is a leaf slot of" };
-    format!(
-        "In the {}-wide layout, node {node} {role} the wide node over binary node {}, which swallows binary nodes {} and has children {}.",
-        g.width,
-        g.top,
-        list(&g.collapsed),
-        list(&g.children)
-    )
 }
 
 /// The exact sweep's curves as CSV.
@@ -276,7 +230,7 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
     let built = match &a.bvh {
-        Some(path) => super::check::import_dump(&scene, path, &a.dump_limit)?,
+        Some(path) => a.dump_limit.import(&scene, path)?,
         None => build_scene(&scene, &a.build.scene_build(params))?,
     };
     let SceneBvh::Single { bvh, .. } = &built else { unreachable!("one level was asked for") };
@@ -311,9 +265,10 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     let path = h.path(node);
     // The visits of the frame's primary rays, through the binary tree (as the Tree window counts).
     let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
-    let visits = crate::bvh::visits::frame_visits(&tree, &camera, a.build.trace(), &crate::work::WorkControl::new())
-        .map_err(|_| CliError::Usage("cancelled".into()))?
-        .counts[node as usize];
+    let visits =
+        crate::explain::visits::frame_visits(&tree, &camera, a.build.trace(), &crate::work::WorkControl::new())
+            .map_err(|_| CliError::Usage("cancelled".into()))?
+            .counts[node as usize];
     // A built wide tree is collapsed from the binary one; an imported one is not.
     let wide = names.is_none().then(|| wide_group_in(bvh.params().layout, &tree.nodes, &h.parent, node)).flatten();
     let dump_id = names.map(|n| n.dump_of_binary_node(node));
@@ -351,9 +306,4 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
             }
         }
     })
-}
-
-/// "12", or for a node added to binarise a 4-wide dump, what it is.
-pub fn dump_text(d: Option<u32>) -> String {
-    d.map_or("none: added to binarise a node of more than two children".into(), |d| d.to_string())
 }

@@ -4,7 +4,6 @@
 mod args;
 pub mod check;
 mod compare;
-mod compare_gpu;
 pub mod device;
 mod grade;
 pub mod inspect;
@@ -14,7 +13,8 @@ pub mod replay;
 pub mod stats;
 pub mod trace;
 
-pub use args::{parse_camera, parse_size, BuildArgs, Device, GpuNodes};
+pub use crate::gpu_path::{Device, GpuNodes};
+pub use args::{parse_camera, parse_size, BuildArgs};
 pub use compare::{compare_rows, CompareRow};
 
 use crate::mesh::MeshError;

@@ -4,6 +4,7 @@ use super::args::{BuildArgs, DeviceArgs, ViewArgs};
 use super::device::{self, GpuTree};
 use super::{load_mesh, progress, CliError};
 use crate::bvh::SceneBvh;
+use crate::files::file_name;
 use crate::render::{
     draw_legend, render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, RenderSettings, View,
 };
@@ -191,11 +192,6 @@ fn run_against(
     Ok(())
 }
 
-/// The file name of a path, for captions.
-pub(crate) fn file_name(p: &std::path::Path) -> String {
-    p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
-}
-
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     check_outputs(a)?;
     let gpu = device::open(&a.device)?;
@@ -207,7 +203,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         device::check_traceable(&a.build.scene_build(params), a.build.trace())?;
     }
     let bvh = match &a.bvh {
-        Some(path) => super::check::import_dump(&loaded, path, &a.dump_limit)?,
+        Some(path) => a.dump_limit.import(&loaded, path)?,
         None => device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
     };
     let count = a.view.is_heatmap() || a.counts.is_some();

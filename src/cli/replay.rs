@@ -1,14 +1,14 @@
 //! `bvhscope replay MESH`: the build played back as an animated PNG, one frame per step on a log
 //! scale of the number of splits k (the first splits change the most), each the heatmap of the tree
 //! after k splits on one colour scale; and the table of k, the partial tree's SAH cost and the mean
-//! of the heatmap's metric, for a lab report (`bvh::replay`).
+//! of the heatmap's metric, for a lab report (`explain::replay`).
 
 use super::args::{BuildArgs, ViewArgs};
-use super::render::file_name;
 use super::{build_scene, load_mesh, progress, CliError};
-use crate::bvh::replay::Replay;
 use crate::bvh::{Layout, SceneBvh};
+use crate::explain::replay::Replay;
 use crate::explain::replay_film::{film, steps, FilmSettings};
+use crate::files::file_name;
 use crate::render::{ColorMap, View};
 use clap::Args;
 use std::path::PathBuf;

@@ -2,15 +2,15 @@
 //! lists, from the same traversal (`bvh::trace`). The ray is a pixel of the camera (0-based, x from
 //! the left, y from the top, as everywhere) or typed as an origin and a direction.
 
-use super::args::{build_flags, shell_word, BuildArgs, DeviceArgs, ViewArgs};
+use super::args::{BuildArgs, DeviceArgs, ViewArgs};
 use super::device::{self, GpuTree};
 use super::{load_mesh, CliError};
-use crate::bvh::{trace_ray, RayCounters, SceneBuild, SceneBvh, StepKind, TraceLevel, TraceOptions};
+use crate::bvh::{trace_ray, RayCounters, SceneBvh, StepKind, TraceLevel};
 use crate::geometry::Ray;
 use clap::{Args, ValueEnum};
 use glam::Vec3;
 use std::fmt::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum TraceFormat {
@@ -71,29 +71,6 @@ fn parse_ray(s: &str) -> Result<(Vec3, Vec3), String> {
     Ok((o, d))
 }
 
-/// The `bvhscope trace` command that rebuilds `build` over the scene file at `path` and traces
-/// `ray` as the app did (the Ray window shows it, to paste into a terminal or a lab report). The
-/// ray is given as numbers (each written so it reads back to the same `f32`), not as a pixel, so
-/// the window's size does not matter.
-/// An imported tree's trace names its dump (`--bvh`) instead of the build.
-pub fn command(path: &Path, ray: &Ray, build: &SceneBuild, opts: TraceOptions, dump: Option<&Path>) -> String {
-    let v = |v: Vec3| format!("{},{},{}", v.x, v.y, v.z);
-    let mut words = vec!["bvhscope trace".to_string(), shell_word(&path.display().to_string())];
-    words.push(format!("--ray {}:{}", v(ray.origin()), v(ray.dir())));
-    match dump {
-        Some(d) => {
-            words.push(format!("--bvh {}", shell_word(&d.display().to_string())));
-            words.extend(
-                build_flags(build, opts)
-                    .into_iter()
-                    .filter(|w| w.starts_with("--order") || w.starts_with("--triangle-test")),
-            );
-        }
-        None => words.extend(build_flags(build, opts)),
-    }
-    words.join(" ")
-}
-
 fn level_text(l: TraceLevel) -> String {
     match l {
         TraceLevel::Mesh => "".into(),
@@ -124,7 +101,7 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
         device::check_traceable(&a.build.scene_build(params), a.build.trace())?;
     }
     let bvh = match &a.bvh {
-        Some(path) => super::check::import_dump(&scene, path, &a.dump_limit)?,
+        Some(path) => a.dump_limit.import(&scene, path)?,
         None => device::build_scene(gpu.as_ref(), &scene, &a.build.scene_build(params))?.0,
     };
     let on_gpu = match &gpu {

@@ -234,7 +234,7 @@ fn a_node_is_selected_from_the_tree_the_icicle_and_the_viewport() {
     {
         let app = h.state();
         let e = app.nodes.explained.as_ref().unwrap();
-        let want = bvhscope::bvh::inspect::inspect(&e.tree, &e.hierarchy, 2).unwrap();
+        let want = bvhscope::explain::inspect::inspect(&e.tree, &e.hierarchy, 2).unwrap();
         let got = app.nodes.inspection.as_ref().unwrap();
         assert_eq!((got.triangles, got.markers.clone()), (want.triangles, want.markers), "the core's inspection");
     }

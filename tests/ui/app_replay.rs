@@ -75,7 +75,7 @@ fn the_build_replay_traces_the_partial_tree() {
         let (node, marker, _) = app.replay.newest.as_ref().expect("the newest split");
         assert_eq!(*node, newest);
         let e = app.nodes.explained.as_ref().unwrap();
-        let ins = bvhscope::bvh::inspect::inspect(&e.tree, &e.hierarchy, newest).unwrap();
+        let ins = bvhscope::explain::inspect::inspect(&e.tree, &e.hierarchy, newest).unwrap();
         let own = e.tree.params.strategy;
         assert_eq!(*marker, ins.markers.iter().find(|(s, _)| *s == own).unwrap().1);
     }

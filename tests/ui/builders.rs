@@ -120,7 +120,7 @@ fn sbvh_shows_its_references_as_stats_and_inspect_print_them() {
     h.state_mut().act(Action::SelectNode(0));
     run_until(&mut h, "the root's inspection", |a| a.nodes.inspection.is_some() && idle(a));
     let ins = h.state().nodes.inspection.clone().unwrap();
-    let line = bvhscope::cli::inspect::sbvh_text(&ins).expect("the SBVH's line");
+    let line = bvhscope::explain::inspect::text::sbvh_text(&ins).expect("the SBVH's line");
     h.get_by_label(&line);
     let words = ["bvhscope", "inspect", rods.to_str().unwrap(), "--strategy", "sbvh", "--sbvh-growth", "50"];
     let Some(Command::Inspect(args)) =

@@ -38,7 +38,7 @@ impl AnyBvh {
 
     /// Build with a control whose total is set to this build's work (see `Bvh::build_controlled`).
     pub fn build_controlled(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<AnyBvh, Cancelled> {
-        control.set_total(super::build::build_work(mesh.triangle_count(), params));
+        control.set_total(super::builders::build_work(mesh.triangle_count(), params));
         Self::build_counted(mesh, params, control)
     }
 

@@ -9,8 +9,8 @@
 //! interior node, C_isect·(its triangles) for a leaf. A(t ∩ box) is the area of the triangle
 //! clipped to the box (Sutherland & Hodgman's polygon clipping, 1974).
 
-use super::inspect::Hierarchy;
 use super::Bvh;
+use super::Hierarchy;
 use crate::geometry::Aabb;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;

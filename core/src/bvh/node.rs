@@ -6,7 +6,7 @@ use crate::geometry::Aabb;
 use glam::Vec3;
 
 /// Depth of the traversal stack's fixed part. The builder keeps the trees it makes shallower than
-/// this (see `build::HEURISTIC_DEPTH_LIMIT`), so their walks never leave it; an imported tree of
+/// this (see `builders::HEURISTIC_DEPTH_LIMIT`), so their walks never leave it; an imported tree of
 /// any depth spills onto the heap (`stack::TraversalStack`).
 pub const TRAVERSAL_STACK_SIZE: usize = 128;
 

@@ -24,7 +24,7 @@
 use super::node::{Bvh, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;
 use super::{Hit, TraceOptions};
-use crate::geometry::slab::{RayGroup, RayInterval};
+use crate::geometry::slab_packet::{RayGroup, RayInterval};
 use crate::geometry::{Aabb, Ray, TriangleHit, TriangleIntersector};
 use glam::Vec3;
 use std::mem::MaybeUninit;

@@ -1,9 +1,192 @@
-//! What a build is asked for and what it reports: the strategy and its numbers (every one described
-//! for users in `crate::options`), the SAH's constants, the layout, and the report of the phases.
+//! What a build is asked for and what it reports: the strategy and its numbers, the SAH's
+//! constants, the layout, and the report of the phases. The builder owns each number's limits and
+//! default (`Param`); `crate::options` gives them their names, labels and help for users.
 
-use super::split::SplitStrategy;
-use crate::options::{MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TRAVERSAL_COST};
+use super::SplitStrategy;
 use std::time::Duration;
+
+/// A number's limits (inclusive) and default, as the builder accepts it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limits<T> {
+    pub min: T,
+    pub max: T,
+    pub default: T,
+}
+
+impl<T: PartialOrd + Copy> Limits<T> {
+    pub fn contains(&self, v: T) -> bool {
+        self.min <= v && v <= self.max
+    }
+
+    /// `v` within the limits (a NaN, which is in no order with them, gives the default).
+    pub fn clamp(&self, v: T) -> T {
+        if v.partial_cmp(&self.min).is_none() {
+            self.default
+        } else if v < self.min {
+            self.min
+        } else if v > self.max {
+            self.max
+        } else {
+            v
+        }
+    }
+
+    /// The limits, for messages: "1..=255".
+    pub fn range_text(&self) -> String
+    where
+        T: std::fmt::Display,
+    {
+        format!("{}..={}", self.min, self.max)
+    }
+}
+
+/// A number of a build that users set. Which strategies read which is the strategy's to say
+/// (`SplitStrategy::reads`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Param {
+    /// Most triangles in a leaf (the node format's count field would take 65535; trees with leaves
+    /// that big are not worth building).
+    MaxLeafSize,
+    /// Bins per axis of the binned SAH (`split::sah_binned`).
+    SahBins,
+    /// PLOC's neighbour search radius (`ploc`).
+    PlocRadius,
+    /// Stich et al.'s α: where the SBVH prices spatial splits (`sbvh`).
+    SbvhAlpha,
+    /// The SBVH's reference budget, in percent of the triangles.
+    SbvhGrowth,
+    /// Passes of reinsertion after any build (`reinsert`).
+    ReinsertPasses,
+    /// The SAH's cost of a traversal step against a triangle test's.
+    TraversalCost,
+}
+
+/// A parameter's value: a whole number or a real one, as its limits are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamValue {
+    Whole(u32),
+    Real(f32),
+}
+
+impl std::fmt::Display for ParamValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ParamValue::Whole(v) => write!(f, "{v}"),
+            ParamValue::Real(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+/// A parameter's limits, whole or real.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamLimits {
+    Whole(Limits<u32>),
+    Real(Limits<f32>),
+}
+
+impl ParamLimits {
+    pub fn default_value(&self) -> ParamValue {
+        match self {
+            ParamLimits::Whole(l) => ParamValue::Whole(l.default),
+            ParamLimits::Real(l) => ParamValue::Real(l.default),
+        }
+    }
+
+    pub fn range_text(&self) -> String {
+        match self {
+            ParamLimits::Whole(l) => l.range_text(),
+            ParamLimits::Real(l) => l.range_text(),
+        }
+    }
+
+    /// `v` within the limits, of the limits' kind (a real number for a whole one is rounded; a
+    /// NaN gives the default).
+    pub fn clamp(&self, v: ParamValue) -> ParamValue {
+        match (self, v) {
+            (ParamLimits::Whole(l), ParamValue::Whole(x)) => ParamValue::Whole(l.clamp(x)),
+            (ParamLimits::Whole(l), ParamValue::Real(x)) if x.is_nan() => ParamValue::Whole(l.default),
+            (ParamLimits::Whole(l), ParamValue::Real(x)) => ParamValue::Whole(l.clamp(x.round().max(0.0) as u32)),
+            (ParamLimits::Real(l), v) => ParamValue::Real(l.clamp(v.real())),
+        }
+    }
+}
+
+impl ParamValue {
+    /// As a whole number (a real one rounded).
+    pub fn whole(self) -> u32 {
+        match self {
+            ParamValue::Whole(x) => x,
+            ParamValue::Real(x) => x.round().max(0.0) as u32,
+        }
+    }
+
+    pub fn real(self) -> f32 {
+        match self {
+            ParamValue::Whole(x) => x as f32,
+            ParamValue::Real(x) => x,
+        }
+    }
+}
+
+pub const MAX_LEAF_SIZE: Limits<u32> = Limits { min: 1, max: 255, default: 4 };
+pub const SAH_BINS: Limits<u32> = Limits { min: 2, max: super::split::sah_binned_max_bins() as u32, default: 16 };
+pub const PLOC_RADIUS: Limits<u32> = Limits { min: 1, max: 64, default: 16 };
+pub const SBVH_ALPHA: Limits<f32> = Limits { min: 0.0, max: 1.0, default: 1e-5 };
+pub const SBVH_GROWTH: Limits<u32> = Limits { min: 0, max: 300, default: 30 };
+pub const REINSERT_PASSES: Limits<u32> = Limits { min: 0, max: 32, default: 0 };
+pub const TRAVERSAL_COST: Limits<f32> = Limits { min: 0.01, max: 100.0, default: 1.0 };
+/// Placements in a leaf of a two-level BVH's top level (one: each placement's box tested alone).
+pub const TOP_MAX_LEAF_SIZE: Limits<u32> = Limits { min: 1, max: 255, default: 1 };
+
+impl Param {
+    pub const ALL: [Param; 7] = [
+        Param::MaxLeafSize,
+        Param::SahBins,
+        Param::PlocRadius,
+        Param::SbvhAlpha,
+        Param::SbvhGrowth,
+        Param::ReinsertPasses,
+        Param::TraversalCost,
+    ];
+
+    pub fn limits(self) -> ParamLimits {
+        match self {
+            Param::MaxLeafSize => ParamLimits::Whole(MAX_LEAF_SIZE),
+            Param::SahBins => ParamLimits::Whole(SAH_BINS),
+            Param::PlocRadius => ParamLimits::Whole(PLOC_RADIUS),
+            Param::SbvhAlpha => ParamLimits::Real(SBVH_ALPHA),
+            Param::SbvhGrowth => ParamLimits::Whole(SBVH_GROWTH),
+            Param::ReinsertPasses => ParamLimits::Whole(REINSERT_PASSES),
+            Param::TraversalCost => ParamLimits::Real(TRAVERSAL_COST),
+        }
+    }
+
+    /// Its value in `p`.
+    pub fn get(self, p: &BuildParams) -> ParamValue {
+        match self {
+            Param::MaxLeafSize => ParamValue::Whole(p.max_leaf_size),
+            Param::SahBins => ParamValue::Whole(p.sah_bins),
+            Param::PlocRadius => ParamValue::Whole(p.ploc_radius),
+            Param::SbvhAlpha => ParamValue::Real(p.sbvh_alpha),
+            Param::SbvhGrowth => ParamValue::Whole(p.sbvh_growth),
+            Param::ReinsertPasses => ParamValue::Whole(p.reinsert_passes),
+            Param::TraversalCost => ParamValue::Real(p.cost.traversal),
+        }
+    }
+
+    /// Set it in `p` (as given: `BuildParams::clamped` brings it within the limits).
+    pub fn set(self, p: &mut BuildParams, v: ParamValue) {
+        match self {
+            Param::MaxLeafSize => p.max_leaf_size = v.whole(),
+            Param::SahBins => p.sah_bins = v.whole(),
+            Param::PlocRadius => p.ploc_radius = v.whole(),
+            Param::SbvhAlpha => p.sbvh_alpha = v.real(),
+            Param::SbvhGrowth => p.sbvh_growth = v.whole(),
+            Param::ReinsertPasses => p.reinsert_passes = v.whole(),
+            Param::TraversalCost => p.cost.traversal = v.real(),
+        }
+    }
+}
 
 /// Cost constants of the surface area heuristic (Goldsmith & Salmon 1987; MacDonald & Booth 1990).
 /// The defaults, 1 and 1, make the normalised SAH cost of a tree read as "expected traversal steps
@@ -127,17 +310,12 @@ impl BuildReport {
 }
 
 impl BuildParams {
-    /// The parameters with every field in the range the builder accepts.
-    pub(super) fn clamped(&self) -> BuildParams {
-        BuildParams {
-            max_leaf_size: MAX_LEAF_SIZE.clamp(self.max_leaf_size),
-            sah_bins: SAH_BINS.clamp(self.sah_bins),
-            ploc_radius: PLOC_RADIUS.clamp(self.ploc_radius),
-            reinsert_passes: REINSERT_PASSES.clamp(self.reinsert_passes),
-            sbvh_alpha: SBVH_ALPHA.clamp(self.sbvh_alpha),
-            sbvh_growth: SBVH_GROWTH.clamp(self.sbvh_growth),
-            cost: SahCost { traversal: TRAVERSAL_COST.clamp(self.cost.traversal), ..self.cost },
-            ..*self
+    /// The parameters with every number within the limits the builder accepts.
+    pub fn clamped(&self) -> BuildParams {
+        let mut p = *self;
+        for param in Param::ALL {
+            param.set(&mut p, param.limits().clamp(param.get(self)));
         }
+        p
     }
 }

@@ -1,6 +1,6 @@
 //! The traversal stack: a fixed array on the call stack, not initialised up front, that spills onto
 //! the heap past its fixed part. Zeroing a few kilobytes per ray would cost more than traversing a
-//! small BVH, and the builder bounds the tree depth (`build::HEURISTIC_DEPTH_LIMIT`), so a built
+//! small BVH, and the builder bounds the tree depth (`builders::HEURISTIC_DEPTH_LIMIT`), so a built
 //! tree never spills; an imported tree may be of any depth (a student's chain of 10,000 nodes is
 //! correct, if slow), and its rays push onto the heap beyond the fixed part. The spill check is one
 //! predicted branch where the bounds check used to be.

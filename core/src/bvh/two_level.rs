@@ -12,7 +12,7 @@
 //! The top level is always a binary tree (a scene has few instances next to its triangles); its
 //! strategy and leaf size are chosen separately from the bottom level's, which may be wide.
 
-use super::build::{build_over_boxes, build_work};
+use super::builders::{build_over_boxes, build_work};
 use super::node::{walk_nodes, BvhNode};
 use super::traverse::{walk, TopLevelWalk};
 use super::tree::{NodeKind, NodeView, TreeView};

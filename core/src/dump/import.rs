@@ -69,7 +69,7 @@ fn leaves_split(dump: &BvhDump, cap: u32) -> (BvhDump, u32) {
 /// (`oversized_leaves`). The dump's structure must be sound (`explain::check::check_tree` finds
 /// no structure defect); `Err` says why a tree cannot be traced when it cannot.
 pub fn import(dump: &BvhDump, mesh: &Mesh, path: &std::path::Path) -> Result<(AnyBvh, Imported), String> {
-    let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let name = crate::files::file_name(path);
     let path = path.to_path_buf();
     if let Some(why) = untraceable(dump) {
         return Err(why);

@@ -4,6 +4,9 @@
 
 pub mod check;
 pub mod grade;
+pub mod inspect;
+pub mod replay;
 pub mod replay_film;
 pub mod timing;
+pub mod visits;
 pub mod words;

@@ -1,11 +1,11 @@
-//! A build replay (`bvh::replay`) as a film: `frames` steps from the root alone to the finished
+//! A build replay (`explain::replay`) as a film: `frames` steps from the root alone to the finished
 //! tree, each the heatmap of the partial tree on one logarithmic colour scale with its legend, and
 //! the table of each step's SAH cost and mean cost per ray. One implementation for `bvhscope
 //! replay` and the app's Replay window, which write the same files.
 
 use crate::bvh::morton::MortonOrder;
-use crate::bvh::replay::Replay;
 use crate::bvh::{SahCost, TraceOptions};
+use crate::explain::replay::Replay;
 use crate::mesh::Mesh;
 use crate::render::{draw_legend, grid_values, render_progressive, Camera, ColorMap, Legend, RenderSettings, View};
 use crate::work::{Cancelled, WorkControl};

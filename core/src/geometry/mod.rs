@@ -5,6 +5,7 @@ mod ray;
 mod shear;
 pub mod slab;
 pub mod slab8;
+pub mod slab_packet;
 pub(crate) mod triangle;
 mod triangle4;
 

@@ -137,9 +137,7 @@ impl Scene {
     /// The file name, or the built-in mesh's name.
     pub fn title(&self) -> String {
         match (&self.source, &self.geometry) {
-            (SceneSource::File(p), _) => {
-                p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
-            }
+            (SceneSource::File(p), _) => crate::files::file_name(p),
             (SceneSource::Builtin, Geometry::Mesh(m)) => m.name.clone(),
             (SceneSource::Builtin, Geometry::Placed { .. }) => "built-in scene".into(),
         }

@@ -133,23 +133,9 @@ fn transform(t: &serde_json::Value, field: &str, f: &Fields) -> Result<Affine3A,
 
 /// The scene's `bvh` object: the names and limits of `crate::options`, as the CLI takes them.
 fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
-    use crate::options::{
-        Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TRAVERSAL_COST,
-    };
+    use crate::options::{Choice, BUILD_PARAMS};
     fn choice<T: Choice>(v: &serde_json::Value, field: &str, f: &Fields) -> Result<T, SceneError> {
         v.as_str().and_then(T::from_name).ok_or_else(|| f.err(field, format!("expected one of {}", T::names())))
-    }
-    fn whole(v: &serde_json::Value, n: &Number<u32>, field: &str, f: &Fields) -> Result<u32, SceneError> {
-        match v.as_u64() {
-            Some(x) if x <= u32::MAX as u64 && n.contains(x as u32) => Ok(x as u32),
-            _ => Err(f.err(field, format!("expected a whole number {}", n.range_text()))),
-        }
-    }
-    fn real(v: &serde_json::Value, n: &Number<f32>, field: &str, f: &Fields) -> Result<f32, SceneError> {
-        match v.as_f64() {
-            Some(x) if n.contains(x as f32) => Ok(x as f32),
-            _ => Err(f.err(field, format!("expected a number {}", n.range_text()))),
-        }
     }
     let o = b.as_object().ok_or_else(|| f.err("bvh", format!("expected an object, found {}", kind(b))))?;
     let mut p = BuildParams::default();
@@ -158,28 +144,14 @@ fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
         match key.as_str() {
             "strategy" => p.strategy = choice(v, &field, f)?,
             "layout" => p.layout = choice(v, &field, f)?,
-            k if k == MAX_LEAF_SIZE.key => p.max_leaf_size = whole(v, &MAX_LEAF_SIZE, &field, f)?,
-            k if k == SAH_BINS.key => p.sah_bins = whole(v, &SAH_BINS, &field, f)?,
-            k if k == PLOC_RADIUS.key => p.ploc_radius = whole(v, &PLOC_RADIUS, &field, f)?,
-            k if k == REINSERT_PASSES.key => p.reinsert_passes = whole(v, &REINSERT_PASSES, &field, f)?,
-            k if k == SBVH_GROWTH.key => p.sbvh_growth = whole(v, &SBVH_GROWTH, &field, f)?,
-            k if k == SBVH_ALPHA.key => p.sbvh_alpha = real(v, &SBVH_ALPHA, &field, f)?,
-            k if k == TRAVERSAL_COST.key => p.cost.traversal = real(v, &TRAVERSAL_COST, &field, f)?,
-            _ => {
-                let keys = [
-                    "strategy",
-                    "layout",
-                    MAX_LEAF_SIZE.key,
-                    SAH_BINS.key,
-                    PLOC_RADIUS.key,
-                    REINSERT_PASSES.key,
-                    SBVH_ALPHA.key,
-                    SBVH_GROWTH.key,
-                    TRAVERSAL_COST.key,
-                ]
-                .join(", ");
-                return Err(f.err(&field, format!("unknown field (expected {keys})")));
-            }
+            k => match BUILD_PARAMS.iter().find(|o| o.key == k) {
+                Some(o) => o.param.set(&mut p, o.from_json(v).map_err(|e| f.err(&field, e))?),
+                None => {
+                    let keys: Vec<&str> =
+                        ["strategy", "layout"].into_iter().chain(BUILD_PARAMS.map(|o| o.key)).collect();
+                    return Err(f.err(&field, format!("unknown field (expected {})", keys.join(", "))));
+                }
+            },
         }
     }
     Ok(p)
@@ -197,6 +169,11 @@ pub fn parse_scene_file(path: &Path, text: &str) -> Result<SceneDesc, SceneError
 
 /// A scene file for a camera, the meshes (paths written as given) and BVH settings.
 pub fn write_scene_file(camera: &Camera, meshes: &[super::SceneMesh], build: &BuildParams) -> String {
+    use crate::options::{ParamOption, BUILD_PARAMS};
+    let mut bvh = serde_json::json!({ "strategy": build.strategy.name(), "layout": build.layout.name() });
+    for o in &BUILD_PARAMS {
+        bvh[o.key] = ParamOption::to_json(o.param.get(build));
+    }
     let v3 = |v: Vec3| serde_json::json!([v.x, v.y, v.z]);
     let meshes: Vec<serde_json::Value> = meshes
         .iter()
@@ -211,12 +188,7 @@ pub fn write_scene_file(camera: &Camera, meshes: &[super::SceneMesh], build: &Bu
             "vertical_fov": camera.vfov_deg, "size": [camera.width, camera.height],
         },
         "meshes": meshes,
-        "bvh": {
-            "strategy": build.strategy.name(), "layout": build.layout.name(),
-            "max_leaf_size": build.max_leaf_size, "bins": build.sah_bins, "ploc_radius": build.ploc_radius,
-            "reinsert_passes": build.reinsert_passes, "sbvh_alpha": build.sbvh_alpha, "sbvh_growth": build.sbvh_growth,
-            "traversal_cost": build.cost.traversal,
-        },
+        "bvh": bvh,
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()
 }

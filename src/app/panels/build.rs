@@ -2,11 +2,8 @@
 //! rebuilds (or re-renders) in the background.
 
 use crate::app::{Action, Actions, BvhscopeApp};
-use crate::bvh::{Preset, SplitStrategy};
-use crate::options::{
-    Choice, Number, MAX_LEAF_SIZE, PLOC_RADIUS, REINSERT_PASSES, SAH_BINS, SBVH_ALPHA, SBVH_GROWTH, TOP_MAX_LEAF_SIZE,
-    TRAVERSAL_COST,
-};
+use crate::bvh::{BuildParams, Param, ParamLimits, ParamValue, Preset, SplitStrategy};
+use crate::options::{Choice, ParamOption, BUILD_PARAMS, TOP_MAX_LEAF_SIZE};
 
 /// The reinsertion the current single BVH's build made, if any.
 fn reinsertion_of(bvh: &crate::bvh::SceneBvh) -> Option<crate::bvh::reinsert::Reinsertion> {
@@ -16,10 +13,25 @@ fn reinsertion_of(bvh: &crate::bvh::SceneBvh) -> Option<crate::bvh::reinsert::Re
     }
 }
 
-/// A slider over a number's whole range (logarithmic: leaf sizes of 1..255 and costs of 0.01..100
-/// are chosen near their small ends), labelled and explained by the option table.
-fn number<T: egui::emath::Numeric>(ui: &mut egui::Ui, value: &mut T, n: &Number<T>, log: bool) {
-    ui.add(egui::Slider::new(value, n.min..=n.max).logarithmic(log).text(n.label)).on_hover_text(n.help);
+/// A slider over a build parameter's whole range (logarithmic where the table says: leaf sizes of
+/// 1..255 and costs of 0.01..100 are chosen near their small ends), labelled and explained by it.
+fn param(ui: &mut egui::Ui, build: &mut BuildParams, o: &ParamOption) {
+    let v = o.param.get(build);
+    let r = match o.limits() {
+        ParamLimits::Whole(l) => {
+            let mut x = v.whole();
+            let r = ui.add(egui::Slider::new(&mut x, l.min..=l.max).logarithmic(o.log).text(o.label));
+            o.param.set(build, ParamValue::Whole(x));
+            r
+        }
+        ParamLimits::Real(l) => {
+            let mut x = v.real();
+            let r = ui.add(egui::Slider::new(&mut x, l.min..=l.max).logarithmic(o.log).text(o.label));
+            o.param.set(build, ParamValue::Real(x));
+            r
+        }
+    };
+    r.on_hover_text(o.help_line());
 }
 
 /// One radio button per value of a choice, with its help.
@@ -64,7 +76,13 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                     .response
                     .labelled_by(label.id);
             });
-            number(ui, &mut s.top_build.max_leaf_size, &TOP_MAX_LEAF_SIZE, true);
+            let n = &TOP_MAX_LEAF_SIZE;
+            ui.add(
+                egui::Slider::new(&mut s.top_build.max_leaf_size, n.limits.min..=n.limits.max)
+                    .logarithmic(true)
+                    .text(n.label),
+            )
+            .on_hover_text(n.help);
             ui.label("Bottom level (each mesh's BVH)");
         }
     }
@@ -107,22 +125,16 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
 
     // An imported tree is traced as written: the build's parameters do not apply to it.
     ui.add_enabled_ui(!on, |ui| {
-        number(ui, &mut s.build.max_leaf_size, &MAX_LEAF_SIZE, true);
-        let sbvh = s.build.strategy == SplitStrategy::Sbvh;
-        let sah = s.build.strategy == SplitStrategy::SahBinned || sbvh;
-        ui.add_enabled_ui(sah, |ui| number(ui, &mut s.build.sah_bins, &SAH_BINS, true));
-        let ploc = s.build.strategy == SplitStrategy::Ploc;
-        ui.add_enabled_ui(ploc, |ui| number(ui, &mut s.build.ploc_radius, &PLOC_RADIUS, true));
-        ui.add_enabled_ui(sbvh, |ui| {
-            number(ui, &mut s.build.sbvh_alpha, &SBVH_ALPHA, true);
-            number(ui, &mut s.build.sbvh_growth, &SBVH_GROWTH, false);
-        });
-        number(ui, &mut s.build.reinsert_passes, &REINSERT_PASSES, false);
-        // What the last build's reinsertion did (the binary tree's SAH cost before and after).
-        if let Some(r) = app.current_bvh().and_then(|b| reinsertion_of(&b.bvh)) {
-            ui.weak(format!("Reinsertion: {}", r.summary()));
+        // Each parameter of the table, greyed out where the strategy does not read it.
+        for o in &BUILD_PARAMS {
+            ui.add_enabled_ui(s.build.strategy.reads(o.param), |ui| param(ui, &mut s.build, o));
+            // What the last build's reinsertion did (the binary tree's SAH cost before and after).
+            if o.param == Param::ReinsertPasses {
+                if let Some(r) = app.current_bvh().and_then(|b| reinsertion_of(&b.bvh)) {
+                    ui.weak(format!("Reinsertion: {}", r.summary()));
+                }
+            }
         }
-        number(ui, &mut s.build.cost.traversal, &TRAVERSAL_COST, true);
     });
 
     ui.add_space(4.0);

@@ -31,9 +31,9 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             });
             // B's leaf size, layout and traversal.
             let (mut leaf, mut layout, mut trace) = (c.max_leaf_size, c.layout, c.trace);
-            let n = &crate::options::MAX_LEAF_SIZE;
+            let (n, l) = (crate::bvh::Param::MaxLeafSize.option(), crate::bvh::params::MAX_LEAF_SIZE);
             let mut changed = ui
-                .add(egui::Slider::new(&mut leaf, n.min..=n.max).text("B's max leaf size"))
+                .add(egui::Slider::new(&mut leaf, l.min..=l.max).text("B's max leaf size"))
                 .on_hover_text(n.help)
                 .changed();
             ui.horizontal(|ui| {

@@ -1,11 +1,11 @@
-//! The Node window: the selected node of the binary tree explained (`bvh::inspect`, the same
+//! The Node window: the selected node of the binary tree explained (`explain::inspect`, the same
 //! figures as `bvhscope inspect`): its breadcrumb, its figures, and per axis the SAH cost of
 //! splitting its triangles at every candidate plane (the exact sweep as a line, the binned SAH's
 //! bins as steps), with where each strategy puts its plane and the cost of a leaf.
 
 use crate::app::{Action, Actions, BvhscopeApp, NodeStep};
-use crate::bvh::inspect::{CurvePoint, Inspection};
 use crate::bvh::SplitStrategy;
+use crate::explain::inspect::{CurvePoint, Inspection};
 use egui::Color32;
 use egui_plot::{HLine, Line, LineStyle, Plot, PlotPoints, VLine};
 
@@ -78,14 +78,14 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             figures(ui, ins, e.epo_terms[node as usize], visits);
             let imported = e.bvh.import();
             if let Some(names) = imported {
-                let d = crate::cli::inspect::dump_text(names.dump_of_binary_node(node));
+                let d = crate::explain::inspect::text::dump_text(names.dump_of_binary_node(node));
                 ui.label(format!("Imported from {}: dump node {d}.", names.name))
                     .on_hover_text("The node's id in the dump; bvhscope inspect MESH --bvh DUMP --node ID takes that id");
             }
             let layout = e.bvh.build_params().bvh.layout;
             if imported.is_none() {
                 if let Some(g) = crate::bvh::wide::wide_group_in(layout, &e.tree.nodes, &e.hierarchy.parent, node) {
-                    ui.label(wide_group_text(node, &g)).on_hover_text(
+                    ui.label(crate::explain::inspect::text::wide_group_text(node, &g)).on_hover_text(
                         "A wide layout collapses the binary tree: a wide node takes the children of a binary node and, while it has fewer than four (or eight), opens the largest interior one",
                     );
                 }
@@ -105,7 +105,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                     "SAH cost of splitting these {} triangles at each plane (C_trav + C_isect (A_L n_L + A_R n_R) / A); {whose}.",
                     ins.triangles
                 ));
-                if let Some(line) = crate::cli::inspect::sbvh_text(ins) {
+                if let Some(line) = crate::explain::inspect::text::sbvh_text(ins) {
                     ui.label(line).on_hover_text(
                         "Stich et al. 2009: the SBVH prices spatial splits (which cut triangles straddling the plane) only where the object split's two boxes overlap by more than α of the root's area, while its budget of extra references lasts",
                     );
@@ -127,11 +127,6 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
     if !open {
         out.push(Action::ShowTree(false));
     }
-}
-
-/// Which wide node a binary node ends up in (the CLI's `inspect` prints the same sentence).
-pub fn wide_group_text(node: u32, g: &crate::bvh::wide::WideGroup) -> String {
-    crate::cli::inspect::wide_group_text(node, g)
 }
 
 fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<(u32, u32, u32)>) {
@@ -161,8 +156,7 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<(u32, u
         for (s, m) in &ins.markers {
             let text = match m {
                 Some(m) => format!("{} = {:.4}: {} | {}, cost {:.3}", AXES[m.axis as usize], m.position, m.left, m.right, m.cost),
-                None if !s.splits_top_down() => "no plane priced here: it builds from the Morton order".into(),
-                None => "no split (the builder falls back to equal count)".into(),
+                None => crate::explain::inspect::text::no_split_text(*s).into(),
             };
             ui.label(egui::RichText::new(s.label()).color(strategy_color(*s)));
             match m {
@@ -264,7 +258,7 @@ fn curve_plot(
     }
     let (sweep_name, binned_name, spatial_name) =
         (SplitStrategy::SahSweep.label(), SplitStrategy::SahBinned.label(), SplitStrategy::Sbvh.label());
-    let markers: Vec<(SplitStrategy, crate::bvh::inspect::Marker)> =
+    let markers: Vec<(SplitStrategy, crate::explain::inspect::Marker)> =
         ins.markers.iter().filter_map(|(s, m)| m.filter(|m| m.axis as usize == axis).map(|m| (*s, m))).collect();
     let mut hovered = None;
     ui.horizontal(|ui| {

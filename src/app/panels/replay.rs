@@ -1,4 +1,4 @@
-//! The Replay window: the build played back split by split (`bvh::replay`). A slider and play
+//! The Replay window: the build played back split by split (`explain::replay`). A slider and play
 //! button choose how many splits are made; the viewport traces the tree after them (its frontier
 //! nodes acting as leaves) and draws the frontier's boxes with the newest split's two children
 //! highlighted; a plot shows the partial tree's SAH cost against the number of splits.

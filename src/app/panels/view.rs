@@ -3,7 +3,7 @@
 
 use crate::app::gpu::Probe;
 use crate::app::{Action, Actions, BoxLevel, BvhscopeApp};
-use crate::cli::{Device, GpuNodes};
+use crate::gpu_path::{Device, GpuNodes};
 use crate::render::warp::WarpSize;
 use crate::render::{ColorMap, UpAxis, View};
 

@@ -209,7 +209,7 @@ mod tests {
             &mesh,
             &crate::bvh::BuildParams { layout: crate::bvh::Layout::Binary, ..Default::default() },
         );
-        let h = crate::bvh::inspect::Hierarchy::of(&binary);
+        let h = crate::bvh::Hierarchy::of(&binary);
         let mut tops = std::collections::HashSet::new();
         let mut swallowed = 0;
         for (i, n) in binary.nodes.iter().enumerate() {

@@ -5,8 +5,8 @@
 
 use super::{ChildRef, WideBvh};
 use crate::bvh::packet::PacketTree;
-use crate::geometry::slab::{Boxes4, RayInterval};
 use crate::geometry::Aabb;
+use crate::geometry::{slab::Boxes4, slab_packet::RayInterval};
 use glam::Vec3;
 use wide::f32x4;
 

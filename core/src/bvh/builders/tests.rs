@@ -2,6 +2,7 @@
 //! can be cancelled while it runs.
 
 use super::*;
+use crate::bvh::SplitStrategy;
 use crate::mesh::generate::torus;
 
 #[test]

@@ -11,118 +11,11 @@
 //! Costs use the SAH as the builder does (Goldsmith & Salmon 1987; pbrt-v4 §7.3.2): a split costs
 //! C_trav + C_isect·(A_L·n_L + A_R·n_R)/A, a leaf C_isect·n, with A the node's surface area.
 
-use super::split::{binned_planes, sweep_planes, BuildPrim, NodeInfo, PlaneSink, Proposal};
-use super::{Bvh, SahCost, SplitStrategy};
+use crate::bvh::sbvh;
+use crate::bvh::split::{binned_planes, sweep_planes, BuildPrim, NodeInfo, PlaneSink, Proposal};
+use crate::bvh::{BuildParams, Bvh, Hierarchy, SahCost, SplitStrategy};
 use crate::geometry::Aabb;
 use serde::Serialize;
-
-/// Where each node sits in the binary tree: what the tree view, the breadcrumb and the inspector
-/// need and the nodes do not store. Computed once per tree, O(nodes).
-#[derive(Clone, Debug, Default)]
-pub struct Hierarchy {
-    /// The parent of each node (`u32::MAX` for the root).
-    pub parent: Vec<u32>,
-    pub depth: Vec<u32>,
-    /// The subtree's triangles, a contiguous range of the leaf order: `first..first + count`.
-    pub first: Vec<u32>,
-    pub count: Vec<u32>,
-    /// The leaf holding each slot of the leaf order.
-    pub leaf_of_slot: Vec<u32>,
-    /// The slot of each mesh triangle in the leaf order (of a triangle in several leaves, an
-    /// SBVH's cut triangle, its last slot: `other_slots` has the rest).
-    pub slot_of_prim: Vec<u32>,
-    /// The other slots of triangles in several leaves (empty unless spatial splits cut some).
-    pub other_slots: std::collections::HashMap<u32, Vec<u32>>,
-}
-
-impl Hierarchy {
-    pub fn of(bvh: &Bvh) -> Hierarchy {
-        let n = bvh.nodes.len();
-        let mut h = Hierarchy {
-            parent: vec![u32::MAX; n],
-            depth: vec![0; n],
-            first: vec![0; n],
-            count: vec![0; n],
-            leaf_of_slot: vec![0; bvh.prim_ids.len()],
-            slot_of_prim: vec![u32::MAX; bvh.prim_ids.len()],
-            other_slots: Default::default(),
-        };
-        // Parents come before their children in the node array, so one pass down sets parents and
-        // depths, and one pass back up sums the ranges.
-        for (i, node) in bvh.nodes.iter().enumerate() {
-            if node.is_leaf() {
-                h.first[i] = node.index;
-                h.count[i] = node.count as u32;
-                for s in node.prims() {
-                    h.leaf_of_slot[s] = i as u32;
-                }
-            } else {
-                for c in [node.index, node.index + 1] {
-                    h.parent[c as usize] = i as u32;
-                    h.depth[c as usize] = h.depth[i] + 1;
-                }
-            }
-        }
-        for i in (0..n).rev() {
-            let node = &bvh.nodes[i];
-            if !node.is_leaf() {
-                let (l, r) = (node.index as usize, node.index as usize + 1);
-                h.first[i] = h.first[l].min(h.first[r]);
-                h.count[i] = h.count[l] + h.count[r];
-            }
-        }
-        for (slot, &prim) in bvh.prim_ids.iter().enumerate() {
-            if let Some(s) = h.slot_of_prim.get_mut(prim as usize) {
-                if *s != u32::MAX {
-                    h.other_slots.entry(prim).or_default().push(*s);
-                }
-                *s = slot as u32;
-            }
-        }
-        h
-    }
-
-    /// Every slot of a triangle in the leaf order (more than one where spatial splits cut it).
-    pub fn slots_of_prim(&self, prim: u32) -> impl Iterator<Item = u32> + '_ {
-        let last = self.slot_of_prim.get(prim as usize).copied().filter(|&s| s != u32::MAX);
-        last.into_iter().chain(self.other_slots.get(&prim).into_iter().flatten().copied())
-    }
-
-    /// The leaf that holds the part of triangle `prim` at `point` (a pixel's hit): its leaf, or of
-    /// a triangle cut among several leaves the one whose box is nearest the point (holds it, but
-    /// for rounding).
-    pub fn leaf_of_hit(&self, bvh: &Bvh, prim: u32, point: glam::Vec3) -> Option<u32> {
-        let away = |leaf: u32| {
-            let b = bvh.nodes[leaf as usize].bounds();
-            (glam::Vec3::from(b.min) - point).max(point - glam::Vec3::from(b.max)).max(glam::Vec3::ZERO).length()
-        };
-        let leaves = self.slots_of_prim(prim).filter_map(|s| self.leaf_of_slot.get(s as usize).copied());
-        leaves.min_by(|&a, &b| away(a).total_cmp(&away(b)))
-    }
-
-    /// The node's ancestors from the root down, the node last: the breadcrumb.
-    pub fn path(&self, node: u32) -> Vec<u32> {
-        let mut out = vec![node];
-        let mut n = node;
-        while let Some(&p) = self.parent.get(n as usize).filter(|&&p| p != u32::MAX) {
-            out.push(p);
-            n = p;
-        }
-        out.reverse();
-        out
-    }
-
-    /// The leaf that holds a mesh triangle (a pixel's hit: its leaf).
-    pub fn leaf_of_prim(&self, prim: u32) -> Option<u32> {
-        let slot = *self.slot_of_prim.get(prim as usize)?;
-        self.leaf_of_slot.get(slot as usize).copied()
-    }
-
-    /// Whether leaf-order slot `slot` lies in `node`'s subtree.
-    pub fn holds(&self, node: usize, slot: u32) -> bool {
-        slot.wrapping_sub(self.first[node]) < self.count[node]
-    }
-}
 
 /// The box two boxes share.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -253,7 +146,7 @@ pub struct Inspection {
     pub spatial: [Vec<CurvePoint>; 3],
     /// What the SBVH does here: for an SBVH tree what its build did, for another tree what it
     /// would do with these triangles.
-    pub sbvh: Option<super::sbvh::Explained>,
+    pub sbvh: Option<sbvh::Explained>,
     /// Each strategy's plane, or none when it finds no split (all centroids on one side or
     /// coinciding: the builder then falls back to equal count).
     pub markers: Vec<(SplitStrategy, Option<Marker>)>,
@@ -298,14 +191,14 @@ fn triangles_by_id(bvh: &Bvh) -> Vec<[glam::Vec3; 3]> {
 /// build held there (found by replaying its decisions from the root, `sbvh::descend`); for the
 /// others the node's triangles, in leaf order (every strategy's choice is independent of the
 /// order). With their bounds, and the SBVH's work there.
-fn node_work(bvh: &Bvh, h: &Hierarchy, tris: &[[glam::Vec3; 3]], node: usize) -> (super::sbvh::Work, NodeInfo) {
+fn node_work(bvh: &Bvh, h: &Hierarchy, tris: &[[glam::Vec3; 3]], node: usize) -> (sbvh::Work, NodeInfo) {
     let params = &bvh.params;
-    let prims: Vec<BuildPrim> = if params.strategy == SplitStrategy::Sbvh {
+    let prims: Vec<BuildPrim> = if params.strategy.splits_references() {
         let path = h.path(node as u32);
         let steps: Vec<bool> = path.windows(2).map(|w| bvh.nodes[w[0] as usize].index != w[1]).collect();
         let root = tris.iter().enumerate().map(|(i, t)| BuildPrim::new(Aabb::from_points(t), i as u32)).collect();
         let tri = |i: u32| tris[i as usize];
-        match super::sbvh::descend(root, &tri, params, &steps) {
+        match sbvh::descend(root, &tri, params, &steps) {
             Some(work) => {
                 let info = info_of(&work.refs);
                 return (work, info);
@@ -317,13 +210,13 @@ fn node_work(bvh: &Bvh, h: &Hierarchy, tris: &[[glam::Vec3; 3]], node: usize) ->
         range.map(|s| BuildPrim::new(Aabb::from_points(&bvh.tris[s]), bvh.prim_ids[s])).collect()
     };
     let info = info_of(&prims);
-    (super::sbvh::work_of(prims, params, h.depth[node]), info)
+    (sbvh::work_of(prims, params, h.depth[node]), info)
 }
 
 /// The node's triangles as the builder saw them, and their bounds (`node_work`).
 #[cfg(test)]
 fn node_prims(bvh: &Bvh, h: &Hierarchy, node: usize) -> (Vec<BuildPrim>, NodeInfo) {
-    let tris = if bvh.params.strategy == SplitStrategy::Sbvh { triangles_by_id(bvh) } else { Vec::new() };
+    let tris = if bvh.params.strategy.splits_references() { triangles_by_id(bvh) } else { Vec::new() };
     let (work, info) = node_work(bvh, h, &tris, node);
     (work.refs, info)
 }
@@ -362,12 +255,7 @@ pub fn subtree_sah(bvh: &Bvh, node: usize) -> f64 {
 
 /// Where `strategy`'s own splitter cuts `prims` (a copy is partitioned), and at what cost; none
 /// when it finds no split.
-fn marker(
-    strategy: SplitStrategy,
-    prims: &[BuildPrim],
-    info: &NodeInfo,
-    params: &super::BuildParams,
-) -> Option<Marker> {
+fn marker(strategy: SplitStrategy, prims: &[BuildPrim], info: &NodeInfo, params: &BuildParams) -> Option<Marker> {
     let area = info.bounds.area();
     if prims.len() < 2 || area <= 0.0 {
         return None;
@@ -402,20 +290,20 @@ pub fn own_split(bvh: &Bvh, h: &Hierarchy, node: u32) -> (Option<Marker>, [Vec<C
         return (None, Default::default());
     }
     let params = bvh.params;
-    let tris = if params.strategy == SplitStrategy::Sbvh { triangles_by_id(bvh) } else { Vec::new() };
+    let tris = if params.strategy.splits_references() { triangles_by_id(bvh) } else { Vec::new() };
     let (work, info) = node_work(bvh, h, &tris, i);
     let prims = work.refs.clone();
     let mut binned = <[Vec<CurvePoint>; 3]>::default();
     let area = info.bounds.area();
-    let binning = matches!(params.strategy, SplitStrategy::SahBinned | SplitStrategy::Sbvh);
+    let binning = params.strategy.uses_bins();
     if binning && prims.len() >= 2 && area > 0.0 {
         let bins = params.sah_bins as usize;
         binned_planes(&mut prims.clone(), &info, bins, &mut Curves { out: &mut binned, cost: params.cost, area });
     }
-    let own = if params.strategy == SplitStrategy::Sbvh {
+    let own = if params.strategy.splits_references() {
         let tri = |i: u32| tris[i as usize];
-        let e = super::sbvh::explain(work, &tri, &params, &bvh.root_bounds(), &mut ());
-        sbvh_marker(&e, &params, area)
+        let e = sbvh::explain(work, &tri, &params, &bvh.root_bounds(), &mut ());
+        sbvh_marker(&e, params.strategy, &params, area)
     } else {
         marker(params.strategy, &prims, &info, &params)
     };
@@ -424,10 +312,10 @@ pub fn own_split(bvh: &Bvh, h: &Hierarchy, node: u32) -> (Option<Marker>, [Vec<C
 
 /// The SBVH's split as a marker (its left and right counts are references: a cut triangle is on
 /// both sides).
-fn sbvh_marker(e: &super::sbvh::Explained, params: &super::BuildParams, area: f32) -> Option<Marker> {
+fn sbvh_marker(e: &sbvh::Explained, strategy: SplitStrategy, params: &BuildParams, area: f32) -> Option<Marker> {
     let s = e.split.filter(|_| area > 0.0)?;
     Some(Marker {
-        strategy: SplitStrategy::Sbvh,
+        strategy,
         axis: s.axis,
         position: s.plane,
         left: s.left,
@@ -462,13 +350,13 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
     let sbvh = (count >= 1).then(|| {
         let tri = |i: u32| tris[i as usize];
         let sink = &mut Curves { out: &mut spatial, cost: params.cost, area: area.max(f32::MIN_POSITIVE) };
-        super::sbvh::explain(work, &tri, &params, &bvh.root_bounds(), sink)
+        sbvh::explain(work, &tri, &params, &bvh.root_bounds(), sink)
     });
     let markers = SplitStrategy::ALL
         .into_iter()
         .map(|strategy| {
             let m = match (strategy, &sbvh) {
-                (SplitStrategy::Sbvh, Some(e)) => sbvh_marker(e, &params, area),
+                (s, Some(e)) if s.splits_references() => sbvh_marker(e, s, &params, area),
                 _ => marker(strategy, &prims, &info, &params),
             };
             (strategy, m)
@@ -477,7 +365,7 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
     let child_overlap =
         children.map(|[l, r]| Overlap::of(&bvh.nodes[l as usize].bounds(), &bvh.nodes[r as usize].bounds()));
     // (An SBVH subtree's leaves hold more references than its node did: its marker is its split.)
-    let own_cost = children.filter(|_| area > 0.0 && params.strategy != SplitStrategy::Sbvh).map(|[l, r]| {
+    let own_cost = children.filter(|_| area > 0.0 && !params.strategy.splits_references()).map(|[l, r]| {
         let side = |c: u32| bvh.nodes[c as usize].bounds().area() * h.count[c as usize] as f32;
         params.cost.traversal + params.cost.intersection * (side(l) + side(r)) / area
     });
@@ -504,7 +392,7 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         leaf_cost: params.cost.intersection * count as f32,
         sweep,
         binned,
-        bins: super::split::bins_for(count as usize, bins),
+        bins: crate::bvh::split::bins_for(count as usize, bins),
         spatial,
         sbvh,
         markers,
@@ -513,6 +401,7 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
     })
 }
 
+pub mod text;
+
 #[cfg(test)]
-#[path = "inspect_tests.rs"]
 mod tests;

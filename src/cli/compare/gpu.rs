@@ -4,11 +4,12 @@
 //! random directions): MRays/s of each, from the GPU's submit-to-completion time (read-backs left
 //! out), the median of `--runs` runs after one untimed run that compiles the kernels.
 
-use super::args::{BuildArgs, GpuNodes};
-use super::compare::CompareRow;
-use super::device::{self, GpuTree};
-use super::{progress, CliError};
+use super::rows::CompareRow;
 use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SceneBvh, SplitStrategy, TraceOptions, TreeStats, TreeView};
+use crate::cli::args::BuildArgs;
+use crate::cli::device::{self, GpuTree};
+use crate::cli::{progress, CliError};
+use crate::gpu_path::GpuNodes;
 use crate::mesh::Mesh;
 use crate::render::warp::{WarpSize, WarpView, WarpWork};
 use crate::render::Camera;

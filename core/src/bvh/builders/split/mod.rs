@@ -1,7 +1,7 @@
 //! Split strategies: given the primitives of one node, propose where to split and partition the
 //! primitives accordingly. One file per strategy, each a `Splitter` that keeps the scratch memory it
 //! reuses from node to node; the driver that calls them, and decides leaf or split, is
-//! `bvh::build`.
+//! `bvh::builders`.
 
 mod equal_count;
 mod midpoint;
@@ -9,6 +9,7 @@ mod sah_binned;
 mod sah_sweep;
 mod spatial;
 
+pub use super::strategy::SplitStrategy;
 use crate::geometry::Aabb;
 use glam::{Vec3A, Vec4};
 
@@ -35,49 +36,6 @@ pub trait Splitter: Send {
 
     /// Propose a split of `prims`, partitioned so the first `mid` go left.
     fn split(&mut self, prims: &mut [BuildPrim], node: &NodeInfo) -> Proposal;
-}
-
-impl SplitStrategy {
-    /// A splitter of this strategy for a build with `params`; `None` for a builder that does not
-    /// split node by node at a plane it chooses there (LBVH: its planes follow from the sort), or
-    /// that splits references rather than partitions triangles (SBVH, its own driver).
-    pub fn splitter(self, params: &crate::bvh::BuildParams) -> Option<Box<dyn Splitter>> {
-        match self {
-            SplitStrategy::Midpoint => Some(Box::new(Midpoint)),
-            SplitStrategy::EqualCount => Some(Box::new(EqualCount)),
-            SplitStrategy::SahBinned => Some(Box::new(SahBinned::new(params))),
-            SplitStrategy::SahSweep => Some(Box::new(SahSweep::new(params))),
-            SplitStrategy::Lbvh | SplitStrategy::Ploc | SplitStrategy::Sbvh => None,
-        }
-    }
-
-    /// Whether the top-down driver (`bvh::build`) builds with this strategy's splitter.
-    pub fn splits_top_down(self) -> bool {
-        !matches!(self, SplitStrategy::Lbvh | SplitStrategy::Ploc | SplitStrategy::Sbvh)
-    }
-}
-
-/// How the builder chooses splits.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-pub enum SplitStrategy {
-    /// Middle of the centroid bounds on the widest axis.
-    Midpoint,
-    /// Median centroid on the widest axis: equally many triangles on each side.
-    EqualCount,
-    /// Surface area heuristic, evaluated at bin boundaries on all three axes.
-    #[default]
-    SahBinned,
-    /// Surface area heuristic, evaluated between every pair of neighbouring centroids.
-    SahSweep,
-    /// Not a split strategy but a builder of its own (`bvh::lbvh`): the hierarchy of the
-    /// centroids' sorted Morton codes.
-    Lbvh,
-    /// A bottom-up builder of its own (`bvh::ploc`): clusters merged with their nearest
-    /// neighbours in Morton order.
-    Ploc,
-    /// The binned SAH with spatial splits (`bvh::sbvh`): triangles cut where that beats sorting
-    /// them to one side, so a triangle may be referenced by several leaves.
-    Sbvh,
 }
 
 /// A triangle as the builder sees it: its bounds in SIMD registers' layout (a box union is two

@@ -11,6 +11,7 @@ pub(crate) mod ploc;
 pub mod reinsert;
 pub mod sbvh;
 pub mod split;
+pub mod strategy;
 mod subtree;
 
 use crate::bvh::node::{Bvh, BvhNode};
@@ -21,8 +22,9 @@ use crate::work::{Cancelled, WorkControl};
 pub use common::{build_work, HEURISTIC_DEPTH_LIMIT};
 use common::{leaf_is_cheaper, node_info, progress_levels, Overrides, Progress, PARALLEL_MIN_PRIMS};
 use rayon::prelude::*;
-use split::{BuildPrim, EqualCount, NodeInfo, Proposal, SplitStrategy, Splitter};
+use split::{BuildPrim, EqualCount, NodeInfo, Proposal, Splitter};
 use std::time::Instant;
+use strategy::Builder;
 use subtree::Subtree;
 
 struct Task {
@@ -55,7 +57,7 @@ impl Bvh {
         let t0 = Instant::now();
         let params = params.clamped();
         let n = mesh.triangle_count();
-        if params.strategy == SplitStrategy::Lbvh {
+        if params.strategy.follows_morton_order() {
             let progress = Progress { control, levels: progress_levels(n, &params) };
             return Self::finish(lbvh::build_mesh(mesh, &params, &progress)?, control);
         }
@@ -121,28 +123,28 @@ fn build_nodes(
 ) -> Result<(Vec<BvhNode>, BuildReport), Cancelled> {
     let t1 = Instant::now();
     let progress = Progress { control, levels: progress_levels(prims.len(), params) };
-    if params.strategy == SplitStrategy::Sbvh {
-        let (nodes, refs, kinds) = sbvh::build(std::mem::take(prims), tri, params, &progress)?;
-        *prims = refs;
-        let report = BuildReport {
-            split_time: t1.elapsed(),
-            fallback_splits: kinds.over.fallback,
-            depth_limited_splits: kinds.over.depth_limited,
-            spatial_splits: kinds.spatial,
-            ..Default::default()
-        };
-        return Ok((nodes, report));
-    }
-    let (tree, over) = match params.strategy {
-        SplitStrategy::Lbvh => {
+    let (tree, over) = match params.strategy.builder() {
+        Builder::SpatialSplits => {
+            let (nodes, refs, kinds) = sbvh::build(std::mem::take(prims), tri, params, &progress)?;
+            *prims = refs;
+            let report = BuildReport {
+                split_time: t1.elapsed(),
+                fallback_splits: kinds.over.fallback,
+                depth_limited_splits: kinds.over.depth_limited,
+                spatial_splits: kinds.spatial,
+                ..Default::default()
+            };
+            return Ok((nodes, report));
+        }
+        Builder::Morton => {
             let (tree, fallback) = lbvh::build(prims, params, &progress)?;
             (tree, Overrides { fallback, depth_limited: 0 })
         }
-        SplitStrategy::Ploc => {
+        Builder::Clustering => {
             let (tree, _) = ploc::build(prims, params, params.ploc_radius as usize, &progress)?;
             (tree, Overrides::default())
         }
-        _ => build_subtree(prims, 0, 0, params, &progress)?,
+        Builder::TopDown(_) => build_subtree(prims, 0, 0, params, &progress)?,
     };
     let nodes = tree.into_nodes();
     Ok((

@@ -7,7 +7,6 @@
 
 use super::split::BuildPrim;
 use crate::bvh::node::Bvh;
-use crate::bvh::SplitStrategy;
 use crate::geometry::Aabb;
 use glam::Vec3A;
 use rayon::prelude::*;
@@ -140,7 +139,7 @@ impl MortonOrder {
     /// The order of an LBVH tree as built (`None` for other strategies, or after reinsertion,
     /// which moves subtrees out of Morton order).
     pub fn of(bvh: &Bvh) -> Option<MortonOrder> {
-        if bvh.params.strategy != SplitStrategy::Lbvh || bvh.report.reinsertion.is_some() {
+        if !bvh.params.strategy.follows_morton_order() || bvh.report.reinsertion.is_some() {
             return None;
         }
         let prims: Vec<BuildPrim> =
@@ -179,7 +178,7 @@ impl MortonOrder {
 #[cfg(test)]
 mod morton_order_tests {
     use super::MortonOrder;
-    use crate::bvh::inspect::Hierarchy;
+    use crate::bvh::Hierarchy;
     use crate::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
     use crate::mesh::generate;
 

@@ -7,10 +7,8 @@
 //! same binary walk as the finished one. The SAH cost of each partial tree is kept, so the cost can
 //! be plotted against k.
 
-use super::counters::TraversalStats;
-use super::inspect::Hierarchy;
-use super::traverse::{test_triangles, walk, walk_from, MeshLevel};
-use super::{Accelerator, Bvh, BvhNode, Hit, NoStats};
+use crate::bvh::traverse::{test_triangles, walk, walk_from, MeshLevel};
+use crate::bvh::{Accelerator, Bvh, BvhNode, Hierarchy, Hit, NoStats, TraversalStats};
 use crate::geometry::{Ray, TriangleIntersector};
 use std::sync::Arc;
 

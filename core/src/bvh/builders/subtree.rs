@@ -1,4 +1,4 @@
-//! The parallel build's subtrees and their placement in the final node array (`bvh::build`).
+//! The parallel build's subtrees and their placement in the final node array (`bvh::builders`).
 
 use crate::bvh::node::BvhNode;
 use crate::geometry::Aabb;

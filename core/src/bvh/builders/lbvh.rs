@@ -153,7 +153,7 @@ fn root_bounds(t: &Subtree) -> Aabb {
     }
 }
 
-/// One thread's subtree, laid out as `build::build_sequential` lays out its nodes (each node's
+/// One thread's subtree, laid out as `builders::build_sequential` lays out its nodes (each node's
 /// children a pair, the left subtree right after it): the topology top-down, then the boxes from
 /// the leaves up (children come after their parent, so one pass backwards).
 fn sequential<T: Bounded>(

@@ -18,7 +18,7 @@
 //! the root's area, which never changes.
 
 use crate::bvh::node::{Bvh, BvhNode};
-use crate::bvh::{BuildParams, SplitStrategy, TreeStats};
+use crate::bvh::{BuildParams, TreeStats};
 use crate::geometry::Aabb;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -276,7 +276,7 @@ pub fn optimise(bvh: &mut Bvh, passes: u32) -> Reinsertion {
     // Single triangles move, not only whole leaves (Bittner et al. optimise trees of one triangle
     // per leaf); an SBVH's leaves hold clipped parts of triangles, whose boxes are not the
     // triangles', so they stay whole.
-    let split_leaves = bvh.params.strategy != SplitStrategy::Sbvh;
+    let split_leaves = !bvh.params.strategy.splits_references();
     let mut t = Tree::of(bvh, split_leaves);
     let mut heap = BinaryHeap::new();
     let mut order: Vec<u32> = Vec::with_capacity(t.kids.len());

@@ -3,7 +3,7 @@
 //! the step reports away, so it costs nothing when not asked for. The tree view's "visits" column
 //! and the icicle's visits colouring come from here.
 
-use super::{Accelerator, Bvh, NodeId, TraceOptions, TraversalStats};
+use crate::bvh::{Accelerator, Bvh, NodeId, TraceOptions, TraversalStats};
 use crate::render::Camera;
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;

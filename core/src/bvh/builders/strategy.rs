@@ -1,0 +1,145 @@
+//! The strategies, and the one table that says what each is: how it builds and which numbers it
+//! reads. The driver, the node inspector, the build panel, the CLI and the scene files ask these
+//! methods; none of them names a strategy to decide what it does. A new strategy is a variant
+//! here, its row in `REGISTRY`, its names in `crate::options`, and its splitter's file
+//! (ARCHITECTURE.md, "Adding a strategy").
+
+use super::split::{EqualCount, Midpoint, SahBinned, SahSweep, Splitter};
+use crate::bvh::{BuildParams, Param};
+
+/// How the builder chooses splits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum SplitStrategy {
+    /// Middle of the centroid bounds on the widest axis.
+    Midpoint,
+    /// Median centroid on the widest axis: equally many triangles on each side.
+    EqualCount,
+    /// Surface area heuristic, evaluated at bin boundaries on all three axes.
+    #[default]
+    SahBinned,
+    /// Surface area heuristic, evaluated between every pair of neighbouring centroids.
+    SahSweep,
+    /// Not a split strategy but a builder of its own (`builders::lbvh`): the hierarchy of the
+    /// centroids' sorted Morton codes.
+    Lbvh,
+    /// A bottom-up builder of its own (`builders::ploc`): clusters merged with their nearest
+    /// neighbours in Morton order.
+    Ploc,
+    /// The binned SAH with spatial splits (`builders::sbvh`): triangles cut where that beats
+    /// sorting them to one side, so a triangle may be referenced by several leaves.
+    Sbvh,
+}
+
+/// How a strategy builds.
+#[derive(Clone, Copy)]
+pub enum Builder {
+    /// Top-down by the driver (`builders::build_nodes`), node by node, with a splitter made for
+    /// the build's parameters.
+    TopDown(fn(&BuildParams) -> Box<dyn Splitter>),
+    /// The hierarchy of the sorted Morton codes (`lbvh`): no plane is chosen at a node.
+    Morton,
+    /// Bottom-up clustering in Morton order (`ploc`).
+    Clustering,
+    /// Top-down over references, with spatial splits that cut triangles (`sbvh`).
+    SpatialSplits,
+}
+
+struct Entry {
+    strategy: SplitStrategy,
+    builder: Builder,
+    /// The numbers it reads besides those every build reads (`Param::every_build`).
+    params: &'static [Param],
+}
+
+const REGISTRY: [Entry; 7] = [
+    Entry { strategy: SplitStrategy::Midpoint, builder: Builder::TopDown(|_| Box::new(Midpoint)), params: &[] },
+    Entry { strategy: SplitStrategy::EqualCount, builder: Builder::TopDown(|_| Box::new(EqualCount)), params: &[] },
+    Entry {
+        strategy: SplitStrategy::SahBinned,
+        builder: Builder::TopDown(|p| Box::new(SahBinned::new(p))),
+        params: &[Param::SahBins],
+    },
+    Entry { strategy: SplitStrategy::SahSweep, builder: Builder::TopDown(|p| Box::new(SahSweep::new(p))), params: &[] },
+    Entry { strategy: SplitStrategy::Lbvh, builder: Builder::Morton, params: &[] },
+    Entry { strategy: SplitStrategy::Ploc, builder: Builder::Clustering, params: &[Param::PlocRadius] },
+    Entry {
+        strategy: SplitStrategy::Sbvh,
+        builder: Builder::SpatialSplits,
+        params: &[Param::SahBins, Param::SbvhAlpha, Param::SbvhGrowth],
+    },
+];
+
+impl Param {
+    /// Whether every build reads it, whatever its strategy (the leaf size, the SAH's constant,
+    /// and reinsertion, which works on any binary tree).
+    pub fn every_build(self) -> bool {
+        matches!(self, Param::MaxLeafSize | Param::ReinsertPasses | Param::TraversalCost)
+    }
+}
+
+impl SplitStrategy {
+    fn entry(self) -> &'static Entry {
+        REGISTRY.iter().find(|e| e.strategy == self).expect("every strategy has its row")
+    }
+
+    pub fn builder(self) -> Builder {
+        self.entry().builder
+    }
+
+    /// A splitter of this strategy for a build with `params`; `None` for a builder that does not
+    /// split node by node at a plane it chooses there.
+    pub fn splitter(self, params: &BuildParams) -> Option<Box<dyn Splitter>> {
+        match self.builder() {
+            Builder::TopDown(make) => Some(make(params)),
+            _ => None,
+        }
+    }
+
+    /// Whether the top-down driver builds with this strategy's splitter.
+    pub fn splits_top_down(self) -> bool {
+        matches!(self.builder(), Builder::TopDown(_))
+    }
+
+    /// Whether its leaves hold references (parts of triangles) rather than triangles: a triangle
+    /// may be in several leaves, and a node's triangles are found by replaying the build.
+    pub fn splits_references(self) -> bool {
+        matches!(self.builder(), Builder::SpatialSplits)
+    }
+
+    /// Whether its tree's leaf order is its Morton order (an LBVH's, not reinserted).
+    pub fn follows_morton_order(self) -> bool {
+        matches!(self.builder(), Builder::Morton)
+    }
+
+    /// Whether it prices splits at bins (`Param::SahBins`).
+    pub fn uses_bins(self) -> bool {
+        self.reads(Param::SahBins)
+    }
+
+    /// The numbers it reads besides those every build reads.
+    pub fn params(self) -> &'static [Param] {
+        self.entry().params
+    }
+
+    /// Whether a build with this strategy reads `p`.
+    pub fn reads(self, p: Param) -> bool {
+        p.every_build() || self.params().contains(&p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_strategy_has_one_row() {
+        for (i, e) in REGISTRY.iter().enumerate() {
+            assert!(REGISTRY[..i].iter().all(|f| f.strategy != e.strategy), "{:?} twice", e.strategy);
+            assert!(e.params.iter().all(|p| !p.every_build()), "{:?}: a number every build reads", e.strategy);
+        }
+        assert_eq!(REGISTRY.len(), SplitStrategy::ALL.len());
+        assert!(SplitStrategy::Sbvh.splits_references() && !SplitStrategy::SahBinned.splits_references());
+        assert!(SplitStrategy::Sbvh.uses_bins() && !SplitStrategy::Ploc.uses_bins());
+        assert!(SplitStrategy::Ploc.reads(Param::PlocRadius) && !SplitStrategy::Lbvh.reads(Param::PlocRadius));
+    }
+}

@@ -1,0 +1,157 @@
+//! `bvhscope compare`: the lab-report table. Every strategy is built and measured on the same
+//! primary rays, next to a linear scan of all triangles.
+//!
+//! Three timings per strategy. "trace ms" is what a student's renderer would see: one thread (or
+//! `--threads`), one ray at a time, closest hit only, no shading; it follows the work per ray, and
+//! the speedup over the linear scan compares it with the scan timed the same way. "frame ms" is
+//! the app's frame: the renderer on all threads (or `--threads`), 8×8 ray packets, shading
+//! included; there, making rays and shading cost as much as tracing, so strategies differ little.
+//! Both are medians of `--runs` frames of the plain (non-counting) traversal; the per-ray means
+//! come from one extra counting frame, over all rays and over the rays that enter the root box.
+//! Build times are the median of as many builds, or of fewer when they pass a second in all: one
+//! build of a small mesh takes a few milliseconds, and a single one can be twice the next on a
+//! busy machine. The linear scan is timed on the full frame when that is projected to take at most
+//! ~10 s, else on an evenly spread sample of its rays, and the table says so.
+
+mod csv;
+mod gpu;
+mod rows;
+
+pub use csv::{rows_csv, rows_csv_with_gpu};
+pub use rows::{compare_rows, CompareRow};
+
+use crate::cli::args::{BuildArgs, DeviceArgs, ViewArgs};
+use crate::cli::{load_mesh, CliError};
+use crate::gpu_path::GpuNodes;
+use clap::{Args, ValueEnum};
+use std::fmt::Write;
+use std::path::PathBuf;
+use std::time::Duration;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum CompareFormat {
+    Markdown,
+    Csv,
+    Json,
+}
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// The mesh (.obj) or scene (.json: bvhscope's or Moer-lite's).
+    pub mesh: PathBuf,
+    #[command(flatten)]
+    pub build: BuildArgs,
+    /// With --device gpu, GPU rows follow the table: every strategy's binary tree traced on the
+    /// GPU in both node formats (or --gpu-nodes'), counted and plain, primary and incoherent rays.
+    #[command(flatten)]
+    pub device: DeviceArgs,
+    #[command(flatten)]
+    pub view_args: ViewArgs,
+    #[arg(long, value_enum, default_value = "markdown")]
+    pub format: CompareFormat,
+    /// Frames timed per strategy, and builds (the medians are reported; builds stop early once
+    /// they have taken a second).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub runs: u32,
+    /// Threads for all the work: builds, frames and the single-ray trace timing [default: all
+    /// cores for builds and frames, one for the trace timing].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+pub fn run(a: &CompareArgs) -> Result<(), CliError> {
+    let gpu = crate::cli::device::open(&a.device)?;
+    let loaded = load_mesh(&a.mesh)?;
+    let mesh_arc = loaded.flat_mesh()?;
+    let mesh = &*mesh_arc;
+    let camera = a.view_args.camera(&mesh.bounds(), loaded.camera.as_ref())?;
+    let scene = loaded.build.as_ref();
+    if gpu.is_some() {
+        // Refused before the CPU rows are measured, not after.
+        crate::cli::device::check_traceable(&a.build.scene_build(a.build.params(scene)), a.build.trace())?;
+    }
+    let (rows, setup) = compare_rows(mesh, &camera, &a.build, scene, a.runs, a.threads, Duration::from_secs(10));
+    let linear_ms = rows.last().map_or(0.0, |r| r.trace_ms);
+    let formats = a.device.gpu_nodes.map_or(vec![GpuNodes::Binary, GpuNodes::Cwbvh], |n| vec![n]);
+    let gpu_rows = match &gpu {
+        Some(g) => Some(gpu::gpu_rows(g, &mesh_arc, &camera, &a.build, scene, a.runs, &formats, linear_ms)?),
+        None => None,
+    };
+    let rays = setup.rays;
+    let trace = a.build.trace();
+    let mut o = String::new();
+    match a.format {
+        CompareFormat::Json => {
+            let v = serde_json::json!({
+                "mesh": a.mesh, "triangles": mesh.triangle_count(), "width": camera.width, "height": camera.height,
+                "setup": setup, "trace": trace, "preset": a.build.preset, "rows": rows,
+                "gpu": gpu.as_ref().zip(gpu_rows.as_ref()).map(|(g, (r, n))| serde_json::json!({
+                    "adapter": g.name(), "software": g.is_software(), "incoherent_rays": n, "rows": r,
+                })),
+            });
+            let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
+        }
+        CompareFormat::Csv => {
+            o = match &gpu_rows {
+                Some((g, _)) => rows_csv_with_gpu(&rows, g),
+                None => rows_csv(&rows),
+            }
+        }
+        CompareFormat::Markdown => {
+            let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | EPO | nodes / ray: all / in root box | tri tests / ray: all / in root box | trace ms | frame ms | speedup vs linear |");
+            let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+            for r in &rows {
+                let depth =
+                    if r.nodes > 0 { format!("{} / {:.1}", r.max_depth, r.mean_leaf_depth) } else { "—".into() };
+                let sampled = if r.sampled_rays.is_some() { " *" } else { "" };
+                let dash = |v: Option<f64>, d: usize| v.map_or("—".to_string(), |v| format!("{v:.d$}"));
+                let _ = writeln!(
+                    o,
+                    "| {} | {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} / {:.1} | {}{sampled} | {}{sampled} | {:.0}× |",
+                    r.name,
+                    r.build_ms.map_or("—".to_string(), crate::bvh::fmt_ms),
+                    r.nodes,
+                    depth,
+                    dash(r.sah_cost, 2),
+                    dash(r.epo, 2),
+                    r.nodes_per_ray,
+                    r.root_nodes_per_ray,
+                    r.tri_tests_per_ray,
+                    r.root_tri_tests_per_ray,
+                    crate::bvh::fmt_ms(r.trace_ms),
+                    crate::bvh::fmt_ms(r.frame_ms),
+                    r.speedup_over_linear
+                );
+            }
+            let _ = writeln!(o);
+            let preset = a.build.preset.map_or(String::new(), |p| format!("preset {}; ", p.name()));
+            let _ = writeln!(
+                o,
+                "{}: {} triangles; {}x{} primary rays ({} rays, {} = {:.0}% enter the root box); {preset}traversal {}, {} test.",
+                a.mesh.display(), mesh.triangle_count(), camera.width, camera.height, rays, setup.root_rays,
+                100.0 * setup.root_rays as f64 / rays.max(1) as f64, trace.order.label(), trace.test.label()
+            );
+            let _ = writeln!(
+                o,
+                "trace ms: single rays, closest hit, no shading, {} thread(s); frame ms: the renderer (8×8 packets, shading) on {} thread(s); medians of {} frames; build ms: median of up to {} builds on {} thread(s); speedup: the linear scan's trace ms over the row's.",
+                setup.trace_threads, setup.frame_threads, a.runs, a.runs, setup.frame_threads
+            );
+            if let Some(n) = rows.last().and_then(|r| r.sampled_rays) {
+                let _ = writeln!(o, "* linear scan timed on {n} of {rays} rays (a full frame would take over 10 s) and scaled to the full frame.");
+            }
+            let fallbacks: Vec<String> = rows
+                .iter()
+                .filter(|r| r.fallback_splits > 0)
+                .map(|r| format!("{} {}", r.name, r.fallback_splits))
+                .collect();
+            if !fallbacks.is_empty() {
+                let _ = writeln!(o, "Equal-count fallback splits (no useful split found): {}.", fallbacks.join(", "));
+            }
+            if let (Some(g), Some((r, n))) = (&gpu, &gpu_rows) {
+                o += &gpu::markdown(g, r, &camera, *n, a.runs, trace);
+            }
+        }
+    }
+    crate::cli::out(&o);
+    Ok(())
+}

@@ -1,0 +1,195 @@
+//! The table's rows: every strategy built and measured on the same primary rays, next to a
+//! linear scan of all triangles (how, in `compare`'s module comment).
+
+use crate::bvh::{epo, AnyBvh, BuildParams, LinearScan, SplitStrategy, TreeStats, TreeView};
+use crate::cli::args::BuildArgs;
+use crate::cli::progress;
+use crate::explain::timing::{ms, time_linear, trace_rays};
+use crate::render::{render, Camera, RenderSettings};
+use std::time::{Duration, Instant};
+
+/// One row of the table.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CompareRow {
+    pub name: String,
+    pub build_ms: Option<f64>,
+    pub nodes: usize,
+    pub max_depth: u32,
+    pub mean_leaf_depth: f64,
+    pub sah_cost: Option<f64>,
+    /// End-point overlap of the binary tree (the same for both layouts of a strategy).
+    pub epo: Option<f64>,
+    /// Means over all primary rays.
+    pub nodes_per_ray: f64,
+    pub tri_tests_per_ray: f64,
+    /// Means over the rays that enter the root box.
+    pub root_nodes_per_ray: f64,
+    pub root_tri_tests_per_ray: f64,
+    /// Single rays, closest hit, no shading, on `trace_threads` (median; projected from a sample
+    /// for a sampled row).
+    pub trace_ms: f64,
+    /// The renderer's full frame with shading (median of the timed frames; the linear scan's is
+    /// its single-ray trace on the frame's threads, as it has no packets).
+    pub frame_ms: f64,
+    /// Rays per second of the frame.
+    pub mrays_per_s: f64,
+    /// The linear scan's trace time over this row's.
+    pub speedup_over_linear: f64,
+    /// Rays actually timed, when fewer than the frame's.
+    pub sampled_rays: Option<usize>,
+    pub fallback_splits: u32,
+}
+
+/// How the rows were measured (for the table's footer and the JSON).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct CompareSetup {
+    pub trace_threads: usize,
+    pub frame_threads: usize,
+    /// Rays that enter the root box (the same for every strategy: they share the root box).
+    pub root_rays: u64,
+    pub rays: u64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Builds of one strategy stop once they have taken this long in all (at least one is made).
+const BUILD_BUDGET_MS: f64 = 1000.0;
+
+/// A thread pool of `n` threads (`None`: rayon's default, one per core).
+fn pool(n: Option<u32>) -> rayon::ThreadPool {
+    let b = rayon::ThreadPoolBuilder::new();
+    let b = match n {
+        Some(n) => b.num_threads(n as usize),
+        None => b,
+    };
+    b.build().expect("a thread pool can be started")
+}
+
+/// Build and measure every strategy and the linear scan. Builds and frames run on `threads` (all
+/// cores when `None`), the single-ray trace timing on `threads` (one when `None`).
+pub fn compare_rows(
+    mesh: &crate::mesh::Mesh,
+    camera: &Camera,
+    build: &BuildArgs,
+    scene: Option<&BuildParams>,
+    runs: u32,
+    threads: Option<u32>,
+    linear_budget: Duration,
+) -> (Vec<CompareRow>, CompareSetup) {
+    let (frames, traces) = (pool(threads), pool(Some(threads.unwrap_or(1))));
+    let rays = camera.width as f64 * camera.height as f64;
+    let trace = build.trace();
+    let plain = RenderSettings { trace, count: false, progressive: false };
+    let counting = RenderSettings { count: true, ..plain };
+    let mut rows = Vec::new();
+    let mut root_rays = 0;
+    let mut epo_of = std::collections::HashMap::new();
+    let layouts = build.compare_layouts();
+    for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))) {
+        let params = build.params_with(scene, strategy, layout);
+        let name = format!("{} ({})", strategy.label(), layout.name());
+        let (bvh, build_ms) = progress::with_spinner(&format!("building {name}"), || {
+            frames.install(|| {
+                let build_ms = |bvh: &AnyBvh| ms(bvh.report().total_time());
+                let mut bvh = AnyBvh::build(mesh, &params);
+                let mut times = vec![build_ms(&bvh)];
+                // Past the budget, one more build when the count is even: the median of two would be
+                // the slower, often the first, cold one.
+                while times.len() < runs as usize
+                    && (times.iter().sum::<f64>() < BUILD_BUDGET_MS || times.len().is_multiple_of(2))
+                {
+                    bvh = AnyBvh::build(mesh, &params);
+                    times.push(build_ms(&bvh));
+                }
+                (bvh, median(times))
+            })
+        });
+        let (stats, summary, frame_times, trace_times) = progress::with_spinner(&format!("tracing {name}"), || {
+            let stats = TreeStats::of(&bvh);
+            let (summary, frame_times) = frames.install(|| {
+                let summary = render(&bvh, mesh, camera, &counting).ray_summary();
+                let times: Vec<f64> = (0..runs)
+                    .map(|_| {
+                        let t = Instant::now();
+                        std::hint::black_box(render(&bvh, mesh, camera, &plain));
+                        ms(t.elapsed())
+                    })
+                    .collect();
+                (summary, times)
+            });
+            let total = rays as usize;
+            let trace_times: Vec<f64> =
+                traces.install(|| (0..runs).map(|_| ms(trace_rays(&bvh, camera, trace, total))).collect());
+            (stats, summary, frame_times, trace_times)
+        });
+        root_rays = summary.root_rays;
+        let frame_ms = median(frame_times);
+        let epo = *epo_of.entry(strategy).or_insert_with(|| {
+            progress::with_spinner(&format!("measuring the end-point overlap of {}", strategy.label()), || {
+                frames.install(|| epo::of(&bvh.binary_tree(mesh)))
+            })
+        });
+        rows.push(CompareRow {
+            name,
+            build_ms: Some(build_ms),
+            nodes: stats.nodes,
+            max_depth: stats.max_depth,
+            mean_leaf_depth: stats.mean_leaf_depth,
+            sah_cost: Some(stats.sah_cost),
+            epo: Some(epo),
+            nodes_per_ray: summary.mean_nodes_visited,
+            tri_tests_per_ray: summary.mean_triangle_tests,
+            root_nodes_per_ray: summary.root_mean_nodes_visited,
+            root_tri_tests_per_ray: summary.root_mean_triangle_tests,
+            trace_ms: median(trace_times),
+            frame_ms,
+            mrays_per_s: rays / frame_ms / 1e3,
+            speedup_over_linear: 0.0,
+            sampled_rays: None,
+            fallback_splits: stats.fallback_splits,
+        });
+    }
+    let linear = LinearScan::new(mesh);
+    let ((linear_ms, sampled), (frame_ms, _)) = progress::with_spinner("timing the linear scan", || {
+        // The scan has no packets: its "frame" is its trace on the frame's threads.
+        let control = crate::work::WorkControl::new();
+        let timed = |pool: &rayon::ThreadPool| {
+            pool.install(|| time_linear(&linear, camera, trace, linear_budget, &control))
+                .expect("nobody else holds this control")
+        };
+        (timed(&traces), timed(&frames))
+    });
+    let n = mesh.triangle_count() as f64;
+    rows.push(CompareRow {
+        name: "Linear scan".to_string(),
+        build_ms: None,
+        nodes: 0,
+        max_depth: 0,
+        mean_leaf_depth: 0.0,
+        sah_cost: None,
+        epo: None,
+        nodes_per_ray: 0.0,
+        tri_tests_per_ray: n,
+        root_nodes_per_ray: 0.0,
+        root_tri_tests_per_ray: n,
+        trace_ms: linear_ms,
+        frame_ms,
+        mrays_per_s: rays / frame_ms / 1e3,
+        speedup_over_linear: 1.0,
+        sampled_rays: sampled,
+        fallback_splits: 0,
+    });
+    for r in &mut rows {
+        r.speedup_over_linear = linear_ms / r.trace_ms;
+    }
+    let setup = CompareSetup {
+        trace_threads: traces.current_num_threads(),
+        frame_threads: frames.current_num_threads(),
+        root_rays,
+        rays: rays as u64,
+    };
+    (rows, setup)
+}

@@ -1,0 +1,176 @@
+//! The GPU path shared by the command line and the app: which device traces, the node format it
+//! walks, the trees built on the GPU (lbvh and ploc, core's trees node for node, with their phases
+//! timed) and a tree uploaded for tracing. The command line's flags and messages over it are in
+//! `cli::device`, the app's jobs in `app::gpu`.
+
+use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, RayCounters, SceneBvh, SplitStrategy, TraceOptions};
+use crate::mesh::Mesh;
+use crate::render::Camera;
+use bvhscope_gpu::{Cwbvh, Gpu, GpuBinaryBvh, GpuBuildTimings, GpuCwbvh, GpuError, GpuLbvh, GpuPloc, GpuTrace, Rays};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// Where rays are traced: the CPU (the renderer of `core`) or the GPU (`bvhscope-gpu`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Device {
+    #[default]
+    Cpu,
+    Gpu,
+}
+
+/// The node format the GPU walks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GpuNodes {
+    /// The binary tree as built: core's 32-byte nodes, byte for byte.
+    #[default]
+    Binary,
+    /// Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree.
+    Cwbvh,
+}
+
+impl GpuNodes {
+    /// How messages and tables name the format.
+    pub fn name(self) -> &'static str {
+        match self {
+            GpuNodes::Binary => "binary",
+            GpuNodes::Cwbvh => "CWBVH",
+        }
+    }
+}
+
+/// A build made on the GPU: which builder, and how long each phase took.
+#[derive(Clone, Copy, Debug)]
+pub struct GpuBuild {
+    pub strategy: SplitStrategy,
+    pub timings: GpuBuildTimings,
+}
+
+impl GpuBuild {
+    /// The phases as `stats` prints them (PLOC's emission is its clustering, its boxes the host's
+    /// layout of the leaves).
+    pub fn text(&self) -> String {
+        let t = &self.timings;
+        let ms = |d: std::time::Duration| format!("{:.2}", d.as_secs_f64() * 1e3);
+        let (emission, boxes) = match self.strategy {
+            SplitStrategy::Ploc => {
+                (format!("clustering {} ({} rounds)", ms(t.emission), t.rounds), "layout on the host")
+            }
+            _ => (format!("emission {}", ms(t.emission)), "boxes"),
+        };
+        format!(
+            "{} ms (upload {}, codes {}, sort {}, {emission}, {boxes} {}, download {})",
+            ms(t.total()),
+            ms(t.upload),
+            ms(t.codes),
+            ms(t.sort),
+            ms(t.boxes),
+            ms(t.download)
+        )
+    }
+
+    pub fn json(&self) -> serde_json::Value {
+        let t = &self.timings;
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        serde_json::json!({
+            "strategy": self.strategy.name(), "total_ms": ms(t.total()), "upload_ms": ms(t.upload),
+            "codes_ms": ms(t.codes), "sort_ms": ms(t.sort), "emission_ms": ms(t.emission), "boxes_ms": ms(t.boxes),
+            "download_ms": ms(t.download), "ploc_rounds": t.rounds,
+        })
+    }
+}
+
+/// Lay a built binary tree out as `layout` asks (as `AnyBvh::build` does after its build).
+fn lay_out(bvh: Bvh, layout: Layout) -> AnyBvh {
+    match layout {
+        Layout::Binary => AnyBvh::Binary(bvh),
+        Layout::Wide4 => AnyBvh::Wide(crate::bvh::WideBvh::from_binary(bvh)),
+        Layout::Wide8 => AnyBvh::Wide8(crate::bvh::WideBvh::collapse(bvh)),
+    }
+}
+
+/// Whether the GPU builds `strategy` (lbvh and ploc; the others are built on the CPU).
+pub fn builds_on_gpu(strategy: SplitStrategy) -> bool {
+    matches!(strategy, SplitStrategy::Lbvh | SplitStrategy::Ploc)
+}
+
+/// `gpu_build` without a spinner (the app's build job).
+pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<(AnyBvh, GpuBuild)>, GpuError> {
+    let strategy = params.strategy;
+    let built = match strategy {
+        SplitStrategy::Lbvh => GpuLbvh::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
+        SplitStrategy::Ploc => GpuPloc::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
+        _ => Ok(None),
+    }?;
+    Ok(built.map(|(mut bvh, timings)| {
+        if params.reinsert_passes > 0 {
+            bvh.report.reinsertion = Some(crate::bvh::reinsert::optimise(&mut bvh, params.reinsert_passes));
+        }
+        (lay_out(bvh, params.layout), GpuBuild { strategy, timings })
+    }))
+}
+
+/// A tree on the GPU in the node format asked for, with the mesh its hits are on.
+pub enum GpuTree {
+    Binary(GpuBinaryBvh),
+    /// The CWBVH's CPU form too: its CPU walk is the reference for the GPU's counts.
+    Cwbvh(Box<Cwbvh>, GpuCwbvh),
+}
+
+impl GpuTree {
+    /// Upload the binary tree of `bvh` (one level: as built, or an imported dump's) as `nodes`.
+    pub fn new(gpu: &Gpu, bvh: &SceneBvh, nodes: GpuNodes) -> Result<(GpuTree, Arc<Mesh>), GpuError> {
+        let SceneBvh::Single { mesh, .. } = bvh else {
+            return Err(GpuError::Input("the GPU traces one BVH, not two levels".into()));
+        };
+        let tree = bvh.binary_tree().ok_or_else(|| {
+            GpuError::Input("this imported wide tree has no binary form the GPU could walk; trace it on the CPU".into())
+        })?;
+        let uploaded = match nodes {
+            GpuNodes::Binary => GpuTree::Binary(GpuBinaryBvh::upload(gpu, &tree)?),
+            GpuNodes::Cwbvh => {
+                let cw = Cwbvh::from_bvh(&tree)?;
+                let on_gpu = GpuCwbvh::upload(gpu, &cw)?;
+                GpuTree::Cwbvh(Box::new(cw), on_gpu)
+            }
+        };
+        Ok((uploaded, mesh.clone()))
+    }
+
+    pub fn nodes(&self) -> GpuNodes {
+        match self {
+            GpuTree::Binary(_) => GpuNodes::Binary,
+            GpuTree::Cwbvh(..) => GpuNodes::Cwbvh,
+        }
+    }
+
+    /// Trace `rays` (closest hits), counting when `counted`, in `trace`'s order (binary nodes;
+    /// CWBVH orders its children by octant).
+    pub fn walk(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, GpuError> {
+        let opts = bvhscope_gpu::GpuTraceOptions { order: trace.order, counted, exact: true };
+        match self {
+            GpuTree::Binary(t) => t.trace(gpu, rays, opts),
+            GpuTree::Cwbvh(_, t) => t.trace(gpu, rays, opts),
+        }
+    }
+
+    /// The per-pixel counts of the same walk on the CPU (row by row): core's renderer for binary
+    /// nodes (`cpu` is the binary tree's `SceneBvh`), the CWBVH's own CPU walk for CWBVH nodes.
+    pub fn cpu_counts(&self, cpu: &SceneBvh, camera: &Camera, trace: TraceOptions) -> Vec<RayCounters> {
+        match self {
+            GpuTree::Binary(_) => {
+                let settings = crate::render::RenderSettings { trace, count: true, progressive: false };
+                let frame = crate::render::render(cpu, cpu, camera, &settings);
+                frame.traced().map(|(_, c)| c).collect()
+            }
+            GpuTree::Cwbvh(cw, _) => {
+                let gen = camera.ray_gen();
+                (0..camera.width * camera.height)
+                    .into_par_iter()
+                    .map(|i| cw.trace_cpu(&mut gen.pixel_ray(i % camera.width, i / camera.width)).1)
+                    .collect()
+            }
+        }
+    }
+}
