@@ -135,6 +135,10 @@ pub enum Action {
     /// Show the tree after `k` splits.
     ReplayStep(usize),
     ReplayPlay(bool),
+    /// Write the replay as an animation (.gif or .png), as `bvhscope replay -o` does.
+    ExportReplay,
+    /// Stop writing it.
+    CancelFilm,
     /// Highlight the pixels whose heatmap value is above this (None: no highlight).
     SetThreshold(Option<f32>),
 
@@ -257,6 +261,12 @@ impl BvhscopeApp {
                 }
                 self.replay.playing = on;
                 self.replay.last_tick = Some(Instant::now());
+            }
+            A::ExportReplay => self.jobs.pick_file(Pick::SaveAnimation, &export::default_name(self, "gif")),
+            A::CancelFilm => {
+                if let Some(job) = self.jobs.film.take() {
+                    job.control.cancel();
+                }
             }
             A::ToggleBoxes => self.settings.show_boxes = !self.settings.show_boxes,
             A::DepthUp => {

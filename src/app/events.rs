@@ -24,6 +24,8 @@ impl BvhscopeApp {
             JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
             JobEvent::Failed(e) => self.message(MessageKind::Error, e),
             JobEvent::Speedup(t) => self.speedup = Some(*t),
+            JobEvent::Filmed(Ok(saved)) => self.message(MessageKind::Info, saved),
+            JobEvent::Filmed(Err(why)) => self.message(MessageKind::Error, why),
             e @ (JobEvent::GpuProbed(_) | JobEvent::GpuFailed(_)) => self.gpu_event(e),
             JobEvent::Explained(e) => {
                 // A new tree: keep the selection where the id still exists, and its open rows.
@@ -105,6 +107,13 @@ impl BvhscopeApp {
                 return;
             }
             Pick::SaveBvh => export::save_bvh(self, &path),
+            Pick::SaveAnimation => match export::film_request(self) {
+                Ok(r) => {
+                    self.jobs.film(r, path);
+                    return;
+                }
+                Err(e) => Err(e),
+            },
             Pick::SaveScene => self
                 .scene_file_text()
                 .and_then(|t| crate::files::write_bytes(&path, t.as_bytes()).map_err(|e| e.to_string())),

@@ -212,3 +212,47 @@ fn two_strategies_side_by_side_and_their_difference() {
     assert_eq!(app.settings.build.max_leaf_size, 4, "A keeps its own");
     assert!(app.compare_images(&ctx).is_some());
 }
+
+/// The Replay window's "Export animation…" writes what `bvhscope replay -o` writes: a real GIF
+/// for a .gif name (24 frames, or one per step of a smaller tree), in the background with its
+/// progress; any other name is refused before anything is traced, and nothing is written.
+#[test]
+fn the_replay_window_exports_the_animation() {
+    let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, torus.clone()));
+    run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus.clone()) && idle(a));
+    h.state_mut().act(Action::ShowReplay(true));
+    run_until(&mut h, "the replay", |a| a.replay.replay.is_some() && idle(a));
+    h.get_by_label("Export animation…");
+    let dir = std::env::temp_dir().join(format!("bvhscope-ui-film-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let wrong = dir.join("replay.txt");
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveAnimation, wrong.clone()));
+    run_until(&mut h, "the refusal", |a| a.messages.iter().any(|m| m.kind == MessageKind::Error));
+    assert!(h.state().messages.iter().any(|m| m.text.contains(".gif")), "the message names what is allowed");
+    assert!(!wrong.exists() && h.state().jobs.film.is_none(), "nothing traced, nothing written");
+
+    let gif = dir.join("replay.gif");
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveAnimation, gif.clone()));
+    assert!(h.state().jobs.film.is_some(), "written in the background");
+    run_until(&mut h, "the animation", |a| a.jobs.film.is_none());
+    let splits = h.state().replay.replay.as_ref().unwrap().splits();
+    let frames = bvhscope::explain::replay_film::steps(splits, 24).len();
+    let saved = format!("Saved {} ({frames} frames", gif.display());
+    assert!(
+        h.state().messages.iter().any(|m| m.kind == MessageKind::Info && m.text.starts_with(&saved)),
+        "{:?}",
+        h.state().messages.iter().map(|m| &m.text).collect::<Vec<_>>()
+    );
+    let bytes = std::fs::read(&gif).unwrap();
+    assert_eq!(&bytes[..6], b"GIF89a", "a GIF, not a PNG under a .gif name");
+    let mut d = gif::DecodeOptions::new().read_info(&bytes[..]).unwrap();
+    let mut n = 0;
+    while d.read_next_frame().unwrap().is_some() {
+        n += 1;
+    }
+    assert_eq!(n, frames, "one frame per step");
+    std::fs::remove_dir_all(&dir).ok();
+}

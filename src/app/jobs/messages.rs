@@ -90,6 +90,8 @@ pub enum Pick {
     OpenBvh,
     /// Where to write the current tree as a dump.
     SaveBvh,
+    /// Where to write the build replay's animation (.gif or .png).
+    SaveAnimation,
 }
 
 pub enum JobEvent {
@@ -124,6 +126,8 @@ pub enum JobEvent {
     Speedup(Box<Timed>),
     /// The look for a GPU adapter at start: the GPU, or why there is none.
     GpuProbed(Result<Arc<bvhscope_gpu::Gpu>, String>),
+    /// The replay's animation written: what to tell the user (saved, or why not).
+    Filmed(Result<String, String>),
     /// A GPU render or build failed: what to tell the user (the app goes back to the CPU).
     GpuFailed(String),
 }

@@ -47,6 +47,8 @@ pub struct Jobs {
     pub wrong: Option<Running>,
     /// Timing the BVH against the linear scan (the statistics panel's speed-up).
     pub speedup: Option<Running>,
+    /// Writing the build replay's animation (the Replay window's export).
+    pub film: Option<Running>,
     /// What the last compare job was asked for.
     pub last_compare: Option<(SceneBuild, u64, Camera, TraceOptions)>,
     pub picking: Option<Pick>,
@@ -98,6 +100,7 @@ impl Jobs {
             import: None,
             wrong: None,
             speedup: None,
+            film: None,
             last_compare: None,
             picking: None,
             last_render: None,
@@ -177,6 +180,7 @@ impl Jobs {
                     &mut self.import,
                     &mut self.wrong,
                     &mut self.speedup,
+                    &mut self.film,
                 ] {
                     if slot.as_ref().is_some_and(|r| r.id == id) {
                         *slot = None;
@@ -205,6 +209,7 @@ impl Jobs {
                 JobEvent::Imported(_) if current(&self.import) => self.import = None,
                 JobEvent::Wrong(_) if current(&self.wrong) => self.wrong = None,
                 JobEvent::Speedup(_) if current(&self.speedup) => self.speedup = None,
+                JobEvent::Filmed(_) if current(&self.film) => self.film = None,
                 JobEvent::Inspected { .. } if self.inspect.as_ref().is_some_and(|(r, _)| r.id == id) => {
                     self.inspect = None
                 }

@@ -206,6 +206,37 @@ impl Jobs {
         self.speedup = Some(job);
     }
 
+    /// Write the replay's animation to `path` (`bvhscope replay`'s film, the same frames and
+    /// file), with progress; a newer export replaces a running one.
+    pub fn film(&mut self, r: crate::app::export::FilmRequest, path: PathBuf) {
+        if let Some(old) = self.film.take() {
+            old.control.cancel();
+        }
+        let job = self.start("Writing the replay".to_string());
+        let (send, control) = (self.sender(job.id), job.control.clone());
+        let steps = crate::explain::replay_film::steps(r.replay.splits(), r.settings.frames).len();
+        control.set_total(steps as u64);
+        self.spawn(&job, move || {
+            use crate::explain::replay_film::film;
+            let Ok(f) = film(&r.replay, &r.mesh, &r.camera, &r.settings, &r.subject, &control) else {
+                return send(JobEvent::Filmed(Err("Writing the replay was cancelled".into())));
+            };
+            let delay = crate::app::export::FILM_DELAY_MS;
+            let result = crate::render::animation::write_animation(&path, &f.images, delay)
+                .map(|()| {
+                    let fewer = if f.images.len() < r.settings.frames as usize {
+                        format!(": the tree has {} splits, so one frame per step", r.replay.splits())
+                    } else {
+                        String::new()
+                    };
+                    format!("Saved {} ({} frames{fewer})", path.display(), f.images.len())
+                })
+                .map_err(|e| e.to_string());
+            send(JobEvent::Filmed(result));
+        });
+        self.film = Some(job);
+    }
+
     /// Stop the speed-up's timing.
     pub fn cancel_speedup(&mut self) {
         if let Some(old) = self.speedup.take() {
@@ -270,6 +301,10 @@ impl Jobs {
                     Pick::SaveStatsJson => dialog.add_filter("JSON", &["json"]).set_file_name(&name).save_file().await,
                     Pick::SaveCounts => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
                     Pick::OpenBvh => dialog.add_filter("bvhscope-bvh dumps", &["json", "gz", "txt"]).pick_file().await,
+                    Pick::SaveAnimation => {
+                        let filters = dialog.add_filter("GIF", &["gif"]).add_filter("animated PNG", &["png"]);
+                        filters.set_file_name(&name).save_file().await
+                    }
                     Pick::SaveBvh => {
                         let filters =
                             dialog.add_filter("bvhscope-bvh JSON", &["json"]).add_filter("text form", &["txt"]);

@@ -54,6 +54,21 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 if ui.button("Last").on_hover_text("The finished tree").clicked() {
                     out.push(Action::ReplayStep(n));
                 }
+                ui.separator();
+                match &app.jobs.film {
+                    Some(job) => {
+                        ui.add(egui::ProgressBar::new(job.control.fraction()).desired_width(80.0).show_percentage());
+                        if ui.button("Cancel").on_hover_text("Stop writing the animation").clicked() {
+                            out.push(Action::CancelFilm);
+                        }
+                    }
+                    None => {
+                        let tip = "Write the whole replay as an animation, 24 steps on one colour scale: .gif for slides, .png for an animated PNG (what bvhscope replay -o writes)";
+                        if ui.button("Export animation…").on_hover_text(tip).clicked() {
+                            out.push(Action::ExportReplay);
+                        }
+                    }
+                }
             });
             let mut kk = k;
             let slider = egui::Slider::new(&mut kk, 0..=n.max(1)).logarithmic(true).text(format!("of {n} splits"));

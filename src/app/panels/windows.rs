@@ -39,6 +39,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         Pick::SaveCounts => "Export counts (CSV)",
         Pick::OpenBvh => "Import a BVH dump for this mesh",
         Pick::SaveBvh => "Export the BVH as a dump",
+        Pick::SaveAnimation => "Export the replay as an animation (.gif or .png)",
     };
     let mut keep = true;
     let mut chosen = None;
