@@ -30,6 +30,12 @@ impl Aabb {
         points.iter().fold(Self::EMPTY, |b, &p| b.grow(p))
     }
 
+    /// The box of some boxes (`EMPTY` for none): what a node's bounds are, from its children's
+    /// or its references' boxes.
+    pub fn of(boxes: impl IntoIterator<Item = Aabb>) -> Self {
+        boxes.into_iter().fold(Self::EMPTY, Self::union)
+    }
+
     #[inline(always)]
     pub fn grow(self, p: impl Into<Vec3A>) -> Self {
         let p = p.into();
@@ -41,10 +47,16 @@ impl Aabb {
         Self { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
-    /// The part of both boxes; empty (some `min` above its `max`) where they do not meet.
+    /// The part of both boxes; `EMPTY` itself where they do not meet (not a box with some `min`
+    /// above its `max`), so the result can be unioned into another box and its area is 0.
     #[inline(always)]
     pub fn intersection(self, o: Aabb) -> Self {
-        Self { min: self.min.max(o.min), max: self.max.min(o.max) }
+        let i = Self { min: self.min.max(o.min), max: self.max.min(o.max) };
+        if i.is_empty() {
+            Self::EMPTY
+        } else {
+            i
+        }
     }
 
     /// The box grown by `d` on every side.
@@ -79,7 +91,8 @@ impl Aabb {
         ((self.min + self.max) * 0.5).into()
     }
 
-    /// Surface area; 0 for an empty box (so empty children add no SAH cost).
+    /// Surface area; 0 for `EMPTY` (so empty children add no SAH cost) and so for every empty
+    /// box `union`, `of` and `intersection` make (not for one made inverted with `new`).
     #[inline(always)]
     pub fn area(&self) -> f32 {
         let e = (self.max - self.min).max(Vec3A::ZERO);
@@ -217,6 +230,17 @@ mod tests {
     fn box_behind_origin_misses() {
         let r = Ray::new(Vec3::new(2.0, 0.5, 0.5), Vec3::X);
         assert_eq!(unit().intersect(&r), None);
+    }
+
+    #[test]
+    fn boxes_that_do_not_meet_intersect_in_the_empty_box() {
+        let far = Aabb::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(3.0, 1.0, 1.0));
+        assert_eq!(unit().intersection(far), Aabb::EMPTY);
+        assert_eq!(unit().intersection(far).area(), 0.0);
+        let half = Aabb::new(Vec3::splat(0.5), Vec3::splat(2.0));
+        assert_eq!(unit().intersection(half), Aabb::new(Vec3::splat(0.5), Vec3::ONE));
+        assert_eq!(Aabb::of([unit(), far]), Aabb::new(Vec3::ZERO, Vec3::new(3.0, 1.0, 1.0)));
+        assert_eq!(Aabb::of([]), Aabb::EMPTY);
     }
 
     #[test]

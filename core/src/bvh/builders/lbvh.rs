@@ -178,7 +178,7 @@ fn sequential<T: Bounded>(
         }
         let n = end - start;
         if n <= leaf {
-            let b = prims[start..end].iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds()));
+            let b = Aabb::of(prims[start..end].iter().map(|p| p.bounds()));
             nodes[node] = BvhNode::leaf(b, offset + start as u32, n as u16);
             done += progress.leaf_units(n, depth);
             continue;

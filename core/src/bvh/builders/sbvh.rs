@@ -128,8 +128,7 @@ pub(super) fn split_node(
         _ => None,
     };
     if let Some((_, mid, _, _)) = object {
-        let common = intersection(&bounds_of(&work.refs[..mid]), &bounds_of(&work.refs[mid..]));
-        decided.overlap = common.map_or(0.0, |c| c.area());
+        decided.overlap = bounds_of(&work.refs[..mid]).intersection(bounds_of(&work.refs[mid..])).area();
     }
     // §4.4: spatial splits only where the object split's children overlap by more than α of the
     // root's area (or where there is no object split), and while the budget lasts.
@@ -222,16 +221,11 @@ fn share(parent: &Work, l: Vec<BuildPrim>, r: Vec<BuildPrim>, added: u64) -> (Wo
 
 /// The box of some references.
 fn bounds_of(refs: &[BuildPrim]) -> Aabb {
-    refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds()))
+    Aabb::of(refs.iter().map(BuildPrim::bounds))
 }
 
 fn area_of(refs: &[BuildPrim]) -> f32 {
     bounds_of(refs).area()
-}
-
-fn intersection(a: &Aabb, b: &Aabb) -> Option<Aabb> {
-    let i = Aabb { min: a.min.max(b.min), max: a.max.min(b.max) };
-    (!i.is_empty()).then_some(i)
 }
 
 /// Splits of each kind in a build.

@@ -57,17 +57,8 @@ pub fn split_reference(tri: &[Vec3; 3], b: &Aabb, axis: usize, pos: f32) -> (Aab
     lb.max[axis] = lb.max[axis].min(pos);
     let mut rb = *b;
     rb.min[axis] = rb.min[axis].max(pos);
-    (intersect(left, lb), intersect(right, rb))
-}
-
-/// The common box of two boxes (`EMPTY` when they do not meet).
-fn intersect(a: Aabb, b: Aabb) -> Aabb {
-    let i = Aabb { min: a.min.max(b.min), max: a.max.min(b.max) };
-    if i.is_empty() {
-        Aabb::EMPTY
-    } else {
-        i
-    }
+    // `intersection` gives `EMPTY` for a part that is not there, so the bins can union it.
+    (left.intersection(lb), right.intersection(rb))
 }
 
 /// The spatial split a node's bins price cheapest.
@@ -141,7 +132,7 @@ pub fn spatial_planes(
         for k in (1..bins).rev() {
             acc = acc.union(slices[k].bounds);
             exits += slices[k].exit;
-            right_area[k] = area(&acc);
+            right_area[k] = acc.area();
             right_count[k] = exits;
         }
         let (mut acc, mut enters) = (Aabb::EMPTY, 0u32);
@@ -152,7 +143,7 @@ pub fn spatial_planes(
             if left == 0 || right == 0 {
                 continue;
             }
-            let areas = [area(&acc), right_area[k]];
+            let areas = [acc.area(), right_area[k]];
             let weighted = areas[0] * left as f32 + areas[1] * right as f32;
             let position = plane(lo, width, k);
             if is_active(sink) {
@@ -165,15 +156,6 @@ pub fn spatial_planes(
         debug_assert!(enters + slices[bins - 1].enter == n);
     }
     best
-}
-
-/// The surface area of a box that may be empty (0 then).
-fn area(b: &Aabb) -> f32 {
-    if b.is_empty() {
-        0.0
-    } else {
-        b.area()
-    }
 }
 
 /// Partition `refs` at the spatial plane `split` (§4.5): references wholly on one side go there;
@@ -221,9 +203,9 @@ pub fn spatial_partition(
     let (mut nl, mut nr) = ((left.len() + straddling.len()) as f32, (right.len() + straddling.len()) as f32);
     for (r, l, rr) in straddling {
         let whole = r.bounds();
-        let split = area(&lbox) * nl + area(&rbox) * nr;
-        let to_left = area(&lbox.union(whole)) * nl + area(&rbox) * (nr - 1.0);
-        let to_right = area(&lbox) * (nl - 1.0) + area(&rbox.union(whole)) * nr;
+        let split = lbox.area() * nl + rbox.area() * nr;
+        let to_left = lbox.union(whole).area() * nl + rbox.area() * (nr - 1.0);
+        let to_right = lbox.area() * (nl - 1.0) + rbox.union(whole).area() * nr;
         if to_left < split && to_left <= to_right {
             lbox = lbox.union(whole);
             nr -= 1.0;
@@ -252,16 +234,13 @@ mod tests {
     /// a barycentric grid, at the vertices and where the edges cross the plane.
     #[test]
     fn the_parts_of_a_split_reference_hold_the_triangle() {
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 40) as f32 / (1u64 << 24) as f32) * 200.0 - 100.0
-        };
+        let mut rng = crate::random::Rng::new(7);
         for _ in 0..2000 {
-            let tri = [Vec3::new(rnd(), rnd(), rnd()), Vec3::new(rnd(), rnd(), rnd()), Vec3::new(rnd(), rnd(), rnd())];
+            let mut corner = || Vec3::new(rng.range(-100.0, 100.0), rng.range(-100.0, 100.0), rng.range(-100.0, 100.0));
+            let tri = [corner(), corner(), corner()];
             let b = Aabb::from_points(&tri);
-            let axis = (rnd().abs() as usize) % 3;
-            let pos = b.min[axis] + (b.max[axis] - b.min[axis]) * (rnd() + 100.0) / 200.0;
+            let axis = rng.below(3) as usize;
+            let pos = b.min[axis] + (b.max[axis] - b.min[axis]) * rng.unit();
             let (l, r) = split_reference(&tri, &b, axis, pos);
             assert!(l.is_empty() || (b.contains_box(&l) && l.max[axis] <= pos));
             assert!(r.is_empty() || (b.contains_box(&r) && r.min[axis] >= pos));
@@ -318,7 +297,7 @@ mod tests {
         ];
         let refs: Vec<BuildPrim> =
             tris.iter().enumerate().map(|(i, t)| BuildPrim::new(Aabb::from_points(t), i as u32)).collect();
-        let bounds = refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds()));
+        let bounds = Aabb::of(refs.iter().map(BuildPrim::bounds));
         let tri = |i: u32| tris[i as usize];
         let mut seen = Vec::new();
         struct Seen<'a>(&'a mut Vec<(usize, f32, u32, u32)>);
