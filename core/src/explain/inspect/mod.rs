@@ -11,6 +11,8 @@
 //! Costs use the SAH as the builder does (Goldsmith & Salmon 1987; pbrt-v4 §7.3.2): a split costs
 //! C_trav + C_isect·(A_L·n_L + A_R·n_R)/A, a leaf C_isect·n, with A the node's surface area.
 
+// The node's bounds as the builders take them, so the inspector's curves start from the same box.
+use crate::bvh::builders::common::node_info;
 use crate::bvh::sbvh;
 use crate::bvh::split::{binned_planes, sweep_planes, BuildPrim, NodeInfo, PlaneSink, Proposal};
 use crate::bvh::{BuildParams, Bvh, Hierarchy, SahCost, SplitStrategy};
@@ -25,12 +27,10 @@ pub struct Overlap {
 }
 
 impl Overlap {
+    /// Zero for boxes that do not meet (their intersection is `EMPTY`, of no extent or area).
     pub fn of(a: &Aabb, b: &Aabb) -> Overlap {
-        let i = Aabb { min: a.min.max(b.min), max: a.max.min(b.max) };
-        if (i.max.cmplt(i.min)).any() {
-            return Overlap::default();
-        }
-        let e = i.max - i.min;
+        let i = a.intersection(*b);
+        let e = i.extent();
         Overlap { volume: e.x * e.y * e.z, area: i.area() }
     }
 }
@@ -200,7 +200,7 @@ fn node_work(bvh: &Bvh, h: &Hierarchy, tris: &[[glam::Vec3; 3]], node: usize) ->
         let tri = |i: u32| tris[i as usize];
         match sbvh::descend(root, &tri, params, &steps) {
             Some(work) => {
-                let info = info_of(&work.refs);
+                let info = node_info(&work.refs);
                 return (work, info);
             }
             None => Vec::new(),
@@ -209,7 +209,7 @@ fn node_work(bvh: &Bvh, h: &Hierarchy, tris: &[[glam::Vec3; 3]], node: usize) ->
         let range = h.first[node] as usize..(h.first[node] + h.count[node]) as usize;
         range.map(|s| BuildPrim::new(Aabb::from_points(&bvh.tris[s]), bvh.prim_ids[s])).collect()
     };
-    let info = info_of(&prims);
+    let info = node_info(&prims);
     (sbvh::work_of(prims, params, h.depth[node]), info)
 }
 
@@ -219,15 +219,6 @@ fn node_prims(bvh: &Bvh, h: &Hierarchy, node: usize) -> (Vec<BuildPrim>, NodeInf
     let tris = if bvh.params.strategy.splits_references() { triangles_by_id(bvh) } else { Vec::new() };
     let (work, info) = node_work(bvh, h, &tris, node);
     (work.refs, info)
-}
-
-fn info_of(prims: &[BuildPrim]) -> NodeInfo {
-    let mut info = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY };
-    for p in prims {
-        info.bounds = info.bounds.union(p.bounds());
-        info.centroid_bounds = info.centroid_bounds.grow(p.centroid());
-    }
-    info
 }
 
 /// The SAH cost of the subtree under `node`, relative to its area (as `TreeStats` costs the whole
@@ -264,7 +255,7 @@ fn marker(strategy: SplitStrategy, prims: &[BuildPrim], info: &NodeInfo, params:
     let mut splitter = strategy.splitter(params)?;
     match splitter.split(&mut p, info) {
         Proposal::Split { axis, mid, plane, .. } if mid > 0 && mid < p.len() => {
-            let side = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, q| b.union(q.bounds()));
+            let side = |s: &[BuildPrim]| Aabb::of(s.iter().map(BuildPrim::bounds));
             let (l, r) = (side(&p[..mid]), side(&p[mid..]));
             let weighted = l.area() * mid as f32 + r.area() * (p.len() - mid) as f32;
             Some(Marker {

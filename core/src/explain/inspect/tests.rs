@@ -186,7 +186,7 @@ fn curves_and_markers_match_a_brute_force_sah() {
                 let (last, next) = (l[l.len() - 1].centroid()[axis], r[0].centroid()[axis]);
                 assert!(last < next && last <= p.position && p.position <= next, "node {node} axis {axis}");
                 assert_eq!(p.left + p.right, prims.len() as u32);
-                let bounds = |s: &[BuildPrim]| s.iter().fold(Aabb::EMPTY, |b, q| b.union(q.bounds()));
+                let bounds = |s: &[BuildPrim]| Aabb::of(s.iter().map(BuildPrim::bounds));
                 let weighted = bounds(l).area() * l.len() as f32 + bounds(r).area() * r.len() as f32;
                 let brute = c.traversal + c.intersection * weighted / area;
                 assert!((p.cost - brute).abs() <= 1e-5 * brute, "{} against {brute}", p.cost);
