@@ -7,7 +7,7 @@ use super::args::{BuildArgs, DumpLimit, ViewArgs};
 use super::{load_mesh, progress, CliError};
 use crate::bvh::{epo, AnyBvh, BuildParams, Layout, SplitStrategy, TreeStats, TreeView};
 use crate::dump::BvhDump;
-use crate::explain::check::{check, Finding, Group, Subject, LISTED, MAX_RAYS};
+use crate::explain::check::{check, Finding, Group, Subject, FINDINGS_LISTED, LISTED, MAX_RAYS};
 use crate::render::{render, RenderSettings};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
@@ -137,9 +137,6 @@ pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
     }
     Ok((o, defects))
 }
-
-/// Findings printed per group unless `--all`.
-const FINDINGS_LISTED: usize = 12;
 
 fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality], list: usize) -> String {
     let mut o = String::new();

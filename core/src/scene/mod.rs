@@ -7,7 +7,8 @@ mod flatten;
 mod moer_lite;
 mod open;
 mod scene_file;
-mod strict_json;
+/// Also the grader's rubric reader's (`explain::grade::rubric`): one check for every JSON a person writes.
+pub(crate) mod strict_json;
 
 pub use flatten::{flatten, load_instances, SceneInstances};
 pub use open::{load_any, Geometry, Scene, SceneBuildError, SceneSource, MAX_FLAT_TRIANGLES};

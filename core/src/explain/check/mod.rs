@@ -69,6 +69,10 @@ pub struct Finding {
 /// Examples listed after a finding unless all are asked for (`check --all`).
 pub const LISTED: usize = 4;
 
+/// Findings listed per group unless all are asked for: `check` prints so many, and the grader
+/// keeps so many in a student's row (a dump for another mesh has thousands).
+pub const FINDINGS_LISTED: usize = 12;
+
 impl Finding {
     /// The finding as one line: its text, then up to `list` of its examples and how many there
     /// are in all when some are left out.
@@ -219,7 +223,8 @@ pub struct Checked {
 }
 
 /// Findings of every group for `s`: the tree's, then, when its structure is sound, the rays'
-/// (the camera's primary rays and `rays` random ones, `control` told of each batch).
+/// (the camera's primary rays and `rays` random ones, `control` told of each batch), checked
+/// against a `Reference` built here and kept in the answer (the app's wrong pixels use it again).
 pub fn check(
     s: &Subject,
     camera: &crate::render::Camera,
@@ -227,20 +232,68 @@ pub fn check(
     opts: TraceOptions,
     control: &WorkControl,
 ) -> Result<Checked, Cancelled> {
+    let (out, tree) = match check_structure(s) {
+        Ok(traced) => traced,
+        Err(findings) => return Ok(Checked::untraced(findings)),
+    };
+    // Built only once the tree can be traced: past 4,096 triangles it is a whole SAH build.
+    let reference = Reference::of(s.mesh);
+    let mut checked = check_rays_of(s, out, tree, &reference, camera, rays, opts, control)?;
+    checked.reference = Some(reference);
+    Ok(checked)
+}
+
+/// `check` against a `reference` the caller built once for the mesh (the grader checks a whole
+/// class against one); the answer's `reference` is `None`.
+pub fn check_with(
+    s: &Subject,
+    reference: &Reference,
+    camera: &crate::render::Camera,
+    rays: u64,
+    opts: TraceOptions,
+    control: &WorkControl,
+) -> Result<Checked, Cancelled> {
+    match check_structure(s) {
+        Ok((out, tree)) => check_rays_of(s, out, tree, reference, camera, rays, opts, control),
+        Err(findings) => Ok(Checked::untraced(findings)),
+    }
+}
+
+impl Checked {
+    fn untraced(findings: Vec<Finding>) -> Checked {
+        Checked { findings, tree: None, wrong_pixels: Vec::new(), reference: None, rays: 0 }
+    }
+}
+
+/// The tree's findings, and the tree to trace; `Err` with the findings when it cannot be traced.
+fn check_structure(s: &Subject) -> Result<(Vec<Finding>, (AnyBvh, Imported)), Vec<Finding>> {
     let mut out: Vec<Finding> = wrong_mesh(s).into_iter().collect();
     out.extend(check_tree(s.dump, s.mesh));
-    let nothing = |findings| Checked { findings, tree: None, wrong_pixels: Vec::new(), reference: None, rays: 0 };
     if out.iter().any(|f| f.group == Group::Structure && f.defect) {
-        return Ok(nothing(out));
+        return Err(out);
     }
-    let (bvh, imported) = match import(s.dump, s.mesh, s.dump_path) {
-        Ok(b) => b,
+    match import(s.dump, s.mesh, s.dump_path) {
+        Ok(tree) => Ok((out, tree)),
         Err(why) => {
             // Not a warning: a tree bvhscope cannot trace is a tree nobody can see is right.
             out.push(defect(Group::Rays, None, None, format!("the tree cannot be traced: {why}")));
-            return Ok(nothing(out));
+            Err(out)
         }
-    };
+    }
+}
+
+/// The rays' findings of a traceable tree, after the tree's (`out`).
+#[allow(clippy::too_many_arguments)]
+fn check_rays_of(
+    s: &Subject,
+    mut out: Vec<Finding>,
+    (bvh, imported): (AnyBvh, Imported),
+    reference: &Reference,
+    camera: &crate::render::Camera,
+    rays: u64,
+    opts: TraceOptions,
+    control: &WorkControl,
+) -> Result<Checked, Cancelled> {
     let (cap, big) = crate::dump::oversized_leaves(s.dump);
     if let Some(&first) = big.first() {
         let text = format!(
@@ -255,8 +308,7 @@ pub fn check(
         out.push(f);
     }
     let set = RaySet::new(s.mesh, camera, rays);
-    let reference = Reference::of(s.mesh);
-    let wrong = wrong_rays(&bvh, s.mesh, &reference, &set, opts, control)?;
+    let wrong = wrong_rays(&bvh, s.mesh, reference, &set, opts, control)?;
     if let Some(f) = wrong.finding(set.len()) {
         out.push(f);
     }
@@ -264,7 +316,7 @@ pub fn check(
         findings: out,
         tree: Some((bvh, imported)),
         wrong_pixels: wrong.pixels,
-        reference: Some(reference),
+        reference: None,
         rays: set.len(),
     })
 }

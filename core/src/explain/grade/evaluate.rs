@@ -1,4 +1,4 @@
-//! One submission graded: its dump read (bounded), checked (`check::check`: the rays on every
+//! One submission graded: its dump read (bounded), checked (`check::check_with`: the rays on every
 //! thread), its tree measured and timed, its two images written, its row made; then all of it
 //! dropped but the row. Nothing about a submission stops the class: an unreadable file, a
 //! missing folder, a tree that takes too long (`Setup::max_seconds`, enforced through the
@@ -9,7 +9,7 @@ use super::{FindingLine, Images, References, ReportDir, Row, Setup, Submission, 
 use crate::bvh::imported::Imported;
 use crate::bvh::{AnyBvh, Bvh, TreeView};
 use crate::dump::BvhDump;
-use crate::explain::check::{check, wrong_mesh, Group, Subject};
+use crate::explain::check::{check_with, wrong_mesh, Group, Reference, Subject, FINDINGS_LISTED, LISTED};
 use crate::render::diff::{difference, difference_image};
 use crate::render::{draw_legend, view_image, ColorMap, HeatRange, View};
 use crate::work::{Cancelled, WorkControl};
@@ -17,18 +17,12 @@ use std::panic::AssertUnwindSafe;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-/// Cases of a finding listed in its line (the report's rows stay short; the count says how many).
-const LISTED: usize = 4;
-
-/// Findings kept per group, as `check` prints them without `--all`.
-const FINDINGS_KEPT: usize = 12;
-
 /// Grade one submission: never fails, never panics out (a panic becomes the row's reason).
 pub fn evaluate(sub: &Submission, setup: &Setup, refs: &mut References, out: &ReportDir) -> Row {
     let start = Instant::now();
     let limit = Duration::from_secs_f64(setup.max_seconds.max(0.001));
     let graded = std::panic::catch_unwind(AssertUnwindSafe(|| {
-        let (row, traced) = match with_deadline(limit, |control| checked(sub, setup, control))? {
+        let (row, traced) = match with_deadline(limit, |control| checked(sub, setup, &refs.truth, control))? {
             Checked::Row(row) => return Ok(row),
             Checked::Traced(row, tree) => (row, tree),
         };
@@ -98,7 +92,7 @@ enum Checked {
 }
 
 /// The dump read and checked: the row's verdict, reason and findings.
-fn checked(sub: &Submission, setup: &Setup, control: &WorkControl) -> Result<Checked, Cancelled> {
+fn checked(sub: &Submission, setup: &Setup, truth: &Reference, control: &WorkControl) -> Result<Checked, Cancelled> {
     let Some(path) = &sub.dump else {
         let why = sub.problem.clone().unwrap_or_else(|| "no dump".into());
         return Ok(Checked::Row(Row::not_checked(sub, Verdict::NoDump, format!("{}: {why}", sub.path.display()))));
@@ -108,7 +102,7 @@ fn checked(sub: &Submission, setup: &Setup, control: &WorkControl) -> Result<Che
         Err(e) => return Ok(Checked::Row(Row::not_checked(sub, Verdict::Unreadable, e.to_string()))),
     };
     let subject = Subject { dump: &dump, dump_path: path, mesh: setup.mesh, mesh_path: setup.mesh_path };
-    let checked = check(&subject, &setup.camera, setup.rays, setup.trace, control)?;
+    let checked = check_with(&subject, truth, &setup.camera, setup.rays, setup.trace, control)?;
     let required = &setup.rubric.required;
     let findings: Vec<FindingLine> = checked
         .findings
@@ -133,8 +127,8 @@ fn checked(sub: &Submission, setup: &Setup, control: &WorkControl) -> Result<Che
     } else if let Some(f) = first_required {
         (row.verdict, row.reason) = (Verdict::Defects, format!("{}: {}", f.group.label(), f.line));
     }
-    // The first few of each group are kept (a dump for another mesh has thousands), as `check`
-    // prints them; the count says how many there are in all.
+    // The first few of each group are kept, as `check` prints them (its `LISTED` cases each):
+    // the report's rows stay short, and the count says how many there are in all.
     row.findings_total = findings.len();
     let mut kept = [0usize; 4];
     row.findings = findings
@@ -142,7 +136,7 @@ fn checked(sub: &Submission, setup: &Setup, control: &WorkControl) -> Result<Che
         .filter(|f| {
             let k = &mut kept[Group::ALL.iter().position(|g| *g == f.group).unwrap_or(0)];
             *k += 1;
-            *k <= FINDINGS_KEPT
+            *k <= FINDINGS_LISTED
         })
         .collect();
     // A tree over another mesh is not measured: its figures would say nothing of the student's work.

@@ -1,12 +1,14 @@
 //! bvhscope's own trees on the class's mesh and camera: what every submission is measured
 //! against. Built and measured once per layout the class uses (binary from the start; a 4- or
 //! 8-wide layout when a dump of that width first comes), then dropped: the figures stay, and of
-//! the SAH tree its counted frame, for the students' difference images.
+//! the SAH tree its counted frame, for the students' difference images. The checker's reference
+//! (the linear scan's hits) is built here too, once for the class.
 
 use super::measure::{measure, time_linear, timed, Quality, Timing, RUNS};
 use super::Setup;
 use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SplitStrategy};
 use crate::dump::{import, BvhDump};
+use crate::explain::check::Reference;
 use crate::mesh::Mesh;
 use crate::render::Frame;
 use crate::work::WorkControl;
@@ -34,10 +36,14 @@ struct LayoutRefs {
     visits_max: f32,
 }
 
-/// The reference trees of every layout met so far, and how trees are timed.
+/// The reference trees of every layout met so far, how trees are timed, and what the checker
+/// holds every submission's rays against.
 pub struct References {
     pub timing: Timing,
     layouts: Vec<LayoutRefs>,
+    /// The linear scan's hits (past 4,096 triangles through bvhscope's SAH tree, which the tests
+    /// hold equal to it): built once for the class, not once per submission.
+    pub truth: Reference,
 }
 
 impl References {
@@ -54,7 +60,7 @@ impl References {
         let rays = setup.time_rays.clamp(1, setup.camera.width as usize * setup.camera.height as usize);
         let (linear_ns_per_ray, linear_rays) = time_linear(setup.mesh, &setup.camera, setup.trace, rays);
         let timing = Timing { rays, runs: RUNS, linear_rays, linear_ns_per_ray };
-        let mut r = References { timing, layouts: Vec::new() };
+        let mut r = References { timing, layouts: Vec::new(), truth: Reference::of(setup.mesh) };
         r.ensure(Layout::Binary, setup);
         r
     }

@@ -137,7 +137,10 @@ impl Rubric {
     /// A rubric from its text (`path` names it in errors and anchors `mesh`).
     pub fn parse(path: &Path, text: &str) -> Result<Rubric, GradeError> {
         let f = Fields { path };
-        let json: Value = distinct::parse(text).map_err(|e| f.err(&format!("line {}", e.line()), e.to_string()))?;
+        // A key given twice is refused: a rubric whose first "good" were silently lost would
+        // grade as if nothing were wrong.
+        let json: Value =
+            crate::scene::strict_json::parse(text).map_err(|e| f.err(&format!("line {}", e.line()), e.to_string()))?;
         let root = json
             .as_object()
             .ok_or_else(|| f.err("(top level)", format!("expected an object, found {}", kind(&json))))?;
@@ -366,67 +369,5 @@ fn shown(v: &Value) -> String {
     match v {
         Value::Number(n) => n.to_string(),
         other => kind(other).to_string(),
-    }
-}
-
-/// JSON whose objects give each key once: `serde_json::Value` keeps the last of two `"good"`
-/// silently, and a rubric whose thresholds were lost would grade as if nothing were wrong. (The
-/// scene file's reader has the same check, private to `scene`.)
-mod distinct {
-    use serde::de::{Deserialize, Deserializer, Error, MapAccess, SeqAccess, Visitor};
-
-    struct Distinct;
-
-    impl<'de> Deserialize<'de> for Distinct {
-        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-            d.deserialize_any(V)
-        }
-    }
-
-    struct V;
-
-    impl<'de> Visitor<'de> for V {
-        type Value = Distinct;
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            f.write_str("any JSON value")
-        }
-        fn visit_bool<E>(self, _: bool) -> Result<Distinct, E> {
-            Ok(Distinct)
-        }
-        fn visit_i64<E>(self, _: i64) -> Result<Distinct, E> {
-            Ok(Distinct)
-        }
-        fn visit_u64<E>(self, _: u64) -> Result<Distinct, E> {
-            Ok(Distinct)
-        }
-        fn visit_f64<E>(self, _: f64) -> Result<Distinct, E> {
-            Ok(Distinct)
-        }
-        fn visit_str<E>(self, _: &str) -> Result<Distinct, E> {
-            Ok(Distinct)
-        }
-        fn visit_unit<E>(self) -> Result<Distinct, E> {
-            Ok(Distinct)
-        }
-        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Distinct, A::Error> {
-            while seq.next_element::<Distinct>()?.is_some() {}
-            Ok(Distinct)
-        }
-        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Distinct, A::Error> {
-            let mut keys = std::collections::HashSet::new();
-            while let Some(k) = map.next_key::<String>()? {
-                if !keys.insert(k.clone()) {
-                    return Err(A::Error::custom(format!("the key \"{k}\" is given twice in one object")));
-                }
-                map.next_value::<Distinct>()?;
-            }
-            Ok(Distinct)
-        }
-    }
-
-    /// `text` as JSON, refused when an object repeats a key.
-    pub fn parse(text: &str) -> Result<serde_json::Value, serde_json::Error> {
-        serde_json::from_str::<Distinct>(text)?;
-        serde_json::from_str(text)
     }
 }
