@@ -11,7 +11,8 @@
 //!   submission at a time besides the references, whatever the size of the class;
 //! - `rank`: the order within the class, by a key the rubric names (`rubric`);
 //! - `report`: the report folder (`ReportDir`) and what is written there: `table` (the CSV's
-//!   records), `json`, `html` (with `page`'s style and script).
+//!   records), `json`, `html` (with `page`'s style and script);
+//! - `report_file`: `grade.json` read back (`GradeReport`), its paths found again, for the app.
 //!
 //! One broken file never stops the run: every failure of a submission becomes its row's verdict
 //! and reason, a panic included (`evaluate`).
@@ -25,6 +26,7 @@ mod page;
 mod rank;
 mod reference;
 mod report;
+mod report_file;
 mod rubric;
 mod table;
 #[cfg(test)]
@@ -38,6 +40,7 @@ pub use measure::{Quality, Timing};
 pub use rank::{rank, RankBy};
 pub use reference::{ReferenceTree, References};
 pub use report::{ReportDir, CSV_FILE, HTML_FILE, IMAGES_DIR, JSON_FILE};
+pub use report_file::{is_report, GradeReport, GradedStudent};
 pub use rubric::{Good, Rubric};
 pub use table::csv_records;
 
@@ -50,7 +53,8 @@ use crate::work::WorkControl;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-/// The version of `grade.json`'s layout (`json::document`), for readers such as the app.
+/// The version of `grade.json`'s layout (`json::document`), for readers such as the app
+/// (`report_file`).
 pub const FORMAT: &str = "bvhscope-grade";
 pub const VERSION: u32 = 1;
 
@@ -63,6 +67,9 @@ pub enum GradeError {
     Rubric { path: PathBuf, field: String, message: String },
     #[error("{}: {message}", .path.display())]
     Output { path: PathBuf, message: String },
+    /// A `grade.json` that cannot be read back (`GradeReport::read`).
+    #[error("{}: {message}", .path.display())]
+    Report { path: PathBuf, message: String },
 }
 
 /// What every submission is graded against.
@@ -89,7 +96,7 @@ pub struct Setup<'a> {
 }
 
 /// What the checker and the rubric say of a submission.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
     /// No defect in a check the rubric requires (warnings allowed).

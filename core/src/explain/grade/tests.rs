@@ -166,6 +166,23 @@ fn the_epo_of_a_tree_whose_boxes_all_overlap_is_refused_not_waited_for() {
     assert_eq!(epo_bounded(&sah).unwrap(), crate::bvh::epo::of(&sah), "a sound tree's EPO is measured");
 }
 
+/// A tiny class's settings: a 48x32 frame, few rays, the default rubric.
+fn small_setup<'a>(mesh: &'a crate::mesh::Mesh, mesh_path: &'a Path) -> Setup<'a> {
+    Setup {
+        mesh,
+        mesh_path,
+        given_path: mesh_path,
+        camera: crate::render::Camera::framing(&mesh.bounds(), 48, 32),
+        rays: 2000,
+        time_rays: 200,
+        trace: Default::default(),
+        params: Default::default(),
+        dump_limit: 1 << 26,
+        max_seconds: 60.0,
+        rubric: Rubric::default(),
+    }
+}
+
 /// Three students over a small knot: a midpoint tree, the SAH tree and a tree with a shrunk
 /// leaf box; every row, rank and image as it should be.
 #[test]
@@ -183,19 +200,7 @@ fn a_small_class_is_graded_ranked_and_drawn() {
     let leaf = bad.nodes.iter().position(|n| n.count.is_some_and(|c| c >= 2)).unwrap();
     bad.nodes[leaf].max[0] = (bad.nodes[leaf].min[0] + bad.nodes[leaf].max[0]) / 2.0;
     bad.write(&d.join("bo.txt")).unwrap();
-    let setup = Setup {
-        mesh: &mesh,
-        mesh_path: &mesh_path,
-        given_path: &mesh_path,
-        camera: crate::render::Camera::framing(&mesh.bounds(), 48, 32),
-        rays: 2000,
-        time_rays: 200,
-        trace: Default::default(),
-        params: Default::default(),
-        dump_limit: 1 << 26,
-        max_seconds: 60.0,
-        rubric: Rubric::default(),
-    };
+    let setup = small_setup(&mesh, &mesh_path);
     let subs = discover(&["mia.txt", "sam.json", "bo.txt"].map(|n| d.join(n)));
     let out = ReportDir::prepare(&d.join("report"), vec![(mesh_path.clone(), "the mesh".into())]).unwrap();
     let refs = References::new(&setup);
@@ -218,4 +223,89 @@ fn a_small_class_is_graded_ranked_and_drawn() {
     let q = r[1].quality.as_ref().unwrap();
     assert_eq!(q.leaf_sizes.iter().sum::<usize>(), q.leaves);
     assert!(q.trace_ns_per_ray > 0.0 && q.speedup_over_linear > 0.0 && q.epo.is_some());
+}
+
+/// A class graded and its grade.json read back as the app reads it: the students in order, each
+/// one's dump found again though the report names it relative to where `grade` ran (here the
+/// class's folder, not the test's), the reason of those without a traceable tree; a report of
+/// another format or version refused in one line naming the file.
+#[test]
+fn a_grade_report_is_read_back_with_its_paths_found_again() {
+    let d = tmp("readback");
+    let mesh = generate::torus_knot(2, 3, 0.3, 64, 6);
+    let mesh_path = d.join("knot.obj");
+    std::fs::write(&mesh_path, "# the class's mesh; only its name is read back\n").unwrap();
+    let params =
+        crate::bvh::BuildParams { strategy: SplitStrategy::Midpoint, layout: Layout::Binary, ..Default::default() };
+    let mid = BvhDump::of_any(&AnyBvh::build(&mesh, &params), &mesh, None);
+    std::fs::create_dir_all(d.join("class/empty")).unwrap();
+    mid.write(&d.join("class/mia.txt")).unwrap();
+    mid.write(&d.join("class/moved.txt")).unwrap();
+    mid.write(&d.join("class/gone.txt")).unwrap();
+    let mut broken = mid.clone();
+    broken.nodes[0].children = Some(vec![1, 99_999]);
+    broken.write(&d.join("class/cy.txt")).unwrap();
+    std::fs::write(d.join("class/junk.txt"), "not a dump").unwrap();
+    let names = ["mia.txt", "cy.txt", "junk.txt", "empty", "moved.txt", "gone.txt"];
+    let subs = discover(&names.map(|n| d.join("class").join(n)));
+    let setup = small_setup(&mesh, &mesh_path);
+    let out = ReportDir::prepare(&d.join("report"), vec![(mesh_path.clone(), "the mesh".into())]).unwrap();
+    let graded = grade_class(&setup, References::new(&setup), &subs, &out, &WorkControl::new(), |_| {});
+    // The paths as `grade` writes them when run in the class's parent folder: relative to it.
+    let mut doc = document(&setup, &graded);
+    let prefix = format!("{}/", d.display());
+    let relative = |v: &mut serde_json::Value| {
+        if let Some(p) = v.as_str().and_then(|p| p.strip_prefix(&prefix)) {
+            *v = serde_json::Value::String(p.to_string());
+        }
+    };
+    relative(&mut doc["mesh"]);
+    for s in doc["students"].as_array_mut().unwrap() {
+        relative(&mut s["dump"]);
+    }
+    // One dump moved into the report folder (the last place looked in), one gone altogether.
+    std::fs::rename(d.join("class/moved.txt"), d.join("report/class-moved.txt")).unwrap();
+    doc["students"][4]["dump"] = "class-moved.txt".into();
+    std::fs::remove_file(d.join("class/gone.txt")).unwrap();
+    out.write(JSON_FILE, serde_json::to_string_pretty(&doc).unwrap().as_bytes()).unwrap();
+
+    let r = GradeReport::read(&out.root).unwrap();
+    assert_eq!(r.file, out.file(JSON_FILE), "a report folder is read through its grade.json");
+    assert_eq!(r.mesh, Ok(d.join("knot.obj")), "found from the report folder's parent");
+    assert_eq!((r.camera, r.trace), (setup.camera, setup.trace));
+    let s = &r.students;
+    assert_eq!(s.iter().map(|s| s.name.as_str()).collect::<Vec<_>>(), ["mia", "cy", "junk", "empty", "moved", "gone"]);
+    let verdicts: Vec<Verdict> = s.iter().map(|s| s.verdict).collect();
+    use Verdict::*;
+    assert_eq!(verdicts, [Correct, Defects, Unreadable, NoDump, Correct, Correct]);
+    assert_eq!(s.iter().map(|s| s.rank).collect::<Vec<_>>(), graded.rows.iter().map(|r| r.rank).collect::<Vec<_>>());
+    assert_eq!(s[0].openable(), Ok(d.join("class/mia.txt").as_path()));
+    assert_eq!(s[0].layout, Some(Layout::Binary));
+    assert_eq!(s[4].openable(), Ok(d.join("report/class-moved.txt").as_path()), "found in the report folder");
+    for (i, want) in [(1, "structure: "), (2, "not a bvhscope-bvh file"), (3, "holds no dump")] {
+        let why = s[i].openable().unwrap_err();
+        assert!(why.contains(want) && why == s[i].reason, "{}: {why}", s[i].name);
+    }
+    let gone = s[5].openable().unwrap_err();
+    assert!(gone.starts_with("gone's dump class/gone.txt is not found (looked for class/gone.txt, "), "{gone}");
+    assert!(gone.contains(&d.join("class/gone.txt").display().to_string()), "{gone}");
+    assert!(is_report(&out.root) && is_report(&out.file(JSON_FILE)) && !is_report(&d.join("class/mia.txt")));
+
+    let refused = |change: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = doc.clone();
+        change(&mut v);
+        let p = d.join("other.json");
+        std::fs::write(&p, v.to_string()).unwrap();
+        GradeReport::read(&p).unwrap_err().to_string()
+    };
+    let other = d.join("other.json").display().to_string();
+    assert_eq!(
+        refused(&|v| v["version"] = 2.into()),
+        format!("{other}: version 2 of the bvhscope-grade format; this bvhscope reads version 1")
+    );
+    assert_eq!(
+        refused(&|v| v["format"] = "bvhscope-bvh".into()),
+        format!("{other}: not a bvhscope grade report: its format is \"bvhscope-bvh\"")
+    );
+    assert!(refused(&|v| v["students"] = 3.into()).starts_with(&format!("{other}: not a readable grade report: ")));
 }
