@@ -187,6 +187,27 @@ pub fn diagonal_rods(rings: u32, sides: u32, length: f32, radius: f32, spacing: 
     m
 }
 
+/// `count` long thin triangles crossing the box -1..1 diagonally, from seed `seed`: each a
+/// sliver about 0.01 wide and 1 to 2.5 long (the box's diagonal is 3.5) centred at a random point
+/// and running near the (1, 1, 1) direction, so that they cross one another and every box of a
+/// BVH overlaps many others: the messy case for end-point overlap and for tracing.
+pub fn needles(count: u32, seed: u64) -> Mesh {
+    let mut rng = crate::random::Rng::new(seed);
+    let mut positions = Vec::with_capacity(3 * count as usize);
+    for _ in 0..count {
+        let mut v = |s: f32| Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s));
+        let (centre, dir, side) = (v(1.0), (Vec3::ONE + v(0.3)).normalize(), v(1.0));
+        let across = dir.cross(side).normalize_or(Vec3::X);
+        let (length, along) = (rng.range(1.0, 2.5), rng.range(-0.5, 0.5));
+        let width = rng.range(0.002, 0.01);
+        positions.push(centre - dir * length * 0.5);
+        positions.push(centre + dir * length * 0.5);
+        positions.push(centre + dir * length * along + across * width);
+    }
+    let triangles = (0..count).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    Mesh::from_triangles("needles", positions, triangles)
+}
+
 /// A square floor of two triangles in the y = 0 plane, `size` on a side, facing up: the two huge
 /// triangles of `scenes/knot-on-floor.json`.
 pub fn floor(size: f32) -> Mesh {
