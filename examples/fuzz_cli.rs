@@ -11,24 +11,16 @@
 //! ```
 //! It prints how many inputs it tried and what failed (issue 34's closing note has a run's count).
 
+use bvhscope::random::Rng;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// SplitMix64, seeded by the run's start (the inputs are kept, so a failure reproduces).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
+/// A number in 0..n (0 for n = 0) from the run's generator, seeded by the run's start (the inputs
+/// are kept, so a failure reproduces).
+fn below(r: &mut Rng, n: usize) -> usize {
+    r.below(n as u64) as usize
 }
 
 const EXTREMES: [&str; 14] = [
@@ -54,28 +46,28 @@ fn mutate(bytes: &mut Vec<u8>, r: &mut Rng) {
         bytes.push(b'{');
     }
     // Numbers replaced most often: the file stays readable and the checker goes deep.
-    match r.below(12) {
+    match below(r, 12) {
         0 => {
-            let i = r.below(bytes.len());
-            bytes[i] ^= 1 << r.below(8);
+            let i = below(r, bytes.len());
+            bytes[i] ^= 1 << below(r, 8);
         }
         1 => {
-            let i = r.below(bytes.len() + 1);
-            let n = 1 + r.below(16);
-            let junk: Vec<u8> = (0..n).map(|_| r.next() as u8).collect();
+            let i = below(r, bytes.len() + 1);
+            let n = 1 + below(r, 16);
+            let junk: Vec<u8> = (0..n).map(|_| r.next_u64() as u8).collect();
             bytes.splice(i..i, junk);
         }
         2 => {
-            let a = r.below(bytes.len());
-            let b = (a + 1 + r.below(64)).min(bytes.len());
+            let a = below(r, bytes.len());
+            let b = (a + 1 + below(r, 64)).min(bytes.len());
             bytes.drain(a..b);
         }
         3 => {
             // Repeat a chunk (a node, a line) many times.
-            let a = r.below(bytes.len());
-            let b = (a + 1 + r.below(200)).min(bytes.len());
+            let a = below(r, bytes.len());
+            let b = (a + 1 + below(r, 200)).min(bytes.len());
             let chunk = bytes[a..b].to_vec();
-            let times = 1 + r.below(50);
+            let times = 1 + below(r, 50);
             for _ in 0..times {
                 bytes.splice(b..b, chunk.iter().copied());
             }
@@ -88,12 +80,12 @@ fn mutate(bytes: &mut Vec<u8>, r: &mut Rng) {
             if starts.is_empty() {
                 return;
             }
-            let a = starts[r.below(starts.len())];
+            let a = starts[below(r, starts.len())];
             let mut b = a;
             while b < bytes.len() && (bytes[b].is_ascii_digit() || b".eE-+".contains(&bytes[b])) {
                 b += 1;
             }
-            let with = EXTREMES[r.below(EXTREMES.len())].as_bytes().to_vec();
+            let with = EXTREMES[below(r, EXTREMES.len())].as_bytes().to_vec();
             bytes.splice(a..b, with);
         }
         _ => {
@@ -102,9 +94,9 @@ fn mutate(bytes: &mut Vec<u8>, r: &mut Rng) {
             if lines.len() < 2 {
                 return;
             }
-            let k = r.below(lines.len() - 1);
+            let k = below(r, lines.len() - 1);
             let (a, b) = (lines[k] + 1, lines[k + 1] + 1);
-            if r.below(2) == 0 {
+            if below(r, 2) == 0 {
                 bytes.drain(a..b);
             } else {
                 let line = bytes[a..b].to_vec();
@@ -191,18 +183,19 @@ fn main() {
     let obj = std::fs::read(&torus).unwrap();
     seeds.push(("mesh.obj".into(), obj[..obj.len().min(20_000)].to_vec()));
 
-    let mut r = Rng(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_nanos() as u64);
+    let r =
+        &mut Rng::new(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_nanos() as u64);
     let start = Instant::now();
     let (mut tried, mut runs, mut failures) = (0u64, 0u64, 0u64);
     let mut codes = std::collections::BTreeMap::new();
     let limit = Duration::from_secs(30);
     while start.elapsed() < Duration::from_secs(seconds) {
-        let (name, seed) = &seeds[r.below(seeds.len())];
+        let (name, seed) = &seeds[below(r, seeds.len())];
         let mut bytes = seed.clone();
-        for _ in 0..1 + r.below(3) {
-            mutate(&mut bytes, &mut r);
+        for _ in 0..1 + below(r, 3) {
+            mutate(&mut bytes, r);
         }
-        let gz = name.starts_with("dump.json") && r.below(4) == 0;
+        let gz = name.starts_with("dump.json") && below(r, 4) == 0;
         let file = work.join(if gz { format!("case-{tried}.json.gz") } else { format!("case-{tried}-{name}") });
         std::fs::write(&file, if gz { gzip(&bytes) } else { bytes.clone() }).unwrap();
         tried += 1;
@@ -211,7 +204,7 @@ fn main() {
         let png = work.join("out.png").to_str().unwrap().to_string();
         let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<String>>();
         let commands: Vec<Vec<String>> = if name.starts_with("dump") {
-            let node = r.below(400).to_string();
+            let node = below(r, 400).to_string();
             vec![
                 s(&["check", &t, "--bvh", &f, "--rays", "300", "--size", "16x12", "--no-compare"]),
                 s(&["render", &t, "--bvh", &f, "--size", "16x12", "--view", "visits", "-o", &png]),

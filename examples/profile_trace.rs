@@ -8,6 +8,7 @@
 use bvhscope::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, TraceOptions};
 use bvhscope::geometry::Ray;
 use bvhscope::mesh::load_obj;
+use bvhscope::random::Rng;
 use bvhscope::render::Camera;
 use glam::Vec3;
 use std::time::Instant;
@@ -108,18 +109,12 @@ fn main() {
             .map(|r| if std::env::var("AWAY").is_ok() { Ray::new(r.origin(), -r.dir()) } else { r })
             .collect()
     } else {
-        let mut s = 12345u64;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = Rng::new(12345);
         (0..1_000_000)
             .map(|_| {
-                let t = mesh.triangle((rnd() * mesh.triangle_count() as f32) as u32 % mesh.triangle_count() as u32);
+                let t = mesh.triangle(rng.below(mesh.triangle_count() as u64) as u32);
                 let p = (t[0] + t[1] + t[2]) / 3.0;
-                let d = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(Vec3::X);
+                let d = Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5).normalize_or(Vec3::X);
                 Ray::new(p + d * 1e-4, d)
             })
             .collect()

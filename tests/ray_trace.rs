@@ -11,6 +11,7 @@ use bvhscope::bvh::{
 };
 use bvhscope::geometry::{Ray, TriangleTest};
 use bvhscope::mesh::{generate, Mesh};
+use bvhscope::random::Rng;
 use glam::Vec3;
 
 /// Rays from around the mesh towards points of its box (many hit, many pass by), and rays from
@@ -18,23 +19,17 @@ use glam::Vec3;
 fn rays(mesh: &Mesh, n: usize) -> Vec<Ray> {
     let b = mesh.bounds();
     let (c, r) = (b.center(), b.extent().length());
-    let mut state = 0x2545_f491_u32;
-    let mut rand = move || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        state as f32 / u32::MAX as f32
-    };
+    let mut rng = Rng::new(0x2545_f491);
+    let centred = |rng: &mut Rng| Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5);
     (0..n)
         .map(|i| {
-            let dir = Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5).normalize_or(Vec3::Y);
+            let dir = centred(&mut rng).normalize_or(Vec3::Y);
             if i % 4 == 3 {
-                let [a, p, q] =
-                    mesh.triangle((rand() * mesh.triangle_count() as f32) as u32 % mesh.triangle_count() as u32);
+                let [a, p, q] = mesh.triangle(rng.below(mesh.triangle_count() as u64) as u32);
                 Ray::new((a + p + q) / 3.0, dir)
             } else {
                 let from = c + dir * r;
-                let to = c + Vec3::new(rand() - 0.5, rand() - 0.5, rand() - 0.5) * b.extent();
+                let to = c + centred(&mut rng) * b.extent();
                 Ray::new(from, to - from)
             }
         })

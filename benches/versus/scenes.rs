@@ -1,6 +1,7 @@
 //! The meshes of the benchmark: two shared scans and two generated scenes.
 
 use bvhscope::mesh::{generate, load_obj, Mesh, MeshGroup};
+use bvhscope::random::Rng;
 use glam::Vec3;
 use std::path::Path;
 
@@ -37,13 +38,8 @@ pub fn big_knot() -> Mesh {
 /// surface like the 2M knot: the builders meet clusters, gaps and long thin triangles.
 pub fn knot_field() -> Mesh {
     let mut m = Mesh { name: "knot field 500k".into(), ..Default::default() };
-    let mut seed = 0x2545_F491_4F6C_DD1Du64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rng = Rng::new(0x2545_F491_4F6C_DD1D);
+    let mut next = move || rng.unit();
     for k in 0..64u32 {
         let (p, q) = ([2, 3, 2, 3, 5][k as usize % 5], [3, 5, 5, 7, 2][k as usize % 5]);
         let knot = generate::torus_knot(p, q, 0.05 + 0.3 * next(), 256, 16);

@@ -153,13 +153,8 @@ fn binary_and_wide_counts_relate_as_documented() {
     let linear = LinearScan::new(&mesh);
     let b = mesh.bounds();
     let (c, r) = (b.center(), b.extent().length());
-    let mut state = 0x9e37_79b9_u32;
-    let mut rand = move || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        state as f32 / u32::MAX as f32
-    };
+    let mut rng = bvhscope_core::random::Rng::new(0x9e37_79b9);
+    let mut rand = move || rng.unit();
     let (mut misses, mut crossing) = (0, 0);
     let (mut visits4, mut visits8) = (0u64, 0u64);
     for _ in 0..20_000 {

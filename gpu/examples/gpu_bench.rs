@@ -9,54 +9,17 @@
 //! ```
 //! Without a mesh: ../shared/models/stanford-bunny.obj, else core's built-in scene. Primary rays:
 //! one per pixel of the default view (`Camera::framing`). Incoherent rays: from random points on
-//! random triangles in random directions, a hair off the surface (benches/versus/rays.rs's
-//! construction, seed 1). Each figure is the best of `reps` runs of submit-to-completion time;
+//! random triangles in random directions, a hair off the surface (core's `incoherent_rays`, as
+//! benches/versus traces them, seed 1). Each figure is the best of `reps` runs of submit-to-completion time;
 //! read-backs are not timed.
 
 use bvhscope_core::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
-use bvhscope_core::geometry::Ray;
 use bvhscope_core::mesh::{generate, load_obj, Mesh};
-use bvhscope_core::render::Camera;
+use bvhscope_core::render::{incoherent_rays, Camera};
 use bvhscope_gpu::{
     Cwbvh, Gpu, GpuBinaryBvh, GpuCwbvh, GpuLbvh, GpuPloc, GpuTrace, GpuTraceOptions, Rays, WarpSize, WarpView, WarpWork,
 };
-use glam::Vec3;
 use std::time::{Duration, Instant};
-
-struct SplitMix(u64);
-
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
-
-fn incoherent(mesh: &Mesh, count: usize, seed: u64) -> Vec<Ray> {
-    let mut rng = SplitMix(seed);
-    let eps = mesh.bounds().extent().length() * 1e-4;
-    (0..count)
-        .map(|_| {
-            let tri = mesh.triangle((rng.next() % mesh.triangle_count() as u64) as u32);
-            let (mut u, mut v) = (rng.unit(), rng.unit());
-            if u + v > 1.0 {
-                (u, v) = (1.0 - u, 1.0 - v);
-            }
-            let p = tri[0] * (1.0 - u - v) + tri[1] * u + tri[2] * v;
-            let z = 2.0 * rng.unit() - 1.0;
-            let phi = rng.unit() * std::f32::consts::TAU;
-            let s = (1.0 - z * z).max(0.0).sqrt();
-            let dir = Vec3::new(s * phi.cos(), s * phi.sin(), z);
-            Ray::new(p + dir * eps, dir)
-        })
-        .collect()
-}
 
 struct Args {
     meshes: Vec<String>,
@@ -135,7 +98,7 @@ fn run() -> Result<(), String> {
         let cw = Cwbvh::from_bvh(&bvh).map_err(|e| e.to_string())?;
         let cwbvh = GpuCwbvh::upload(&gpu, &cw).map_err(|e| e.to_string())?;
         let cam = Camera::framing(&mesh.bounds(), a.width, a.height);
-        let list = incoherent(mesh, a.rays, 1);
+        let list = incoherent_rays(mesh, a.rays, 1);
         for (kind, rays) in [("primary", Rays::Camera(&cam)), ("incoherent", Rays::List(&list))] {
             for format in ["binary", "cwbvh"] {
                 for (counted, exact) in [(true, true), (false, true), (false, false)] {

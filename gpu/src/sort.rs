@@ -103,11 +103,8 @@ mod tests {
         let Some(gpu) = crate::device::gpu_for_tests() else { return };
         let sort = RadixSort::new(&gpu).unwrap();
         let scan = Scan::new(&gpu).unwrap();
-        let mut state = 99u64;
-        let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 33) as u32
-        };
+        let mut rng = bvhscope_core::random::Rng::new(99);
+        let mut next = || (rng.next_u64() >> 32) as u32;
         for (n, range, bits) in [
             (1u32, 16u32, 4u32),
             (300, 7, 8),

@@ -81,9 +81,9 @@ fn mesh_tri(w: &Cwbvh, prim: u32) -> [glam::Vec3; 3] {
 
 /// A ray a few ulps away gives the GPU's answer on the CPU (see common::explain).
 fn explain_cwbvh(w: &Cwbvh, ray: &Ray, hit: Option<Hit>, counts: RayCounters) -> bool {
-    let mut rng = Rng(ray.origin().y.to_bits() as u64);
+    let mut rng = Rng::new(ray.origin().y.to_bits() as u64);
     (0..512).any(|_| {
-        let mut k = || (rng.below(9) as i32 - 4) as f32 * f32::EPSILON;
+        let mut k = || (below(&mut rng, 9) as i32 - 4) as f32 * f32::EPSILON;
         let (o, d) = (ray.origin(), ray.dir());
         let o = o * glam::Vec3::new(1.0 + k(), 1.0 + k(), 1.0 + k());
         let d = d * glam::Vec3::new(1.0 + k(), 1.0 + k(), 1.0 + k());

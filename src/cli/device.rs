@@ -8,7 +8,7 @@
 use super::args::{BuildArgs, DeviceArgs};
 use super::{progress, CliError};
 use crate::bvh::{AnyBvh, BuildParams, Layout, SceneBuild, SceneBvh, TraceOptions};
-use crate::geometry::{Ray, TriangleTest};
+use crate::geometry::TriangleTest;
 pub use crate::gpu_path::{build_on_gpu, builds_on_gpu, GpuBuild, GpuNodes, GpuTree};
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame};
@@ -102,32 +102,6 @@ pub fn build_scene(
         }
     }
     Ok((super::build_scene(scene, build)?, None))
-}
-
-/// `n` incoherent rays: from random points on random triangles of `mesh` in random directions, a
-/// hair off the surface (gpu_bench's and benches/versus's construction), from a fixed seed.
-pub fn incoherent_rays(mesh: &Mesh, n: usize) -> Vec<Ray> {
-    let count = mesh.triangle_count() as u64;
-    if count == 0 {
-        return Vec::new();
-    }
-    let eps = mesh.bounds().extent().length() * 1e-4;
-    let mut rng = crate::random::Rng::new(1);
-    (0..n)
-        .map(|_| {
-            let tri = mesh.triangle(rng.below(count) as u32);
-            let (mut u, mut v) = (rng.unit(), rng.unit());
-            if u + v > 1.0 {
-                (u, v) = (1.0 - u, 1.0 - v);
-            }
-            let p = tri[0] * (1.0 - u - v) + tri[1] * u + tri[2] * v;
-            let z = 2.0 * rng.unit() - 1.0;
-            let phi = rng.unit() * std::f32::consts::TAU;
-            let s = (1.0 - z * z).max(0.0).sqrt();
-            let dir = glam::Vec3::new(s * phi.cos(), s * phi.sin(), z);
-            Ray::new(p + dir * eps, dir)
-        })
-        .collect()
 }
 
 /// The command line's spinners and errors over the GPU path's tree.

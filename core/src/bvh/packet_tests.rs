@@ -52,14 +52,10 @@ fn primary_blocks(mesh: &Mesh, size: u32) -> Vec<Ray> {
     rays
 }
 
-/// A fixed-seed xorshift64 stream of floats in [0, 1): the same random cases on every run.
-fn uniform(mut s: u64) -> impl FnMut() -> f32 {
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 40) as f32 / (1u64 << 24) as f32
-    }
+/// The seeded generator's floats in [0, 1), as a closure: the same random cases on every run.
+fn uniform(seed: u64) -> impl FnMut() -> f32 {
+    let mut rng = crate::random::Rng::new(seed);
+    move || rng.unit()
 }
 
 /// Rays in every direction from points around the mesh: packets whose rays diverge at once

@@ -171,20 +171,11 @@ mod tests {
     use crate::mesh::generate;
     use glam::Vec3;
 
+    /// A fixed pseudo-random set through the scene's box.
     fn rays(b: &crate::geometry::Aabb, n: usize) -> Vec<Ray> {
-        // A fixed pseudo-random set through the scene's box.
-        let mut s = 12345u64;
-        let mut r = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let (c, e) = (b.center(), b.extent());
-        (0..n)
-            .map(|_| {
-                let o = c + Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * e * 3.0;
-                let target = c + Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * e;
-                Ray::new(o, target - o)
-            })
+        crate::random::Rng::rays_at(12345, n, (b.min.into(), b.max.into()))
+            .into_iter()
+            .map(|(o, d)| Ray::new(o, d))
             .collect()
     }
 

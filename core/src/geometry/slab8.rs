@@ -174,13 +174,8 @@ mod tests {
     /// far reciprocal, `slab.rs`). Without it this fails for some of these rays.
     #[test]
     fn rays_aimed_at_box_corners_from_afar_hit_in_every_kernel() {
-        let mut state = 0x2545_f491_u32;
-        let mut rand = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / u32::MAX as f32
-        };
+        let mut rng = crate::random::Rng::new(0x2545_f491);
+        let mut rand = move || rng.unit();
         for _ in 0..20_000 {
             let lo = Vec3::new(rand(), rand(), rand()) * 10.0 - 5.0;
             let hi = lo + Vec3::new(rand(), rand(), rand()) * 3.0 + 0.01;

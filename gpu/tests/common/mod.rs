@@ -13,23 +13,17 @@ use std::path::PathBuf;
 
 pub use bvhscope_gpu::gpu_for_tests as gpu;
 
-/// A fixed-seed generator (SplitMix64) so every run uses the same scene and rays.
-pub struct Rng(pub u64);
+/// Core's generator (SplitMix64), so every run uses the same scene and rays.
+pub use bvhscope_core::random::Rng;
+/// The incoherent rays of the benchmarks (core's), for the GPU against the CPU (not every test
+/// file traces them).
+#[allow(unused_imports)]
+pub use bvhscope_core::render::incoherent_rays;
 
-impl Rng {
-    pub fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    pub fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-    pub fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
+/// A number in 0..n by a modulo (not `Rng::below`): the picks the GPU tests were checked with
+/// on a GPU, kept so that the exact mesh and the jittered rays stay those.
+pub fn below(rng: &mut Rng, n: u64) -> u64 {
+    rng.next_u64() % n
 }
 
 /// Unit cubes at integer positions of a 6×6×6 grid (a third of the cells), and slanted triangles
@@ -39,7 +33,7 @@ impl Rng {
 /// integer grid meet edges and vertices exactly (the watertight test's double-precision
 /// fallback) and lie in box planes (the slab test's NaN rule).
 pub fn exact_mesh() -> Mesh {
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     let (mut positions, mut triangles) = (Vec::new(), Vec::new());
     let quad = |p: [Vec3; 4], positions: &mut Vec<Vec3>, triangles: &mut Vec<[u32; 3]>| {
         let b = positions.len() as u32;
@@ -50,7 +44,7 @@ pub fn exact_mesh() -> Mesh {
     for x in 0..6 {
         for y in 0..6 {
             for z in 0..6 {
-                if rng.below(3) != 0 {
+                if below(&mut rng, 3) != 0 {
                     continue;
                 }
                 let o = Vec3::new(x as f32, y as f32, z as f32);
@@ -64,7 +58,7 @@ pub fn exact_mesh() -> Mesh {
         }
     }
     for _ in 0..40 {
-        let mut v = || Vec3::new(rng.below(7) as f32, rng.below(7) as f32, rng.below(7) as f32);
+        let mut v = || Vec3::new(below(&mut rng, 7) as f32, below(&mut rng, 7) as f32, below(&mut rng, 7) as f32);
         let (a, b, c) = (v(), v(), v());
         if (b - a).cross(c - a).length_squared() > 0.0 {
             let i = positions.len() as u32;
@@ -139,28 +133,6 @@ pub fn camera_rays(cam: &Camera) -> Vec<Ray> {
     (0..cam.height).flat_map(|y| (0..cam.width).map(move |x| g.pixel_ray(x, y))).collect()
 }
 
-/// `count` rays from random points on random triangles in random directions, a hair off the
-/// surface (the construction of benches/versus/rays.rs).
-pub fn incoherent_rays(mesh: &Mesh, count: usize, seed: u64) -> Vec<Ray> {
-    let mut rng = Rng(seed);
-    let eps = mesh.bounds().extent().length() * 1e-4;
-    (0..count)
-        .map(|_| {
-            let tri = mesh.triangle(rng.below(mesh.triangle_count() as u64) as u32);
-            let (mut u, mut v) = (rng.unit(), rng.unit());
-            if u + v > 1.0 {
-                (u, v) = (1.0 - u, 1.0 - v);
-            }
-            let p = tri[0] * (1.0 - u - v) + tri[1] * u + tri[2] * v;
-            let z = 2.0 * rng.unit() - 1.0;
-            let phi = rng.unit() * std::f32::consts::TAU;
-            let s = (1.0 - z * z).max(0.0).sqrt();
-            let dir = Vec3::new(s * phi.cos(), s * phi.sin(), z);
-            Ray::new(p + dir * eps, dir)
-        })
-        .collect()
-}
-
 /// `../shared/models` beside the checkout; absent, a notice (a failure under CI=true).
 pub fn shared_mesh(name: &str) -> Option<Mesh> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/models");
@@ -197,7 +169,7 @@ pub fn explain(
     ulps: i32,
 ) -> Option<String> {
     let opts = TraceOptions { order, test: TriangleTest::Watertight };
-    let mut rng = Rng(ray.origin().x.to_bits() as u64 ^ (ray.dir().y.to_bits() as u64) << 32);
+    let mut rng = Rng::new(ray.origin().x.to_bits() as u64 ^ (ray.dir().y.to_bits() as u64) << 32);
     let same_hit = |a: Option<Hit>, b: Option<Hit>| match (a, b) {
         (None, None) => true,
         (Some(a), Some(b)) => a.prim == b.prim && (a.t - b.t).abs() <= 1e-5 * a.t.abs().max(1e-30),
@@ -205,7 +177,7 @@ pub fn explain(
     };
     let (mut hit_ok, mut counts_ok) = (false, gpu.1.is_none());
     for _ in 0..512 {
-        let mut k = || rng.below(2 * ulps as u64 + 1) as i32 - ulps;
+        let mut k = || below(&mut rng, 2 * ulps as u64 + 1) as i32 - ulps;
         let o = ray.origin();
         let d = ray.dir();
         let o = Vec3::new(nudge(o.x, k()), nudge(o.y, k()), nudge(o.z, k()));

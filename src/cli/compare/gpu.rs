@@ -53,7 +53,7 @@ pub fn gpu_rows(
     let trace = build.trace();
     device::check_traceable(&build.scene_build(build.params(scene)), trace)?;
     let pixels = camera.width as usize * camera.height as usize;
-    let incoherent = device::incoherent_rays(mesh, pixels);
+    let incoherent = crate::render::incoherent_rays(mesh, pixels, 1);
     let mut rows = Vec::new();
     for strategy in SplitStrategy::ALL {
         let params = build.params_with(scene, strategy, Layout::Binary);
