@@ -6,8 +6,8 @@
 mod common;
 
 use bvhscope::bvh::{
-    trace_ray, Accelerator, AnyBvh, BuildParams, Layout, NodeId, RayCounters, SceneBuild, SplitStrategy, Step,
-    StepKind, TraceLevel, TraceOptions, TraversalOrder,
+    trace_ray, Accelerator, AnyBvh, BuildParams, Layout, NodeId, RayCounters, SceneBuild, SplitStrategy, StepKind,
+    TraceLevel, TraceOptions, TraceStep, TraversalOrder,
 };
 use bvhscope::geometry::{Ray, TriangleTest};
 use bvhscope::mesh::{generate, Mesh};
@@ -44,7 +44,7 @@ fn counts_of(c: RayCounters) -> (u32, u32, u32, u32, u32) {
 /// rule picks: the nearest entry (entry-distance order, the wide layout, the top level), or in
 /// the binary layout under the handout's rule the side the ray's sign on the split axis picks
 /// (`axis_of` gives a binary node's split axis).
-fn check_order(steps: &[Step], ray: &Ray, order: TraversalOrder, axis_of: Option<&dyn Fn(u32) -> usize>) {
+fn check_order(steps: &[TraceStep], ray: &Ray, order: TraversalOrder, axis_of: Option<&dyn Fn(u32) -> usize>) {
     let mut i = 0;
     while i < steps.len() {
         let StepKind::Enter { node: parent, .. } = steps[i].kind else {

@@ -23,7 +23,7 @@ pub struct PinnedRay {
     pub hit: Option<Hit>,
     pub trace: Trace,
     /// The steps as the Ray window lists them: an imported tree's nodes by the dump's ids.
-    pub named: Vec<crate::bvh::Step>,
+    pub named: Vec<crate::bvh::TraceStep>,
     /// The trace's totals: the counting sink's counts for this ray.
     pub counts: RayCounters,
     /// The `bvhscope trace` command that traces this ray through the same build (the scene's

@@ -1,6 +1,6 @@
 //! A built BVH in any layout behind one type: what the app, the CLI and the tests hold.
 
-use super::tree::{NodeView, TreeView};
+use super::tree::{TreeNode, TreeView};
 use super::wide::WideBvh;
 use super::{Accelerator, BuildParams, BuildReport, Bvh, Hit, Layout, TraceOptions, TraversalStats};
 use crate::geometry::TriangleIntersector;
@@ -90,7 +90,7 @@ impl Accelerator for AnyBvh {
 }
 
 impl TreeView for AnyBvh {
-    fn walk(&self, f: &mut dyn FnMut(&NodeView) -> bool) {
+    fn walk(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
         self.tree().walk(f)
     }
     fn triangle_count(&self) -> usize {

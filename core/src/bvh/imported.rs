@@ -68,7 +68,7 @@ impl Imported {
     }
 
     /// A trace step with nodes named by the dump's ids and triangles by their numbers in the file.
-    pub fn rename(&self, step: &super::Step, mesh: &Mesh) -> super::Step {
+    pub fn rename(&self, step: &super::TraceStep, mesh: &Mesh) -> super::TraceStep {
         step.renamed(|id| self.dump_id(id).map_or(id, NodeId::Node), |t| mesh.file_number(t))
     }
 }

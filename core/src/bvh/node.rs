@@ -91,13 +91,13 @@ impl Bvh {
 
 /// Visit a binary node array parents first (the `TreeView` walk of every binary tree); an `empty`
 /// tree's root is a leaf with no primitives.
-pub(crate) fn walk_nodes(nodes: &[BvhNode], empty: bool, f: &mut dyn FnMut(&super::tree::NodeView) -> bool) {
-    use super::tree::{NodeKind, NodeView};
+pub(crate) fn walk_nodes(nodes: &[BvhNode], empty: bool, f: &mut dyn FnMut(&super::tree::TreeNode) -> bool) {
+    use super::tree::{NodeKind, TreeNode};
     let mut stack = vec![(0usize, 0u32)];
     while let Some((i, depth)) = stack.pop() {
         let n = &nodes[i];
         let kind = if n.is_leaf() || empty { NodeKind::Leaf { count: n.count as u32 } } else { NodeKind::Interior };
-        let descend = f(&NodeView { id: i, bounds: n.bounds(), depth, kind });
+        let descend = f(&TreeNode { id: i, bounds: n.bounds(), depth, kind });
         if descend && kind == NodeKind::Interior {
             stack.push((n.index as usize + 1, depth + 1));
             stack.push((n.index as usize, depth + 1));
@@ -106,7 +106,7 @@ pub(crate) fn walk_nodes(nodes: &[BvhNode], empty: bool, f: &mut dyn FnMut(&supe
 }
 
 impl super::tree::TreeView for Bvh {
-    fn walk(&self, f: &mut dyn FnMut(&super::tree::NodeView) -> bool) {
+    fn walk(&self, f: &mut dyn FnMut(&super::tree::TreeNode) -> bool) {
         walk_nodes(&self.nodes, self.prim_ids.is_empty(), f)
     }
 

@@ -70,17 +70,18 @@ pub enum StepKind {
     InstanceDone { instance: u32 },
 }
 
+/// One step of a ray's trace: what the walk did (`kind`) and in which level of the tree.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Step {
+pub struct TraceStep {
     pub level: TraceLevel,
     #[serde(flatten)]
     pub kind: StepKind,
 }
 
-impl Step {
+impl TraceStep {
     /// The same step with nodes and triangles named otherwise (an imported tree's own node ids,
     /// the file's triangle numbers): `node` maps a node, `triangle` a triangle id.
-    pub fn renamed(&self, node: impl Fn(NodeId) -> NodeId, triangle: impl Fn(u32) -> u32) -> Step {
+    pub fn renamed(&self, node: impl Fn(NodeId) -> NodeId, triangle: impl Fn(u32) -> u32) -> TraceStep {
         let n = &node;
         let st = |v: &[(NodeId, f32)]| v.iter().map(|&(id, t)| (n(id), t)).collect::<Vec<_>>();
         let kind = match &self.kind {
@@ -110,7 +111,7 @@ impl Step {
             StepKind::ClosestHit { triangle: tri, t } => StepKind::ClosestHit { triangle: triangle(*tri), t: *t },
             other => other.clone(),
         };
-        Step { level: self.level, kind }
+        TraceStep { level: self.level, kind }
     }
 }
 
@@ -118,7 +119,7 @@ impl Step {
 /// its box (`None`: missed).
 type Seen = (u32, Option<(f32, f32)>);
 
-impl Step {
+impl TraceStep {
     /// The depth of the node the step is about; `None` for a step of the node entered last (a
     /// stack operation, a triangle test), which a listing indents under that node.
     pub fn depth(&self) -> Option<u32> {
@@ -202,7 +203,7 @@ impl Step {
 /// trace are read from its steps (`counts`).
 #[derive(Clone, Debug, Default)]
 pub struct Trace {
-    pub steps: Vec<Step>,
+    pub steps: Vec<TraceStep>,
     two_levels: bool,
     instance: Option<(u32, u32)>,
     /// Per level, each node's depth and box interval, learnt from its box test.
@@ -231,7 +232,7 @@ impl Trace {
     }
 
     fn push(&mut self, kind: StepKind) {
-        self.steps.push(Step { level: self.level(), kind });
+        self.steps.push(TraceStep { level: self.level(), kind });
     }
 
     fn depth(&self, node: NodeId) -> u32 {

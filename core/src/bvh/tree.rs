@@ -10,9 +10,9 @@ pub enum NodeKind {
     Leaf { count: u32 },
 }
 
-/// One node as the view presents it. `id` is unique within the tree (for colours and caching).
+/// One node as a `TreeView` walk presents it. `id` is unique within the tree (for colours and caching).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NodeView {
+pub struct TreeNode {
     pub id: usize,
     pub bounds: Aabb,
     /// Root = 0.
@@ -22,7 +22,7 @@ pub struct NodeView {
 
 pub trait TreeView {
     /// Visit every node, parents before children; `f` returns whether to visit the node's children.
-    fn walk(&self, f: &mut dyn FnMut(&NodeView) -> bool);
+    fn walk(&self, f: &mut dyn FnMut(&TreeNode) -> bool);
     /// Triangle references in leaves: the triangles, plus the duplicates of any cut by spatial
     /// splits (SBVH).
     fn triangle_count(&self) -> usize;

@@ -15,7 +15,7 @@
 use super::builders::{build_over_boxes, build_work};
 use super::node::{walk_nodes, BvhNode};
 use super::traverse::{walk, TopLevelWalk};
-use super::tree::{NodeKind, NodeView, TreeView};
+use super::tree::{NodeKind, TreeNode, TreeView};
 use super::{Accelerator, AnyBvh, BuildParams, BuildReport, Hit, TraversalStats};
 use crate::geometry::{Aabb, Ray, TriangleIntersector};
 use crate::mesh::Mesh;
@@ -47,7 +47,7 @@ pub struct TopLevel {
 }
 
 impl TreeView for TopLevel {
-    fn walk(&self, f: &mut dyn FnMut(&NodeView) -> bool) {
+    fn walk(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
         walk_nodes(&self.nodes, self.order.is_empty(), f)
     }
     /// The top level's primitives are instances.

@@ -385,13 +385,13 @@ pub(crate) fn explain(
     params: &BuildParams,
     root: &Aabb,
     spatials: &mut impl PlaneSink,
-) -> Explained {
+) -> NodeDecision {
     let ctx = Ctx::new(Some(tri), params, root);
     let info = node_info(&work.refs);
     let budget = work.budget;
     let decided = split_node(work, &info, &ctx, &mut (), spatials);
     let split = match &decided.outcome {
-        Outcome::Split { kind, axis, plane, left, right } => Some(ExplainedSplit {
+        Outcome::Split { kind, axis, plane, left, right } => Some(DecidedSplit {
             kind: *kind,
             axis: *axis,
             plane: *plane,
@@ -403,7 +403,7 @@ pub(crate) fn explain(
         Outcome::Leaf(_) => None,
     };
     let area = if root.is_empty() { 0.0 } else { root.area() };
-    Explained {
+    NodeDecision {
         budget,
         overlap_ratio: if area > 0.0 { decided.overlap / area } else { 0.0 },
         spatial_priced: decided.spatial_priced,
@@ -414,7 +414,7 @@ pub(crate) fn explain(
 
 /// What the SBVH builder made of a node (`explain`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Explained {
+pub struct NodeDecision {
     /// Duplicates its subtree could still add.
     pub budget: u64,
     /// λ / A(root): the object split's children's common area over the root's (spatial splits
@@ -424,11 +424,11 @@ pub struct Explained {
     /// The duplicates the cheaper spatial split needed, when they were more than the budget.
     pub over_budget: Option<u64>,
     /// `None`: a leaf.
-    pub split: Option<ExplainedSplit>,
+    pub split: Option<DecidedSplit>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ExplainedSplit {
+pub struct DecidedSplit {
     pub kind: SplitKind,
     pub axis: u8,
     pub plane: f32,

@@ -29,7 +29,7 @@ use collapse::{collapse_parallel, collapse_sequential, PARALLEL_MIN_NODES};
 pub use collapse::{wide_group_in, wide_group_of, WideGroup};
 
 use super::node::Bvh;
-use super::tree::{NodeKind, NodeView, TreeView};
+use super::tree::{NodeKind, TreeNode, TreeView};
 use super::{BuildParams, BuildReport};
 use crate::geometry::slab::Boxes;
 use crate::geometry::Aabb;
@@ -213,9 +213,9 @@ impl<const W: usize> WideBvh<W> {
 impl<const W: usize> TreeView for WideBvh<W> {
     /// The root is node 0 with the whole box; each valid slot is a child: an interior wide node
     /// (id = its index) or a leaf (id = nodes.len() + W·parent + slot).
-    fn walk(&self, f: &mut dyn FnMut(&NodeView) -> bool) {
+    fn walk(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
         let root_kind = if self.prim_ids.is_empty() { NodeKind::Leaf { count: 0 } } else { NodeKind::Interior };
-        if !f(&NodeView { id: 0, bounds: self.root_bounds, depth: 0, kind: root_kind }) || self.prim_ids.is_empty() {
+        if !f(&TreeNode { id: 0, bounds: self.root_bounds, depth: 0, kind: root_kind }) || self.prim_ids.is_empty() {
             return;
         }
         let mut stack = vec![(0usize, 0u32)];
@@ -226,10 +226,10 @@ impl<const W: usize> TreeView for WideBvh<W> {
                 let d = depth + 1;
                 if node.count[slot] > 0 {
                     let id = self.nodes.len() + W * i + slot;
-                    f(&NodeView { id, bounds, depth: d, kind: NodeKind::Leaf { count: node.count[slot] as u32 } });
+                    f(&TreeNode { id, bounds, depth: d, kind: NodeKind::Leaf { count: node.count[slot] as u32 } });
                 } else {
                     let c = node.child[slot] as usize;
-                    if f(&NodeView { id: c, bounds, depth: d, kind: NodeKind::Interior }) {
+                    if f(&TreeNode { id: c, bounds, depth: d, kind: NodeKind::Interior }) {
                         stack.push((c, d));
                     }
                 }

@@ -146,7 +146,7 @@ pub struct Inspection {
     pub spatial: [Vec<CurvePoint>; 3],
     /// What the SBVH does here: for an SBVH tree what its build did, for another tree what it
     /// would do with these triangles.
-    pub sbvh: Option<sbvh::Explained>,
+    pub sbvh: Option<sbvh::NodeDecision>,
     /// Each strategy's plane, or none when it finds no split (all centroids on one side or
     /// coinciding: the builder then falls back to equal count).
     pub markers: Vec<(SplitStrategy, Option<Marker>)>,
@@ -303,7 +303,7 @@ pub fn own_split(bvh: &Bvh, h: &Hierarchy, node: u32) -> (Option<Marker>, [Vec<C
 
 /// The SBVH's split as a marker (its left and right counts are references: a cut triangle is on
 /// both sides).
-fn sbvh_marker(e: &sbvh::Explained, strategy: SplitStrategy, params: &BuildParams, area: f32) -> Option<Marker> {
+fn sbvh_marker(e: &sbvh::NodeDecision, strategy: SplitStrategy, params: &BuildParams, area: f32) -> Option<Marker> {
     let s = e.split.filter(|_| area > 0.0)?;
     Some(Marker {
         strategy,
