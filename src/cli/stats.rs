@@ -11,8 +11,9 @@ use clap::{Args, ValueEnum};
 use std::fmt::Write;
 use std::path::PathBuf;
 
+/// How `stats` prints (`--format`); the app's stats files are `app::export::StatsFormat`.
 #[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum StatsFormat {
+pub enum StatsOutput {
     Text,
     Json,
 }
@@ -35,7 +36,7 @@ pub struct StatsArgs {
     #[arg(long)]
     pub no_rays: bool,
     #[arg(long, value_enum, default_value = "text")]
-    pub format: StatsFormat,
+    pub format: StatsOutput,
 }
 
 fn parse_warp(s: &str) -> Result<WarpSize, String> {
@@ -147,7 +148,7 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
         (SceneBvh::Single { bvh: b, mesh, .. }, format) => {
             let epo = progress::with_spinner("measuring the end-point overlap", || epo::of(&b.binary_tree(mesh)));
             let stats = TreeStats { epo: Some(epo), ..TreeStats::of(b) };
-            if let StatsFormat::Json = format {
+            if let StatsOutput::Json = format {
                 let v = serde_json::json!({
                     "mesh": report, "params": params, "stats": stats, "gpu_build": gpu_build_json, "rays": rays_json,
                 });
@@ -171,7 +172,7 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
                     (name, TreeStats::of(b))
                 })
                 .collect();
-            if let StatsFormat::Json = format {
+            if let StatsOutput::Json = format {
                 let bottom_json: Vec<_> =
                     bottom.iter().map(|(name, s)| serde_json::json!({ "mesh": name, "stats": s })).collect();
                 let v = serde_json::json!({

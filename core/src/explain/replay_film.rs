@@ -35,7 +35,8 @@ pub struct FilmStep {
     pub split: Option<String>,
 }
 
-pub struct Film {
+/// A build's replay as frames: one image per step shown, and what each step was.
+pub struct ReplayFilm {
     pub images: Vec<RgbImage>,
     pub steps: Vec<FilmStep>,
 }
@@ -83,7 +84,7 @@ pub fn film(
     s: &FilmSettings,
     subject: &str,
     control: &WorkControl,
-) -> Result<Film, Cancelled> {
+) -> Result<ReplayFilm, Cancelled> {
     let settings = RenderSettings { trace: s.trace, count: true, progressive: false };
     let ks = steps(replay.splits(), s.frames);
     // Each step's metric per pixel; then one colour scale for all of them.
@@ -134,10 +135,10 @@ pub fn film(
         images.push(draw_legend(&img, &legend));
         out.push(FilmStep { splits: k, sah: replay.sah[k], mean, split });
     }
-    Ok(Film { images, steps: out })
+    Ok(ReplayFilm { images, steps: out })
 }
 
-impl Film {
+impl ReplayFilm {
     /// The table `bvhscope replay` prints: splits, SAH cost, mean of the view per ray.
     pub fn table(&self, view: View) -> String {
         let mut t = format!("{:>8}  {:>12}  mean {} per ray\n", "splits", "SAH cost", view.label().to_lowercase());

@@ -72,10 +72,10 @@ pub struct SpatialSplit {
     pub right: u32,
 }
 
-/// A spatial bin: the box of the parts of references inside it, and how many references start
-/// (enter) and end (exit) in it.
+/// A spatial bin (named apart from the object split's `sah_binned::Bin`): the box of the parts of
+/// references inside it, and how many references start (enter) and end (exit) in it.
 #[derive(Clone, Copy, Debug)]
-struct Bin {
+struct Slice {
     bounds: Aabb,
     enter: u32,
     exit: u32,
@@ -100,14 +100,14 @@ pub fn spatial_planes(
 ) -> Option<SpatialSplit> {
     let n = refs.len() as u32;
     let mut best: Option<SpatialSplit> = None;
-    let mut slices = vec![Bin { bounds: Aabb::EMPTY, enter: 0, exit: 0 }; bins];
+    let mut slices = vec![Slice { bounds: Aabb::EMPTY, enter: 0, exit: 0 }; bins];
     for axis in 0..3 {
         let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
         let width = (hi - lo) / bins as f32;
         if !(width > 0.0) || !width.is_finite() {
             continue;
         }
-        slices.fill(Bin { bounds: Aabb::EMPTY, enter: 0, exit: 0 });
+        slices.fill(Slice { bounds: Aabb::EMPTY, enter: 0, exit: 0 });
         let bin_of = |x: f32| (((x - lo) / width) as usize).min(bins - 1);
         for r in refs {
             let b = r.bounds();
