@@ -67,8 +67,12 @@ fn clicking_a_pixel_pins_its_ray_and_the_ray_window_steps_through_it() {
     assert!(n > 10, "{n} steps");
     assert!(app.orbit == h.state().orbit, "a click does not orbit");
 
-    // The window lists the steps and steps through them.
-    h.get_by_label_contains("box of node 0: hit");
+    // The window lists the steps (the chosen one also whole above the list) and steps through them.
+    assert_eq!(
+        h.get_all_by_label_contains("box of node 0: hit").count(),
+        2,
+        "the step chosen, and its line in the list"
+    );
     assert_eq!(h.state().pins.step, 0);
     // The pointer goes to the window first, as a hand would: the hover read-out it left over the
     // image goes with it.

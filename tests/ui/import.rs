@@ -113,7 +113,10 @@ fn a_dropped_dump_is_checked_and_traced_by_every_view() {
     // A finding that names a node selects it in the tree view (by the dump's id).
     h.get_by_role_and_label(
         egui::accesskit::Role::Link,
-        &format!("defect: {}", findings.iter().find(|f| f.group == Group::Bounds).unwrap().line(8)),
+        &format!(
+            "defect: {}",
+            findings.iter().find(|f| f.group == Group::Bounds).unwrap().line(bvhscope::explain::check::LISTED)
+        ),
     )
     .click();
     run_until(&mut h, "the node selected", |a| {
