@@ -15,7 +15,6 @@ pub mod packet;
 pub mod params;
 mod preset;
 mod scene_bvh;
-mod simd;
 mod stack;
 mod stats;
 pub mod trace;
