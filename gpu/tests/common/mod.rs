@@ -6,12 +6,18 @@ use bvhscope_core::bvh::{
     Accelerator, BuildParams, Bvh, Hit, Layout, RayCounters, SplitStrategy, TraceOptions, TraversalOrder,
 };
 use bvhscope_core::geometry::{Ray, TriangleTest};
-use bvhscope_core::mesh::{load_obj, Mesh};
+use bvhscope_core::mesh::Mesh;
 use bvhscope_core::render::Camera;
 use glam::Vec3;
-use std::path::PathBuf;
 
 pub use bvhscope_gpu::gpu_for_tests as gpu;
+
+/// The shared meshes, as every package's tests find them (`../shared/models`, a notice when
+/// absent, a failure under CI=true).
+#[path = "../../../core/tests/common/mod.rs"]
+mod core_helpers;
+#[allow(unused_imports)]
+pub use core_helpers::shared_mesh;
 
 /// Core's generator (SplitMix64), so every run uses the same scene and rays.
 pub use bvhscope_core::random::Rng;
@@ -133,19 +139,6 @@ pub fn camera_rays(cam: &Camera) -> Vec<Ray> {
     (0..cam.height).flat_map(|y| (0..cam.width).map(move |x| g.pixel_ray(x, y))).collect()
 }
 
-/// `../shared/models` beside the checkout; absent, a notice (a failure under CI=true).
-pub fn shared_mesh(name: &str) -> Option<Mesh> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/models");
-    if !dir.is_dir() {
-        if std::env::var("CI").is_ok_and(|v| v == "true") {
-            panic!("CI=true but the shared test meshes are missing: {}", dir.display());
-        }
-        use std::io::Write;
-        let _ = writeln!(std::io::stderr(), "notice: {} not found; skipping tests on shared meshes", dir.display());
-        return None;
-    }
-    Some(load_obj(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}")).0)
-}
 
 /// `x` moved by `k` units in the last place.
 fn nudge(x: f32, k: i32) -> f32 {

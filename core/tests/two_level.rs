@@ -3,11 +3,11 @@
 
 mod common;
 
-use bvhscope::bvh::{AnyBvh, BuildParams, Layout, SplitStrategy, TwoLevelBvh};
-use bvhscope::mesh::{generate, Mesh};
-use bvhscope::render::{render, Camera, Frame, RenderSettings};
-use bvhscope::scene::{flatten, load_any, SceneInstances};
-use bvhscope::work::WorkControl;
+use bvhscope_core::bvh::{AnyBvh, BuildParams, Layout, SplitStrategy, TwoLevelBvh};
+use bvhscope_core::mesh::{generate, Mesh};
+use bvhscope_core::render::{render, Camera, Frame, RenderSettings};
+use bvhscope_core::scene::{flatten, load_any, SceneInstances};
+use bvhscope_core::work::WorkControl;
 use glam::{Affine3A, Quat, Vec3};
 use std::path::Path;
 use std::sync::Arc;

@@ -2,10 +2,10 @@
 
 mod common;
 
-use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy};
-use bvhscope::render::{render, RenderSettings};
-use bvhscope::scene::{load_any, parse_scene_file, write_scene_file, SceneError};
-use bvhscope::work::WorkControl;
+use bvhscope_core::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy};
+use bvhscope_core::render::{render, RenderSettings};
+use bvhscope_core::scene::{load_any, parse_scene_file, write_scene_file, SceneError};
+use bvhscope_core::work::WorkControl;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -176,8 +176,8 @@ fn analytic_shapes_are_listed_in_a_warning_and_the_rest_loads() {
 
 #[test]
 fn a_scene_of_many_placements_costs_memory_per_placement_and_flattens_only_within_the_budget() {
-    use bvhscope::bvh::SceneBuild;
-    use bvhscope::scene::{SceneError, MAX_FLAT_TRIANGLES};
+    use bvhscope_core::bvh::SceneBuild;
+    use bvhscope_core::scene::{SceneError, MAX_FLAT_TRIANGLES};
     let dir = temp_dir();
     // 21,000 placements of 1,000 triangles: 21M placed triangles, past the one-level budget.
     let n = 21_000;
@@ -202,22 +202,22 @@ fn a_scene_of_many_placements_costs_memory_per_placement_and_flattens_only_withi
     let top = BuildParams { max_leaf_size: 1, layout: Layout::Binary, ..BuildParams::default() };
     let two = scene.build(&SceneBuild { bvh: BuildParams::default(), top: Some(top) }, &WorkControl::new()).unwrap();
     let t = two.two_level().unwrap();
-    let mesh_bvh = bvhscope::bvh::TreeView::memory_bytes(&t.bottom[0]);
+    let mesh_bvh = bvhscope_core::bvh::TreeView::memory_bytes(&t.bottom[0]);
     let per_placement = (two.memory_bytes() - mesh_bvh) as f64 / n as f64;
     assert!(per_placement < 400.0, "{per_placement:.0} bytes per placement");
     // The scene holds its one mesh and no flattened copy.
     match &scene.geometry {
-        bvhscope::scene::Geometry::Placed { instances, flat, .. } => {
+        bvhscope_core::scene::Geometry::Placed { instances, flat, .. } => {
             assert_eq!(instances.meshes.len(), 1);
             assert!(flat.get().is_none(), "nothing was flattened");
         }
         other => panic!("a scene file's geometry is its placements: {other:?}"),
     }
     // It traces and shades: the ray down onto the first torus's ring hits it.
-    let mut ray = bvhscope::geometry::Ray::new(Vec3::new(1.0, 5.0, 0.0), -Vec3::Y);
-    let hit = bvhscope::bvh::Accelerator::closest_hit(&two, &mut ray, Default::default(), &mut bvhscope::bvh::NoStats)
+    let mut ray = bvhscope_core::geometry::Ray::new(Vec3::new(1.0, 5.0, 0.0), -Vec3::Y);
+    let hit = bvhscope_core::bvh::Accelerator::closest_hit(&two, &mut ray, Default::default(), &mut bvhscope_core::bvh::NoStats)
         .expect("hits the torus");
     assert!((hit.t - 4.7).abs() < 0.01, "t = {}", hit.t);
-    let n = bvhscope::mesh::Surface::shading_normal(&two, &ray, hit.prim, hit.triangle_hit());
+    let n = bvhscope_core::mesh::Surface::shading_normal(&two, &ray, hit.prim, hit.triangle_hit());
     assert!(n.y > 0.9, "the top of the ring faces up: {n}");
 }

@@ -4,13 +4,13 @@
 
 mod common;
 
-use bvhscope::bvh::{
+use bvhscope_core::bvh::{
     Accelerator, AnyBvh, BuildParams, Layout, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions,
     TraversalOrder, TreeView,
 };
-use bvhscope::cpu::Simd;
-use bvhscope::geometry::{Ray, TriangleTest};
-use bvhscope::mesh::Mesh;
+use bvhscope_core::cpu::Simd;
+use bvhscope_core::geometry::{Ray, TriangleTest};
+use bvhscope_core::mesh::Mesh;
 use glam::Vec3;
 use proptest::prelude::*;
 
@@ -57,7 +57,7 @@ fn check_ray(mesh: &Mesh, bvhs: &[AnyBvh], linear: &LinearScan, ray: Ray) {
                     if e.prim != g.prim {
                         // Allowed only when the two triangles are hit at the same distance.
                         let tri = mesh.triangle(g.prim);
-                        let h = bvhscope::geometry::intersect_triangle(opts.test, &ray, &tri).expect("BVH prim is hit");
+                        let h = bvhscope_core::geometry::intersect_triangle(opts.test, &ray, &tri).expect("BVH prim is hit");
                         assert_eq!(h.t, e.t, "different primitive at a different t: {what}");
                     }
                     assert_eq!(r.t_max, g.t, "ray t_max updated to the hit: {what}");
@@ -147,7 +147,7 @@ fn soup() -> impl Strategy<Value = Mesh> {
         let mut m = Mesh::from_triangles("soup", positions, triangles);
         // Drop triangles that came out degenerate, as the loader does.
         let pos = m.positions.clone();
-        m.triangles.retain(|t| bvhscope::geometry::triangle_double_area(&t.map(|i| pos[i as usize])) > 0.0);
+        m.triangles.retain(|t| bvhscope_core::geometry::triangle_double_area(&t.map(|i| pos[i as usize])) > 0.0);
         m.groups[0].triangles = 0..m.triangles.len() as u32;
         m
     })
@@ -228,8 +228,8 @@ fn identical_triangles_build_a_bounded_tree() {
     let mesh = Mesh::from_triangles("same", positions, vec![[0, 1, 2]; n as usize]);
     for (s, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| Layout::ALL.map(|l| (s, l))) {
         let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(s) });
-        let stats = bvhscope::bvh::TreeStats::of(&bvh);
-        assert!(stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32, "{s:?} depth {}", stats.max_depth);
+        let stats = bvhscope_core::bvh::TreeStats::of(&bvh);
+        assert!(stats.max_depth < bvhscope_core::bvh::TRAVERSAL_STACK_SIZE as u32, "{s:?} depth {}", stats.max_depth);
         assert!(stats.leaf_size_histogram.len() <= 5, "{s:?} leaf sizes");
         // Equal count always separates; PLOC merges and never splits, so nothing falls back.
         if !matches!(s, SplitStrategy::EqualCount | SplitStrategy::Ploc) {
@@ -262,8 +262,8 @@ fn exponentially_spaced_triangles_stay_within_the_stack_depth() {
         })
         .into();
     for bvh in &bvhs {
-        let stats = bvhscope::bvh::TreeStats::of(bvh);
-        assert!(stats.max_depth < bvhscope::bvh::TRAVERSAL_STACK_SIZE as u32);
+        let stats = bvhscope_core::bvh::TreeStats::of(bvh);
+        assert!(stats.max_depth < bvhscope_core::bvh::TRAVERSAL_STACK_SIZE as u32);
         assert!(stats.depth_limited_splits > 0, "this input must reach the depth limit: {stats:?}");
         common::check_any(bvh, &mesh);
     }

@@ -7,10 +7,10 @@
 
 mod common;
 
-use bvhscope::bvh::{Accelerator, AnyBvh, BuildParams, Hit, Layout, LinearScan, NoStats, SplitStrategy, TraceOptions};
-use bvhscope::bvh::{TraversalOrder, TreeView};
-use bvhscope::geometry::{Ray, TriangleTest};
-use bvhscope::mesh::Mesh;
+use bvhscope_core::bvh::{Accelerator, AnyBvh, BuildParams, Hit, Layout, LinearScan, NoStats, SplitStrategy, TraceOptions};
+use bvhscope_core::bvh::{TraversalOrder, TreeView};
+use bvhscope_core::geometry::{Ray, TriangleTest};
+use bvhscope_core::mesh::Mesh;
 use glam::Vec3;
 use proptest::prelude::*;
 
@@ -66,7 +66,7 @@ const MOLLER_TRUMBORE_SPREAD: f32 = 1.0 / 1024.0;
 /// test's error is bounded and gets no exception; the traversal is the same code for both.
 fn same_hit(mesh: &Mesh, ray: &Ray, opts: TraceOptions, want: Option<Hit>, got: Option<Hit>) -> bool {
     let hits_at = |g: &Hit, t: f32| {
-        bvhscope::geometry::intersect_triangle(opts.test, ray, &mesh.triangle(g.prim)).is_some_and(|h| h.t == t)
+        bvhscope_core::geometry::intersect_triangle(opts.test, ray, &mesh.triangle(g.prim)).is_some_and(|h| h.t == t)
     };
     match (want, got) {
         (None, None) => true,
@@ -161,11 +161,11 @@ fn check_mesh(mesh: &Mesh, stride: usize) {
 
 #[test]
 fn rays_at_vertices_edges_and_box_corners_of_generated_meshes() {
-    let mut knot = bvhscope::mesh::generate::torus_knot(2, 3, 0.3, 48, 8);
+    let mut knot = bvhscope_core::mesh::generate::torus_knot(2, 3, 0.3, 48, 8);
     knot.name = "knot".into();
     check_mesh(&knot, 1);
-    check_mesh(&bvhscope::mesh::generate::cornell_box(), 1);
-    check_mesh(&bvhscope::mesh::generate::stadium(), 2);
+    check_mesh(&bvhscope_core::mesh::generate::cornell_box(), 1);
+    check_mesh(&bvhscope_core::mesh::generate::stadium(), 2);
 }
 
 #[test]
@@ -207,7 +207,7 @@ fn shared_vertex_soup() -> impl Strategy<Value = Mesh> {
                 .map(|(a, b, c)| [(a % n) as u32, (b % n) as u32, (c % n) as u32])
                 .filter(|t| {
                     let v = t.map(|i| points[i as usize]);
-                    bvhscope::geometry::triangle_double_area(&v) > 1e-4
+                    bvhscope_core::geometry::triangle_double_area(&v) > 1e-4
                 })
                 .collect();
             Mesh::from_triangles("soup", points, triangles)
