@@ -30,7 +30,7 @@
 //! units in the last place; Möller–Trumbore's has no fixed bound (it grows with the origin's
 //! distance against the triangle's size), so with it, of two triangles meeting where a ray is
 //! aimed, the BVH may return the one whose rounded distance is a few hundred units in the last
-//! place farther: the same point, the other triangle (`tests/watertight_traversal.rs`). Both widenings stay off the per-node dependency chain: a widening
+//! place farther: the same point, the other triangle (`core/tests/watertight_traversal.rs`). Both widenings stay off the per-node dependency chain: a widening
 //! of each exit there cost a fifth of the wide traversal's speed.
 
 use super::{Aabb, Ray};

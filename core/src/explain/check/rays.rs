@@ -79,7 +79,7 @@ pub fn check_rays(mesh: &Mesh, camera: &Camera, n: usize) -> Vec<(Ray, Option<(u
 
 /// Where the checker takes a ray's true hit from: the linear scan's hits. Past a few thousand
 /// triangles they are found through bvhscope's own SAH tree instead, which returns the linear
-/// scan's hit for every ray (tests/bvh_matches_linear.rs, tests/watertight_traversal.rs): a
+/// scan's hit for every ray (core/tests/bvh_matches_linear.rs and watertight_traversal.rs): a
 /// million rays over a million triangles one by one would take days. Made once per mesh (the
 /// app keeps it for every view of an imported tree).
 pub enum Reference {
