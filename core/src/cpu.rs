@@ -1,8 +1,9 @@
-//! Which SIMD kernels this CPU runs, decided once at run time: AVX2 where the CPU has AVX2 and FMA
-//! (`is_x86_feature_detected!`), else four-lane SIMD (SSE2 on every x86-64, NEON on aarch64),
-//! else one box at a time. Users need no `-C target-cpu` flag; a build for another architecture
-//! takes the portable path. `BVHSCOPE_SIMD=scalar|simd4|avx2` asks for a lower level than the CPU
-//! offers (for comparing kernels, and for tests); asking for one it lacks gives what it has.
+//! Which SIMD kernels this CPU runs, decided once at run time: AVX-512 where the CPU has AVX-512F
+//! and VL on top of AVX2, else AVX2 where it has AVX2 and FMA (`is_x86_feature_detected!`), else
+//! four-lane SIMD (SSE2 on every x86-64, NEON on aarch64), else one box at a time. Users need no
+//! `-C target-cpu` flag; a build for another architecture takes the portable path.
+//! `BVHSCOPE_SIMD=scalar|simd4|avx2|avx512` asks for a lower level than the CPU offers (for
+//! comparing kernels, and for tests); asking for one it lacks gives what it has.
 //! Every kernel computes the same results bit for bit (`geometry::slab::SlabKernel`).
 
 use std::sync::OnceLock;
@@ -16,21 +17,30 @@ pub enum Simd {
     Simd4,
     /// Eight lanes with AVX2 (x86-64 only, when the CPU has AVX2 and FMA).
     Avx2,
+    /// AVX-512F and VL on top of AVX2 (x86-64 only): the eight-box test with mask registers, a
+    /// leaf's triangles in one pass of up to sixteen lanes, packets in groups of sixteen rays
+    /// (`geometry::avx512`).
+    Avx512,
 }
 
 impl Simd {
-    pub const ALL: [Simd; 3] = [Simd::Scalar, Simd::Simd4, Simd::Avx2];
+    pub const ALL: [Simd; 4] = [Simd::Scalar, Simd::Simd4, Simd::Avx2, Simd::Avx512];
 
     pub fn name(self) -> &'static str {
         match self {
             Simd::Scalar => "scalar",
             Simd::Simd4 => "simd4",
             Simd::Avx2 => "avx2",
+            Simd::Avx512 => "avx512",
         }
     }
 
     /// The best level this CPU has.
     pub fn detected() -> Simd {
+        #[cfg(target_arch = "x86_64")]
+        if crate::geometry::avx512::Avx512::detect().is_some() {
+            return Simd::Avx512;
+        }
         #[cfg(target_arch = "x86_64")]
         if crate::geometry::slab8::Avx2::detect().is_some() {
             return Simd::Avx2;

@@ -14,7 +14,7 @@ use super::stack::TraversalStack;
 use super::trace::NodeId;
 use super::{Accelerator, Hit, TraceOptions, TraversalStats};
 use crate::geometry::slab::{widen, OneRay};
-use crate::geometry::{Ray, TriangleIntersector};
+use crate::geometry::{Ray, TriangleHit, TriangleIntersector};
 use std::ops::Range;
 
 /// Which level of a hierarchy a walk is on, for the counters: a mesh's BVH, or the top level of a
@@ -201,39 +201,115 @@ pub(crate) fn test_triangles<T: TriangleIntersector, const ANY: bool, S: Travers
     false
 }
 
-/// `test_triangles` four triangles at a time, each group in one SIMD pass
-/// (`TriangleIntersector::intersect_group`). The lanes are then taken in order against the
-/// closest hit so far, as the one-by-one loop takes them, so the same hits are reported and the
-/// same closest hit kept, bit for bit. Counts are the one-by-one loop's too, so that no count
-/// depends on the CPU: every triangle of the leaf for a closest hit; for an any-hit query, the
-/// triangles up to the one that hit (the SIMD pass computed the rest of its group, unused).
-/// The `count` triangles come from the 8-wide layout's leaf storage: `coords` are the floats from
-/// the leaf's first one on, coordinate by coordinate (`wide::leaves`).
+/// How a leaf stored coordinate by coordinate (`wide::leaves`) is tested: `N` triangles per SIMD
+/// pass, four with every kernel (`Groups4`), sixteen with AVX-512 (`Groups16`).
+pub(crate) trait LeafGroups: Copy {
+    const N: usize;
+    /// One pass's hits (`Hits4`, `Hits16`).
+    type Hits: Copy;
+    /// Triangles `N·g..N·g + N` (those below `count`) against the ray.
+    fn test<T: TriangleIntersector>(
+        self,
+        p: &T::Prepared,
+        ray: &Ray,
+        coords: &[f32],
+        count: usize,
+        g: usize,
+    ) -> Self::Hits;
+    /// The mask of the lanes hit.
+    fn mask(h: &Self::Hits) -> u32;
+    /// Lane k's hit (meaningful where its bit of the mask is set).
+    fn lane(h: &Self::Hits, k: usize) -> TriangleHit;
+}
+
+/// Four triangles per pass (`TriangleIntersector::intersect_group_coords`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Groups4;
+
+impl LeafGroups for Groups4 {
+    const N: usize = 4;
+    type Hits = crate::geometry::triangle::Hits4;
+    #[inline(always)]
+    fn test<T: TriangleIntersector>(
+        self,
+        p: &T::Prepared,
+        ray: &Ray,
+        coords: &[f32],
+        count: usize,
+        g: usize,
+    ) -> crate::geometry::triangle::Hits4 {
+        T::intersect_group_coords(p, ray, coords, count, g)
+    }
+    #[inline(always)]
+    fn mask(h: &crate::geometry::triangle::Hits4) -> u32 {
+        h.mask
+    }
+    #[inline(always)]
+    fn lane(h: &crate::geometry::triangle::Hits4, k: usize) -> TriangleHit {
+        TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] }
+    }
+}
+
+/// Sixteen triangles per pass with AVX-512 (`TriangleIntersector::intersect_group16_coords`).
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Groups16(pub crate::geometry::avx512::Avx512);
+
+#[cfg(target_arch = "x86_64")]
+impl LeafGroups for Groups16 {
+    const N: usize = 16;
+    type Hits = crate::geometry::avx512::Hits16;
+    #[inline(always)]
+    fn test<T: TriangleIntersector>(
+        self,
+        p: &T::Prepared,
+        ray: &Ray,
+        coords: &[f32],
+        count: usize,
+        g: usize,
+    ) -> crate::geometry::avx512::Hits16 {
+        T::intersect_group16_coords(self.0, p, ray, coords, count, g)
+    }
+    #[inline(always)]
+    fn mask(h: &crate::geometry::avx512::Hits16) -> u32 {
+        h.mask
+    }
+    #[inline(always)]
+    fn lane(h: &crate::geometry::avx512::Hits16, k: usize) -> TriangleHit {
+        TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] }
+    }
+}
+
+/// `test_triangles` `L::N` triangles at a time, each group in one SIMD pass. The lanes are then
+/// taken in order against the closest hit so far, as the one-by-one loop takes them, so the same
+/// hits are reported and the same closest hit kept, bit for bit. Counts are the one-by-one loop's
+/// too, so that no count depends on the CPU: every triangle of the leaf for a closest hit; for an
+/// any-hit query, the triangles up to the one that hit (the SIMD pass computed the rest of its
+/// group, unused). The `count` triangles come from the 8-wide layout's leaf storage: `coords` are
+/// the floats from the leaf's first one on, coordinate by coordinate (`wide::leaves`).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
+pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S: TraversalStats, L: LeafGroups>(
+    groups: L,
     coords: &[f32],
     count: usize,
     first: usize,
     ray: &mut Ray,
     stats: &mut S,
     prepared: &mut Option<T::Prepared>,
-    best: &mut Option<(usize, crate::geometry::TriangleHit)>,
+    best: &mut Option<(usize, TriangleHit)>,
     prim_of: impl Fn(usize) -> u32,
 ) -> bool {
     let p = *prepared.get_or_insert_with(|| T::prepare(ray));
-    for g in 0..count.div_ceil(4) {
-        let hits = T::intersect_group_coords(&p, ray, coords, count, g);
-        if hits.mask == 0 && !S::STEPS {
+    for g in 0..count.div_ceil(L::N) {
+        let hits = groups.test::<T>(&p, ray, coords, count, g);
+        let mask = L::mask(&hits);
+        if mask == 0 && !S::STEPS {
             continue;
         }
-        for k in 0..(count - 4 * g).min(4) {
-            let hit = (hits.mask & (1 << k) != 0 && hits.t[k] < ray.t_max).then(|| crate::geometry::TriangleHit {
-                t: hits.t[k],
-                u: hits.u[k],
-                v: hits.v[k],
-            });
-            let i = first + 4 * g + k;
+        for k in 0..(count - L::N * g).min(L::N) {
+            let hit = (mask & (1 << k) != 0).then(|| L::lane(&hits, k)).filter(|h| h.t < ray.t_max);
+            let i = first + L::N * g + k;
             if S::STEPS {
                 stats.step_triangle(prim_of(i), hit);
             }
@@ -241,7 +317,7 @@ pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S:
                 ray.t_max = h.t;
                 *best = Some((i, h));
                 if ANY {
-                    stats.triangle_tests((4 * g + k + 1) as u32);
+                    stats.triangle_tests((L::N * g + k + 1) as u32);
                     return true;
                 }
             }

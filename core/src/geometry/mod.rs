@@ -1,6 +1,8 @@
 //! Rays, axis-aligned boxes and the two ray–triangle tests.
 
 mod aabb;
+#[cfg(target_arch = "x86_64")]
+pub mod avx512;
 mod ray;
 mod shear;
 pub mod slab;

@@ -157,6 +157,8 @@ pub fn box_once(lo: &[f32; 3], hi: &[f32; 3], ray: &Ray) -> (f32, f32) {
 
 /// `W` boxes' planes in SoA order (`min[axis][box]`), for one SIMD slab test of all of them: a
 /// wide node's children (four, or eight in `slab8`), or a binary node's two with empty slots.
+/// `repr(C)`: the AVX-512 kernel picks a ray's near and far planes by their offsets in it.
+#[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Boxes<const W: usize> {
     pub min: [[f32; W]; 3],

@@ -98,6 +98,7 @@ impl RayGroup {
 /// directions per axis. Valid only when every ray's direction has the same sign on each axis and
 /// no component is zero (then each ray's near plane of a box is the same one, and the bounds on
 /// its slab distances follow from the corners of the ranges).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayInterval {
     valid: bool,
     org_lo: [f32; 3],
@@ -151,17 +152,27 @@ impl RayInterval {
         // Written out per axis: `array::map` was left out of line here, a twentieth of a packet.
         let lows = |v: &[f32x4; 3]| [low(v[0]), low(v[1]), low(v[2])];
         let highs = |v: &[f32x4; 3]| [high(v[0]), high(v[1]), high(v[2])];
-        let (inv_lo, inv_hi) = (lows(&inv_lo), highs(&inv_hi));
+        let (org_lo, org_hi, inv_lo, inv_hi) = (lows(&org_lo), highs(&org_hi), lows(&inv_lo), highs(&inv_hi));
+        Self::of_bounds([org_lo, org_hi, inv_lo, inv_hi], low(t_min), !groups.is_empty() && finite.all())
+    }
+
+    /// The interval of rays whose origins lie in `[org_lo, org_hi]` and reciprocal directions in
+    /// `[inv_lo, inv_hi]` per axis (`bounds`, in that order), starting at `t_min` or later; valid
+    /// when every value was `finite` and each axis has one sign. Shared by the four-lane groups
+    /// (`new`) and the sixteen-lane ones (`avx512::packet`).
+    #[inline(always)]
+    pub(crate) fn of_bounds(bounds: [[f32; 3]; 4], t_min: f32, finite: bool) -> Self {
+        let [org_lo, org_hi, inv_lo, inv_hi] = bounds;
         // One sign per axis, no zero or infinite component, finite origins.
         let one_sign = (0..3).all(|a| inv_lo[a] > 0.0 || inv_hi[a] < 0.0);
         RayInterval {
-            valid: !groups.is_empty() && one_sign && finite.all(),
-            org_lo: lows(&org_lo),
-            org_hi: highs(&org_hi),
+            valid: finite && one_sign,
+            org_lo,
+            org_hi,
             neg: [inv_hi[0] < 0.0, inv_hi[1] < 0.0, inv_hi[2] < 0.0],
             inv_lo,
             inv_hi,
-            t_min: low(t_min),
+            t_min,
         }
     }
 

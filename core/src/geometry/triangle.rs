@@ -6,9 +6,13 @@
 //! keep the first of two hits at the same distance and keeps an occlusion ray from hitting the
 //! surface at its far end.
 
+#[cfg(target_arch = "x86_64")]
+use super::avx512::{packet::WatertightRay16, Avx512, Hits16};
 pub use super::shear::{Hits4, WatertightRay};
 use super::Ray;
 use glam::{DVec3, Vec3};
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::__m512;
 use wide::f32x4;
 
 /// Distance and barycentrics of a ray–triangle hit.
@@ -46,6 +50,23 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
     /// `intersect` (packets must find exactly what single rays find).
     fn intersect4(p: &Self::Prepared4, t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4;
 
+    /// `Prepared4` for a group of sixteen rays (AVX-512 packets, `avx512::packet`).
+    #[cfg(target_arch = "x86_64")]
+    type Prepared16: Copy;
+    /// The setup of rays `base..base + 16` of `rays` (lanes past the end repeat the last ray).
+    #[cfg(target_arch = "x86_64")]
+    fn prepare16(k: Avx512, rays: &[Ray], base: usize) -> Self::Prepared16;
+    /// `intersect4` for sixteen rays: lane by lane the same result as `intersect`.
+    #[cfg(target_arch = "x86_64")]
+    fn intersect16(
+        k: Avx512,
+        p: &Self::Prepared16,
+        t_min: __m512,
+        t_max: __m512,
+        lanes: u32,
+        tri: &[Vec3; 3],
+    ) -> Hits16;
+
     /// One ray against up to four triangles (`tris.len() <= 4`): lane k of the result is
     /// `intersect(p, ray, &tris[k])`, bit for bit. The watertight test does the four in one SIMD
     /// pass (`triangle4.rs`, the wide BVHs' leaves); this default runs `intersect` lane by lane.
@@ -71,6 +92,31 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
         let tri = |k: usize| super::leaf_triangle(coords, count, 4 * g + k);
         let tris = [tri(0), tri(1.min(n - 1)), tri(2.min(n - 1)), tri(3.min(n - 1))];
         Self::intersect_group(p, ray, &tris[..n])
+    }
+
+    /// `intersect_group_coords` of triangles `16g..16g + 16` (those below `count`) at once: lane k
+    /// of the result is triangle `16g + k`'s `intersect`, bit for bit. The watertight test does
+    /// them in one AVX-512 pass (`avx512::leaf`); this default runs four groups of four.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect_group16_coords(
+        _: Avx512,
+        p: &Self::Prepared,
+        ray: &Ray,
+        coords: &[f32],
+        count: usize,
+        g: usize,
+    ) -> Hits16 {
+        let mut hits = Hits16::NONE;
+        for q in (4 * g..4 * g + 4).take_while(|&q| 4 * q < count) {
+            let h = Self::intersect_group_coords(p, ray, coords, count, q);
+            let at = 4 * (q - 4 * g);
+            hits.mask |= h.mask << at;
+            hits.t[at..at + 4].copy_from_slice(&h.t);
+            hits.u[at..at + 4].copy_from_slice(&h.u);
+            hits.v[at..at + 4].copy_from_slice(&h.v);
+        }
+        hits
     }
 }
 
@@ -149,6 +195,19 @@ impl TriangleIntersector for Watertight {
         super::triangle4::watertight_group_coords(p, ray, coords, count, g)
     }
 
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect_group16_coords(
+        k: Avx512,
+        p: &WatertightRay,
+        ray: &Ray,
+        coords: &[f32],
+        count: usize,
+        g: usize,
+    ) -> Hits16 {
+        super::avx512::watertight_leaf16(k, p, ray, coords, count, g)
+    }
+
     type Prepared4 = WatertightRay4;
 
     #[inline(always)]
@@ -184,6 +243,28 @@ impl TriangleIntersector for Watertight {
         let (cx, cy) = (dot(&c, &p.rx), dot(&c, &p.ry));
         let z = [dot(&a, &p.rz), dot(&b, &p.rz), dot(&c, &p.rz)];
         super::triangle4::edge_test4([ax, ay, bx, by, cx, cy], z, t_min, t_max, lanes)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    type Prepared16 = WatertightRay16;
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn prepare16(k: Avx512, rays: &[Ray], base: usize) -> WatertightRay16 {
+        WatertightRay16::new(k, rays, base)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect16(
+        k: Avx512,
+        p: &WatertightRay16,
+        t_min: __m512,
+        t_max: __m512,
+        lanes: u32,
+        tri: &[Vec3; 3],
+    ) -> Hits16 {
+        p.intersect(k, t_min, t_max, lanes, tri)
     }
 }
 
@@ -249,6 +330,35 @@ impl TriangleIntersector for MollerTrumbore {
     fn intersect4(rays: &[Ray; 4], t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
         let mut hits = Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
         let (t_min, t_max) = (t_min.to_array(), t_max.to_array());
+        let mut m = lanes;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let mut ray = rays[k];
+            (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
+            if let Some(h) = Self::intersect(&(), &ray, tri) {
+                hits.mask |= 1 << k;
+                (hits.t[k], hits.u[k], hits.v[k]) = (h.t, h.u, h.v);
+            }
+        }
+        hits
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    type Prepared16 = [Ray; 16];
+
+    #[cfg(target_arch = "x86_64")]
+    fn prepare16(_: Avx512, rays: &[Ray], base: usize) -> [Ray; 16] {
+        std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
+    }
+
+    /// Lane by lane, as `intersect4`.
+    #[cfg(target_arch = "x86_64")]
+    fn intersect16(_: Avx512, rays: &[Ray; 16], t_min: __m512, t_max: __m512, lanes: u32, tri: &[Vec3; 3]) -> Hits16 {
+        let mut hits = Hits16::NONE;
+        // SAFETY: `__m512` and `[f32; 16]` have the same size, and every bit pattern is a float.
+        let (t_min, t_max): ([f32; 16], [f32; 16]) =
+            unsafe { (std::mem::transmute(t_min), std::mem::transmute(t_max)) };
         let mut m = lanes;
         while m != 0 {
             let k = m.trailing_zeros() as usize;

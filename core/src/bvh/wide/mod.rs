@@ -25,6 +25,9 @@ mod leaves;
 mod packet;
 mod traverse;
 
+#[cfg(test)]
+mod kernel_tests;
+
 use collapse::{collapse_parallel, collapse_sequential, PARALLEL_MIN_NODES};
 pub use collapse::{wide_group_in, wide_group_of, WideGroup};
 

@@ -11,6 +11,11 @@ use glam::Vec3;
 use wide::f32x4;
 
 impl<const W: usize> PacketTree for WideBvh<W> {
+    /// The tree's kernel choice (`with_simd`): groups of sixteen rays where it is AVX-512, in both
+    /// widths (the 4-wide walk of single rays has no AVX-512 kernel; its packets do).
+    fn simd(&self) -> crate::cpu::Simd {
+        self.simd
+    }
     fn prim_ids(&self) -> &[u32] {
         &self.prim_ids
     }

@@ -1,6 +1,6 @@
 //! The wide BVHs' walk, written once for four and eight children: one SIMD slab test for the child
-//! boxes of a node (a `geometry::slab::SlabKernel`: four lanes, or eight with AVX2 where the CPU
-//! has it, chosen per tree from `crate::cpu`), hit children visited nearest first. The common cases take few
+//! boxes of a node (a `geometry::slab::SlabKernel`: four lanes, or eight with AVX2 or AVX-512 where
+//! the CPU has it, chosen per tree from `crate::cpu`), hit children visited nearest first. The common cases take few
 //! branches: one child hit is entered directly, two are ordered by one comparison; only three or
 //! more hits are sorted (on the stack). Leaves travel through the same path as nodes, as child
 //! references (`ChildRef`; the loop layout of Embree's BVH4 traversal, Wald et al., "Embree: A
@@ -13,7 +13,7 @@
 use super::{ChildRef, WideBvh, WideNode};
 use crate::bvh::stack::TraversalStack;
 use crate::bvh::trace::NodeId;
-use crate::bvh::traverse::{test_triangles, test_triangles_grouped};
+use crate::bvh::traverse::{test_triangles, test_triangles_grouped, Groups4, LeafGroups};
 use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
 use crate::cpu::Simd;
 use crate::geometry::slab::{widen, Scalar, Simd4, SlabKernel};
@@ -237,7 +237,8 @@ fn report_stack<S: TraversalStats, const W: usize, const N: usize>(stats: &mut S
 
 impl<const W: usize> WideBvh<W> {
     /// One ray's closest (or, with `ANY`, first) hit with box kernel `kernel`; leaves tested
-    /// four triangles at a time in SIMD when `GROUPED`, one by one otherwise (the scalar path).
+    /// `groups` at a time in SIMD when `GROUPED` (four, or sixteen with AVX-512), one by one
+    /// otherwise (the scalar path).
     #[inline(always)]
     fn trace_with<
         T: TriangleIntersector,
@@ -249,6 +250,7 @@ impl<const W: usize> WideBvh<W> {
     >(
         &self,
         kernel: K,
+        groups: impl LeafGroups,
         ray: &mut Ray,
         stats: &mut S,
     ) -> Option<Hit> {
@@ -258,7 +260,17 @@ impl<const W: usize> WideBvh<W> {
             if GROUPED {
                 // The 8-wide layout's leaves, coordinate by coordinate (`leaves.rs`).
                 let coords = &super::leaves::floats(&self.tris)[9 * first..];
-                test_triangles_grouped::<T, ANY, S>(coords, count, first, ray, stats, &mut prepared, &mut best, ids)
+                test_triangles_grouped::<T, ANY, S, _>(
+                    groups,
+                    coords,
+                    count,
+                    first,
+                    ray,
+                    stats,
+                    &mut prepared,
+                    &mut best,
+                    ids,
+                )
             } else {
                 self.with_leaf(first, count, |tris| {
                     test_triangles::<T, ANY, S>(tris, first, ray, stats, &mut prepared, &mut best, ids)
@@ -277,8 +289,8 @@ impl Accelerator for WideBvh {
         stats: &mut S,
     ) -> Option<Hit> {
         match self.simd {
-            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK, false>(Scalar, ray, stats),
-            Simd::Simd4 | Simd::Avx2 => self.trace_with::<T, ANY, S, _, STACK, false>(Simd4, ray, stats),
+            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK, false>(Scalar, Groups4, ray, stats),
+            _ => self.trace_with::<T, ANY, S, _, STACK, false>(Simd4, Groups4, ray, stats),
         }
     }
 
@@ -307,7 +319,25 @@ impl WideBvh<8> {
         ray: &mut Ray,
         stats: &mut S,
     ) -> Option<Hit> {
-        self.trace_with::<T, ANY, S, _, STACK8, true>(kernel, ray, stats)
+        self.trace_with::<T, ANY, S, _, STACK8, true>(kernel, Groups4, ray, stats)
+    }
+
+    /// The walk compiled for AVX-512F/VL on top of the AVX2 set: the eight boxes tested with mask
+    /// registers and planes picked by offsets (`avx512::slab8`), a leaf's triangles in one pass of up
+    /// to sixteen lanes (`avx512::leaf`). Nothing is fused; results are the other kernels'.
+    ///
+    /// # Safety
+    /// The CPU must have these features: `kernel` proves it.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl,avx2,fma,popcnt,bmi1,bmi2,lzcnt")]
+    unsafe fn trace_avx512<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
+        &self,
+        kernel: crate::geometry::avx512::Avx512,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
+        let groups = crate::bvh::traverse::Groups16(kernel);
+        self.trace_with::<T, ANY, S, _, STACK8, true>(kernel, groups, ray, stats)
     }
 }
 
@@ -321,13 +351,19 @@ impl Accelerator for WideBvh<8> {
     ) -> Option<Hit> {
         match self.simd {
             #[cfg(target_arch = "x86_64")]
+            Simd::Avx512 => match crate::geometry::avx512::Avx512::detect() {
+                // SAFETY: `detect` found AVX-512F/VL and the AVX2 set.
+                Some(k) => unsafe { self.trace_avx512::<T, ANY, S>(k, ray, stats) },
+                None => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, Groups4, ray, stats),
+            },
+            #[cfg(target_arch = "x86_64")]
             Simd::Avx2 => match crate::geometry::slab8::Avx2::detect() {
                 // SAFETY: `detect` found AVX2 and FMA.
                 Some(k) => unsafe { self.trace_avx2::<T, ANY, S>(k, ray, stats) },
-                None => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, ray, stats),
+                None => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, Groups4, ray, stats),
             },
-            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK8, false>(Scalar, ray, stats),
-            _ => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, ray, stats),
+            Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK8, false>(Scalar, Groups4, ray, stats),
+            _ => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, Groups4, ray, stats),
         }
     }
 

@@ -109,6 +109,31 @@ fn packets_find_what_single_rays_find() {
     }
 }
 
+/// The same with each kernel forced on the wide trees (`with_simd`): four-ray groups (`Simd4`,
+/// `Avx2`, `Scalar`) and sixteen-ray groups (`Avx512`, where the CPU has it), every packet size.
+#[test]
+fn packets_with_every_kernel_find_what_single_rays_find() {
+    use crate::cpu::Simd;
+    let mesh = torus_knot(2, 3, 0.3, 256, 16);
+    for layout in [Layout::Wide4, Layout::Wide8] {
+        let built = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::default() });
+        for simd in Simd::ALL.into_iter().filter(|&s| s <= Simd::detected()) {
+            let bvh = match &built {
+                AnyBvh::Wide(w) => AnyBvh::Wide(w.clone().with_simd(simd)),
+                AnyBvh::Wide8(w) => AnyBvh::Wide8(w.clone().with_simd(simd)),
+                AnyBvh::Binary(_) => unreachable!("a wide layout"),
+            };
+            let what = format!("{layout:?} {simd:?}");
+            assert!(agree(&bvh, &primary_blocks(&mesh, 64), PACKET, &what) > 200, "{what}");
+            for size in [1, 3, 5, 17, 33, 63] {
+                agree(&bvh, &primary_blocks(&mesh, 40), size, &what);
+            }
+            assert!(agree(&bvh, &scattered(&mesh, 2048), PACKET, &what) > 0);
+            assert!(agree(&bvh, &axis_aligned(&mesh), PACKET, &what) > 0);
+        }
+    }
+}
+
 /// Rays at the edges of what a ray can be: subnormal and negative-zero direction components,
 /// NaN, intervals starting at -inf or ending at -inf, origins inside the mesh; in packets of every
 /// size, so the padding lanes of the last group repeat such a ray.
@@ -209,7 +234,8 @@ fn the_frustum_rejects_only_boxes_every_ray_misses() {
             .collect();
         let mut traced = rays.clone();
         let mut slot = MaybeUninit::uninit();
-        let frustum = &Packet::<crate::geometry::Watertight>::new_in(&mut slot, &mut traced).frustum;
+        let frustum =
+            &Packet::<crate::geometry::Watertight, Four, GROUPS>::new_in(&mut slot, Four, &mut traced).frustum;
         valid += frustum.is_valid() as usize;
         let t_far = rays.iter().fold(f32::NEG_INFINITY, |m, r| m.max(r.t_max));
         for _ in 0..2 {

@@ -1,0 +1,255 @@
+//! One ray against up to sixteen triangles of a leaf in one pass: the watertight test (Woop,
+//! Benthin & Wald, "Watertight Ray/Triangle Intersection", JCGT 2013) with one lane per triangle,
+//! for the 8-wide layout's leaves stored coordinate by coordinate (`bvh::wide::leaves`). The
+//! arithmetic is `Watertight::intersect`'s in the same order and `triangle4`'s lane by lane (glam's
+//! dot is `(x·x' + y·y') + z·z'`, nothing fused, the double-precision fallback per lane where an edge
+//! function is exactly zero), so lane k is the scalar test of triangle k bit for bit. AVX-512's
+//! masked loads read exactly the leaf's triangles: nothing past its end is touched, so the
+//! four-lane kernel's copy at the array's end is not needed. Up to eight triangles take 256-bit
+//! registers (AVX-512VL), more take 512-bit ones.
+
+use super::{Avx512, Lanes};
+use crate::geometry::shear::WatertightRay;
+use crate::geometry::Ray;
+use std::arch::x86_64::*;
+
+/// The hits of one pass: lane k (triangle k of the group) hit when bit k of `mask` is set, with
+/// its `t` and barycentrics.
+#[derive(Clone, Copy, Debug)]
+pub struct Hits16 {
+    pub mask: u32,
+    pub t: [f32; 16],
+    pub u: [f32; 16],
+    pub v: [f32; 16],
+}
+
+impl Hits16 {
+    pub const NONE: Hits16 = Hits16 { mask: 0, t: [0.0; 16], u: [0.0; 16], v: [0.0; 16] };
+}
+
+/// The watertight test of triangles `16g..16g + 16` (those below `count`) of a leaf stored
+/// coordinate by coordinate (`coords`: the `count` values of v0.x, then of v0.y, …, v2.z) against
+/// one ray prepared as `p`, within `[ray.t_min, ray.t_max)`.
+#[inline(always)]
+pub(crate) fn watertight_leaf16(
+    _: Avx512,
+    p: &WatertightRay,
+    ray: &Ray,
+    coords: &[f32],
+    count: usize,
+    g: usize,
+) -> Hits16 {
+    let n = count.saturating_sub(16 * g).min(16);
+    assert!(coords.len() >= 9 * count, "a leaf's nine coordinates of {count} triangles");
+    if n == 0 {
+        return Hits16::NONE;
+    }
+    let lanes = (1u32 << n) - 1;
+    let base = coords.as_ptr();
+    // SAFETY: the `Avx512` argument proves the CPU has AVX-512F/VL; lane k < n of coordinate j
+    // reads coords[j·count + 16g + k], inside the slice (asserted above); masked-off lanes are not
+    // read.
+    unsafe {
+        let at = |j: usize| base.add(j * count + 16 * g);
+        if n <= 8 {
+            one_ray::<__m256>(p, ray, &at, lanes)
+        } else {
+            one_ray::<__m512>(p, ray, &at, lanes)
+        }
+    }
+}
+
+/// The test in registers of `V::N` lanes; `at(j)` points at coordinate j of the group's first
+/// triangle.
+///
+/// # Safety
+/// The CPU has AVX-512F/VL, and `at(j) + k` is readable for every j < 9 and lane k in `lanes`.
+#[inline(always)]
+unsafe fn one_ray<V: Lanes>(p: &WatertightRay, ray: &Ray, at: &impl Fn(usize) -> *const f32, lanes: u32) -> Hits16 {
+    let o = ray.origin();
+    let vertex = |v: usize| {
+        [
+            V::load(at(3 * v), lanes).sub(V::splat(o.x)),
+            V::load(at(3 * v + 1), lanes).sub(V::splat(o.y)),
+            V::load(at(3 * v + 2), lanes).sub(V::splat(o.z)),
+        ]
+    };
+    let (a, b, c) = (vertex(0), vertex(1), vertex(2));
+    let dot =
+        |v: &[V; 3], r: glam::Vec3| v[0].mul(V::splat(r.x)).add(v[1].mul(V::splat(r.y))).add(v[2].mul(V::splat(r.z)));
+    let (ax, ay) = (dot(&a, p.rx), dot(&a, p.ry));
+    let (bx, by) = (dot(&b, p.rx), dot(&b, p.ry));
+    let (cx, cy) = (dot(&c, p.rx), dot(&c, p.ry));
+    let z = [dot(&a, p.rz), dot(&b, p.rz), dot(&c, p.rz)];
+    edge_test([ax, ay, bx, by, cx, cy], z, V::splat(ray.t_min), V::splat(ray.t_max), lanes)
+}
+
+/// The watertight test's second half in `V::N` lanes, `triangle4::edge_test4` lane for lane: from
+/// the sheared vertices `[ax, ay, bx, by, cx, cy]` and their distances `z`, the edge functions (in
+/// double precision in a lane where one is exactly zero), the inside test and the hit within
+/// `[t_min, t_max)`, for the lanes in `lanes`.
+///
+/// # Safety
+/// The CPU has AVX-512F/VL.
+#[inline(always)]
+pub(super) unsafe fn edge_test<V: Lanes>(xy: [V; 6], z: [V; 3], t_min: V, t_max: V, lanes: u32) -> Hits16 {
+    let [ax, ay, bx, by, cx, cy] = xy;
+    let mut u = cx.mul(by).sub(cy.mul(bx));
+    let mut v = ax.mul(cy).sub(ay.mul(cx));
+    let mut w = bx.mul(ay).sub(by.mul(ax));
+    let zero_v = V::splat(0.0);
+    let zero = (u.cmp::<_CMP_EQ_OQ>(zero_v) | v.cmp::<_CMP_EQ_OQ>(zero_v) | w.cmp::<_CMP_EQ_OQ>(zero_v)) & lanes;
+    if zero != 0 {
+        (u, v, w) = in_double(xy, [u, v, w], zero);
+    }
+    let neg = u.cmp::<_CMP_LT_OQ>(zero_v) | v.cmp::<_CMP_LT_OQ>(zero_v) | w.cmp::<_CMP_LT_OQ>(zero_v);
+    let pos = u.cmp::<_CMP_GT_OQ>(zero_v) | v.cmp::<_CMP_GT_OQ>(zero_v) | w.cmp::<_CMP_GT_OQ>(zero_v);
+    let outside = neg & pos;
+    let det = u.add(v).add(w);
+    let t_scaled = u.mul(z[0]).add(v.mul(z[1])).add(w.mul(z[2]));
+    let inv_det = V::splat(1.0).div(det);
+    let t = t_scaled.mul(inv_det);
+    // `det != 0` true for NaN, as the scalar `det == 0.0` rejects only zero.
+    let inside = det.cmp::<_CMP_NEQ_UQ>(zero_v) & t.cmp::<_CMP_GE_OQ>(t_min) & t.cmp::<_CMP_LT_OQ>(t_max);
+    let mask = inside & !outside & lanes;
+    let mut hits = Hits16 { mask, ..Hits16::NONE };
+    if mask != 0 {
+        t.store(&mut hits.t);
+        v.mul(inv_det).store(&mut hits.u);
+        w.mul(inv_det).store(&mut hits.v);
+    }
+    hits
+}
+
+/// The edge functions of the lanes in `zero` redone in double precision (the paper's fallback,
+/// as the scalar test does it); the other lanes unchanged. Rare: out of line.
+///
+/// # Safety
+/// The CPU has AVX-512F/VL.
+#[inline(never)]
+#[cold]
+#[target_feature(enable = "avx512f,avx512vl")]
+unsafe fn in_double<V: Lanes>(xy: [V; 6], uvw: [V; 3], zero: u32) -> (V, V, V) {
+    let lanes = |v: V| {
+        let mut a = [0f32; 16];
+        v.store(&mut a);
+        a
+    };
+    let [ax, ay, bx, by, cx, cy] = xy.map(lanes);
+    let [mut u, mut v, mut w] = uvw.map(lanes);
+    let mut m = zero;
+    while m != 0 {
+        let k = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let f = |a: &[f32; 16]| a[k] as f64;
+        let (ax, ay, bx, by, cx, cy) = (f(&ax), f(&ay), f(&bx), f(&by), f(&cx), f(&cy));
+        u[k] = (cx * by - cy * bx) as f32;
+        v[k] = (ax * cy - ay * cx) as f32;
+        w[k] = (bx * ay - by * ax) as f32;
+    }
+    let back = |a: &[f32; 16]| V::load(a.as_ptr(), (1u32 << V::N) - 1);
+    (back(&u), back(&v), back(&w))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::triangle::{TriangleIntersector, Watertight};
+    use glam::Vec3;
+    use proptest::prelude::*;
+
+    /// Grid points: shared vertices and edges, axis-parallel rays and exactly-zero edge functions
+    /// (the double-precision fallback) come up often.
+    fn point() -> impl Strategy<Value = Vec3> {
+        [(-4i32..=4), (-4i32..=4), (-4i32..=4)].prop_map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32) * 0.5)
+    }
+
+    /// A leaf of 1 to 20 triangles (more than one pass of sixteen) built from a few shared
+    /// vertices, and a ray aimed at a vertex, an edge or an inner point of one of them from a grid
+    /// point, with an interval that may cut the hits off.
+    fn leaf_case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ray)> {
+        let pool = proptest::collection::vec(point(), 6);
+        let picks = proptest::collection::vec([0usize..6, 0usize..6, 0usize..6], 1..=20);
+        let aim = (0usize..20, 0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..4);
+        (pool, picks, aim).prop_map(|(pool, picks, (target, i, j, k, d, s, interval))| {
+            let tris: Vec<[Vec3; 3]> = picks.iter().map(|p| p.map(|q| pool[q])).collect();
+            let t = &tris[target % tris.len()];
+            let w = (i + j + k).max(1) as f32;
+            let at = (t[0] * i as f32 + t[1] * j as f32 + t[2] * k as f32) / w;
+            let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
+            let mut ray = Ray::new(at - dir * s as f32, dir);
+            match interval {
+                0 => ray.t_max = s as f32, // a hit exactly at t_max is excluded
+                1 => ray.t_min = s as f32 + 0.25,
+                _ => {}
+            }
+            (tris, ray)
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(4000))]
+        /// Lane k of each pass is the scalar test of its triangle, bit for bit; no lane past the
+        /// leaf is set. Also the four-lane default of `intersect_group16_coords` (what the
+        /// Möller–Trumbore test runs) agrees, so the two paths of `Groups16` are checked.
+        #[test]
+        fn a_leaf_in_passes_of_sixteen_is_its_scalar_tests((tris, ray) in leaf_case()) {
+            let Some(k) = Avx512::detect() else { return Ok(()) };
+            let count = tris.len();
+            let coords: Vec<f32> = (0..9).flat_map(|j| tris.iter().map(move |t| t[j / 3][j % 3])).collect();
+            let p = Watertight::prepare(&ray);
+            for g in 0..count.div_ceil(16) {
+                let got = watertight_leaf16(k, &p, &ray, &coords, count, g);
+                let n = (count - 16 * g).min(16);
+                prop_assert_eq!(got.mask >> n, 0, "no lane past the leaf");
+                let four = four_by_four(k, &p, &ray, &coords, count, g);
+                prop_assert_eq!(four.mask, got.mask, "groups of four");
+                for lane in 0..n {
+                    let want = Watertight::intersect(&p, &ray, &tris[16 * g + lane]);
+                    prop_assert_eq!(got.mask & (1 << lane) != 0, want.is_some(), "pass {} lane {}", g, lane);
+                    if let Some(h) = want {
+                        let bits = |x: f32| x.to_bits();
+                        let lanes = |h: &Hits16| (bits(h.t[lane]), bits(h.u[lane]), bits(h.v[lane]));
+                        prop_assert_eq!(lanes(&got), (bits(h.t), bits(h.u), bits(h.v)), "lane {}", lane);
+                        prop_assert_eq!(lanes(&four), lanes(&got), "groups of four, lane {}", lane);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The trait's default: four passes of the four-lane kernel.
+    fn four_by_four(k: Avx512, p: &WatertightRay, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits16 {
+        #[derive(Clone, Copy)]
+        struct Four;
+        impl TriangleIntersector for Four {
+            type Prepared = WatertightRay;
+            fn prepare(ray: &Ray) -> WatertightRay {
+                Watertight::prepare(ray)
+            }
+            fn intersect(p: &WatertightRay, ray: &Ray, tri: &[Vec3; 3]) -> Option<crate::geometry::TriangleHit> {
+                Watertight::intersect(p, ray, tri)
+            }
+            fn intersect_group_coords(p: &WatertightRay, ray: &Ray, c: &[f32], count: usize, g: usize) -> Hits4 {
+                Watertight::intersect_group_coords(p, ray, c, count, g)
+            }
+            type Prepared4 = <Watertight as TriangleIntersector>::Prepared4;
+            fn prepare4(rays: &[Ray], base: usize) -> Self::Prepared4 {
+                Watertight::prepare4(rays, base)
+            }
+            fn intersect4(p: &Self::Prepared4, t0: f32x4, t1: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
+                Watertight::intersect4(p, t0, t1, lanes, tri)
+            }
+            type Prepared16 = <Watertight as TriangleIntersector>::Prepared16;
+            fn prepare16(k: Avx512, rays: &[Ray], base: usize) -> Self::Prepared16 {
+                Watertight::prepare16(k, rays, base)
+            }
+            fn intersect16(k: Avx512, p: &Self::Prepared16, t0: __m512, t1: __m512, l: u32, tri: &[Vec3; 3]) -> Hits16 {
+                Watertight::intersect16(k, p, t0, t1, l, tri)
+            }
+        }
+        use crate::geometry::triangle::Hits4;
+        use wide::f32x4;
+        Four::intersect_group16_coords(k, p, ray, coords, count, g)
+    }
+}

@@ -1,0 +1,145 @@
+//! Tests of `packet.rs`: sixteen-ray groups against the four-lane groups and the scalar tests, on
+//! adversarial rays (box corners, axis-parallel directions with origins on box planes, both zeros).
+
+use super::*;
+use crate::geometry::slab::{widen, OneRay};
+use crate::geometry::slab_packet::RayGroup;
+use crate::geometry::triangle::{TriangleIntersector, Watertight};
+use crate::geometry::Aabb;
+use proptest::prelude::*;
+
+/// Halves on a small grid, and -0: origins on box planes with zero direction components (the
+/// NaN case), rays through corners and edges.
+fn coord() -> impl Strategy<Value = f32> {
+    prop_oneof![(-6i32..6).prop_map(|v| v as f32 * 0.5), Just(-0.0f32)]
+}
+fn point() -> impl Strategy<Value = Vec3> {
+    (coord(), coord(), coord()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+/// Up to 20 rays (so a second group with padding lanes), some with their `t_max` cut short.
+fn rays() -> impl Strategy<Value = Vec<Ray>> {
+    proptest::collection::vec((point(), point(), prop_oneof![Just(f32::INFINITY), 0.0f32..8.0]), 1..=20).prop_map(|v| {
+        v.into_iter()
+            .map(|(o, d, t)| {
+                let mut r = Ray::new(o, d);
+                r.t_max = r.t_max.min(t);
+                r
+            })
+            .collect()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+    /// The box test of a group of sixteen is four groups of four's, lane for lane (padding lanes
+    /// included), and for every real ray the scalar test's verdict; with the planes chosen once
+    /// (`hit_planes`) where every ray shares the signs, the same.
+    #[test]
+    fn sixteen_rays_against_a_box_are_the_scalar_tests(rays in rays(), a in point(), b in point()) {
+        let Some(k) = Avx512::detect() else { return Ok(()) };
+        let (lo, hi) = (a.min(b).to_array(), a.max(b).to_array());
+        for base in (0..rays.len()).step_by(16) {
+            let g = RayGroup16::new(k, &rays, base);
+            let got = g.hit(k, lo, hi);
+            let four = (0..4).fold(0, |m, q| m | RayGroup::new(&rays, base + 4 * q).hit(lo, hi) << (4 * q));
+            prop_assert_eq!(got, four, "sixteen lanes against four groups of four");
+            for lane in 0..(rays.len() - base).min(16) {
+                let r = &rays[base + lane];
+                let (t0, t1) = OneRay::new(r).one_box(&lo, &hi, r.t_min, widen(r.t_max));
+                prop_assert_eq!(got >> lane & 1 == 1, t0 <= t1, "lane {} of {:?}", lane, r);
+            }
+            let neg = |axis: usize| rays[base].inv_dir()[axis] < 0.0;
+            let shared = rays[base..].iter().take(16).all(|r| (0..3).all(|a| (r.inv_dir()[a] < 0.0) == neg(a)));
+            if shared {
+                let pick = |axis: usize, near: bool| if neg(axis) == near { hi[axis] } else { lo[axis] };
+                let near = [pick(0, true), pick(1, true), pick(2, true)];
+                let far = [pick(0, false), pick(1, false), pick(2, false)];
+                prop_assert_eq!(g.hit_planes(k, near, far), got, "planes chosen once");
+            }
+        }
+    }
+
+    /// The frustum of sixteen-ray groups is the four-lane one, field for field.
+    #[test]
+    fn the_frustum_of_sixteen_ray_groups_is_the_four_lane_one(rays in rays()) {
+        let Some(k) = Avx512::detect() else { return Ok(()) };
+        let g16: Vec<RayGroup16> = (0..rays.len()).step_by(16).map(|b| RayGroup16::new(k, &rays, b)).collect();
+        let g4: Vec<RayGroup> = (0..rays.len()).step_by(4).map(|b| RayGroup::new(&rays, b)).collect();
+        prop_assert_eq!(interval16(k, &g16), RayInterval::new(&g4));
+    }
+}
+
+/// Triangles on a small grid and sixteen rays aimed at their vertices, edges and inner points (the
+/// watertight test's exactly-zero edge functions), or anywhere, some with short intervals.
+fn triangle_case() -> impl Strategy<Value = ([Vec3; 3], Vec<Ray>)> {
+    let grid = || [(-4i32..=4), (-4i32..=4), (-4i32..=4)].prop_map(|v| Vec3::from_array(v.map(|x| x as f32 * 0.5)));
+    let aim = (0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..4);
+    ([grid(), grid(), grid()], proptest::collection::vec(aim, 1..=16)).prop_map(|(tri, aims)| {
+        let rays = aims
+            .into_iter()
+            .map(|(i, j, k, d, s, interval)| {
+                let w = (i + j + k).max(1) as f32;
+                let at = (tri[0] * i as f32 + tri[1] * j as f32 + tri[2] * k as f32) / w;
+                let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
+                let mut ray = Ray::new(at - dir * s as f32, dir);
+                match interval {
+                    0 => ray.t_max = s as f32,
+                    1 => ray.t_min = s as f32 + 0.25,
+                    _ => {}
+                }
+                ray
+            })
+            .collect();
+        (tri, rays)
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(4000))]
+    /// Lane k of the sixteen-ray triangle test is `Watertight::intersect` of ray k, bit for bit,
+    /// and no lane outside `lanes` is reported.
+    #[test]
+    fn sixteen_rays_against_a_triangle_are_the_scalar_tests((tri, rays) in triangle_case(), drop in 0u32..16) {
+        let Some(k) = Avx512::detect() else { return Ok(()) };
+        let p = WatertightRay16::new(k, &rays, 0);
+        let g = RayGroup16::new(k, &rays, 0);
+        let lanes = ((1u32 << rays.len()) - 1) & !(1 << drop);
+        let got = p.intersect(k, g.t_min, g.t_max, lanes, &tri);
+        prop_assert_eq!(got.mask & !lanes, 0, "only the lanes asked for");
+        for (lane, ray) in rays.iter().enumerate().filter(|&(l, _)| lanes >> l & 1 == 1) {
+            let want = Watertight::intersect(&Watertight::prepare(ray), ray, &tri);
+            prop_assert_eq!(got.mask >> lane & 1 == 1, want.is_some(), "lane {}: {:?}", lane, ray);
+            if let Some(h) = want {
+                let bits = |x: f32| x.to_bits();
+                prop_assert_eq!((bits(got.t[lane]), bits(got.u[lane]), bits(got.v[lane])), (bits(h.t), bits(h.u), bits(h.v)));
+            }
+        }
+    }
+}
+
+/// Rays lying in a box's face planes (origin on the plane, zero direction component: 0·inf =
+/// NaN): every lane keeps its interval (the NaN rule) and hits, as the scalar test does.
+#[test]
+fn rays_lying_in_box_planes_hit_as_the_scalar_test_says() {
+    let Some(k) = Avx512::detect() else { return };
+    let b = Aabb::new(Vec3::ZERO, Vec3::ONE);
+    let (lo, hi) = (b.min.to_array(), b.max.to_array());
+    let rays: Vec<Ray> = (0..16)
+        .map(|i| {
+            let f = i as f32 / 15.0;
+            match i % 4 {
+                0 => Ray::new(Vec3::new(0.0, f, -1.0), Vec3::Z),
+                1 => Ray::new(Vec3::new(1.0, -1.0, f), Vec3::Y),
+                2 => Ray::new(Vec3::new(-1.0, 1.0, f), Vec3::new(1.0, -0.0, 0.0)),
+                _ => Ray::new(Vec3::new(f, 0.0, 2.0), Vec3::new(0.0, 0.0, -1.0)),
+            }
+        })
+        .collect();
+    let got = RayGroup16::new(k, &rays, 0).hit(k, lo, hi);
+    for (lane, r) in rays.iter().enumerate() {
+        let (t0, t1) = OneRay::new(r).one_box(&lo, &hi, r.t_min, widen(r.t_max));
+        assert_eq!(got >> lane & 1 == 1, t0 <= t1, "lane {lane}: {r:?}");
+        assert!(t0 <= t1, "a ray along a face hits the box: {r:?}");
+    }
+}
