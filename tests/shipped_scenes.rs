@@ -120,18 +120,13 @@ fn every_scene_builds_everywhere_and_hits_what_the_linear_scan_hits() {
             let two = loaded.build(&SceneBuild { bvh: p, top: Some(p) }, &WorkControl::new()).unwrap();
             let (a, b) =
                 (render(&two, &two, &camera, &settings), render(&AnyBvh::build(mesh, &p), mesh, &camera, &settings));
-            let mut differ = 0;
-            for (x, y) in a.full_samples().unwrap().iter().zip(b.full_samples().unwrap()) {
-                if x.is_hit() != y.is_hit() {
-                    differ += 1;
-                } else if x.is_hit() {
-                    assert!((x.t - y.t).abs() <= 1e-4 * y.t, "{n}, {strategy:?}: two levels t {} vs one {}", x.t, y.t);
-                    if x.prim == y.prim {
-                        let (nx, ny) = (x.normal, y.normal);
-                        assert!(nx.dot(ny) > 0.999, "{n}, {strategy:?}: triangle {} shaded {nx} vs {ny}", x.prim);
-                    }
+            let differ = common::hit_differences(&a, &b, |x, y| {
+                assert!((x.t - y.t).abs() <= 1e-4 * y.t, "{n}, {strategy:?}: two levels t {} vs one {}", x.t, y.t);
+                if x.prim == y.prim {
+                    let (nx, ny) = (x.normal, y.normal);
+                    assert!(nx.dot(ny) > 0.999, "{n}, {strategy:?}: triangle {} shaded {nx} vs {ny}", x.prim);
                 }
-            }
+            });
             // Rotated placements round differently in object space: allow a grazing ray in 1000.
             assert!(
                 differ * 1000 <= a.full_samples().unwrap().len(),

@@ -1,9 +1,12 @@
 //! The meshes of the benchmark: two shared scans and two generated scenes.
 
-use bvhscope::mesh::{generate, load_obj, Mesh, MeshGroup};
+use bvhscope::mesh::{generate, Mesh, MeshGroup};
 use bvhscope::random::Rng;
 use glam::Vec3;
-use std::path::Path;
+
+/// The tests' helpers, for the shared meshes (`shared`).
+#[path = "../../core/tests/common/mod.rs"]
+mod common;
 
 /// Append `b` to `a` (positions, triangles, groups).
 pub fn merge(a: &mut Mesh, b: &Mesh, transform: impl Fn(Vec3) -> Vec3) {
@@ -51,17 +54,8 @@ pub fn knot_field() -> Mesh {
     m
 }
 
+/// A mesh of `../shared/models` beside the checkout, as the tests find them: `None` with a
+/// notice when the folder is absent (a failure under CI=true).
 pub fn shared(name: &str) -> Option<Mesh> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
-    if !dir.is_dir() {
-        if std::env::var("CI").is_ok_and(|v| v == "true") {
-            panic!("CI=true but {} is missing", dir.display());
-        }
-        eprintln!("notice: {} not found; skipping {name}", dir.display());
-        return None;
-    }
-    match load_obj(dir.join(name)) {
-        Ok((m, _)) => Some(m),
-        Err(e) => panic!("{e}"),
-    }
+    common::shared_mesh(name)
 }

@@ -110,14 +110,9 @@ fn rotated_and_scaled_instances_agree_with_the_flattened_scene() {
     let p = BuildParams::default();
     let (two, single) = frames(&scene, &camera, &p, &p);
     let n = two.full_samples().unwrap().len();
-    let mut mask_diff = 0;
-    for (a, b) in two.full_samples().unwrap().iter().zip(single.full_samples().unwrap()) {
-        if a.is_hit() != b.is_hit() {
-            mask_diff += 1;
-        } else if a.is_hit() {
-            assert!((a.t - b.t).abs() <= 1e-4 * b.t, "distances agree: {} vs {}", a.t, b.t);
-        }
-    }
+    let mask_diff = common::hit_differences(&two, &single, |a, b| {
+        assert!((a.t - b.t).abs() <= 1e-4 * b.t, "distances agree: {} vs {}", a.t, b.t);
+    });
     assert!(single.full_samples().unwrap().iter().filter(|s| s.is_hit()).count() > n / 10, "the scene fills the view");
     assert!(mask_diff * 1000 <= n, "{mask_diff} of {n} pixels differ in hit or miss");
 }

@@ -205,3 +205,21 @@ pub fn many_placements(dir: &Path, n: usize) -> PathBuf {
     std::fs::write(&path, text).unwrap();
     path
 }
+
+/// Two finished frames of one camera, pixel by pixel: how many pixels one hits and the other
+/// misses; `both(a, b)` is called for every pixel both hit, where a test compares what it found.
+pub fn hit_differences(
+    a: &bvhscope_core::render::Frame,
+    b: &bvhscope_core::render::Frame,
+    mut both: impl FnMut(&bvhscope_core::render::PixelSample, &bvhscope_core::render::PixelSample),
+) -> usize {
+    let mut differ = 0;
+    for (x, y) in a.full_samples().unwrap().iter().zip(b.full_samples().unwrap()) {
+        if x.is_hit() != y.is_hit() {
+            differ += 1;
+        } else if x.is_hit() {
+            both(x, y);
+        }
+    }
+    differ
+}
