@@ -127,10 +127,7 @@ fn binarised(dump: &BvhDump) -> (BvhDump, u32) {
                 if let [one] = part {
                     return *one;
                 }
-                let b = part
-                    .iter()
-                    .filter_map(|&c| out.nodes.get(c as usize))
-                    .fold(Aabb::EMPTY, |b, n| b.union(n.bounds()));
+                let b = Aabb::of(part.iter().filter_map(|&c| out.nodes.get(c as usize)).map(|n| n.bounds()));
                 let (min, max) = (glam::Vec3::from(b.min).to_array(), glam::Vec3::from(b.max).to_array());
                 let node =
                     super::DumpNode { min, max, children: Some(part.to_vec()), first: None, count: None, axis: None };

@@ -206,7 +206,7 @@ impl Cwbvh {
             out.depth = out.depth.max(level);
             let kids = if b[i].is_leaf() { vec![i] } else { collapse(b, i) };
             let boxes: Vec<Aabb> = kids.iter().map(|&k| b[k].bounds()).collect();
-            let node_box = boxes.iter().fold(Aabb::EMPTY, |a, &c| a.union(c));
+            let node_box = Aabb::of(boxes.iter().copied());
             let slots = assign_slots(&node_box, &boxes);
             let (lo, hi) = node_box.planes();
             let mut n = CwbvhNode {
