@@ -3,28 +3,11 @@
 //! selection never outlives the scale or the tree it was made for, and messages never hide a window.
 
 use super::support::*;
-use bvhscope::app::{Action, BvhscopeApp, Film, MessageKind, SceneSource};
+use bvhscope::app::{Action, BvhscopeApp, Film, MessageKind};
 use bvhscope::bvh::SplitStrategy;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn open(h: &mut Harness<'_, BvhscopeApp>, file: &Path) {
-    run_until(h, "the first frame", idle);
-    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, file.to_path_buf()));
-    let f = file.to_path_buf();
-    run_until(h, "the file", move |a| a.scene.source == SceneSource::File(f.clone()) && idle(a));
-}
-
-fn with_strategy(h: &mut Harness<'_, BvhscopeApp>, s: SplitStrategy) {
-    let mut settings = h.state().settings.clone();
-    settings.build.strategy = s;
-    h.state_mut().act(Action::Edit(Box::new(settings)));
-}
+use std::path::PathBuf;
 
 /// A scene's film: the image is its camera's 1200×800, letterboxed, traced with its camera as
 /// written; the statistics panel's per-ray figures are then `bvhscope stats SCENE`'s, exactly.

@@ -86,3 +86,23 @@ pub fn camera_words(c: &bvhscope::render::Camera) -> Vec<String> {
         format!("{}x{}", c.width, c.height),
     ]
 }
+
+/// The checkout (scenes/, assets/).
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Open `file` as File ▸ Open does, once the first frame is done, and wait for its frame.
+pub fn open(h: &mut Harness<'_, BvhscopeApp>, file: &Path) {
+    run_until(h, "the first frame", idle);
+    h.state_mut().act(bvhscope::app::Action::Picked(bvhscope::app::Pick::Open, file.to_path_buf()));
+    let f = file.to_path_buf();
+    run_until(h, "the file", move |a| a.scene.source == bvhscope::app::SceneSource::File(f.clone()) && idle(a));
+}
+
+/// Switch the build panel's strategy to `s`.
+pub fn with_strategy(h: &mut Harness<'_, BvhscopeApp>, s: bvhscope::bvh::SplitStrategy) {
+    let mut settings = h.state().settings.clone();
+    settings.build.strategy = s;
+    h.state_mut().act(bvhscope::app::Action::Edit(Box::new(settings)));
+}

@@ -4,27 +4,8 @@
 mod support;
 use support::*;
 
-use bvhscope::app::{Action, BvhscopeApp, SceneSource};
+use bvhscope::app::Action;
 use bvhscope::bvh::SplitStrategy;
-use egui_kittest::Harness;
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn open(h: &mut Harness<'_, BvhscopeApp>, file: &Path) {
-    run_until(h, "the first frame", idle);
-    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, file.to_path_buf()));
-    let f = file.to_path_buf();
-    run_until(h, "the file", move |a| a.scene.source == SceneSource::File(f.clone()) && idle(a));
-}
-
-fn with_strategy(h: &mut Harness<'_, BvhscopeApp>, s: SplitStrategy) {
-    let mut settings = h.state().settings.clone();
-    settings.build.strategy = s;
-    h.state_mut().act(Action::Edit(Box::new(settings)));
-}
 
 /// A build started while the previous frame still renders waits for the render to stop: its time
 /// is the build's alone, as `stats` measures it (it used to be several times more, and the

@@ -50,41 +50,19 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
 /// (`/dev/zero`, `/dev/urandom`) or a socket would be read forever, or block until another
 /// program writes.
 pub fn read_user_file(path: &Path) -> Result<Vec<u8>, MeshError> {
-    let io = |e: std::io::Error| match e.kind() {
+    use crate::files::FileError;
+    let metadata = crate::files::regular(path).map_err(|e| match e {
+        FileError::NotFound { path } => MeshError::NotFound { path },
+        FileError::IsDirectory { path } => MeshError::IsDirectory { path },
+        FileError::NotRegular { path, what } => MeshError::NotRegular { path, what },
+        FileError::Read { path, source } => MeshError::Io { path, source },
+        // `regular` reports only the four above.
+        e => MeshError::Io { path: path.into(), source: std::io::Error::other(e.to_string()) },
+    })?;
+    read_file(path, metadata.len() as usize).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => MeshError::NotFound { path: path.into() },
         _ => MeshError::Io { path: path.into(), source: e },
-    };
-    let metadata = std::fs::metadata(path).map_err(io)?;
-    let kind = metadata.file_type();
-    if kind.is_dir() {
-        return Err(MeshError::IsDirectory { path: path.into() });
-    }
-    if !kind.is_file() {
-        return Err(MeshError::NotRegular { path: path.into(), what: special_file_kind(&kind) });
-    }
-    read_file(path, metadata.len() as usize).map_err(io)
-}
-
-/// What a file that is neither a regular file nor a directory is, in words.
-fn special_file_kind(kind: &std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if kind.is_fifo() {
-            return "a FIFO (named pipe)";
-        }
-        if kind.is_char_device() {
-            return "a character device";
-        }
-        if kind.is_block_device() {
-            return "a block device";
-        }
-        if kind.is_socket() {
-            return "a socket";
-        }
-    }
-    let _ = kind;
-    "a special file"
+    })
 }
 
 /// The file's bytes as text. A UTF-8 byte-order mark (Windows exporters write one) is dropped.
