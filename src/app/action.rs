@@ -44,6 +44,15 @@ pub enum Action {
     ShowImported(bool),
     /// The red mask over the pixels whose hit through the imported tree is wrong.
     WrongMask(bool),
+    /// File ▸ Open grade report…: a class's grade.json (`bvhscope grade`), by the dialog, a typed
+    /// path, or a file (or report folder) dropped; its students listed in the Grade report window.
+    OpenGradeReport,
+    OpenGradeReportPath,
+    OpenGradeReportFile(PathBuf),
+    /// The Grade report window.
+    ShowGrade(bool),
+    /// Student `i` of the report: their tree against SAH binned, or why there is none to show.
+    ChooseStudent(usize),
     /// Select a node or a triangle as the dump names them (a finding's).
     SelectDumpNode(u32),
     SelectTriangle(u32),
@@ -192,6 +201,13 @@ impl BvhscopeApp {
             A::UseImported(on) => self.import.on = on && self.import.traced(self.scene_id).is_some(),
             A::ShowImported(open) => self.import.window = open,
             A::WrongMask(on) => self.import.mask = on,
+            A::OpenGradeReport => self.jobs.pick_file(Pick::OpenGradeReport, ""),
+            A::OpenGradeReportPath => {
+                self.path_window = Some(PathWindow::new(Pick::OpenGradeReport, String::new(), None))
+            }
+            A::OpenGradeReportFile(path) => self.jobs.grade_report(path),
+            A::ShowGrade(open) => self.grade.window = open,
+            A::ChooseStudent(i) => self.choose_student(i),
             A::SelectDumpNode(d) => self.select_dump_node(d),
             A::SelectTriangle(t) => self.select_triangle(t),
             A::Picked(pick, path) => {

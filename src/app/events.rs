@@ -20,8 +20,13 @@ impl BvhscopeApp {
                 if let Some(dump) = self.pending_import.take() {
                     self.import_file(dump);
                 }
+                self.grade_scene_loaded();
             }
-            JobEvent::Loaded(Err(e)) => self.message(MessageKind::Error, e),
+            JobEvent::Loaded(Err(e)) => {
+                self.grade_load_failed(&e);
+                self.message(MessageKind::Error, e);
+            }
+            JobEvent::GradeReport(read) => self.report_read(read),
             JobEvent::Failed(e) => self.message(MessageKind::Error, e),
             JobEvent::Speedup(t) => self.speedup = Some(*t),
             JobEvent::Filmed(Ok(saved)) => self.message(MessageKind::Info, saved),
@@ -55,7 +60,10 @@ impl BvhscopeApp {
             {
                 self.set_built(bvh)
             }
-            JobEvent::Imported(Err(e)) => self.message(MessageKind::Error, e),
+            JobEvent::Imported(Err(e)) => {
+                self.grade_imported(None, Err(e.clone()));
+                self.message(MessageKind::Error, e);
+            }
             JobEvent::Imported(Ok(tree)) if tree.scene_id == self.scene_id => {
                 let (d, w) = (tree.defects(), tree.findings.len() - tree.defects());
                 let kind = if d > 0 { MessageKind::Warning } else { MessageKind::Info };
@@ -67,7 +75,10 @@ impl BvhscopeApp {
                 self.import.on = tree.bvh.is_ok();
                 self.import.window = true;
                 self.import.wrong = None;
+                let traced = tree.bvh.as_ref().map(|_| ()).map_err(|why| format!("not traced: {why}"));
+                let path = tree.path.clone();
                 self.import.tree = Some(*tree);
+                self.grade_imported(Some(&path), traced);
             }
             JobEvent::Imported(_) => {}
             JobEvent::Wrong(w) => self.import.wrong = Some(w),
@@ -104,6 +115,10 @@ impl BvhscopeApp {
             Pick::SaveCounts => export::save_counts(self, &path),
             Pick::OpenBvh => {
                 self.import_file(path);
+                return;
+            }
+            Pick::OpenGradeReport => {
+                self.jobs.grade_report(path);
                 return;
             }
             Pick::SaveBvh => export::save_bvh(self, &path),
@@ -174,8 +189,17 @@ impl BvhscopeApp {
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
         });
-        // A dump dropped is imported for the current mesh; anything else is opened.
-        let open = |p: PathBuf| if BvhDump::sniff(&p) { Action::ImportFile(p) } else { Action::OpenFile(p) };
+        // A grade report (its grade.json or its folder) is listed, a dump is imported for the
+        // current mesh, anything else is opened.
+        let open = |p: PathBuf| {
+            if crate::explain::grade::is_report(&p) {
+                Action::OpenGradeReportFile(p)
+            } else if BvhDump::sniff(&p) {
+                Action::ImportFile(p)
+            } else {
+                Action::OpenFile(p)
+            }
+        };
         actions.extend(dropped.into_iter().take(1).map(open));
         actions.extend(shortcuts::pressed(ctx));
         // Info messages fade out; errors stay until dismissed.

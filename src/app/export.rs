@@ -30,7 +30,7 @@ pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
 pub fn check_output(app: &BvhscopeApp, pick: Pick, path: &Path) -> Result<(), String> {
     use crate::files::{CSV, JSON, PNG};
     let kind = match pick {
-        Pick::Open | Pick::OpenBvh => return Ok(()),
+        Pick::Open | Pick::OpenBvh | Pick::OpenGradeReport => return Ok(()),
         Pick::SavePng => PNG,
         Pick::SaveStatsCsv | Pick::SaveCounts => CSV,
         Pick::SaveStatsJson | Pick::SaveScene => JSON,

@@ -11,6 +11,7 @@ mod explain_overlay;
 mod export;
 mod figures;
 pub mod gpu;
+mod grade_view;
 mod import_view;
 mod jobs;
 mod node_view;
@@ -30,6 +31,7 @@ pub use figures::{MeasuredRays, Message, MessageKind, PathWindow, Shown, Strateg
 pub use crate::scene::{Scene, SceneSource};
 pub use action::{Action, Actions};
 pub use compare_view::{CompareMode, CompareView};
+pub use grade_view::GradeView;
 pub use import_view::{ImportView, ImportedTree};
 pub use jobs::Pick;
 pub use node_view::{Metric, NodeView, Step as NodeStep};
@@ -42,7 +44,7 @@ pub use settings::{BoxLevel, Film, Settings};
 
 use crate::bvh::{SceneBuild, SceneBvh, TraceOptions, TreeStats};
 use crate::dump::BvhDump;
-use crate::render::{Camera, Frame, Legend, RaySummary, UpAxis, View};
+use crate::render::{Camera, Frame, Legend, RaySummary, View};
 use crate::scene::SceneBuildError;
 pub use jobs::Timed;
 use jobs::{JobEvent, Jobs, PassOutput, ViewStyle};
@@ -108,6 +110,8 @@ pub struct BvhscopeApp {
     pub compare: CompareView,
     /// Bring your own BVH: the imported dump, its findings, the wrong pixels.
     pub import: ImportView,
+    /// A class's grade report: its students, the one chosen, how far showing them has got.
+    pub grade: GradeView,
     /// The current BVH timed against the linear scan (the statistics panel, on demand).
     pub speedup: Option<jobs::Timed>,
     /// The rank of the last hottest pixel pinned (0: the hottest), for "Next".
@@ -168,15 +172,6 @@ struct BoxCache {
     boxes: Arc<Vec<OverlayBox>>,
 }
 
-/// How a scene file's camera orbits: about the axis its up vector is nearest to (Y or Z).
-fn up_axis_of(c: &Camera) -> UpAxis {
-    if c.up.z.abs() > c.up.y.abs() && c.up.z.abs() >= c.up.x.abs() {
-        UpAxis::Z
-    } else {
-        UpAxis::Y
-    }
-}
-
 impl BvhscopeApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
         let settings: Settings = cc.storage.and_then(|s| eframe::get_value(s, eframe::APP_KEY)).unwrap_or_default();
@@ -203,6 +198,7 @@ impl BvhscopeApp {
             replay: ReplayView::default(),
             compare: CompareView::default(),
             import: ImportView { mask: true, ..Default::default() },
+            grade: GradeView::default(),
             speedup: None,
             hottest: None,
             pending_import: options.bvh.clone(),
@@ -246,7 +242,7 @@ impl BvhscopeApp {
         // with; two levels are the start only where a mesh is placed more than once (the
         // Moer-lite lab scene places its monkey once: one level, as the handout builds it).
         if let Some(c) = &scene.camera {
-            self.settings.up_axis = up_axis_of(c);
+            self.settings.up_axis = orbit::up_axis_of(c);
         }
         self.orbit = match &scene.camera {
             Some(c) => OrbitCamera::exactly(c, self.settings.up_axis),

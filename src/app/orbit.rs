@@ -158,3 +158,13 @@ mod tests {
         o.camera(1600, 1000).validate().unwrap();
     }
 }
+
+/// How a given camera (a scene file's, a grade report's) orbits: about the axis its up vector is
+/// nearest to (Y or Z).
+pub fn up_axis_of(c: &Camera) -> UpAxis {
+    if c.up.z.abs() > c.up.y.abs() && c.up.z.abs() >= c.up.x.abs() {
+        UpAxis::Z
+    } else {
+        UpAxis::Y
+    }
+}

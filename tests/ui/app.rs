@@ -10,6 +10,7 @@ use support::*;
 // two strategies side by side): the same binary, another file.
 mod app_explain;
 mod app_gpu;
+mod app_grade;
 mod app_look;
 mod app_replay;
 mod app_scenes;

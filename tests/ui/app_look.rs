@@ -77,3 +77,22 @@ fn look_ray_window() {
     h.state_mut().act(Action::RayStep(n.saturating_sub(1)));
     save(&mut h, "app-ray-trace");
 }
+
+/// The Grade report window over a class of three on the torus, ada chosen: her midpoint tree (A)
+/// against SAH binned (B) on the report's camera, nodes visited per ray on one scale, with the
+/// Imported BVH and Compare windows.
+#[test]
+#[ignore]
+fn look_grade_report() {
+    let report = super::app_grade::graded_class("look");
+    let mut h = looking();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::OpenGradeReportFile(report));
+    run_until(&mut h, "the report", |a| a.grade.report.is_some());
+    h.state_mut().act(Action::View(2));
+    h.state_mut().act(Action::ChooseStudent(0));
+    run_until(&mut h, "ada against SAH binned", |a| {
+        super::app_grade::student_shown(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some())
+    });
+    save(&mut h, "app-grade-report");
+}

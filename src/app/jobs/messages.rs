@@ -92,6 +92,8 @@ pub enum Pick {
     SaveBvh,
     /// Where to write the build replay's animation (.gif or .png).
     SaveAnimation,
+    /// A class's grade report (`bvhscope grade`'s grade.json) to list.
+    OpenGradeReport,
 }
 
 pub enum JobEvent {
@@ -115,6 +117,8 @@ pub enum JobEvent {
     Imported(Result<Box<ImportedTree>, String>),
     /// A frame's pixels whose hit through the imported tree is wrong.
     Wrong(WrongPixels),
+    /// A grade report read, its files looked for, or why it cannot be read.
+    GradeReport(Result<Box<crate::explain::grade::GradeReport>, String>),
     Picked {
         pick: Pick,
         path: Option<PathBuf>,

@@ -49,6 +49,8 @@ pub struct Jobs {
     pub speedup: Option<Running>,
     /// Writing the build replay's animation (the Replay window's export).
     pub film: Option<Running>,
+    /// Reading a grade report.
+    pub grade: Option<Running>,
     /// What the last compare job was asked for.
     pub last_compare: Option<(SceneBuild, u64, Camera, TraceOptions)>,
     pub picking: Option<Pick>,
@@ -101,6 +103,7 @@ impl Jobs {
             wrong: None,
             speedup: None,
             film: None,
+            grade: None,
             last_compare: None,
             picking: None,
             last_render: None,
@@ -181,6 +184,7 @@ impl Jobs {
                     &mut self.wrong,
                     &mut self.speedup,
                     &mut self.film,
+                    &mut self.grade,
                 ] {
                     if slot.as_ref().is_some_and(|r| r.id == id) {
                         *slot = None;
@@ -210,6 +214,7 @@ impl Jobs {
                 JobEvent::Wrong(_) if current(&self.wrong) => self.wrong = None,
                 JobEvent::Speedup(_) if current(&self.speedup) => self.speedup = None,
                 JobEvent::Filmed(_) if current(&self.film) => self.film = None,
+                JobEvent::GradeReport(_) if current(&self.grade) => self.grade = None,
                 JobEvent::Inspected { .. } if self.inspect.as_ref().is_some_and(|(r, _)| r.id == id) => {
                     self.inspect = None
                 }

@@ -186,6 +186,18 @@ impl Jobs {
         self.import = Some(job);
     }
 
+    /// Read the grade report at `path` (its grade.json, or its folder), its mesh and dumps looked
+    /// for (`explain::grade::GradeReport::read`); a newer report replaces one being read.
+    pub fn grade_report(&mut self, path: PathBuf) {
+        let job = self.start(format!("Reading {}", path.display()));
+        let send = self.sender(job.id);
+        self.spawn(&job, move || {
+            let read = crate::explain::grade::GradeReport::read(&path).map(Box::new).map_err(|e| e.to_string());
+            send(JobEvent::GradeReport(read));
+        });
+        self.grade = Some(job);
+    }
+
     /// Time `bvh` (a single BVH) against the linear scan on `camera`'s frame, single rays on one
     /// thread (`explain::timing`, as `compare`'s trace column); a running timing is cancelled.
     pub fn speedup(&mut self, bvh: Arc<SceneBvh>, camera: Camera, trace: TraceOptions) {
@@ -301,6 +313,7 @@ impl Jobs {
                     Pick::SaveStatsJson => dialog.add_filter("JSON", &["json"]).set_file_name(&name).save_file().await,
                     Pick::SaveCounts => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
                     Pick::OpenBvh => dialog.add_filter("bvhscope-bvh dumps", &["json", "gz", "txt"]).pick_file().await,
+                    Pick::OpenGradeReport => dialog.add_filter("grade report", &["json"]).pick_file().await,
                     Pick::SaveAnimation => {
                         let filters = dialog.add_filter("GIF", &["gif"]).add_filter("animated PNG", &["png"]);
                         filters.set_file_name(&name).save_file().await

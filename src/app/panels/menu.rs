@@ -46,6 +46,16 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 out.push(Action::OpenBvhPath);
             }
             if ui
+                .button("Open grade report…")
+                .on_hover_text("A class's report from bvhscope grade (its grade.json): the students listed; choosing one shows their BVH against SAH binned")
+                .clicked()
+            {
+                out.push(Action::OpenGradeReport);
+            }
+            if ui.button("Open grade report path…").on_hover_text("Type the path of grade.json or its folder").clicked() {
+                out.push(Action::OpenGradeReportPath);
+            }
+            if ui
                 .button("Export BVH…")
                 .on_hover_text("The current tree in the bvhscope-bvh format (JSON; the text form when the name ends in .txt), as bvhscope export-bvh writes it")
                 .clicked()
@@ -110,6 +120,14 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 .clicked()
             {
                 out.push(Action::ShowImported(true));
+            }
+            if ui
+                .add_enabled(app.grade.report.is_some(), egui::Button::new("Grade report…"))
+                .on_hover_text("The class of the grade report opened")
+                .on_disabled_hover_text("No grade report is open: File ▸ Open grade report…")
+                .clicked()
+            {
+                out.push(Action::ShowGrade(true));
             }
             if ui.button("Compare side by side…").on_hover_text("B, another strategy's build, next to A on the same camera and scale").clicked() {
                 out.push(Action::Compare(true));

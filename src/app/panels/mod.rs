@@ -2,6 +2,7 @@
 
 pub mod build;
 pub mod compare;
+pub mod grade;
 pub mod imported;
 pub mod menu;
 pub mod node;
@@ -66,4 +67,5 @@ pub fn show_all(app: &mut super::BvhscopeApp, ui: &mut egui::Ui, out: &mut super
     replay::show(app, &ctx, out);
     compare::show(app, &ctx, out);
     imported::show(app, &ctx, out);
+    grade::show(app, &ctx, out);
 }

@@ -27,9 +27,10 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
             None => ui.label("no full frame yet"),
         };
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-            for job in [&app.jobs.render, &app.jobs.build, &app.jobs.load, &app.jobs.import, &app.jobs.film]
-                .into_iter()
-                .flatten()
+            for job in
+                [&app.jobs.render, &app.jobs.build, &app.jobs.load, &app.jobs.import, &app.jobs.film, &app.jobs.grade]
+                    .into_iter()
+                    .flatten()
             {
                 let fraction = job.control.fraction();
                 if job.control.total() > 0 {

@@ -40,6 +40,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         Pick::OpenBvh => "Import a BVH dump for this mesh",
         Pick::SaveBvh => "Export the BVH as a dump",
         Pick::SaveAnimation => "Export the replay as an animation (.gif or .png)",
+        Pick::OpenGradeReport => "Open a grade report (its grade.json or its folder)",
     };
     let mut keep = true;
     let mut chosen = None;
@@ -61,7 +62,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         }
         ui.horizontal(|ui| {
             let verb = match window.pick {
-                Pick::Open => "Open",
+                Pick::Open | Pick::OpenGradeReport => "Open",
                 Pick::OpenBvh => "Import",
                 _ => "Save",
             };
