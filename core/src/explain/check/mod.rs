@@ -18,6 +18,8 @@ mod rays;
 mod structure;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_adversarial;
 
 pub use rays::{check_rays, wrong_rays, RaySet, Reference, WrongRay, WrongRays, LINEAR_REFERENCE_MAX, MAX_RAYS};
 
