@@ -57,7 +57,8 @@ fn check_ray(mesh: &Mesh, bvhs: &[AnyBvh], linear: &LinearScan, ray: Ray) {
                     if e.prim != g.prim {
                         // Allowed only when the two triangles are hit at the same distance.
                         let tri = mesh.triangle(g.prim);
-                        let h = bvhscope_core::geometry::intersect_triangle(opts.test, &ray, &tri).expect("BVH prim is hit");
+                        let h = bvhscope_core::geometry::intersect_triangle(opts.test, &ray, &tri)
+                            .expect("BVH prim is hit");
                         assert_eq!(h.t, e.t, "different primitive at a different t: {what}");
                     }
                     assert_eq!(r.t_max, g.t, "ray t_max updated to the hit: {what}");

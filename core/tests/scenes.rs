@@ -215,8 +215,13 @@ fn a_scene_of_many_placements_costs_memory_per_placement_and_flattens_only_withi
     }
     // It traces and shades: the ray down onto the first torus's ring hits it.
     let mut ray = bvhscope_core::geometry::Ray::new(Vec3::new(1.0, 5.0, 0.0), -Vec3::Y);
-    let hit = bvhscope_core::bvh::Accelerator::closest_hit(&two, &mut ray, Default::default(), &mut bvhscope_core::bvh::NoStats)
-        .expect("hits the torus");
+    let hit = bvhscope_core::bvh::Accelerator::closest_hit(
+        &two,
+        &mut ray,
+        Default::default(),
+        &mut bvhscope_core::bvh::NoStats,
+    )
+    .expect("hits the torus");
     assert!((hit.t - 4.7).abs() < 0.01, "t = {}", hit.t);
     let n = bvhscope_core::mesh::Surface::shading_normal(&two, &ray, hit.prim, hit.triangle_hit());
     assert!(n.y > 0.9, "the top of the ring faces up: {n}");

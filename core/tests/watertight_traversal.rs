@@ -7,7 +7,9 @@
 
 mod common;
 
-use bvhscope_core::bvh::{Accelerator, AnyBvh, BuildParams, Hit, Layout, LinearScan, NoStats, SplitStrategy, TraceOptions};
+use bvhscope_core::bvh::{
+    Accelerator, AnyBvh, BuildParams, Hit, Layout, LinearScan, NoStats, SplitStrategy, TraceOptions,
+};
 use bvhscope_core::bvh::{TraversalOrder, TreeView};
 use bvhscope_core::geometry::{Ray, TriangleTest};
 use bvhscope_core::mesh::Mesh;

@@ -139,7 +139,6 @@ pub fn camera_rays(cam: &Camera) -> Vec<Ray> {
     (0..cam.height).flat_map(|y| (0..cam.width).map(move |x| g.pixel_ray(x, y))).collect()
 }
 
-
 /// `x` moved by `k` units in the last place.
 fn nudge(x: f32, k: i32) -> f32 {
     let mut y = x;
