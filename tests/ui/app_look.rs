@@ -4,9 +4,9 @@
 //! --test-threads 1` writes them into DIR, to be looked at and copied to assets/screenshots/.
 
 use super::support::*;
-use bvhscope::app::{Action, AppOptions, BvhscopeApp, SceneSource};
+use bvhscope::app::{Action, AppOptions, BvhscopeApp};
 use egui_kittest::Harness;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn out_dir() -> PathBuf {
     let dir =
@@ -31,17 +31,6 @@ fn save(h: &mut Harness<'_, BvhscopeApp>, name: &str) {
     let path = out_dir().join(format!("{name}.png"));
     img.save(&path).unwrap();
     eprintln!("wrote {}", path.display());
-}
-
-fn open(h: &mut Harness<'_, BvhscopeApp>, file: &Path) {
-    run_until(h, "the first frame", idle);
-    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, file.to_path_buf()));
-    let f = file.to_path_buf();
-    run_until(h, "the file", move |a| a.scene.source == SceneSource::File(f.clone()) && idle(a));
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
 /// The Node window on the monkey's root: the three axes' curves, the legend beside them, the cost
