@@ -268,6 +268,16 @@ impl LeafGroups for Groups16 {
         count: usize,
         g: usize,
     ) -> crate::geometry::avx512::Hits16 {
+        if count <= 4 {
+            // A leaf of up to four: the four-lane pass, inlined into the walk, costs no more than
+            // a masked AVX-512 one, and that one is a call (`watertight_leaf16`).
+            let h = T::intersect_group_coords(p, ray, coords, count, 0);
+            let mut hits = crate::geometry::avx512::Hits16 { mask: h.mask, ..crate::geometry::avx512::Hits16::NONE };
+            hits.t[..4].copy_from_slice(&h.t);
+            hits.u[..4].copy_from_slice(&h.u);
+            hits.v[..4].copy_from_slice(&h.v);
+            return hits;
+        }
         T::intersect_group16_coords(self.0, p, ray, coords, count, g)
     }
     #[inline(always)]

@@ -205,7 +205,8 @@ impl TriangleIntersector for Watertight {
         count: usize,
         g: usize,
     ) -> Hits16 {
-        super::avx512::watertight_leaf16(k, p, ray, coords, count, g)
+        // SAFETY: `k` proves the CPU has AVX-512F/VL.
+        unsafe { super::avx512::watertight_leaf16(k, p, ray, coords, count, g) }
     }
 
     type Prepared4 = WatertightRay4;
@@ -251,7 +252,8 @@ impl TriangleIntersector for Watertight {
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn prepare16(k: Avx512, rays: &[Ray], base: usize) -> WatertightRay16 {
-        WatertightRay16::new(k, rays, base)
+        // SAFETY: `k` proves the CPU has AVX-512F/VL.
+        unsafe { WatertightRay16::new(k, rays, base) }
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -264,7 +266,8 @@ impl TriangleIntersector for Watertight {
         lanes: u32,
         tri: &[Vec3; 3],
     ) -> Hits16 {
-        p.intersect(k, t_min, t_max, lanes, tri)
+        // SAFETY: `k` proves the CPU has AVX-512F/VL.
+        unsafe { p.intersect(k, t_min, t_max, lanes, tri) }
     }
 }
 

@@ -39,6 +39,56 @@ pub(crate) trait PacketLanes<T: TriangleIntersector>: Copy {
     fn mask(h: &Self::Hits) -> u32;
     /// Lane k's hit (meaningful where its bit of the mask is set).
     fn lane(h: &Self::Hits, k: usize) -> TriangleHit;
+    /// A leaf for group `g` (rays `base..base + N` of `rays`): `leaf_loop`.
+    #[allow(clippy::too_many_arguments)]
+    fn leaf(
+        self,
+        p: &Self::Prepared,
+        g: &mut Self::Group,
+        lanes: u32,
+        tris: &[[Vec3; 3]],
+        rays: &mut [Ray],
+        base: usize,
+        record: impl FnMut(usize, usize, TriangleHit),
+    ) -> bool {
+        leaf_loop::<T, Self>(self, p, g, lanes, tris, rays, base, record)
+    }
+}
+
+/// Each triangle of `tris` in order against the rays of group `g` in `lanes`: a ray that hits
+/// takes the hit's distance as its `t_max` and `record(ray in the group, triangle, hit)` is told;
+/// after a triangle that hit, the group takes its rays' new `t_max` before the next one is tested.
+/// True when some ray found a nearer hit.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn leaf_loop<T: TriangleIntersector, K: PacketLanes<T>>(
+    kernel: K,
+    p: &K::Prepared,
+    g: &mut K::Group,
+    lanes: u32,
+    tris: &[[Vec3; 3]],
+    rays: &mut [Ray],
+    base: usize,
+    mut record: impl FnMut(usize, usize, TriangleHit),
+) -> bool {
+    let mut found = false;
+    for (i, tri) in tris.iter().enumerate() {
+        let hits = kernel.intersect(p, g, lanes, tri);
+        let mut m = K::mask(&hits);
+        if m == 0 {
+            continue;
+        }
+        while m != 0 {
+            let lane = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let h = K::lane(&hits, lane);
+            rays[base + lane].t_max = h.t;
+            record(lane, i, h);
+        }
+        kernel.refresh(g, rays, base);
+        found = true;
+    }
+    found
 }
 
 /// Groups of four rays (`wide::f32x4`: SSE on x86-64, NEON on aarch64).
@@ -119,6 +169,8 @@ mod sixteen {
     #[derive(Clone, Copy, Debug)]
     pub(crate) struct Sixteen(pub Avx512);
 
+    // SAFETY (every `unsafe` below): the kernels are compiled for AVX-512 (`#[target_feature]`),
+    // and `self.0` proves the CPU has it.
     impl<T: TriangleIntersector> PacketLanes<T> for Sixteen {
         const N: usize = 16;
         type Group = RayGroup16;
@@ -127,19 +179,19 @@ mod sixteen {
 
         #[inline(always)]
         fn group(self, rays: &[Ray], base: usize) -> RayGroup16 {
-            RayGroup16::new(self.0, rays, base)
+            unsafe { RayGroup16::new(self.0, rays, base) }
         }
         #[inline(always)]
         fn hit(self, g: &RayGroup16, lo: [f32; 3], hi: [f32; 3]) -> u32 {
-            g.hit(self.0, lo, hi)
+            unsafe { g.hit(self.0, lo, hi) }
         }
         #[inline(always)]
         fn hit_planes(self, g: &RayGroup16, near: [f32; 3], far: [f32; 3]) -> u32 {
-            g.hit_planes(self.0, near, far)
+            unsafe { g.hit_planes(self.0, near, far) }
         }
         #[inline(always)]
         fn refresh(self, g: &mut RayGroup16, rays: &[Ray], base: usize) {
-            g.refresh(self.0, rays, base);
+            unsafe { g.refresh(self.0, rays, base) };
         }
         #[inline(always)]
         fn signs(self, groups: &[RayGroup16]) -> (bool, [bool; 3]) {
@@ -154,11 +206,11 @@ mod sixteen {
         }
         #[inline(always)]
         fn t_far(self, groups: &[RayGroup16]) -> f32 {
-            groups.iter().map(|g| g.t_far(self.0)).fold(f32::NEG_INFINITY, f32::max)
+            groups.iter().map(|g| unsafe { g.t_far(self.0) }).fold(f32::NEG_INFINITY, f32::max)
         }
         #[inline(always)]
         fn frustum(self, groups: &[RayGroup16]) -> RayInterval {
-            interval16(self.0, groups)
+            unsafe { interval16(self.0, groups) }
         }
         #[inline(always)]
         fn prepare(self, rays: &[Ray], base: usize) -> T::Prepared16 {
@@ -176,5 +228,39 @@ mod sixteen {
         fn lane(h: &Hits16, k: usize) -> TriangleHit {
             TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] }
         }
+        #[inline(always)]
+        fn leaf(
+            self,
+            p: &T::Prepared16,
+            g: &mut RayGroup16,
+            lanes: u32,
+            tris: &[[Vec3; 3]],
+            rays: &mut [Ray],
+            base: usize,
+            record: impl FnMut(usize, usize, TriangleHit),
+        ) -> bool {
+            unsafe { leaf16::<T, _>(self, p, g, lanes, tris, rays, base, record) }
+        }
+    }
+
+    /// `leaf_loop` compiled for AVX-512, so that the triangle test inlines into the loop over the
+    /// leaf's triangles (the packet walk calls it from a closure, which has no target features).
+    ///
+    /// # Safety
+    /// The CPU has AVX-512F/VL (`k.0` proves it).
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn leaf16<T: TriangleIntersector, F: FnMut(usize, usize, TriangleHit)>(
+        k: Sixteen,
+        p: &T::Prepared16,
+        g: &mut RayGroup16,
+        lanes: u32,
+        tris: &[[Vec3; 3]],
+        rays: &mut [Ray],
+        base: usize,
+        record: F,
+    ) -> bool {
+        leaf_loop::<T, Sixteen>(k, p, g, lanes, tris, rays, base, record)
     }
 }

@@ -123,8 +123,7 @@ impl<'r, T: TriangleIntersector, K: PacketLanes<T>, const G: usize> Packet<'r, T
     }
 
     /// Test triangles `tris` (the first at `first` in leaf order) against the rays of group `g`
-    /// in `mask`; true when one of them found a nearer hit. After a triangle that hit, the group
-    /// takes its rays' new `t_max` before the next one is tested.
+    /// in `mask` (`PacketLanes::leaf`); true when one of them found a nearer hit.
     fn leaf(&mut self, g: usize, mask: u32, tris: &[[glam::Vec3; 3]], first: usize) -> bool {
         let (n, kernel) = (K::N, self.kernel);
         // Only the lanes of real rays (the last group may have padding lanes).
@@ -136,26 +135,12 @@ impl<'r, T: TriangleIntersector, K: PacketLanes<T>, const G: usize> Packet<'r, T
         // SAFETY: bit g of `prepared_mask` is set only after slot g was written; `new_in` wrote
         // group g (g < n_groups).
         let (prepared, group) = unsafe { (self.prepared[g].assume_init_ref(), self.groups[g].assume_init_mut()) };
-        let mut found = false;
-        for (i, tri) in tris.iter().enumerate() {
-            let hits = kernel.intersect(prepared, group, mask, tri);
-            let mut m = K::mask(&hits);
-            if m == 0 {
-                continue;
-            }
-            while m != 0 {
-                let lane = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let k = n * g + lane;
-                let h = K::lane(&hits, lane);
-                self.rays[k].t_max = h.t;
-                self.best[k].write(((first + i) as u32, h));
-                self.hit_mask |= 1 << k;
-            }
-            kernel.refresh(group, self.rays, n * g);
-            found = true;
-        }
-        found
+        let (best, hit_mask) = (&mut self.best, &mut self.hit_mask);
+        kernel.leaf(prepared, group, mask, tris, self.rays, n * g, |lane, i, h| {
+            let k = n * g + lane;
+            best[k].write(((first + i) as u32, h));
+            *hit_mask |= 1 << k;
+        })
     }
 
     /// Each ray's closest hit, with the mesh's triangle index (`prim_ids` maps leaf order to it).

@@ -351,9 +351,18 @@ impl Accelerator for WideBvh<8> {
     ) -> Option<Hit> {
         match self.simd {
             #[cfg(target_arch = "x86_64")]
-            Simd::Avx512 => match crate::geometry::avx512::Avx512::detect() {
+            // Leaves of up to four triangles (the fastest preset's) take the AVX2 walk: there the
+            // AVX-512 one measured 1–8% slower (BENCHMARKS.md, "AVX-512"); it pays from leaves of
+            // eight on, which it tests in one pass.
+            Simd::Avx512 if self.params.max_leaf_size > 4 => match crate::geometry::avx512::Avx512::detect() {
                 // SAFETY: `detect` found AVX-512F/VL and the AVX2 set.
                 Some(k) => unsafe { self.trace_avx512::<T, ANY, S>(k, ray, stats) },
+                None => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, Groups4, ray, stats),
+            },
+            #[cfg(target_arch = "x86_64")]
+            Simd::Avx512 => match crate::geometry::slab8::Avx2::detect() {
+                // SAFETY: `detect` found AVX2 and FMA.
+                Some(k) => unsafe { self.trace_avx2::<T, ANY, S>(k, ray, stats) },
                 None => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, Groups4, ray, stats),
             },
             #[cfg(target_arch = "x86_64")]

@@ -29,8 +29,10 @@ impl Hits16 {
 
 /// The watertight test of triangles `16g..16g + 16` (those below `count`) of a leaf stored
 /// coordinate by coordinate (`coords`: the `count` values of v0.x, then of v0.y, …, v2.z) against
-/// one ray prepared as `p`, within `[ray.t_min, ray.t_max)`.
-#[inline(always)]
+/// one ray prepared as `p`, within `[ray.t_min, ray.t_max)`. Compiled for AVX-512 (see `Lanes`);
+/// the `Avx512` argument proves the CPU has it.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl")]
 pub(crate) fn watertight_leaf16(
     _: Avx512,
     p: &WatertightRay,
@@ -64,7 +66,8 @@ pub(crate) fn watertight_leaf16(
 ///
 /// # Safety
 /// The CPU has AVX-512F/VL, and `at(j) + k` is readable for every j < 9 and lane k in `lanes`.
-#[inline(always)]
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl")]
 unsafe fn one_ray<V: Lanes>(p: &WatertightRay, ray: &Ray, at: &impl Fn(usize) -> *const f32, lanes: u32) -> Hits16 {
     let o = ray.origin();
     let vertex = |v: usize| {
@@ -91,7 +94,8 @@ unsafe fn one_ray<V: Lanes>(p: &WatertightRay, ray: &Ray, at: &impl Fn(usize) ->
 ///
 /// # Safety
 /// The CPU has AVX-512F/VL.
-#[inline(always)]
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl")]
 pub(super) unsafe fn edge_test<V: Lanes>(xy: [V; 6], z: [V; 3], t_min: V, t_max: V, lanes: u32) -> Hits16 {
     let [ax, ay, bx, by, cx, cy] = xy;
     let mut u = cx.mul(by).sub(cy.mul(bx));
@@ -199,7 +203,8 @@ mod tests {
             let coords: Vec<f32> = (0..9).flat_map(|j| tris.iter().map(move |t| t[j / 3][j % 3])).collect();
             let p = Watertight::prepare(&ray);
             for g in 0..count.div_ceil(16) {
-                let got = watertight_leaf16(k, &p, &ray, &coords, count, g);
+                // SAFETY: `k` proves the CPU has AVX-512F/VL.
+                let got = unsafe { watertight_leaf16(k, &p, &ray, &coords, count, g) };
                 let n = (count - 16 * g).min(16);
                 prop_assert_eq!(got.mask >> n, 0, "no lane past the leaf");
                 let four = four_by_four(k, &p, &ray, &coords, count, g);

@@ -8,6 +8,27 @@ use crate::geometry::triangle::{TriangleIntersector, Watertight};
 use crate::geometry::Aabb;
 use proptest::prelude::*;
 
+// The kernels are compiled for AVX-512 (`#[target_feature]`): called through these wrappers.
+// SAFETY (each): `k` comes from `Avx512::detect`, so the CPU has AVX-512F/VL.
+fn group(k: Avx512, rays: &[Ray], base: usize) -> RayGroup16 {
+    unsafe { RayGroup16::new(k, rays, base) }
+}
+fn hit(k: Avx512, g: &RayGroup16, lo: [f32; 3], hi: [f32; 3]) -> u32 {
+    unsafe { g.hit(k, lo, hi) }
+}
+fn hit_planes(k: Avx512, g: &RayGroup16, near: [f32; 3], far: [f32; 3]) -> u32 {
+    unsafe { g.hit_planes(k, near, far) }
+}
+fn interval(k: Avx512, groups: &[RayGroup16]) -> RayInterval {
+    unsafe { interval16(k, groups) }
+}
+fn rows(k: Avx512, rays: &[Ray], base: usize) -> WatertightRay16 {
+    unsafe { WatertightRay16::new(k, rays, base) }
+}
+fn intersect(k: Avx512, p: &WatertightRay16, g: &RayGroup16, lanes: u32, tri: &[Vec3; 3]) -> Hits16 {
+    unsafe { p.intersect(k, g.t_min, g.t_max, lanes, tri) }
+}
+
 /// Halves on a small grid, and -0: origins on box planes with zero direction components (the
 /// NaN case), rays through corners and edges.
 fn coord() -> impl Strategy<Value = f32> {
@@ -40,8 +61,8 @@ proptest! {
         let Some(k) = Avx512::detect() else { return Ok(()) };
         let (lo, hi) = (a.min(b).to_array(), a.max(b).to_array());
         for base in (0..rays.len()).step_by(16) {
-            let g = RayGroup16::new(k, &rays, base);
-            let got = g.hit(k, lo, hi);
+            let g = group(k, &rays, base);
+            let got = hit(k, &g, lo, hi);
             let four = (0..4).fold(0, |m, q| m | RayGroup::new(&rays, base + 4 * q).hit(lo, hi) << (4 * q));
             prop_assert_eq!(got, four, "sixteen lanes against four groups of four");
             for lane in 0..(rays.len() - base).min(16) {
@@ -55,7 +76,7 @@ proptest! {
                 let pick = |axis: usize, near: bool| if neg(axis) == near { hi[axis] } else { lo[axis] };
                 let near = [pick(0, true), pick(1, true), pick(2, true)];
                 let far = [pick(0, false), pick(1, false), pick(2, false)];
-                prop_assert_eq!(g.hit_planes(k, near, far), got, "planes chosen once");
+                prop_assert_eq!(hit_planes(k, &g, near, far), got, "planes chosen once");
             }
         }
     }
@@ -64,9 +85,9 @@ proptest! {
     #[test]
     fn the_frustum_of_sixteen_ray_groups_is_the_four_lane_one(rays in rays()) {
         let Some(k) = Avx512::detect() else { return Ok(()) };
-        let g16: Vec<RayGroup16> = (0..rays.len()).step_by(16).map(|b| RayGroup16::new(k, &rays, b)).collect();
+        let g16: Vec<RayGroup16> = (0..rays.len()).step_by(16).map(|b| group(k, &rays, b)).collect();
         let g4: Vec<RayGroup> = (0..rays.len()).step_by(4).map(|b| RayGroup::new(&rays, b)).collect();
-        prop_assert_eq!(interval16(k, &g16), RayInterval::new(&g4));
+        prop_assert_eq!(interval(k, &g16), RayInterval::new(&g4));
     }
 }
 
@@ -102,10 +123,10 @@ proptest! {
     #[test]
     fn sixteen_rays_against_a_triangle_are_the_scalar_tests((tri, rays) in triangle_case(), drop in 0u32..16) {
         let Some(k) = Avx512::detect() else { return Ok(()) };
-        let p = WatertightRay16::new(k, &rays, 0);
-        let g = RayGroup16::new(k, &rays, 0);
+        let p = rows(k, &rays, 0);
+        let g = group(k, &rays, 0);
         let lanes = ((1u32 << rays.len()) - 1) & !(1 << drop);
-        let got = p.intersect(k, g.t_min, g.t_max, lanes, &tri);
+        let got = intersect(k, &p, &g, lanes, &tri);
         prop_assert_eq!(got.mask & !lanes, 0, "only the lanes asked for");
         for (lane, ray) in rays.iter().enumerate().filter(|&(l, _)| lanes >> l & 1 == 1) {
             let want = Watertight::intersect(&Watertight::prepare(ray), ray, &tri);
@@ -136,10 +157,40 @@ fn rays_lying_in_box_planes_hit_as_the_scalar_test_says() {
             }
         })
         .collect();
-    let got = RayGroup16::new(k, &rays, 0).hit(k, lo, hi);
+    let got = hit(k, &group(k, &rays, 0), lo, hi);
     for (lane, r) in rays.iter().enumerate() {
         let (t0, t1) = OneRay::new(r).one_box(&lo, &hi, r.t_min, widen(r.t_max));
         assert_eq!(got >> lane & 1 == 1, t0 <= t1, "lane {lane}: {r:?}");
         assert!(t0 <= t1, "a ray along a face hits the box: {r:?}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+    /// The rows of sixteen rays made at once are `WatertightRay::with_branches`'s, bit for bit,
+    /// zeros' signs included: directions with equal magnitudes on two or three axes (the axis
+    /// choice's ties), zero and -0 components, negative largest components (the swap).
+    #[test]
+    fn sixteen_rays_rows_are_the_branchy_rows(dirs in proptest::collection::vec(point(), 1..=16)) {
+        let Some(k) = Avx512::detect() else { return Ok(()) };
+        let rays: Vec<Ray> = dirs.iter().map(|&d| Ray::new(Vec3::ONE, d)).collect();
+        let p = rows(k, &rays, 0);
+        let lanes = |v: &[__m512; 3]| {
+            let mut a = [[0f32; 16]; 3];
+            for (axis, out) in a.iter_mut().enumerate() {
+                // SAFETY: sixteen floats each way.
+                unsafe { _mm512_storeu_ps(out.as_mut_ptr(), v[axis]) };
+            }
+            a
+        };
+        let (rx, ry, rz) = (lanes(&p.rx), lanes(&p.ry), lanes(&p.rz));
+        for (lane, ray) in rays.iter().enumerate() {
+            let w = crate::geometry::shear::WatertightRay::with_branches(ray.dir());
+            for axis in 0..3 {
+                let got = [rx[axis][lane], ry[axis][lane], rz[axis][lane]].map(f32::to_bits);
+                let want = [w.rx[axis], w.ry[axis], w.rz[axis]].map(f32::to_bits);
+                prop_assert_eq!(got, want, "lane {} axis {} of {:?}", lane, axis, ray.dir());
+            }
+        }
     }
 }

@@ -35,44 +35,63 @@ impl SlabKernel<8> for Avx512 {
 
     #[inline(always)]
     fn prepare(self, ray: &Ray) -> RayX8Masked {
-        let (o, i) = (ray.origin(), ray.inv_dir());
-        let f = i * (1.0 + SLACK);
         // SAFETY: `self` exists only if the CPU has AVX-512F/VL (`Avx512::detect`).
-        let s = |x: f32| unsafe { _mm256_set1_ps(x) };
-        // `is_sign_negative`, as the scalar test: -0 gives -inf, whose near plane is the max.
-        let neg = [i.x.is_sign_negative(), i.y.is_sign_negative(), i.z.is_sign_negative()];
-        RayX8Masked {
-            org: [s(o.x), s(o.y), s(o.z)],
-            inv: [s(i.x), s(i.y), s(i.z)],
-            inv_far: [s(f.x), s(f.y), s(f.z)],
-            near: [offset(neg[0], 0), offset(neg[1], 1), offset(neg[2], 2)],
-            far: [offset(!neg[0], 0), offset(!neg[1], 1), offset(!neg[2], 2)],
-        }
+        unsafe { prepare(ray) }
     }
 
     #[inline(always)]
     fn test(self, r: &RayX8Masked, boxes: &Boxes8, valid: u32, t_min: f32, t_max: f32) -> ([f32; 8], u32) {
-        let planes = (boxes as *const Boxes8).cast::<f32>();
-        // SAFETY: `self` exists only if the CPU has AVX-512F/VL; every offset is that of one of the
-        // six arrays of eight floats of `boxes` (`offset`, checked against its size above).
-        unsafe {
-            let mut enter = _mm256_set1_ps(t_min);
-            let mut exit = _mm256_set1_ps(t_max);
-            for axis in 0..3 {
-                let near = _mm256_loadu_ps(planes.add(r.near[axis]));
-                let far = _mm256_loadu_ps(planes.add(r.far[axis]));
-                let t0 = _mm256_mul_ps(_mm256_sub_ps(near, r.org[axis]), r.inv[axis]);
-                let t1 = _mm256_mul_ps(_mm256_sub_ps(far, r.org[axis]), r.inv_far[axis]);
-                // The second operand survives a NaN: `max_keep`'s rule.
-                enter = _mm256_max_ps(t0, enter);
-                exit = _mm256_min_ps(t1, exit);
-            }
-            let mask = _mm256_mask_cmp_ps_mask::<_CMP_LE_OQ>(valid as __mmask8, enter, exit) as u32;
-            let mut out = [0.0f32; 8];
-            _mm256_storeu_ps(out.as_mut_ptr(), enter);
-            (out, mask)
-        }
+        // SAFETY: `self` exists only if the CPU has AVX-512F/VL.
+        unsafe { eight_boxes(r, boxes, valid, t_min, t_max) }
     }
+}
+
+/// The ray splat and its planes' offsets, compiled for AVX-512 (see `eight_boxes`).
+///
+/// # Safety
+/// The CPU has AVX-512F/VL.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl")]
+unsafe fn prepare(ray: &Ray) -> RayX8Masked {
+    let (o, i) = (ray.origin(), ray.inv_dir());
+    let f = i * (1.0 + SLACK);
+    let s = |x: f32| _mm256_set1_ps(x);
+    // `is_sign_negative`, as the scalar test: -0 gives -inf, whose near plane is the max.
+    let neg = [i.x.is_sign_negative(), i.y.is_sign_negative(), i.z.is_sign_negative()];
+    RayX8Masked {
+        org: [s(o.x), s(o.y), s(o.z)],
+        inv: [s(i.x), s(i.y), s(i.z)],
+        inv_far: [s(f.x), s(f.y), s(f.z)],
+        near: [offset(neg[0], 0), offset(neg[1], 1), offset(neg[2], 2)],
+        far: [offset(!neg[0], 0), offset(!neg[1], 1), offset(!neg[2], 2)],
+    }
+}
+
+/// The test itself, compiled for AVX-512 (a trait method cannot carry the features; see `Lanes`).
+///
+/// # Safety
+/// The CPU has AVX-512F/VL.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl")]
+unsafe fn eight_boxes(r: &RayX8Masked, boxes: &Boxes8, valid: u32, t_min: f32, t_max: f32) -> ([f32; 8], u32) {
+    let planes = (boxes as *const Boxes8).cast::<f32>();
+    let mut enter = _mm256_set1_ps(t_min);
+    let mut exit = _mm256_set1_ps(t_max);
+    for axis in 0..3 {
+        // SAFETY: every offset is that of one of the six arrays of eight floats of `boxes`
+        // (`offset`, checked against its size above).
+        let (near, far) = unsafe { (planes.add(r.near[axis]), planes.add(r.far[axis])) };
+        let (near, far) = (_mm256_loadu_ps(near), _mm256_loadu_ps(far));
+        let t0 = _mm256_mul_ps(_mm256_sub_ps(near, r.org[axis]), r.inv[axis]);
+        let t1 = _mm256_mul_ps(_mm256_sub_ps(far, r.org[axis]), r.inv_far[axis]);
+        // The second operand survives a NaN: `max_keep`'s rule.
+        enter = _mm256_max_ps(t0, enter);
+        exit = _mm256_min_ps(t1, exit);
+    }
+    let mask = _mm256_mask_cmp_ps_mask::<_CMP_LE_OQ>(valid as __mmask8, enter, exit) as u32;
+    let mut out = [0.0f32; 8];
+    _mm256_storeu_ps(out.as_mut_ptr(), enter);
+    (out, mask)
 }
 
 #[cfg(test)]
