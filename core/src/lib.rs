@@ -14,6 +14,7 @@ pub mod files;
 pub mod geometry;
 pub mod mesh;
 pub mod options;
+pub mod parallel;
 pub mod random;
 pub mod render;
 pub mod scene;

@@ -96,7 +96,7 @@ pub(crate) fn node_info(prims: &[BuildPrim]) -> NodeInfo {
         centroid_bounds: a.centroid_bounds.union(b.centroid_bounds),
     };
     if prims.len() >= PARALLEL_MIN_PRIMS {
-        prims.par_chunks(4096).map(|c| c.iter().fold(EMPTY, add)).reduce(|| EMPTY, merge)
+        crate::parallel::region(|| prims.par_chunks(4096).map(|c| c.iter().fold(EMPTY, add)).reduce(|| EMPTY, merge))
     } else {
         prims.iter().fold(EMPTY, add)
     }

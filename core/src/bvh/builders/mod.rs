@@ -18,6 +18,7 @@ use crate::bvh::node::{Bvh, BvhNode};
 use crate::bvh::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
+use crate::parallel::{region, PARTITION_MIN};
 use crate::work::{Cancelled, WorkControl};
 pub use common::{build_work, HEURISTIC_DEPTH_LIMIT};
 use common::{leaf_is_cheaper, node_info, progress_levels, Overrides, Progress, PARALLEL_MIN_PRIMS};
@@ -66,8 +67,11 @@ impl Bvh {
             let bounds = Aabb::from_points(&tri);
             BuildPrim::new(bounds, i as u32)
         };
-        let mut prims: Vec<BuildPrim> =
-            if n >= 1 << 16 { (0..n).into_par_iter().map(make).collect() } else { (0..n).map(make).collect() };
+        let mut prims: Vec<BuildPrim> = if n >= 1 << 16 {
+            region(|| (0..n).into_par_iter().map(make).collect())
+        } else {
+            (0..n).map(make).collect()
+        };
         let setup_time = t0.elapsed();
         control.check()?;
 
@@ -76,8 +80,11 @@ impl Bvh {
         report.setup_time = setup_time;
 
         let t2 = Instant::now();
-        let prim_ids: Vec<u32> = prims.iter().map(|p| p.index()).collect();
-        let tris = prim_ids.par_iter().with_min_len(4096).map(|&i| mesh.triangle(i)).collect();
+        let (prim_ids, tris) = region(|| {
+            let prim_ids: Vec<u32> = prims.par_iter().with_min_len(4096).map(|p| p.index()).collect();
+            let tris = prim_ids.par_iter().with_min_len(4096).map(|&i| mesh.triangle(i)).collect();
+            (prim_ids, tris)
+        });
         report.reorder_time = t2.elapsed();
         Self::finish(Bvh { nodes, prim_ids, tris, params, report }, control)
     }
@@ -240,6 +247,25 @@ fn build_subtree(
     if prims.len() < PARALLEL_MIN_PRIMS || depth >= PARALLEL_MAX_DEPTH {
         return sequential(prims);
     }
+    if prims.len() < PARTITION_MIN {
+        // One of many subtrees built side by side, each on one thread from here (issue 37's
+        // serial fraction counts the bigger nodes' own work, outside their parallel passes).
+        return region(|| build_parallel(prims, offset, depth, params, progress));
+    }
+    build_parallel(prims, offset, depth, params, progress)
+}
+
+/// `build_subtree` for a node that is split here, its children in parallel.
+fn build_parallel(
+    prims: &mut [BuildPrim],
+    offset: u32,
+    depth: u32,
+    params: &BuildParams,
+    progress: &Progress,
+) -> Result<(Subtree, Overrides), Cancelled> {
+    let sequential = |prims: &mut [BuildPrim]| {
+        build_sequential(prims, offset, depth, params, progress).map(|(nodes, over)| (Subtree::Flat(nodes), over))
+    };
     progress.check()?;
     let info = node_info(prims);
     let mut over = Overrides::default();

@@ -89,18 +89,22 @@ pub(super) fn split_of(codes: &[u64]) -> Option<(usize, u8)> {
 /// Sort `prims` by the Morton codes of their centroids in the grid over the centroid bounds;
 /// the codes in that order.
 pub(super) fn sort(prims: &mut Vec<BuildPrim>) -> Vec<u64> {
-    let (lo, scale) = grid(prims.par_iter().map(|p| p.centroid()));
-    let mut keyed: Vec<Keyed> = prims
-        .par_iter()
-        .with_min_len(4096)
-        .enumerate()
-        .map(|(i, p)| Keyed(morton(p.centroid(), lo, scale) << 32 | i as u64))
-        .collect();
-    rdst::RadixSort::radix_sort_unstable(&mut keyed);
-    in_triangle_order(&mut keyed);
-    // The sorted records replace the vector (a copy back into it cost a pass over all of them).
-    *prims = keyed.par_iter().with_min_len(4096).map(|k| prims[k.slot()]).collect();
-    keyed.par_iter().with_min_len(4096).map(|k| k.code()).collect()
+    // Every step splits the records among the threads (rdst's radix sort too): one parallel
+    // region for issue 37's serial fraction.
+    crate::parallel::region(|| {
+        let (lo, scale) = grid(prims.par_iter().map(|p| p.centroid()));
+        let mut keyed: Vec<Keyed> = prims
+            .par_iter()
+            .with_min_len(4096)
+            .enumerate()
+            .map(|(i, p)| Keyed(morton(p.centroid(), lo, scale) << 32 | i as u64))
+            .collect();
+        rdst::RadixSort::radix_sort_unstable(&mut keyed);
+        in_triangle_order(&mut keyed);
+        // The sorted records replace the vector (a copy back into it cost a pass over all of them).
+        *prims = keyed.par_iter().with_min_len(4096).map(|k| prims[k.slot()]).collect();
+        keyed.par_iter().with_min_len(4096).map(|k| k.code()).collect()
+    })
 }
 
 /// The Morton grid over the centroids' bounds: its lower corner and cells per unit.

@@ -3,13 +3,15 @@
 //! one cluster each; every round, each cluster finds its nearest neighbour among the `radius`
 //! clusters before and after it in that order (the one whose union with it has the smallest
 //! surface area), mutual nearest neighbours merge, and the clusters are compacted, keeping the
-//! order; until one is left. The neighbour search, the round's work, runs on all threads.
+//! order; until one is left. The whole round runs on all threads: the neighbour search, and the
+//! merges and compaction by prefix sums over fixed chunks (the paper's §4.3), so the tree does not
+//! depend on the thread count.
 //!
-//! The tree has a primitive per leaf; a bottom-up pass then makes a leaf of every subtree of at
-//! most `max_leaf_size` primitives that is cheaper under the SAH as one leaf than as its split
-//! (as the paper's leaves of several primitives, and obvhs's, are made). Bottom-up, the tree
-//! cannot be cut off at a leaf size before it is built: the clusters do not know their size
-//! when they meet.
+//! The tree has a primitive per leaf; each merge also decides whether its subtree of at most
+//! `max_leaf_size` primitives is cheaper under the SAH as one leaf than as its split, and then
+//! is one (as the paper's leaves of several primitives, and obvhs's, are made). Bottom-up, the
+//! tree cannot be cut off at a leaf size before it is built: the clusters do not know their size
+//! when they meet. The layout then places big subtrees in parallel: each merge knows its size.
 
 use super::common::Progress;
 use super::split::BuildPrim;
@@ -17,19 +19,34 @@ use super::subtree::Subtree;
 use crate::bvh::node::BvhNode;
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
+use crate::parallel::region;
 use crate::work::Cancelled;
 use rayon::prelude::*;
 
 /// A node while clustering: a primitive (`left == LEAF`, `right` its slot in the sorted array) or
-/// the merge of two nodes.
+/// the merge of two nodes, with what the layout needs of its subtree, worked out when it is made
+/// (its children are made in earlier rounds): primitives, SAH cost, whether it becomes one leaf,
+/// and how many nodes it lays out as.
 #[derive(Clone, Copy)]
 struct Cluster {
     bounds: Aabb,
     left: u32,
     right: u32,
+    count: u32,
+    size: u32,
+    cost: f64,
+    leaf: bool,
 }
 
 const LEAF: u32 = u32::MAX;
+
+/// Clusters per task of a round's compaction (fixed, so the order does not depend on threads).
+const CHUNK: usize = 1 << 12;
+
+/// Subtrees of at least this many primitives are laid out in parallel (`rayon::join`), down to
+/// `PARALLEL_MAX_DEPTH`; the rest with an explicit stack, however deep.
+const PARALLEL_MIN: u32 = 1 << 14;
+const PARALLEL_MAX_DEPTH: u32 = 48;
 
 /// Build the tree over `prims` (left in leaf order) with a neighbour search `radius` each side.
 pub(super) fn build(
@@ -44,46 +61,121 @@ pub(super) fn build(
     }
     super::morton::sort(prims);
     progress.check()?;
-    let mut nodes: Vec<Cluster> = prims
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| Cluster { bounds: p.bounds(), left: LEAF, right: i as u32 })
-        .collect();
-    nodes.reserve(n.saturating_sub(1));
-    let mut clusters: Vec<u32> = (0..n as u32).collect();
-    // The clusters' boxes side by side in cluster order: the search reads them in a row.
-    let mut boxes: Vec<Aabb> = nodes.iter().map(|c| c.bounds).collect();
+    let ci = params.cost.intersection as f64;
+    let (mut nodes, mut clusters, mut boxes) = region(|| {
+        let mut nodes: Vec<Cluster> = Vec::with_capacity(2 * n - 1);
+        nodes.par_extend(prims.par_iter().enumerate().map(|(i, p)| {
+            let bounds = p.bounds();
+            let cost = ci * bounds.area() as f64;
+            Cluster { bounds, left: LEAF, right: i as u32, count: 1, size: 1, cost, leaf: true }
+        }));
+        let clusters: Vec<u32> = (0..n as u32).into_par_iter().collect();
+        // The clusters' boxes side by side in cluster order: the search reads them in a row.
+        let boxes: Vec<Aabb> = nodes.par_iter().map(|c| c.bounds).collect();
+        (nodes, clusters, boxes)
+    });
     let radius = radius.max(1);
     while clusters.len() > 1 {
         progress.check()?;
-        let mut nearest = nearest_neighbours(&boxes, radius);
-        // The closest pair of the whole list is always mutual, but equal areas could make a
-        // round without one: then the first cluster and its nearest are made mutual.
-        if !(0..clusters.len()).any(|i| nearest[nearest[i]] == i) {
-            let j = nearest[0];
-            nearest[j] = 0;
-        }
-        let mut next = Vec::with_capacity(clusters.len());
-        let mut next_boxes = Vec::with_capacity(clusters.len());
-        for (i, &c) in clusters.iter().enumerate() {
-            let j = nearest[i];
-            if nearest[j] == i {
-                // Mutual: the first of the pair makes the merged cluster, in its place.
-                if i < j {
-                    let bounds = boxes[i].union(boxes[j]);
-                    nodes.push(Cluster { bounds, left: c, right: clusters[j] });
-                    next.push(nodes.len() as u32 - 1);
-                    next_boxes.push(bounds);
-                }
-            } else {
-                next.push(c);
-                next_boxes.push(boxes[i]);
+        // A round too small to give 16 threads a chunk each is not marked parallel: issue 37's
+        // serial fraction, for a 16-thread projection, counts it as serial.
+        let small = clusters.len() < 16 * CHUNK;
+        let mut round = || {
+            let mut nearest = nearest_neighbours(&boxes, radius);
+            // The closest pair of the whole list is always mutual, but equal areas could make a
+            // round without one: then the first cluster and its nearest are made mutual.
+            if !(0..clusters.len()).into_par_iter().any(|i| nearest[nearest[i]] == i) {
+                let j = nearest[0];
+                nearest[j] = 0;
             }
-        }
-        (clusters, boxes) = (next, next_boxes);
+            compact(&mut nodes, &clusters, &boxes, &nearest, params)
+        };
+        (clusters, boxes) = if small { round() } else { region(round) };
     }
     let root = clusters[0];
-    Ok((Subtree::Flat(layout(&nodes, root, prims, params, progress)?), 0))
+    let (out, order) = layout(&nodes, root, prims, progress)?;
+    *prims = order;
+    Ok((Subtree::Flat(out), 0))
+}
+
+/// One round's merges and compaction, in parallel over fixed chunks of clusters (Meister &
+/// Bittner §4.3): each chunk counts the clusters it keeps and the merges it makes, prefix sums
+/// give each chunk its places, and every chunk writes its part of the next round's clusters and
+/// boxes and its merged nodes, in order. Mutual nearest neighbours merge into the first of the
+/// pair's place; the merged nodes are numbered in cluster order.
+fn compact(
+    nodes: &mut Vec<Cluster>,
+    clusters: &[u32],
+    boxes: &[Aabb],
+    nearest: &[usize],
+    params: &BuildParams,
+) -> (Vec<u32>, Vec<Aabb>) {
+    let len = clusters.len();
+    let chunks = len.div_ceil(CHUNK);
+    let range = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(len);
+    // Each cluster is kept (alone or as the first of a merged pair) or dropped (the second).
+    let kept = |i: usize| nearest[nearest[i]] != i || i < nearest[i];
+    let merges = |i: usize| nearest[nearest[i]] == i && i < nearest[i];
+    let counts: Vec<(usize, usize)> = (0..chunks)
+        .into_par_iter()
+        .map(|c| range(c).fold((0, 0), |(k, m), i| (k + kept(i) as usize, m + merges(i) as usize)))
+        .collect();
+    let old = nodes.len();
+    let (kept_total, merged_total) = counts.iter().fold((0, 0), |(k, m), &(a, b)| (k + a, m + b));
+    let mut next = vec![0u32; kept_total];
+    let mut next_boxes: Vec<Aabb> = Vec::with_capacity(kept_total);
+    next_boxes.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, kept_total));
+    let placeholder = nodes[0];
+    nodes.par_extend(rayon::iter::repeat_n(placeholder, merged_total));
+    let (done, fresh) = nodes.split_at_mut(old);
+    let done: &[Cluster] = done;
+    // Each chunk's slices of the outputs, cut in order.
+    let mut parts = Vec::with_capacity(chunks);
+    let (mut rest, mut rest_boxes, mut rest_fresh) = (&mut next[..], &mut next_boxes[..], fresh);
+    for (c, &(k, m)) in counts.iter().enumerate() {
+        let (a, more) = std::mem::take(&mut rest).split_at_mut(k);
+        let (b, more_boxes) = std::mem::take(&mut rest_boxes).split_at_mut(k);
+        let (f, more_fresh) = std::mem::take(&mut rest_fresh).split_at_mut(m);
+        (rest, rest_boxes, rest_fresh) = (more, more_boxes, more_fresh);
+        parts.push((c, a, b, f));
+    }
+    let first_merge: Vec<usize> =
+        counts.iter().scan(old, |sum, &(_, m)| Some(std::mem::replace(sum, *sum + m))).collect();
+    parts.into_par_iter().for_each(|(c, next, next_boxes, fresh)| {
+        let (mut k, mut m) = (0, 0);
+        for i in range(c) {
+            let j = nearest[i];
+            if nearest[j] == i {
+                if i < j {
+                    // Mutual: the first of the pair makes the merged cluster, in its place.
+                    let (l, r) = (clusters[i], clusters[j]);
+                    fresh[m] = merged(node(done, l), node(done, r), l, r, boxes[i].union(boxes[j]), params);
+                    (next[k], next_boxes[k]) = ((first_merge[c] + m) as u32, fresh[m].bounds);
+                    (k, m) = (k + 1, m + 1);
+                }
+            } else {
+                (next[k], next_boxes[k]) = (clusters[i], boxes[i]);
+                k += 1;
+            }
+        }
+    });
+    (next, next_boxes)
+}
+
+/// A node made in an earlier round.
+#[inline]
+fn node(done: &[Cluster], k: u32) -> &Cluster {
+    &done[k as usize]
+}
+
+/// The merge of `a` (node `l`) and `b` (node `r`): primitives, cost, leaf or not (a subtree of at
+/// most `max_leaf_size` primitives cheaper under the SAH as one leaf than as its split becomes
+/// one), and its size in nodes once laid out.
+fn merged(a: &Cluster, b: &Cluster, l: u32, r: u32, bounds: Aabb, params: &BuildParams) -> Cluster {
+    let count = a.count + b.count;
+    let (cost, leaf) = params.cost.leaf_or_split(bounds.area() as f64, count, a.cost + b.cost, params.max_leaf_size);
+    let size = if leaf { 1 } else { 1 + a.size + b.size };
+    Cluster { bounds, left: l, right: r, count, size, cost, leaf }
 }
 
 /// For each cluster (by its box in `boxes`), the index of the one within `radius` whose union
@@ -132,71 +224,151 @@ fn nearest_neighbours(boxes: &[Aabb], radius: usize) -> Vec<usize> {
 }
 
 /// The clustered tree in bvhscope's layout (each node's children a pair, parents before
-/// children), the subtrees worth one leaf made leaves, and `prims` put into leaf order.
+/// children, a node's left subtree right after its pair, as the top-down builds lay out theirs)
+/// and the primitives in leaf order. Every subtree's place is known from the sizes worked out
+/// while clustering, so big subtrees are laid out in parallel.
 fn layout(
     nodes: &[Cluster],
     root: u32,
-    prims: &mut [BuildPrim],
-    params: &BuildParams,
+    prims: &[BuildPrim],
     progress: &Progress,
-) -> Result<Vec<BvhNode>, Cancelled> {
-    // Bottom-up (merged nodes come after their children): primitives and SAH cost per node.
-    let ci = params.cost.intersection as f64;
-    let mut count = vec![0u32; nodes.len()];
-    let mut cost = vec![0f64; nodes.len()];
-    let mut leaf = vec![false; nodes.len()];
-    for (k, c) in nodes.iter().enumerate() {
-        let area = c.bounds.area() as f64;
-        if c.left == LEAF {
-            (count[k], cost[k], leaf[k]) = (1, ci * area, true);
-            continue;
-        }
-        let (l, r) = (c.left as usize, c.right as usize);
-        count[k] = count[l] + count[r];
-        (cost[k], leaf[k]) = params.cost.leaf_or_split(area, count[k], cost[l] + cost[r], params.max_leaf_size);
+) -> Result<(Vec<BvhNode>, Vec<BuildPrim>), Cancelled> {
+    let (mut out, mut order) = region(|| {
+        let size = nodes[root as usize].size as usize;
+        let mut out = Vec::with_capacity(size);
+        out.par_extend(rayon::iter::repeat_n(BvhNode::leaf(Aabb::EMPTY, 0, 0), size));
+        let mut order = Vec::with_capacity(prims.len());
+        order.par_extend(rayon::iter::repeat_n(prims[0], prims.len()));
+        (out, order)
+    });
+    let (slot, rest) = out.split_first_mut().expect("a root");
+    let at = Place { nodes, prims, progress };
+    at.subtree(root, slot, rest, 1, &mut order, 0, 0)?;
+    Ok((out, order))
+}
+
+/// What every subtree's layout reads.
+struct Place<'a> {
+    nodes: &'a [Cluster],
+    prims: &'a [BuildPrim],
+    progress: &'a Progress<'a>,
+}
+
+/// The widest axis of a box: an interior node's `axis` (clusters are not split on a plane).
+fn widest(b: &Aabb) -> u8 {
+    let e = b.max - b.min;
+    if e.x >= e.y && e.x >= e.z {
+        0
+    } else if e.y >= e.z {
+        1
+    } else {
+        2
     }
-    // Top-down, depth first: the layout, and the leaves' primitives gathered in order.
-    let mut out = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
-    let mut order: Vec<BuildPrim> = Vec::with_capacity(prims.len());
-    let mut stack = vec![(root, 0usize, 0u32)];
-    let mut under = Vec::new();
-    let mut done = 0u64;
-    while let Some((k, slot, depth)) = stack.pop() {
-        let c = nodes[k as usize];
-        if leaf[k as usize] {
-            let first = order.len() as u32;
-            under.clear();
-            under.push(k);
-            while let Some(u) = under.pop() {
-                let cu = nodes[u as usize];
-                if cu.left == LEAF {
-                    order.push(prims[cu.right as usize]);
-                } else {
-                    under.extend([cu.right, cu.left]);
-                }
+}
+
+impl Place<'_> {
+    /// Lay out node `k` into `slot`, its other nodes into `rest` (the first of which has global
+    /// index `rest_base`), its primitives into `order` (the first of which is leaf slot `first`).
+    #[allow(clippy::too_many_arguments)]
+    fn subtree(
+        &self,
+        k: u32,
+        slot: &mut BvhNode,
+        rest: &mut [BvhNode],
+        rest_base: u32,
+        order: &mut [BuildPrim],
+        first: u32,
+        depth: u32,
+    ) -> Result<(), Cancelled> {
+        let c = &self.nodes[k as usize];
+        if c.leaf || c.count < PARALLEL_MIN {
+            // One of many subtrees laid out side by side (a task of the parallel layout).
+            return region(|| self.sequential(k, slot, rest, rest_base, order, first, depth));
+        }
+        if depth >= PARALLEL_MAX_DEPTH {
+            return self.sequential(k, slot, rest, rest_base, order, first, depth);
+        }
+        self.progress.check()?;
+        *slot = BvhNode::interior(c.bounds, rest_base, widest(&c.bounds));
+        self.progress.add(self.progress.split_units(c.count as usize, depth));
+        let (l, r) = (&self.nodes[c.left as usize], &self.nodes[c.right as usize]);
+        let (pair, rests) = rest.split_at_mut(2);
+        let (left_slot, right_slot) = pair.split_at_mut(1);
+        let (left_rest, right_rest) = rests.split_at_mut(l.size as usize - 1);
+        let (left_order, right_order) = order.split_at_mut(l.count as usize);
+        let right_base = rest_base + 2 + left_rest.len() as u32;
+        let (a, b) = rayon::join(
+            || self.subtree(c.left, &mut left_slot[0], left_rest, rest_base + 2, left_order, first, depth + 1),
+            || {
+                self.subtree(
+                    c.right,
+                    &mut right_slot[0],
+                    right_rest,
+                    right_base,
+                    right_order,
+                    first + l.count,
+                    depth + 1,
+                )
+            },
+        );
+        debug_assert_eq!(r.size as usize - 1, right_rest.len());
+        a.and(b)
+    }
+
+    /// `subtree` with an explicit stack (no recursion, however deep the tree): local place 0 is
+    /// `slot`, place q ≥ 1 is `rest[q - 1]`.
+    #[allow(clippy::too_many_arguments)]
+    fn sequential(
+        &self,
+        root: u32,
+        slot: &mut BvhNode,
+        rest: &mut [BvhNode],
+        rest_base: u32,
+        order: &mut [BuildPrim],
+        first: u32,
+        depth0: u32,
+    ) -> Result<(), Cancelled> {
+        let (mut next, mut filled, mut done, mut steps) = (1usize, 0usize, 0u64, 0u32);
+        let mut stack = vec![(root, 0usize, depth0)];
+        let mut under = Vec::new();
+        while let Some((k, place, depth)) = stack.pop() {
+            steps += 1;
+            if steps.is_multiple_of(256) {
+                self.progress.check()?;
             }
-            out[slot] = BvhNode::leaf(c.bounds, first, count[k as usize] as u16);
-            done += progress.leaf_units(count[k as usize] as usize, depth);
-            continue;
+            let c = &self.nodes[k as usize];
+            let node = if c.leaf {
+                let start = first + filled as u32;
+                under.clear();
+                under.push(k);
+                while let Some(u) = under.pop() {
+                    let cu = &self.nodes[u as usize];
+                    if cu.left == LEAF {
+                        order[filled] = self.prims[cu.right as usize];
+                        filled += 1;
+                    } else {
+                        under.extend([cu.right, cu.left]);
+                    }
+                }
+                done += self.progress.leaf_units(c.count as usize, depth);
+                BvhNode::leaf(c.bounds, start, c.count as u16)
+            } else {
+                let left = next;
+                next += 2;
+                done += self.progress.split_units(c.count as usize, depth);
+                stack.push((c.right, left + 1, depth + 1));
+                stack.push((c.left, left, depth + 1));
+                BvhNode::interior(c.bounds, rest_base + left as u32 - 1, widest(&c.bounds))
+            };
+            if place == 0 {
+                *slot = node;
+            } else {
+                rest[place - 1] = node;
+            }
         }
-        let left = out.len();
-        out.extend([BvhNode::leaf(Aabb::EMPTY, 0, 0); 2]);
-        let e = c.bounds.max - c.bounds.min;
-        let axis = if e.x >= e.y && e.x >= e.z {
-            0
-        } else if e.y >= e.z {
-            1
-        } else {
-            2
-        };
-        out[slot] = BvhNode::interior(c.bounds, left as u32, axis);
-        done += progress.split_units(count[k as usize] as usize, depth);
-        stack.push((c.right, left + 1, depth + 1));
-        stack.push((c.left, left, depth + 1));
+        self.progress.add(done);
+        Ok(())
     }
-    progress.add(done);
-    prims.copy_from_slice(&order);
-    Ok(out)
 }
 
 #[cfg(test)]

@@ -25,12 +25,16 @@ use super::subtree::Subtree;
 use crate::bvh::node::BvhNode;
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
+use crate::parallel::region;
 use crate::work::Cancelled;
 use glam::Vec3;
+use rayon::prelude::*;
 
 /// Nodes at least this big are split in parallel (`rayon::join`), down to `PARALLEL_MAX_DEPTH`.
 const PARALLEL_MIN: usize = 4096;
 const PARALLEL_MAX_DEPTH: u32 = 16;
+/// Nodes at least this big make their passes over references (bounds, copies) in parallel.
+const PARALLEL_PASS_MIN: usize = 1 << 14;
 
 /// The triangles spatial splits clip: the mesh's triangle of an index.
 pub(super) type Triangles<'a> = &'a (dyn Fn(u32) -> [Vec3; 3] + Sync);
@@ -162,7 +166,7 @@ pub(super) fn split_node(
         let (left, right) = share(&work, l, r, added);
         Outcome::Split { kind: SplitKind::Spatial, axis, plane, left, right }
     } else if let Some((axis, mid, _, plane)) = object {
-        let r = work.refs.split_off(mid);
+        let r = split_off(&mut work.refs, mid);
         let l = std::mem::take(&mut work.refs);
         let (left, right) = share(&work, l, r, 0);
         Outcome::Split { kind: SplitKind::Object, axis, plane, left, right }
@@ -177,7 +181,7 @@ pub(super) fn split_node(
 fn equal_count(mut work: Work, info: &NodeInfo) -> Outcome {
     let (axis, mid) = EqualCount::median(&mut work.refs, info);
     let plane = work.refs[mid].centroid()[axis as usize];
-    let r = work.refs.split_off(mid);
+    let r = split_off(&mut work.refs, mid);
     let l = std::mem::take(&mut work.refs);
     let (left, right) = share(&work, l, r, 0);
     Outcome::Split { kind: SplitKind::EqualCount, axis, plane, left, right }
@@ -219,9 +223,25 @@ fn share(parent: &Work, l: Vec<BuildPrim>, r: Vec<BuildPrim>, added: u64) -> (Wo
     (Work { refs: l, budget: bl, weight: wl, depth }, Work { refs: r, budget: br, weight: parent.weight - wl, depth })
 }
 
-/// The box of some references.
+/// The box of some references (in parallel chunks for many: exact unions, any order).
 fn bounds_of(refs: &[BuildPrim]) -> Aabb {
-    Aabb::of(refs.iter().map(BuildPrim::bounds))
+    let of = |r: &[BuildPrim]| Aabb::of(r.iter().map(BuildPrim::bounds));
+    if refs.len() >= PARALLEL_PASS_MIN {
+        region(|| refs.par_chunks(PARALLEL_PASS_MIN / 4).map(of).reduce(|| Aabb::EMPTY, |a, b| a.union(b)))
+    } else {
+        of(refs)
+    }
+}
+
+/// `refs` cut at `mid`: the references from `mid` on, copied in parallel for big nodes (the
+/// root's right half is millions of references).
+fn split_off(refs: &mut Vec<BuildPrim>, mid: usize) -> Vec<BuildPrim> {
+    if refs.len() < PARALLEL_PASS_MIN {
+        return refs.split_off(mid);
+    }
+    let right: Vec<BuildPrim> = region(|| refs[mid..].par_iter().copied().collect());
+    refs.truncate(mid);
+    right
 }
 
 fn area_of(refs: &[BuildPrim]) -> f32 {
@@ -259,32 +279,52 @@ pub(super) fn build(
 ) -> Result<(Vec<BvhNode>, Vec<BuildPrim>, Kinds), Cancelled> {
     let root = node_info(&refs);
     let ctx = Ctx::new(tri, params, &root.bounds);
-    let (tree, mut out, kinds) = build_subtree(Work::root(refs, params), &ctx, progress)?;
-    let mut nodes = tree.into_nodes();
-    // Leaves were written without their first reference: the references are in depth-first
-    // (left before right) leaf order, so one walk in that order numbers them.
-    // (An empty mesh's root is an empty leaf, whose count of 0 reads as interior: no walk.)
-    let mut stack = if out.is_empty() { vec![] } else { vec![0usize] };
-    let mut next = 0u32;
-    while let Some(i) = stack.pop() {
-        let n = &mut nodes[i];
-        if n.is_leaf() {
-            n.index = next;
-            next += n.count as u32;
-        } else {
-            stack.extend([n.index as usize + 1, n.index as usize]);
-        }
-    }
-    debug_assert_eq!(next as usize, out.len());
-    out.shrink_to_fit();
-    Ok((nodes, out, kinds))
+    let (mut tree, pieces, kinds) = build_subtree(Work::root(refs, params), &ctx, progress)?;
+    // Each flat piece numbered its leaves' references from 0, and the pieces' references are in
+    // depth-first (left before right) order, as the pieces are: each piece's leaves move by the
+    // references before it, and the pieces are copied one after the other, both in parallel.
+    let mut flats = tree.flats_mut();
+    debug_assert_eq!(flats.len(), pieces.len());
+    let offsets: Vec<u32> =
+        pieces.iter().scan(0, |sum, p| Some(std::mem::replace(sum, *sum + p.len() as u32))).collect();
+    region(|| {
+        flats.par_iter_mut().zip(offsets).for_each(|(nodes, offset)| {
+            // (An empty mesh's root is an empty leaf, whose count of 0 reads as interior: unmoved.)
+            nodes.iter_mut().filter(|n| n.is_leaf()).for_each(|n| n.index += offset);
+        })
+    });
+    let out = crate::parallel::concat(pieces, 0);
+    Ok((tree.into_nodes(), out, kinds))
 }
 
-fn build_subtree(work: Work, ctx: &Ctx, progress: &Progress) -> Result<(Subtree, Vec<BuildPrim>, Kinds), Cancelled> {
+/// The subtree over `work`, its references as pieces in depth-first order (one per flat piece of
+/// the subtree: concatenating them at every level copied the top levels' references once per
+/// level, on one thread), and its split counts.
+fn build_subtree(
+    work: Work,
+    ctx: &Ctx,
+    progress: &Progress,
+) -> Result<(Subtree, Vec<Vec<BuildPrim>>, Kinds), Cancelled> {
     if work.refs.len() < PARALLEL_MIN || work.depth >= PARALLEL_MAX_DEPTH {
-        let (nodes, refs, kinds) = build_sequential(work, ctx, progress)?;
-        return Ok((Subtree::Flat(nodes), refs, kinds));
+        // One of many subtrees built side by side, unless the depth limit made it (issue 37's
+        // serial fraction).
+        let small = work.refs.len() < PARALLEL_PASS_MIN;
+        let sequential = || build_sequential(work, ctx, progress);
+        let (nodes, refs, kinds) = if small { region(sequential)? } else { sequential()? };
+        return Ok((Subtree::Flat(nodes), vec![refs], kinds));
     }
+    if work.refs.len() < PARALLEL_PASS_MIN {
+        return region(|| build_parallel(work, ctx, progress));
+    }
+    build_parallel(work, ctx, progress)
+}
+
+/// `build_subtree` for a node split here, its children in parallel.
+fn build_parallel(
+    work: Work,
+    ctx: &Ctx,
+    progress: &Progress,
+) -> Result<(Subtree, Vec<Vec<BuildPrim>>, Kinds), Cancelled> {
     progress.check()?;
     let info = node_info(&work.refs);
     let (weight, depth) = (work.weight, work.depth);
@@ -296,21 +336,22 @@ fn build_subtree(work: Work, ctx: &Ctx, progress: &Progress) -> Result<(Subtree,
             // (Not reached for nodes this big, which never fit a leaf; kept for completeness.)
             progress.leaf(weight as usize, depth);
             let leaf = BvhNode::leaf(info.bounds, 0, refs.len() as u16);
-            Ok((Subtree::Flat(vec![leaf]), refs, kinds))
+            Ok((Subtree::Flat(vec![leaf]), vec![refs], kinds))
         }
         Outcome::Split { axis, left, right, .. } => {
             progress.add(progress.split_units(weight as usize, depth));
             let (l, r) = rayon::join(|| build_subtree(left, ctx, progress), || build_subtree(right, ctx, progress));
-            let ((lt, mut lrefs, lk), (rt, rrefs, rk)) = (l?, r?);
-            lrefs.extend(rrefs);
+            let ((lt, mut pieces, lk), (rt, right_pieces, rk)) = (l?, r?);
+            pieces.extend(right_pieces);
             let len = 1 + lt.len() + rt.len();
             let tree = Subtree::Split { bounds: info.bounds, axis, left: Box::new(lt), right: Box::new(rt), len };
-            Ok((tree, lrefs, kinds.merge(lk).merge(rk)))
+            Ok((tree, pieces, kinds.merge(lk).merge(rk)))
         }
     }
 }
 
-/// A subtree with an explicit stack; leaves' references appended in depth-first order.
+/// A subtree with an explicit stack; leaves' references appended in depth-first order, each
+/// leaf's first reference its place in that list.
 fn build_sequential(
     work: Work,
     ctx: &Ctx,
@@ -335,7 +376,8 @@ fn build_sequential(
         kinds.add(&decided);
         match decided.outcome {
             Outcome::Leaf(refs) => {
-                nodes[slot] = BvhNode::leaf(info.bounds, 0, refs.len() as u16);
+                // Numbered within this piece; `build` adds the references of the pieces before.
+                nodes[slot] = BvhNode::leaf(info.bounds, out.len() as u32, refs.len() as u16);
                 progress.leaf(weight as usize, depth);
                 out.extend(refs);
             }
@@ -442,53 +484,5 @@ pub struct DecidedSplit {
 }
 
 #[cfg(test)]
-mod tests {
-    use crate::bvh::{BuildParams, Bvh, Layout, SplitStrategy, TreeStats};
-    use crate::mesh::generate;
-
-    fn sbvh(growth: u32) -> BuildParams {
-        BuildParams { strategy: SplitStrategy::Sbvh, layout: Layout::Binary, sbvh_growth: growth, ..Default::default() }
-    }
-
-    /// Long thin triangles whose boxes overlap: spatial splits cut them, within the growth bound,
-    /// and the tree is far cheaper than the binned SAH's; with no growth allowed it is the binned
-    /// SAH's tree (the same object splits by the same code).
-    #[test]
-    fn spatial_splits_cut_slivers_within_the_growth_bound() {
-        let mesh = generate::diagonal_rods(4, 6, 6.0, 0.03, 0.2);
-        let n = mesh.triangle_count();
-        let sah = Bvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..Default::default() });
-        let none = Bvh::build(&mesh, &sbvh(0));
-        assert!(none.nodes == sah.nodes && none.prim_ids == sah.prim_ids, "growth 0: the binned SAH's tree");
-        for growth in [30, 100] {
-            let bvh = Bvh::build(&mesh, &sbvh(growth));
-            let stats = TreeStats::of(&bvh);
-            assert_eq!(stats.triangles, n);
-            assert!(stats.references > n && stats.references <= n + n * growth as usize / 100, "{stats:?}");
-            assert!(stats.spatial_splits > 0 && bvh.report.spatial_splits == stats.spatial_splits);
-            let base = TreeStats::of(&sah).sah_cost;
-            assert!(stats.sah_cost < 0.85 * base, "growth {growth}: SAH {} against {base}", stats.sah_cost);
-        }
-    }
-
-    /// The parallel top of the build and the sequential rest make the same tree on any number of
-    /// threads: budgets and progress are shared by rule, not by whoever gets there first.
-    #[test]
-    fn the_tree_does_not_depend_on_the_thread_count() {
-        let mut mesh = generate::torus_knot(2, 3, 0.3, 512, 16);
-        let rods = generate::diagonal_rods(4, 6, 6.0, 0.03, 0.2);
-        let base = mesh.positions.len() as u32;
-        mesh.positions.extend(&rods.positions);
-        mesh.triangles.extend(rods.triangles.iter().map(|t| t.map(|i| i + base)));
-        mesh.groups.clear();
-        mesh.groups.push(crate::mesh::MeshGroup { name: "all".into(), triangles: 0..mesh.triangles.len() as u32 });
-        assert!(mesh.triangle_count() > 4 * super::PARALLEL_MIN);
-        let build = |threads| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| Bvh::build(&mesh, &sbvh(30)))
-        };
-        let (one, two) = (build(1), build(2));
-        assert!(one.prim_ids.len() > mesh.triangle_count());
-        assert!(one.nodes == two.nodes && one.prim_ids == two.prim_ids);
-    }
-}
+#[path = "sbvh_tests.rs"]
+mod tests;

@@ -29,18 +29,32 @@ impl Subtree {
         }
     }
 
+    /// The flat pieces in depth-first order, left before right: the order of their leaves.
+    pub(super) fn flats_mut(&mut self) -> Vec<&mut Vec<BvhNode>> {
+        match self {
+            Subtree::Flat(nodes) => vec![nodes],
+            Subtree::Split { left, right, .. } => {
+                let mut flats = left.flats_mut();
+                flats.extend(right.flats_mut());
+                flats
+            }
+        }
+    }
+
     /// The flat array: the layout is [root, left root, right root, rest of left, rest of right]
     /// at every split, as a sequential build makes it, so each node's children stay a pair.
     pub(super) fn into_nodes(self) -> Vec<BvhNode> {
         if let Subtree::Flat(nodes) = self {
             return nodes;
         }
-        let mut nodes = Vec::with_capacity(self.len());
-        // Filled in parallel: first touch of fresh pages is much of the cost of a big array.
-        nodes.par_extend(rayon::iter::repeat_n(BvhNode::leaf(Aabb::EMPTY, 0, 0), self.len()));
-        let (root, rest) = nodes.split_first_mut().expect("a subtree has a root");
-        self.write(root, rest, 1);
-        nodes
+        crate::parallel::region(|| {
+            let mut nodes = Vec::with_capacity(self.len());
+            // Filled in parallel: first touch of fresh pages is much of the cost of a big array.
+            nodes.par_extend(rayon::iter::repeat_n(BvhNode::leaf(Aabb::EMPTY, 0, 0), self.len()));
+            let (root, rest) = nodes.split_first_mut().expect("a subtree has a root");
+            self.write(root, rest, 1);
+            nodes
+        })
     }
 
     /// Write the root into `root` and the other nodes into `rest`, whose first node has global

@@ -84,3 +84,43 @@ fn a_build_cancelled_while_running_stops() {
     assert_eq!(result.unwrap_err(), Cancelled, "cancelled part-way, after {} units", control.done());
     assert!(control.done() < control.total());
 }
+
+/// Issue 37: the builds split big nodes, cluster and lay out in parallel, and the tree must not
+/// depend on the thread count. Every strategy builds a mesh big enough for every parallel path
+/// (the partition, the selection and the sweep from 65,536 triangles, PLOC's chunked rounds, the
+/// SBVH's passes from 16,384 references, and its spatial binning on crossing needles) on one
+/// and on four threads; the nodes must be equal to the bit, and the leaves' triangles too.
+#[test]
+fn every_strategy_builds_the_same_tree_on_one_and_four_threads() {
+    let big = torus(2.0, 0.5, 512, 256);
+    assert!(big.triangle_count() >= 4 * crate::parallel::PARTITION_MIN);
+    let needles = crate::mesh::generate::needles(40_000, 37);
+    let bits = |nodes: &[BvhNode]| -> Vec<[u32; 8]> {
+        let f = |x: [f32; 3]| x.map(f32::to_bits);
+        nodes
+            .iter()
+            .map(|n| {
+                let (lo, hi) = (f(n.lo), f(n.hi));
+                [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], n.index, (n.count as u32) << 8 | n.axis as u32]
+            })
+            .collect()
+    };
+    for strategy in SplitStrategy::ALL {
+        let meshes = if strategy == SplitStrategy::Sbvh { vec![&big, &needles] } else { vec![&big] };
+        for mesh in meshes {
+            let params = BuildParams { strategy, layout: crate::bvh::Layout::Binary, ..Default::default() };
+            let build = |threads| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| Bvh::build(mesh, &params))
+            };
+            let (one, four) = (build(1), build(4));
+            let what = format!("{strategy:?}, {} triangles", mesh.triangle_count());
+            assert_eq!(one.nodes.len(), four.nodes.len(), "{what}");
+            assert!(bits(&one.nodes) == bits(&four.nodes), "{what}: the same nodes, to the bit");
+            assert!(one.prim_ids == four.prim_ids, "{what}: the same triangles in the same leaves");
+            if std::ptr::eq(mesh, &needles) {
+                assert!(one.report.spatial_splits > 0, "{what}: spatial splits were made");
+            }
+        }
+    }
+}

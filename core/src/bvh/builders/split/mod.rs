@@ -126,22 +126,12 @@ impl PlaneSink for () {
     fn plane(&mut self, _: usize, _: f32, _: u32, _: u32, _: f32, _: [f32; 2]) {}
 }
 
-/// Move the elements satisfying `left` to the front; returns how many there are. Unstable.
-///
-/// Branch-free Lomuto: every element is swapped with the first non-left one (a no-op while there
-/// is none) and the boundary advances by the predicate's 0 or 1. In the top levels `left` is a coin
-/// toss the branch predictor loses half the time; two extra moves per element cost less.
+/// Move the elements satisfying `left` to the front; returns how many there are. Unstable; big
+/// slices (the top of the tree) are partitioned in parallel, in an order that does not depend on
+/// the thread count (`crate::parallel::partition`).
 #[inline]
-pub(crate) fn partition<T: Copy>(items: &mut [T], mut left: impl FnMut(&T) -> bool) -> usize {
-    let mut boundary = 0;
-    for i in 0..items.len() {
-        let x = items[i];
-        let goes_left = left(&x);
-        items[i] = items[boundary];
-        items[boundary] = x;
-        boundary += goes_left as usize;
-    }
-    boundary
+pub(crate) fn partition<T: Copy + Send + Sync>(items: &mut [T], left: impl Fn(&T) -> bool + Sync) -> usize {
+    crate::parallel::partition(items, left)
 }
 
 #[cfg(test)]

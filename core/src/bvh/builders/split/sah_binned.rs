@@ -130,19 +130,21 @@ fn binned<P: PlaneSink>(
     if n >= PARALLEL_BINNING_MIN {
         // Big nodes (the top of the tree, where the parallel subtrees have not started yet) are
         // binned in parallel chunks whose bins are then merged.
-        let merged = prims
-            .par_chunks(PARALLEL_BINNING_MIN / 4)
-            .map(|chunk| {
-                let mut local = vec![Bin::EMPTY; 3 * bins];
-                bin_into(&mut local, chunk);
-                local
-            })
-            .reduce_with(|mut a, b| {
-                for (x, y) in a.iter_mut().zip(&b) {
-                    x.merge(y);
-                }
-                a
-            });
+        let merged = crate::parallel::region(|| {
+            prims
+                .par_chunks(PARALLEL_BINNING_MIN / 4)
+                .map(|chunk| {
+                    let mut local = vec![Bin::EMPTY; 3 * bins];
+                    bin_into(&mut local, chunk);
+                    local
+                })
+                .reduce_with(|mut a, b| {
+                    for (x, y) in a.iter_mut().zip(&b) {
+                        x.merge(y);
+                    }
+                    a
+                })
+        });
         if let Some(m) = merged {
             all.copy_from_slice(&m);
         }

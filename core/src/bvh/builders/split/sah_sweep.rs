@@ -1,14 +1,26 @@
 //! Full-sweep SAH: on each axis, sort the centroids and evaluate the SAH between every pair of
 //! neighbours — the exact object-split optimum for this node. MacDonald & Booth, "Heuristics for
 //! ray tracing using space subdivision" (The Visual Computer, 1990); Wald 2007 §3 for the sweep.
-//! O(n log n) per node; use the binned version for big meshes in interactive work.
+//! O(n log n) per node; use the binned version for big meshes in interactive work. Big nodes (the
+//! top of the tree) are sorted and swept in parallel (`sweep_parallel`), to the same split.
 
 use super::{is_active, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
 use crate::bvh::BuildParams;
 use crate::geometry::Aabb;
+use crate::parallel::{region, PARTITION_MIN};
+use rayon::prelude::*;
 
+/// Sorted by centroid, ties by index: a total order over distinct indices, so the parallel sort
+/// of a big node gives the one order the serial sort gives.
 fn sort_on(prims: &mut [BuildPrim], axis: usize) {
-    prims.sort_unstable_by(|a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]).then(a.index().cmp(&b.index())));
+    let order = |a: &BuildPrim, b: &BuildPrim| {
+        a.centroid()[axis].total_cmp(&b.centroid()[axis]).then(a.index().cmp(&b.index()))
+    };
+    if prims.len() >= PARTITION_MIN {
+        region(|| prims.par_sort_unstable_by(order));
+    } else {
+        prims.sort_unstable_by(order);
+    }
 }
 
 /// The exact sweep, with its scratch: the area of every suffix of the sorted primitives.
@@ -51,6 +63,14 @@ fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>, si
         }
         sort_on(prims, axis);
         sorted_on = Some(axis);
+        if n >= PARTITION_MIN && !is_active(sink) {
+            let found = sweep_parallel(prims, axis, right_area);
+            if found.is_some_and(|(c, _)| best.is_none_or(|(b, _, _)| c < b)) {
+                let (cost, mid) = found.expect("checked");
+                best = Some((cost, axis, mid));
+            }
+            continue;
+        }
         // right_area[i] = area of prims[i..]
         let mut acc = Aabb::EMPTY;
         for i in (1..n).rev() {
@@ -82,4 +102,59 @@ fn sweep(prims: &mut [BuildPrim], node: &NodeInfo, right_area: &mut Vec<f32>, si
     }
     let plane = (prims[mid - 1].centroid()[axis] + prims[mid].centroid()[axis]) * 0.5;
     Proposal::Split { axis: axis as u8, mid, weighted: Some(weighted), plane }
+}
+
+/// The sweep of one axis over sorted `prims` in fixed chunks: each chunk's box, the boxes of the
+/// chunks before and after it (unions are exact, so each plane's boxes and costs are the serial
+/// sweep's to the bit), then each chunk's planes in parallel. The cheapest plane (the first of
+/// equal ones, as the serial sweep keeps) with its cost.
+fn sweep_parallel(prims: &[BuildPrim], axis: usize, right_area: &mut [f32]) -> Option<(f32, usize)> {
+    const CHUNK: usize = 1 << 14;
+    let n = prims.len();
+    let boxes: Vec<Aabb> =
+        region(|| prims.par_chunks(CHUNK).map(|c| Aabb::of(c.iter().map(BuildPrim::bounds))).collect());
+    // before[c]: the union of chunks ..c; after[c]: of chunks c + 1.. (one thread: one box a chunk).
+    let (mut before, mut after) = (vec![Aabb::EMPTY; boxes.len()], vec![Aabb::EMPTY; boxes.len()]);
+    for c in 1..boxes.len() {
+        before[c] = before[c - 1].union(boxes[c - 1]);
+        let k = boxes.len() - 1 - c;
+        after[k] = after[k + 1].union(boxes[k + 1]);
+    }
+    // right_area[i] = area of prims[i..]
+    region(|| {
+        right_area.par_chunks_mut(CHUNK).zip(prims.par_chunks(CHUNK)).zip(&after).for_each(|((areas, c), &tail)| {
+            let mut acc = tail;
+            for (a, p) in areas.iter_mut().zip(c).rev() {
+                acc = acc.union(p.bounds());
+                *a = acc.area();
+            }
+        })
+    });
+    let chunk_best = |c: usize| {
+        let mut acc = before[c];
+        let mut best: Option<(f32, usize)> = None;
+        for i in (c * CHUNK).max(1)..((c + 1) * CHUNK).min(n) {
+            acc = acc.union(prims[i - 1].bounds());
+            if prims[i - 1].centroid()[axis] == prims[i].centroid()[axis] {
+                continue;
+            }
+            let cost = acc.area() * i as f32 + right_area[i] * (n - i) as f32;
+            if best.is_none_or(|(b, _)| cost < b) {
+                best = Some((cost, i));
+            }
+        }
+        best
+    };
+    let bests: Vec<Option<(f32, usize)>> = region(|| (0..boxes.len()).into_par_iter().map(chunk_best).collect());
+    // In order: the first chunk's best unless a later one is strictly cheaper, as the serial loop.
+    bests.into_iter().flatten().fold(
+        None,
+        |best, (cost, i)| {
+            if best.is_none_or(|(b, _)| cost < b) {
+                Some((cost, i))
+            } else {
+                best
+            }
+        },
+    )
 }

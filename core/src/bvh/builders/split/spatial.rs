@@ -15,11 +15,23 @@
 //! side's count one lower. A reference kept whole is not duplicated.
 //!
 //! The bins report every plane to a `PlaneSink`, so the node inspector's spatial cost curve is
-//! what the builder (`bvh::sbvh`) priced.
+//! what the builder (`bvh::sbvh`) priced. Big nodes are binned and partitioned in parallel chunks
+//! whose bins and lists are merged in order (counts add, boxes unite exactly), so the split does
+//! not depend on the thread count.
 
 use super::{is_active, BuildPrim, PlaneSink};
 use crate::geometry::Aabb;
+use crate::parallel::{concat, region};
 use glam::{Vec3, Vec3A};
+use rayon::prelude::*;
+
+/// Nodes with at least this many references are binned and partitioned in parallel chunks of
+/// `CHUNK` (fixed: the merged result must not depend on the thread count).
+const PARALLEL_MIN: usize = 1 << 14;
+const CHUNK: usize = 1 << 12;
+
+/// The triangle of a reference's index.
+pub type Triangles<'a> = &'a (dyn Fn(u32) -> [Vec3; 3] + Sync);
 
 /// The parts of a reference (triangle `tri`, its box so far `b`) on each side of the plane at
 /// `pos` on `axis`: the boxes of the triangle clipped to each half-space, each cut to `b`. A part
@@ -81,6 +93,34 @@ struct Slice {
     exit: u32,
 }
 
+impl Slice {
+    const EMPTY: Slice = Slice { bounds: Aabb::EMPTY, enter: 0, exit: 0 };
+}
+
+/// Bin `refs` into `slices` on `axis` (bins from `lo`, `width` wide): each enters the bin of its
+/// box's lower corner, exits that of its upper corner, and its box is chopped at every boundary in
+/// between, each chop clipping the triangle itself.
+fn bin_axis(slices: &mut [Slice], refs: &[BuildPrim], tri: Triangles, axis: usize, lo: f32, width: f32) {
+    let bins = slices.len();
+    let bin_of = |x: f32| (((x - lo) / width) as usize).min(bins - 1);
+    for r in refs {
+        let b = r.bounds();
+        let (first, last) = (bin_of(b.min[axis]), bin_of(b.max[axis]));
+        slices[first].enter += 1;
+        slices[last].exit += 1;
+        let mut rest = b;
+        if first < last {
+            let t = tri(r.index());
+            for (k, slice) in slices.iter_mut().enumerate().take(last).skip(first) {
+                let (l, right) = split_reference(&t, &rest, axis, plane(lo, width, k + 1));
+                slice.bounds = slice.bounds.union(l);
+                rest = right;
+            }
+        }
+        slices[last].bounds = slices[last].bounds.union(rest);
+    }
+}
+
 /// The plane between bins `k - 1` and `k` of a node whose bins start at `lo` and are `width` wide:
 /// the one formula for the chops of the binning, the planes priced and the partition.
 #[inline]
@@ -93,37 +133,40 @@ fn plane(lo: f32, width: f32, k: usize) -> f32 {
 /// the cheapest (`None` when no axis has extent or no plane has both sides).
 pub fn spatial_planes(
     refs: &[BuildPrim],
-    tri: &dyn Fn(u32) -> [Vec3; 3],
+    tri: Triangles,
     bounds: &Aabb,
     bins: usize,
     sink: &mut impl PlaneSink,
 ) -> Option<SpatialSplit> {
     let n = refs.len() as u32;
     let mut best: Option<SpatialSplit> = None;
-    let mut slices = vec![Slice { bounds: Aabb::EMPTY, enter: 0, exit: 0 }; bins];
+    let mut slices = vec![Slice::EMPTY; bins];
     for axis in 0..3 {
         let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
         let width = (hi - lo) / bins as f32;
         if !(width > 0.0) || !width.is_finite() {
             continue;
         }
-        slices.fill(Slice { bounds: Aabb::EMPTY, enter: 0, exit: 0 });
-        let bin_of = |x: f32| (((x - lo) / width) as usize).min(bins - 1);
-        for r in refs {
-            let b = r.bounds();
-            let (first, last) = (bin_of(b.min[axis]), bin_of(b.max[axis]));
-            slices[first].enter += 1;
-            slices[last].exit += 1;
-            let mut rest = b;
-            if first < last {
-                let t = tri(r.index());
-                for (k, slice) in slices.iter_mut().enumerate().take(last).skip(first) {
-                    let (l, right) = split_reference(&t, &rest, axis, plane(lo, width, k + 1));
-                    slice.bounds = slice.bounds.union(l);
-                    rest = right;
-                }
-            }
-            slices[last].bounds = slices[last].bounds.union(rest);
+        slices.fill(Slice::EMPTY);
+        if refs.len() >= PARALLEL_MIN {
+            let merged = region(|| {
+                refs.par_chunks(CHUNK)
+                    .map(|c| {
+                        let mut local = vec![Slice::EMPTY; bins];
+                        bin_axis(&mut local, c, tri, axis, lo, width);
+                        local
+                    })
+                    .reduce_with(|mut a, b| {
+                        for (x, y) in a.iter_mut().zip(&b) {
+                            (x.bounds, x.enter, x.exit) =
+                                (x.bounds.union(y.bounds), x.enter + y.enter, x.exit + y.exit);
+                        }
+                        a
+                    })
+            });
+            slices.copy_from_slice(&merged.expect("a big node has references"));
+        } else {
+            bin_axis(&mut slices, refs, tri, axis, lo, width);
         }
         // Right to left: the box and the exits of bins k.. for every plane k.
         let mut right_area = vec![0f32; bins];
@@ -165,61 +208,108 @@ pub fn spatial_planes(
 /// whole to the other.
 pub fn spatial_partition(
     refs: &[BuildPrim],
-    tri: &dyn Fn(u32) -> [Vec3; 3],
+    tri: Triangles,
     axis: usize,
     pos: f32,
 ) -> (Vec<BuildPrim>, Vec<BuildPrim>) {
-    let (mut left, mut right) = (Vec::new(), Vec::new());
-    // Straddlers with their two parts; the children's boxes and counts with every straddler split.
-    let mut straddling: Vec<(BuildPrim, Aabb, Aabb)> = Vec::new();
-    let (mut lbox, mut rbox) = (Aabb::EMPTY, Aabb::EMPTY);
-    for r in refs {
-        let b = r.bounds();
-        if b.max[axis] <= pos {
-            lbox = lbox.union(b);
-            left.push(*r);
-        } else if b.min[axis] >= pos {
-            rbox = rbox.union(b);
-            right.push(*r);
-        } else {
-            let (l, rr) = split_reference(&tri(r.index()), &b, axis, pos);
-            match (l.is_empty(), rr.is_empty()) {
-                (false, false) => {
-                    lbox = lbox.union(l);
-                    rbox = rbox.union(rr);
-                    straddling.push((*r, l, rr));
-                }
-                (true, _) => {
-                    rbox = rbox.union(b);
-                    right.push(*r);
-                }
-                (false, true) => {
-                    lbox = lbox.union(b);
-                    left.push(*r);
+    let sorted = if refs.len() >= PARALLEL_MIN {
+        let parts: Vec<Sorted> = region(|| refs.par_chunks(CHUNK).map(|c| Sorted::of(c, tri, axis, pos)).collect());
+        Sorted::merge(parts)
+    } else {
+        Sorted::of(refs, tri, axis, pos)
+    };
+    // The straddlers one by one, in order: each decision moves the boxes and counts the next sees.
+    sorted.unsplit()
+}
+
+/// References sorted to the sides of a plane: those wholly on each side, the straddlers with their
+/// two parts, and the children's boxes with every straddler split.
+struct Sorted {
+    left: Vec<BuildPrim>,
+    right: Vec<BuildPrim>,
+    straddling: Vec<(BuildPrim, Aabb, Aabb)>,
+    lbox: Aabb,
+    rbox: Aabb,
+}
+
+impl Sorted {
+    fn of(refs: &[BuildPrim], tri: Triangles, axis: usize, pos: f32) -> Sorted {
+        let mut s = Sorted {
+            left: Vec::new(),
+            right: Vec::new(),
+            straddling: Vec::new(),
+            lbox: Aabb::EMPTY,
+            rbox: Aabb::EMPTY,
+        };
+        for r in refs {
+            let b = r.bounds();
+            if b.max[axis] <= pos {
+                s.lbox = s.lbox.union(b);
+                s.left.push(*r);
+            } else if b.min[axis] >= pos {
+                s.rbox = s.rbox.union(b);
+                s.right.push(*r);
+            } else {
+                let (l, rr) = split_reference(&tri(r.index()), &b, axis, pos);
+                match (l.is_empty(), rr.is_empty()) {
+                    (false, false) => {
+                        s.lbox = s.lbox.union(l);
+                        s.rbox = s.rbox.union(rr);
+                        s.straddling.push((*r, l, rr));
+                    }
+                    (true, _) => {
+                        s.rbox = s.rbox.union(b);
+                        s.right.push(*r);
+                    }
+                    (false, true) => {
+                        s.lbox = s.lbox.union(b);
+                        s.left.push(*r);
+                    }
                 }
             }
         }
+        s
     }
-    let (mut nl, mut nr) = ((left.len() + straddling.len()) as f32, (right.len() + straddling.len()) as f32);
-    for (r, l, rr) in straddling {
-        let whole = r.bounds();
-        let split = lbox.area() * nl + rbox.area() * nr;
-        let to_left = lbox.union(whole).area() * nl + rbox.area() * (nr - 1.0);
-        let to_right = lbox.area() * (nl - 1.0) + rbox.union(whole).area() * nr;
-        if to_left < split && to_left <= to_right {
-            lbox = lbox.union(whole);
-            nr -= 1.0;
-            left.push(r);
-        } else if to_right < split {
-            rbox = rbox.union(whole);
-            nl -= 1.0;
-            right.push(r);
-        } else {
-            left.push(BuildPrim::new(l, r.index()));
-            right.push(BuildPrim::new(rr, r.index()));
+
+    /// The chunks' lists one after the other, in order: what one pass over all of them makes.
+    fn merge(parts: Vec<Sorted>) -> Sorted {
+        let (mut lefts, mut rights, mut straddling) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut lbox, mut rbox) = (Aabb::EMPTY, Aabb::EMPTY);
+        for p in parts {
+            (lbox, rbox) = (lbox.union(p.lbox), rbox.union(p.rbox));
+            lefts.push(p.left);
+            rights.push(p.right);
+            straddling.extend(p.straddling);
         }
+        // Room for the straddlers `unsplit` adds to each side, without copying the lists again.
+        let (left, right) = (concat(lefts, straddling.len()), concat(rights, straddling.len()));
+        Sorted { left, right, straddling, lbox, rbox }
     }
-    (left, right)
+
+    /// §4.5: each straddler is split in two, or kept whole on the side where that is cheaper.
+    fn unsplit(self) -> (Vec<BuildPrim>, Vec<BuildPrim>) {
+        let Sorted { mut left, mut right, straddling, mut lbox, mut rbox } = self;
+        let (mut nl, mut nr) = ((left.len() + straddling.len()) as f32, (right.len() + straddling.len()) as f32);
+        for (r, l, rr) in straddling {
+            let whole = r.bounds();
+            let split = lbox.area() * nl + rbox.area() * nr;
+            let to_left = lbox.union(whole).area() * nl + rbox.area() * (nr - 1.0);
+            let to_right = lbox.area() * (nl - 1.0) + rbox.union(whole).area() * nr;
+            if to_left < split && to_left <= to_right {
+                lbox = lbox.union(whole);
+                nr -= 1.0;
+                left.push(r);
+            } else if to_right < split {
+                rbox = rbox.union(whole);
+                nl -= 1.0;
+                right.push(r);
+            } else {
+                left.push(BuildPrim::new(l, r.index()));
+                right.push(BuildPrim::new(rr, r.index()));
+            }
+        }
+        (left, right)
+    }
 }
 
 #[cfg(test)]
