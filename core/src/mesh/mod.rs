@@ -6,6 +6,7 @@ pub mod generate;
 mod mesh;
 mod obj;
 mod obj_lines;
+mod obj_numbering;
 mod obj_parallel;
 mod surface;
 

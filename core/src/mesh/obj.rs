@@ -7,9 +7,10 @@
 
 use super::error::{MeshError, MAX_COORDINATE};
 use super::obj_lines::{diagnose, first_bad_face, first_bad_line, line_at, statements, Corner};
-use super::obj_parallel;
+use super::obj_parallel::{self, extend_with};
 use super::{Mesh, MeshGroup};
 use crate::geometry::triangle::double_area;
+use crate::parallel::region;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::borrow::Cow;
@@ -71,19 +72,28 @@ pub fn read_user_file(path: &Path) -> Result<Vec<u8>, MeshError> {
 /// A NUL byte means binary data, not OBJ text.
 pub(crate) fn decode_text<'a>(path: &Path, bytes: &'a [u8]) -> Result<Cow<'a, str>, MeshError> {
     let bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
-    if let Some(pos) = bytes.iter().position(|&b| b == 0) {
+    // Both passes in parallel pieces (issue 37: a big file's load on one thread otherwise).
+    if let Some(pos) = obj_parallel::first_byte(bytes, 0) {
         return Err(MeshError::NotText { path: path.into(), line: line_at(bytes, pos) });
     }
-    Ok(String::from_utf8_lossy(bytes))
+    Ok(obj_parallel::utf8(bytes).map_or_else(|| String::from_utf8_lossy(bytes), Cow::Borrowed))
 }
 
 /// The whole file. Big files are read in parallel pieces: on this machine faulting in the pages
 /// of a fresh buffer costs about as much as the copy, and the threads share that.
 /// `len` is the size the file had when looked at; whatever it has grown by since is read too.
 fn read_file(path: &Path, len: usize) -> std::io::Result<Vec<u8>> {
-    use std::io::{Read, Seek, SeekFrom};
-    const PIECE: usize = 16 << 20;
+    // Pieces small enough that a 160 MB file is read by 16 threads (issue 37), counted parallel.
+    const PIECE: usize = 4 << 20;
     let pieces = (len / PIECE).clamp(1, rayon::current_num_threads());
+    if len >= 16 * PIECE {
+        return crate::parallel::region(|| read_pieces(path, len, pieces));
+    }
+    read_pieces(path, len, pieces)
+}
+
+fn read_pieces(path: &Path, len: usize, pieces: usize) -> std::io::Result<Vec<u8>> {
+    use std::io::{Read, Seek, SeekFrom};
     if pieces == 1 {
         return std::fs::read(path);
     }
@@ -129,7 +139,8 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
 /// format allows it). The line breaks removed are put back after the joined statement, so every
 /// line keeps its number in error messages (a joined statement is reported at its first line).
 fn join_continued_lines(text: &str) -> Cow<'_, str> {
-    if !text.contains("\\\n") && !text.contains("\\\r\n") {
+    let continued = || text.contains("\\\n") || text.contains("\\\r\n");
+    if obj_parallel::first_byte(text.as_bytes(), b'\\').is_none() || !continued() {
         return Cow::Borrowed(text);
     }
     let mut out = String::with_capacity(text.len());
@@ -245,10 +256,10 @@ fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
         let nverts = m.positions.len() / 3;
-        mesh.positions.extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        extend_with(&mut mesh.positions, m.positions.as_chunks::<3>().0, |p| Vec3::from_array(*p));
         if has_normals {
             if m.normals.len() == m.positions.len() {
-                mesh.normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])));
+                extend_with(&mut mesh.normals, m.normals.as_chunks::<3>().0, |n| Vec3::from_array(*n));
             } else {
                 // A part without normals: zero normals make `fill_intersection` use the plane's.
                 mesh.normals.extend(std::iter::repeat_n(Vec3::ZERO, nverts));
@@ -256,7 +267,7 @@ fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport
         }
         if has_uvs {
             if m.texcoords.len() / 2 == nverts {
-                mesh.uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+                extend_with(&mut mesh.uvs, m.texcoords.as_chunks::<2>().0, |t| Vec2::from_array(*t));
             } else {
                 mesh.uvs.extend(std::iter::repeat_n(Vec2::ZERO, nverts));
             }
@@ -274,30 +285,30 @@ fn build_mesh(path: &Path, models: Vec<tobj::Model>) -> Result<(Mesh, LoadReport
         // Each kept triangle with its number in the file (zero-area ones counted, as dumps do).
         let numbered = |(i, f): (usize, &[u32])| (file_base + i as u32, corners(f));
         let kept: Vec<(u32, [u32; 3])> = if m.indices.len() >= 3 << 14 {
-            m.indices.par_chunks_exact(3).enumerate().map(numbered).filter(|(_, t)| keep(t)).collect()
+            region(|| m.indices.par_chunks_exact(3).enumerate().map(numbered).filter(|(_, t)| keep(t)).collect())
         } else {
             m.indices.chunks_exact(3).enumerate().map(numbered).filter(|(_, t)| keep(t)).collect()
         };
         file_base += (m.indices.len() / 3) as u32;
         degenerate += m.indices.len() / 3 - kept.len();
-        mesh.triangles.extend(kept.iter().map(|&(_, t)| t));
-        mesh.file_numbers.extend(kept.iter().map(|&(f, _)| f));
+        extend_with(&mut mesh.triangles, &kept, |&(_, t)| t);
+        extend_with(&mut mesh.file_numbers, &kept, |&(f, _)| f);
         let last = mesh.triangles.len() as u32;
         if last > first {
             mesh.groups.push(MeshGroup { name: model.name.clone(), triangles: first..last });
         }
     }
 
-    if mesh.positions.par_iter().any(|p| !p.is_finite()) {
+    if region(|| mesh.positions.par_iter().any(|p| !p.is_finite())) {
         return Err(Problem::NonFinite("a vertex position", "v", 3));
     }
-    if mesh.positions.par_iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+    if region(|| mesh.positions.par_iter().any(|p| p.abs().max_element() > MAX_COORDINATE)) {
         return Err(Problem::TooLarge);
     }
-    if mesh.normals.par_iter().any(|n| !n.is_finite()) {
+    if region(|| mesh.normals.par_iter().any(|n| !n.is_finite())) {
         return Err(Problem::NonFinite("a vertex normal", "vn", 3));
     }
-    if mesh.uvs.par_iter().any(|t| !t.is_finite()) {
+    if region(|| mesh.uvs.par_iter().any(|t| !t.is_finite())) {
         return Err(Problem::NonFinite("a texture coordinate", "vt", 1));
     }
     if mesh.triangles.is_empty() {

@@ -23,13 +23,14 @@
 //! a corner of four parts, a face naming a vertex declared after it), where declining is the safe
 //! side.
 
+use super::obj_numbering::Numbering;
+use crate::parallel::{concat, region};
 use rayon::prelude::*;
-use std::collections::HashMap;
 
 /// An absent texture or normal index.
-const MISSING: u32 = u32::MAX;
+pub(super) const MISSING: u32 = u32::MAX;
 /// Floats per position, texture coordinate and normal, the three attributes a corner names.
-const WIDTH: [usize; 3] = [3, 2, 3];
+pub(super) const WIDTH: [usize; 3] = [3, 2, 3];
 /// Chunks smaller than this are not worth a task.
 const MIN_CHUNK: usize = 1 << 20;
 
@@ -46,7 +47,7 @@ fn chunk_count(len: usize) -> usize {
 /// [`models`] with the text cut into (about) `chunks` pieces; the tests cut small files finely.
 fn models_in_chunks(text: &str, chunks: usize) -> Option<Vec<tobj::Model>> {
     let pieces = split_at_lines(text, chunks);
-    let mut parsed: Vec<Chunk> = pieces.par_iter().map(|p| Chunk::parse(p, None)).collect::<Option<_>>()?;
+    let mut parsed: Vec<Chunk> = region(|| pieces.par_iter().map(|p| Chunk::parse(p, None)).collect::<Option<_>>())?;
 
     // Each chunk's indices count from the vertices declared before it.
     let mut prefixes = Vec::with_capacity(parsed.len());
@@ -63,7 +64,7 @@ fn models_in_chunks(text: &str, chunks: usize) -> Option<Vec<tobj::Model>> {
     // Relative (negative) indices need that prefix while parsing: read those chunks again.
     let again: Vec<usize> = (0..parsed.len()).filter(|&i| parsed[i].relative).collect();
     let redone: Vec<Chunk> =
-        again.par_iter().map(|&i| Chunk::parse(pieces[i], Some(prefixes[i]))).collect::<Option<_>>()?;
+        region(|| again.par_iter().map(|&i| Chunk::parse(pieces[i], Some(prefixes[i]))).collect::<Option<_>>())?;
     for (i, c) in again.into_iter().zip(redone) {
         parsed[i] = c;
     }
@@ -75,6 +76,48 @@ fn models_in_chunks(text: &str, chunks: usize) -> Option<Vec<tobj::Model>> {
         return None;
     }
     Some(export(Stitched::new(parsed)))
+}
+
+/// Bytes per task of the passes over a whole file below.
+const PASS_CHUNK: usize = 1 << 20;
+
+/// Where the first `byte` is in `bytes`, looked for in parallel pieces.
+pub(super) fn first_byte(bytes: &[u8], byte: u8) -> Option<usize> {
+    let piece = region(|| bytes.par_chunks(PASS_CHUNK).position_first(|c| c.contains(&byte)))?;
+    let start = piece * PASS_CHUNK;
+    bytes[start..].iter().position(|&b| b == byte).map(|i| start + i)
+}
+
+/// The bytes as text, when they are UTF-8, checked in parallel pieces: each piece ends before an
+/// ASCII byte (never inside a character), so the text is UTF-8 exactly when every piece is.
+/// `None`: not UTF-8 (the caller decodes it lossily, on one thread, as before).
+pub(super) fn utf8(bytes: &[u8]) -> Option<&str> {
+    let mut cuts = vec![0];
+    while let Some(&last) = cuts.last() {
+        let at = (last + PASS_CHUNK).min(bytes.len());
+        let cut = bytes[at..].iter().position(|&b| b < 0x80).map_or(bytes.len(), |i| at + i);
+        cuts.push(cut);
+        if cut == bytes.len() {
+            break;
+        }
+    }
+    let valid = region(|| cuts.par_windows(2).all(|w| std::str::from_utf8(&bytes[w[0]..w[1]]).is_ok()));
+    // SAFETY: every piece is UTF-8 and each ends where a character starts (an ASCII byte, or
+    // the end), so their concatenation, all of `bytes`, is UTF-8.
+    valid.then(|| unsafe { std::str::from_utf8_unchecked(bytes) })
+}
+
+/// Items from this many on are converted in parallel (a big model's positions and triangles;
+/// a file of many small objects must not pay the pool for each).
+const PARALLEL_ITEMS: usize = 1 << 14;
+
+/// `to` extended with `f` of each of `from`, in order (in parallel for many).
+pub(super) fn extend_with<T: Sync, U: Send>(to: &mut Vec<U>, from: &[T], f: impl Fn(&T) -> U + Sync + Send) {
+    if from.len() >= PARALLEL_ITEMS {
+        region(|| to.par_extend(from.par_iter().map(f)));
+    } else {
+        to.extend(from.iter().map(f));
+    }
 }
 
 /// Cut `text` after line ends into about `chunks` pieces of similar size.
@@ -243,21 +286,20 @@ struct Stitched {
 }
 
 impl Stitched {
+    /// The chunks' lists one after the other, copied in parallel (a serial copy of a big file's
+    /// attributes and corners was a tenth of its load on many threads).
     fn new(chunks: Vec<Chunk>) -> Stitched {
-        let mut all = Stitched {
-            attrs: [0, 1, 2].map(|a| Vec::with_capacity(chunks.iter().map(|c| c.attrs[a].len()).sum())),
-            corners: Vec::with_capacity(chunks.iter().map(|c| c.corners.len()).sum()),
-            objects: Vec::new(),
-        };
+        let (mut attrs, mut corners, mut objects) = (<[Vec<Vec<f32>>; 3]>::default(), Vec::new(), Vec::new());
+        let mut before = 0;
         for c in chunks {
-            let before = all.corners.len() / 3;
-            all.objects.extend(c.objects.into_iter().map(|(t, name)| (before + t, name)));
-            all.corners.extend_from_slice(&c.corners);
-            for (to, from) in all.attrs.iter_mut().zip(&c.attrs) {
-                to.extend_from_slice(from);
+            objects.extend(c.objects.into_iter().map(|(t, name)| (before + t, name)));
+            before += c.corners.len() / 3;
+            for (to, from) in attrs.iter_mut().zip(c.attrs) {
+                to.push(from);
             }
+            corners.push(c.corners);
         }
-        all
+        Stitched { attrs: attrs.map(|a| concat(a, 0)), corners: concat(corners, 0), objects }
     }
 }
 
@@ -276,62 +318,6 @@ fn export(all: Stitched) -> Vec<tobj::Model> {
     }
     models.push(tobj::Model::new(numbering.mesh(&all.attrs, &all.corners[3 * start..]), name));
     models
-}
-
-/// Numbers each distinct corner of a model in order of first use, as tobj's single index does.
-/// Most corners name a position whose first corner already has the same texture coordinate and
-/// normal, so a table by position answers them; only a position met with different ones (a seam,
-/// a crease) needs the hash map.
-struct Numbering {
-    by_position: Vec<u32>,
-    others: HashMap<[u32; 3], u32>,
-}
-
-impl Numbering {
-    fn new(positions: usize) -> Numbering {
-        Numbering { by_position: vec![MISSING; positions], others: HashMap::new() }
-    }
-
-    fn mesh(&mut self, attrs: &[Vec<f32>; 3], corners: &[[u32; 3]]) -> tobj::Mesh {
-        let mut mesh = tobj::Mesh::default();
-        let mut keys: Vec<[u32; 3]> = Vec::new();
-        mesh.indices.reserve(corners.len());
-        for &key in corners {
-            let first = self.by_position[key[0] as usize];
-            let index = if first != MISSING && keys[first as usize] == key {
-                first
-            } else {
-                let next = keys.len() as u32;
-                let index = if first == MISSING {
-                    self.by_position[key[0] as usize] = next;
-                    next
-                } else {
-                    *self.others.entry(key).or_insert(next)
-                };
-                if index == next {
-                    keys.push(key);
-                    let [v, vt, vn] = key.map(|i| i as usize);
-                    mesh.positions.extend_from_slice(&attrs[0][3 * v..3 * v + 3]);
-                    if vt != MISSING as usize {
-                        mesh.texcoords.extend_from_slice(&attrs[1][2 * vt..2 * vt + 2]);
-                    }
-                    if vn != MISSING as usize {
-                        mesh.normals.extend_from_slice(&attrs[2][3 * vn..3 * vn + 3]);
-                    }
-                }
-                index
-            };
-            mesh.indices.push(index);
-        }
-        // Ready for the next model.
-        for k in &keys {
-            self.by_position[k[0] as usize] = MISSING;
-        }
-        // A fresh map, not `clear()`: clearing costs the map's capacity, which one big object with
-        // many seams would leave behind for every small object after it.
-        self.others = HashMap::new();
-        mesh
-    }
 }
 
 #[cfg(test)]
