@@ -5,6 +5,7 @@ use bvhscope::bvh::packet::PACKET;
 use bvhscope::bvh::{
     Accelerator, AnyBvh, BuildParams, Layout, NoStats, RayCounters, SplitStrategy, TraceOptions, TreeStats,
 };
+use bvhscope::cpu::Simd;
 use bvhscope::geometry::{intersect_triangle, Ray, TriangleTest};
 use bvhscope::mesh::Mesh;
 use glam::{Vec3, Vec3A};
@@ -132,6 +133,16 @@ pub fn ours(strategy: SplitStrategy, layout: Layout, tracing: Tracing) -> Conten
 
 /// Our BVH built with `params` (named `label` in the table), traced as `tracing` says.
 pub fn ours_with(label: &str, params: BuildParams, tracing: Tracing) -> Contender {
+    ours_with_kernels(label, params, tracing, None)
+}
+
+/// `ours_with`, walked with the kernels of `simd` instead of the best this CPU has (`with_simd`):
+/// the same tree raced with AVX2 and with AVX-512 in one run (named "…, avx2").
+pub fn ours_with_kernels(label: &str, params: BuildParams, tracing: Tracing, simd: Option<Simd>) -> Contender {
+    let label = match simd {
+        Some(s) => format!("{label}, {}", s.name()),
+        None => label.to_string(),
+    };
     let layout_name = match params.layout {
         Layout::Binary => "BVH2",
         Layout::Wide4 => "BVH4",
@@ -156,7 +167,11 @@ pub fn ours_with(label: &str, params: BuildParams, tracing: Tracing) -> Contende
             if let Some(l) = std::env::var("BENCH_MAX_LEAF").ok().and_then(|c| c.parse().ok()) {
                 params.max_leaf_size = l;
             }
-            let bvh = AnyBvh::build(mesh, &params);
+            let bvh = match (AnyBvh::build(mesh, &params), simd) {
+                (AnyBvh::Wide(w), Some(s)) => AnyBvh::Wide(w.with_simd(s)),
+                (AnyBvh::Wide8(w), Some(s)) => AnyBvh::Wide8(w.with_simd(s)),
+                (bvh, _) => bvh,
+            };
             let took = t.elapsed();
             let stats = TreeStats::of(&bvh);
             let built = Built {

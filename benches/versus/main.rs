@@ -4,7 +4,9 @@
 //! `BENCH_QUICK=1` runs a reduced set (under two minutes on 2 cores). For iterating on one thing:
 //! `BENCH_ONLY=sah,medium` keeps contenders whose names contain a word, `BENCH_MESH=bunny` one mesh,
 //! `BENCH_APP=1` prints only the app figures, `BENCH_OVERHEAD=1` only the counting overhead,
-//! `BENCH_COUNTS=1` only the work per ray (nodes, triangle tests) of our strategies' trees.
+//! `BENCH_COUNTS=1` only the work per ray (nodes, triangle tests) of our strategies' trees,
+//! `BENCH_KERNELS=1` only our SIMD kernels (four lanes, AVX2, AVX-512) raced on one tree, alternated
+//! with Embree (`BENCH_KERNEL_LEAVES=16:10,…` adds trees of larger leaves: leaf size : traversal cost).
 //! Tuning: `BENCH_TRAVERSAL_COST=c` and `BENCH_MAX_LEAF=n` build our trees with that SAH traversal
 //! cost and leaf size; `BENCH_EMBREE_ISA=avx2` asks Embree for its kernels of another CPU,
 //! `BENCH_EMBREE_ROBUST=1` for its robust mode.
@@ -13,6 +15,7 @@
 mod contenders;
 mod counts;
 mod embree;
+mod kernels;
 mod ratios;
 mod rays;
 mod scenes;
@@ -361,6 +364,20 @@ fn main() {
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Plain));
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Packets));
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Counting));
+    // Where the CPU has AVX-512, the same tree with the AVX2 kernels forced, in the same run, and
+    // trees of larger leaves (one AVX-512 pass tests sixteen triangles; BENCHMARKS.md, "AVX-512").
+    if bvhscope::cpu::Simd::detected() > bvhscope::cpu::Simd::Avx2 {
+        let avx2 = Some(bvhscope::cpu::Simd::Avx2);
+        contenders.push(contenders::ours_with_kernels("fastest", fastest, Tracing::Plain, avx2));
+        contenders.push(contenders::ours_with_kernels("fastest", fastest, Tracing::Packets, avx2));
+        for (leaf, cost) in [(16, 10.0), (32, 12.0)] {
+            let cost = bvhscope::bvh::SahCost { traversal: cost, ..fastest.cost };
+            let p = bvhscope::bvh::BuildParams { max_leaf_size: leaf, cost, ..fastest };
+            let label = format!("fastest, leaves {leaf}");
+            contenders.push(contenders::ours_with(&label, p, Tracing::Plain));
+            contenders.push(contenders::ours_with(&label, p, Tracing::Packets));
+        }
+    }
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Counting));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Counting));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide8, Tracing::Counting));
@@ -402,6 +419,13 @@ fn main() {
         for mesh in &meshes {
             let (p, i) = (rays::primary(mesh, s.primary_size), rays::incoherent(mesh, s.incoherent, 0x5EED));
             print!("{}", all.install(|| counts::table(mesh, &p, &i)));
+        }
+        return;
+    }
+    // BENCH_KERNELS=1: only our SIMD kernels raced on one tree, alternated (`kernels.rs`).
+    if std::env::var("BENCH_KERNELS").is_ok_and(|v| v == "1") {
+        for mesh in &meshes {
+            print!("{}", kernels::table(mesh, &s, &one));
         }
         return;
     }
