@@ -41,7 +41,7 @@ pub struct TreeStats {
     pub epo: Option<f64>,
     /// The reinsertion after the build, if one was asked for (its SAH cost before and after).
     pub reinsertion: Option<super::reinsert::Reinsertion>,
-    /// The SIMD kernels a wide layout's walk runs on this CPU ("avx2", "simd4", "scalar").
+    /// The SIMD kernels a wide layout's walk runs on this CPU ("avx512", "avx2", "simd4", "scalar").
     pub simd: Option<&'static str>,
 }
 
