@@ -1,0 +1,273 @@
+//! End-point overlap (EPO; Aila, Karras & Laine, "On Quality Metrics of Bounding Volume
+//! Hierarchies", HPG 2013): how much of the scene's surface lies inside boxes of nodes that do not
+//! hold it. A ray that starts or ends on a triangle (every secondary ray does) must visit every
+//! node whose box contains that point; the nodes not above the triangle's leaf are pure overhead,
+//! which the SAH, counting only box areas, does not see.
+//!
+//! EPO = Σ over nodes n of C(n) · Σ over triangles t outside n's subtree of A(t ∩ box(n)),
+//! divided by the total surface area, with C(n) weighting nodes as the SAH does: C_trav for an
+//! interior node, C_isect·(its triangles) for a leaf. A(t ∩ box) is the area of the triangle
+//! clipped to the box (Sutherland & Hodgman's polygon clipping, 1974). Triangles are the slots of
+//! the leaf order: a triangle an SBVH cut into several leaves counts once per leaf.
+//!
+//! The cost. One node's sum is found exactly by walking the tree from the root (`exact`): the tree
+//! is a spatial index of its own triangles, subtrees that miss the box or lie inside it cost one
+//! test, and only triangles crossing the box's boundary are clipped. Over all nodes that is
+//! cheap only where boxes overlap little; where they overlap much (long thin crossing triangles)
+//! the pairs of a node and a triangle meeting its box grow as nodes × triangles (the 40,000
+//! needles of BENCHMARKS.md: 6·10⁹ units of work, 100 s). And even on a scan it costs several
+//! builds, since each node clips the triangles along its box's faces. So `measure` has a budget
+//! of work proportional to the build's, `BUDGET_PER_TRIANGLE_LEVEL` · n log₂ n units for n
+//! triangles (`budget`; at least `SMALL_BUDGET` for a small mesh), and spends it where it buys
+//! most:
+//!
+//! 1. a pilot walks a thousand nodes spread over the tree with a small cap; where by its prices
+//!    most of the other walks fit the budget at some cap, they are made at that cap (in blocks,
+//!    stopping where the pilot was wrong by much), then again for those left while there is room.
+//!    A node whose walk finished has its exact term. On a small mesh all do.
+//! 2. The terms of the other nodes are estimated together from points on the surface with what
+//!    is left (`sample`): unbiased, with a standard error from independent replicates, by walks
+//!    down the tree from points or by pairs of a node and a point, whichever the pilot finds
+//!    better. `Epo` says how many terms are exact and the error of the rest (± two standard
+//!    errors are about a 95% interval).
+//!
+//! Work is counted, not timed, so the figure is the same on every machine and thread count.
+
+mod clip;
+mod exact;
+mod sample;
+
+pub use clip::{clipped_area, triangle_area};
+
+use super::Bvh;
+use super::Hierarchy;
+use exact::Prepared;
+use rayon::prelude::*;
+use sample::Estimator;
+
+/// Units of work (a node visited or a triangle's box tested; a clip is `exact::CLIP_WORK` more)
+/// per triangle and level of the tree (log₂ of the triangles): the budget of `measure`, which
+/// costs about the SAH build's time on the meshes of BENCHMARKS.md ("EPO (issue 37)").
+pub const BUDGET_PER_TRIANGLE_LEVEL: f64 = 0.5;
+/// Meshes of up to `SMALL` triangles get at least `SMALL_BUDGET`, in which they are measured
+/// exactly (a few milliseconds).
+pub const SMALL: usize = 4096;
+pub const SMALL_BUDGET: u64 = 1 << 21;
+/// The share of the budget the exact walks may take; the estimate has the rest, or all that
+/// they leave.
+const EXACT_SHARE: f64 = 0.75;
+/// Nodes the pilot walks, at most, and the share of the walks' budget it may take (1/this).
+const PILOT_NODES: usize = 1024;
+const PILOT_SHARE: u64 = 16;
+/// The walks' caps, at least and at most.
+const MIN_CAP: u64 = 64;
+const MAX_CAP: u64 = 1 << 20;
+/// The walks run only where the pilot says that at least this share of them would finish.
+const MIN_FINISHED: f64 = 0.5;
+/// Nodes walked between two looks at the work done.
+const WALK_BLOCK: usize = 1 << 14;
+
+/// The largest cap at which `count` walks cost at most `left` by the pilot's `priced` walks (0
+/// where none does, or where it would finish fewer than `MIN_FINISHED` of them): a walk costs
+/// what it cost the pilot, at most the cap; one the pilot did not finish, the cap.
+fn cap_within(priced: &[(Option<f64>, u64)], count: usize, left: u64) -> u64 {
+    let mut costs: Vec<u64> = priced.iter().filter(|d| d.0.is_some()).map(|d| d.1).collect();
+    costs.sort_unstable();
+    let (all, mut below) = (priced.len() as f64, 0f64);
+    let mut best = 0;
+    for (i, &c) in costs.iter().enumerate() {
+        // Walks up to this one cost what they did; the others, c each.
+        let mean = (below + c as f64 * (all - i as f64)) / all;
+        if mean * count as f64 > left as f64 {
+            break;
+        }
+        best = c;
+        below += c as f64;
+    }
+    // Walks that would finish too few nodes spend what the estimate does better with.
+    let finished = costs.iter().filter(|&&c| c <= best).count();
+    if (finished as f64) < MIN_FINISHED * all {
+        0
+    } else {
+        best
+    }
+}
+
+/// The end-point overlap of a tree, and how it was found.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Epo {
+    /// The tree's EPO: the sum of `terms`.
+    pub value: f64,
+    /// The standard error of `value`: 0 where every node's term is exact.
+    pub std_error: f64,
+    /// Each node's term (its share of `value`): exact, or estimated where its walk would have
+    /// passed the budget.
+    pub terms: Vec<f64>,
+    /// Nodes whose terms are exact (of `terms.len()`).
+    pub exact_nodes: usize,
+    /// The estimate's samples: points walked from, or tests of a point against a node's box (0
+    /// where all is exact).
+    pub samples: usize,
+    /// Units of work done, and the budget.
+    pub work: u64,
+    pub budget: u64,
+}
+
+impl Epo {
+    /// Whether every node's term is exact.
+    pub fn is_exact(&self) -> bool {
+        self.exact_nodes == self.terms.len()
+    }
+
+    /// "2.205" where exact, "7664 ± 43" where estimated: ± two standard errors (about 95%).
+    pub fn text(&self) -> String {
+        if self.is_exact() {
+            format!("{:.3}", self.value)
+        } else {
+            let e = 2.0 * self.std_error;
+            // As many decimals as the error leaves meaningful, at most three.
+            let d = if e > 0.0 { (-(e.log10().floor()) as i32 + 1).clamp(0, 3) as usize } else { 3 };
+            format!("{:.d$} ± {:.d$}", self.value, e)
+        }
+    }
+
+    /// How it was found, for a note beside the figure.
+    pub fn method(&self) -> String {
+        if self.is_exact() {
+            "exact".into()
+        } else {
+            format!(
+                "{} of {} nodes exact, the rest estimated from {} samples of the surface; ± two standard errors",
+                self.exact_nodes,
+                self.terms.len(),
+                self.samples
+            )
+        }
+    }
+}
+
+/// The budget of `measure` for a tree of `slots` triangles (`BUDGET_PER_TRIANGLE_LEVEL`).
+pub fn budget(slots: usize) -> u64 {
+    let levels = (slots.max(2) as f64).log2().ceil();
+    let budget = (BUDGET_PER_TRIANGLE_LEVEL * slots as f64 * levels) as u64;
+    if slots <= SMALL {
+        budget.max(SMALL_BUDGET)
+    } else {
+        budget
+    }
+}
+
+/// The tree's EPO and each node's term, within `budget(triangles)` units of work.
+pub fn measure(bvh: &Bvh, h: &Hierarchy) -> Epo {
+    measure_within(bvh, h, budget(bvh.tris.len()))
+}
+
+/// `measure` with a given budget (the tests give small ones to exercise the estimate).
+pub fn measure_within(bvh: &Bvh, h: &Hierarchy, budget: u64) -> Epo {
+    measure_with(bvh, h, budget, sample::SEED, Estimator::Best)
+}
+
+/// `measure_within`, the estimate's points drawn from `seed`, by `by`.
+fn measure_with(bvh: &Bvh, h: &Hierarchy, budget: u64, seed: u64, by: Estimator) -> Epo {
+    let n = bvh.nodes.len();
+    let p = Prepared::new(bvh, h);
+    let total = p.total();
+    if n == 0 || !(total > 0.0) {
+        return Epo { terms: vec![0.0; n], exact_nodes: n, budget, ..Epo::default() };
+    }
+    let mut terms = vec![0.0; n];
+    let exact_budget = (budget as f64 * EXACT_SHARE) as u64;
+    let walk = |nodes: &[u32], cap: u64| -> Vec<(Option<f64>, u64)> {
+        nodes.par_iter().map_init(Vec::new, |stack, &m| p.walk(m as usize, cap, stack)).collect()
+    };
+    let mut spent = 0u64;
+    let mut hard = Vec::new();
+    let mut keep = |nodes: &[u32], done: &[(Option<f64>, u64)], hard: &mut Vec<u32>| {
+        for (&m, (sum, _)) in nodes.iter().zip(done) {
+            match sum {
+                Some(s) => terms[m as usize] = p.weight(m as usize) * s / total,
+                None => hard.push(m),
+            }
+        }
+        done.iter().map(|d| d.1).sum::<u64>()
+    };
+    // A pilot of nodes spread over the array, with a `PILOT_SHARE`th of the walks' share, prices the
+    // walks: the cap for the rest is the largest at which, by the pilot, they fit what is left.
+    let stride = n.div_ceil(PILOT_NODES);
+    let pilot: Vec<u32> = (0..n).step_by(stride).map(|m| m as u32).collect();
+    // (All of the share where the pilot is every node, half of it for a small mesh, which is
+    // most likely to be measured exactly.)
+    let share = if pilot.len() == n {
+        1
+    } else if bvh.tris.len() <= SMALL {
+        2
+    } else {
+        PILOT_SHARE
+    };
+    let pilot_cap = (exact_budget / (share * pilot.len() as u64)).clamp(MIN_CAP, MAX_CAP);
+    let priced = walk(&pilot, pilot_cap);
+    spent += keep(&pilot, &priced, &mut hard);
+    let mut todo: Vec<u32> = (0..n).filter(|m| m % stride != 0).map(|m| m as u32).collect();
+    let mut cap = cap_within(&priced, todo.len(), exact_budget.saturating_sub(spent));
+    // In blocks, so the walks stop where the pilot was wrong by much (the same place whatever
+    // the threads); then again for those left, while what remains gives each twice the cap.
+    while cap > 0 {
+        let mut left = Vec::new();
+        for (k, block) in todo.chunks(WALK_BLOCK).enumerate() {
+            if spent > exact_budget + exact_budget / 4 {
+                left.extend(todo[k * WALK_BLOCK..].iter().copied());
+                break;
+            }
+            let done = walk(block, cap);
+            spent += keep(block, &done, &mut left);
+        }
+        todo = std::mem::take(&mut hard);
+        todo.extend(left);
+        // (The pilot's walks left here were tried at its cap.)
+        let tried = cap.max(pilot_cap);
+        let next = exact_budget.saturating_sub(spent) / todo.len().max(1) as u64;
+        if todo.is_empty() || next < 2 * tried || tried >= MAX_CAP {
+            break;
+        }
+        cap = next.min(MAX_CAP);
+    }
+    hard.extend(todo);
+    let pending = hard;
+    let mut epo = Epo { exact_nodes: n - pending.len(), work: spent, budget, ..Epo::default() };
+    if !pending.is_empty() {
+        let e = sample::estimate(&p, &pending, budget.saturating_sub(spent), seed, by);
+        for (&m, t) in pending.iter().zip(&e.terms) {
+            terms[m as usize] = *t;
+        }
+        (epo.std_error, epo.samples) = (e.std_error, e.samples);
+        epo.work += e.work;
+    }
+    epo.value = terms.iter().sum();
+    epo.terms = terms;
+    epo
+}
+
+/// Each node's term of the EPO sum (its share of the total; they add up to `of`): `measure`'s.
+pub fn node_terms(bvh: &Bvh, h: &Hierarchy) -> Vec<f64> {
+    measure(bvh, h).terms
+}
+
+/// One node's term, exactly (the node inspector's "EPO share"): one walk, which costs at most a
+/// box test per node and a clip per triangle.
+pub fn node_term(bvh: &Bvh, h: &Hierarchy, node: usize) -> f64 {
+    let p = Prepared::new(bvh, h);
+    let total = p.total();
+    if !(total > 0.0) {
+        return 0.0;
+    }
+    let sum = p.walk(node, u64::MAX, &mut Vec::new()).0.unwrap_or(0.0);
+    p.weight(node) * sum / total
+}
+
+/// The tree's EPO (`measure`'s value).
+pub fn of(bvh: &Bvh) -> f64 {
+    measure(bvh, &Hierarchy::of(bvh)).value
+}
+
+#[cfg(test)]
+mod tests;
