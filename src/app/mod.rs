@@ -418,7 +418,10 @@ impl BvhscopeApp {
         self.current_bvh().map(|b| StrategyFigures {
             label: b.bvh.label(),
             // The end-point overlap comes with the prepared tree, a moment after the image.
-            stats: TreeStats { epo: self.nodes.current(Some(&b.bvh)).map(|e| e.epo), ..b.stats.clone() },
+            stats: {
+                let e = self.nodes.current(Some(&b.bvh));
+                TreeStats { epo: e.map(|e| e.epo), epo_error: e.and_then(|e| e.epo_error), ..b.stats.clone() }
+            },
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
             rays: self.rays,
         })

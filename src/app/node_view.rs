@@ -18,9 +18,11 @@ pub struct Explained {
     pub bvh: Arc<SceneBvh>,
     pub tree: Arc<Bvh>,
     pub hierarchy: Hierarchy,
-    /// Each node's term of the end-point overlap (`bvh::epo`), and their sum.
+    /// Each node's term of the end-point overlap (`bvh::epo`), their sum, and two standard errors
+    /// of it where it was estimated (`epo::Epo::error`).
     pub epo_terms: Vec<f64>,
     pub epo: f64,
+    pub epo_error: Option<f64>,
     /// Each node's term of the tree's SAH cost: C(n)·A(n)/A(root).
     pub sah_terms: Vec<f64>,
 }
@@ -28,8 +30,9 @@ pub struct Explained {
 impl Explained {
     pub fn new(bvh: Arc<SceneBvh>, tree: Arc<Bvh>) -> Explained {
         let hierarchy = Hierarchy::of(&tree);
-        let epo_terms = crate::bvh::epo::node_terms(&tree, &hierarchy);
-        let epo = epo_terms.iter().sum();
+        let measured = crate::bvh::epo::measure(&tree, &hierarchy);
+        let (epo, epo_error) = (measured.value, measured.error());
+        let epo_terms = measured.terms;
         let c = tree.params.cost;
         let root = tree.nodes.first().map_or(0.0, |n| n.bounds().area() as f64);
         let sah_terms = tree
@@ -44,7 +47,7 @@ impl Explained {
                 }
             })
             .collect();
-        Explained { bvh, tree, hierarchy, epo_terms, epo, sah_terms }
+        Explained { bvh, tree, hierarchy, epo_terms, epo, epo_error, sah_terms }
     }
 
     /// The overlap of a node's children's boxes, as a share of the node's own area (0 for a leaf).

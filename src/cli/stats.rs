@@ -4,7 +4,7 @@
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
 use super::device::{self, GpuBuild, GpuTree};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{epo, RayCounters, SceneBvh, TreeStats, TreeView};
+use crate::bvh::{epo, Hierarchy, RayCounters, SceneBvh, TreeStats, TreeView};
 use crate::render::warp::{WarpSize, WarpSummary, WarpView, WarpWork};
 use crate::render::{render, Camera, RaySummary, RenderSettings};
 use clap::{Args, ValueEnum};
@@ -146,8 +146,13 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
     let gpu_build_json = gpu_build.as_ref().map(GpuBuild::json);
     Ok(match (&bvh, a.format) {
         (SceneBvh::Single { bvh: b, mesh, .. }, format) => {
-            let epo = progress::with_spinner("measuring the end-point overlap", || epo::of(&b.binary_tree(mesh)));
-            let stats = TreeStats { epo: Some(epo), ..TreeStats::of(b) };
+            let (epo, ms) = progress::with_spinner("measuring the end-point overlap", || {
+                let tree = b.binary_tree(mesh);
+                let start = std::time::Instant::now();
+                (epo::measure(&tree, &Hierarchy::of(&tree)), start.elapsed().as_secs_f64() * 1e3)
+            });
+            let stats =
+                TreeStats { epo: Some(epo.value), epo_error: epo.error(), epo_ms: Some(ms), ..TreeStats::of(b) };
             if let StatsOutput::Json = format {
                 let v = serde_json::json!({
                     "mesh": report, "params": params, "stats": stats, "gpu_build": gpu_build_json, "rays": rays_json,
@@ -316,7 +321,16 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         s.sah_cost, s.sah_constants.traversal, s.sah_constants.intersection
     );
     if let Some(epo) = s.epo {
-        let _ = writeln!(o, "EPO             {epo:.3} (end-point overlap of the binary tree, Aila et al. 2013)");
+        let how = match s.epo_error {
+            Some(_) => "estimated where summing would cost more than the build, ± two standard errors",
+            None => "exact",
+        };
+        let time = s.epo_ms.map_or(String::new(), |ms| format!(", {} ms", crate::bvh::fmt_ms(ms)));
+        let _ = writeln!(
+            o,
+            "EPO             {} (end-point overlap of the binary tree, Aila et al. 2013; {how}{time})",
+            epo::figure(epo, s.epo_error)
+        );
     }
     let _ = writeln!(
         o,
@@ -325,8 +339,16 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         s.memory_bytes as f64 / s.triangles.max(1) as f64
     );
     if let Some(k) = s.simd {
-        let _ =
-            writeln!(o, "SIMD kernels    {k} (the best this CPU has, unless BVHSCOPE_SIMD=simd4|scalar asks for less)");
+        // A 4-wide tree's four boxes fit one four-lane pass: AVX2 and AVX-512 serve eight children.
+        let why = if k == "simd4" && crate::cpu::Simd::chosen() > crate::cpu::Simd::Simd4 {
+            format!(
+                "four children per node take one four-lane pass; this CPU's {} serves --layout wide8",
+                crate::cpu::Simd::chosen().name()
+            )
+        } else {
+            "the best this CPU has for this layout, unless BVHSCOPE_SIMD=avx2|simd4|scalar asks for less".to_string()
+        };
+        let _ = writeln!(o, "SIMD kernels    {k} ({why})");
     }
     if s.fallback_splits > 0 || s.depth_limited_splits > 0 {
         let _ = writeln!(

@@ -39,6 +39,10 @@ pub struct TreeStats {
     /// End-point overlap of the binary tree as built (`bvh::epo`), when it was computed: it costs
     /// a box query per node, so `of` leaves it out and the callers that show it add it.
     pub epo: Option<f64>,
+    /// Where the EPO was estimated rather than summed (`epo::Epo`): two standard errors of it.
+    pub epo_error: Option<f64>,
+    /// How long measuring the EPO took (ms), where it was measured.
+    pub epo_ms: Option<f64>,
     /// The reinsertion after the build, if one was asked for (its SAH cost before and after).
     pub reinsertion: Option<super::reinsert::Reinsertion>,
     /// The SIMD kernels a wide layout's walk runs on this CPU ("avx512", "avx2", "simd4", "scalar").

@@ -148,8 +148,9 @@ impl Jobs {
             let _ = render_passes(&*bvh, &*bvh, &camera, &settings, &frames, &control, |frame, _| last = Some(frame));
             if let Some(frame) = last.filter(|f| f.is_complete()) {
                 // B's end-point overlap, of its binary tree as A's is (the statistics' EPO row).
-                let epo = bvh.binary_tree().map(|t| crate::bvh::epo::of(&t));
-                let stats = crate::bvh::TreeStats { epo, ..crate::bvh::TreeStats::of(bvh.tree()) };
+                let epo = bvh.binary_tree().map(|t| crate::bvh::epo::measure(&t, &crate::bvh::Hierarchy::of(&t)));
+                let (epo, epo_error) = (epo.as_ref().map(|e| e.value), epo.as_ref().and_then(|e| e.error()));
+                let stats = crate::bvh::TreeStats { epo, epo_error, ..crate::bvh::TreeStats::of(bvh.tree()) };
                 let summary = frame.ray_summary();
                 let b = CompareB { scene_id, build, bvh, stats, frame: Arc::new(frame), camera, trace, summary };
                 send(JobEvent::Compared(Box::new(b)));

@@ -47,9 +47,9 @@ const ROWS: &[Row] = &[
     },
     Row {
         name: "EPO",
-        tip: "End-point overlap (Aila, Karras & Laine 2013, \"On Quality Metrics of Bounding Volume Hierarchies\"): Σ over nodes of C(n) × the area of other subtrees' triangles inside the node's box, over the total triangle area, with C(n) = C_trav for interior nodes and C_isect × triangles for leaves. A ray that starts or ends on a surface must visit every box around that point; EPO counts the ones that are not its leaf's ancestors, which the SAH does not see. Of the binary tree as built (the 4-wide layout is collapsed from it)",
+        tip: "End-point overlap (Aila, Karras & Laine 2013, \"On Quality Metrics of Bounding Volume Hierarchies\"): Σ over nodes of C(n) × the area of other subtrees' triangles inside the node's box, over the total triangle area, with C(n) = C_trav for interior nodes and C_isect × triangles for leaves. A ray that starts or ends on a surface must visit every box around that point; EPO counts the ones that are not its leaf's ancestors, which the SAH does not see. Of the binary tree as built (the 4-wide layout is collapsed from it). Where summing every node would cost more than about the build, the terms it could not afford are estimated from points on the surface: value ± two standard errors",
         per_ray: false,
-        value: |f| f.stats.epo.map(|e| format!("{e:.3}")),
+        value: |f| f.stats.epo.map(|e| crate::bvh::epo::figure(e, f.stats.epo_error)),
     },
     Row {
         name: "References / triangle",

@@ -7,7 +7,7 @@ fn opt(v: Option<f64>, digits: usize) -> String {
     v.map_or(String::new(), |v| format!("{v:.digits$}"))
 }
 
-const CSV_HEADER: [&str; 16] = [
+const CSV_HEADER: [&str; 17] = [
     "strategy",
     "build_ms",
     "nodes",
@@ -15,6 +15,7 @@ const CSV_HEADER: [&str; 16] = [
     "mean_leaf_depth",
     "sah_cost",
     "epo",
+    "epo_error",
     "nodes_per_ray",
     "tri_tests_per_ray",
     "root_box_nodes_per_ray",
@@ -36,6 +37,7 @@ fn csv_record(r: &CompareRow) -> Vec<String> {
         format!("{:.2}", r.mean_leaf_depth),
         opt(r.sah_cost, 3),
         opt(r.epo, 3),
+        opt(r.epo_error, 3),
         format!("{:.3}", r.nodes_per_ray),
         format!("{:.3}", r.tri_tests_per_ray),
         format!("{:.3}", r.root_nodes_per_ray),
@@ -101,6 +103,7 @@ mod tests {
             mean_leaf_depth: 1.5,
             sah_cost: build_ms.map(|_| 3.25),
             epo: build_ms.map(|_| 0.5),
+            epo_error: None,
             nodes_per_ray: 1.0,
             tri_tests_per_ray: 2.0,
             root_nodes_per_ray: 4.0,

@@ -111,6 +111,7 @@ pub fn gpu_rows(
                         mean_leaf_depth: stats.mean_leaf_depth,
                         sah_cost: Some(stats.sah_cost),
                         epo: None,
+                        epo_error: None,
                         nodes_per_ray: summary.mean_nodes_visited,
                         tri_tests_per_ray: summary.mean_triangle_tests,
                         root_nodes_per_ray: summary.root_mean_nodes_visited,

@@ -6,11 +6,12 @@
 //! the speedup over the linear scan compares it with the scan timed the same way. "frame ms" is
 //! the app's frame: the renderer on all threads (or `--threads`), 8×8 ray packets, shading
 //! included; there, making rays and shading cost as much as tracing, so strategies differ little.
-//! Both are medians of `--runs` frames of the plain (non-counting) traversal; the per-ray means
-//! come from one extra counting frame, over all rays and over the rays that enter the root box.
-//! Build times are the median of as many builds, or of fewer when they pass a second in all: one
-//! build of a small mesh takes a few milliseconds, and a single one can be twice the next on a
-//! busy machine. The linear scan is timed on the full frame when that is projected to take at most
+//! Both are medians of up to `--runs` frames of the plain (non-counting) traversal; the per-ray
+//! means come from one extra counting frame, over all rays and over the rays that enter the root
+//! box. Build times are the median of as many builds. Each of the three stops at fewer once its
+//! runs pass a second in all: one build of a small mesh takes a few milliseconds, and a single one
+//! can be twice the next on a busy machine, while a dense mesh's frames take a second each and
+//! twenty-one rows of five would pass the two minutes a table may take (issue 37). The linear scan is timed on the full frame when that is projected to take at most
 //! ~10 s, else on an evenly spread sample of its rays, and the table says so.
 
 mod csv;
@@ -113,7 +114,10 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
                     r.nodes,
                     depth,
                     dash(r.sah_cost, 2),
-                    dash(r.epo, 2),
+                    r.epo.map_or("—".to_string(), |v| match r.epo_error {
+                        Some(e) => crate::bvh::epo::figure(v, Some(e)),
+                        None => format!("{v:.2}"),
+                    }),
                     r.nodes_per_ray,
                     r.root_nodes_per_ray,
                     r.tri_tests_per_ray,
@@ -133,9 +137,12 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
             );
             let _ = writeln!(
                 o,
-                "trace ms: single rays, closest hit, no shading, {} thread(s); frame ms: the renderer (8×8 packets, shading) on {} thread(s); medians of {} frames; build ms: median of up to {} builds on {} thread(s); speedup: the linear scan's trace ms over the row's.",
+                "trace ms: single rays, closest hit, no shading, {} thread(s); frame ms: the renderer (8×8 packets, shading) on {} thread(s); medians of up to {} frames; build ms: median of up to {} builds on {} thread(s) (fewer runs of each where they pass a second in all); speedup: the linear scan's trace ms over the row's.",
                 setup.trace_threads, setup.frame_threads, a.runs, a.runs, setup.frame_threads
             );
+            if rows.iter().any(|r| r.epo_error.is_some()) {
+                let _ = writeln!(o, "EPO a ± b: estimated, where summing every node's overlap would cost more than about the build (± two standard errors).");
+            }
             if let Some(n) = rows.last().and_then(|r| r.sampled_rays) {
                 let _ = writeln!(o, "* linear scan timed on {n} of {rays} rays (a full frame would take over 10 s) and scaled to the full frame.");
             }

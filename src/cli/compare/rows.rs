@@ -1,7 +1,7 @@
 //! The table's rows: every strategy built and measured on the same primary rays, next to a
 //! linear scan of all triangles (how, in `compare`'s module comment).
 
-use crate::bvh::{epo, AnyBvh, BuildParams, LinearScan, SplitStrategy, TreeStats, TreeView};
+use crate::bvh::{epo, AnyBvh, BuildParams, Hierarchy, LinearScan, SplitStrategy, TreeStats, TreeView};
 use crate::cli::args::BuildArgs;
 use crate::cli::progress;
 use crate::explain::timing::{ms, time_linear, trace_rays};
@@ -19,6 +19,8 @@ pub struct CompareRow {
     pub sah_cost: Option<f64>,
     /// End-point overlap of the binary tree (the same for both layouts of a strategy).
     pub epo: Option<f64>,
+    /// Where the EPO was estimated (`bvh::epo::Epo`): two standard errors of it.
+    pub epo_error: Option<f64>,
     /// Means over all primary rays.
     pub nodes_per_ray: f64,
     pub tri_tests_per_ray: f64,
@@ -55,8 +57,20 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Builds of one strategy stop once they have taken this long in all (at least one is made).
-const BUILD_BUDGET_MS: f64 = 1000.0;
+/// Builds, frames and traces of one row stop once each kind has taken this long in all (at least one
+/// is made).
+const BUDGET_MS: f64 = 1000.0;
+
+/// The median of up to `runs` timings by `time` (ms), or of fewer once they pass `BUDGET_MS` in
+/// all, so that a slow mesh's table still comes in minutes. Past the budget, one more run when the
+/// count is even: the median of two would be the slower, often the first, cold one.
+fn budgeted_median(runs: u32, mut time: impl FnMut() -> f64) -> f64 {
+    let mut times = vec![time()];
+    while times.len() < runs as usize && (times.iter().sum::<f64>() < BUDGET_MS || times.len().is_multiple_of(2)) {
+        times.push(time());
+    }
+    median(times)
+}
 
 /// A thread pool of `n` threads (`None`: rayon's default, one per core).
 fn pool(n: Option<u32>) -> rayon::ThreadPool {
@@ -88,48 +102,50 @@ pub fn compare_rows(
     let mut root_rays = 0;
     let mut epo_of = std::collections::HashMap::new();
     let layouts = build.compare_layouts();
-    for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))) {
+    let rows_to_make = SplitStrategy::ALL.len() * layouts.len();
+    for (row, (strategy, layout)) in
+        SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))).enumerate()
+    {
         let params = build.params_with(scene, strategy, layout);
         let name = format!("{} ({})", strategy.label(), layout.name());
-        let (bvh, build_ms) = progress::with_spinner(&format!("building {name}"), || {
+        // Which row of how many, before each step's own spinner.
+        let step = |what: &str| format!("[{}/{rows_to_make}] {what} {name}", row + 1);
+        let (bvh, build_ms) = progress::with_spinner(&step("building"), || {
             frames.install(|| {
-                let build_ms = |bvh: &AnyBvh| ms(bvh.report().total_time());
-                let mut bvh = AnyBvh::build(mesh, &params);
-                let mut times = vec![build_ms(&bvh)];
-                // Past the budget, one more build when the count is even: the median of two would be
-                // the slower, often the first, cold one.
-                while times.len() < runs as usize
-                    && (times.iter().sum::<f64>() < BUILD_BUDGET_MS || times.len().is_multiple_of(2))
-                {
-                    bvh = AnyBvh::build(mesh, &params);
-                    times.push(build_ms(&bvh));
-                }
-                (bvh, median(times))
+                let mut bvh = None;
+                let build_ms = budgeted_median(runs, || {
+                    let b = AnyBvh::build(mesh, &params);
+                    let t = ms(b.report().total_time());
+                    bvh = Some(b);
+                    t
+                });
+                (bvh.expect("at least one build"), build_ms)
             })
         });
-        let (stats, summary, frame_times, trace_times) = progress::with_spinner(&format!("tracing {name}"), || {
+        let (stats, summary, frame_ms, trace_ms) = progress::with_spinner(&step("tracing"), || {
             let stats = TreeStats::of(&bvh);
-            let (summary, frame_times) = frames.install(|| {
+            let (summary, frame_ms) = frames.install(|| {
                 let summary = render(&bvh, mesh, camera, &counting).ray_summary();
-                let times: Vec<f64> = (0..runs)
-                    .map(|_| {
-                        let t = Instant::now();
-                        std::hint::black_box(render(&bvh, mesh, camera, &plain));
-                        ms(t.elapsed())
-                    })
-                    .collect();
-                (summary, times)
+                let frame_ms = budgeted_median(runs, || {
+                    let t = Instant::now();
+                    std::hint::black_box(render(&bvh, mesh, camera, &plain));
+                    ms(t.elapsed())
+                });
+                (summary, frame_ms)
             });
             let total = rays as usize;
-            let trace_times: Vec<f64> =
-                traces.install(|| (0..runs).map(|_| ms(trace_rays(&bvh, camera, trace, total))).collect());
-            (stats, summary, frame_times, trace_times)
+            let trace_ms = traces.install(|| budgeted_median(runs, || ms(trace_rays(&bvh, camera, trace, total))));
+            (stats, summary, frame_ms, trace_ms)
         });
         root_rays = summary.root_rays;
-        let frame_ms = median(frame_times);
-        let epo = *epo_of.entry(strategy).or_insert_with(|| {
-            progress::with_spinner(&format!("measuring the end-point overlap of {}", strategy.label()), || {
-                frames.install(|| epo::of(&bvh.binary_tree(mesh)))
+        // Within a budget of about the build's time (`bvh::epo`), so bounded on any mesh.
+        let (epo, epo_error) = *epo_of.entry(strategy).or_insert_with(|| {
+            progress::with_spinner(&step("measuring the end-point overlap of"), || {
+                frames.install(|| {
+                    let tree = bvh.binary_tree(mesh);
+                    let e = epo::measure(&tree, &Hierarchy::of(&tree));
+                    (e.value, e.error())
+                })
             })
         });
         rows.push(CompareRow {
@@ -140,11 +156,12 @@ pub fn compare_rows(
             mean_leaf_depth: stats.mean_leaf_depth,
             sah_cost: Some(stats.sah_cost),
             epo: Some(epo),
+            epo_error,
             nodes_per_ray: summary.mean_nodes_visited,
             tri_tests_per_ray: summary.mean_triangle_tests,
             root_nodes_per_ray: summary.root_mean_nodes_visited,
             root_tri_tests_per_ray: summary.root_mean_triangle_tests,
-            trace_ms: median(trace_times),
+            trace_ms,
             frame_ms,
             mrays_per_s: rays / frame_ms / 1e3,
             speedup_over_linear: 0.0,
@@ -171,6 +188,7 @@ pub fn compare_rows(
         mean_leaf_depth: 0.0,
         sah_cost: None,
         epo: None,
+        epo_error: None,
         nodes_per_ray: 0.0,
         tri_tests_per_ray: n,
         root_nodes_per_ray: 0.0,

@@ -121,14 +121,12 @@ impl Epo {
 
     /// "2.205" where exact, "7664 ± 43" where estimated: ± two standard errors (about 95%).
     pub fn text(&self) -> String {
-        if self.is_exact() {
-            format!("{:.3}", self.value)
-        } else {
-            let e = 2.0 * self.std_error;
-            // As many decimals as the error leaves meaningful, at most three.
-            let d = if e > 0.0 { (-(e.log10().floor()) as i32 + 1).clamp(0, 3) as usize } else { 3 };
-            format!("{:.d$} ± {:.d$}", self.value, e)
-        }
+        figure(self.value, self.error())
+    }
+
+    /// Two standard errors where the figure is estimated (about a 95% interval).
+    pub fn error(&self) -> Option<f64> {
+        (!self.is_exact()).then_some(2.0 * self.std_error)
     }
 
     /// How it was found, for a note beside the figure.
@@ -142,6 +140,18 @@ impl Epo {
                 self.terms.len(),
                 self.samples
             )
+        }
+    }
+}
+
+/// An EPO figure as `Epo::text` writes it: three decimals, or "value ± error" with as many
+/// decimals as the error leaves meaningful (at most three).
+pub fn figure(value: f64, error: Option<f64>) -> String {
+    match error {
+        None => format!("{value:.3}"),
+        Some(e) => {
+            let d = if e > 0.0 { (-(e.log10().floor()) as i32 + 1).clamp(0, 3) as usize } else { 3 };
+            format!("{value:.d$} ± {e:.d$}")
         }
     }
 }
