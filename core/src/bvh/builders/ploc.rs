@@ -75,22 +75,31 @@ pub(super) fn build(
         (nodes, clusters, boxes)
     });
     let radius = radius.max(1);
+    // The next round's lists are written into the last round's buffers: freeing the first
+    // rounds' lists (hundreds of megabytes) took a serial tenth of the rounds' time.
+    let (mut spare, mut spare_boxes, mut nearest) = (Vec::new(), Vec::new(), Vec::new());
     while clusters.len() > 1 {
         progress.check()?;
         // A round too small to give 16 threads a chunk each is not marked parallel: issue 37's
         // serial fraction, for a 16-thread projection, counts it as serial.
         let small = clusters.len() < 16 * CHUNK;
         let mut round = || {
-            let mut nearest = nearest_neighbours(&boxes, radius);
+            nearest_into(&boxes, radius, &mut nearest);
             // The closest pair of the whole list is always mutual, but equal areas could make a
             // round without one: then the first cluster and its nearest are made mutual.
             if !(0..clusters.len()).into_par_iter().any(|i| nearest[nearest[i]] == i) {
                 let j = nearest[0];
                 nearest[j] = 0;
             }
-            compact(&mut nodes, &clusters, &boxes, &nearest, params)
+            compact(&mut nodes, &clusters, &boxes, &nearest, params, &mut spare, &mut spare_boxes);
         };
-        (clusters, boxes) = if small { round() } else { region(round) };
+        if small {
+            round()
+        } else {
+            region(round)
+        }
+        std::mem::swap(&mut clusters, &mut spare);
+        std::mem::swap(&mut boxes, &mut spare_boxes);
     }
     let root = clusters[0];
     let (out, order) = layout(&nodes, root, prims, progress)?;
@@ -109,7 +118,9 @@ fn compact(
     boxes: &[Aabb],
     nearest: &[usize],
     params: &BuildParams,
-) -> (Vec<u32>, Vec<Aabb>) {
+    next: &mut Vec<u32>,
+    next_boxes: &mut Vec<Aabb>,
+) {
     let len = clusters.len();
     let chunks = len.div_ceil(CHUNK);
     let range = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(len);
@@ -122,8 +133,9 @@ fn compact(
         .collect();
     let old = nodes.len();
     let (kept_total, merged_total) = counts.iter().fold((0, 0), |(k, m), &(a, b)| (k + a, m + b));
-    let mut next = vec![0u32; kept_total];
-    let mut next_boxes: Vec<Aabb> = Vec::with_capacity(kept_total);
+    next.clear();
+    next.par_extend(rayon::iter::repeat_n(0, kept_total));
+    next_boxes.clear();
     next_boxes.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, kept_total));
     let placeholder = nodes[0];
     nodes.par_extend(rayon::iter::repeat_n(placeholder, merged_total));
@@ -159,7 +171,6 @@ fn compact(
             }
         }
     });
-    (next, next_boxes)
 }
 
 /// A node made in an earlier round.
@@ -178,14 +189,15 @@ fn merged(a: &Cluster, b: &Cluster, l: u32, r: u32, bounds: Aabb, params: &Build
     Cluster { bounds, left: l, right: r, count, size, cost, leaf }
 }
 
-/// For each cluster (by its box in `boxes`), the index of the one within `radius` whose union
+/// For each cluster (by its box in `boxes`), into `out`, the index of the one within `radius` whose union
 /// with it has the smallest area. Ties go to the nearer in order; at equal distance d, a cluster in an even
 /// block of d (i / d even) takes the one after it, in an odd block the one before, so that equal
 /// boxes (a million copies of one triangle) pair up, all of them each round, instead of one pair.
-fn nearest_neighbours(boxes: &[Aabb], radius: usize) -> Vec<usize> {
+fn nearest_into(boxes: &[Aabb], radius: usize, out: &mut Vec<usize>) {
     const CHUNK: usize = 2048;
     let len = boxes.len();
-    let mut out = vec![0usize; len];
+    out.clear();
+    out.par_extend(rayon::iter::repeat_n(0, len));
     // Each pair's area is computed once: a chunk of clusters first works out, for every cluster
     // from `radius` before the chunk to its end, the areas with the `radius` clusters after it,
     // then each cluster of the chunk reads its pairs both ways from that table.
@@ -220,6 +232,13 @@ fn nearest_neighbours(boxes: &[Aabb], radius: usize) -> Vec<usize> {
             *o = best.1;
         }
     });
+}
+
+/// `nearest_into` a new vector.
+#[cfg(test)]
+fn nearest_neighbours(boxes: &[Aabb], radius: usize) -> Vec<usize> {
+    let mut out = Vec::new();
+    nearest_into(boxes, radius, &mut out);
     out
 }
 

@@ -14,6 +14,10 @@ use wide::f32x4;
 pub(crate) trait PacketLanes<T: TriangleIntersector>: Copy {
     /// Rays per group.
     const N: usize;
+    /// Whether the walk puts every child to the packet's frustum before its first group (one
+    /// test for the packet instead of a group pass per child: worth it where a group pass is
+    /// dear), or only the children that group misses.
+    const FRUSTUM_FIRST: bool;
     type Group;
     /// The triangle test's per-group setup, made at the group's first leaf.
     type Prepared: Copy;
@@ -97,6 +101,7 @@ pub(crate) struct Four;
 
 impl<T: TriangleIntersector> PacketLanes<T> for Four {
     const N: usize = 4;
+    const FRUSTUM_FIRST: bool = false;
     type Group = RayGroup;
     type Prepared = T::Prepared4;
     type Hits = Hits4;
@@ -173,6 +178,7 @@ mod sixteen {
     // and `self.0` proves the CPU has it.
     impl<T: TriangleIntersector> PacketLanes<T> for Sixteen {
         const N: usize = 16;
+        const FRUSTUM_FIRST: bool = true;
         type Group = RayGroup16;
         type Prepared = T::Prepared16;
         type Hits = Hits16;

@@ -190,6 +190,11 @@ fn walk<B: PacketTree, T: TriangleIntersector, K: PacketLanes<T>, const G: usize
             };
             let mut missed = 0u32;
             let mut todo = bvh.slots(cur);
+            // Groups of sixteen: the frustum first, for every child (`PacketLanes::FRUSTUM_FIRST`).
+            let culled = K::FRUSTUM_FIRST && packet.frustum.is_valid();
+            if culled {
+                todo = bvh.may_hit(cur, todo, &packet.frustum, t_far);
+            }
             while todo != 0 {
                 let s = todo.trailing_zeros() as usize;
                 todo &= todo - 1;
@@ -201,7 +206,9 @@ fn walk<B: PacketTree, T: TriangleIntersector, K: PacketLanes<T>, const G: usize
                 }
             }
             if missed != 0 && first + 1 < packet.n_groups {
-                missed &= bvh.may_hit(cur, missed, &packet.frustum, t_far);
+                if !culled {
+                    missed &= bvh.may_hit(cur, missed, &packet.frustum, t_far);
+                }
                 while missed != 0 {
                     let s = missed.trailing_zeros() as usize;
                     missed &= missed - 1;
