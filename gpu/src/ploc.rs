@@ -75,7 +75,7 @@ fn leaf_or_split(c: &SahCost, area: f64, count: u32, children: f64, max_leaf: u3
 }
 
 /// A node of the clustered tree as read back: its box and children (LEAF: a primitive's slot).
-struct Cluster {
+struct ClusterNode {
     bounds: Aabb,
     left: u32,
     right: u32,
@@ -84,7 +84,7 @@ struct Cluster {
 /// core's `ploc::layout`: leaves where a subtree of at most `max_leaf` primitives is cheaper
 /// as one, then the nodes depth first, each node's children a pair; the primitive order of the
 /// leaves. Merged nodes come after their children (`compact` numbers them round by round).
-fn layout(nodes: &[Cluster], root: u32, params: &BuildParams) -> (Vec<BvhNode>, Vec<u32>) {
+fn layout(nodes: &[ClusterNode], root: u32, params: &BuildParams) -> (Vec<BvhNode>, Vec<u32>) {
     let ci = params.cost.intersection as f64;
     let mut count = vec![0u32; nodes.len()];
     let mut cost = vec![0f64; nodes.len()];
@@ -261,11 +261,11 @@ impl GpuPloc {
         let words: Vec<[u32; 8]> = bytemuck::pod_collect_to_vec(&data[0]);
         let sorted: Vec<u32> = bytemuck::pod_collect_to_vec(&data[1]);
         let root = u32::from_le_bytes(data[2][..4].try_into().expect("4 bytes"));
-        let nodes: Vec<Cluster> = words
+        let nodes: Vec<ClusterNode> = words
             .iter()
             .map(|w| {
                 let f = |i: usize| f32::from_bits(w[i]);
-                Cluster {
+                ClusterNode {
                     bounds: Aabb::new(Vec3::new(f(0), f(1), f(2)), Vec3::new(f(3), f(4), f(5))),
                     left: w[6],
                     right: w[7],

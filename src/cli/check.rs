@@ -51,7 +51,7 @@ pub struct CheckArgs {
 
 /// One row of the quality table.
 #[derive(serde::Serialize)]
-struct Quality {
+struct QualityRow {
     name: String,
     nodes: usize,
     max_depth: u32,
@@ -68,11 +68,11 @@ fn quality(
     mesh: &crate::mesh::Mesh,
     camera: &crate::render::Camera,
     trace: crate::bvh::TraceOptions,
-) -> Quality {
+) -> QualityRow {
     let s = TreeStats::of(bvh);
     let f = render(bvh, mesh, camera, &RenderSettings { trace, count: true, progressive: false });
     let r = f.ray_summary();
-    Quality {
+    QualityRow {
         name,
         nodes: s.nodes,
         max_depth: s.max_depth,
@@ -138,7 +138,7 @@ pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
     Ok((o, defects))
 }
 
-fn text(path: &std::path::Path, findings: &[Finding], table: &[Quality], list: usize) -> String {
+fn text(path: &std::path::Path, findings: &[Finding], table: &[QualityRow], list: usize) -> String {
     let mut o = String::new();
     let defects = findings.iter().filter(|f| f.defect).count();
     let warnings = findings.len() - defects;

@@ -7,8 +7,8 @@ use super::args::{BuildArgs, DumpLimit, ViewArgs};
 use super::{load_mesh, progress, CliError};
 use crate::explain::check::MAX_RAYS;
 use crate::explain::grade::{
-    csv_records, discover, document, grade_class, write_html, GradeError, Graded, References, ReportDir, Row, Rubric,
-    Setup, CSV_FILE, HTML_FILE, JSON_FILE,
+    csv_records, discover, document, grade_class, write_html, GradeError, GradeRow, Graded, References, ReportDir,
+    Rubric, Setup, CSV_FILE, HTML_FILE, JSON_FILE,
 };
 use crate::work::WorkControl;
 use clap::Args;
@@ -182,7 +182,7 @@ fn write_report(setup: &Setup, graded: &Graded, dir: &ReportDir) -> Result<(), C
 }
 
 /// The class on stdout: rank, student, verdict and the main figures, in the order given.
-fn summary(rows: &[Row]) -> String {
+fn summary(rows: &[GradeRow]) -> String {
     let w = rows.iter().map(|r| r.name.chars().count()).max().unwrap_or(7).clamp(7, 40);
     let mut o = format!(
         "{:>4}  {:<w$}  {:<10}  {:>9}  {:>8}  {:>11}  {:>8}  first cause\n",

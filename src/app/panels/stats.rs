@@ -8,7 +8,7 @@ use egui_plot::{Bar, BarChart, Plot};
 
 /// A row: its name, what it means (tooltip), and its value for a strategy (`None`: not measured
 /// yet). Per-ray rows are marked, because they depend on the camera as well as on the tree.
-struct Row {
+struct StatRow {
     name: &'static str,
     tip: &'static str,
     per_ray: bool,
@@ -19,99 +19,99 @@ fn rays(f: &StrategyFigures) -> Option<&RaySummary> {
     f.rays.as_ref().map(|r| &r.summary)
 }
 
-const ROWS: &[Row] = &[
-    Row {
+const ROWS: &[StatRow] = &[
+    StatRow {
         name: "Build ms",
         tip: "Time to build the BVH: every level (for two levels, the meshes' BVHs and the top level), with the tree laid out for traversal",
         per_ray: false,
         value: |f| Some(fmt_ms(f.build_ms)),
     },
-    Row {
+    StatRow {
         name: "Nodes",
         tip: "Interior nodes and leaves (for the 4-wide layout: wide nodes and leaf slots)",
         per_ray: false,
         value: |f| Some(f.stats.nodes.to_string()),
     },
-    Row { name: "Leaves", tip: "Nodes that hold triangles", per_ray: false, value: |f| Some(f.stats.leaves.to_string()) },
-    Row {
+    StatRow { name: "Leaves", tip: "Nodes that hold triangles", per_ray: false, value: |f| Some(f.stats.leaves.to_string()) },
+    StatRow {
         name: "Depth max / mean",
         tip: "Levels from the root (depth 0) to the deepest leaf, and the mean over leaves, in levels of this layout",
         per_ray: false,
         value: |f| Some(format!("{} / {:.1}", f.stats.max_depth, f.stats.mean_leaf_depth)),
     },
-    Row {
+    StatRow {
         name: "SAH cost",
         tip: "Surface area heuristic of the whole tree: Σ interior C_trav·A(node)/A(root) + Σ leaves C_isect·N·A(leaf)/A(root). The expected traversal steps plus triangle tests of a random ray through the root box (constants below)",
         per_ray: false,
         value: |f| Some(format!("{:.2}", f.stats.sah_cost)),
     },
-    Row {
+    StatRow {
         name: "EPO",
         tip: "End-point overlap (Aila, Karras & Laine 2013, \"On Quality Metrics of Bounding Volume Hierarchies\"): Σ over nodes of C(n) × the area of other subtrees' triangles inside the node's box, over the total triangle area, with C(n) = C_trav for interior nodes and C_isect × triangles for leaves. A ray that starts or ends on a surface must visit every box around that point; EPO counts the ones that are not its leaf's ancestors, which the SAH does not see. Of the binary tree as built (the 4-wide layout is collapsed from it). Where summing every node would cost more than about the build, the terms it could not afford are estimated from points on the surface: value ± two standard errors",
         per_ray: false,
         value: |f| f.stats.epo.map(|e| crate::bvh::epo::figure(e, f.stats.epo_error)),
     },
-    Row {
+    StatRow {
         name: "References / triangle",
         tip: "Leaf entries per triangle: 1, unless SBVH's spatial splits cut triangles so several leaves reference the parts of one (its growth bound limits this). In parentheses: the spatial splits",
         per_ray: false,
         value: |f| Some(format!("{:.3} ({})", f.stats.references_per_triangle(), f.stats.spatial_splits)),
     },
-    Row {
+    StatRow {
         name: "Bytes / triangle",
         tip: "Memory of the nodes, the triangle index array and the triangles the tree keeps in leaf order (36 bytes each), per triangle",
         per_ray: false,
         value: |f| Some(format!("{:.1}", f.stats.memory_bytes as f64 / f.stats.triangles.max(1) as f64)),
     },
-    Row {
+    StatRow {
         name: "SIMD kernels",
         tip: "What the wide layout's walk runs on this CPU, chosen when the program starts: avx2 (eight boxes in one pass, leaves four triangles per pass), simd4 (four lanes: SSE2 or NEON), scalar. BVHSCOPE_SIMD=simd4 or scalar asks for a more portable one. Every choice finds the same hits with the same counts",
         per_ray: false,
         value: |f| Some(f.stats.simd.unwrap_or("— (binary)").to_string()),
     },
-    Row {
+    StatRow {
         name: "Fallback splits",
         tip: "Nodes where the strategy found no useful split (midpoint with an empty side, SAH with coincident centroids) and an equal-count split was used",
         per_ray: false,
         value: |f| Some(f.stats.fallback_splits.to_string()),
     },
-    Row {
+    StatRow {
         name: "Rays in root box",
         tip: "Share of the frame's primary rays that enter the root box; the others cost one box test and visit nothing. The per-ray rows below are means over these rays, unless they say all rays",
         per_ray: true,
         value: |f| rays(f).map(|r| format!("{:.1} %", 100.0 * r.root_fraction())),
     },
-    Row {
+    StatRow {
         name: "Nodes visited / ray",
         tip: "Nodes taken from the stack and processed (interior and leaf), per ray that enters the root box",
         per_ray: true,
         value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_nodes_visited)),
     },
-    Row {
+    StatRow {
         name: "Box tests / ray",
         tip: "Ray–box slab tests per ray that enters the root box (the root's own test included; a wide node tests each valid child)",
         per_ray: true,
         value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_box_tests)),
     },
-    Row {
+    StatRow {
         name: "Triangle tests / ray",
         tip: "Ray–triangle tests per ray that enters the root box",
         per_ray: true,
         value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_triangle_tests)),
     },
-    Row {
+    StatRow {
         name: "Nodes / ray, all rays",
         tip: "Nodes visited per ray over all primary rays of the frame, those that miss the root box (0 nodes) included",
         per_ray: true,
         value: |f| rays(f).map(|r| format!("{:.2}", r.mean_nodes_visited)),
     },
-    Row {
+    StatRow {
         name: "Tri tests / ray, all rays",
         tip: "Triangle tests per ray over all primary rays of the frame",
         per_ray: true,
         value: |f| rays(f).map(|r| format!("{:.2}", r.mean_triangle_tests)),
     },
-    Row {
+    StatRow {
         name: "Most in one ray",
         tip: "The most nodes visited, and the most triangle tests, of any one ray of the frame",
         per_ray: true,

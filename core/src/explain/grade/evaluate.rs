@@ -5,7 +5,7 @@
 //! checker's and the renderer's cancel points) and even a panic become the row's verdict.
 
 use super::measure::{measure, timed};
-use super::{FindingLine, Images, References, ReportDir, Row, Setup, Submission, Verdict, VersusSah};
+use super::{FindingLine, GradeRow, Images, References, ReportDir, Setup, Submission, Verdict, VersusSah};
 use crate::bvh::imported::Imported;
 use crate::bvh::{AnyBvh, Bvh, TreeView};
 use crate::dump::BvhDump;
@@ -18,13 +18,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Grade one submission: never fails, never panics out (a panic becomes the row's reason).
-pub fn evaluate(sub: &Submission, setup: &Setup, refs: &mut References, out: &ReportDir) -> Row {
+pub fn evaluate(sub: &Submission, setup: &Setup, refs: &mut References, out: &ReportDir) -> GradeRow {
     let start = Instant::now();
     let limit = Duration::from_secs_f64(setup.max_seconds.max(0.001));
     let graded = std::panic::catch_unwind(AssertUnwindSafe(|| {
         let (row, traced) = match with_deadline(limit, |control| checked(sub, setup, &refs.truth, control))? {
-            Checked::Row(row) => return Ok(row),
-            Checked::Traced(row, tree) => (row, tree),
+            CheckedDump::Finished(row) => return Ok(row),
+            CheckedDump::Traced(row, tree) => (row, tree),
         };
         // Outside the submission's time: references of a layout the class had not met yet.
         let layout = traced.0.params().layout;
@@ -35,7 +35,7 @@ pub fn evaluate(sub: &Submission, setup: &Setup, refs: &mut References, out: &Re
     }));
     let mut row = match graded {
         Ok(Ok(row)) => row,
-        Ok(Err(Cancelled)) => Row::not_checked(
+        Ok(Err(Cancelled)) => GradeRow::not_checked(
             sub,
             Verdict::TimedOut,
             format!(
@@ -50,7 +50,7 @@ pub fn evaluate(sub: &Submission, setup: &Setup, refs: &mut References, out: &Re
                 .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
                 .unwrap_or_else(|| "a panic".into());
             let reason = format!("bvhscope failed while grading it ({what}); please report this with the file");
-            Row::not_checked(sub, Verdict::Unreadable, reason)
+            GradeRow::not_checked(sub, Verdict::Unreadable, reason)
         }
     };
     row.seconds = start.elapsed().as_secs_f64();
@@ -85,21 +85,30 @@ fn with_deadline<T>(limit: Duration, work: impl FnOnce(&WorkControl) -> T) -> T 
 }
 
 /// What the check left: a finished row, or a row and the tree to measure.
-enum Checked {
-    Row(Row),
+enum CheckedDump {
+    Finished(GradeRow),
     /// Boxed: the tree is large beside a row, and most rows have none.
-    Traced(Row, Box<(AnyBvh, Imported)>),
+    Traced(GradeRow, Box<(AnyBvh, Imported)>),
 }
 
 /// The dump read and checked: the row's verdict, reason and findings.
-fn checked(sub: &Submission, setup: &Setup, truth: &Reference, control: &WorkControl) -> Result<Checked, Cancelled> {
+fn checked(
+    sub: &Submission,
+    setup: &Setup,
+    truth: &Reference,
+    control: &WorkControl,
+) -> Result<CheckedDump, Cancelled> {
     let Some(path) = &sub.dump else {
         let why = sub.problem.clone().unwrap_or_else(|| "no dump".into());
-        return Ok(Checked::Row(Row::not_checked(sub, Verdict::NoDump, format!("{}: {why}", sub.path.display()))));
+        return Ok(CheckedDump::Finished(GradeRow::not_checked(
+            sub,
+            Verdict::NoDump,
+            format!("{}: {why}", sub.path.display()),
+        )));
     };
     let dump = match BvhDump::read(path, setup.dump_limit) {
         Ok(d) => d,
-        Err(e) => return Ok(Checked::Row(Row::not_checked(sub, Verdict::Unreadable, e.to_string()))),
+        Err(e) => return Ok(CheckedDump::Finished(GradeRow::not_checked(sub, Verdict::Unreadable, e.to_string()))),
     };
     let subject = Subject { dump: &dump, dump_path: path, mesh: setup.mesh, mesh_path: setup.mesh_path };
     let checked = check_with(&subject, truth, &setup.camera, setup.rays, setup.trace, control)?;
@@ -117,7 +126,7 @@ fn checked(sub: &Submission, setup: &Setup, truth: &Reference, control: &WorkCon
             cases: f.examples.len().max(1),
         })
         .collect();
-    let mut row = Row::not_checked(sub, Verdict::Correct, String::new());
+    let mut row = GradeRow::not_checked(sub, Verdict::Correct, String::new());
     row.defects = findings.iter().filter(|f| f.defect).count();
     row.warnings = findings.len() - row.defects;
     row.rays_checked = checked.rays;
@@ -141,21 +150,21 @@ fn checked(sub: &Submission, setup: &Setup, truth: &Reference, control: &WorkCon
         .collect();
     // A tree over another mesh is not measured: its figures would say nothing of the student's work.
     Ok(match checked.tree {
-        Some(tree) if row.verdict != Verdict::WrongMesh => Checked::Traced(row, Box::new(tree)),
-        _ => Checked::Row(row),
+        Some(tree) if row.verdict != Verdict::WrongMesh => CheckedDump::Traced(row, Box::new(tree)),
+        _ => CheckedDump::Finished(row),
     })
 }
 
 /// The traced tree measured, timed and drawn into `row`.
 fn measured(
-    mut row: Row,
+    mut row: GradeRow,
     sub: &Submission,
     (tree, imported): &(AnyBvh, Imported),
     setup: &Setup,
     refs: &References,
     out: &ReportDir,
     control: &WorkControl,
-) -> Result<Row, Cancelled> {
+) -> Result<GradeRow, Cancelled> {
     let layout = tree.params().layout;
     // The EPO is of a binary tree: the dump's own, or a wide dump binarised as the tree view shows it.
     let binary: Option<&Bvh> = match tree {

@@ -9,7 +9,7 @@
 
 use super::measure::Quality;
 use super::page::{SCRIPT, STYLE};
-use super::{Graded, ReportDir, Row, Setup, Verdict};
+use super::{GradeRow, Graded, ReportDir, Setup, Verdict};
 use crate::files::FileError;
 use crate::render::legend::fmt_value;
 use std::fmt::Write as _;
@@ -222,7 +222,7 @@ fn class_table(graded: &Graded) -> String {
     o
 }
 
-fn figures(q: &Quality, row: &Row) -> String {
+fn figures(q: &Quality, row: &GradeRow) -> String {
     let mut o = String::from("<div class=\"figures\">");
     let mut f = |label: &str, value: String| {
         let _ = write!(o, "<div><span>{label}</span> {}</div>", esc(&value));
@@ -262,7 +262,7 @@ fn histogram(h: &[usize]) -> String {
     o
 }
 
-fn student(w: &mut impl Write, row: &Row, out: &ReportDir) -> std::io::Result<()> {
+fn student(w: &mut impl Write, row: &GradeRow, out: &ReportDir) -> std::io::Result<()> {
     let mut o = format!("<section class=\"student\" id=\"s-{}\">\n<h3>{} ", esc(&row.slug), esc(&row.name));
     o += &badge(row.verdict);
     if let Some(k) = row.rank {

@@ -164,7 +164,7 @@ pub struct Images {
 
 /// One student's row.
 #[derive(Clone, Debug, Serialize)]
-pub struct Row {
+pub struct GradeRow {
     /// Order of the submissions as given (after discovery).
     pub index: usize,
     /// The student, by the file or folder handed in.
@@ -204,10 +204,10 @@ pub struct Row {
     pub seconds: f64,
 }
 
-impl Row {
+impl GradeRow {
     /// A row for a submission that was not checked: `verdict` and why.
-    pub fn not_checked(sub: &Submission, verdict: Verdict, reason: String) -> Row {
-        Row {
+    pub fn not_checked(sub: &Submission, verdict: Verdict, reason: String) -> GradeRow {
+        GradeRow {
             index: sub.index,
             name: sub.name.clone(),
             slug: sub.slug.clone(),
@@ -247,7 +247,7 @@ fn lossy_opt<S: serde::Serializer>(p: &Option<PathBuf>, s: S) -> Result<S::Ok, S
 
 /// A graded class: the rows in the order given, and what they were measured against.
 pub struct Graded {
-    pub rows: Vec<Row>,
+    pub rows: Vec<GradeRow>,
     pub references: References,
     /// Seconds spent on the submissions (the references are built before).
     pub seconds: f64,
@@ -263,7 +263,7 @@ pub fn grade_class(
     submissions: &[Submission],
     out: &ReportDir,
     control: &WorkControl,
-    mut on_row: impl FnMut(&Row),
+    mut on_row: impl FnMut(&GradeRow),
 ) -> Graded {
     let start = std::time::Instant::now();
     control.set_total(submissions.len() as u64);

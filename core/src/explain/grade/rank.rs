@@ -3,7 +3,7 @@
 //! 4-wide dump is held to the 4-wide SAH tree; ties go by name, then by the order given, so the
 //! same class ranks the same every time. Incorrect submissions get no rank.
 
-use super::{Row, Verdict, VersusSah};
+use super::{GradeRow, Verdict, VersusSah};
 use serde::Serialize;
 
 /// What ranks the class.
@@ -64,7 +64,7 @@ impl RankBy {
 }
 
 /// Set `rank` on every correct row that was measured (1 = best), and clear it on the others.
-pub fn rank(rows: &mut [Row], by: RankBy) {
+pub fn rank(rows: &mut [GradeRow], by: RankBy) {
     let mut ranked: Vec<(f64, &str, usize, usize)> = rows
         .iter()
         .enumerate()

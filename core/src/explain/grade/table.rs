@@ -3,7 +3,7 @@
 //! the `csv` crate quotes them by RFC 4180 where the CLI writes them (the core has no CSV writer).
 
 use super::measure::leaf_sizes_text;
-use super::Row;
+use super::GradeRow;
 
 pub const HEADER: [&str; 26] = [
     "rank",
@@ -39,7 +39,7 @@ fn opt<T: ToString>(v: Option<T>) -> String {
 }
 
 /// The header, then one record per row.
-pub fn csv_records(rows: &[Row]) -> Vec<Vec<String>> {
+pub fn csv_records(rows: &[GradeRow]) -> Vec<Vec<String>> {
     let mut out = vec![HEADER.map(String::from).to_vec()];
     for r in rows {
         let q = r.quality.as_ref();

@@ -100,9 +100,9 @@ fn a_submission_is_a_file_or_a_folder_holding_one_dump() {
     assert_eq!(subs[1].slug, "002-alice-2");
 }
 
-fn row(name: &str, index: usize, verdict: Verdict, sah: f64) -> Row {
+fn row(name: &str, index: usize, verdict: Verdict, sah: f64) -> GradeRow {
     let sub = Submission { index, name: name.into(), slug: name.into(), path: name.into(), dump: None, problem: None };
-    let mut r = Row::not_checked(&sub, verdict, String::new());
+    let mut r = GradeRow::not_checked(&sub, verdict, String::new());
     r.versus_sah = Some(VersusSah { sah_cost: sah, nodes_per_ray: 2.0 - sah, tri_tests_per_ray: 1.0, trace_time: 1.0 });
     r
 }
@@ -116,7 +116,7 @@ fn ranks_go_to_correct_rows_by_the_key_ties_by_name_and_are_the_same_in_any_orde
         row("abe", 3, Verdict::Correct, 1.2),
         row("zed", 4, Verdict::Correct, f64::NAN),
     ];
-    let ranks = |mut rows: Vec<Row>, by: RankBy| {
+    let ranks = |mut rows: Vec<GradeRow>, by: RankBy| {
         rank(&mut rows, by);
         let mut v: Vec<(String, Option<usize>)> = rows.into_iter().map(|r| (r.name, r.rank)).collect();
         v.sort();
