@@ -4,7 +4,7 @@
 //! `cargo run --release --example write_epo_meshes -- grid /tmp/grid4m.obj ../shared/models/stanford-bunny.obj 58`
 //! (that many copies of a mesh side by side on a square grid, a little apart: 58 bunnies are
 //! 4,028,158 triangles).
-use bvhscope::mesh::{load_obj, write_obj, Mesh};
+use bvhscope::mesh::{load_obj, write_obj};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -17,7 +17,7 @@ fn main() {
         }
         Some("grid") => {
             let (one, _) = load_obj(arg(2).expect("the mesh to repeat")).expect("reading the mesh");
-            grid(&one, arg(3).map_or(58, |c| c.parse().expect("a count")))
+            bvhscope::mesh::generate::grid_of(&one, arg(3).map_or(58, |c| c.parse().expect("a count")))
         }
         _ => panic!("usage: write_epo_meshes needles PATH [COUNT [SEED]] | grid PATH MESH [COPIES]"),
     };
@@ -25,19 +25,4 @@ fn main() {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).expect("create"));
     write_obj(&mesh, &mut f).expect("write");
     println!("wrote {path}: {} triangles", mesh.triangle_count());
-}
-
-/// `copies` of `one` on a square grid in the xz plane, 1.2 of its size apart.
-fn grid(one: &Mesh, copies: u32) -> Mesh {
-    let b = one.bounds();
-    let size = glam::Vec3::from(b.max) - glam::Vec3::from(b.min);
-    let side = (copies as f32).sqrt().ceil() as u32;
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for k in 0..copies {
-        let shift = glam::Vec3::new((k % side) as f32 * size.x * 1.2, 0.0, (k / side) as f32 * size.z * 1.2);
-        let base = positions.len() as u32;
-        positions.extend(one.positions.iter().map(|&p| p + shift));
-        triangles.extend(one.triangles.iter().map(|t| t.map(|v| v + base)));
-    }
-    Mesh::from_triangles("grid", positions, triangles)
 }

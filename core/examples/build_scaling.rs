@@ -8,7 +8,7 @@
 //! with the time each spends outside parallel regions (`bvhscope_core::parallel::serial`), and
 //! projects the speed-up on 16 threads from it with Amdahl's law.
 use bvhscope_core::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
-use bvhscope_core::mesh::{load_obj, write_obj, Mesh};
+use bvhscope_core::mesh::{load_obj, write_obj};
 use bvhscope_core::parallel::measure_serial;
 use std::time::{Duration, Instant};
 
@@ -18,7 +18,7 @@ fn main() {
     match arg(0) {
         Some("grid") => {
             let (one, _) = load_obj(arg(2).expect("the mesh to repeat")).expect("reading the mesh");
-            let mesh = grid(&one, arg(3).map_or(58, |c| c.parse().expect("a count")));
+            let mesh = bvhscope_core::mesh::generate::grid_of(&one, arg(3).map_or(58, |c| c.parse().expect("a count")));
             let path = arg(1).expect("the output path");
             let mut f = std::io::BufWriter::new(std::fs::File::create(path).expect("create"));
             write_obj(&mesh, &mut f).expect("write");
@@ -142,20 +142,4 @@ fn time(path: &str, threads: &[usize], runs: usize, strategies: &[SplitStrategy]
             amdahl(f, 16.0)
         );
     }
-}
-
-/// `copies` of `one` on a square grid in the xz plane, 1.2 of its size apart (as
-/// examples/write_epo_meshes.rs makes them).
-fn grid(one: &Mesh, copies: u32) -> Mesh {
-    let b = one.bounds();
-    let size = glam::Vec3::from(b.max) - glam::Vec3::from(b.min);
-    let side = (copies as f32).sqrt().ceil() as u32;
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for k in 0..copies {
-        let shift = glam::Vec3::new((k % side) as f32 * size.x * 1.2, 0.0, (k / side) as f32 * size.z * 1.2);
-        let base = positions.len() as u32;
-        positions.extend(one.positions.iter().map(|&p| p + shift));
-        triangles.extend(one.triangles.iter().map(|t| t.map(|v| v + base)));
-    }
-    Mesh::from_triangles("grid", positions, triangles)
 }
