@@ -5,6 +5,8 @@
 //! every finite heatmap range draws; the smaller refusals name what is wrong.
 
 mod cli_support;
+#[path = "common/mod.rs"]
+mod common;
 
 use cli_support::{bvhscope, tmp};
 use std::path::{Path, PathBuf};
@@ -14,30 +16,12 @@ fn p(x: &Path) -> String {
     x.to_str().unwrap().to_string()
 }
 
-/// `n` stacked unit triangles and a correct chain-shaped dump over them (depth n - 1).
+/// `n` stacked unit triangles and a correct chain-shaped dump over them (depth n - 1), in files.
 fn chain(n: u32, name: &str) -> (PathBuf, PathBuf) {
     let (obj, json) = (tmp(&format!("{name}.obj")), tmp(&format!("{name}.json")));
-    let mut o = String::new();
-    for k in 0..n {
-        o += &format!("v 0 0 {k}\nv 1 0 {k}\nv 0 1 {k}\n");
-    }
-    for k in 0..n {
-        o += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
-    }
+    let (o, d) = common::chain_texts(n, None);
     std::fs::write(&obj, o).unwrap();
-    let inner = n - 1;
-    let mut nodes = Vec::new();
-    for k in 0..inner {
-        let next = if k + 1 < inner { k + 1 } else { inner + n - 1 };
-        nodes.push(
-            serde_json::json!({"min": [0, 0, k], "max": [1, 1, n - 1], "children": [inner + k, next], "axis": 2}),
-        );
-    }
-    for k in 0..n {
-        nodes.push(serde_json::json!({"min": [0, 0, k], "max": [1, 1, k], "first": k, "count": 1}));
-    }
-    let v = serde_json::json!({"format": "bvhscope-bvh", "version": 1, "primitives": (0..n).collect::<Vec<_>>(), "nodes": nodes});
-    std::fs::write(&json, v.to_string()).unwrap();
+    std::fs::write(&json, d).unwrap();
     (obj, json)
 }
 

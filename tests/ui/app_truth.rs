@@ -150,35 +150,11 @@ fn the_speedup_over_linear_search_is_timed_on_demand() {
     h.get_by_label_contains("× faster: this BVH");
 }
 
-/// A chain of `n` stacked triangles and a correct chain-shaped dump (depth n - 1), in files.
+/// A chain of `n` stacked triangles and a correct chain-shaped dump (depth n - 1), in files;
+/// triangle 7 twice in its leaf: the Tree window says so.
 fn chain(n: u32, name: &str) -> (PathBuf, PathBuf) {
-    let (obj, json) = (temp_file(&format!("{name}.obj"), ""), temp_file(&format!("{name}.json"), ""));
-    let mut o = String::new();
-    for k in 0..n {
-        o += &format!("v 0 0 {k}\nv 1 0 {k}\nv 0 1 {k}\n");
-    }
-    for k in 0..n {
-        o += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
-    }
-    std::fs::write(&obj, o).unwrap();
-    let inner = n - 1;
-    let mut nodes = Vec::new();
-    for k in 0..inner {
-        let next = if k + 1 < inner { k + 1 } else { inner + n - 1 };
-        nodes.push(
-            serde_json::json!({"min": [0, 0, k], "max": [1, 1, n - 1], "children": [inner + k, next], "axis": 2}),
-        );
-    }
-    for k in 0..n {
-        // Triangle 7 twice in its leaf: the Tree window says so.
-        let (first, count) = if k == 7 { (n, 2) } else { (k, 1) };
-        nodes.push(serde_json::json!({"min": [0, 0, k], "max": [1, 1, k], "first": first, "count": count}));
-    }
-    let mut prims: Vec<u32> = (0..n).collect();
-    prims.extend([7, 7]);
-    let v = serde_json::json!({"format": "bvhscope-bvh", "version": 1, "primitives": prims, "nodes": nodes});
-    std::fs::write(&json, v.to_string()).unwrap();
-    (obj, json)
+    let (o, d) = crate::common::chain_texts(n, Some(7));
+    (temp_file(&format!("{name}.obj"), &o), temp_file(&format!("{name}.json"), &d))
 }
 
 /// A deep walk in the Ray window: its steps' indent is capped (the depth written out past it),
