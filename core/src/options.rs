@@ -134,8 +134,8 @@ const LAYOUTS: [Named<Layout>; 3] = [
     Named {
         value: Layout::Wide8,
         name: "wide8",
-        label: "8-wide AVX2",
-        help: "collapsed into 8-wide nodes: eight boxes in one AVX2 pass where the CPU has it (chosen at run time), half as many levels again",
+        label: "8-wide SIMD",
+        help: "collapsed into 8-wide nodes: eight boxes in one AVX2 or AVX-512 pass where the CPU has it (chosen at run time), half as many levels again",
     },
 ];
 choice!(Layout, LAYOUTS, 3);

@@ -85,3 +85,26 @@ fn look_grade_report() {
     });
     save(&mut h, "app-grade-report");
 }
+
+/// Trace on: GPU (issues 38 and 39): the default scene's heatmap of nodes visited, LBVH built and
+/// traced on the GPU (lavapipe here), with the "Traced on" line and the GPU build's phases.
+#[test]
+#[ignore]
+fn look_gpu_frame() {
+    use bvhscope::app::gpu::Probe;
+    let mut h = looking();
+    run_until(&mut h, "the first frame", idle);
+    run_until(&mut h, "the look for a GPU", |a| !matches!(a.jobs.gpu.probe, Probe::Looking));
+    let mut s = h.state().settings.clone();
+    s.view = bvhscope::render::View::Visits;
+    s.build.strategy = bvhscope::bvh::SplitStrategy::Lbvh;
+    s.device = bvhscope::cli::Device::Gpu;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    h.state_mut().reconcile();
+    run_until(&mut h, "lbvh built and traced on the GPU", |a| {
+        idle(a)
+            && a.shown.as_ref().is_some_and(|s| s.gpu.is_some())
+            && a.current_bvh().is_some_and(|b| a.jobs.gpu.build_of(&b.bvh).is_some())
+    });
+    save(&mut h, "app-gpu-lbvh");
+}

@@ -139,9 +139,14 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
 
     ui.add_space(4.0);
     ui.label("Layout");
-    ui.add_enabled_ui(!on, |ui| radios(ui, &mut s.build.layout));
+    // On the GPU the tree is built binary and traced in the GPU's own node format (View ▸ GPU
+    // nodes): the CPU's layout choice would show one thing and trace another.
+    let gpu = s.device == crate::cli::Device::Gpu;
+    ui.add_enabled_ui(!on && !gpu, |ui| radios(ui, &mut s.build.layout));
     if on {
         ui.weak("The imported tree keeps its own layout and leaves.");
+    } else if gpu {
+        ui.weak("Traced on the GPU in its own node format: GPU nodes, under View.");
     }
     ui.label("Traversal order (binary layout)");
     radios(ui, &mut s.trace.order);
