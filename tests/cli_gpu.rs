@@ -156,6 +156,10 @@ fn a_gpu_build_of_lbvh_and_ploc_exports_the_cpus_dump_and_stats_gives_its_phases
         };
         let (gpu, cpu) = (dump("gpu"), dump("cpu"));
         assert!(gpu.len() > 1000 && gpu == cpu, "{strategy}: the GPU's dump differs from the CPU's");
+        // And the checker finds no defect in the GPU's tree (issue 39: "checked by check with zero defects").
+        let gpu_dump = tmp(&format!("{strategy}-gpu.json"));
+        let checked = ok(&["check", torus, "--bvh", gpu_dump.to_str().unwrap(), "--rays", "5000", "--size", "48x32"]).0;
+        assert!(checked.contains(": 0 defects"), "{checked}");
         let (text, _) = ok(&["stats", torus, "--strategy", strategy, "--device", "gpu", "--no-rays"]);
         let line = text.lines().find(|l| l.starts_with("GPU build")).unwrap_or_else(|| panic!("{text}"));
         for phase in ["upload", "codes", "sort", "download"] {

@@ -107,4 +107,15 @@ fn look_gpu_frame() {
             && a.current_bvh().is_some_and(|b| a.jobs.gpu.build_of(&b.bvh).is_some())
     });
     save(&mut h, "app-gpu-lbvh");
+    // PLOC's rounds on the GPU too (its phases: clustering, the layout on the host).
+    let mut s = h.state().settings.clone();
+    s.build.strategy = bvhscope::bvh::SplitStrategy::Ploc;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    h.state_mut().reconcile();
+    run_until(&mut h, "ploc built and traced on the GPU", |a| {
+        idle(a)
+            && a.shown.as_ref().is_some_and(|s| s.gpu.is_some())
+            && a.current_bvh().is_some_and(|b| b.bvh.label().contains("PLOC") && a.jobs.gpu.build_of(&b.bvh).is_some())
+    });
+    save(&mut h, "app-gpu-ploc");
 }
