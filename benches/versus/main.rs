@@ -7,6 +7,12 @@
 //! `BENCH_COUNTS=1` only the work per ray (nodes, triangle tests) of our strategies' trees,
 //! `BENCH_KERNELS=1` only our SIMD kernels (four lanes, AVX2, AVX-512) raced on one tree, alternated
 //! with Embree (`BENCH_KERNEL_LEAVES=16:10,…` adds trees of larger leaves: leaf size : traversal cost).
+//! `BENCH_THREADS=1,2,4,8,16` only the scaling tables (`scaling.rs`): per phase (OBJ load, each
+//! strategy's build and Embree's, EPO, a counted and a packet 4K frame) the median time on each
+//! thread count, the speed-up over one thread, and the serial fraction measured on this machine with
+//! its Amdahl projection for 16 threads; counts above the machine's cores run, flagged
+//! oversubscribed. `BENCH_SCALING_MESH=path.obj` times another mesh than the bunny,
+//! `BENCH_SCALING_REPS=n` runs per thread count (3).
 //! Tuning: `BENCH_TRAVERSAL_COST=c` and `BENCH_MAX_LEAF=n` build our trees with that SAH traversal
 //! cost and leaf size; `BENCH_EMBREE_ISA=avx2` asks Embree for its kernels of another CPU,
 //! `BENCH_EMBREE_ROBUST=1` for its robust mode.
@@ -18,6 +24,7 @@ mod embree;
 mod kernels;
 mod ratios;
 mod rays;
+mod scaling;
 mod scenes;
 
 use bvhscope::bvh::Layout;
@@ -347,6 +354,12 @@ fn main() {
     // Wake both pools' threads once, so the first contender's figures do not include their start.
     for pool in [&one, &all] {
         pool.install(|| (0..1 << 20).into_par_iter().map(|i: u64| i * i).sum::<u64>());
+    }
+
+    // BENCH_THREADS=1,2,…: only the scaling tables (`scaling.rs`), on pools of their own.
+    if let Ok(list) = std::env::var("BENCH_THREADS") {
+        print!("{}", scaling::table(&scaling::thread_counts(&list)));
+        return;
     }
 
     let mut contenders = vec![];

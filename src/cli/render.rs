@@ -251,7 +251,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         None => img,
     };
     crate::files::write_png(&a.output, &img)?;
-    let hits = frame.traced().filter(|(s, _)| s.is_hit()).count();
+    let hits = frame.hit_count();
     let legend_note = if legend.is_some() { " with the legend below" } else { "" };
     eprint!(
         "wrote {} ({}x{} image, {}x{} render{legend_note}; {} of {} pixels hit",

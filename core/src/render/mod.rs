@@ -6,6 +6,7 @@ pub mod animation;
 mod camera;
 mod colormap;
 pub mod diff;
+mod exact_stats;
 mod frame;
 mod incoherent;
 pub mod legend;

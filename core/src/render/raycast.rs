@@ -1,10 +1,11 @@
 //! Progressive ray casting: pass 1 traces every 8th pixel in x and y, then every 4th, 2nd, and
 //! finally the rest, each pass tracing only pixels no earlier pass traced, so the full frame costs
-//! one ray per pixel in total. Work is split into bands of 16-pixel-square tiles run on rayon; the
-//! cancel flag is read before each band, and the caller sees the frame after each pass. Without
-//! counters, an accelerator that traces packets (both BVH layouts, `bvh::packet`; not the linear
-//! scan) gets each pass in packets of up to 8×8 pixels of the pass's grid; with counters on (the
-//! heatmaps, and the app, which counts for its hover read-out) every ray is traced alone.
+//! one ray per pixel in total. Work is split into bands of 16 rows, cut into pieces of 128 columns
+//! (traced in 16-pixel-square tiles) run on rayon; the cancel flag is read before each piece, and
+//! the caller sees the frame after each pass. Without counters, an accelerator that traces packets
+//! (both BVH layouts, `bvh::packet`; not the linear scan) gets each pass in packets of up to 8×8
+//! pixels of the pass's grid; with counters on (the heatmaps, and the app, which counts for its
+//! hover read-out) every ray is traced alone.
 
 use super::{Camera, Frame, FramePool, PixelSample};
 use crate::bvh::packet::{packet_position, PACKET, PACKET_SIDE};
@@ -129,23 +130,24 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
     fn trace<S: TraversalStats + Default + Into<RayCounters>>(&self, frame: &mut Frame) -> u64 {
         let Pass { accel, mesh, camera, trace, stride, previous, control } = *self;
         let gen = camera.ray_gen();
-        let w = frame.width();
-        for_each_band(frame, control, |y0, rows, samples, counters| {
+        for_each_piece(frame, control, |piece| {
             let mut traced = 0u64;
-            for x0 in (0..w).step_by(TILE as usize) {
-                for dy in (0..rows).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
+            let Piece { y0, x0, x1, mut samples, mut counters } = piece;
+            // Tile by tile across the piece: neighbouring rays walk the same nodes.
+            for t0 in (x0..x1).step_by(TILE as usize) {
+                for dy in (0..samples.len() as u32).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
                     let y = y0 + dy;
-                    for x in (x0..(x0 + TILE).min(w)).step_by(stride as usize) {
+                    for x in (t0..(t0 + TILE).min(x1)).step_by(stride as usize) {
                         if previous != 0 && x.is_multiple_of(previous) && y.is_multiple_of(previous) {
                             continue;
                         }
                         let mut ray = gen.pixel_ray(x, y);
                         let mut stats = S::default();
                         let hit = accel.closest_hit(&mut ray, trace, &mut stats);
-                        let i = (dy * w + x) as usize;
-                        samples[i] = sample(mesh, &ray, hit);
-                        if let Some(c) = counters.get_mut(i) {
-                            *c = stats.into();
+                        let i = (x - x0) as usize;
+                        samples[dy as usize][i] = sample(mesh, &ray, hit);
+                        if let Some(c) = counters.get_mut(dy as usize) {
+                            c[i] = stats.into();
                         }
                         traced += 1;
                     }
@@ -156,37 +158,82 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
     }
 }
 
-/// Run `trace_band(y0, rows, samples, counters)` on each band of `TILE` rows in parallel (rayon),
-/// skipping bands once the control is cancelled; `counters` is the band's counters, or empty when
-/// the frame does not count. The closure returns the rays it traced, which are added to the
-/// control's progress and summed.
-fn for_each_band(
-    frame: &mut Frame,
-    control: &WorkControl,
-    trace_band: impl Fn(u32, u32, &mut [PixelSample], &mut [RayCounters]) -> u64 + Sync,
-) -> u64 {
-    let band = (frame.width() * TILE) as usize;
+/// Columns of a piece: a multiple of every pass's packet span (`PACKET_SIDE` × the largest
+/// stride, 64), so the packets of a pass are those of the whole band, and pieces small enough
+/// (2,048 pixels) that 16 threads share a 4K frame's 4,000 of them evenly where the mesh makes
+/// some rows far costlier than others (the band alone, 135 of them, left threads idle at the end).
+const PIECE_COLUMNS: u32 = 128;
+
+/// A piece of a band for one task: `TILE` rows (fewer at the bottom) from row `y0`, columns
+/// `x0..x1`; its slots row by row, each row's from `x0`, and its counters likewise (no rows when the
+/// frame does not count).
+struct Piece<'a> {
+    y0: u32,
+    x0: u32,
+    x1: u32,
+    samples: Vec<&'a mut [PixelSample]>,
+    counters: Vec<&'a mut [RayCounters]>,
+}
+
+/// Run `trace_piece` on each piece of each band of `TILE` rows in parallel (rayon: the bands, and
+/// in each band its pieces, split on the worker that takes the band), skipping pieces once the
+/// control is cancelled. The closure returns the rays it traced, which are added to the control's
+/// progress and summed.
+fn for_each_piece(frame: &mut Frame, control: &WorkControl, trace_piece: impl Fn(Piece) -> u64 + Sync) -> u64 {
     let w = frame.width() as usize;
+    let band = w * TILE as usize;
     let (samples, counters) = frame.slots_mut();
+    if w == 0 {
+        return 0;
+    }
+    let bands = samples.len().div_ceil(band);
     let counter_bands: Vec<&mut [RayCounters]> = if counters.is_empty() {
-        samples.chunks(band).map(|_| Default::default()).collect()
+        (0..bands).map(|_| Default::default()).collect()
     } else {
         counters.chunks_mut(band).collect()
     };
-    samples
-        .par_chunks_mut(band)
-        .zip(counter_bands)
-        .enumerate()
-        .map(|(band, (samples, counters))| {
-            if control.is_cancelled() {
-                return 0;
+    // Each row cut at the pieces' columns, the cuts dealt to the pieces.
+    fn cut<T>(band: &mut [T], w: usize) -> Vec<Vec<&mut [T]>> {
+        let mut pieces: Vec<Vec<&mut [T]>> = Vec::new();
+        for row in band.chunks_mut(w) {
+            for (k, part) in row.chunks_mut(PIECE_COLUMNS as usize).enumerate() {
+                match pieces.get_mut(k) {
+                    Some(p) => p.push(part),
+                    None => pieces.push(vec![part]),
+                }
             }
-            let rows = (samples.len() / w) as u32;
-            let traced = trace_band(band as u32 * TILE, rows, samples, counters);
-            control.add_done(traced);
-            traced
-        })
-        .sum()
+        }
+        pieces
+    }
+    crate::parallel::region(|| {
+        samples
+            .par_chunks_mut(band)
+            .zip(counter_bands)
+            .enumerate()
+            .map(|(b, (samples, counters))| {
+                let mut counters = cut(counters, w).into_iter();
+                let pieces: Vec<Piece> = (cut(samples, w).into_iter().enumerate())
+                    .map(|(k, samples)| {
+                        let x0 = k as u32 * PIECE_COLUMNS;
+                        let x1 = (x0 + PIECE_COLUMNS).min(w as u32);
+                        let counters = counters.next().unwrap_or_default();
+                        Piece { y0: b as u32 * TILE, x0, x1, samples, counters }
+                    })
+                    .collect();
+                pieces
+                    .into_par_iter()
+                    .map(|piece| {
+                        if control.is_cancelled() {
+                            return 0;
+                        }
+                        let traced = trace_piece(piece);
+                        control.add_done(traced);
+                        traced
+                    })
+                    .sum::<u64>()
+            })
+            .sum()
+    })
 }
 
 /// The pixel a ray's closest hit (or miss) shows (also what `Frame::from_hits` makes of hits
@@ -208,16 +255,18 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
     fn trace_packets(&self, frame: &mut Frame) -> u64 {
         let Pass { accel, mesh, camera, trace, stride, previous, control } = *self;
         let gen = camera.ray_gen();
-        let w = frame.width();
         let span = PACKET_SIDE * stride;
-        for_each_band(frame, control, |y0, rows, samples, _| {
+        for_each_piece(frame, control, |piece| {
+            let Piece { y0, x0, x1, mut samples, .. } = piece;
+            let rows = samples.len() as u32;
             let mut traced = 0u64;
             let mut rays = Vec::with_capacity(PACKET);
             let mut pixels = Vec::with_capacity(PACKET);
             let mut hits = [None; PACKET];
-            // Bands start on a multiple of TILE, which every stride divides: row 0 is on the grid.
+            // Bands start on a multiple of TILE, which every stride divides: row 0 is on the grid;
+            // pieces on a multiple of `PIECE_COLUMNS`, which every span divides.
             for by in (0..rows).step_by(span as usize) {
-                for bx in (0..w).step_by(span as usize) {
+                for bx in (x0..x1).step_by(span as usize) {
                     rays.clear();
                     pixels.clear();
                     for k in 0..PACKET as u32 {
@@ -225,15 +274,15 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
                         let (x, dy) = (bx + gx * stride, by + gy * stride);
                         let done_before =
                             previous != 0 && x.is_multiple_of(previous) && (y0 + dy).is_multiple_of(previous);
-                        if x < w && dy < rows && !done_before {
+                        if x < x1 && dy < rows && !done_before {
                             rays.push(gen.pixel_ray(x, y0 + dy));
-                            pixels.push((dy * w + x) as usize);
+                            pixels.push((dy as usize, (x - x0) as usize));
                         }
                     }
                     let hits = &mut hits[..rays.len()];
                     accel.closest_hits(&mut rays, hits, trace);
-                    for ((ray, hit), &i) in rays.iter().zip(hits.iter()).zip(&pixels) {
-                        samples[i] = sample(mesh, ray, *hit);
+                    for ((ray, hit), &(dy, i)) in rays.iter().zip(hits.iter()).zip(&pixels) {
+                        samples[dy][i] = sample(mesh, ray, *hit);
                     }
                     traced += rays.len() as u64;
                 }
@@ -329,6 +378,54 @@ mod tests {
             for (i, (p, c)) in samples.iter().zip(counted.full_samples().unwrap()).enumerate() {
                 assert_eq!(p.t.to_bits(), c.t.to_bits(), "{layout:?}: pixel {i}");
                 assert!(counted.counters(i as u32 % 45, i as u32 / 45).box_tests >= 1, "{layout:?}: pixel {i}");
+            }
+        }
+    }
+
+    /// The pieces are shared among however many threads there are: the frame, its images and
+    /// the heatmap's legend are the same on one thread and on three, counted and in packets.
+    #[test]
+    fn a_frame_is_the_same_on_one_thread_and_on_three() {
+        use crate::render::{draw_legend, view_image, ColorMap, HeatRange, View};
+        let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 128, 12);
+        // Wider than a piece, with partial pieces and bands at the right and bottom edges.
+        let cam = Camera::framing_from(&mesh.bounds(), 301, 45, Vec3::new(0.3, 0.5, 1.0), 45.0);
+        let bvh = crate::bvh::AnyBvh::build(&mesh, &BuildParams::default());
+        let cost = BuildParams::default().cost;
+        let on = |threads: usize, settings: RenderSettings, view: View| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut passes = Vec::new();
+                let f = render_progressive(
+                    &bvh,
+                    &mesh,
+                    &cam,
+                    &settings,
+                    &FramePool::default(),
+                    &WorkControl::new(),
+                    |f, _| passes.push(view_image(f, view, ColorMap::Viridis, HeatRange::Auto, cost).0),
+                )
+                .unwrap();
+                assert_eq!(f.hit_count(), f.traced().filter(|(s, _)| s.is_hit()).count());
+                let (img, legend) = view_image(&f, view, ColorMap::Viridis, HeatRange::Auto, cost);
+                let img = legend.as_ref().map_or(img.clone(), |l| draw_legend(&img, l));
+                (
+                    f.full_samples().unwrap().to_vec(),
+                    f.traced().map(|(_, c)| c).collect::<Vec<_>>(),
+                    passes,
+                    img,
+                    legend,
+                )
+            })
+        };
+        for progressive in [false, true] {
+            for (count, view) in
+                [(true, View::Visits), (true, View::Cost), (false, View::Normals), (false, View::Depth)]
+            {
+                let settings = RenderSettings { count, progressive, ..Default::default() };
+                let one = on(1, settings, view);
+                assert!(one.0.iter().any(|s| s.is_hit()), "{view:?}");
+                assert!(on(3, settings, view) == one, "{view:?}, progressive {progressive}");
             }
         }
     }

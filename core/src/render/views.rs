@@ -1,6 +1,7 @@
 //! Turning a frame into pixels: the normal view (n·0.5+0.5, as the handout's normal integrator),
 //! depth, and heatmaps of per-ray work through a perceptual colour map.
 
+use super::exact_stats::exact_stats;
 use super::warp::{WarpSize, WarpView, WarpWork};
 use super::{ColorMap, Frame};
 use crate::bvh::{RayCounters, SahCost};
@@ -126,15 +127,33 @@ pub fn hottest(frame: &Frame, view: View, cost: SahCost, k: usize) -> Option<(u3
     Some((i % w, i / w, v))
 }
 
-/// Min, max and mean of a heatmap metric over the traced rays.
+/// Min, max and mean of a heatmap metric over the traced rays: the serial loop's figures, found
+/// row by row in parallel (`exact_stats`).
 pub fn metric_stats(frame: &Frame, view: View, cost: SahCost) -> (f32, f32, f64) {
-    let (mut lo, mut hi, mut sum, mut n) = (f32::INFINITY, f32::NEG_INFINITY, 0f64, 0u64);
-    for v in values(frame, view, cost) {
-        lo = lo.min(v);
-        hi = hi.max(v);
-        sum += v as f64;
-        n += 1;
-    }
+    let stats = match view.warp() {
+        Some(_) => {
+            exact_stats(&grid_values(frame, view, cost), 4096, |values, acc| values.iter().for_each(|&v| acc.add(v)))
+        }
+        None => {
+            let rows: Vec<u32> = (0..traced_size(frame).1).collect();
+            exact_stats(&rows, 4, |rows, acc| {
+                for &gy in rows {
+                    frame.grid_row(gy).for_each(|(_, c)| acc.add(view.metric(&c, cost)));
+                }
+            })
+        }
+    };
+    let serial = || {
+        let (mut lo, mut hi, mut sum, mut n) = (f32::INFINITY, f32::NEG_INFINITY, 0f64, 0u64);
+        for v in values(frame, view, cost) {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            sum += v as f64;
+            n += 1;
+        }
+        (lo, hi, sum, n)
+    };
+    let (lo, hi, sum, n) = stats.unwrap_or_else(serial);
     if n == 0 {
         (0.0, 0.0, 0.0)
     } else {
@@ -182,11 +201,17 @@ pub fn view_image(
             None,
         ),
         View::Depth => {
-            let (mut near, mut far) = (f32::INFINITY, 0f32);
-            for (s, _) in frame.traced().filter(|(s, _)| s.is_hit()) {
-                near = near.min(s.t);
-                far = far.max(s.t);
-            }
+            // Rows in parallel: a minimum and a maximum do not depend on the order.
+            let rows = traced_size(frame).1;
+            let (near, far) = crate::parallel::region(|| {
+                (0..rows)
+                    .into_par_iter()
+                    .map(|gy| {
+                        let hits = frame.grid_row(gy).filter(|(s, _)| s.is_hit());
+                        hits.fold((f32::INFINITY, 0f32), |(n, f), (s, _)| (n.min(s.t), f.max(s.t)))
+                    })
+                    .reduce(|| (f32::INFINITY, 0f32), |a, b| (a.0.min(b.0), a.1.max(b.1)))
+            });
             let span = (far - near).max(1e-20);
             let img = grid_image(frame, |s, _| {
                 if !s.is_hit() {
@@ -284,10 +309,12 @@ fn grid_image(frame: &Frame, pixel: impl Fn(&super::PixelSample, RayCounters) ->
     if w == 0 {
         return RgbImage::new(0, h);
     }
-    buf.par_chunks_mut(w as usize * 3).enumerate().for_each(|(gy, row)| {
-        for (rgb, (s, c)) in row.chunks_exact_mut(3).zip(frame.grid_row(gy as u32)) {
-            rgb.copy_from_slice(&pixel(s, c));
-        }
+    crate::parallel::region(|| {
+        buf.par_chunks_mut(w as usize * 3).enumerate().for_each(|(gy, row)| {
+            for (rgb, (s, c)) in row.chunks_exact_mut(3).zip(frame.grid_row(gy as u32)) {
+                rgb.copy_from_slice(&pixel(s, c));
+            }
+        })
     });
     RgbImage::from_raw(w, h, buf).expect("the buffer holds w×h pixels")
 }
