@@ -12,7 +12,7 @@
 //! thread count, the speed-up over one thread, and the serial fraction measured on this machine with
 //! its Amdahl projection for 16 threads; counts above the machine's cores run, flagged
 //! oversubscribed. `BENCH_SCALING_MESH=path.obj` times another mesh than the bunny,
-//! `BENCH_SCALING_REPS=n` runs per thread count (3).
+//! `BENCH_SCALING_REPS=n` runs per thread count (3), `BENCH_SCALING_ONLY=frame,…` some phases.
 //! Tuning: `BENCH_TRAVERSAL_COST=c` and `BENCH_MAX_LEAF=n` build our trees with that SAH traversal
 //! cost and leaf size; `BENCH_EMBREE_ISA=avx2` asks Embree for its kernels of another CPU,
 //! `BENCH_EMBREE_ROBUST=1` for its robust mode.

@@ -1,9 +1,9 @@
 //! `BENCH_THREADS=1,2,4,8,16`: how each phase scales with the thread count (issue 37). Per phase —
 //! the OBJ load, each strategy's build, EPO of the SAH tree, a counted frame (the visits heatmap:
 //! single rays with counters) and a packet frame (normals: 8×8 packets), both 3840×2160 with their
-//! image made, without PNG encoding, which has its own row — the median time on a rayon pool of each
-//! thread count and the speed-up over one thread, with Embree's builds beside ours where it was
-//! found. Counts above this machine's cores still run, flagged as oversubscribed.
+//! image made, without PNG encoding, which has rows of its own — the median time on a rayon pool
+//! of each thread count and the speed-up over one thread, with Embree's builds beside ours where it
+//! was found. Counts above this machine's cores still run, flagged as oversubscribed.
 //!
 //! A machine with few cores cannot show 16 threads, so each phase's serial fraction f is measured
 //! as well (`parallel::measure_serial`: the time outside the stretches marked parallel, on one
@@ -13,7 +13,8 @@
 //!
 //! The mesh: the bunny of `../shared/models`, or `BENCH_SCALING_MESH=path.obj`;
 //! `BENCH_SCALING_REPS=n` runs per phase and thread count (default 3, the thread counts taking
-//! turns so that the machine's drift falls on all of them).
+//! turns so that the machine's drift falls on all of them); `BENCH_SCALING_ONLY=frame,png` keeps
+//! the phases whose names contain a word.
 
 use bvhscope::bvh::{epo, AnyBvh, BuildParams, Bvh, Hierarchy, Layout, SplitStrategy};
 use bvhscope::mesh::{load_obj, Mesh};
@@ -111,17 +112,21 @@ fn phases<'a>(path: &'a PathBuf, mesh: &'a Mesh, sah: &'a Bvh, frame_bvh: &'a An
     };
     v.push(phase(&format!("counted frame {w}×{h}"), Box::new(move || timed(|| frame(View::Visits)))));
     v.push(phase(&format!("packet frame {w}×{h}"), Box::new(move || timed(|| frame(View::Normals)))));
-    let (_, image) = frame(View::Visits);
-    v.push(phase(
-        "PNG encoding of the counted frame",
-        Box::new(move || {
-            timed(|| {
-                let mut bytes = Vec::new();
-                image.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).expect("encoding");
-                bytes
-            })
-        }),
-    ));
+    // PNG encoding, on one thread whatever the pool (the `png` crate's deflate is serial): what
+    // `render` does after the frame, for both images.
+    for (what, view) in [("counted", View::Visits), ("packet", View::Normals)] {
+        let (_, image) = frame(view);
+        v.push(phase(
+            &format!("PNG encoding, {what} frame's image"),
+            Box::new(move || {
+                timed(|| {
+                    let mut bytes = Vec::new();
+                    image.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).expect("encoding");
+                    bytes
+                })
+            }),
+        ));
+    }
     v
 }
 
@@ -137,8 +142,13 @@ pub fn table(threads: &[usize]) -> String {
     let all = pools.last().expect("a pool");
     let sah = all.install(|| Bvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..Default::default() }));
     let frame_bvh = all.install(|| AnyBvh::build(&mesh, &BuildParams::default()));
+    let mut phases = phases(&path, &mesh, &sah, &frame_bvh);
+    if let Ok(only) = std::env::var("BENCH_SCALING_ONLY") {
+        let words: Vec<String> = only.split(',').map(|w| w.trim().to_lowercase()).collect();
+        phases.retain(|p| words.iter().any(|w| p.name.to_lowercase().contains(w.as_str())));
+    }
     let mut rows = Vec::new();
-    for p in phases(&path, &mesh, &sah, &frame_bvh) {
+    for p in phases {
         eprintln!("  {} ...", p.name);
         let mut times = vec![Vec::new(); threads.len()];
         let mut serial = Vec::new();
