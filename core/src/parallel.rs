@@ -183,6 +183,17 @@ pub fn region<R>(f: impl FnOnce() -> R) -> R {
     r
 }
 
+/// `region(f)` where `wide` (the stretch has work for 16 threads), else `f()`: a pass over a
+/// few chunks stays serial in the count, as it would be on 16 threads.
+#[inline]
+pub fn region_if<R>(wide: bool, f: impl FnOnce() -> R) -> R {
+    if wide {
+        region(f)
+    } else {
+        f()
+    }
+}
+
 /// Run `f` on a pool of one thread and return, with its result, the time it spent outside every
 /// `region`: the serial part of Amdahl's law, for projecting a speed-up on more cores than this
 /// machine has. What is not marked as a region counts as serial, so a stretch overlooked makes the

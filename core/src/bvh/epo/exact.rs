@@ -28,7 +28,9 @@ pub(super) struct Prepared<'a> {
 
 impl<'a> Prepared<'a> {
     pub fn new(bvh: &'a Bvh, h: &'a Hierarchy) -> Prepared<'a> {
-        let areas: Vec<f64> = bvh.tris.par_iter().map(triangle_area).collect();
+        // Passes over every triangle and node: parallel regions where they give 16 threads work.
+        let wide = bvh.tris.len() >= crate::parallel::PARTITION_MIN;
+        let areas: Vec<f64> = crate::parallel::region_if(wide, || bvh.tris.par_iter().map(triangle_area).collect());
         let mut prefix = Vec::with_capacity(areas.len() + 1);
         let mut sum = 0f64;
         prefix.push(0.0);
@@ -37,15 +39,17 @@ impl<'a> Prepared<'a> {
             prefix.push(sum);
         }
         let nodes = &bvh.nodes;
-        let sound = (0..nodes.len()).into_par_iter().all(|i| {
-            let (node, b) = (&nodes[i], nodes[i].bounds());
-            if node.is_leaf() {
-                node.prims().all(|s| bvh.tris.get(s).is_some_and(|t| inside(&tri_box(t), &b)))
-            } else {
-                [node.index as usize, node.index as usize + 1]
-                    .iter()
-                    .all(|&c| c > i && nodes.get(c).is_some_and(|c| inside(&c.bounds(), &b)))
-            }
+        let sound = crate::parallel::region_if(wide, || {
+            (0..nodes.len()).into_par_iter().all(|i| {
+                let (node, b) = (&nodes[i], nodes[i].bounds());
+                if node.is_leaf() {
+                    node.prims().all(|s| bvh.tris.get(s).is_some_and(|t| inside(&tri_box(t), &b)))
+                } else {
+                    [node.index as usize, node.index as usize + 1]
+                        .iter()
+                        .all(|&c| c > i && nodes.get(c).is_some_and(|c| inside(&c.bounds(), &b)))
+                }
+            })
         });
         let cover = (!sound).then(|| {
             let mut cover: Vec<Aabb> = nodes.iter().map(|n| n.bounds()).collect();

@@ -188,7 +188,10 @@ fn measure_with(bvh: &Bvh, h: &Hierarchy, budget: u64, seed: u64, by: Estimator)
     let mut terms = vec![0.0; n];
     let exact_budget = (budget as f64 * EXACT_SHARE) as u64;
     let walk = |nodes: &[u32], cap: u64| -> Vec<(Option<f64>, u64)> {
-        nodes.par_iter().map_init(Vec::new, |stack, &m| p.walk(m as usize, cap, stack)).collect()
+        // Marked parallel (issue 37's serial fraction) where 16 threads would each get some nodes.
+        crate::parallel::region_if(nodes.len() >= 16, || {
+            nodes.par_iter().map_init(Vec::new, |stack, &m| p.walk(m as usize, cap, stack)).collect()
+        })
     };
     let mut spent = 0u64;
     let mut hard = Vec::new();

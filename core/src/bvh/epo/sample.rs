@@ -143,8 +143,12 @@ pub(super) fn estimate(p: &Prepared, hard: &[u32], budget: u64, seed: u64, by: E
         // Counted by node (the walks find nodes, not places in `hard`).
         let hits: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(0)).collect();
         let k = ((left / per_point) as usize).clamp(MIN_POINTS, MAX_POINTS);
-        for r in 0..REPLICATES as u64 {
-            let w = q.walks(r, k, Some(&hits));
+        // The replicates side by side (each a few chunks on a small mesh: one at a time left 16
+        // threads idle); each one's sums are its own, so the figures do not depend on the order.
+        let walked: Vec<Walked> = crate::parallel::region(|| {
+            (0..REPLICATES as u64).into_par_iter().map(|r| q.walks(r, k, Some(&hits))).collect()
+        });
+        for w in walked {
             estimates.push(w.sum / k as f64);
             work += w.work;
         }
@@ -228,19 +232,22 @@ impl Query<'_, '_> {
     /// node's hits into `hits`.
     fn walks(&self, r: u64, k: usize, hits: Option<&[AtomicU32]>) -> Walked {
         let offset = self.offset(r);
-        let chunks: Vec<Walked> = (0..k.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|c| {
-                let mut stack = Vec::new();
-                let mut out = Walked::default();
-                for (slot, point) in self.spread(r, offset, c * CHUNK..((c + 1) * CHUNK).min(k), k) {
-                    let (g, g2, w) = self.g(slot, point, &mut stack, hits);
-                    (out.sum, out.squares, out.weighted_hits, out.work) =
-                        (out.sum + g, out.squares + g * g, out.weighted_hits + g2, out.work + w);
-                }
-                out
-            })
-            .collect();
+        let wide = k.div_ceil(CHUNK) >= 16;
+        let chunks: Vec<Walked> = crate::parallel::region_if(wide, || {
+            (0..k.div_ceil(CHUNK))
+                .into_par_iter()
+                .map(|c| {
+                    let mut stack = Vec::new();
+                    let mut out = Walked::default();
+                    for (slot, point) in self.spread(r, offset, c * CHUNK..((c + 1) * CHUNK).min(k), k) {
+                        let (g, g2, w) = self.g(slot, point, &mut stack, hits);
+                        (out.sum, out.squares, out.weighted_hits, out.work) =
+                            (out.sum + g, out.squares + g * g, out.weighted_hits + g2, out.work + w);
+                    }
+                    out
+                })
+                .collect()
+        });
         chunks.iter().fold(Walked::default(), |a, c| Walked {
             sum: a.sum + c.sum,
             squares: a.squares + c.squares,
@@ -254,40 +261,45 @@ impl Query<'_, '_> {
     /// over `share`, are added to `counts`; Σ w·hits/`share`, the hits and the work.
     fn pairs(&self, r: u64, pool: usize, k: usize, share: f64, counts: &mut [f64]) -> (f64, u64, u64) {
         let offset = self.offset(r);
-        let points: Vec<(u32, Vec3A)> = (0..pool.div_ceil(CHUNK))
-            .into_par_iter()
-            .flat_map_iter(|c| self.spread(r, offset, c * CHUNK..((c + 1) * CHUNK).min(pool), pool))
-            .collect();
+        let points: Vec<(u32, Vec3A)> = crate::parallel::region_if(pool.div_ceil(CHUNK) >= 16, || {
+            (0..pool.div_ceil(CHUNK))
+                .into_par_iter()
+                .flat_map_iter(|c| self.spread(r, offset, c * CHUNK..((c + 1) * CHUNK).min(pool), pool))
+                .collect()
+        });
         let (bvh, h) = (self.p.bvh, self.p.h);
-        let done: Vec<(f64, u64, u64)> = counts
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(c, counts)| {
-                let (mut sum, mut hits, mut tests) = (0f64, 0u64, 0u64);
-                for (j, count) in counts.iter_mut().enumerate() {
-                    let j = c * CHUNK + j;
-                    // Streams apart from the pool's (whose draws are numbered below `pool`).
-                    let mut rng = self.rng(r, (1 << 40) + (j as u64) * (k as u64 + 1));
-                    if share < 1.0 && unit(&mut rng) >= share {
-                        continue;
-                    }
-                    let m = self.hard[j] as usize;
-                    let b = bvh.nodes[m].bounds();
-                    let mut found = 0u32;
-                    for _ in 0..k {
-                        let (slot, point) = points[rng.below(pool as u64) as usize];
-                        if holds_point(&b, point) && !h.holds(m, slot) {
-                            found += 1;
+        let wide = counts.len().div_ceil(CHUNK) >= 16;
+        let done: Vec<(f64, u64, u64)> = crate::parallel::region_if(wide, || {
+            counts
+                .par_chunks_mut(CHUNK)
+                .enumerate()
+                .map(|(c, counts)| {
+                    let (mut sum, mut hits, mut tests) = (0f64, 0u64, 0u64);
+                    for (j, count) in counts.iter_mut().enumerate() {
+                        let j = c * CHUNK + j;
+                        // Streams apart from the pool's (whose draws are numbered below `pool`).
+                        let mut rng = self.rng(r, (1 << 40) + (j as u64) * (k as u64 + 1));
+                        if share < 1.0 && unit(&mut rng) >= share {
+                            continue;
                         }
+                        let m = self.hard[j] as usize;
+                        let b = bvh.nodes[m].bounds();
+                        let mut found = 0u32;
+                        for _ in 0..k {
+                            let (slot, point) = points[rng.below(pool as u64) as usize];
+                            if holds_point(&b, point) && !h.holds(m, slot) {
+                                found += 1;
+                            }
+                        }
+                        (tests, hits) = (tests + k as u64, hits + found as u64);
+                        let scaled = found as f64 / share;
+                        *count += scaled;
+                        sum += self.weights[j] * scaled;
                     }
-                    (tests, hits) = (tests + k as u64, hits + found as u64);
-                    let scaled = found as f64 / share;
-                    *count += scaled;
-                    sum += self.weights[j] * scaled;
-                }
-                (sum, hits, tests)
-            })
-            .collect();
+                    (sum, hits, tests)
+                })
+                .collect()
+        });
         let (sum, hits, tests) = done.iter().fold((0.0, 0, 0), |(s, h, t), &(a, b, c)| (s + a, h + b, t + c));
         (sum, hits, pool as u64 * POINT_WORK + tests)
     }
