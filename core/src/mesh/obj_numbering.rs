@@ -8,11 +8,15 @@
 //! first, and prefix sums over those flags give the numbers. Every step's result is a minimum, a
 //! sort or a sum, so the numbers are the serial ones on any thread count (a test compares them).
 
-use super::obj_parallel::{MISSING, WIDTH};
 use crate::parallel::{exclusive_scan, region};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU32, Ordering};
+
+/// An absent texture or normal index.
+pub(super) const MISSING: u32 = u32::MAX;
+/// Floats per position, texture coordinate and normal, the three attributes a corner names.
+pub(super) const WIDTH: [usize; 3] = [3, 2, 3];
 
 /// Models with at least this many corners are numbered in parallel; smaller ones on the calling
 /// thread (a file of 50,000 small objects must not pay the pool 50,000 times).

@@ -23,14 +23,10 @@
 //! a corner of four parts, a face naming a vertex declared after it), where declining is the safe
 //! side.
 
-use super::obj_numbering::Numbering;
+use super::obj_numbering::{Numbering, MISSING, WIDTH};
 use crate::parallel::{concat, region};
 use rayon::prelude::*;
 
-/// An absent texture or normal index.
-pub(super) const MISSING: u32 = u32::MAX;
-/// Floats per position, texture coordinate and normal, the three attributes a corner names.
-pub(super) const WIDTH: [usize; 3] = [3, 2, 3];
 /// Chunks smaller than this are not worth a task.
 const MIN_CHUNK: usize = 1 << 20;
 
