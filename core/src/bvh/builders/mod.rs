@@ -18,7 +18,7 @@ use crate::bvh::node::{Bvh, BvhNode};
 use crate::bvh::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
-use crate::parallel::{region, PARTITION_MIN};
+use crate::parallel::{region, region_if, PARTITION_MIN};
 use crate::work::{Cancelled, WorkControl};
 pub use common::{build_work, HEURISTIC_DEPTH_LIMIT};
 use common::{leaf_is_cheaper, node_info, progress_levels, Overrides, Progress, PARALLEL_MIN_PRIMS};
@@ -241,18 +241,23 @@ fn build_subtree(
     params: &BuildParams,
     progress: &Progress,
 ) -> Result<(Subtree, Overrides), Cancelled> {
-    let sequential = |prims: &mut [BuildPrim]| {
-        build_sequential(prims, offset, depth, params, progress).map(|(nodes, over)| (Subtree::Flat(nodes), over))
-    };
     if prims.len() < PARALLEL_MIN_PRIMS || depth >= PARALLEL_MAX_DEPTH {
-        return sequential(prims);
+        return flat(prims, offset, depth, params, progress);
     }
-    if prims.len() < PARTITION_MIN {
-        // One of many subtrees built side by side, each on one thread from here (issue 37's
-        // serial fraction counts the bigger nodes' own work, outside their parallel passes).
-        return region(|| build_parallel(prims, offset, depth, params, progress));
-    }
-    build_parallel(prims, offset, depth, params, progress)
+    // Below PARTITION_MIN, one of many subtrees built side by side, each on one thread from here
+    // (issue 37's serial fraction counts the bigger nodes' own work, outside their parallel passes).
+    region_if(prims.len() < PARTITION_MIN, || build_parallel(prims, offset, depth, params, progress))
+}
+
+/// `build_sequential`'s nodes as a subtree.
+fn flat(
+    prims: &mut [BuildPrim],
+    offset: u32,
+    depth: u32,
+    params: &BuildParams,
+    progress: &Progress,
+) -> Result<(Subtree, Overrides), Cancelled> {
+    build_sequential(prims, offset, depth, params, progress).map(|(nodes, over)| (Subtree::Flat(nodes), over))
 }
 
 /// `build_subtree` for a node that is split here, its children in parallel.
@@ -263,15 +268,12 @@ fn build_parallel(
     params: &BuildParams,
     progress: &Progress,
 ) -> Result<(Subtree, Overrides), Cancelled> {
-    let sequential = |prims: &mut [BuildPrim]| {
-        build_sequential(prims, offset, depth, params, progress).map(|(nodes, over)| (Subtree::Flat(nodes), over))
-    };
     progress.check()?;
     let info = node_info(prims);
     let mut over = Overrides::default();
     let decision = decide(prims, &info, depth, params, &mut *top_down(params), &mut over);
     let Decision::Split { axis, mid } = decision else {
-        return sequential(prims);
+        return flat(prims, offset, depth, params, progress);
     };
     progress.split(prims.len(), depth);
     let (l, r) = prims.split_at_mut(mid);
