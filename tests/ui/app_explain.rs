@@ -378,3 +378,47 @@ fn the_heatmap_histogram_sets_a_threshold() {
     h.run_steps(2);
     assert_eq!(h.state().threshold, None, "another view, another scale: the threshold goes");
 }
+
+/// The statistics' EPO is `bvhscope stats`'s for the same mesh and build, to the last digit, and
+/// so is its error where it is estimated (the bunny's 69,451 triangles are past what is summed
+/// exactly within the budget): the same tree (the binary tree as built) and the same points.
+#[test]
+fn the_statistics_epo_is_bvhscope_stats_epo() {
+    let Some(models) = common::shared_models() else { return };
+    let bunny = models.join("stanford-bunny.obj");
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, bunny.clone()));
+    run_until(&mut h, "the bunny and its prepared tree", |a| {
+        a.scene.source == SceneSource::File(bunny.clone())
+            && idle(a)
+            && a.nodes.current(a.current_bvh().map(|b| &b.bvh)).is_some()
+    });
+    let (epo, error) = {
+        let a = h.state();
+        let e = a.nodes.current(a.current_bvh().map(|b| &b.bvh)).unwrap();
+        (e.epo, e.epo_error)
+    };
+    assert!(error.is_some(), "the bunny's EPO is estimated within the budget");
+    let p = h.state().settings.build;
+    let words = [
+        "bvhscope".to_string(),
+        "stats".into(),
+        bunny.display().to_string(),
+        "--strategy".into(),
+        bvhscope::options::Choice::named(p.strategy).name.to_string(),
+        "--layout".into(),
+        bvhscope::options::Choice::named(p.layout).name.to_string(),
+        "--no-rays".into(),
+        "--format".into(),
+        "json".into(),
+    ];
+    let cli = bvhscope::cli::Cli::from_words(&words).unwrap();
+    let Some(bvhscope::cli::Command::Stats(args)) = cli.command else { panic!("not stats") };
+    let v: serde_json::Value = serde_json::from_str(&bvhscope::cli::stats::output(&args).unwrap()).unwrap();
+    assert_eq!(v["stats"]["epo"].as_f64(), Some(epo), "the same EPO");
+    assert_eq!(v["stats"]["epo_error"].as_f64(), error, "the same error");
+    // And the panel shows it as `stats` prints it.
+    h.step();
+    h.get_by_label(&bvhscope::bvh::epo::figure(epo, error));
+}
