@@ -154,6 +154,47 @@ pub fn concat<T: Copy + Send + Sync>(parts: Vec<Vec<T>>, spare: usize) -> Vec<T>
     out
 }
 
+/// A slice that many tasks write at once, each slot by one task (a tree's nodes, each reached
+/// once from the root): the caller promises that no two tasks touch the same slot.
+pub struct Disjoint<'a, T> {
+    base: *mut T,
+    len: usize,
+    _slice: std::marker::PhantomData<&'a mut [T]>,
+}
+
+// SAFETY: shared between tasks only through `set` and `get`, whose callers promise that each slot
+// is touched by one task.
+unsafe impl<T: Send> Sync for Disjoint<'_, T> {}
+unsafe impl<T: Send> Send for Disjoint<'_, T> {}
+
+impl<'a, T: Copy> Disjoint<'a, T> {
+    pub fn new(slice: &'a mut [T]) -> Self {
+        Disjoint { base: slice.as_mut_ptr(), len: slice.len(), _slice: std::marker::PhantomData }
+    }
+
+    /// Write slot `i` (checked against the length).
+    ///
+    /// # Safety
+    /// No other task reads or writes slot `i` while the slice is shared.
+    #[inline]
+    pub unsafe fn set(&self, i: usize, v: T) {
+        assert!(i < self.len);
+        // SAFETY: in bounds; the caller promises no other task touches the slot.
+        unsafe { self.base.add(i).write(v) }
+    }
+
+    /// Read slot `i`, which this task wrote.
+    ///
+    /// # Safety
+    /// As `set`.
+    #[inline]
+    pub unsafe fn get(&self, i: usize) -> T {
+        assert!(i < self.len);
+        // SAFETY: as `set`.
+        unsafe { self.base.add(i).read() }
+    }
+}
+
 static MEASURING: AtomicBool = AtomicBool::new(false);
 static PARALLEL_NANOS: AtomicU64 = AtomicU64::new(0);
 
