@@ -132,6 +132,16 @@ pub fn exclusive_scan(counts: &mut [u32]) -> u32 {
     total
 }
 
+/// Items per chunk of `sum`.
+const SUM_CHUNK: usize = 1 << 14;
+
+/// The sum of `values`, in fixed chunks (each's sum, then theirs in order): the same on any thread
+/// count, which rayon's `sum` (split by the threads' stealing) is not for floats.
+pub fn sum(values: &[f64]) -> f64 {
+    let sums: Vec<f64> = values.par_chunks(SUM_CHUNK).map(|c| c.iter().sum::<f64>()).collect();
+    sums.iter().sum()
+}
+
 /// The parts one after the other, copied in parallel (a serial `concat` of a build's top-level
 /// pieces is a pass over all of its references on one thread), with room for `spare` more. Each
 /// part is freed by the thread that copied it: freeing big buffers one after the other on the

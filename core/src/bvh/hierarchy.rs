@@ -25,12 +25,15 @@ pub struct Hierarchy {
     pub other_slots: std::collections::HashMap<u32, Vec<u32>>,
 }
 
+/// Trees of at least this many nodes are read in parallel (a few tasks' worth).
+const PARALLEL_MIN: usize = 1 << 14;
+
 impl Hierarchy {
     /// The hierarchy of `bvh`. A big tree whose every node but the root is the child of exactly
     /// one node before it (every tree the builders and the importer make) is read in parallel,
     /// level by level; anything else, and a small tree, by `serial_of`. The two give the same.
     pub fn of(bvh: &Bvh) -> Hierarchy {
-        if bvh.nodes.len() >= crate::parallel::PARTITION_MIN && well_formed(bvh) {
+        if bvh.nodes.len() >= PARALLEL_MIN && well_formed(bvh) {
             parallel_of(bvh)
         } else {
             Hierarchy::serial_of(bvh)
@@ -326,10 +329,15 @@ mod tests {
     fn a_big_tree_read_in_parallel_is_read_as_on_one_thread() {
         let mesh = grid_of(&torus_knot(2, 3, 0.3, 200, 40), 3);
         for strategy in [SplitStrategy::SahBinned, SplitStrategy::Sbvh] {
-            let params =
-                BuildParams { strategy, layout: Layout::Binary, max_leaf_size: 1, sbvh_growth: 100, ..Default::default() };
+            let params = BuildParams {
+                strategy,
+                layout: Layout::Binary,
+                max_leaf_size: 1,
+                sbvh_growth: 100,
+                ..Default::default()
+            };
             let bvh = Bvh::build(&mesh, &params);
-            assert!(bvh.nodes.len() >= crate::parallel::PARTITION_MIN && well_formed(&bvh), "{strategy:?}");
+            assert!(bvh.nodes.len() >= PARALLEL_MIN && well_formed(&bvh), "{strategy:?}");
             let serial = Hierarchy::serial_of(&bvh);
             if strategy == SplitStrategy::Sbvh {
                 assert!(!serial.other_slots.is_empty(), "the SBVH cut some triangles");

@@ -41,6 +41,7 @@ pub use clip::{clipped_area, triangle_area};
 
 use super::Bvh;
 use super::Hierarchy;
+use crate::parallel::Disjoint;
 use exact::Prepared;
 use rayon::prelude::*;
 use sample::Estimator;
@@ -185,24 +186,38 @@ fn measure_with(bvh: &Bvh, h: &Hierarchy, budget: u64, seed: u64, by: Estimator)
     if n == 0 || !(total > 0.0) {
         return Epo { terms: vec![0.0; n], exact_nodes: n, budget, ..Epo::default() };
     }
+    // Zeroed; each node's term is written once, by the task that finds it (`Disjoint`).
     let mut terms = vec![0.0; n];
+    let out = Disjoint::new(&mut terms);
     let exact_budget = (budget as f64 * EXACT_SHARE) as u64;
+    // Passes over every node are parallel regions (issue 37's serial fraction) where they give
+    // 16 threads work.
+    let wide = |items: usize| items >= 1 << 12;
     let walk = |nodes: &[u32], cap: u64| -> Vec<(Option<f64>, u64)> {
-        // Marked parallel (issue 37's serial fraction) where 16 threads would each get some nodes.
         crate::parallel::region_if(nodes.len() >= 16, || {
             nodes.par_iter().map_init(Vec::new, |stack, &m| p.walk(m as usize, cap, stack)).collect()
         })
     };
     let mut spent = 0u64;
     let mut hard = Vec::new();
-    let mut keep = |nodes: &[u32], done: &[(Option<f64>, u64)], hard: &mut Vec<u32>| {
-        for (&m, (sum, _)) in nodes.iter().zip(done) {
-            match sum {
-                Some(s) => terms[m as usize] = p.weight(m as usize) * s / total,
-                None => hard.push(m),
-            }
-        }
-        done.iter().map(|d| d.1).sum::<u64>()
+    // The finished walks' terms written; the others added, in order, to `hard`; the work done.
+    let keep = |nodes: &[u32], done: &[(Option<f64>, u64)], hard: &mut Vec<u32>| {
+        crate::parallel::region_if(wide(nodes.len()), || {
+            let unfinished: Vec<u32> = nodes
+                .par_iter()
+                .zip(done)
+                .filter_map(|(&m, (sum, _))| match sum {
+                    Some(s) => {
+                        // SAFETY: each node is walked once, in one of the lists `keep` is given.
+                        unsafe { out.set(m as usize, p.weight(m as usize) * s / total) };
+                        None
+                    }
+                    None => Some(m),
+                })
+                .collect();
+            hard.extend(unfinished);
+            done.par_iter().map(|d| d.1).sum::<u64>()
+        })
     };
     // A pilot of nodes spread over the array, with a `PILOT_SHARE`th of the walks' share, prices the
     // walks: the cap for the rest is the largest at which, by the pilot, they fit what is left.
@@ -220,7 +235,9 @@ fn measure_with(bvh: &Bvh, h: &Hierarchy, budget: u64, seed: u64, by: Estimator)
     let pilot_cap = (exact_budget / (share * pilot.len() as u64)).clamp(MIN_CAP, MAX_CAP);
     let priced = walk(&pilot, pilot_cap);
     spent += keep(&pilot, &priced, &mut hard);
-    let mut todo: Vec<u32> = (0..n).filter(|m| m % stride != 0).map(|m| m as u32).collect();
+    let mut todo: Vec<u32> = crate::parallel::region_if(wide(n), || {
+        (0..n as u32).into_par_iter().filter(|&m| m as usize % stride != 0).collect()
+    });
     let mut cap = cap_within(&priced, todo.len(), exact_budget.saturating_sub(spent));
     // In blocks, so the walks stop where the pilot was wrong by much (the same place whatever
     // the threads); then again for those left, while what remains gives each twice the cap.
@@ -244,18 +261,19 @@ fn measure_with(bvh: &Bvh, h: &Hierarchy, budget: u64, seed: u64, by: Estimator)
         }
         cap = next.min(MAX_CAP);
     }
-    hard.extend(todo);
-    let pending = hard;
+    let pending = crate::parallel::region_if(wide(todo.len()), || crate::parallel::concat(vec![hard, todo], 0));
     let mut epo = Epo { exact_nodes: n - pending.len(), work: spent, budget, ..Epo::default() };
     if !pending.is_empty() {
         let e = sample::estimate(&p, &pending, budget.saturating_sub(spent), seed, by);
-        for (&m, t) in pending.iter().zip(&e.terms) {
-            terms[m as usize] = *t;
-        }
+        crate::parallel::region_if(wide(pending.len()), || {
+            // SAFETY: the pending nodes are those no walk finished, each once.
+            pending.par_iter().zip(&e.terms).for_each(|(&m, &t)| unsafe { out.set(m as usize, t) })
+        });
         (epo.std_error, epo.samples) = (e.std_error, e.samples);
         epo.work += e.work;
     }
-    epo.value = terms.iter().sum();
+    drop(out);
+    epo.value = crate::parallel::region_if(wide(n), || crate::parallel::sum(&terms));
     epo.terms = terms;
     epo
 }

@@ -26,7 +26,7 @@ use super::exact::Prepared;
 use crate::random::Rng;
 use glam::{DVec3, Vec3A};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
 /// `Query::flags`: the node is hard; it or a node below it is.
 const HARD: u8 = 1;
@@ -75,22 +75,27 @@ pub(super) struct Estimate {
 /// replicate, whatever the budget), the points drawn from `seed`.
 pub(super) fn estimate(p: &Prepared, hard: &[u32], budget: u64, seed: u64, by: Estimator) -> Estimate {
     let n = p.bvh.nodes.len();
+    let wide = |items: usize| items >= 1 << 12;
     // Per node, one byte: whether it is hard, and whether it or one below it is (the walks skip
-    // the rest). Children come after their parents.
-    let mut flags = vec![0u8; n];
-    for &m in hard {
-        flags[m as usize] = HARD | BELOW;
-    }
-    for i in (0..n).rev() {
-        let node = &p.bvh.nodes[i];
-        if !node.is_leaf()
-            && [node.index, node.index + 1].iter().any(|&c| flags.get(c as usize).is_some_and(|f| f & BELOW != 0))
-        {
-            flags[i] |= BELOW;
-        }
-    }
-    let weights: Vec<f64> = hard.iter().map(|&m| p.weight(m as usize)).collect();
-    let q = Query { p, seed, hard, flags: &flags, weights: &weights };
+    // the rest): from each hard node up its parents until one already marked, in parallel where
+    // there are many (the marks, not their order, make the flags).
+    let marks: Vec<AtomicU8> =
+        crate::parallel::region_if(wide(n), || (0..n).into_par_iter().map(|_| AtomicU8::new(0)).collect());
+    crate::parallel::region_if(wide(hard.len()), || {
+        hard.par_iter().for_each(|&m| {
+            marks[m as usize].fetch_or(HARD, Ordering::Relaxed);
+            let mut up = m;
+            while let Some(f) = marks.get(up as usize) {
+                if f.fetch_or(BELOW, Ordering::Relaxed) & BELOW != 0 {
+                    break;
+                }
+                up = p.h.parent[up as usize];
+            }
+        })
+    });
+    let flags: Vec<u8> =
+        crate::parallel::region_if(wide(n), || marks.into_par_iter().map(AtomicU8::into_inner).collect());
+    let q = Query { p, seed, hard, flags: &flags };
 
     // The pilot walks double as a price list.
     let mut pilot = Walked::default();
@@ -131,17 +136,33 @@ pub(super) fn estimate(p: &Prepared, hard: &[u32], budget: u64, seed: u64, by: E
         let pool = pool.clamp(CHUNK, 1 << 20);
         let mut counts = vec![0f64; hard.len()];
         let mut hits = 0;
+        // Small pools are made all at once, side by side (one at a time, each is a few tasks);
+        // big ones one by one, each in parallel (all at once they would take much memory).
+        let small = pool.div_ceil(CHUNK) < 16;
+        let mut pools: Vec<Vec<(u32, Vec3A)>> = match small {
+            true => {
+                crate::parallel::region(|| (0..REPLICATES as u64).into_par_iter().map(|r| q.pool(r, pool)).collect())
+            }
+            false => Vec::new(),
+        };
         for r in 0..REPLICATES as u64 {
-            let (sum, h, w) = q.pairs(r, pool, k, share, &mut counts);
+            let points = match small {
+                true => std::mem::take(&mut pools[r as usize]),
+                false => q.pool(r, pool),
+            };
+            let (sum, h, w) = q.pairs(r, &points, k, share, &mut counts);
             estimates.push(sum / k as f64);
             (hits, work) = (hits + h, work + w);
         }
         found = hits;
         tests = ((REPLICATES * k * hard.len()) as f64 * share) as usize;
-        terms = counts.iter().zip(&weights).map(|(&c, w)| w * c / (REPLICATES * k) as f64).collect();
+        terms = crate::parallel::region_if(wide(hard.len()), || {
+            counts.par_iter().zip(hard).map(|(&c, &m)| p.weight(m as usize) * c / (REPLICATES * k) as f64).collect()
+        });
     } else {
         // Counted by node (the walks find nodes, not places in `hard`).
-        let hits: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(0)).collect();
+        let hits: Vec<AtomicU32> =
+            crate::parallel::region_if(wide(n), || (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect());
         let k = ((left / per_point) as usize).clamp(MIN_POINTS, MAX_POINTS);
         // The replicates side by side (each a few chunks on a small mesh: one at a time left 16
         // threads idle); each one's sums are its own, so the figures do not depend on the order.
@@ -153,9 +174,11 @@ pub(super) fn estimate(p: &Prepared, hard: &[u32], budget: u64, seed: u64, by: E
             work += w.work;
         }
         tests = REPLICATES * k;
-        let hits: Vec<u32> = hard.iter().map(|&m| hits[m as usize].load(Ordering::Relaxed)).collect();
-        found = hits.iter().map(|&h| h as u64).sum();
-        terms = hits.iter().zip(&weights).map(|(&h, w)| w * h as f64 / tests as f64).collect();
+        (terms, found) = crate::parallel::region_if(wide(hard.len()), || {
+            let hits = |&m: &u32| hits[m as usize].load(Ordering::Relaxed);
+            let terms = hard.par_iter().map(|m| p.weight(*m as usize) * hits(m) as f64 / tests as f64).collect();
+            (terms, hard.par_iter().map(|m| hits(m) as u64).sum())
+        });
     }
     let mean = estimates.iter().sum::<f64>() / REPLICATES as f64;
     let var = estimates.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (REPLICATES * (REPLICATES - 1)) as f64;
@@ -181,8 +204,6 @@ struct Query<'a, 'b> {
     hard: &'b [u32],
     /// `HARD` and `BELOW` of each node.
     flags: &'b [u8],
-    /// Of each node of `hard`.
-    weights: &'b [f64],
 }
 
 impl Query<'_, '_> {
@@ -256,17 +277,22 @@ impl Query<'_, '_> {
         })
     }
 
-    /// Replicate `r` of pairs: a pool of `pool` points spread over the surface, and `k` tests of
-    /// points drawn from it by each hard node (by each with probability `share`), whose hits,
-    /// over `share`, are added to `counts`; Σ w·hits/`share`, the hits and the work.
-    fn pairs(&self, r: u64, pool: usize, k: usize, share: f64, counts: &mut [f64]) -> (f64, u64, u64) {
+    /// Replicate `r`'s pool of pairs: `pool` points spread over the surface.
+    fn pool(&self, r: u64, pool: usize) -> Vec<(u32, Vec3A)> {
         let offset = self.offset(r);
-        let points: Vec<(u32, Vec3A)> = crate::parallel::region_if(pool.div_ceil(CHUNK) >= 16, || {
+        crate::parallel::region_if(pool.div_ceil(CHUNK) >= 16, || {
             (0..pool.div_ceil(CHUNK))
                 .into_par_iter()
                 .flat_map_iter(|c| self.spread(r, offset, c * CHUNK..((c + 1) * CHUNK).min(pool), pool))
                 .collect()
-        });
+        })
+    }
+
+    /// Replicate `r` of pairs: `k` tests of points drawn from its pool `points` by each hard
+    /// node (by each with probability `share`), whose hits, over `share`, are added to `counts`;
+    /// Σ w·hits/`share`, the hits and the work.
+    fn pairs(&self, r: u64, points: &[(u32, Vec3A)], k: usize, share: f64, counts: &mut [f64]) -> (f64, u64, u64) {
+        let pool = points.len();
         let (bvh, h) = (self.p.bvh, self.p.h);
         let wide = counts.len().div_ceil(CHUNK) >= 16;
         let done: Vec<(f64, u64, u64)> = crate::parallel::region_if(wide, || {
@@ -294,7 +320,7 @@ impl Query<'_, '_> {
                         (tests, hits) = (tests + k as u64, hits + found as u64);
                         let scaled = found as f64 / share;
                         *count += scaled;
-                        sum += self.weights[j] * scaled;
+                        sum += self.p.weight(m) * scaled;
                     }
                     (sum, hits, tests)
                 })
