@@ -31,7 +31,8 @@ const PARALLEL_MIN: usize = 1 << 14;
 impl Hierarchy {
     /// The hierarchy of `bvh`. A big tree whose every node but the root is the child of exactly
     /// one node before it (every tree the builders and the importer make) is read in parallel,
-    /// level by level; anything else, and a small tree, by `serial_of`. The two give the same.
+    /// its subtrees side by side; anything else, and a small tree, by `serial_of`. The two give
+    /// the same (a test compares them).
     pub fn of(bvh: &Bvh) -> Hierarchy {
         if bvh.nodes.len() >= PARALLEL_MIN && well_formed(bvh) {
             parallel_of(bvh)
@@ -130,7 +131,7 @@ impl Hierarchy {
 }
 
 /// Whether every node but the root is the child of exactly one node before it, and every leaf's
-/// slots lie in the leaf order: then the levels from the root hold each node once, and each
+/// slots lie in the leaf order: then the walk from the root reaches each node once, and each
 /// node's parent, depth and range are the one `serial_of` finds.
 fn well_formed(bvh: &Bvh) -> bool {
     crate::parallel::region(|| well_formed_in_parallel(bvh))
@@ -176,9 +177,9 @@ impl Bits {
 }
 
 /// `serial_of` for a well-formed tree, in parallel: depth first from the root, the subtrees below
-/// the first `JOIN_LEVELS` levels each a task that walks its nodes in the order they lie in the
-/// array (children after parents; levels side by side would hop about it) and sums their ranges
-/// on the way back. Every node is reached once, so each is written by one task and the result
+/// the first `JOIN_LEVELS` levels each a task that walks its nodes depth first (near the order
+/// the builders lay them out in; a level at a time hopped about the array and cost four times
+/// as much) and sums their ranges on the way back. Every node is reached once, so each is written by one task and the result
 /// does not depend on the thread count.
 fn parallel_of(bvh: &Bvh) -> Hierarchy {
     use crate::parallel::{region, Disjoint};
