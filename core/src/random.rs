@@ -80,8 +80,8 @@ mod tests {
     fn a_stream_can_be_entered_anywhere() {
         let mut a = Rng::new(42);
         let first: Vec<u64> = (0..10).map(|_| a.next_u64()).collect();
-        for i in 0..10 {
-            assert_eq!(Rng::at(42, i as u64).next_u64(), first[i]);
+        for (i, &f) in first.iter().enumerate() {
+            assert_eq!(Rng::at(42, i as u64).next_u64(), f);
         }
         // SplitMix64's published first output for seed 0.
         assert_eq!(Rng::new(0).next_u64(), 0xE220_A839_7B1D_CDAF);

@@ -360,8 +360,9 @@ impl TriangleIntersector for MollerTrumbore {
     fn intersect16(_: Avx512, rays: &[Ray; 16], t_min: __m512, t_max: __m512, lanes: u32, tri: &[Vec3; 3]) -> Hits16 {
         let mut hits = Hits16::NONE;
         // SAFETY: `__m512` and `[f32; 16]` have the same size, and every bit pattern is a float.
-        let (t_min, t_max): ([f32; 16], [f32; 16]) =
-            unsafe { (std::mem::transmute(t_min), std::mem::transmute(t_max)) };
+        let (t_min, t_max): ([f32; 16], [f32; 16]) = unsafe {
+            (std::mem::transmute::<__m512, [f32; 16]>(t_min), std::mem::transmute::<__m512, [f32; 16]>(t_max))
+        };
         let mut m = lanes;
         while m != 0 {
             let k = m.trailing_zeros() as usize;

@@ -236,7 +236,7 @@ fn measure_with(bvh: &Bvh, h: &Hierarchy, budget: u64, seed: u64, by: Estimator)
     let priced = walk(&pilot, pilot_cap);
     spent += keep(&pilot, &priced, &mut hard);
     let mut todo: Vec<u32> = crate::parallel::region_if(wide(n), || {
-        (0..n as u32).into_par_iter().filter(|&m| m as usize % stride != 0).collect()
+        (0..n as u32).into_par_iter().filter(|&m| !(m as usize).is_multiple_of(stride)).collect()
     });
     let mut cap = cap_within(&priced, todo.len(), exact_budget.saturating_sub(spent));
     // In blocks, so the walks stop where the pilot was wrong by much (the same place whatever
@@ -272,7 +272,6 @@ fn measure_with(bvh: &Bvh, h: &Hierarchy, budget: u64, seed: u64, by: Estimator)
         (epo.std_error, epo.samples) = (e.std_error, e.samples);
         epo.work += e.work;
     }
-    drop(out);
     epo.value = crate::parallel::region_if(wide(n), || crate::parallel::sum(&terms));
     epo.terms = terms;
     epo

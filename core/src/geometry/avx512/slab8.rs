@@ -150,7 +150,7 @@ mod tests {
     #[test]
     fn rays_aimed_at_box_corners_from_afar_hit() {
         let Some(k) = Avx512::detect() else { return };
-        let mut rng = crate::random::Rng::new(0x51ab_512);
+        let mut rng = crate::random::Rng::new(0x051a_b512);
         let mut rand = move || rng.unit();
         for _ in 0..20_000 {
             let lo = Vec3::new(rand(), rand(), rand()) * 10.0 - 5.0;
