@@ -40,8 +40,16 @@ struct Cluster {
 
 const LEAF: u32 = u32::MAX;
 
-/// Clusters per task of a round's compaction (fixed, so the order does not depend on threads).
-const CHUNK: usize = 1 << 12;
+/// Clusters per task of a round (its search and its compaction): a 64th of the round, within
+/// `MIN_CHUNK..=MAX_CHUNK`, so that rounds of a mid-sized mesh (the bunny's are all under 70k
+/// clusters) still give 16 threads a task each. Any cutting gives the same round (each chunk
+/// writes its part in order); it follows the round's size, never the thread count.
+const MIN_CHUNK: usize = 256;
+const MAX_CHUNK: usize = 1 << 12;
+
+fn chunk_of(len: usize) -> usize {
+    (len / 64).clamp(MIN_CHUNK, MAX_CHUNK)
+}
 
 /// Subtrees of at least this many primitives are laid out in parallel (`rayon::join`), down to
 /// `PARALLEL_MAX_DEPTH`; the rest with an explicit stack, however deep.
@@ -82,7 +90,7 @@ pub(super) fn build(
         progress.check()?;
         // A round too small to give 16 threads a chunk each is not marked parallel: issue 37's
         // serial fraction, for a 16-thread projection, counts it as serial.
-        let small = clusters.len() < 16 * CHUNK;
+        let small = clusters.len() < 16 * MIN_CHUNK;
         let mut round = || {
             nearest_into(&boxes, radius, &mut nearest);
             // The closest pair of the whole list is always mutual, but equal areas could make a
@@ -122,8 +130,9 @@ fn compact(
     next_boxes: &mut Vec<Aabb>,
 ) {
     let len = clusters.len();
-    let chunks = len.div_ceil(CHUNK);
-    let range = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(len);
+    let chunk = chunk_of(len);
+    let chunks = len.div_ceil(chunk);
+    let range = |c: usize| c * chunk..((c + 1) * chunk).min(len);
     // Each cluster is kept (alone or as the first of a merged pair) or dropped (the second).
     let kept = |i: usize| nearest[nearest[i]] != i || i < nearest[i];
     let merges = |i: usize| nearest[nearest[i]] == i && i < nearest[i];
@@ -194,15 +203,15 @@ fn merged(a: &Cluster, b: &Cluster, l: u32, r: u32, bounds: Aabb, params: &Build
 /// block of d (i / d even) takes the one after it, in an odd block the one before, so that equal
 /// boxes (a million copies of one triangle) pair up, all of them each round, instead of one pair.
 fn nearest_into(boxes: &[Aabb], radius: usize, out: &mut Vec<usize>) {
-    const CHUNK: usize = 2048;
     let len = boxes.len();
+    let chunk = chunk_of(len);
     out.clear();
     out.par_extend(rayon::iter::repeat_n(0, len));
     // Each pair's area is computed once: a chunk of clusters first works out, for every cluster
     // from `radius` before the chunk to its end, the areas with the `radius` clusters after it,
     // then each cluster of the chunk reads its pairs both ways from that table.
-    out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
-        let start = c * CHUNK;
+    out.par_chunks_mut(chunk).enumerate().for_each(|(c, out)| {
+        let start = c * chunk;
         let from = start.saturating_sub(radius);
         let end = start + out.len();
         let mut ahead = vec![f32::INFINITY; (end - from) * radius];
