@@ -245,6 +245,12 @@ pub fn region_if<R>(wide: bool, f: impl FnOnce() -> R) -> R {
     }
 }
 
+/// Whether `measure_serial` is timing: code that chooses its path by the thread count takes the
+/// one it would take on many threads.
+pub fn measuring() -> bool {
+    MEASURING.load(Ordering::Relaxed)
+}
+
 /// Run `f` on a pool of one thread and return, with its result, the time it spent outside every
 /// `region`: the serial part of Amdahl's law, for projecting a speed-up on more cores than this
 /// machine has. What is not marked as a region counts as serial, so a stretch overlooked makes the
