@@ -267,8 +267,11 @@ impl Checked {
     }
 }
 
+/// A tree as traced, and what tells it from a built one (its file, the dump's node ids).
+type Traced = (AnyBvh, Imported);
+
 /// The tree's findings, and the tree to trace; `Err` with the findings when it cannot be traced.
-fn check_structure(s: &Subject) -> Result<(Vec<Finding>, (AnyBvh, Imported)), Vec<Finding>> {
+fn check_structure(s: &Subject) -> Result<(Vec<Finding>, Traced), Vec<Finding>> {
     let mut out: Vec<Finding> = wrong_mesh(s).into_iter().collect();
     out.extend(check_tree(s.dump, s.mesh));
     if out.iter().any(|f| f.group == Group::Structure && f.defect) {
