@@ -189,6 +189,42 @@ pub fn save_stats(app: &BvhscopeApp, path: &Path, format: StatsFormat) -> Result
     crate::files::write_bytes(path, text.as_bytes()).map_err(|e| e.to_string())
 }
 
+/// What the replay's animation is made of, as `bvhscope replay` makes it: the replay shown, its
+/// mesh, the view's camera, and the view if it is a heatmap (else the combined cost, the
+/// command's default), 24 frames.
+pub fn film_request(app: &BvhscopeApp) -> Result<FilmRequest, String> {
+    use crate::bvh::SceneBvh;
+    let replay = app.replay.replay.clone().ok_or("the replay is not ready yet")?;
+    let built = app.current_bvh().ok_or("build a BVH first")?;
+    let SceneBvh::Single { mesh, .. } = &*built.bvh else {
+        return Err("the replay shows one BVH's build; this scene is built as two levels".into());
+    };
+    let camera = app.shown.as_ref().map(|s| s.camera).ok_or("nothing rendered yet")?;
+    let view = if app.settings.view.is_heatmap() { app.settings.view } else { crate::render::View::Cost };
+    let settings = crate::explain::replay_film::FilmSettings {
+        view,
+        colormap: app.settings.colormap,
+        frames: FILM_FRAMES,
+        trace: app.settings.trace,
+        cost: app.settings.build.cost,
+    };
+    let subject = format!("{}, {}, log scale", app.scene.title(), replay.tree.params.strategy.label());
+    Ok(FilmRequest { replay, mesh: mesh.clone(), camera, settings, subject })
+}
+
+/// Frames of the app's replay animation and how long each shows (`bvhscope replay`'s defaults).
+pub const FILM_FRAMES: u32 = 24;
+pub const FILM_DELAY_MS: u16 = 400;
+
+/// The replay's animation to write (`film_request`).
+pub struct FilmRequest {
+    pub replay: std::sync::Arc<crate::explain::replay::Replay>,
+    pub mesh: std::sync::Arc<crate::mesh::Mesh>,
+    pub camera: crate::render::Camera,
+    pub settings: crate::explain::replay_film::FilmSettings,
+    pub subject: String,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -244,40 +280,4 @@ mod tests {
         assert_eq!(field(&records[1], "mean_nodes_visited"), "", "not measured is empty, not 0");
         assert_eq!(field(&records[1], "build_ms"), "0.500");
     }
-}
-
-/// What the replay's animation is made of, as `bvhscope replay` makes it: the replay shown, its
-/// mesh, the view's camera, and the view if it is a heatmap (else the combined cost, the
-/// command's default), 24 frames.
-pub fn film_request(app: &BvhscopeApp) -> Result<FilmRequest, String> {
-    use crate::bvh::SceneBvh;
-    let replay = app.replay.replay.clone().ok_or("the replay is not ready yet")?;
-    let built = app.current_bvh().ok_or("build a BVH first")?;
-    let SceneBvh::Single { mesh, .. } = &*built.bvh else {
-        return Err("the replay shows one BVH's build; this scene is built as two levels".into());
-    };
-    let camera = app.shown.as_ref().map(|s| s.camera).ok_or("nothing rendered yet")?;
-    let view = if app.settings.view.is_heatmap() { app.settings.view } else { crate::render::View::Cost };
-    let settings = crate::explain::replay_film::FilmSettings {
-        view,
-        colormap: app.settings.colormap,
-        frames: FILM_FRAMES,
-        trace: app.settings.trace,
-        cost: app.settings.build.cost,
-    };
-    let subject = format!("{}, {}, log scale", app.scene.title(), replay.tree.params.strategy.label());
-    Ok(FilmRequest { replay, mesh: mesh.clone(), camera, settings, subject })
-}
-
-/// Frames of the app's replay animation and how long each shows (`bvhscope replay`'s defaults).
-pub const FILM_FRAMES: u32 = 24;
-pub const FILM_DELAY_MS: u16 = 400;
-
-/// The replay's animation to write (`film_request`).
-pub struct FilmRequest {
-    pub replay: std::sync::Arc<crate::explain::replay::Replay>,
-    pub mesh: std::sync::Arc<crate::mesh::Mesh>,
-    pub camera: crate::render::Camera,
-    pub settings: crate::explain::replay_film::FilmSettings,
-    pub subject: String,
 }

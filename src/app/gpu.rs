@@ -37,13 +37,16 @@ struct Uploaded {
     mesh: Arc<Mesh>,
 }
 
+/// A build made on the GPU, with the tree it made (held weakly: the scene may drop it).
+type BuiltOnGpu = (Weak<SceneBvh>, GpuBuild);
+
 /// The GPU state the jobs share: the probe's result, the uploaded tree, the builds made on the
 /// GPU with their phases.
 #[derive(Clone)]
 pub struct GpuJobs {
     pub probe: Probe,
     uploaded: Arc<Mutex<Option<Uploaded>>>,
-    built: Arc<Mutex<Vec<(Weak<SceneBvh>, GpuBuild)>>>,
+    built: Arc<Mutex<Vec<BuiltOnGpu>>>,
     /// Whether the last build started was asked to build on the GPU.
     pub last_build_on_gpu: bool,
 }

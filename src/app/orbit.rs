@@ -109,6 +109,16 @@ fn aspect_size(aspect: f32) -> (u32, u32) {
     ((1000.0 * aspect).round().max(1.0) as u32, 1000)
 }
 
+/// How a given camera (a scene file's, a grade report's) orbits: about the axis its up vector is
+/// nearest to (Y or Z).
+pub fn up_axis_of(c: &Camera) -> UpAxis {
+    if c.up.z.abs() > c.up.y.abs() && c.up.z.abs() >= c.up.x.abs() {
+        UpAxis::Z
+    } else {
+        UpAxis::Y
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,15 +166,5 @@ mod tests {
         assert!((turned.position - oc.position).length() > 0.1);
         o.frame(&b, 1.6);
         o.camera(1600, 1000).validate().unwrap();
-    }
-}
-
-/// How a given camera (a scene file's, a grade report's) orbits: about the axis its up vector is
-/// nearest to (Y or Z).
-pub fn up_axis_of(c: &Camera) -> UpAxis {
-    if c.up.z.abs() > c.up.y.abs() && c.up.z.abs() >= c.up.x.abs() {
-        UpAxis::Z
-    } else {
-        UpAxis::Y
     }
 }
