@@ -367,7 +367,9 @@ impl Query<'_, '_> {
                     hits[m].fetch_add(1, Ordering::Relaxed);
                 }
             }
-            if !node.is_leaf() {
+            // Children come after their parents; a malformed array whose links loop back would
+            // otherwise be walked for ever (the flags mark every node above a hard one).
+            if !node.is_leaf() && node.index as usize > m {
                 stack.extend([node.index, node.index + 1]);
             }
         }

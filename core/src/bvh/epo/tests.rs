@@ -230,3 +230,24 @@ fn the_stated_error_is_honest() {
         }
     }
 }
+
+/// A node array whose child links loop back (an imported tree that slipped past the checks)
+/// gets a figure, not a walk for ever: the estimate's walks follow links forward only.
+#[test]
+fn a_tree_whose_links_loop_is_measured_in_bounded_time() {
+    let mut bvh = build(&generate::torus_knot(2, 3, 0.3, 48, 6), SplitStrategy::SahBinned, 4);
+    let h = Hierarchy::of(&bvh);
+    // The deepest interior node's children become the root's pair: a loop back to the top.
+    let i = (0..bvh.nodes.len()).rev().find(|&i| !bvh.nodes[i].is_leaf()).expect("an interior node");
+    bvh.nodes[i].index = bvh.nodes[0].index;
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for by in [Estimator::Walks, Estimator::Pairs] {
+            let _ = tx.send(measure_with(&bvh, &h, 20_000, 1, by).value.is_finite());
+        }
+    });
+    for _ in 0..2 {
+        let finite = rx.recv_timeout(std::time::Duration::from_secs(120)).expect("the EPO of a looping tree ends");
+        assert!(finite);
+    }
+}
