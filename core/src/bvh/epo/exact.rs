@@ -176,7 +176,9 @@ impl<'a> Prepared<'a> {
                         work += CLIP_WORK;
                     }
                 }
-            } else {
+            } else if node.index as usize > m {
+                // (Forward only, as children lie: a malformed array's loop is not walked for ever
+                // by `node_term`, whose walk has no cap.)
                 stack.extend([node.index, node.index + 1]);
             }
         }

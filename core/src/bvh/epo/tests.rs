@@ -245,8 +245,10 @@ fn a_tree_whose_links_loop_is_measured_in_bounded_time() {
         for by in [Estimator::Walks, Estimator::Pairs] {
             let _ = tx.send(measure_with(&bvh, &h, 20_000, 1, by).value.is_finite());
         }
+        // The inspector's exact share of one node: a walk without a cap.
+        let _ = tx.send(node_term(&bvh, &h, 1).is_finite());
     });
-    for _ in 0..2 {
+    for _ in 0..3 {
         let finite = rx.recv_timeout(std::time::Duration::from_secs(120)).expect("the EPO of a looping tree ends");
         assert!(finite);
     }
