@@ -111,19 +111,23 @@ const SCAN_CHUNK: usize = 1 << 14;
 
 /// Replace each count by the sum of those before it; returns the total. Two parallel passes over
 /// fixed chunks (their sums, then each chunk from its offset), the chunks' offsets summed on this
-/// thread: integer sums, so the same on any thread count.
-pub fn exclusive_scan(counts: &mut [u32]) -> u32 {
-    let scan = |c: &mut [u32], mut sum: u32| {
+/// thread: the same sums in the same order on any thread count (floats included).
+pub fn exclusive_scan<T>(counts: &mut [T]) -> T
+where
+    T: Copy + Default + Send + Sync + std::ops::Add<Output = T>,
+{
+    let scan = |c: &mut [T], mut sum: T| {
         for x in c {
             (*x, sum) = (sum, sum + *x);
         }
         sum
     };
     if counts.len() < 2 * SCAN_CHUNK {
-        return scan(counts, 0);
+        return scan(counts, T::default());
     }
-    let mut offsets: Vec<u32> = region(|| counts.par_chunks(SCAN_CHUNK).map(|c| c.iter().sum()).collect());
-    let total = scan(&mut offsets, 0);
+    let mut offsets: Vec<T> =
+        region(|| counts.par_chunks(SCAN_CHUNK).map(|c| c.iter().fold(T::default(), |a, &b| a + b)).collect());
+    let total = scan(&mut offsets, T::default());
     region(|| {
         counts.par_chunks_mut(SCAN_CHUNK).zip(offsets).for_each(|(c, o)| {
             scan(c, o);

@@ -26,37 +26,18 @@ pub(super) struct Prepared<'a> {
     cover: Option<Vec<Aabb>>,
 }
 
-/// `prefix[s]`: the area of triangles `0..s`. Summed in fixed chunks (each's running sums, then
-/// the chunks' offsets), so the same on any thread count.
+/// `prefix[s]`: the area of triangles `0..s` (`parallel::exclusive_scan`: the same on any
+/// thread count).
 fn running_areas(tris: &[[glam::Vec3; 3]]) -> Vec<f64> {
-    const CHUNK: usize = 1 << 14;
-    let mut prefix = vec![0f64; tris.len() + 1];
-    let totals: Vec<f64> = prefix[1..]
-        .par_chunks_mut(CHUNK)
-        .zip(tris.par_chunks(CHUNK))
-        .map(|(out, tris)| {
-            let mut sum = 0f64;
-            for (o, t) in out.iter_mut().zip(tris) {
-                sum += triangle_area(t);
-                *o = sum;
-            }
-            sum
-        })
-        .collect();
-    let mut offsets = Vec::with_capacity(totals.len());
-    let mut sum = 0f64;
-    for t in totals {
-        offsets.push(sum);
-        sum += t;
-    }
-    prefix[1..].par_chunks_mut(CHUNK).zip(offsets).for_each(|(out, offset)| out.iter_mut().for_each(|o| *o += offset));
+    let mut prefix: Vec<f64> = tris.par_iter().map(triangle_area).chain(rayon::iter::once(0.0)).collect();
+    crate::parallel::exclusive_scan(&mut prefix);
     prefix
 }
 
 impl<'a> Prepared<'a> {
     pub fn new(bvh: &'a Bvh, h: &'a Hierarchy) -> Prepared<'a> {
         // Passes over every triangle and node: parallel regions where they give 16 threads work.
-        let wide = bvh.tris.len() >= 1 << 14;
+        let wide = super::wide(bvh.tris.len());
         let prefix = crate::parallel::region_if(wide, || running_areas(&bvh.tris));
         let nodes = &bvh.nodes;
         let sound = crate::parallel::region_if(wide, || {

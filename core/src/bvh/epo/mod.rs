@@ -68,6 +68,12 @@ const MIN_FINISHED: f64 = 0.5;
 /// Nodes walked between two looks at the work done.
 const WALK_BLOCK: usize = 1 << 14;
 
+/// Whether a pass over `items` nodes, triangles or points gives 16 threads work: then it is
+/// marked a parallel region (issue 37's serial fraction), else it counts as serial.
+fn wide(items: usize) -> bool {
+    items >= 1 << 12
+}
+
 /// The largest cap at which `count` walks cost at most `left` by the pilot's `priced` walks (0
 /// where none does, or where it would finish fewer than `MIN_FINISHED` of them): a walk costs
 /// what it cost the pilot, at most the cap; one the pilot did not finish, the cap.
@@ -190,9 +196,6 @@ fn measure_with(bvh: &Bvh, h: &Hierarchy, budget: u64, seed: u64, by: Estimator)
     let mut terms = vec![0.0; n];
     let out = Disjoint::new(&mut terms);
     let exact_budget = (budget as f64 * EXACT_SHARE) as u64;
-    // Passes over every node are parallel regions (issue 37's serial fraction) where they give
-    // 16 threads work.
-    let wide = |items: usize| items >= 1 << 12;
     let walk = |nodes: &[u32], cap: u64| -> Vec<(Option<f64>, u64)> {
         crate::parallel::region_if(nodes.len() >= 16, || {
             nodes.par_iter().map_init(Vec::new, |stack, &m| p.walk(m as usize, cap, stack)).collect()

@@ -23,6 +23,7 @@
 
 use super::clip::holds_point;
 use super::exact::Prepared;
+use super::wide;
 use crate::random::Rng;
 use glam::{DVec3, Vec3A};
 use rayon::prelude::*;
@@ -75,7 +76,6 @@ pub(super) struct Estimate {
 /// replicate, whatever the budget), the points drawn from `seed`.
 pub(super) fn estimate(p: &Prepared, hard: &[u32], budget: u64, seed: u64, by: Estimator) -> Estimate {
     let n = p.bvh.nodes.len();
-    let wide = |items: usize| items >= 1 << 12;
     // Per node, one byte: whether it is hard, and whether it or one below it is (the walks skip
     // the rest): from each hard node up its parents until one already marked, in parallel where
     // there are many (the marks, not their order, make the flags).
