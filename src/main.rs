@@ -13,7 +13,8 @@ fn main() -> ExitCode {
         // `check` has printed its report: exit 1 says the BVH has defects.
         Err(CliError::Defects(_)) => ExitCode::from(1),
         Err(e) => {
-            eprintln!("error: {e}");
+            // A file name in the message may hold anything, an escape sequence included.
+            eprintln!("error: {}", bvhscope::cli::printable(&e.to_string()));
             ExitCode::from(2)
         }
     }

@@ -152,9 +152,10 @@ fn a_class_is_graded_row_by_row_and_ranked_the_same_twice() {
         );
     }
     // Ranked by SAH cost over the SAH tree of the same layout: bob's and carol's are bvhscope's
-    // own SAH trees (1.0, the tie by name), then midpoint, then equal count; no defects ranked.
+    // own SAH trees (1.0: they share first place), then midpoint, then equal count; no defects
+    // ranked.
     let ranks: Vec<&str> = (0..wants.len()).map(|i| field(&a, i, "rank")).collect();
-    assert_eq!(ranks, ["3", "1", "2", "4", "", "", "", "", "", "", ""]);
+    assert_eq!(ranks, ["3", "1", "1", "4", "", "", "", "", "", "", ""]);
     assert_eq!((field(&a, 1, "sah_cost_vs_sah_tree"), field(&a, 2, "sah_cost_vs_sah_tree")), ("1.0000", "1.0000"));
     assert_eq!((field(&a, 1, "layout"), field(&a, 2, "layout")), ("binary", "wide4"));
     assert_eq!(field(&a, 1, "good"), "yes", "within 10 % of the SAH tree");

@@ -148,7 +148,12 @@ impl BvhscopeApp {
             // arrives after a rebuild must not be shown (or remembered) under the new strategy.
             // A replay's partial tree is not the strategy's tree: its figures are not recorded.
             if p.partial.is_none() && self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
-                self.rays = Some(MeasuredRays { summary: p.frame.ray_summary(), camera: p.camera, trace: p.trace });
+                // An imported tree's rays counted on the mesh's box, as the tree beside it.
+                let summary = match p.bvh.yardstick() {
+                    Some(y) => p.frame.ray_summary_in(&p.camera, &y),
+                    None => p.frame.ray_summary(),
+                };
+                self.rays = Some(MeasuredRays { summary, camera: p.camera, trace: p.trace });
             }
         }
         let texture = match self.shown.take() {

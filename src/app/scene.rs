@@ -36,7 +36,11 @@ impl BuiltBvh {
                 };
                 (rows, Some(top), bottom)
             }
-            None => (TreeStats::of(bvh.tree()), None, Vec::new()),
+            None => match bvh.yardstick() {
+                // An imported tree: on the mesh's box, as the tree it is compared with.
+                Some(y) => (TreeStats::against(bvh.tree(), &y), None, Vec::new()),
+                None => (TreeStats::of(bvh.tree()), None, Vec::new()),
+            },
         };
         Self { bvh, stats, top_stats, bottom, scene_id }
     }

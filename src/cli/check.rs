@@ -69,7 +69,8 @@ fn quality(
     camera: &crate::render::Camera,
     trace: crate::bvh::TraceOptions,
 ) -> QualityRow {
-    let s = TreeStats::of(bvh);
+    // Every row against the mesh's box, the imported tree's too (`TreeStats::against`).
+    let s = TreeStats::against(bvh, &mesh.bounds());
     let f = render(bvh, mesh, camera, &RenderSettings { trace, count: true, progressive: false });
     let r = f.ray_summary();
     QualityRow {

@@ -4,7 +4,7 @@
 //! Exit 0 once the report is written, whatever the students' verdicts; 2 when it cannot be.
 
 use super::args::{BuildArgs, DumpLimit, ViewArgs};
-use super::{load_mesh, progress, CliError};
+use super::{load_mesh, printable, progress, CliError};
 use crate::explain::check::MAX_RAYS;
 use crate::explain::grade::{
     csv_records, discover, document, grade_class, write_html, GradeError, GradeRow, Graded, References, ReportDir,
@@ -104,7 +104,7 @@ pub fn run(a: &GradeArgs) -> Result<(), CliError> {
             inputs.push((d.clone(), format!("the dump of '{}'", s.name)));
         }
     }
-    let dir = ReportDir::prepare(&a.out, inputs).map_err(grade_err)?;
+    let mut dir = ReportDir::prepare(&a.out, inputs).map_err(grade_err)?;
     let scene = load_mesh(&a.mesh)?;
     let mesh = scene.flat_mesh()?;
     // A scene of one mesh file: the dumps name that file, and are checked against it.
@@ -150,15 +150,16 @@ pub fn run(a: &GradeArgs) -> Result<(), CliError> {
         grade_class(&setup, refs, &subs, &dir, &control, |row| {
             done += 1;
             if lines {
-                eprintln!("[{done}/{n}] {}: {} ({:.1} s)", row.name, row.verdict.label(), row.seconds);
+                eprintln!("[{done}/{n}] {}: {} ({:.1} s)", printable(&row.name), row.verdict.label(), row.seconds);
             }
         })
     });
     write_report(&setup, &graded, &dir)?;
+    dir.publish().map_err(grade_err)?;
     super::out(&summary(&graded.rows));
     eprintln!(
         "wrote {} ({}, {} and images/): {n} submissions graded in {:.1} s",
-        dir.file(HTML_FILE).display(),
+        printable(&dir.file(HTML_FILE).display().to_string()),
         CSV_FILE,
         JSON_FILE,
         start.elapsed().as_secs_f64()
@@ -183,15 +184,16 @@ fn write_report(setup: &Setup, graded: &Graded, dir: &ReportDir) -> Result<(), C
 
 /// The class on stdout: rank, student, verdict and the main figures, in the order given.
 fn summary(rows: &[GradeRow]) -> String {
-    let w = rows.iter().map(|r| r.name.chars().count()).max().unwrap_or(7).clamp(7, 40);
+    let w = rows.iter().map(|r| printable(&r.name).chars().count()).max().unwrap_or(7).clamp(7, 40);
     let mut o = format!(
         "{:>4}  {:<w$}  {:<10}  {:>9}  {:>8}  {:>11}  {:>8}  first cause\n",
         "rank", "student", "verdict", "SAH cost", "vs SAH", "nodes / ray", "speed-up"
     );
     for r in rows {
         let q = r.quality.as_ref();
-        let name: String = r.name.chars().take(w).collect();
-        let cause: String = r.reason.chars().take(100).collect();
+        // Escaped before they are cut to width: an escape sequence cut in half is still one.
+        let name: String = printable(&r.name).chars().take(w).collect();
+        let cause: String = printable(&r.reason).chars().take(100).collect();
         let _ = writeln!(
             o,
             "{:>4}  {:<w$}  {:<10}  {:>9}  {:>8}  {:>11}  {:>8}  {cause}",

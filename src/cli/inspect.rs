@@ -6,7 +6,7 @@ use super::args::{BuildArgs, ViewArgs};
 use super::{build_scene, load_mesh, CliError};
 use crate::bvh::wide::wide_group_in;
 use crate::bvh::Hierarchy;
-use crate::bvh::{epo, SceneBvh, TreeView};
+use crate::bvh::{SceneBvh, TreeView};
 use crate::explain::inspect::text::{dump_text, no_split_text, sbvh_text, wide_group_text};
 use crate::explain::inspect::{inspect, CurvePoint, Inspection};
 use crate::options::Choice;
@@ -66,7 +66,7 @@ fn points_json(points: &[CurvePoint], sah: crate::bvh::SahCost) -> serde_json::V
         .collect()
 }
 
-fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
+fn json(ins: &Inspection, path: &[u32]) -> serde_json::Value {
     let curves: serde_json::Map<String, serde_json::Value> = (0..3)
         .map(|a| {
             let v = serde_json::json!({ "sweep": points_json(&ins.sweep[a], ins.sah),
@@ -95,7 +95,7 @@ fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
         "bounds": { "min": b(ins.bounds.min), "max": b(ins.bounds.max) },
         "centroid_bounds": { "min": b(ins.centroid_bounds.min), "max": b(ins.centroid_bounds.max) },
         "area": ins.area, "area_ratio_to_parent": ins.area_ratio, "subtree_sah_cost": ins.subtree_sah,
-        "child_overlap": ins.child_overlap, "leaf_cost": ins.leaf_cost, "epo_contribution": epo_term,
+        "child_overlap": ins.child_overlap, "leaf_cost": ins.leaf_cost, "epo_contribution": ins.epo_share,
         "bins": ins.bins, "curves": curves, "markers": markers, "own_cost": ins.own_cost,
         "sbvh": ins.sbvh.map(|e| serde_json::json!({
             "split": e.split.map(|s| s.kind), "overlap_ratio": e.overlap_ratio,
@@ -105,7 +105,7 @@ fn json(ins: &Inspection, epo_term: f64, path: &[u32]) -> serde_json::Value {
 }
 
 /// The node's figures and each strategy's choice, as a human-readable block.
-pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
+pub fn text(ins: &Inspection, path: &[u32]) -> String {
     let mut o = String::new();
     let crumbs = path.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" > ");
     let _ = writeln!(o, "node            {} (depth {}; path {crumbs})", ins.node, ins.depth);
@@ -126,7 +126,7 @@ pub fn text(ins: &Inspection, epo_term: f64, path: &[u32]) -> String {
     if let Some(ov) = ins.child_overlap {
         let _ = writeln!(o, "child overlap   volume {:.6}, area {:.6}", ov.volume, ov.area);
     }
-    let _ = writeln!(o, "EPO share       {epo_term:.4} (this node's term of the tree's end-point overlap)");
+    let _ = writeln!(o, "EPO share       {:.4} (this node's term of the tree's end-point overlap)", ins.epo_share);
     let _ = writeln!(o, "as a leaf       cost {:.3} (C_isect x triangles)", ins.leaf_cost);
     let _ = writeln!(o);
     let _ = writeln!(o, "where each strategy splits these triangles (cost C_trav + C_isect (A_L n_L + A_R n_R) / A):");
@@ -275,8 +275,7 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     Ok(match a.format {
         InspectFormat::Csv => csv(&ins),
         InspectFormat::Json => {
-            let term = epo::node_term(&tree, &h, node as usize);
-            let mut v = json(&ins, term, &path);
+            let mut v = json(&ins, &path);
             v["visits"] = serde_json::json!(visits);
             v["camera"] = serde_json::json!(camera);
             if let Some(d) = dump_id {
@@ -288,22 +287,19 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
             format!("{}\n", serde_json::to_string_pretty(&v).expect("plain data serialises"))
         }
         InspectFormat::Text => {
-            let term = epo::node_term(&tree, &h, node as usize);
-            {
-                let p = bvh.params();
-                let build = match names {
-                    Some(n) => format!("{} (dump node {})", n.label(), dump_text(dump_id.flatten())),
-                    None => {
-                        format!("{}, max leaf size {}, {} SAH bins", p.strategy.label(), p.max_leaf_size, p.sah_bins)
-                    }
-                };
-                let wide = wide.map_or(String::new(), |g| format!("\n{}\n", wide_group_text(node, &g)));
-                let visits = format!(
-                    "visits          {visits} of the {}x{} frame's primary rays entered it (binary traversal)\n",
-                    camera.width, camera.height
-                );
-                format!("build           {build} (the binary tree)\n{}{visits}{wide}", text(&ins, term, &path))
-            }
+            let p = bvh.params();
+            let build = match names {
+                Some(n) => format!("{} (dump node {})", n.label(), dump_text(dump_id.flatten())),
+                None => {
+                    format!("{}, max leaf size {}, {} SAH bins", p.strategy.label(), p.max_leaf_size, p.sah_bins)
+                }
+            };
+            let wide = wide.map_or(String::new(), |g| format!("\n{}\n", wide_group_text(node, &g)));
+            let visits = format!(
+                "visits          {visits} of the {}x{} frame's primary rays entered it (binary traversal)\n",
+                camera.width, camera.height
+            );
+            format!("build           {build} (the binary tree)\n{}{visits}{wide}", text(&ins, &path))
         }
     })
 }

@@ -287,10 +287,12 @@ fn a_node_is_selected_from_the_tree_the_icicle_and_the_viewport() {
     h.get_by_label("EPO");
 }
 
-/// The inspector's figures for a node are `bvhscope inspect`'s for the same node and build.
+/// The inspector's figures for a node are `bvhscope inspect`'s for the same node and build, its
+/// EPO share included on a mesh of more than 4,096 triangles (where the tree's EPO is estimated:
+/// the share of one node is still walked exactly, in both).
 #[test]
 fn the_node_inspector_and_bvhscope_inspect_agree() {
-    let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
+    let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/diagonal-rods.obj");
     let mut h = harness();
     run_until(&mut h, "the first frame", idle);
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, torus.clone()));
@@ -351,6 +353,13 @@ fn the_node_inspector_and_bvhscope_inspect_agree() {
     }
     assert_eq!(v["visits"], visits, "the Tree window's visits of node 3 for the same camera");
     assert!(visits > 0);
+    assert_eq!(v["epo_contribution"].as_f64().unwrap(), ins.epo_share, "the EPO share, to the last digit");
+    assert!(ins.epo_share > 0.0, "node 3's share is not nothing");
+    // The Node window prints that figure.
+    h.state_mut().act(Action::ShowTree(true));
+    run_until(&mut h, "the Node window", |a| a.nodes.inspection.as_ref().is_some_and(|i| i.node == 3));
+    h.run();
+    h.get_by_label(&format!("{:.4}", ins.epo_share));
 }
 
 /// The legend's histogram counts every pixel of the heatmap; a click on it sets the threshold

@@ -58,6 +58,17 @@ impl SceneBvh {
         SceneBvh::Single { bvh, mesh, imported: Some(Arc::new(imported)) }
     }
 
+    /// The box an imported tree is measured against (its SAH cost, the rays that enter it): the
+    /// mesh's, so it compares with a built tree on one yardstick (`TreeStats::against`,
+    /// `Frame::ray_summary_in`) even where its root box is larger. `None` for a built tree, whose
+    /// root box is the mesh's, and for two levels.
+    pub fn yardstick(&self) -> Option<crate::geometry::Aabb> {
+        match self {
+            SceneBvh::Single { mesh, imported: Some(_), .. } => Some(mesh.bounds()),
+            _ => None,
+        }
+    }
+
     /// Where the tree came from when it was imported, not built.
     pub fn import(&self) -> Option<&Imported> {
         match self {

@@ -73,6 +73,19 @@ fn ms(d: Duration) -> f64 {
 impl TreeStats {
     /// Statistics of any hierarchy (binary or wide). `nodes` counts interior nodes and leaves.
     pub fn of(tree: &(impl TreeView + ?Sized)) -> TreeStats {
+        Self::over(tree, None)
+    }
+
+    /// `of`, with the SAH cost normalised by `yardstick`'s area (the mesh's box) instead of the
+    /// tree's own root box: the one yardstick of a comparison. A root box larger than the mesh's
+    /// (a degenerate triangle kept far away) then costs what it costs (its area over the mesh's
+    /// is above 1) instead of shrinking every other term. For a tree whose root box is the mesh's
+    /// it is `of`.
+    pub fn against(tree: &(impl TreeView + ?Sized), yardstick: &crate::geometry::Aabb) -> TreeStats {
+        Self::over(tree, Some(yardstick.area() as f64))
+    }
+
+    fn over(tree: &(impl TreeView + ?Sized), area: Option<f64>) -> TreeStats {
         let c = tree.params().cost;
         let report = tree.report();
         let mut root_area = 0f64;
@@ -96,7 +109,7 @@ impl TreeStats {
         let mut cost = 0f64;
         tree.walk(&mut |n| {
             if n.depth == 0 {
-                root_area = n.bounds.area() as f64;
+                root_area = area.unwrap_or(n.bounds.area() as f64);
             }
             let rel = if root_area > 0.0 { n.bounds.area() as f64 / root_area } else { 0.0 };
             s.nodes += 1;

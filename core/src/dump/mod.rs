@@ -64,14 +64,29 @@ pub struct BvhDump {
 pub enum DumpError {
     #[error(transparent)]
     File(#[from] FileError),
+    /// `plain`: what is wrong in bvhscope's own words, when `why` quotes the file (`without_content`).
     #[error("{path}: not a bvhscope-bvh file: {why}")]
-    NotTheFormat { path: String, why: String },
+    NotTheFormat { path: String, why: String, plain: Option<&'static str> },
     #[error("{path}: version {found} of the bvhscope-bvh format; this bvhscope reads version {VERSION}")]
     FutureVersion { path: String, found: u32 },
     #[error("{path}: line {line}: {why}")]
-    Text { path: String, line: usize, why: String },
+    Text { path: String, line: usize, why: String, plain: Option<&'static str> },
     #[error("{path}: {what} more than {} MB, the limit (by default what a BVH dump of this mesh can need; --max-dump-mb sets it)", .limit.div_ceil(1 << 20))]
     TooBig { path: String, what: &'static str, limit: u64 },
+}
+
+impl DumpError {
+    /// The message without a byte of the file's content: what `grade` reports of a file that is
+    /// not a dump (it may be anything a student's archive holds, a link's target included, and the
+    /// report goes to the whole class). Where the message quotes the file (a word, a field, a
+    /// format's name), its `plain` words stand instead.
+    pub fn without_content(&self) -> String {
+        match self {
+            DumpError::NotTheFormat { path, plain: Some(p), .. } => format!("{path}: not a bvhscope-bvh file: {p}"),
+            DumpError::Text { path, line, plain: Some(p), .. } => format!("{path}: line {line}: {p}"),
+            other => other.to_string(),
+        }
+    }
 }
 
 /// Bytes a dump of a mesh of `triangles` triangles may take, decompressed: what its largest tree
@@ -82,6 +97,9 @@ pub enum DumpError {
 pub fn max_bytes(triangles: usize) -> u64 {
     (64 << 20) + triangles as u64 * 8 * (2 * 400 + 16)
 }
+
+/// `without_content`'s words for a format that is not this one.
+const OTHER_FORMAT: &str = "its \"format\" names another format";
 
 /// The forms a dump is written in, by the file's name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -120,7 +138,11 @@ impl BvhDump {
             // error (MultiGzDecoder reads them as a broken member), not silently ignored.
             let gz = flate2::read::MultiGzDecoder::new(head.chain(file));
             crate::files::read_limited(gz, limit)
-                .map_err(|e| DumpError::NotTheFormat { path: name.clone(), why: format!("broken gzip data: {e}") })?
+                .map_err(|e| DumpError::NotTheFormat {
+                    path: name.clone(),
+                    why: format!("broken gzip data: {e}"),
+                    plain: None,
+                })?
                 .ok_or_else(|| too_big("decompresses to"))?
         } else {
             crate::files::read_limited(head.chain(file), limit).map_err(io)?.ok_or_else(|| too_big("is"))?
@@ -128,6 +150,7 @@ impl BvhDump {
         let text = decode(&bytes).ok_or_else(|| DumpError::NotTheFormat {
             path: name.clone(),
             why: "not text (a NUL byte: binary data, nor gzip)".into(),
+            plain: None,
         })?;
         let start = text.trim_start();
         let dump = if start.starts_with('{') || start.starts_with('[') || start.starts_with("null") {
@@ -136,7 +159,11 @@ impl BvhDump {
             Self::from_text(&text, &name)?
         };
         if dump.format != FORMAT {
-            return Err(DumpError::NotTheFormat { path: name, why: format!("its format is \"{}\"", dump.format) });
+            return Err(DumpError::NotTheFormat {
+                path: name,
+                why: format!("its format is \"{}\"", dump.format),
+                plain: Some(OTHER_FORMAT),
+            });
         }
         if dump.version != VERSION {
             return Err(DumpError::FutureVersion { path: name, found: dump.version });
@@ -145,7 +172,10 @@ impl BvhDump {
     }
 
     fn from_json(text: &str, name: &str) -> Result<BvhDump, DumpError> {
-        let not = |why: String| DumpError::NotTheFormat { path: name.into(), why };
+        let not = |why: String| DumpError::NotTheFormat { path: name.into(), why, plain: None };
+        // A message that quotes the file (serde's name a field or a value from it).
+        let quotes =
+            |why: String, plain: &'static str| DumpError::NotTheFormat { path: name.into(), why, plain: Some(plain) };
         // The format and version first, so a future version is named as such, not as broken JSON.
         #[derive(Deserialize)]
         struct Head {
@@ -163,10 +193,11 @@ impl BvhDump {
             };
             return Err(not(format!("the JSON is {kind}, not an object with \"format\": \"{FORMAT}\"")));
         }
-        let head = Head::deserialize(&value).map_err(|e| not(e.to_string()))?;
+        let head = Head::deserialize(&value)
+            .map_err(|e| quotes(e.to_string(), "\"format\" or \"version\" is not of the right type"))?;
         match head.format.as_deref() {
             Some(FORMAT) => {}
-            Some(f) => return Err(not(format!("its format is \"{f}\""))),
+            Some(f) => return Err(quotes(format!("its format is \"{f}\""), OTHER_FORMAT)),
             None => return Err(not("no \"format\" field".into())),
         }
         match head.version.as_ref().map(|v| v.as_u64()) {
@@ -177,11 +208,20 @@ impl BvhDump {
             Some(Some(_)) => {}
             Some(None) => return Err(not("\"version\" is not a whole number".into())),
         }
-        BvhDump::deserialize(value).map_err(|e| not(e.to_string()))
+        BvhDump::deserialize(value).map_err(|e| {
+            quotes(e.to_string(), "its fields are not a dump's (one missing, unknown, repeated or of the wrong type)")
+        })
     }
 
     fn from_text(text: &str, name: &str) -> Result<BvhDump, DumpError> {
-        let err = |line: usize, why: String| DumpError::Text { path: name.into(), line, why };
+        let err = |line: usize, why: String| DumpError::Text { path: name.into(), line, why, plain: None };
+        // A message that quotes the line.
+        let quotes = |line: usize, why: String, plain: &'static str| DumpError::Text {
+            path: name.into(),
+            line,
+            why,
+            plain: Some(plain),
+        };
         let mut dump =
             BvhDump { format: String::new(), version: 0, mesh: None, primitives: Vec::new(), nodes: Vec::new() };
         for (i, raw) in text.lines().enumerate() {
@@ -190,8 +230,15 @@ impl BvhDump {
             let mut words = line.split_whitespace();
             let Some(head) = words.next() else { continue };
             let rest: Vec<&str> = words.collect();
-            let num = |s: &str| s.parse::<f32>().map_err(|_| err(n, format!("'{s}' is not a number")));
-            let int = |s: &str| s.parse::<u32>().map_err(|_| err(n, format!("'{s}' is not a whole number")));
+            let num = |s: &str| {
+                s.parse::<f32>()
+                    .map_err(|_| quotes(n, format!("'{s}' is not a number"), "a word where a number must be"))
+            };
+            let int = |s: &str| {
+                s.parse::<u32>().map_err(|_| {
+                    quotes(n, format!("'{s}' is not a whole number"), "a word where a whole number must be")
+                })
+            };
             match head {
                 FORMAT if dump.format.is_empty() => {
                     dump.format = FORMAT.into();
@@ -200,9 +247,10 @@ impl BvhDump {
                         return Err(DumpError::FutureVersion { path: name.into(), found: dump.version });
                     }
                     if let Some(extra) = rest.get(1) {
-                        return Err(err(
+                        return Err(quotes(
                             n,
                             format!("'{extra}' after 'bvhscope-bvh 1': the first line holds nothing else"),
+                            "words after 'bvhscope-bvh 1': the first line holds nothing else",
                         ));
                     }
                 }
@@ -210,6 +258,7 @@ impl BvhDump {
                     return Err(DumpError::NotTheFormat {
                         path: name.into(),
                         why: "the first line is not 'bvhscope-bvh 1' (nor is the file JSON)".into(),
+                        plain: None,
                     })
                 }
                 "mesh" => dump.mesh = Some(rest.join(" ")),
@@ -255,23 +304,44 @@ impl BvhDump {
                             if k < rest.len() {
                                 let a = rest.get(k + 1).ok_or_else(|| err(n, "'axis' without a value".into()))?;
                                 let axis = a.parse::<u8>().ok().filter(|&a| a <= 2);
-                                node.axis =
-                                    Some(axis.ok_or_else(|| err(n, format!("axis '{a}' is not 0, 1 or 2 (x, y, z)")))?);
+                                node.axis = Some(axis.ok_or_else(|| {
+                                    quotes(
+                                        n,
+                                        format!("axis '{a}' is not 0, 1 or 2 (x, y, z)"),
+                                        "an axis that is not 0, 1 or 2 (x, y, z)",
+                                    )
+                                })?);
                                 if let Some(extra) = rest.get(k + 2) {
-                                    return Err(err(n, format!("'{extra}' after the axis: a node line ends with it")));
+                                    return Err(quotes(
+                                        n,
+                                        format!("'{extra}' after the axis: a node line ends with it"),
+                                        "words after the axis: a node line ends with it",
+                                    ));
                                 }
                             }
                             node.children = Some(kids);
                         }
-                        other => return Err(err(n, format!("'{other}': expected 'children' or 'leaf FIRST COUNT'"))),
+                        other => {
+                            return Err(quotes(
+                                n,
+                                format!("'{other}': expected 'children' or 'leaf FIRST COUNT'"),
+                                "a word where 'children' or 'leaf FIRST COUNT' must be",
+                            ))
+                        }
                     }
                     dump.nodes.push(node);
                 }
-                other => return Err(err(n, format!("'{other}' is not mesh, primitives or node"))),
+                other => {
+                    return Err(quotes(
+                        n,
+                        format!("'{other}' is not mesh, primitives or node"),
+                        "a line that is not mesh, primitives or node",
+                    ))
+                }
             }
         }
         if dump.format.is_empty() {
-            return Err(DumpError::NotTheFormat { path: name.into(), why: "the file is empty".into() });
+            return Err(DumpError::NotTheFormat { path: name.into(), why: "the file is empty".into(), plain: None });
         }
         Ok(dump)
     }
@@ -337,8 +407,11 @@ impl BvhDump {
     /// renamed over `path` when complete.
     pub fn write(&self, path: &Path) -> Result<(), DumpError> {
         use std::io::Write;
-        let form =
-            Self::written_as(path).map_err(|why| DumpError::NotTheFormat { path: path.display().to_string(), why })?;
+        let form = Self::written_as(path).map_err(|why| DumpError::NotTheFormat {
+            path: path.display().to_string(),
+            why,
+            plain: None,
+        })?;
         let werr = |source| DumpError::File(FileError::Write { path: path.into(), source });
         crate::files::write_atomically(path, |w| {
             let text = match form {

@@ -429,9 +429,47 @@ impl RaySummary {
 
 impl Frame {
     pub fn ray_summary(&self) -> RaySummary {
+        let (mut s, root) = self.summed();
+        let r = s.root_rays.max(1) as f64;
+        (s.root_mean_nodes_visited, s.root_mean_box_tests, s.root_mean_triangle_tests) =
+            (root[0] as f64 / r, root[1] as f64 / r, root[2] as f64 / r);
+        s
+    }
+
+    /// `ray_summary` on one yardstick for every tree of a comparison: its root-box figures are
+    /// the work of every ray that entered this tree's root box over the number of rays that
+    /// enter `yardstick` (the mesh's box, `camera`'s rays), not this tree's root box. A tree
+    /// whose root box is larger than the mesh's (a degenerate triangle kept far away, a loose
+    /// box) lets more rays in; over its own root box those rays' cheap walks would dilute its
+    /// means and rank it ahead of a better tree. For a tree whose root box is the mesh's it is
+    /// `ray_summary`.
+    pub fn ray_summary_in(&self, camera: &super::Camera, yardstick: &crate::geometry::Aabb) -> RaySummary {
+        let (mut s, root) = self.summed();
+        let gen = camera.ray_gen();
+        let step = self.stride.max(1);
+        let (cols, rows) = if self.stride == 0 { (0, 0) } else { self.grid_size() };
+        let entering: u64 = crate::parallel::region(|| {
+            (0..rows)
+                .into_par_iter()
+                .map(|gy| {
+                    (0..cols).filter(|&gx| yardstick.intersect(&gen.pixel_ray(gx * step, gy * step)).is_some()).count()
+                        as u64
+                })
+                .sum()
+        });
+        s.root_rays = entering;
+        let r = entering.max(1) as f64;
+        (s.root_mean_nodes_visited, s.root_mean_box_tests, s.root_mean_triangle_tests) =
+            (root[0] as f64 / r, root[1] as f64 / r, root[2] as f64 / r);
+        s
+    }
+
+    /// The summary's all-ray figures, and the sums of nodes, box tests and triangle tests over
+    /// the rays that entered the root box (their count in `root_rays`).
+    fn summed(&self) -> (RaySummary, [u64; 3]) {
         let mut s = RaySummary::default();
         let (mut nodes, mut boxes, mut tris, mut top, mut inst) = (0u64, 0u64, 0u64, 0u64, 0u64);
-        let (mut root_nodes, mut root_boxes, mut root_tris) = (0u64, 0u64, 0u64);
+        let mut root = [0u64; 3];
         for (p, c) in self.traced() {
             s.rays += 1;
             s.hits += p.is_hit() as u64;
@@ -442,9 +480,9 @@ impl Frame {
             inst += c.instances_entered as u64;
             if c.nodes_visited > 0 {
                 s.root_rays += 1;
-                root_nodes += c.nodes_visited as u64;
-                root_boxes += c.box_tests as u64;
-                root_tris += c.triangle_tests as u64;
+                root[0] += c.nodes_visited as u64;
+                root[1] += c.box_tests as u64;
+                root[2] += c.triangle_tests as u64;
             }
             s.max_nodes_visited = s.max_nodes_visited.max(c.nodes_visited);
             s.max_triangle_tests = s.max_triangle_tests.max(c.triangle_tests);
@@ -455,11 +493,7 @@ impl Frame {
         s.mean_triangle_tests = tris as f64 / n;
         s.mean_top_nodes_visited = top as f64 / n;
         s.mean_instances_entered = inst as f64 / n;
-        let r = s.root_rays.max(1) as f64;
-        s.root_mean_nodes_visited = root_nodes as f64 / r;
-        s.root_mean_box_tests = root_boxes as f64 / r;
-        s.root_mean_triangle_tests = root_tris as f64 / r;
-        s
+        (s, root)
     }
 }
 

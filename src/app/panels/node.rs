@@ -75,7 +75,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             };
             let visits = nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
             let visits = visits.map(|v| (v.counts[node as usize], v.camera.width, v.camera.height));
-            figures(ui, ins, e.epo_terms[node as usize], visits);
+            figures(ui, ins, ins.epo_share, visits);
             let imported = e.bvh.import();
             if let Some(names) = imported {
                 let d = crate::explain::inspect::text::dump_text(names.dump_of_binary_node(node));

@@ -77,7 +77,7 @@ const ROWS: &[StatRow] = &[
     },
     StatRow {
         name: "Rays in root box",
-        tip: "Share of the frame's primary rays that enter the root box; the others cost one box test and visit nothing. The per-ray rows below are means over these rays, unless they say all rays",
+        tip: "Share of the frame's primary rays that enter the root box; the others cost one box test and visit nothing. The per-ray rows below are means over these rays, unless they say all rays. An imported tree is measured on the mesh's box instead (its SAH cost too), as the tree beside it: a root box larger than the mesh's lets more rays in, and their work counts against it",
         per_ray: true,
         value: |f| rays(f).map(|r| format!("{:.1} %", 100.0 * r.root_fraction())),
     },

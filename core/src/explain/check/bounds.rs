@@ -14,7 +14,7 @@
 //! references, plus a logarithm of the depth per triangle that sticks out.
 
 use super::structure::Walk;
-use super::{count, cover, defect, tolerance, Finding, Group, Tally};
+use super::{count, cover, defect, tolerance, warning, Finding, Group, Tally};
 use crate::dump::BvhDump;
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
@@ -62,6 +62,8 @@ fn holds(b: &Aabb, t: &[Vec3; 3], tol: f32) -> bool {
 struct Cause {
     examples: Vec<String>,
     first: Option<u32>,
+    /// The farthest any of them sticks out.
+    excess: f32,
 }
 
 pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Finding>) {
@@ -155,6 +157,8 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
             let child = (k < depth).then(|| path[k + 1] as u32);
             let cause = causes.entry((worst as u32, child)).or_default();
             cause.first.get_or_insert(p);
+            // (NaN, a box that is no box, counts as farthest.)
+            cause.excess = if e.0.is_nan() { f32::INFINITY } else { cause.excess.max(e.0) };
             cause.examples.push(match child {
                 Some(_) => format!("triangle {p} {} (leaf node {i})", by(e)),
                 None => format!("triangle {p} {}", by(e)),
@@ -169,11 +173,11 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
         "leaf's box does not hold all its triangles",
         "leaves' boxes do not hold all their triangles",
     );
+    let mut leaf_causes = Vec::new();
     for ((worst, child), cause) in causes {
         let n = cause.examples.len();
         let Some(c) = child else {
-            let more = if n > 1 { format!(", and {} more", n - 1) } else { String::new() };
-            leaves.add(Some(worst), cause.first, format!("leaf node {worst} ({}{more})", cause.examples[0]));
+            leaf_causes.push((worst, cause));
             continue;
         };
         let child_box = nodes[c as usize].bounds();
@@ -190,7 +194,20 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
         };
         let mut f = defect(Group::Bounds, Some(worst), cause.first, text);
         f.examples = cause.examples;
+        f.excess = Some(cause.excess);
         out.push(f);
+    }
+    // The leaf whose box misses by most first: it is the finding's node, the first cause.
+    leaf_causes.sort_by(|a, b| b.1.excess.total_cmp(&a.1.excess));
+    for (worst, cause) in leaf_causes {
+        let n = cause.examples.len();
+        let more = if n > 1 { format!(", and {} more", n - 1) } else { String::new() };
+        leaves.add_by(
+            Some(worst),
+            cause.first,
+            format!("leaf node {worst} ({}{more})", cause.examples[0]),
+            cause.excess,
+        );
     }
     leaves.finish(out);
     let mut cut = Tally::new(
@@ -215,10 +232,12 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
         };
         match cover::uncovered(&t, &regions, tolerance(&t)) {
             cover::Coverage::Covered => {}
-            cover::Coverage::Uncovered(q) => cut.add(
+            cover::Coverage::Uncovered(q) => cut.add_by(
                 Some(leaves[0] as u32),
                 Some(p),
                 format!("triangle {p} around ({}, {}, {}) (leaves {})", q.x, q.y, q.z, list(4)),
+                // How far the part left out lies from the nearest of the boxes.
+                regions.iter().map(|r| excess(r, &[q]).0).fold(f32::INFINITY, f32::min),
             ),
             cover::Coverage::TooComplex => {
                 complex.add(Some(leaves[0] as u32), Some(p), format!("triangle {p} ({} leaves)", leaves.len()))
@@ -243,4 +262,60 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
     degenerate_out.finish(out);
     degenerate_in.finish(out);
     twice.finish(out);
+}
+
+/// A root box larger than the mesh's box: no defect (every ray still finds its hit), but a
+/// comparison measures every tree against the mesh's box (`TreeStats::against`,
+/// `Frame::ray_summary_in`), so the student is told by how much theirs is larger and why: the
+/// leaf whose box reaches farthest out, and the degenerate triangle it keeps, if any (no ray can
+/// hit one, so nothing else checks where its box is).
+pub(super) fn root_box(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Finding>) {
+    let mb = mesh.bounds();
+    let Some(root) = dump.nodes.first().map(|n| n.bounds()) else { return };
+    if mb.is_empty() || root.is_empty() {
+        return;
+    }
+    let m = mb.min.abs().max(mb.max.abs()).max_element();
+    let tol = (4.0 * f32::EPSILON * m).max(f32::MIN_POSITIVE);
+    let e = excess(&mb, &[root.min.into(), root.max.into()]);
+    if !(e.0 > tol) {
+        return;
+    }
+    let by_file = mesh.triangles_by_file_number();
+    let (nodes, prims) = (&dump.nodes, &dump.primitives);
+    // The reached leaf whose box sticks out farthest, and a degenerate triangle it holds.
+    let mut far: Option<(f32, usize)> = None;
+    for (i, n) in nodes.iter().enumerate() {
+        if !walk.reached[i] || n.children.is_some() {
+            continue;
+        }
+        let b = n.bounds();
+        let x = excess(&mb, &[b.min.into(), b.max.into()]).0;
+        if x > tol && far.is_none_or(|(f, _)| x > f) {
+            far = Some((x, i));
+        }
+    }
+    let leaf_prims = |i: usize| {
+        let n = &nodes[i];
+        let (f, c) = (n.first.unwrap_or(0) as usize, n.count.unwrap_or(0) as usize);
+        prims.get(f..f + c).unwrap_or_default()
+    };
+    let degenerate = far.and_then(|(_, i)| {
+        leaf_prims(i).iter().copied().find(|&p| by_file.get(p as usize).is_some_and(|m| m.is_none()))
+    });
+    let ratio = root.area() as f64 / (mb.area() as f64).max(f64::MIN_POSITIVE);
+    let why = match (far, degenerate) {
+        (Some((_, i)), Some(p)) => format!(
+            "leaf node {i} reaches farthest out; it holds triangle {p}, a degenerate (zero-area) triangle no ray can hit, which a BVH may leave out"
+        ),
+        (Some((_, i)), None) => format!("leaf node {i}'s box reaches farthest out, past every triangle it holds"),
+        (None, _) => "its boxes are larger than the triangles they hold".into(),
+    };
+    let text = format!(
+        "the root box is larger than the mesh's box ({}, {ratio:.2}× its area): {why}; the SAH cost and the rays per ray of comparisons are measured against the mesh's box, so the larger box costs what it costs",
+        by(e)
+    );
+    let mut f = warning(Group::Bounds, far.map(|(_, i)| i as u32).or(Some(0)), degenerate, text);
+    f.excess = Some(e.0);
+    out.push(f);
 }

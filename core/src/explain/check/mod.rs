@@ -66,6 +66,42 @@ pub struct Finding {
     pub triangle: Option<u32>,
     /// Every case, in order (empty for a finding that is one case).
     pub examples: Vec<String>,
+    /// How far a box misses what it must hold, the largest of the finding's cases (bounds
+    /// findings): what orders them, a wrong box before a rounding.
+    pub excess: Option<f32>,
+}
+
+impl Finding {
+    /// How serious it is, most serious first (`by_severity`), causes before what follows from
+    /// them: a broken structure (nothing can be trusted), then triangles no leaf holds (no ray
+    /// can hit them), then boxes that leave triangles out, the farthest first (a box missing by
+    /// a tenth of the mesh before one rounded by an ulp), then the rays that hit wrongly (which
+    /// follow from one of those where there is one: "1 of 2036 rays hit differently" says less
+    /// than the leaf whose box is too small), then warnings.
+    fn severity(&self) -> (u8, f32) {
+        let class = match (self.defect, self.group) {
+            (false, _) => 4,
+            (true, Group::Structure) => 0,
+            (true, Group::Coverage) => 1,
+            (true, Group::Bounds) => 2,
+            (true, Group::Rays) => 3,
+        };
+        // Larger excess first; NaN (a box that is not a box) first of all.
+        let e = self.excess.map_or(0.0, |e| if e.is_nan() { f32::INFINITY } else { e });
+        (class, -e)
+    }
+}
+
+/// Order `findings` most serious first (`Finding::severity`), keeping the order among equals:
+/// the first defect is the root cause a student fixes first (`grade`'s "first cause"). A dump of
+/// another mesh (`wrong_mesh`, the first finding when there is one) stays first: every defect
+/// after it follows from it.
+pub fn by_severity(findings: &mut [Finding], wrong_mesh_first: bool) {
+    let findings = if wrong_mesh_first && !findings.is_empty() { &mut findings[1..] } else { findings };
+    findings.sort_by(|a, b| {
+        let (ka, kb) = (a.severity(), b.severity());
+        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+    });
 }
 
 /// Examples listed after a finding unless all are asked for (`check --all`).
@@ -90,11 +126,11 @@ impl Finding {
 }
 
 pub(crate) fn defect(group: Group, node: Option<u32>, triangle: Option<u32>, text: String) -> Finding {
-    Finding { group, defect: true, text, node, triangle, examples: Vec::new() }
+    Finding { group, defect: true, text, node, triangle, examples: Vec::new(), excess: None }
 }
 
 pub(crate) fn warning(group: Group, node: Option<u32>, triangle: Option<u32>, text: String) -> Finding {
-    Finding { group, defect: false, text, node, triangle, examples: Vec::new() }
+    Finding { group, defect: false, text, node, triangle, examples: Vec::new(), excess: None }
 }
 
 /// "1 node is" / "3 nodes are": a count with its noun and verb agreeing.
@@ -116,11 +152,12 @@ pub(crate) struct Tally {
     node: Option<u32>,
     triangle: Option<u32>,
     examples: Vec<String>,
+    excess: Option<f32>,
 }
 
 impl Tally {
     pub fn new(group: Group, defect: bool, one: &'static str, many: &'static str) -> Self {
-        Tally { group, defect, one, many, node: None, triangle: None, examples: Vec::new() }
+        Tally { group, defect, one, many, node: None, triangle: None, examples: Vec::new(), excess: None }
     }
 
     pub fn add(&mut self, node: Option<u32>, triangle: Option<u32>, example: String) {
@@ -128,6 +165,12 @@ impl Tally {
             (self.node, self.triangle) = (node, triangle);
         }
         self.examples.push(example);
+    }
+
+    /// `add`, for a case that misses by `excess` (the finding keeps the largest).
+    pub fn add_by(&mut self, node: Option<u32>, triangle: Option<u32>, example: String, excess: f32) {
+        self.add(node, triangle, example);
+        self.excess = Some(self.excess.map_or(excess, |e| e.max(excess)));
     }
 
     pub fn finish(self, out: &mut Vec<Finding>) {
@@ -142,6 +185,7 @@ impl Tally {
             node: self.node,
             triangle: self.triangle,
             examples: self.examples,
+            excess: self.excess,
         });
     }
 }
@@ -176,27 +220,34 @@ pub fn check_tree(dump: &BvhDump, mesh: &Mesh) -> Vec<Finding> {
     let mut out = Vec::new();
     let Some(walk) = structure::check(dump, mesh, &mut out) else { return out };
     bounds::check(dump, mesh, &walk, &mut out);
+    bounds::root_box(dump, mesh, &walk, &mut out);
     out
 }
 
-/// When the dump names another mesh than the one given, or numbers more triangles than it has:
-/// one line saying so, before the defects that follow from it.
+/// When the dump names another mesh than the one given, or most of its primitives number
+/// triangles this mesh does not have: one line saying so, before the defects that follow from it.
+/// A few numbers past the end are a student's off-by-one, not another mesh: those are the
+/// structure's defects, naming their nodes.
 pub fn wrong_mesh(s: &Subject) -> Option<Finding> {
     let given = s.mesh_path.file_name().map(|n| n.to_string_lossy().into_owned())?;
     let named = s.dump.mesh.as_deref().map(|m| m.rsplit(['/', '\\']).next().unwrap_or(m).to_string());
     let tris = s.mesh.file_triangle_count();
-    let highest = s.dump.primitives.iter().copied().max();
-    let past = highest.filter(|&h| h as usize >= tris);
+    let past_count = s.dump.primitives.iter().filter(|&&p| p as usize >= tris).count();
+    let most_past = past_count > 0 && 2 * past_count > s.dump.primitives.len();
+    let highest = s.dump.primitives.iter().copied().max().filter(|_| most_past);
     let other_name = named.as_ref().filter(|n| !n.eq_ignore_ascii_case(&given));
-    if other_name.is_none() && past.is_none() {
+    if other_name.is_none() && highest.is_none() {
         return None;
     }
     let mut text = match other_name {
         Some(n) => format!("the dump was written for {n}, but is checked against {given} ({tris} triangles)"),
         None => format!("the dump is checked against {given} ({tris} triangles)"),
     };
-    if let Some(h) = past {
-        text += &format!(", and its primitives number triangles up to {h}");
+    if let Some(h) = highest {
+        text += &format!(
+            ", and {past_count} of its {} primitives number triangles past them (up to {h})",
+            s.dump.primitives.len()
+        );
     }
     text += ": is this the mesh it was built over?";
     Some(warning(Group::Structure, None, None, text))
@@ -236,7 +287,7 @@ pub fn check(
 ) -> Result<Checked, Cancelled> {
     let (out, tree) = match check_structure(s) {
         Ok(traced) => traced,
-        Err(findings) => return Ok(Checked::untraced(findings)),
+        Err(findings) => return Ok(Checked::untraced(findings, s)),
     };
     // Built only once the tree can be traced: past 4,096 triangles it is a whole SAH build.
     let reference = Reference::of(s.mesh);
@@ -257,12 +308,13 @@ pub fn check_with(
 ) -> Result<Checked, Cancelled> {
     match check_structure(s) {
         Ok((out, tree)) => check_rays_of(s, out, tree, reference, camera, rays, opts, control),
-        Err(findings) => Ok(Checked::untraced(findings)),
+        Err(findings) => Ok(Checked::untraced(findings, s)),
     }
 }
 
 impl Checked {
-    fn untraced(findings: Vec<Finding>) -> Checked {
+    fn untraced(mut findings: Vec<Finding>, s: &Subject) -> Checked {
+        by_severity(&mut findings, wrong_mesh(s).is_some());
         Checked { findings, tree: None, wrong_pixels: Vec::new(), reference: None, rays: 0 }
     }
 }
@@ -317,6 +369,7 @@ fn check_rays_of(
     if let Some(f) = wrong.finding(set.len()) {
         out.push(f);
     }
+    by_severity(&mut out, wrong_mesh(s).is_some());
     Ok(Checked {
         findings: out,
         tree: Some((bvh, imported)),

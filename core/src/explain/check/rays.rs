@@ -174,6 +174,11 @@ pub fn wrong_rays(
         let wrong: Vec<WrongRay> = (start..end)
             .into_par_iter()
             .filter_map(|i| {
+                // A tree whose boxes all overlap costs every node per ray: a batch of such rays
+                // takes minutes, so a cancel is heard between rays, not only between batches.
+                if control.is_cancelled() {
+                    return None;
+                }
                 let (r, pixel) = set.ray(i);
                 let want = reference.closest_hit(&r, opts);
                 let got = bvh.closest_hit(&mut r.clone(), opts, &mut NoStats);
@@ -191,6 +196,7 @@ pub fn wrong_rays(
                 })
             })
             .collect();
+        control.check()?;
         out.count += wrong.len() as u64;
         out.pixels.extend(wrong.iter().filter_map(|w| w.pixel));
         let room = EXAMPLES.saturating_sub(out.examples.len());

@@ -106,8 +106,9 @@ fn head(setup: &Setup, graded: &Graded) -> String {
     );
     let _ = writeln!(
         o,
-        "<p class=\"setup\">Trace time: {} primary rays spread over the frame, traced one at a time on one thread, closest hit, no shading; the fastest of {} runs (other work on the machine only adds time). The linear scan was timed on {} of them: {} µs per ray; speed-up is its time over the tree's.</p>",
+        "<p class=\"setup\">One yardstick for every tree: the SAH cost is normalised by the area of the mesh's box (what its triangles span), and the per-ray figures \"in the mesh's box\" are the work of every ray over the rays that enter that box, whatever each tree's own root box; a tree whose root box is larger (a degenerate triangle kept, a loose box) is told by how much and why among its findings.</p>\n<p class=\"setup\">Trace time: {} primary rays spread over the frame, traced one at a time on one thread, closest hit, no shading. Each tree is timed in the same rounds as bvhscope's SAH tree of its layout, {} rays at a time, the trees taking turns, the fastest of {} runs of each kept: its time relative to the SAH tree's is what a busy machine leaves alone, and its speed-up over the linear scan is the SAH tree's (the linear scan timed on {} of the rays: {} µs per ray) over that ratio.</p>",
         t.rays,
+        super::measure::PIECE,
         t.runs,
         t.linear_rays,
         num(t.linear_ns_per_ray / 1e3, 1)
@@ -233,8 +234,11 @@ fn figures(q: &Quality, row: &GradeRow) -> String {
         f("vs SAH tree", format!("{:+.1} %", (v.sah_cost - 1.0) * 100.0));
     }
     f("EPO", q.epo.map_or_else(|| q.epo_skipped.clone().unwrap_or_default(), |e| num(e, 3)));
-    f("nodes / ray", format!("{} (in root box {})", num(q.nodes_per_ray, 2), num(q.root_nodes_per_ray, 2)));
-    f("tri tests / ray", format!("{} (in root box {})", num(q.tri_tests_per_ray, 2), num(q.root_tri_tests_per_ray, 2)));
+    f("nodes / ray", format!("{} (in the mesh's box {})", num(q.nodes_per_ray, 2), num(q.root_nodes_per_ray, 2)));
+    f(
+        "tri tests / ray",
+        format!("{} (in the mesh's box {})", num(q.tri_tests_per_ray, 2), num(q.root_tri_tests_per_ray, 2)),
+    );
     f("trace", format!("{} ns / ray", num(q.trace_ns_per_ray, 0)));
     f("speed-up over linear", format!("{}×", num(q.speedup_over_linear, 0)));
     f("memory", bytes_text(q.memory_bytes));

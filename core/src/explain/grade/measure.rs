@@ -32,7 +32,8 @@ pub struct Quality {
     /// Means over all the camera's primary rays…
     pub nodes_per_ray: f64,
     pub tri_tests_per_ray: f64,
-    /// … and over those that enter the root box.
+    /// … and the work of the rays that entered the tree over those that enter the mesh's box
+    /// (`Frame::ray_summary_in`: the same rays for every tree).
     pub root_nodes_per_ray: f64,
     pub root_tri_tests_per_ray: f64,
     /// Single rays, closest hit, no shading, one thread (`Timing`).
@@ -44,9 +45,13 @@ pub struct Quality {
 }
 
 /// How trees are timed: the same evenly spread primary rays for every tree, traced one at a time
-/// on the calling thread (as a student's renderer does), the fastest of `RUNS` runs (other work
-/// on a shared machine only ever adds time, so the fastest run is the steadiest figure); the
-/// linear scan likewise on as many of them as fit in a fifth of a second per run.
+/// on the calling thread (as a student's renderer does). A busy machine only ever adds time, and
+/// unevenly (two identical trees timed one after the other differed by 2×): so a tree is timed
+/// in the same rounds as bvhscope's SAH tree of its layout, piece by piece (`PIECE` rays, the
+/// two trees alternately first), each piece's fastest of `RUNS` runs kept; the figure compared
+/// is the ratio of the two sums, which a load on the machine leaves alone. The linear scan is
+/// timed once for the class, on as many of the rays as fit in a fifth of a second per run, and
+/// the SAH tree's speed-up over it carries each tree's ratio into a speed-up of its own.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Timing {
     /// Rays timed per tree.
@@ -58,6 +63,10 @@ pub struct Timing {
 }
 
 pub const RUNS: u32 = 5;
+
+/// Rays timed as one piece: some 50 to 500 µs of tracing, short beside a time slice of the
+/// scheduler, so most runs of a piece are not interrupted and its fastest run is a clean one.
+pub const PIECE: usize = 256;
 
 /// What one run of the linear scan's timing may take.
 const LINEAR_BUDGET: Duration = Duration::from_millis(200);
@@ -76,37 +85,78 @@ fn sample_pixel(camera: &Camera, i: usize, n: usize) -> (u32, u32) {
     (p % camera.width, p / camera.width)
 }
 
-/// Seconds to trace `n` sample rays through `accel` on this thread, closest hit only.
-fn trace_once<A: Accelerator>(accel: &A, camera: &Camera, trace: TraceOptions, n: usize) -> f64 {
+/// The `n` sample rays, from `first` on (of `total`).
+fn sample_rays(camera: &Camera, first: usize, n: usize, total: usize) -> Vec<crate::geometry::Ray> {
     let gen = camera.ray_gen();
+    (first..first + n)
+        .map(|i| {
+            let (x, y) = sample_pixel(camera, i, total);
+            gen.pixel_ray(x, y)
+        })
+        .collect()
+}
+
+/// A tree's closest-hit query on one ray, as the timing calls it (`tracer`).
+pub type Tracer<'a> = &'a dyn Fn(&mut crate::geometry::Ray);
+
+/// `accel`'s closest-hit query with `trace`'s options, for `time_together`.
+pub fn tracer<A: Accelerator + ?Sized>(accel: &A, trace: TraceOptions) -> impl Fn(&mut crate::geometry::Ray) + '_ {
+    move |ray| {
+        std::hint::black_box(accel.closest_hit(ray, trace, &mut NoStats));
+    }
+}
+
+/// Seconds to trace `rays` through `tree` on this thread.
+fn trace_once(tree: Tracer, rays: &[crate::geometry::Ray]) -> f64 {
     let start = Instant::now();
-    for i in 0..n {
-        let (x, y) = sample_pixel(camera, i, n);
-        let mut ray = gen.pixel_ray(x, y);
-        std::hint::black_box(accel.closest_hit(&mut ray, trace, &mut NoStats));
+    for r in rays {
+        tree(&mut r.clone());
     }
     start.elapsed().as_secs_f64()
 }
 
-/// Nanoseconds per ray of `accel` on `n` sample rays: the fastest of `runs` runs.
-fn fastest<A: Accelerator>(accel: &A, camera: &Camera, trace: TraceOptions, n: usize, runs: u32) -> f64 {
-    let best = (0..runs.max(1)).map(|_| trace_once(accel, camera, trace, n)).fold(f64::INFINITY, f64::min);
-    best * 1e9 / n.max(1) as f64
-}
-
-/// Nanoseconds per ray of `accel` on `n` sample rays (`Timing`).
-pub fn time_tree<A: Accelerator>(accel: &A, camera: &Camera, trace: TraceOptions, n: usize) -> f64 {
-    fastest(accel, camera, trace, n, RUNS)
+/// Nanoseconds per ray of each of `trees` on `n` sample rays, timed in the same rounds: piece by
+/// piece, every tree on the piece `RUNS` times in a rotating order, each piece's fastest run
+/// kept (`Timing`). `control` is heard between runs: a tree whose boxes all overlap takes a
+/// millisecond a ray.
+pub fn time_together(
+    trees: &[Tracer],
+    camera: &Camera,
+    n: usize,
+    control: &WorkControl,
+) -> Result<Vec<f64>, Cancelled> {
+    let n = n.max(1);
+    let mut sums = vec![0f64; trees.len()];
+    let mut first = 0;
+    while first < n {
+        let rays = sample_rays(camera, first, PIECE.min(n - first), n);
+        let mut best = vec![f64::INFINITY; trees.len()];
+        for run in 0..RUNS as usize {
+            for k in 0..trees.len() {
+                control.check()?;
+                let t = (k + run) % trees.len();
+                best[t] = best[t].min(trace_once(trees[t], &rays));
+            }
+        }
+        for (s, b) in sums.iter_mut().zip(&best) {
+            *s += b;
+        }
+        first += rays.len();
+    }
+    Ok(sums.into_iter().map(|s| s * 1e9 / n as f64).collect())
 }
 
 /// The linear scan's time per ray: a probe of a few rays, then as many of the `max` sample rays as
 /// fit in `LINEAR_BUDGET` (a scan of a million triangles takes milliseconds per ray), `RUNS` times.
 pub fn time_linear(mesh: &Mesh, camera: &Camera, trace: TraceOptions, max: usize) -> (f64, usize) {
     let linear = LinearScan::new(mesh);
+    let scan = tracer(&linear, trace);
     let probe = 8.min(max).max(1);
-    let t = trace_once(&linear, camera, trace, probe) / probe as f64;
+    let t = trace_once(&scan, &sample_rays(camera, 0, probe, max.max(probe))) / probe as f64;
     let n = ((LINEAR_BUDGET.as_secs_f64() / t.max(1e-9)) as usize).clamp(probe, max.max(probe));
-    (fastest(&linear, camera, trace, n, RUNS), n)
+    let rays = sample_rays(camera, 0, n, n);
+    let best = (0..RUNS).map(|_| trace_once(&scan, &rays)).fold(f64::INFINITY, f64::min);
+    (best * 1e9 / n as f64, n)
 }
 
 /// The EPO of `bvh`, unless a sample of its nodes says the measure would cost more than
@@ -150,7 +200,8 @@ pub fn epo_bounded(bvh: &Bvh) -> Result<f64, String> {
 }
 
 /// Everything of `tree` but its time: statistics, EPO (of `binary`, the binary tree behind it),
-/// and the counted frame on `camera` (returned too, for its heatmap). `control` may stop the
+/// and the counted frame on `camera` (returned too, for its heatmap), the SAH cost and the
+/// per-ray figures against the mesh's box. `control` may stop the
 /// frame between bands.
 pub fn measure(
     tree: &AnyBvh,
@@ -160,7 +211,10 @@ pub fn measure(
     trace: TraceOptions,
     control: &WorkControl,
 ) -> Result<(Quality, Frame), Cancelled> {
-    let s = TreeStats::of(tree);
+    // One yardstick for every tree of the class: the mesh's box (what its triangles span), not
+    // each tree's own root box (`TreeStats::against`, `Frame::ray_summary_in`).
+    let yardstick = mesh.bounds();
+    let s = TreeStats::against(tree, &yardstick);
     let (epo, epo_skipped) = match binary.map(epo_bounded) {
         Some(Ok(e)) => (Some(e), None),
         Some(Err(why)) => (None, Some(why)),
@@ -168,7 +222,7 @@ pub fn measure(
     };
     let settings = RenderSettings { trace, count: true, progressive: false };
     let frame = render_progressive(tree, mesh, camera, &settings, &Default::default(), control, |_, _| {})?;
-    let r = frame.ray_summary();
+    let r = frame.ray_summary_in(camera, &yardstick);
     let q = Quality {
         layout: tree.params().layout.name(),
         nodes: s.nodes,
@@ -191,10 +245,12 @@ pub fn measure(
     Ok((q, frame))
 }
 
-/// `q` with the time per ray of `tree` on the timing's rays, and its speed-up over the linear scan.
-pub fn timed(mut q: Quality, tree: &AnyBvh, camera: &Camera, trace: TraceOptions, timing: &Timing) -> Quality {
-    q.trace_ns_per_ray = time_tree(tree, camera, trace, timing.rays);
-    q.speedup_over_linear = timing.linear_ns_per_ray / q.trace_ns_per_ray.max(1e-3);
+/// `q` with its time per ray (`ns_per_ray`) and its speed-up over the linear scan: the SAH tree's
+/// (`sah_speedup`, timed once for the class) over this tree's time relative to the SAH tree's
+/// (`versus_sah`, timed in the same rounds), so a busy moment of the machine moves neither.
+pub fn timed(mut q: Quality, ns_per_ray: f64, versus_sah: f64, sah_speedup: f64) -> Quality {
+    q.trace_ns_per_ray = ns_per_ray;
+    q.speedup_over_linear = sah_speedup / versus_sah.max(1e-9);
     q
 }
 

@@ -31,6 +31,8 @@ mod rubric;
 mod table;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_fair;
 
 pub use discover::{discover, Submission};
 pub use evaluate::evaluate;

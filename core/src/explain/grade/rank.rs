@@ -1,7 +1,8 @@
 //! The order within the class: the correct submissions ranked by one key (the rubric's
 //! `rank_by`), each figure taken over bvhscope's SAH tree of the same layout, lowest first, so a
-//! 4-wide dump is held to the 4-wide SAH tree; ties go by name, then by the order given, so the
-//! same class ranks the same every time. Incorrect submissions get no rank.
+//! 4-wide dump is held to the 4-wide SAH tree; equal figures share a place (they are listed by
+//! name, then by the order given), so the same class ranks the same every time and two students
+//! with the same tree rank alike. Incorrect submissions get no rank.
 
 use super::{GradeRow, Verdict, VersusSah};
 use serde::Serialize;
@@ -73,11 +74,17 @@ pub fn rank(rows: &mut [GradeRow], by: RankBy) {
         .collect();
     // total_cmp: a NaN (a reference of zero work) sorts last, never panics the sort.
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.cmp(b.1)).then(a.2.cmp(&b.2)));
-    let order: Vec<usize> = ranked.iter().map(|r| r.3).collect();
+    // Equal figures share a place (1, 2, 2, 4): two students who handed in the same tree get
+    // the same rank, whatever their names.
+    let mut places = Vec::with_capacity(ranked.len());
+    for (k, &(key, _, _, i)) in ranked.iter().enumerate() {
+        let place = if k > 0 && ranked[k - 1].0.total_cmp(&key).is_eq() { places[k - 1] } else { (i, k + 1) };
+        places.push((i, place.1));
+    }
     for r in rows.iter_mut() {
         r.rank = None;
     }
-    for (place, i) in order.into_iter().enumerate() {
-        rows[i].rank = Some(place + 1);
+    for (i, place) in places {
+        rows[i].rank = Some(place);
     }
 }

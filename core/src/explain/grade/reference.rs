@@ -4,7 +4,7 @@
 //! the SAH tree its counted frame, for the students' difference images. The checker's reference
 //! (the linear scan's hits) is built here too, once for the class.
 
-use super::measure::{measure, time_linear, timed, Quality, Timing, RUNS};
+use super::measure::{measure, time_linear, time_together, timed, tracer, Quality, Timing, Tracer, RUNS};
 use super::Setup;
 use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SplitStrategy};
 use crate::dump::{import, BvhDump};
@@ -32,6 +32,10 @@ struct LayoutRefs {
     trees: Vec<ReferenceTree>,
     /// The SAH tree's counted frame.
     sah_frame: Frame,
+    /// The SAH tree itself: every tree of this layout is timed in the same rounds as it.
+    sah_tree: AnyBvh,
+    /// Its speed-up over the linear scan (timed once for the class).
+    sah_speedup: f64,
     /// The most nodes any reference visits for a pixel: the top of the class's heatmap scale.
     visits_max: f32,
 }
@@ -70,7 +74,7 @@ impl References {
         if self.layouts.iter().any(|l| l.layout == layout) {
             return;
         }
-        let mut trees = Vec::new();
+        let mut built = Vec::new();
         let mut sah_frame = None;
         let mut visits_max = 1f32;
         // Nobody cancels the references: they are what the whole class is measured against.
@@ -86,16 +90,47 @@ impl References {
             let Ok((q, frame)) = measure(&tree, binary, setup.mesh, &setup.camera, setup.trace, &control) else {
                 unreachable!("nobody else holds this control")
             };
-            let q = timed(q, &tree, &setup.camera, setup.trace, &self.timing);
             visits_max = visits_max.max(frame.ray_summary().max_nodes_visited as f32);
             if strategy == SplitStrategy::SahBinned {
                 sah_frame = Some(frame);
             }
+            built.push((strategy, tree, q));
+        }
+        // Timed together, in the same rounds: their ratios to the SAH tree (the first) are what
+        // a busy machine leaves alone.
+        let tracers: Vec<_> = built.iter().map(|(_, t, _)| tracer(t, setup.trace)).collect();
+        let each: Vec<Tracer> = tracers.iter().map(|t| t as Tracer).collect();
+        let ns = time_together(&each, &setup.camera, self.timing.rays, &control).expect("nobody cancels it");
+        drop(tracers);
+        let sah_speedup = self.timing.linear_ns_per_ray / ns[0].max(1e-9);
+        let mut trees = Vec::new();
+        let mut sah_tree = None;
+        for (k, (strategy, tree, q)) in built.into_iter().enumerate() {
+            let q = timed(q, ns[k], ns[k] / ns[0].max(1e-9), sah_speedup);
             let name = format!("{}, {}", strategy.label(), layout.name());
             trees.push(ReferenceTree { strategy: strategy.name(), name, quality: q });
+            if k == 0 {
+                sah_tree = Some(tree);
+            }
         }
         let sah_frame = sah_frame.expect("SAH binned is always among the references");
-        self.layouts.push(LayoutRefs { layout, trees, sah_frame, visits_max });
+        let sah_tree = sah_tree.expect("SAH binned is the first reference");
+        self.layouts.push(LayoutRefs { layout, trees, sah_frame, sah_tree, sah_speedup, visits_max });
+    }
+
+    /// The time per ray of `tree` and its ratio to bvhscope's SAH tree of `layout` (built), timed
+    /// in the same rounds (`time_together`); the SAH tree's speed-up over the linear scan.
+    pub fn time_against_sah(
+        &self,
+        tree: &AnyBvh,
+        layout: Layout,
+        setup: &Setup,
+        control: &WorkControl,
+    ) -> Result<(f64, f64, f64), crate::work::Cancelled> {
+        let l = self.of(layout).expect("the layout's references are built first");
+        let (sah, theirs) = (tracer(&l.sah_tree, setup.trace), tracer(tree, setup.trace));
+        let ns = time_together(&[&sah, &theirs], &setup.camera, self.timing.rays, control)?;
+        Ok((ns[1], ns[1] / ns[0].max(1e-9), l.sah_speedup))
     }
 
     fn of(&self, layout: Layout) -> Option<&LayoutRefs> {

@@ -108,7 +108,7 @@ fn row(name: &str, index: usize, verdict: Verdict, sah: f64) -> GradeRow {
 }
 
 #[test]
-fn ranks_go_to_correct_rows_by_the_key_ties_by_name_and_are_the_same_in_any_order() {
+fn ranks_go_to_correct_rows_by_the_key_ties_share_a_place_and_are_the_same_in_any_order() {
     let rows = vec![
         row("dora", 0, Verdict::Correct, 1.2),
         row("carl", 1, Verdict::Correct, 1.0),
@@ -123,13 +123,16 @@ fn ranks_go_to_correct_rows_by_the_key_ties_by_name_and_are_the_same_in_any_orde
         v
     };
     let want = |v: [(&str, Option<usize>); 5]| v.iter().map(|(n, r)| (n.to_string(), *r)).collect::<Vec<_>>();
-    let by_sah = want([("abe", Some(2)), ("bea", None), ("carl", Some(1)), ("dora", Some(3)), ("zed", Some(4))]);
+    let by_sah = want([("abe", Some(2)), ("bea", None), ("carl", Some(1)), ("dora", Some(2)), ("zed", Some(4))]);
     assert_eq!(ranks(rows.clone(), RankBy::SahCost), by_sah, "a NaN ranks last; defects get no rank");
     let mut reversed = rows.clone();
     reversed.reverse();
     assert_eq!(ranks(reversed, RankBy::SahCost), by_sah, "the order given does not matter");
     let by_nodes = ranks(rows, RankBy::NodesPerRay);
-    assert_eq!(by_nodes[0], ("abe".to_string(), Some(1)), "0.8 nodes per ray ties with dora: by name");
+    assert_eq!(by_nodes[0], ("abe".to_string(), Some(1)), "0.8 nodes per ray ties with dora: one place");
+    assert_eq!(by_nodes[3], ("dora".to_string(), Some(1)));
+    assert_eq!(by_nodes[1], ("bea".to_string(), None));
+    assert_eq!(by_nodes[2], ("carl".to_string(), Some(3)), "after two in first place, third");
 }
 
 /// A chain of leaves hanging off interior nodes whose boxes are all the root's: the EPO would
@@ -212,6 +215,7 @@ fn a_small_class_is_graded_ranked_and_drawn() {
     assert_eq!((r[0].rank, r[1].rank, r[2].rank), (Some(2), Some(1), None));
     assert_eq!(r[1].versus_sah.unwrap().sah_cost, 1.0, "the SAH tree exported is the reference's");
     assert_eq!(r[1].good, Some(true));
+    // The box first, then the rays that hit wrongly because of it.
     assert!(r[2]
         .reason
         .starts_with(&format!("bounds: 1 leaf's box does not hold all its triangles: leaf node {leaf}")));
@@ -249,8 +253,9 @@ fn a_grade_report_is_read_back_with_its_paths_found_again() {
     let names = ["mia.txt", "cy.txt", "junk.txt", "empty", "moved.txt", "gone.txt"];
     let subs = discover(&names.map(|n| d.join("class").join(n)));
     let setup = small_setup(&mesh, &mesh_path);
-    let out = ReportDir::prepare(&d.join("report"), vec![(mesh_path.clone(), "the mesh".into())]).unwrap();
+    let mut out = ReportDir::prepare(&d.join("report"), vec![(mesh_path.clone(), "the mesh".into())]).unwrap();
     let graded = grade_class(&setup, References::new(&setup), &subs, &out, &WorkControl::new(), |_| {});
+    out.publish().unwrap();
     // The paths as `grade` writes them when run in the class's parent folder: relative to it.
     let mut doc = document(&setup, &graded);
     let prefix = format!("{}/", d.display());
@@ -267,7 +272,7 @@ fn a_grade_report_is_read_back_with_its_paths_found_again() {
     std::fs::rename(d.join("class/moved.txt"), d.join("report/class-moved.txt")).unwrap();
     doc["students"][4]["dump"] = "class-moved.txt".into();
     std::fs::remove_file(d.join("class/gone.txt")).unwrap();
-    out.write(JSON_FILE, serde_json::to_string_pretty(&doc).unwrap().as_bytes()).unwrap();
+    std::fs::write(out.file(JSON_FILE), serde_json::to_string_pretty(&doc).unwrap()).unwrap();
 
     let r = GradeReport::read(&out.root).unwrap();
     assert_eq!(r.file, out.file(JSON_FILE), "a report folder is read through its grade.json");

@@ -156,6 +156,9 @@ pub struct Inspection {
     pub own_cost: Option<f32>,
     /// The SAH constants the costs are priced with (for their terms: `CostTerms`).
     pub sah: SahCost,
+    /// Its term of the tree's end-point overlap, exactly (`epo::node_term`: one walk): the same
+    /// figure in the app's Node window and in `bvhscope inspect`, however big the tree.
+    pub epo_share: f64,
 }
 
 /// Collects a sweep's planes as curve points.
@@ -389,6 +392,7 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         markers,
         own_cost,
         sah: params.cost,
+        epo_share: crate::bvh::epo::node_term(bvh, h, i),
     })
 }
 
