@@ -17,12 +17,13 @@ mod import;
 
 pub use import::{import, oversized_leaves, untraceable};
 
+mod read;
+
 use crate::bvh::{AnyBvh, Bvh, WideBvh};
 use crate::files::FileError;
 use crate::geometry::Aabb;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
-use std::io::Read;
 use std::path::Path;
 
 pub const FORMAT: &str = "bvhscope-bvh";
@@ -98,9 +99,6 @@ pub fn max_bytes(triangles: usize) -> u64 {
     (64 << 20) + triangles as u64 * 8 * (2 * 400 + 16)
 }
 
-/// `without_content`'s words for a format that is not this one.
-const OTHER_FORMAT: &str = "its \"format\" names another format";
-
 /// The forms a dump is written in, by the file's name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DumpFile {
@@ -110,242 +108,6 @@ pub enum DumpFile {
 }
 
 impl BvhDump {
-    /// Whether `path` looks like a dump rather than a mesh or a scene (what a file dropped on the
-    /// app is taken for): gzip, or the format's name in its first kilobytes. Only regular files
-    /// are opened (a FIFO would block).
-    pub fn sniff(path: &Path) -> bool {
-        let Ok((file, _)) = crate::files::open_regular(path) else { return false };
-        let mut head = Vec::new();
-        if file.take(4096).read_to_end(&mut head).is_err() {
-            return false;
-        }
-        head.starts_with(&[0x1f, 0x8b]) || head.windows(FORMAT.len()).any(|w| w == FORMAT.as_bytes())
-    }
-
-    /// Read a dump: JSON, gzip-compressed JSON (`.gz`, one member or several), or the text form
-    /// (anything whose first word is `bvhscope-bvh`). At most `limit` bytes are read, counted
-    /// after decompression (`max_bytes`).
-    pub fn read(path: &Path, limit: u64) -> Result<BvhDump, DumpError> {
-        let name = path.display().to_string();
-        let io = |source| DumpError::File(FileError::Read { path: path.into(), source });
-        let too_big = |what| DumpError::TooBig { path: name.clone(), what, limit };
-        let (mut file, _) = crate::files::open_regular(path)?;
-        let mut magic = [0u8; 2];
-        let n = file.read(&mut magic).map_err(io)?;
-        let head = std::io::Cursor::new(magic[..n].to_vec());
-        let bytes = if magic[..n] == [0x1f, 0x8b] {
-            // Every member of a multi-member gzip file, and bytes after the last member are an
-            // error (MultiGzDecoder reads them as a broken member), not silently ignored.
-            let gz = flate2::read::MultiGzDecoder::new(head.chain(file));
-            crate::files::read_limited(gz, limit)
-                .map_err(|e| DumpError::NotTheFormat {
-                    path: name.clone(),
-                    why: format!("broken gzip data: {e}"),
-                    plain: None,
-                })?
-                .ok_or_else(|| too_big("decompresses to"))?
-        } else {
-            crate::files::read_limited(head.chain(file), limit).map_err(io)?.ok_or_else(|| too_big("is"))?
-        };
-        let text = decode(&bytes).ok_or_else(|| DumpError::NotTheFormat {
-            path: name.clone(),
-            why: "not text (a NUL byte: binary data, nor gzip)".into(),
-            plain: None,
-        })?;
-        let start = text.trim_start();
-        let dump = if start.starts_with('{') || start.starts_with('[') || start.starts_with("null") {
-            Self::from_json(start, &name)?
-        } else {
-            Self::from_text(&text, &name)?
-        };
-        if dump.format != FORMAT {
-            return Err(DumpError::NotTheFormat {
-                path: name,
-                why: format!("its format is \"{}\"", dump.format),
-                plain: Some(OTHER_FORMAT),
-            });
-        }
-        if dump.version != VERSION {
-            return Err(DumpError::FutureVersion { path: name, found: dump.version });
-        }
-        Ok(dump)
-    }
-
-    fn from_json(text: &str, name: &str) -> Result<BvhDump, DumpError> {
-        let not = |why: String| DumpError::NotTheFormat { path: name.into(), why, plain: None };
-        // A message that quotes the file (serde's name a field or a value from it).
-        let quotes =
-            |why: String, plain: &'static str| DumpError::NotTheFormat { path: name.into(), why, plain: Some(plain) };
-        // The format and version first, so a future version is named as such, not as broken JSON.
-        #[derive(Deserialize)]
-        struct Head {
-            format: Option<String>,
-            version: Option<serde_json::Value>,
-        }
-        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| not(format!("broken JSON: {e}")))?;
-        if !value.is_object() {
-            let kind = match &value {
-                serde_json::Value::Null => "null",
-                serde_json::Value::Array(_) => "an array",
-                serde_json::Value::String(_) => "a string",
-                serde_json::Value::Number(_) => "a number",
-                _ => "a boolean",
-            };
-            return Err(not(format!("the JSON is {kind}, not an object with \"format\": \"{FORMAT}\"")));
-        }
-        let head = Head::deserialize(&value)
-            .map_err(|e| quotes(e.to_string(), "\"format\" or \"version\" is not of the right type"))?;
-        match head.format.as_deref() {
-            Some(FORMAT) => {}
-            Some(f) => return Err(quotes(format!("its format is \"{f}\""), OTHER_FORMAT)),
-            None => return Err(not("no \"format\" field".into())),
-        }
-        match head.version.as_ref().map(|v| v.as_u64()) {
-            None => return Err(not(format!("no \"version\" field (this bvhscope reads version {VERSION})"))),
-            Some(Some(v)) if v != VERSION as u64 => {
-                return Err(DumpError::FutureVersion { path: name.into(), found: v.min(u32::MAX as u64) as u32 })
-            }
-            Some(Some(_)) => {}
-            Some(None) => return Err(not("\"version\" is not a whole number".into())),
-        }
-        BvhDump::deserialize(value).map_err(|e| {
-            quotes(e.to_string(), "its fields are not a dump's (one missing, unknown, repeated or of the wrong type)")
-        })
-    }
-
-    fn from_text(text: &str, name: &str) -> Result<BvhDump, DumpError> {
-        let err = |line: usize, why: String| DumpError::Text { path: name.into(), line, why, plain: None };
-        // A message that quotes the line.
-        let quotes = |line: usize, why: String, plain: &'static str| DumpError::Text {
-            path: name.into(),
-            line,
-            why,
-            plain: Some(plain),
-        };
-        let mut dump =
-            BvhDump { format: String::new(), version: 0, mesh: None, primitives: Vec::new(), nodes: Vec::new() };
-        for (i, raw) in text.lines().enumerate() {
-            let line = raw.split('#').next().unwrap_or("").trim();
-            let n = i + 1;
-            let mut words = line.split_whitespace();
-            let Some(head) = words.next() else { continue };
-            let rest: Vec<&str> = words.collect();
-            let num = |s: &str| {
-                s.parse::<f32>()
-                    .map_err(|_| quotes(n, format!("'{s}' is not a number"), "a word where a number must be"))
-            };
-            let int = |s: &str| {
-                s.parse::<u32>().map_err(|_| {
-                    quotes(n, format!("'{s}' is not a whole number"), "a word where a whole number must be")
-                })
-            };
-            match head {
-                FORMAT if dump.format.is_empty() => {
-                    dump.format = FORMAT.into();
-                    dump.version = int(rest.first().copied().unwrap_or("?"))?;
-                    if dump.version != VERSION {
-                        return Err(DumpError::FutureVersion { path: name.into(), found: dump.version });
-                    }
-                    if let Some(extra) = rest.get(1) {
-                        return Err(quotes(
-                            n,
-                            format!("'{extra}' after 'bvhscope-bvh 1': the first line holds nothing else"),
-                            "words after 'bvhscope-bvh 1': the first line holds nothing else",
-                        ));
-                    }
-                }
-                _ if dump.format.is_empty() => {
-                    return Err(DumpError::NotTheFormat {
-                        path: name.into(),
-                        why: "the first line is not 'bvhscope-bvh 1' (nor is the file JSON)".into(),
-                        plain: None,
-                    })
-                }
-                "mesh" => dump.mesh = Some(rest.join(" ")),
-                "primitives" => {
-                    for w in rest {
-                        dump.primitives.push(int(w)?);
-                    }
-                }
-                "node" => {
-                    if rest.len() < 8 {
-                        return Err(err(
-                            n,
-                            "a node is 'node MIN(3) MAX(3) children C..' or '... leaf FIRST COUNT'".into(),
-                        ));
-                    }
-                    let f: Vec<f32> = rest[..6].iter().map(|w| num(w)).collect::<Result<_, _>>()?;
-                    let mut node = DumpNode {
-                        min: [f[0], f[1], f[2]],
-                        max: [f[3], f[4], f[5]],
-                        children: None,
-                        first: None,
-                        count: None,
-                        axis: None,
-                    };
-                    match rest[6] {
-                        "leaf" if rest.len() == 9 => {
-                            node.first = Some(int(rest[7])?);
-                            node.count = Some(int(rest[8])?);
-                        }
-                        "leaf" => {
-                            return Err(err(
-                                n,
-                                format!("'leaf' takes FIRST COUNT: two numbers, not {}", rest.len() - 7),
-                            ))
-                        }
-                        "children" => {
-                            let mut kids = Vec::new();
-                            let mut k = 7;
-                            while k < rest.len() && rest[k] != "axis" {
-                                kids.push(int(rest[k])?);
-                                k += 1;
-                            }
-                            if k < rest.len() {
-                                let a = rest.get(k + 1).ok_or_else(|| err(n, "'axis' without a value".into()))?;
-                                let axis = a.parse::<u8>().ok().filter(|&a| a <= 2);
-                                node.axis = Some(axis.ok_or_else(|| {
-                                    quotes(
-                                        n,
-                                        format!("axis '{a}' is not 0, 1 or 2 (x, y, z)"),
-                                        "an axis that is not 0, 1 or 2 (x, y, z)",
-                                    )
-                                })?);
-                                if let Some(extra) = rest.get(k + 2) {
-                                    return Err(quotes(
-                                        n,
-                                        format!("'{extra}' after the axis: a node line ends with it"),
-                                        "words after the axis: a node line ends with it",
-                                    ));
-                                }
-                            }
-                            node.children = Some(kids);
-                        }
-                        other => {
-                            return Err(quotes(
-                                n,
-                                format!("'{other}': expected 'children' or 'leaf FIRST COUNT'"),
-                                "a word where 'children' or 'leaf FIRST COUNT' must be",
-                            ))
-                        }
-                    }
-                    dump.nodes.push(node);
-                }
-                other => {
-                    return Err(quotes(
-                        n,
-                        format!("'{other}' is not mesh, primitives or node"),
-                        "a line that is not mesh, primitives or node",
-                    ))
-                }
-            }
-        }
-        if dump.format.is_empty() {
-            return Err(DumpError::NotTheFormat { path: name.into(), why: "the file is empty".into(), plain: None });
-        }
-        Ok(dump)
-    }
-
     /// The text form.
     pub fn to_text(&self) -> String {
         use std::fmt::Write;
@@ -495,18 +257,4 @@ impl BvhDump {
         nodes.extend(leaves);
         BvhDump { format: FORMAT.into(), version: VERSION, mesh: name, primitives, nodes }
     }
-}
-
-/// A dump's bytes as text: a UTF-8 byte-order mark dropped, bytes that are not UTF-8 decoded as
-/// Latin-1 (as meshes and scenes are: an exporter's comment or mesh name may be written so; the
-/// numbers and words of the format are ASCII). `None` for binary data (a NUL byte).
-fn decode(bytes: &[u8]) -> Option<std::borrow::Cow<'_, str>> {
-    let bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
-    if bytes.contains(&0) {
-        return None;
-    }
-    Some(match std::str::from_utf8(bytes) {
-        Ok(s) => std::borrow::Cow::Borrowed(s),
-        Err(_) => std::borrow::Cow::Owned(bytes.iter().map(|&b| b as char).collect()),
-    })
 }
