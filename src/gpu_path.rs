@@ -111,10 +111,11 @@ pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Opti
     }))
 }
 
-/// A tree on the GPU in the node format asked for, with the mesh its hits are on.
+/// A tree on the GPU in the node format asked for, with its CPU form: the CPU walks of the same
+/// tree finish the rays a GPU walk leaves unfinished at its step budget (`GpuTree::walk`).
 pub enum GpuTree {
-    Binary(GpuBinaryBvh),
-    /// The CWBVH's CPU form too: its CPU walk is the reference for the GPU's counts.
+    Binary(Box<Bvh>, GpuBinaryBvh),
+    /// The CWBVH's CPU walk is the reference for the GPU's counts.
     Cwbvh(Box<Cwbvh>, GpuCwbvh),
 }
 
@@ -128,7 +129,10 @@ impl GpuTree {
             GpuError::Input("this imported wide tree has no binary form the GPU could walk; trace it on the CPU".into())
         })?;
         let uploaded = match nodes {
-            GpuNodes::Binary => GpuTree::Binary(GpuBinaryBvh::upload(gpu, &tree)?),
+            GpuNodes::Binary => {
+                let on_gpu = GpuBinaryBvh::upload(gpu, &tree)?;
+                GpuTree::Binary(Box::new(tree.into_owned()), on_gpu)
+            }
             GpuNodes::Cwbvh => {
                 let cw = Cwbvh::from_bvh(&tree)?;
                 let on_gpu = GpuCwbvh::upload(gpu, &cw)?;
@@ -140,18 +144,41 @@ impl GpuTree {
 
     pub fn nodes(&self) -> GpuNodes {
         match self {
-            GpuTree::Binary(_) => GpuNodes::Binary,
+            GpuTree::Binary(..) => GpuNodes::Binary,
             GpuTree::Cwbvh(..) => GpuNodes::Cwbvh,
         }
     }
 
     /// Trace `rays` (closest hits), counting when `counted`, in `trace`'s order (binary nodes;
-    /// CWBVH orders its children by octant).
+    /// CWBVH orders its children by octant). A ray whose GPU walk reaches the step budget
+    /// (`bvhscope_gpu::STEP_BUDGET`) is finished by the same walk on the CPU, never taken for a
+    /// miss: every hit and count is the CPU's, and `cpu_finished` says how many rays that was.
     pub fn walk(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, GpuError> {
-        let opts = bvhscope_gpu::GpuTraceOptions { order: trace.order, counted, exact: true };
+        let opts = bvhscope_gpu::GpuTraceOptions { order: trace.order, counted, exact: true, test: trace.test };
+        let mut out = match self {
+            GpuTree::Binary(_, t) => t.trace(gpu, rays, opts)?,
+            GpuTree::Cwbvh(_, t) => t.trace(gpu, rays, opts)?,
+        };
+        if !out.unfinished.is_empty() {
+            out.finish(|i| self.cpu_walk(&mut rays.ray(i), trace));
+        }
+        Ok(out)
+    }
+
+    /// One ray's walk on the CPU, with its counts: core's walk of the binary tree, or the CWBVH's
+    /// own CPU walk.
+    pub fn cpu_walk(
+        &self,
+        ray: &mut crate::geometry::Ray,
+        trace: TraceOptions,
+    ) -> (Option<crate::bvh::Hit>, RayCounters) {
         match self {
-            GpuTree::Binary(t) => t.trace(gpu, rays, opts),
-            GpuTree::Cwbvh(_, t) => t.trace(gpu, rays, opts),
+            GpuTree::Binary(b, _) => {
+                let mut c = RayCounters::ZERO;
+                let hit = crate::bvh::Accelerator::closest_hit(&**b, ray, trace, &mut c);
+                (hit, c)
+            }
+            GpuTree::Cwbvh(cw, _) => cw.trace_cpu(ray, trace.test),
         }
     }
 
@@ -159,7 +186,7 @@ impl GpuTree {
     /// nodes (`cpu` is the binary tree's `SceneBvh`), the CWBVH's own CPU walk for CWBVH nodes.
     pub fn cpu_counts(&self, cpu: &SceneBvh, camera: &Camera, trace: TraceOptions) -> Vec<RayCounters> {
         match self {
-            GpuTree::Binary(_) => {
+            GpuTree::Binary(..) => {
                 let settings = crate::render::RenderSettings { trace, count: true, progressive: false };
                 let frame = crate::render::render(cpu, cpu, camera, &settings);
                 frame.traced().map(|(_, c)| c).collect()
@@ -168,7 +195,7 @@ impl GpuTree {
                 let gen = camera.ray_gen();
                 (0..camera.width * camera.height)
                     .into_par_iter()
-                    .map(|i| cw.trace_cpu(&mut gen.pixel_ray(i % camera.width, i / camera.width)).1)
+                    .map(|i| cw.trace_cpu(&mut gen.pixel_ray(i % camera.width, i / camera.width), trace.test).1)
                     .collect()
             }
         }

@@ -13,8 +13,11 @@ fn main() -> ExitCode {
         // `check` has printed its report: exit 1 says the BVH has defects.
         Err(CliError::Defects(_)) => ExitCode::from(1),
         Err(e) => {
-            // A file name in the message may hold anything, an escape sequence included.
-            eprintln!("error: {}", bvhscope::cli::printable(&e.to_string()));
+            // One line (a driver's message comes in several), and a file name in it may hold
+            // anything, an escape sequence included.
+            let text = e.to_string();
+            let one: Vec<&str> = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+            eprintln!("error: {}", bvhscope::cli::printable(&one.join(" ")));
             ExitCode::from(2)
         }
     }

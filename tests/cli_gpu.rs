@@ -247,7 +247,7 @@ fn without_an_adapter_the_gpu_is_one_line_and_exit_2() {
     for (args, says) in [
         (vec!["render", torus, "--gpu-nodes", "cwbvh"], "add --device gpu"),
         (vec!["stats", torus, "--device", "gpu", "--layout", "wide4"], "--layout wide4: the GPU walks binary nodes"),
-        (vec!["stats", torus, "--device", "gpu", "--triangle-test", "moller-trumbore"], "watertight test only"),
+        (vec!["stats", torus, "--device", "gpu", "--two-level"], "--two-level: the GPU traces one BVH"),
     ] {
         let out = bvhscope(&args);
         let err = String::from_utf8_lossy(&out.stderr);
@@ -257,4 +257,58 @@ fn without_an_adapter_the_gpu_is_one_line_and_exit_2() {
             assert!(err.contains(says), "{args:?}: {err}");
         }
     }
+}
+
+/// The handout's preset (Möller–Trumbore, the split-axis-sign order) runs on the GPU, with the
+/// CPU's counts and image (issue 46).
+#[test]
+fn the_handout_preset_runs_on_the_gpu_and_equals_the_cpu() {
+    if !have_gpu() {
+        return;
+    }
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/torus.obj");
+    let run = |device: &str| {
+        let (png, counts) = (tmp(&format!("handout-{device}.png")), tmp(&format!("handout-{device}.csv")));
+        let mut args = vec!["render", torus, "--preset", "handout", "--view", "visits", "--device", device];
+        args.extend(["--counts", counts.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+        args.extend(FRAMED);
+        let (_, stderr) = ok(&args);
+        (std::fs::read_to_string(&counts).unwrap(), std::fs::read(&png).unwrap(), stderr)
+    };
+    let (gpu, gpu_png, said) = run("gpu");
+    let (cpu, cpu_png, _) = run("cpu");
+    assert!(said.contains("traced on the GPU"), "{said}");
+    assert!(gpu == cpu, "the handout's counts on the GPU are the CPU's");
+    assert!(gpu_png == cpu_png);
+}
+
+/// A frame whose walks pass the GPU's step budget (a fan of 20,000 triangles in one box) says how
+/// many rays the CPU finished, and its counts are still the CPU's.
+#[test]
+fn rays_finished_on_the_cpu_are_said_and_counted_right() {
+    if !have_gpu() {
+        return;
+    }
+    let mesh = tmp("fan20k.obj");
+    let mut text = String::from("v 0 0 0\nv 1 1 0\n");
+    for k in 0..20_000 {
+        let a = k as f32 / 20_000.0;
+        text += &format!("v {a} {} 0\n", 1.0 - a * a);
+    }
+    for k in 0..20_000 {
+        text += &format!("f 1 2 {}\n", k + 3);
+    }
+    std::fs::write(&mesh, text).unwrap();
+    let run = |device: &str| {
+        let (png, counts) = (tmp(&format!("fan-{device}.png")), tmp(&format!("fan-{device}.csv")));
+        let mut args = vec!["render", mesh.to_str().unwrap(), "--view", "visits", "--device", device];
+        args.extend(["--counts", counts.to_str().unwrap(), "-o", png.to_str().unwrap(), "--size", "16x12"]);
+        args.extend(["--layout", "binary"]);
+        let (_, stderr) = ok(&args);
+        (std::fs::read_to_string(&counts).unwrap(), stderr)
+    };
+    let (gpu, said) = run("gpu");
+    let (cpu, _) = run("cpu");
+    assert!(said.contains("rays reached the GPU's step budget") && said.contains("finished on the CPU"), "{said}");
+    assert!(gpu == cpu, "the counts are the CPU's");
 }

@@ -38,6 +38,11 @@ pub enum GpuError {
     Readback(String),
     #[error("{0}")]
     Input(String),
+    /// A tree a GPU builder made that is not sound (`verify`): a bug, never a tree anyone uses.
+    #[error(
+        "the GPU's {builder} build made a tree that fails the structure check ({why}); this is a bug in bvhscope: please report it with the mesh (the CPU builds the same tree: --device cpu)"
+    )]
+    Broken { builder: String, why: String },
 }
 
 /// Choices for opening the device; `Default` is what the CLI and the app use.

@@ -67,8 +67,8 @@ const KERNELS: [(&str, &[u32]); 9] = [
     ("codes", &[0, 1, 2, 3]),
     ("run_flags", &[0, 2, 5]),
     ("runs", &[0, 2, 5, 6, 7]),
-    ("karras", &[0, 5, 6, 7, 8]),
-    ("leaf_flags", &[0, 4, 5, 8, 11]),
+    ("karras", &[0, 4, 5, 6, 7, 8]),
+    ("leaf_flags", &[0, 5, 8, 11]),
     ("boxes", &[0, 1, 3, 5, 8, 9, 10]),
     ("verify", &[0, 4, 5, 8, 9]),
     ("emit", &[0, 1, 3, 5, 8, 9, 11, 12]),
@@ -338,6 +338,7 @@ impl GpuLbvh {
             fallback_splits: fallback,
             ..BuildReport::default()
         };
-        Ok((Bvh { nodes, prim_ids, tris, params, report }, t))
+        let bvh = crate::verify::verified("LBVH", Bvh { nodes, prim_ids, tris, params, report }, mesh)?;
+        Ok((bvh, t))
     }
 }

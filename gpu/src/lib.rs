@@ -15,13 +15,14 @@ mod scan;
 mod shaders_valid;
 mod sort;
 mod trace;
+pub mod verify;
 
 pub use binary::{checked_depth, GpuBinaryBvh};
 pub use cwbvh::{Cwbvh, CwbvhNode, GpuCwbvh, META_INTERIOR, META_LEAF};
 pub use device::{gpu_for_tests, Gpu, GpuError, GpuOptions};
 pub use lbvh::{GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
 pub use ploc::GpuPloc;
-pub use trace::{GpuTrace, GpuTraceOptions, Rays};
+pub use trace::{GpuTrace, GpuTraceOptions, Rays, STEP_BUDGET};
 // The warp view needs no GPU: it moved to core, where the heatmaps use it on either path.
 pub use bvhscope_core::render::warp::{WarpGroup, WarpSize, WarpSummary, WarpView, WarpWork};
 

@@ -284,6 +284,7 @@ impl GpuPloc {
             reorder_time: t.download,
             ..BuildReport::default()
         };
-        Ok((Bvh { nodes: bvh_nodes, prim_ids, tris, params, report }, t))
+        let bvh = crate::verify::verified("PLOC", Bvh { nodes: bvh_nodes, prim_ids, tris, params, report }, mesh)?;
+        Ok((bvh, t))
     }
 }

@@ -6,7 +6,7 @@
 use crate::device::{Gpu, GpuError};
 use crate::kernel::{Bind, Kernel};
 use bvhscope_core::bvh::{Hit, RayCounters, TraversalOrder};
-use bvhscope_core::geometry::Ray;
+use bvhscope_core::geometry::{Ray, TriangleTest};
 use bvhscope_core::render::Camera;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -21,11 +21,13 @@ pub struct GpuTraceOptions {
     /// Round every product on its own as the CPU does (see `xm` in shaders/common.wgsl); off, the
     /// compiler may fuse them (faster on some GPUs, results may differ in the last place).
     pub exact: bool,
+    /// The ray–triangle test: core's watertight test or Möller–Trumbore's (the handout's).
+    pub test: TriangleTest,
 }
 
 impl Default for GpuTraceOptions {
     fn default() -> Self {
-        Self { order: TraversalOrder::EntryDistance, counted: true, exact: true }
+        Self { order: TraversalOrder::EntryDistance, counted: true, exact: true, test: TriangleTest::Watertight }
     }
 }
 
@@ -49,6 +51,14 @@ impl Rays<'_> {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+
+    /// Ray `i`: the list's, or the camera's pixel `i` (row by row), as the GPU makes it.
+    pub fn ray(&self, i: usize) -> Ray {
+        match self {
+            Rays::Camera(c) => c.ray_gen().pixel_ray(i as u32 % c.width, i as u32 / c.width),
+            Rays::List(r) => r[i].clone(),
+        }
+    }
 }
 
 /// What a GPU walk found: per ray (per pixel, row by row, for a camera) its closest hit and,
@@ -62,6 +72,33 @@ pub struct GpuTrace {
     pub gpu_time: Duration,
     /// How many dispatches the rays took (more than one where a buffer would pass the limit).
     pub batches: u32,
+    /// The rays (by index) whose walk reached the step budget (`STEP_BUDGET` in
+    /// shaders/entry.wgsl) and stopped unfinished: their hit is `None` and their counts partial
+    /// until the host finishes them on the CPU (`GpuTrace::finish`). Never a miss.
+    pub unfinished: Vec<usize>,
+    /// How many rays were finished on the CPU (`finish`).
+    pub cpu_finished: usize,
+}
+
+/// The most steps one GPU walk may take (shaders/entry.wgsl's `STEP_BUDGET`): nodes visited (a
+/// CWBVH node with its eight slots), stack entries popped and triangles tested.
+pub const STEP_BUDGET: u32 = 16384;
+
+impl GpuTrace {
+    /// Finish the unfinished rays with `cpu`, the same walk on the CPU (the ray, by index, to its
+    /// closest hit and counts), in parallel: afterwards every hit and count is the CPU's walk's.
+    pub fn finish(&mut self, cpu: impl Fn(usize) -> (Option<Hit>, RayCounters) + Sync) {
+        use rayon::prelude::*;
+        let done: Vec<(Option<Hit>, RayCounters)> = self.unfinished.par_iter().map(|&i| cpu(i)).collect();
+        for (&i, (hit, c)) in self.unfinished.iter().zip(done) {
+            self.hits[i] = hit;
+            if let Some(slot) = self.counters.get_mut(i) {
+                *slot = c;
+            }
+        }
+        self.cpu_finished += self.unfinished.len();
+        self.unfinished.clear();
+    }
 }
 
 /// The uniform block of shaders/common.wgsl (`Params`).
@@ -125,9 +162,10 @@ pub(crate) enum Stack {
 const PRIVATE_MAX: u32 = 128;
 
 impl Stack {
-    /// The stack for walks that hold at most `entries` at once.
+    /// The stack for walks that hold at most `entries` at once. A walk pushes at most one entry
+    /// a step, so never more than the step budget: a 100,000-deep chain needs no 800 kB a ray.
     pub(crate) fn for_entries(entries: u32) -> Stack {
-        match entries {
+        match entries.min(STEP_BUDGET) {
             0..=32 => Stack::Private(32),
             33..=64 => Stack::Private(64),
             65..=PRIVATE_MAX => Stack::Private(PRIVATE_MAX),
@@ -185,7 +223,9 @@ impl Kernels {
         let mut binds = binds.to_vec();
         binds.extend(std::iter::repeat_n(Bind::Read, self.tree_buffers()));
         let by_distance = (opts.order == TraversalOrder::EntryDistance) as u8 as f64;
-        let mut constants = vec![("COUNTED", opts.counted as u8 as f64), ("EXACT", opts.exact as u8 as f64)];
+        let moller = (opts.test == TriangleTest::MollerTrumbore) as u8 as f64;
+        let mut constants =
+            vec![("COUNTED", opts.counted as u8 as f64), ("EXACT", opts.exact as u8 as f64), ("MOLLER", moller)];
         if self.format == "binary" {
             constants.push(("BY_DISTANCE", by_distance));
         }
@@ -336,6 +376,10 @@ impl Kernels {
         for [t, u, v, prim] in h {
             match prim {
                 u32::MAX => out.hits.push(None),
+                0xffff_fffd => {
+                    out.unfinished.push(out.hits.len());
+                    out.hits.push(None)
+                }
                 0xffff_fffe => {
                     return Err(GpuError::Rejected(
                         "a ray's walk passed the end of its stack (a bug: please report)".into(),

@@ -52,7 +52,7 @@ fn compare(
     let (binary, _) = cpu_trace(bvh, rays, TraversalOrder::EntryDistance);
     let mut differ = 0;
     for (i, ray) in rays.iter().enumerate() {
-        let (h, c) = w.trace_cpu(&mut ray.clone());
+        let (h, c) = w.trace_cpu(&mut ray.clone(), TriangleTest::Watertight);
         if gpu_hits[i] != h || gpu_counts[i] != c {
             differ += 1;
             assert!(
@@ -87,7 +87,7 @@ fn explain_cwbvh(w: &Cwbvh, ray: &Ray, hit: Option<Hit>, counts: RayCounters) ->
         let (o, d) = (ray.origin(), ray.dir());
         let o = o * glam::Vec3::new(1.0 + k(), 1.0 + k(), 1.0 + k());
         let d = d * glam::Vec3::new(1.0 + k(), 1.0 + k(), 1.0 + k());
-        let (h, c) = w.trace_cpu(&mut Ray::segment(o, d, ray.t_min, ray.t_max));
+        let (h, c) = w.trace_cpu(&mut Ray::segment(o, d, ray.t_min, ray.t_max), TriangleTest::Watertight);
         h.map(|h| h.prim) == hit.map(|h| h.prim) && c == counts
     })
 }

@@ -1,6 +1,6 @@
 //! The GPU LBVH is core's LBVH node for node: the same nodes (boxes, children, leaves, split
 //! axes), the same primitive order, the same triangles in leaf order, for leaves of 1 to 7 and
-//! meshes with long runs of equal Morton codes (cut in the middle as core cuts them), tiny meshes
+//! meshes with long runs of equal Morton codes (split by their places, Karras's tie-break, as core splits them), tiny meshes
 //! and an empty one. Where core's multi-threaded sort puts equal codes out of triangle order (it
 //! sorts on the code alone, unstably), the trees agree on everything the codes decide.
 
@@ -103,10 +103,13 @@ fn the_gpu_lbvh_is_the_cpu_lbvh_node_for_node() {
             let cpu = Bvh::build(mesh, &params(leaf));
             let (g, t) = lbvh.build(&gpu, mesh, &params(leaf)).unwrap();
             assert_same_tree(&format!("{name}, leaves of {leaf}"), mesh, &cpu, &g);
-            assert_eq!(g.report.fallback_splits, cpu.report.fallback_splits, "{name}/{leaf}: ranges cut in the middle");
+            assert_eq!(
+                g.report.fallback_splits, cpu.report.fallback_splits,
+                "{name}/{leaf}: ranges of equal codes split by places"
+            );
             assert!(t.verify_passes >= 1 || mesh.triangle_count() == 0);
             if *name == "run" {
-                assert!(g.report.fallback_splits > 0, "the run of 600 equal codes is cut in the middle");
+                assert!(g.report.fallback_splits > 0, "the run of 600 equal codes is split by places");
             }
         }
     }

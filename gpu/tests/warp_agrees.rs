@@ -4,6 +4,7 @@
 mod common;
 
 use bvhscope_core::bvh::{RayCounters, SplitStrategy, TraversalOrder};
+use bvhscope_core::geometry::TriangleTest;
 use bvhscope_core::render::Camera;
 use bvhscope_gpu::{Cwbvh, GpuBinaryBvh, GpuCwbvh, GpuTraceOptions, Rays, WarpSize, WarpView, WarpWork};
 use common::*;
@@ -21,7 +22,7 @@ fn gpu_and_cpu_counts_give_the_same_warp_view() {
     let gwide = GpuCwbvh::upload(&gpu, &wide).unwrap();
     let opts = GpuTraceOptions::default();
     let cpu_wide = |rays: &[bvhscope_core::geometry::Ray]| -> Vec<RayCounters> {
-        rays.iter().map(|r| wide.trace_cpu(&mut r.clone()).1).collect()
+        rays.iter().map(|r| wide.trace_cpu(&mut r.clone(), TriangleTest::Watertight).1).collect()
     };
     let frames = [
         (

@@ -183,6 +183,7 @@ impl BvhscopeApp {
             trace: p.trace,
             partial: p.partial,
             gpu: p.gpu,
+            cpu_finished: p.cpu_finished,
         });
     }
 

@@ -22,6 +22,8 @@ pub struct Shown {
     pub trace: TraceOptions,
     /// The GPU that traced it, if one did (`app::gpu`).
     pub gpu: Option<super::jobs::GpuRender>,
+    /// Rays of it whose GPU walk reached the step budget and were finished on the CPU.
+    pub cpu_finished: usize,
 }
 
 /// Per-ray figures of a full frame, with what they depend on besides the BVH: the camera (and

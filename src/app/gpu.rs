@@ -5,8 +5,10 @@
 //! `bvhscope render --device gpu`), the tree is built in the binary layout (the GPU walks binary
 //! or CWBVH nodes made from it), and lbvh and ploc are built on the GPU. All of it runs in the
 //! render and build jobs, never on the UI thread. Where the GPU cannot trace (two levels, the
-//! Möller–Trumbore test, the build replay's partial trees) the CPU does and the View panel says
-//! why; a GPU error (device lost, a command rejected) switches back to the CPU with a message.
+//! build replay's partial trees) the CPU does, and the View panel's button and line say so; a
+//! GPU error (device lost, a command rejected) switches back to the CPU with a message. A ray
+//! whose GPU walk reaches the step budget is finished on the CPU (`GpuTree::walk`), and the
+//! statistics say how many were.
 
 use super::jobs::messages::{GpuRender, JobEvent, PassOutput, RenderRequest};
 use super::{BvhscopeApp, MessageKind};
@@ -116,6 +118,7 @@ impl GpuJobs {
             style: r.style,
             partial: None,
             gpu: Some(g.clone()),
+            cpu_finished: t.cpu_finished,
         }))
     }
 
@@ -171,9 +174,6 @@ impl BvhscopeApp {
             Probe::Missing(why) => why.clone(),
             Probe::Found(_) if self.settings.two_level && self.has_instances() => {
                 "two levels are traced on the CPU (the GPU traces one BVH)".into()
-            }
-            Probe::Found(_) if self.settings.trace.test != crate::geometry::TriangleTest::Watertight => {
-                "Möller–Trumbore runs on the CPU only (the GPU runs the watertight test)".into()
             }
             Probe::Found(_) if self.replay.window => "the build replay's partial trees are traced on the CPU".into(),
             Probe::Found(_) => return None,
@@ -239,6 +239,14 @@ pub fn show_in_statistics(app: &BvhscopeApp, ui: &mut egui::Ui) {
             ui.label(format!("GPU, {nodes} nodes"))
                 .on_hover_text(s.gpu.as_ref().map_or(String::new(), |g| g.gpu.name()));
             ui.end_row();
+            if s.cpu_finished > 0 {
+                ui.label("Finished on the CPU").on_hover_text(format!(
+                    "Rays whose GPU walk reached the step budget ({} steps a walk: nodes, stack pops and triangle tests) and were finished by the same walk on the CPU: every hit and count is the CPU walk's",
+                    bvhscope_gpu::STEP_BUDGET
+                ));
+                ui.label(format!("{} of {} rays", s.cpu_finished, s.frame.width() as u64 * s.frame.height() as u64));
+                ui.end_row();
+            }
         }
         if let Some(b) = built {
             ui.label("GPU build").on_hover_text("lbvh and ploc built on the GPU: the phases, as bvhscope stats --device gpu prints them (PLOC: emission is its clustering, boxes the host's layout)");

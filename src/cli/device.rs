@@ -1,14 +1,14 @@
 //! `--device gpu`: how the commands use the GPU crate (`bvhscope-gpu`). The GPU is opened once per
 //! command; without an adapter the command fails with the crate's message (what to install), and
 //! nothing falls back to the CPU unasked. The GPU walks the binary tree as built (core's nodes,
-//! byte for byte) or its CWBVH form, with the watertight test, over one level; its per-ray counts
-//! are the CPU's for the binary layout. The strategies lbvh and ploc are built on the GPU too
+//! byte for byte) or its CWBVH form, with either triangle test, over one level; its per-ray counts
+//! are the CPU's for the binary layout. A walk that reaches the GPU's step budget is finished on
+//! the CPU (`GpuTree::walk`), and every command says how many rays were (`finished_note`). The strategies lbvh and ploc are built on the GPU too
 //! (core's trees node for node), with the build's phases timed.
 
 use super::args::{BuildArgs, DeviceArgs};
 use super::{progress, CliError};
 use crate::bvh::{AnyBvh, BuildParams, Layout, SceneBuild, SceneBvh, TraceOptions};
-use crate::geometry::TriangleTest;
 pub use crate::gpu_path::{build_on_gpu, builds_on_gpu, GpuBuild, GpuNodes, GpuTree};
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame};
@@ -63,21 +63,29 @@ pub fn gpu_params(build: &BuildArgs, scene: Option<&BuildParams>, p: BuildParams
     Ok(BuildParams { layout: Layout::Binary, ..p })
 }
 
-/// Refuse what the GPU does not trace: two levels, the Möller–Trumbore test.
-pub fn check_traceable(build: &SceneBuild, trace: TraceOptions) -> Result<(), CliError> {
+/// Refuse what the GPU does not trace: two levels. (Both triangle tests and both child orders run
+/// there.)
+pub fn check_traceable(build: &SceneBuild, _trace: TraceOptions) -> Result<(), CliError> {
     if build.top.is_some() {
         return Err(CliError::Usage(
             "--two-level: the GPU traces one BVH over the scene's triangles; leave out --two-level or use --device cpu"
                 .into(),
         ));
     }
-    if trace.test != TriangleTest::Watertight {
-        return Err(CliError::Usage(
-            "--triangle-test moller-trumbore: the GPU runs the watertight test only; use --device cpu for Möller–Trumbore"
-                .into(),
-        ));
-    }
     Ok(())
+}
+
+/// What a command prints of the rays a GPU walk left to the CPU ("" when none): every hit and
+/// count is the CPU walk's either way, but where the GPU's time went is then only partly the GPU's.
+pub fn finished_note(t: &GpuTrace) -> Option<String> {
+    (t.cpu_finished > 0).then(|| {
+        format!(
+            "{} of {} rays reached the GPU's step budget ({} steps a walk) and were finished on the CPU",
+            t.cpu_finished,
+            t.hits.len(),
+            bvhscope_gpu::STEP_BUDGET
+        )
+    })
 }
 
 /// Build `params` over `mesh` with lbvh or ploc on the GPU (reinsertion, if asked for, then on the
@@ -127,6 +135,9 @@ impl GpuTree {
     ) -> Result<(Frame, GpuTrace), CliError> {
         let label = format!("tracing the {}x{} frame on the GPU", camera.width, camera.height);
         let t = progress::with_spinner(&label, || self.trace(gpu, Rays::Camera(camera), trace, counted))?;
+        if let Some(note) = finished_note(&t) {
+            eprintln!("note: {note}");
+        }
         let frame = Frame::from_hits(mesh, camera, &t.hits, &t.counters)
             .map_err(|e| CliError::Usage(format!("--device gpu: {e}")))?;
         Ok((frame, t))

@@ -147,10 +147,12 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
     };
     let opts = a.build.trace();
     // On the GPU: its hit and counts, and no steps (an empty trace).
+    let mut finished_on_cpu = false;
     let (mut hit, mut trace, gpu_counts) = match &on_gpu {
         Some((g, (tree, _))) => {
             let t = tree.trace(g, bvhscope_gpu::Rays::List(&[ray]), opts, true)?;
             let counts = t.counters.first().copied().unwrap_or_default();
+            finished_on_cpu = t.cpu_finished > 0;
             (t.hits.first().copied().flatten(), crate::bvh::Trace::new(), Some(counts))
         }
         None => {
@@ -168,8 +170,16 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
     let build_label = bvh.label();
     let counts = gpu_counts.unwrap_or_else(|| trace.counts());
     let gpu_note = on_gpu.as_ref().map(|(g, (tree, _))| {
+        let finished = if finished_on_cpu {
+            format!(
+                "; its walk reached the GPU's step budget ({} steps) and was finished on the CPU (the same walk: its hit and counts are the CPU's)",
+                bvhscope_gpu::STEP_BUDGET
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "traced on the GPU ({} nodes, {}): the GPU walk records no steps (its kernels keep each ray's hit and counts only); for the walk step by step, run this with --device cpu",
+            "traced on the GPU ({} nodes, {}){finished}: the GPU walk records no steps (its kernels keep each ray's hit and counts only); for the walk step by step, run this with --device cpu",
             tree.nodes().name(),
             g.name()
         )

@@ -15,7 +15,7 @@
 use super::Cwbvh;
 use bvhscope_core::bvh::{Hit, RayCounters};
 use bvhscope_core::geometry::slab::{widen, OneRay};
-use bvhscope_core::geometry::{Ray, TriangleIntersector, Watertight};
+use bvhscope_core::geometry::{MollerTrumbore, Ray, TriangleIntersector, TriangleTest, Watertight};
 
 impl Cwbvh {
     /// The octant of `ray`'s direction: bit k set when its reciprocal is negative on axis k (-0
@@ -27,8 +27,17 @@ impl Cwbvh {
             | (inv.z.is_sign_negative() as u32) << 2
     }
 
+    /// The closest hit of `ray` (its `t_max` shrunk to it) and the walk's counts, with the
+    /// triangle test `test` (the GPU's `MOLLER` switch).
+    pub fn trace_cpu(&self, ray: &mut Ray, test: TriangleTest) -> (Option<Hit>, RayCounters) {
+        match test {
+            TriangleTest::Watertight => self.walk_cpu::<Watertight>(ray),
+            TriangleTest::MollerTrumbore => self.walk_cpu::<MollerTrumbore>(ray),
+        }
+    }
+
     /// The closest hit of `ray` (its `t_max` shrunk to it) and the walk's counts.
-    pub fn trace_cpu(&self, ray: &mut Ray) -> (Option<Hit>, RayCounters) {
+    fn walk_cpu<T: TriangleIntersector>(&self, ray: &mut Ray) -> (Option<Hit>, RayCounters) {
         let mut c = RayCounters::default();
         let slab = OneRay::new(ray);
         let mut limit = widen(ray.t_max);
@@ -39,7 +48,7 @@ impl Cwbvh {
             return (None, c);
         }
         let oct = Self::octant(ray);
-        let shear = Watertight::prepare(ray);
+        let shear = T::prepare(ray);
         let mut best: Option<(usize, bvhscope_core::geometry::TriangleHit)> = None;
         let mut stack: Vec<(u32, u32, u32)> = Vec::new(); // (child base, interior bits by key, imask)
         let mut cur = 0usize;
@@ -69,7 +78,7 @@ impl Cwbvh {
                 let [first, count] = self.leaves[n.leaf(s) as usize];
                 c.leaves_visited += 1;
                 for i in first as usize..(first + count) as usize {
-                    if let Some(h) = Watertight::intersect(&shear, ray, &self.tris[i]) {
+                    if let Some(h) = T::intersect(&shear, ray, &self.tris[i]) {
                         ray.t_max = h.t;
                         best = Some((i, h));
                     }

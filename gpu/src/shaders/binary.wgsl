@@ -34,6 +34,9 @@ fn node_slab(i: u32, t_min: f32, limit: f32) -> vec2<f32> {
 
 // core's test_triangles: every triangle of the leaf in order, each nearer hit shrinking t_max.
 fn test_leaf(first: u32, count: u32) {
+    if !spend(count) {
+        return;
+    }
     for (var k = 0u; k < count; k++) {
         let i = first + k;
         let t = tris[i].v;
@@ -52,6 +55,8 @@ fn walk() {
     best = MISS;
     C = vec4<u32>(0u);
     overflow = false;
+    steps = 0u;
+    unfinished = false;
     // The closest hit so far, widened: what boxes and stack entries are compared with.
     var limit = widen(R_t_max);
     count_boxes(1u);
@@ -63,12 +68,18 @@ fn walk() {
     var len = 0u;
     var current = 0u;
     loop {
+        if !spend(1u) {
+            return;
+        }
         let node = nodes[current];
         count_nodes(1u);
         let leaf_count = node.info & 0xffffu;
         if leaf_count != 0u {
             count_leaves(1u);
             test_leaf(node.index, leaf_count);
+            if unfinished {
+                return;
+            }
             limit = widen(R_t_max);
         } else {
             let left = node.index;
@@ -110,6 +121,9 @@ fn walk() {
         loop {
             if len == 0u {
                 break;
+            }
+            if !spend(1u) {
+                return;
             }
             len -= 1u;
             let e = stack_get(len);

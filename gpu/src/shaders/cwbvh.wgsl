@@ -24,6 +24,9 @@ fn slot_byte(n: ptr<function, CNode>, w: u32, s: u32) -> u32 {
 }
 
 fn test_leaf(first: u32, count: u32) {
+    if !spend(count) {
+        return;
+    }
     for (var k = 0u; k < count; k++) {
         let i = first + k;
         let t = tris[i].v;
@@ -42,6 +45,8 @@ fn walk() {
     best = MISS;
     C = vec4<u32>(0u);
     overflow = false;
+    steps = 0u;
+    unfinished = false;
     var limit = widen(R_t_max);
     count_boxes(1u);
     let root = slab(P.root_lo.xyz, P.root_hi.xyz, R_t_min, limit);
@@ -53,6 +58,10 @@ fn walk() {
     var len = 0u;
     var cur = 0u;
     loop {
+        // The node and its eight slots.
+        if !spend(9u) {
+            return;
+        }
         var n = cnodes[cur];
         count_nodes(1u);
         let p = vec3<f32>(bitcast<f32>(n.w[0]), bitcast<f32>(n.w[1]), bitcast<f32>(n.w[2]));
@@ -83,11 +92,17 @@ fn walk() {
         }
         count_boxes(valid);
         while leaf_hits != 0u {
+            if !spend(1u) {
+                return;
+            }
             let s = firstTrailingBit(leaf_hits) ^ oct;
             leaf_hits &= leaf_hits - 1u;
             let rec = leaves[n.w[5] + (slot_byte(&n, 6u, s) & 0x1fu)];
             count_leaves(1u);
             test_leaf(rec.x, rec.y);
+            if unfinished {
+                return;
+            }
             limit = widen(R_t_max);
         }
         var base = n.w[4];

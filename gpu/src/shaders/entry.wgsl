@@ -9,8 +9,31 @@ var<private> best_v: f32;
 // sized from the tree's depth).
 var<private> overflow: bool;
 
+// The most steps one walk may take: nodes visited (a CWBVH node counts its eight slots too),
+// stack entries popped and triangles tested, every iteration of every loop of the walk. The same
+// on every driver, and far below what any driver stops or a watchdog kills: lavapipe cuts a loop
+// off silently after 65,535 iterations (which it counts three to a node), so a walk over a fan
+// of 40,000 triangles in one box, a dump of fat boxes or a 100,000-deep chain came back as a miss.
+// A walk that would pass it stops and says so (`unfinished`): the host finishes that ray on the
+// CPU and says how many it finished (gpu/src/trace.rs).
+const STEP_BUDGET: u32 = 16384u;
+var<private> steps: u32;
+var<private> unfinished: bool;
+
+// Take `n` more steps, unless that passes the budget: then the walk is unfinished and must return.
+fn spend(n: u32) -> bool {
+    steps += n;
+    if steps > STEP_BUDGET {
+        unfinished = true;
+        return false;
+    }
+    return true;
+}
+
 fn store(out: u32) {
-    if best == MISS {
+    if unfinished {
+        hits[out] = vec4<u32>(0u, 0u, 0u, MISS - 2u);
+    } else if best == MISS {
         hits[out] = vec4<u32>(0u, 0u, 0u, select(MISS, MISS - 1u, overflow));
     } else {
         hits[out] = vec4<u32>(bitcast<u32>(R_t_max), bitcast<u32>(best_u), bitcast<u32>(best_v), prim_of(best));

@@ -109,7 +109,9 @@ fn run_flags(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg:
         runid[i] = 0u;
         return;
     }
-    runid[i] = select(1u, 0u, i > 0u && keys[i] == keys[i - 1u]);
+    // Every primitive starts a run of its own: equal codes are told apart by their places
+    // (Karras's tie-break, `delta`), so the tree over them is built in parallel like the rest.
+    runid[i] = 1u;
 }
 
 @compute @workgroup_size(64)
@@ -119,22 +121,25 @@ fn runs(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3
     if i >= LP.n {
         return;
     }
-    if i == 0u || keys[i] != keys[i - 1u] {
-        run_start[runid[i]] = i;
-        run_code[runid[i]] = keys[i];
-    }
+    run_start[runid[i]] = i;
+    run_code[runid[i]] = keys[i];
     if i == 0u {
         run_start[runid[LP.n]] = LP.n;
     }
 }
 
-// The length of the common prefix of runs i and j's codes; -1 outside (Karras's δ; the codes of
-// runs are distinct, so no index is needed to break ties).
+// The length of the common prefix of the keys of places i and j; -1 outside (Karras's δ). Equal
+// codes are told apart by their places: 32 plus the common prefix of i and j (core's
+// `morton::tie_split`), so a run of equal codes is the radix tree of its places.
 fn delta(i: i32, j: i32, m: i32) -> i32 {
     if j < 0 || j >= m {
         return -1;
     }
-    return i32(countLeadingZeros(run_code[u32(i)] ^ run_code[u32(j)]));
+    let x = run_code[u32(i)] ^ run_code[u32(j)];
+    if x == 0u {
+        return 32 + i32(countLeadingZeros(u32(i) ^ u32(j)));
+    }
+    return i32(countLeadingZeros(x));
 }
 
 @compute @workgroup_size(64)
@@ -184,12 +189,17 @@ fn karras(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: ve
     let g = u32(gamma);
     let left = select(g, m - 1u + g, first == g);
     let right = select(g + 1u, m - 1u + g + 1u, last == g + 1u);
-    let bit = 31u - countLeadingZeros(run_code[first] ^ run_code[last]);
+    let x = run_code[first] ^ run_code[last];
+    let bit = 31u - countLeadingZeros(x);
     knodes[t].start = run_start[first];
     knodes[t].end = run_start[last + 1u];
     knodes[t].left = left;
     knodes[t].right = right;
-    knodes[t].axis = 2u - bit % 3u;
+    // A range of equal codes is split by places, on axis 0, and counted as core counts it.
+    knodes[t].axis = select(2u - bit % 3u, 0u, x == 0u);
+    if x == 0u && last + 1u - first > LP.max_leaf {
+        atomicAdd(&stats[6], 1u);
+    }
     knodes[left].parent = t + 1u;
     knodes[right].parent = t + 1u;
 }
@@ -202,8 +212,8 @@ fn parent_size(node: KNode) -> u32 {
     return p.end - p.start;
 }
 
-// core's leaves: a range of at most max_leaf primitives whose parent's is larger (or the root);
-// a run of equal codes longer than that is cut in the middle until it fits.
+// core's leaves: a range of at most max_leaf primitives whose parent's is larger (or the root).
+// (Every leaf of the Karras tree is one primitive, so every range fits somewhere.)
 @compute @workgroup_size(64)
 fn leaf_flags(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
               @builtin(local_invocation_index) lid: u32) {
@@ -216,25 +226,6 @@ fn leaf_flags(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg
     let size = node.end - node.start;
     if size <= LP.max_leaf && parent_size(node) > LP.max_leaf {
         leafp[node.start] = 1u;
-    }
-    if x >= m - 1u && size > LP.max_leaf {
-        var stack: array<vec2<u32>, 64>;
-        stack[0] = vec2<u32>(node.start, size);
-        var len = 1u;
-        var splits = 0u;
-        while len > 0u {
-            len -= 1u;
-            let r = stack[len];
-            if r.y <= LP.max_leaf {
-                leafp[r.x] = 1u;
-            } else {
-                splits += 1u;
-                stack[len] = vec2<u32>(r.x + r.y / 2u, r.y - r.y / 2u);
-                stack[len + 1u] = vec2<u32>(r.x, r.y / 2u);
-                len += 2u;
-            }
-        }
-        atomicAdd(&stats[6], splits);
     }
 }
 
@@ -352,27 +343,7 @@ fn emit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3
     }
     if !interior {
         write(pos, kboxes[x], node.start, size);
-    } else if x + 1u < m {
-        write(pos, kboxes[x], cpos, node.axis << 16u);
     } else {
-        // A run of equal codes longer than a leaf: cut in the middle, as core cuts it (axis 0).
-        var stack: array<vec4<u32>, 64>;
-        stack[0] = vec4<u32>(pos, cpos, node.start, size);
-        var len = 1u;
-        while len > 0u {
-            len -= 1u;
-            let r = stack[len];
-            let b = range_box(r.z, r.z + r.w);
-            if r.w <= LP.max_leaf {
-                write(r.x, b, r.z, r.w);
-            } else {
-                write(r.x, b, r.y, 0u);
-                let half = r.w / 2u;
-                let left_nodes = 2u * leaves_in(r.z, r.z + half) - 1u;
-                stack[len] = vec4<u32>(r.y + 1u, r.y + 1u + left_nodes, r.z + half, r.w - half);
-                stack[len + 1u] = vec4<u32>(r.y, r.y + 2u, r.z, half);
-                len += 2u;
-            }
-        }
+        write(pos, kboxes[x], cpos, node.axis << 16u);
     }
 }

@@ -48,9 +48,56 @@ fn dotx(a: vec3<f32>, r: vec3<f32>) -> f32 {
     return (xm(a.x, r.x) + xm(a.y, r.y)) + xm(a.z, r.z);
 }
 
+// Which test the walk runs: core's TriangleTest, Watertight (false) or MollerTrumbore (true).
+override MOLLER: bool = false;
+
 // The hit of the triangle v0, v1, v2 within [R_t_min, R_t_max): (t, u, v) with u weighting v1
 // and v weighting v2, and w = 1 for a hit, 0 for a miss.
 fn intersect(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec4<f32> {
+    if MOLLER {
+        return intersect_mt(v0, v1, v2);
+    }
+    return intersect_watertight(v0, v1, v2);
+}
+
+// glam's cross, each product rounded on its own.
+fn crossx(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(xm(a.y, b.z) - xm(b.y, a.z), xm(a.z, b.x) - xm(b.z, a.x), xm(a.x, b.y) - xm(b.x, a.y));
+}
+
+// core's geometry::triangle::MollerTrumbore, operation by operation: Möller & Trumbore, "Fast,
+// Minimum Storage Ray/Triangle Intersection", JGT 2(1), 1997 (the handout's test).
+fn intersect_mt(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec4<f32> {
+    let d = R_d;
+    let e1 = v1 - v0;
+    let e2 = v2 - v0;
+    let pv = crossx(d, e2);
+    let det = dotx(e1, pv);
+    // |det| = |d|·|e1 × e2|·|cos|; rejected below 1e-7 of its largest possible value.
+    let scale = xm(xm(sqrt(dotx(d, d)), sqrt(dotx(e1, e1))), sqrt(dotx(e2, e2)));
+    if is_nan(det) || !(abs(det) > xm(1e-7, scale)) {
+        return vec4<f32>(0.0);
+    }
+    let inv_det = 1.0 / det;
+    let s = R_o - v0;
+    let u = xm(dotx(s, pv), inv_det);
+    if is_nan(u) || !(u >= 0.0 && u <= 1.0) {
+        return vec4<f32>(0.0);
+    }
+    let q = crossx(s, e1);
+    let v = xm(dotx(d, q), inv_det);
+    if v < 0.0 || u + v > 1.0 || is_nan(v) {
+        return vec4<f32>(0.0);
+    }
+    let t = xm(dotx(e2, q), inv_det);
+    if t >= R_t_min && t < R_t_max {
+        return vec4<f32>(t, u, v, 1.0);
+    }
+    return vec4<f32>(0.0);
+}
+
+// core's Watertight test (above).
+fn intersect_watertight(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec4<f32> {
     let a = v0 - R_o;
     let b = v1 - R_o;
     let c = v2 - R_o;

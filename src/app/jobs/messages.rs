@@ -75,6 +75,8 @@ pub struct PassOutput {
     pub partial: Option<Arc<PartialBvh>>,
     /// The GPU that traced it, if one did.
     pub gpu: Option<GpuRender>,
+    /// Rays of it whose GPU walk reached the step budget and were finished on the CPU.
+    pub cpu_finished: usize,
 }
 
 /// What a file dialog was opened for.

@@ -90,7 +90,8 @@ impl Jobs {
                 let (bvh, camera, style, trace, partial) =
                     (r.bvh.clone(), r.camera, r.style, r.trace, r.partial.clone());
                 let (frame, gpu) = (Arc::new(frame), None);
-                let pass = PassOutput { bvh, frame, image, legend, info, camera, trace, style, partial, gpu };
+                let pass =
+                    PassOutput { bvh, frame, image, legend, info, camera, trace, style, partial, gpu, cpu_finished: 0 };
                 send(JobEvent::Pass(pass));
             };
             // A replay's partial tree traces in place of the BVH it is part of; the mesh shades.

@@ -191,7 +191,9 @@ fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut crate::app::Settings) 
         }
         Probe::Found(g) => g.name(),
     };
-    ui.add_enabled_ui(matches!(probe, Probe::Found(_)), |ui| ui.radio_value(&mut s.device, Device::Gpu, "GPU"))
+    // The GPU chosen but not tracing now (two levels, the replay): the button says so.
+    let label = if s.device == Device::Gpu && app.gpu_blocked().is_some() { "GPU (CPU now)" } else { "GPU" };
+    ui.add_enabled_ui(matches!(probe, Probe::Found(_)), |ui| ui.radio_value(&mut s.device, Device::Gpu, label))
         .inner
         .on_hover_text(&why)
         .on_disabled_hover_text(&why);

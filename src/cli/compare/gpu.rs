@@ -30,6 +30,9 @@ pub struct GpuRow {
     pub incoherent_mrays_per_s: f64,
     /// 32-lane SIMT efficiency of the primary frame (from the counted walk's counts).
     pub simt_efficiency: f64,
+    /// Rays (primary and incoherent) whose walk reached the GPU's step budget and was finished on
+    /// the CPU: their hits and counts are the CPU's, their time is not in the GPU's.
+    pub cpu_finished: usize,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -71,7 +74,7 @@ pub fn gpu_rows(
             let (tree, _) = GpuTree::upload(gpu, &scene_bvh, format)?;
             let cw_nodes = match &tree {
                 GpuTree::Cwbvh(cw, _) => Some(cw.nodes.len()),
-                GpuTree::Binary(_) => None,
+                GpuTree::Binary(..) => None,
             };
             let label = format!("timing {} ({} nodes) on the GPU", strategy.label(), format.name());
             let measured = progress::with_spinner(&label, || -> Result<_, CliError> {
@@ -87,8 +90,9 @@ pub fn gpu_rows(
                         Ok((median(times), last))
                     };
                     let (primary_ms, primary) = time(Rays::Camera(camera))?;
-                    let (incoherent_ms, _) = time(Rays::List(&incoherent))?;
-                    out.push((counted, primary_ms, primary, incoherent_ms));
+                    let (incoherent_ms, inc) = time(Rays::List(&incoherent))?;
+                    let finished = primary.cpu_finished + inc.cpu_finished;
+                    out.push((counted, primary_ms, primary, incoherent_ms, finished));
                 }
                 Ok(out)
             })?;
@@ -99,7 +103,7 @@ pub fn gpu_rows(
             let simt = WarpView::frame(camera.width, camera.height, counts, WarpSize::W32, WarpWork::Steps)
                 .summary()
                 .simt_efficiency;
-            for (counted, primary_ms, _, incoherent_ms) in measured {
+            for (counted, primary_ms, _, incoherent_ms, cpu_finished) in measured {
                 let mrays = |n: usize, ms: f64| n as f64 / ms.max(1e-9) / 1e3;
                 let kind = if counted { "counted" } else { "plain" };
                 rows.push(GpuRow {
@@ -130,6 +134,7 @@ pub fn gpu_rows(
                     incoherent_ms,
                     incoherent_mrays_per_s: mrays(incoherent.len(), incoherent_ms),
                     simt_efficiency: simt,
+                    cpu_finished,
                 });
             }
         }
@@ -185,11 +190,22 @@ pub fn markdown(
     let _ = writeln!(o);
     let _ = writeln!(
         o,
-        "GPU rows: primary = the {}x{} frame's rays, incoherent = {incoherent} rays from random points on the surface in random directions (seed 1); {} order (binary nodes; CWBVH orders by octant), watertight test; ms: submit to completion on the GPU, read-backs left out, median of {runs} runs after one untimed run; counted: per-ray counts kept and read back.",
+        "GPU rows: primary = the {}x{} frame's rays, incoherent = {incoherent} rays from random points on the surface in random directions (seed 1); {} order (binary nodes; CWBVH orders by octant), {} test; ms: submit to completion on the GPU, read-backs left out, median of {runs} runs after one untimed run; counted: per-ray counts kept and read back.",
         camera.width,
         camera.height,
-        trace.order.label()
+        trace.order.label(),
+        trace.test.label()
     );
+    let finished: Vec<String> =
+        rows.iter().filter(|g| g.cpu_finished > 0).map(|g| format!("{} ({})", g.row.name, g.cpu_finished)).collect();
+    if !finished.is_empty() {
+        let _ = writeln!(
+            o,
+            "Rays whose walk reached the GPU's step budget ({} steps) were finished on the CPU (their hits and counts are the CPU's, their time is left out of the GPU's): {}.",
+            bvhscope_gpu::STEP_BUDGET,
+            finished.join(", ")
+        );
+    }
     if gpu.is_software() {
         let _ = writeln!(
             o,

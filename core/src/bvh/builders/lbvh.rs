@@ -6,11 +6,12 @@
 //! BVHs, Octrees, and k-d Trees", HPG 2012, builds node by node; here top-down with `rayon::join`).
 //! No box is priced: the build is a sort and a pass of binary searches, and the tree is blocky,
 //! each split an axis-aligned plane of the Morton grid. A range of at most `max_leaf_size`
-//! primitives is a leaf; one of equal codes (centroids in one grid cell) above that is cut in the
-//! middle (counted as a fallback split). Boxes are made bottom-up, once per node.
+//! primitives is a leaf; one of equal codes (centroids in one grid cell) above that is split by
+//! its places in the sorted order, Karras's tie-break (`morton::tie_split`; counted as a fallback
+//! split). Boxes are made bottom-up, once per node.
 
 use super::common::Progress;
-use super::morton::{grid, in_triangle_order, morton, sort, split_of, Keyed};
+use super::morton::{grid, in_triangle_order, morton, sort, split_of, tie_split, Keyed};
 use super::split::BuildPrim;
 use super::subtree::Subtree;
 use crate::bvh::node::{Bvh, BvhNode};
@@ -25,7 +26,7 @@ use rayon::prelude::*;
 const PARALLEL_MIN: usize = 1 << 14;
 
 /// Sort `prims` into Morton order and build the hierarchy over them (left in leaf order). The
-/// subtree and the number of ranges of equal codes cut in the middle.
+/// subtree and the number of ranges of equal codes split by their places.
 pub(super) fn build(
     prims: &mut Vec<BuildPrim>,
     params: &BuildParams,
@@ -144,7 +145,7 @@ fn subtree<T: Bounded>(
     progress.check()?;
     let (mid, axis, fallback) = match split_of(codes) {
         Some((mid, axis)) => (mid, axis, 0),
-        None => (prims.len() / 2, 0, 1),
+        None => (tie_split(offset as usize, prims.len()), 0, 1),
     };
     progress.split(prims.len(), depth);
     let ((lp, rp), (lc, rc)) = (prims.split_at(mid), codes.split_at(mid));
@@ -197,7 +198,7 @@ fn sequential<T: Bounded>(
         }
         let (mid, axis) = split_of(&codes[start..end]).unwrap_or_else(|| {
             fallback += 1;
-            (n / 2, 0)
+            (tie_split(offset as usize + start, n), 0)
         });
         let left = nodes.len();
         nodes.extend([BvhNode::leaf(Aabb::EMPTY, 0, 0); 2]);

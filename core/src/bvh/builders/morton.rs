@@ -86,6 +86,20 @@ pub(super) fn split_of(codes: &[u64]) -> Option<(usize, u8)> {
     Some((codes.partition_point(|c| c & mask == 0), axis_of(bit)))
 }
 
+/// Where a range of equal codes is split: Karras's tie-break (HPG 2012, §4), which takes a
+/// primitive's place in the sorted order as the rest of its key, so the range `first..first +
+/// len` of sorted places splits where the highest bit in which its first and last places differ
+/// flips. The tree over a run of equal codes is then the radix tree of their places, which the
+/// GPU's LBVH builds in parallel, node by node, as it builds the rest (a cut in the middle needed
+/// one invocation to walk the whole run, and a run of 5,000 identical triangles passed the
+/// driver's loop limit). The split within the range: at least 1, at most `len - 1`.
+pub(super) fn tie_split(first: usize, len: usize) -> usize {
+    debug_assert!(len >= 2);
+    let (a, b) = (first as u64, (first + len - 1) as u64);
+    let bit = 63 - (a ^ b).leading_zeros();
+    ((b >> bit << bit) - a) as usize
+}
+
 /// Sort `prims` by the Morton codes of their centroids in the grid over the centroid bounds;
 /// the codes in that order.
 pub(super) fn sort(prims: &mut Vec<BuildPrim>) -> Vec<u64> {
@@ -170,7 +184,7 @@ impl MortonOrder {
     }
 
     /// How slots `first..first + count` split: at the highest bit where their codes differ
-    /// (`None` when all are equal: the build then cut the range in the middle).
+    /// (`None` when all are equal: the build then split the range by its places, `tie_split`).
     pub fn split(&self, first: u32, count: u32) -> Option<MortonSplit> {
         let codes = self.codes.get(first as usize..(first + count) as usize)?;
         let (mid, axis) = split_of(codes)?;
@@ -232,5 +246,16 @@ mod tests {
         let codes = [0b0001, 0b0011, 0b0100, 0b0110, 0b0111];
         assert_eq!(split_of(&codes).map(|s| s.0), Some(2), "bit 2 flips between 0b0011 and 0b0100");
         assert_eq!(split_of(&[5, 5, 5]), None);
+        // Equal codes: by the highest bit of their places that flips (Karras's tie-break).
+        assert_eq!(tie_split(0, 5000), 4096);
+        assert_eq!(tie_split(4096, 904), 512, "places 4096..5000 split at 4608");
+        assert_eq!(tie_split(6, 2), 1);
+        assert_eq!(tie_split(7, 2), 1, "7 and 8 differ in bit 3");
+        for first in 0..40 {
+            for len in 2..40 {
+                let m = tie_split(first, len);
+                assert!((1..len).contains(&m), "{first} {len}: {m}");
+            }
+        }
     }
 }

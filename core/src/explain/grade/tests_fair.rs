@@ -5,7 +5,7 @@
 
 use super::*;
 use crate::bvh::{AnyBvh, BuildParams, Layout, SplitStrategy};
-use crate::dump::{BvhDump, DumpNode};
+use crate::dump::BvhDump;
 use crate::mesh::{generate, parse_obj, write_obj, Mesh};
 use crate::work::WorkControl;
 use std::path::Path;
