@@ -12,6 +12,9 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // `check` has printed its report: exit 1 says the BVH has defects.
         Err(CliError::Defects(_)) => ExitCode::from(1),
+        // A reader that stopped early (`| head`): the rest was not wanted; the status a Unix tool
+        // killed by SIGPIPE has.
+        Err(CliError::Stdout(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::from(141),
         Err(e) => {
             // One line (a driver's message comes in several), and a file name in it may hold
             // anything, an escape sequence included.

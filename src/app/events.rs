@@ -144,6 +144,10 @@ impl BvhscopeApp {
         let rays_per_s = p.info.rays as f64 / p.info.pass_time.as_secs_f64().max(1e-9);
         if p.info.stride == 1 {
             self.last_full_frame = Some(p.info.elapsed);
+            // An import's check waits for the scene's first full frame (`Jobs::import`).
+            if p.partial.is_none() && self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
+                self.jobs.shown_scene.store(self.scene_id, std::sync::atomic::Ordering::SeqCst);
+            }
             // Per-ray figures belong to the BVH that traced them; a pass of an older BVH that
             // arrives after a rebuild must not be shown (or remembered) under the new strategy.
             // A replay's partial tree is not the strategy's tree: its figures are not recorded.

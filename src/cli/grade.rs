@@ -16,8 +16,9 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// The frame's size unless told: small enough that a class of a hundred takes minutes, the
-/// scene camera's shape kept.
-const DEFAULT_SIZE: (u32, u32) = (480, 270);
+/// scene camera's shape kept (`check`'s).
+const DEFAULT_SIZE: (u32, u32) = super::check::CHECK_SIZE;
+use super::check::fit;
 const DEFAULT_RAYS: u64 = 100_000;
 const DEFAULT_TIME_RAYS: u32 = 16_384;
 
@@ -72,11 +73,6 @@ fn grade_err(e: GradeError) -> CliError {
     }
 }
 
-/// A scene camera's size shrunk to fit 480x360, its shape kept (never enlarged).
-fn fit((w, h): (u32, u32)) -> (u32, u32) {
-    let s = (480.0 / w as f64).min(360.0 / h as f64).min(1.0);
-    (((w as f64 * s).round() as u32).max(1), ((h as f64 * s).round() as u32).max(1))
-}
 
 pub fn run(a: &GradeArgs) -> Result<(), CliError> {
     let b = &a.build;

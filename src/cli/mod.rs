@@ -120,6 +120,9 @@ pub enum CliError {
     Write { path: PathBuf, source: std::io::Error },
     #[error(transparent)]
     File(#[from] crate::files::FileError),
+    /// Standard output could not be written (a full disk, a closed pipe).
+    #[error("cannot write to standard output: {0}")]
+    Stdout(std::io::Error),
     /// `check` found defects (reported on stdout): exit code 1.
     #[error("{0} defects")]
     Defects(usize),

@@ -5,12 +5,13 @@
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
 use super::device::{self, GpuTree};
 use super::{load_mesh, CliError};
-use crate::bvh::{trace_ray, RayCounters, SceneBvh, StepKind, TraceLevel};
+use crate::bvh::{trace_ray_into, RayCounters, SceneBvh, StepKind, StepOut, Trace, TraceLevel, TraceStep};
 use crate::geometry::Ray;
 use clap::{Args, ValueEnum};
 use glam::Vec3;
 use std::fmt::Write;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum TraceFormat {
@@ -52,6 +53,10 @@ pub struct TraceArgs {
     pub bvh: Option<PathBuf>,
     #[command(flatten)]
     pub dump_limit: super::args::DumpLimit,
+    /// The most steps listed: a longer walk (a tree whose boxes all overlap, a chain thousands
+    /// deep) is listed that far, then counted to its end; its hit and counts are the whole walk's.
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_steps: u64,
 }
 
 fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
@@ -87,12 +92,21 @@ fn counts_json(c: &RayCounters) -> serde_json::Value {
 }
 
 pub fn run(a: &TraceArgs) -> Result<(), CliError> {
-    super::out(&output(a)?);
-    Ok(())
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    write(a, &mut out)?;
+    std::io::Write::flush(&mut out).map_err(CliError::Stdout)
 }
 
 /// What `run` prints: the text table or the JSON (the app's tests compare it with the Ray window).
 pub fn output(a: &TraceArgs) -> Result<String, CliError> {
+    let mut out = Vec::new();
+    write(a, &mut out)?;
+    Ok(String::from_utf8_lossy(&out).into_owned())
+}
+
+/// The listing written to `out` as the walk goes.
+pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError> {
     let gpu = device::open(&a.device)?;
     let scene = load_mesh(&a.mesh)?;
     let mut params = a.build.params(scene.build.as_ref());
@@ -146,31 +160,13 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
         (None, None) => unreachable!("clap requires --pixel or --ray"),
     };
     let opts = a.build.trace();
-    // On the GPU: its hit and counts, and no steps (an empty trace).
-    let mut finished_on_cpu = false;
-    let (mut hit, mut trace, gpu_counts) = match &on_gpu {
-        Some((g, (tree, _))) => {
-            let t = tree.trace(g, bvhscope_gpu::Rays::List(&[ray]), opts, true)?;
-            let counts = t.counters.first().copied().unwrap_or_default();
-            finished_on_cpu = t.cpu_finished > 0;
-            (t.hits.first().copied().flatten(), crate::bvh::Trace::new(), Some(counts))
-        }
-        None => {
-            let (hit, trace) = trace_ray(&bvh, &ray, opts);
-            (hit, trace, None)
-        }
-    };
-    // An imported tree's nodes by the dump's ids, its triangles by the file's numbers.
-    if let (SceneBvh::Single { mesh, imported: Some(names), .. }, true) = (&bvh, a.bvh.is_some()) {
-        trace.steps = trace.steps.iter().map(|s| names.rename(s, mesh)).collect();
-        if let Some(h) = &mut hit {
-            h.prim = mesh.file_number(h.prim);
-        }
-    }
     let build_label = bvh.label();
-    let counts = gpu_counts.unwrap_or_else(|| trace.counts());
-    let gpu_note = on_gpu.as_ref().map(|(g, (tree, _))| {
-        let finished = if finished_on_cpu {
+    let head = Head { a, ray, source, hot, build_label, opts, two_levels: bvh.two_level().is_some() };
+    // On the GPU: its hit and counts, and no steps.
+    if let Some((g, (tree, _))) = &on_gpu {
+        let t = tree.trace(g, bvhscope_gpu::Rays::List(&[ray]), opts, true)?;
+        let counts = t.counters.first().copied().unwrap_or_default();
+        let finished = if t.cpu_finished > 0 {
             format!(
                 "; its walk reached the GPU's step budget ({} steps) and was finished on the CPU (the same walk: its hit and counts are the CPU's)",
                 bvhscope_gpu::STEP_BUDGET
@@ -178,69 +174,139 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
         } else {
             String::new()
         };
-        format!(
+        let note = format!(
             "traced on the GPU ({} nodes, {}){finished}: the GPU walk records no steps (its kernels keep each ray's hit and counts only); for the walk step by step, run this with --device cpu",
             tree.nodes().name(),
             g.name()
-        )
-    });
-    let mut o = String::new();
-    match a.format {
-        TraceFormat::Json => {
-            let v = serde_json::json!({
-                "ray": { "origin": ray.origin().to_array(), "dir": ray.dir().to_array(), "from": source },
-                "build": build_label,
-                "trace": opts,
-                "hit": hit.map(|h| serde_json::json!({ "triangle": h.prim, "t": h.t })),
-                "counts": counts_json(&counts),
-                "steps": if gpu_note.is_some() { serde_json::Value::Null } else { serde_json::json!(trace.steps) },
-                "device": a.device.device,
-                "note": gpu_note,
-            });
-            let _ = writeln!(o, "{}", serde_json::to_string_pretty(&v).expect("plain data serialises"));
+        );
+        let hit = t.hits.first().copied().flatten();
+        let mut sink = Listing::new(out, &head);
+        sink.start(Some(&note));
+        return sink.end(hit, counts, 0, Some(&note));
+    }
+    // On the CPU: each step written as the walk makes it (an imported tree's nodes by the dump's
+    // ids, its triangles by the file's numbers), the first --max-steps of them.
+    let names = match (&bvh, a.bvh.is_some()) {
+        (SceneBvh::Single { mesh, imported: Some(names), .. }, true) => Some((names.clone(), mesh.clone())),
+        _ => None,
+    };
+    let mut sink = Listing::new(out, &head);
+    sink.rename = names;
+    sink.start(None);
+    let (mut hit, trace) = trace_ray_into(&bvh, &ray, opts, Trace::into(sink, a.max_steps));
+    if let (SceneBvh::Single { mesh, imported: Some(_), .. }, true, Some(h)) = (&bvh, a.bvh.is_some(), hit.as_mut()) {
+        h.prim = mesh.file_number(h.prim);
+    }
+    let (counts, dropped) = (trace.counts(), trace.dropped());
+    trace.steps.end(hit, counts, dropped, None)
+}
+
+/// What the listing of one ray says before and around its steps.
+struct Head<'a> {
+    a: &'a TraceArgs,
+    ray: Ray,
+    source: serde_json::Value,
+    hot: Option<(u32, u32)>,
+    build_label: String,
+    opts: crate::bvh::TraceOptions,
+    two_levels: bool,
+}
+
+/// The walk written as it goes, text or JSON, into `out`: the head, each step as the trace makes
+/// it (`StepOut`), then the hit and the counts. Memory holds one step at a time whatever the
+/// walk's length; the first write error is kept and returned at the end (the rest is not tried).
+struct Listing<'a> {
+    out: &'a mut dyn std::io::Write,
+    head: &'a Head<'a>,
+    rename: Option<(Arc<crate::bvh::imported::Imported>, Arc<crate::mesh::Mesh>)>,
+    steps: u64,
+    entered: u32,
+    error: Option<std::io::Error>,
+}
+
+impl<'a> Listing<'a> {
+    fn new(out: &'a mut dyn std::io::Write, head: &'a Head<'a>) -> Self {
+        Listing { out, head, rename: None, steps: 0, entered: 0, error: None }
+    }
+
+    fn json(&self) -> bool {
+        matches!(self.head.a.format, TraceFormat::Json)
+    }
+
+    fn write(&mut self, text: &str) {
+        if self.error.is_none() {
+            if let Err(e) = self.out.write_all(text.as_bytes()) {
+                self.error = Some(e);
+            }
         }
-        TraceFormat::Text => {
-            let (o3, d3) = (ray.origin(), ray.dir());
-            let _ = writeln!(
-                o,
-                "ray             origin ({}, {}, {}), direction ({}, {}, {})",
-                o3.x, o3.y, o3.z, d3.x, d3.y, d3.z
+    }
+
+    /// The head: the ray, its pixel, the build and traversal (the JSON's keys before "steps").
+    fn start(&mut self, gpu_note: Option<&str>) {
+        let h = self.head;
+        if self.json() {
+            let json = |v: serde_json::Value| serde_json::to_string(&v).expect("plain data serialises");
+            let text = format!(
+                "{{\n  \"ray\": {},\n  \"build\": {},\n  \"trace\": {},\n  \"device\": {},\n  \"steps\": {}",
+                json(serde_json::json!({ "origin": h.ray.origin().to_array(), "dir": h.ray.dir().to_array(), "from": h.source })),
+                json(serde_json::json!(h.build_label)),
+                json(serde_json::json!(h.opts)),
+                json(serde_json::json!(h.a.device.device)),
+                if gpu_note.is_some() { "null" } else { "[" }
             );
-            if let Some((x, y)) = a.pixel.or(hot).filter(|_| a.ray.is_none()) {
-                let rank = a.hottest.map_or(String::new(), |k| {
-                    format!(
-                        " (the pixel with the {} most work of {})",
-                        crate::explain::words::ordinal(k),
-                        a.view.label().to_lowercase()
-                    )
-                });
-                let _ = writeln!(o, "pixel           {x},{y}{rank}");
+            self.write(&text);
+            return;
+        }
+        let (o3, d3) = (h.ray.origin(), h.ray.dir());
+        let mut o = format!("ray             origin ({}, {}, {}), direction ({}, {}, {})\n", o3.x, o3.y, o3.z, d3.x, d3.y, d3.z);
+        if let Some((x, y)) = h.a.pixel.or(h.hot).filter(|_| h.a.ray.is_none()) {
+            let rank = h.a.hottest.map_or(String::new(), |k| {
+                format!(" (the pixel with the {} most work of {})", crate::explain::words::ordinal(k), h.a.view.label().to_lowercase())
+            });
+            let _ = writeln!(o, "pixel           {x},{y}{rank}");
+        }
+        let _ = writeln!(o, "build           {}", h.build_label);
+        let _ = writeln!(o, "traversal       {} order, {} test", h.opts.order.label(), h.opts.test.label());
+        let _ = writeln!(o);
+        if let Some(note) = gpu_note {
+            let _ = writeln!(o, "steps           {note}");
+        }
+        self.write(&o);
+    }
+
+    /// The tail: the hit, the counts of the whole walk, and how many steps were left out.
+    fn end(
+        mut self,
+        hit: Option<crate::bvh::Hit>,
+        counts: RayCounters,
+        dropped: u64,
+        gpu_note: Option<&str>,
+    ) -> Result<(), CliError> {
+        let max = self.head.a.max_steps;
+        let cut = (dropped > 0).then(|| {
+            format!(
+                "the walk has {} steps; the first {max} are listed (--max-steps), the hit and counts are the whole walk's",
+                self.steps + dropped
+            )
+        });
+        if self.json() {
+            let json = |v: serde_json::Value| serde_json::to_string(&v).expect("plain data serialises");
+            let text = format!(
+                "{},\n  \"hit\": {},\n  \"counts\": {},\n  \"steps_left_out\": {dropped},\n  \"note\": {}\n}}\n",
+                if gpu_note.is_some() { "" } else { "\n  ]" },
+                json(serde_json::json!(hit.map(|h| serde_json::json!({ "triangle": h.prim, "t": h.t })))),
+                json(counts_json(&counts)),
+                json(serde_json::json!(gpu_note.map(str::to_string).or(cut)))
+            );
+            self.write(&text);
+        } else {
+            let mut o = String::from("\n");
+            if let Some(cut) = &cut {
+                let _ = writeln!(o, "… {cut}\n");
             }
-            let _ = writeln!(o, "build           {build_label}");
-            let _ = writeln!(o, "traversal       {} order, {} test", opts.order.label(), opts.test.label());
-            let _ = writeln!(o);
-            if let Some(note) = &gpu_note {
-                let _ = writeln!(o, "steps           {note}");
-            }
-            let levels = trace.steps.iter().any(|s| s.level != TraceLevel::Mesh);
-            let mut entered = 0;
-            for (i, s) in trace.steps.iter().enumerate() {
-                let (depth, text) = (s.depth(), s.text());
-                if let StepKind::Enter { depth, .. } = s.kind {
-                    entered = depth;
-                }
-                let depth = depth.unwrap_or(entered + 1);
-                let level = if levels { format!("{:<10}", level_text(s.level)) } else { String::new() };
-                let _ = writeln!(o, "{:>5}  {level}{}{text}", i + 1, crate::bvh::trace::indent(depth));
-            }
-            let _ = writeln!(o);
             match hit {
                 Some(h) => {
-                    let _ = writeln!(
-                        o,
-                        "hit             triangle {} at t = {:.6} (u {:.4}, v {:.4})",
-                        h.prim, h.t, h.u, h.v
-                    );
+                    let _ = writeln!(o, "hit             triangle {} at t = {:.6} (u {:.4}, v {:.4})", h.prim, h.t, h.u, h.v);
                 }
                 None => {
                     let _ = writeln!(o, "hit             nothing");
@@ -251,7 +317,35 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
                 "counts          nodes visited {}, box tests {}, leaves visited {}, triangle tests {}",
                 counts.nodes_visited, counts.box_tests, counts.leaves_visited, counts.triangle_tests
             );
+            self.write(&o);
+        }
+        match self.error.take() {
+            None => Ok(()),
+            Some(e) => Err(CliError::Stdout(e)),
         }
     }
-    Ok(o)
+}
+
+impl StepOut for Listing<'_> {
+    fn put(&mut self, step: TraceStep) {
+        let step = match &self.rename {
+            Some((names, mesh)) => names.rename(&step, mesh),
+            None => step,
+        };
+        self.steps += 1;
+        if self.json() {
+            let sep = if self.steps == 1 { "\n    " } else { ",\n    " };
+            let text = format!("{sep}{}", serde_json::to_string(&step).expect("plain data serialises"));
+            self.write(&text);
+            return;
+        }
+        let (depth, text) = (step.depth(), step.text());
+        if let StepKind::Enter { depth, .. } = step.kind {
+            self.entered = depth;
+        }
+        let depth = depth.unwrap_or(self.entered + 1);
+        let level = if self.head.two_levels { format!("{:<10}", level_text(step.level)) } else { String::new() };
+        let line = format!("{:>5}  {level}{}{text}\n", self.steps, crate::bvh::trace::indent(depth));
+        self.write(&line);
+    }
 }

@@ -353,7 +353,10 @@ fn the_node_inspector_and_bvhscope_inspect_agree() {
     }
     assert_eq!(v["visits"], visits, "the Tree window's visits of node 3 for the same camera");
     assert!(visits > 0);
-    assert_eq!(v["epo_contribution"].as_f64().unwrap(), ins.epo_share, "the EPO share, to the last digit");
+    // (serde_json reads a float back to within an ulp: the printed figures are compared too.)
+    let cli_share = v["epo_contribution"].as_f64().unwrap();
+    assert!((cli_share - ins.epo_share).abs() <= 1e-15 * ins.epo_share.abs(), "{cli_share} vs {}", ins.epo_share);
+    assert_eq!(format!("{cli_share:.4}"), format!("{:.4}", ins.epo_share), "the EPO share as both print it");
     assert!(ins.epo_share > 0.0, "node 3's share is not nothing");
     // The Node window prints that figure.
     h.state_mut().act(Action::ShowTree(true));

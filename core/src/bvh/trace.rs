@@ -199,11 +199,33 @@ impl TraceStep {
     }
 }
 
-/// The statistics sink that records the steps. Its counting methods do nothing: the counts of a
-/// trace are read from its steps (`counts`).
+/// Where a trace's steps go: kept (`Vec<TraceStep>`, the app's Ray window), or written out as the
+/// walk goes (`bvhscope trace`), so a walk of millions of steps needs no memory for them.
+pub trait StepOut {
+    fn put(&mut self, step: TraceStep);
+}
+
+impl StepOut for Vec<TraceStep> {
+    fn put(&mut self, step: TraceStep) {
+        self.push(step);
+    }
+}
+
+/// The statistics sink that records the steps, into `steps` (kept, by default), at most
+/// `max_steps` of them: past that the walk goes on to its hit, and is only counted (no step is
+/// made, no node remembered), so memory does not grow with the walk's length. Its counting
+/// methods do nothing: the counts of a trace are those of its steps (`counts`), every step, kept
+/// or not.
 #[derive(Clone, Debug, Default)]
-pub struct Trace {
-    pub steps: Vec<TraceStep>,
+pub struct Trace<O: StepOut = Vec<TraceStep>> {
+    pub steps: O,
+    /// Steps given to `steps`, and the most it takes.
+    taken: u64,
+    max_steps: u64,
+    /// Steps past `max_steps`: counted, not made.
+    dropped: u64,
+    counts: RayCounters,
+    last_hit: Option<(u32, f32)>,
     two_levels: bool,
     instance: Option<(u32, u32)>,
     /// Per level, each node's depth and box interval, learnt from its box test.
@@ -218,8 +240,30 @@ pub struct Trace {
 }
 
 impl Trace {
+    /// A trace that keeps every step.
     pub fn new() -> Self {
-        Trace { closest_t: f32::INFINITY, ..Default::default() }
+        Self::into(Vec::new(), u64::MAX)
+    }
+}
+
+impl<O: StepOut> Trace<O> {
+    /// A trace that gives its first `max_steps` steps to `out`.
+    pub fn into(out: O, max_steps: u64) -> Self {
+        Trace {
+            steps: out,
+            taken: 0,
+            max_steps,
+            dropped: 0,
+            counts: RayCounters::ZERO,
+            last_hit: None,
+            two_levels: false,
+            instance: None,
+            seen: HashMap::new(),
+            stack: Vec::new(),
+            entered_depth: None,
+            outer: (Vec::new(), None),
+            closest_t: f32::INFINITY,
+        }
     }
 
     /// The level the walk is in now.
@@ -231,47 +275,68 @@ impl Trace {
         }
     }
 
+    /// Whether `max_steps` steps were made: the rest are counted only.
+    fn full(&self) -> bool {
+        self.taken >= self.max_steps
+    }
+
     fn push(&mut self, kind: StepKind) {
-        self.steps.push(TraceStep { level: self.level(), kind });
+        self.tally(&kind);
+        if self.full() {
+            self.dropped += 1;
+            return;
+        }
+        self.taken += 1;
+        self.steps.put(TraceStep { level: self.level(), kind });
+    }
+
+    /// Count a step as the counting sink counts its work.
+    fn tally(&mut self, kind: &StepKind) {
+        let top = self.level() == TraceLevel::Top;
+        let c = &mut self.counts;
+        match kind {
+            StepKind::BoxTest { .. } => {
+                c.box_tests += 1;
+                c.top_box_tests += u32::from(top);
+            }
+            StepKind::Enter { .. } => {
+                c.nodes_visited += 1;
+                c.top_nodes_visited += u32::from(top);
+            }
+            StepKind::Leaf { .. } if !top => c.leaves_visited += 1,
+            StepKind::Triangle { .. } => c.triangle_tests += 1,
+            StepKind::Instance { .. } => c.instances_entered += 1,
+            _ => {}
+        }
     }
 
     fn depth(&self, node: NodeId) -> u32 {
         self.seen.get(&(self.level(), node)).map_or(0, |s| s.0)
     }
 
-    /// The work the steps show, as the counting sink counts it.
+    /// The work of the whole walk, as the counting sink counts it (the steps past `max_steps`
+    /// included).
     pub fn counts(&self) -> RayCounters {
-        let mut c = RayCounters::ZERO;
-        for s in &self.steps {
-            let top = s.level == TraceLevel::Top;
-            match s.kind {
-                StepKind::BoxTest { .. } => {
-                    c.box_tests += 1;
-                    c.top_box_tests += u32::from(top);
-                }
-                StepKind::Enter { .. } => {
-                    c.nodes_visited += 1;
-                    c.top_nodes_visited += u32::from(top);
-                }
-                StepKind::Leaf { .. } if !top => c.leaves_visited += 1,
-                StepKind::Triangle { .. } => c.triangle_tests += 1,
-                StepKind::Instance { .. } => c.instances_entered += 1,
-                _ => {}
-            }
-        }
-        c
+        self.counts
     }
 
     /// The last closest hit recorded: (triangle, t).
     pub fn last_hit(&self) -> Option<(u32, f32)> {
-        self.steps.iter().rev().find_map(|s| match s.kind {
-            StepKind::ClosestHit { triangle, t } => Some((triangle, t)),
-            _ => None,
-        })
+        self.last_hit
+    }
+
+    /// Steps of the walk past `max_steps`, counted but not made (0 when all were).
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    /// Steps made.
+    pub fn taken(&self) -> u64 {
+        self.taken
     }
 }
 
-impl TraversalStats for Trace {
+impl<O: StepOut> TraversalStats for Trace<O> {
     #[inline]
     fn node_visited(&mut self) {}
     #[inline]
@@ -288,14 +353,20 @@ impl TraversalStats for Trace {
     }
 
     fn step_box(&mut self, node: NodeId, interval: Option<(f32, f32)>) {
+        let (t_entry, t_exit) = (interval.map(|i| i.0), interval.map(|i| i.1));
+        if self.full() {
+            return self.push(StepKind::BoxTest { node, depth: 0, hit: interval.is_some(), t_entry, t_exit });
+        }
         // The box tested is a child of the node entered last (at this level), or the root.
         let depth = self.entered_depth.map_or(0, |d| d + 1);
         self.seen.insert((self.level(), node), (depth, interval));
-        let (t_entry, t_exit) = (interval.map(|i| i.0), interval.map(|i| i.1));
         self.push(StepKind::BoxTest { node, depth, hit: interval.is_some(), t_entry, t_exit });
     }
 
     fn step_enter(&mut self, node: NodeId) {
+        if self.full() {
+            return self.push(StepKind::Enter { node, depth: 0, t_entry: f32::NAN, t_exit: f32::NAN });
+        }
         let (depth, interval) = self.seen.get(&(self.level(), node)).copied().unwrap_or((0, None));
         let (t_entry, t_exit) = interval.unwrap_or((f32::NAN, f32::NAN));
         self.entered_depth = Some(depth);
@@ -303,11 +374,15 @@ impl TraversalStats for Trace {
     }
 
     fn step_leaf(&mut self, node: NodeId) {
-        let depth = self.depth(node);
+        let depth = if self.full() { 0 } else { self.depth(node) };
         self.push(StepKind::Leaf { node, depth });
     }
 
     fn step_stack(&mut self, len: usize, top: &[(NodeId, f32)]) {
+        // Past the steps made the stack is not mirrored (its steps are not counted work).
+        if self.full() {
+            return;
+        }
         // The entries below the reported top are as they were: compare from there up.
         let base = len - top.len();
         let same = self.stack.get(base..).unwrap_or(&[]).iter().zip(top).take_while(|(a, b)| a == b).count();
@@ -329,6 +404,9 @@ impl TraversalStats for Trace {
     }
 
     fn step_skip(&mut self, node: NodeId, t: f32) {
+        if self.full() {
+            return;
+        }
         // The walk popped it: it is the mirror's top.
         if self.stack.last().is_some_and(|e| e.0 == node) {
             self.stack.pop();
@@ -343,6 +421,7 @@ impl TraversalStats for Trace {
         self.push(StepKind::Triangle { triangle, hit: hit.is_some(), t, u, v });
         if let Some(h) = hit {
             self.closest_t = h.t;
+            self.last_hit = Some((triangle, h.t));
             self.push(StepKind::ClosestHit { triangle, t: h.t });
         }
     }
@@ -397,7 +476,16 @@ fn shown(stack: &[(NodeId, f32)]) -> (Vec<(NodeId, f32)>, u32) {
 
 /// Trace `ray`'s closest hit through `accel` with `opts`, recording every step.
 pub fn trace_ray<A: Accelerator + ?Sized>(accel: &A, ray: &Ray, opts: TraceOptions) -> (Option<Hit>, Trace) {
-    let mut trace = Trace::new();
+    trace_ray_into(accel, ray, opts, Trace::new())
+}
+
+/// `trace_ray` with the steps given to `trace`'s output as the walk makes them.
+pub fn trace_ray_into<A: Accelerator + ?Sized, O: StepOut>(
+    accel: &A,
+    ray: &Ray,
+    opts: TraceOptions,
+    mut trace: Trace<O>,
+) -> (Option<Hit>, Trace<O>) {
     let hit = accel.closest_hit(&mut ray.clone(), opts, &mut trace);
     (hit, trace)
 }

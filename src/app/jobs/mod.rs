@@ -64,6 +64,11 @@ pub struct Jobs {
     /// starts its clock, so its time is the build's alone (as `bvhscope stats` measures it), not
     /// the build's and a render's sharing the cores.
     others: Arc<std::sync::atomic::AtomicUsize>,
+    /// The scene's own work running now (loads, builds, renders) and the scene of the last full
+    /// frame shown: an import's check waits for them (`import`), so a slow but correct dump never
+    /// keeps the mesh's own build and first image waiting.
+    primary: Arc<std::sync::atomic::AtomicUsize>,
+    pub shown_scene: Arc<std::sync::atomic::AtomicU64>,
     /// The GPU the render and build jobs may use, and what they keep on it (`app::gpu`).
     pub gpu: super::gpu::GpuJobs,
 }
@@ -110,6 +115,8 @@ impl Jobs {
             last_build: None,
             frames: FramePool::default(),
             others: Default::default(),
+            primary: Default::default(),
+            shown_scene: Default::default(),
             gpu: Default::default(),
         }
     }

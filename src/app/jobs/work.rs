@@ -9,7 +9,9 @@ impl Jobs {
     pub fn load(&mut self, path: PathBuf) {
         let job = self.start(format!("Loading {}", path.display()));
         let send = self.sender(job.id);
+        let primary = Other::new(&self.primary);
         self.spawn_uncounted(&job, move || {
+            let _primary = primary;
             let result = Scene::open(&path).map(Arc::new).map_err(|e| e.to_string());
             send(JobEvent::Loaded(result));
         });
@@ -41,7 +43,9 @@ impl Jobs {
         let (send, control, others) = (self.sender(job.id), job.control.clone(), self.others.clone());
         let gpu_jobs = self.gpu.clone();
         self.gpu.last_build_on_gpu = gpu.is_some();
+        let primary = Other::new(&self.primary);
         self.spawn_uncounted(&job, move || {
+            let _primary = primary;
             while others.load(std::sync::atomic::Ordering::SeqCst) > 0 && !control.is_cancelled() {
                 std::thread::sleep(Duration::from_millis(1));
             }
@@ -72,7 +76,9 @@ impl Jobs {
         let job = self.start(label.to_string());
         let (send, control) = (self.sender(job.id), job.control.clone());
         let (r, frames, gpu_jobs) = (req.clone(), self.frames.clone(), self.gpu.clone());
+        let primary = Other::new(&self.primary);
         self.spawn(&job, move || {
+            let _primary = primary;
             if let (Some(g), None) = (&r.gpu, &r.partial) {
                 match gpu_jobs.render(&r, g, &control) {
                     Ok(Some(pass)) => send(JobEvent::Pass(pass)),
@@ -177,11 +183,32 @@ impl Jobs {
     }
 
     /// Read the dump at `path` for `scene`'s mesh and check it as `bvhscope check` does, with
-    /// `CHECK_RAYS` random rays and `camera`'s primary rays.
+    /// `CHECK_RAYS` random rays and `camera`'s primary rays. The check waits for the scene's own
+    /// load, build and first full frame (`primary`, `shown_scene`) and is not among the jobs a
+    /// build waits for: a dump whose check takes minutes (every box the root's) never holds the
+    /// mesh's image back.
     pub fn import(&mut self, path: PathBuf, scene: Arc<Scene>, scene_id: u64, camera: Camera, trace: TraceOptions) {
         let job = self.start(format!("Checking {}", path.display()));
         let (send, control) = (self.sender(job.id), job.control.clone());
-        self.spawn(&job, move || {
+        let (primary, shown) = (self.primary.clone(), self.shown_scene.clone());
+        self.spawn_uncounted(&job, move || {
+            use std::sync::atomic::Ordering::SeqCst;
+            // The scene's own work first: while any runs, or until its first full frame (or two
+            // seconds with nothing running: a scene that shows no frame).
+            let mut idle_since: Option<Instant> = None;
+            while !control.is_cancelled() {
+                let busy = primary.load(SeqCst) > 0;
+                if !busy && shown.load(SeqCst) == scene_id {
+                    break;
+                }
+                let idle = *idle_since.get_or_insert_with(Instant::now);
+                if busy {
+                    idle_since = None;
+                } else if idle.elapsed() > Duration::from_secs(2) {
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
             let tree = import_tree(path, &scene, scene_id, &camera, trace, &control);
             send(JobEvent::Imported(tree.map(Box::new)));
         });

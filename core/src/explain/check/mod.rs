@@ -364,7 +364,7 @@ fn check_rays_of(
             .collect();
         out.push(f);
     }
-    let set = RaySet::new(s.mesh, camera, rays);
+    let set = RaySet::checking(s.mesh, camera, rays);
     let wrong = wrong_rays(&bvh, s.mesh, reference, &set, opts, control)?;
     if let Some(f) = wrong.finding(set.len()) {
         out.push(f);
