@@ -30,6 +30,8 @@ pub enum FileError {
     OutputIsInput { path: PathBuf, what: String },
     #[error("{}: {what} is written here, and its name must end in {}", .path.display(), extensions_text(.extensions))]
     WrongName { path: PathBuf, what: &'static str, extensions: &'static [&'static str] },
+    #[error("{}: is read-only: refusing to replace it (as a shell's > would; make it writable, or name another file)", .path.display())]
+    ReadOnly { path: PathBuf },
 }
 
 fn extensions_text(e: &[&str]) -> String {
@@ -143,6 +145,21 @@ where
     E: From<FileError>,
 {
     let err = |source| E::from(FileError::Write { path: path.into(), source });
+    // A file there that may not be written is refused, as a shell's `>` refuses it: the rename
+    // below would replace it whatever its mode. Read-only (no write bit for anyone) is refused
+    // even for root, who may write anything: someone marked it so. Otherwise opening it for
+    // writing, without truncating, asks the system, and changes nothing.
+    if let Some(m) = std::fs::metadata(path).ok().filter(|m| m.is_file()) {
+        let denied = || {
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .is_err_and(|e| e.kind() == std::io::ErrorKind::PermissionDenied)
+        };
+        if m.permissions().readonly() || denied() {
+            return Err(E::from(FileError::ReadOnly { path: path.into() }));
+        }
+    }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -189,11 +206,25 @@ pub fn refuse_inputs(output: &Path, inputs: &[(&Path, &str)]) -> Result<(), File
     Ok(())
 }
 
-/// Refuse two outputs of one command that are the same file.
+/// Where `path` will be written: its folder made canonical (links and `.`/`..` resolved) and its
+/// name, so `same.csv` and `./same.csv`, or `d/x.png` and `d/../d/x.png`, are one place though
+/// the file does not exist yet. `None` when the folder does not exist (nothing can be written).
+fn target(path: &Path) -> Option<PathBuf> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    Some(std::fs::canonicalize(dir).ok()?.join(path.file_name()?))
+}
+
+/// Refuse two outputs of one command that are the same file: the same name, the same place by
+/// its canonical folder and name (`target`), or the same existing file.
 pub fn refuse_same_outputs(outputs: &[(&Path, &str)]) -> Result<(), FileError> {
     for (i, (a, what_a)) in outputs.iter().enumerate() {
         for (b, what_b) in &outputs[i + 1..] {
-            let same = a == b || same_file::is_same_file(a, b).unwrap_or(false);
+            let same = a == b
+                || target(a).is_some_and(|t| Some(t) == target(b))
+                || same_file::is_same_file(a, b).unwrap_or(false);
             if same {
                 return Err(FileError::OutputIsInput { path: a.into(), what: format!("{what_b} (and {what_a})") });
             }

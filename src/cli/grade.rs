@@ -73,7 +73,6 @@ fn grade_err(e: GradeError) -> CliError {
     }
 }
 
-
 pub fn run(a: &GradeArgs) -> Result<(), CliError> {
     let b = &a.build;
     let refused =

@@ -248,7 +248,9 @@ impl<'a> Listing<'a> {
             let json = |v: serde_json::Value| serde_json::to_string(&v).expect("plain data serialises");
             let text = format!(
                 "{{\n  \"ray\": {},\n  \"build\": {},\n  \"trace\": {},\n  \"device\": {},\n  \"steps\": {}",
-                json(serde_json::json!({ "origin": h.ray.origin().to_array(), "dir": h.ray.dir().to_array(), "from": h.source })),
+                json(
+                    serde_json::json!({ "origin": h.ray.origin().to_array(), "dir": h.ray.dir().to_array(), "from": h.source })
+                ),
                 json(serde_json::json!(h.build_label)),
                 json(serde_json::json!(h.opts)),
                 json(serde_json::json!(h.a.device.device)),
@@ -258,10 +260,17 @@ impl<'a> Listing<'a> {
             return;
         }
         let (o3, d3) = (h.ray.origin(), h.ray.dir());
-        let mut o = format!("ray             origin ({}, {}, {}), direction ({}, {}, {})\n", o3.x, o3.y, o3.z, d3.x, d3.y, d3.z);
+        let mut o = format!(
+            "ray             origin ({}, {}, {}), direction ({}, {}, {})\n",
+            o3.x, o3.y, o3.z, d3.x, d3.y, d3.z
+        );
         if let Some((x, y)) = h.a.pixel.or(h.hot).filter(|_| h.a.ray.is_none()) {
             let rank = h.a.hottest.map_or(String::new(), |k| {
-                format!(" (the pixel with the {} most work of {})", crate::explain::words::ordinal(k), h.a.view.label().to_lowercase())
+                format!(
+                    " (the pixel with the {} most work of {})",
+                    crate::explain::words::ordinal(k),
+                    h.a.view.label().to_lowercase()
+                )
             });
             let _ = writeln!(o, "pixel           {x},{y}{rank}");
         }
@@ -285,8 +294,7 @@ impl<'a> Listing<'a> {
         let max = self.head.a.max_steps;
         let cut = (dropped > 0).then(|| {
             format!(
-                "the walk has {} steps; the first {max} are listed (--max-steps), the hit and counts are the whole walk's",
-                self.steps + dropped
+                "the first {max} steps are listed (--max-steps); the walk went on for {dropped} more box tests, nodes, leaves and triangle tests (its stack's steps not counted), and the hit and counts are the whole walk's"
             )
         });
         if self.json() {
@@ -306,7 +314,11 @@ impl<'a> Listing<'a> {
             }
             match hit {
                 Some(h) => {
-                    let _ = writeln!(o, "hit             triangle {} at t = {:.6} (u {:.4}, v {:.4})", h.prim, h.t, h.u, h.v);
+                    let _ = writeln!(
+                        o,
+                        "hit             triangle {} at t = {:.6} (u {:.4}, v {:.4})",
+                        h.prim, h.t, h.u, h.v
+                    );
                 }
                 None => {
                     let _ = writeln!(o, "hit             nothing");

@@ -247,3 +247,48 @@ fn a_dump_opened_by_typing_its_path_is_imported() {
     assert!(h.state().path_window.is_none());
     assert!(h.state().import.tree.as_ref().is_some_and(|t| t.path == dump && t.defects() == 0));
 }
+
+/// `bvhscope MESH --bvh DUMP` with a correct dump whose every box is the root's (its check makes
+/// every ray visit every node: minutes): the mesh's own build and first full frame come first,
+/// while the check is still running, and a strategy changed meanwhile builds at once (no build
+/// waits for the check).
+#[test]
+fn a_slow_import_check_never_holds_the_meshs_own_build_and_image_back() {
+    let mesh = generate_knot_file("slow-knot.obj");
+    let out = temp_file("slow-sah.json", "");
+    let args = [s("export-bvh"), s(mesh.display()), s("--strategy"), s("sah"), s("-o"), s(out.display())];
+    bvhscope::cli::run(words(&args)).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let (min, max) = (v["nodes"][0]["min"].clone(), v["nodes"][0]["max"].clone());
+    for n in v["nodes"].as_array_mut().unwrap() {
+        n["min"] = min.clone();
+        n["max"] = max.clone();
+    }
+    let fat = temp_file("slow-fat.json", &v.to_string());
+    let options = bvhscope::app::AppOptions { file: Some(mesh.clone()), bvh: Some(fat) };
+    let mut h = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1400.0, 860.0))
+        .build_eframe(move |cc| BvhscopeApp::new(cc, options.clone()));
+    run_until(&mut h, "the mesh's own first full frame", |a| {
+        a.scene.source == SceneSource::File(mesh.clone()) && idle(a)
+    });
+    assert!(h.state().jobs.import.is_some() && h.state().import.tree.is_none(), "the check is still running");
+    // A strategy changed now builds and shows without waiting for the check.
+    let mut s = h.state().settings.clone();
+    s.build.strategy = bvhscope::bvh::SplitStrategy::Midpoint;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    run_until(&mut h, "the midpoint tree's frame", |a| {
+        idle(a)
+            && a.current_bvh()
+                .is_some_and(|b| b.bvh.build_params().bvh.strategy == bvhscope::bvh::SplitStrategy::Midpoint)
+    });
+    assert!(h.state().import.tree.is_none(), "the check is still running");
+}
+
+/// A 20,000-triangle knot written as an OBJ (its fat tree's check takes minutes).
+fn generate_knot_file(name: &str) -> PathBuf {
+    let m = bvhscope::mesh::generate::torus_knot(2, 3, 0.3, 500, 20);
+    let mut text = Vec::new();
+    bvhscope::mesh::write_obj(&m, &mut text).unwrap();
+    temp_file(name, std::str::from_utf8(&text).unwrap())
+}

@@ -114,10 +114,15 @@ fn read_pieces(path: &Path, len: usize, pieces: usize) -> std::io::Result<Vec<u8
 /// Parse OBJ text; `path` is used for the mesh name and in error messages.
 pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
-    let text = &*join_continued_lines(text.strip_prefix('\u{feff}').unwrap_or(text));
+    let text = &*super::obj_lines::lone_cr_as_line_break(text.strip_prefix('\u{feff}').unwrap_or(text));
+    let text = &*join_continued_lines(text);
     let (models, by_tobj) = match obj_parallel::models(text) {
         Some(models) => (Ok(models), false),
         None => {
+            // (The parallel reader takes only vertices of three coordinates: the rest is here.)
+            if let Some((line, message)) = super::obj_lines::first_vertex_with_words(text) {
+                return Err(MeshError::Parse { path: path.into(), line: Some(line), message });
+            }
             // Vertex colours (`v x y z r g b`) and weights (`v x y z w`) are not needed to show a
             // BVH, and tobj refuses a file that gives colours to some vertices only.
             let plain = positions_only(text);

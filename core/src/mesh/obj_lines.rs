@@ -130,3 +130,43 @@ pub(super) fn diagnose(path: &Path, text: &str, e: tobj::LoadError) -> MeshError
         other => parse(None, &format!("not a valid OBJ file ({other})")),
     }
 }
+
+/// The text with every lone carriage return (old Mac line ends, or a file whose line ends were
+/// mixed up) made a line break, as CR LF and LF are: otherwise `v 0 0 0\rv 9 9 9` reads as one
+/// vertex and every face after it points one vertex off. CR LF is left as it is.
+pub(super) fn lone_cr_as_line_break(text: &str) -> std::borrow::Cow<'_, str> {
+    use rayon::prelude::*;
+    let b = text.as_bytes();
+    let lone = |i: usize| b[i] == b'\r' && b.get(i + 1) != Some(&b'\n');
+    // (In parallel pieces: a big file is scanned before anything else is read.)
+    if !(0..b.len()).into_par_iter().with_min_len(1 << 16).any(lone) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        if c == '\r' && chars.peek() != Some(&'\n') {
+            out.push('\n');
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+/// The first `v` statement with words after its coordinates that are not numbers (`v 0 0 0
+/// garbage`), or more than a position, a weight and a colour: (line, why). Exporters write a
+/// weight (`v x y z w`) or a colour (`v x y z r g b`, MeshLab, ZBrush), which are numbers and
+/// are accepted (and not read); anything else is an error naming the line, not a vertex that
+/// silently drops what followed it.
+pub(super) fn first_vertex_with_words(text: &str) -> Option<(usize, String)> {
+    statements(text).find_map(|(n, k, args)| {
+        if k != "v" || args.len() <= 3 {
+            return None;
+        }
+        if let Some(w) = args.iter().skip(3).find(|a| a.parse::<f32>().is_err()) {
+            return Some((n, format!("'{w}' after the vertex's coordinates: a vertex is x y z, optionally followed by a weight w or a colour r g b")));
+        }
+        (args.len() > 7).then(|| (n, format!("a vertex of {} numbers: a vertex is x y z, optionally followed by a weight w or a colour r g b", args.len())))
+    })
+}

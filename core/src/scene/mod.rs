@@ -76,14 +76,51 @@ pub fn trs(translate: Vec3, axis: Vec3, radians: f32, scale: Vec3) -> Affine3A {
     Affine3A::from_scale_rotation_translation(scale, rotation, translate)
 }
 
+/// The most placements a scene file may hold. Each costs some 900 bytes while the file is read
+/// (a JSON object, then a placement with its path and transform), so three million took 2.6 GB
+/// and 17 s; a quarter of a million stays near 200 MB. More instances than that are a program's
+/// to make (`TwoLevelBvh`), not a file's to list.
+pub const MAX_PLACEMENTS: usize = 250_000;
+
+/// The largest scene file read (what `MAX_PLACEMENTS` written out takes, and room to spare): a
+/// bigger one is refused before it is read, so its JSON is never held in memory.
+pub const MAX_SCENE_BYTES: u64 = 32 << 20;
+
+/// Refuse a scene of more than `MAX_PLACEMENTS` placements, naming the file.
+pub(crate) fn check_placements(path: &Path, n: usize) -> Result<(), SceneError> {
+    if n > MAX_PLACEMENTS {
+        return Err(SceneError::Field {
+            path: path.into(),
+            field: "meshes".into(),
+            message: format!("{n} placements, more than the {MAX_PLACEMENTS} a scene file may hold"),
+        });
+    }
+    Ok(())
+}
+
 /// Read a JSON file, with errors that name the file and the line.
 fn read_json(path: &Path) -> Result<serde_json::Value, SceneError> {
+    if let Ok(m) = std::fs::metadata(path) {
+        if m.is_file() && m.len() > MAX_SCENE_BYTES {
+            return Err(SceneError::Field {
+                path: path.into(),
+                field: "(the file)".into(),
+                message: format!(
+                    "{} MB, more than the {} MB a scene file may take (at most {MAX_PLACEMENTS} placements)",
+                    m.len() >> 20,
+                    MAX_SCENE_BYTES >> 20
+                ),
+            });
+        }
+    }
     let bytes = crate::mesh::read_user_file(path).map_err(|e| match e {
         MeshError::NotFound { path } => SceneError::NotFound { path },
         MeshError::Io { path, source } => SceneError::Io { path, source },
         other => SceneError::Mesh(other),
     })?;
     let text = crate::mesh::decode_text(path, &bytes)?;
+    // Every placement names its file: counted in the text, before a JSON value is made of it.
+    check_placements(path, text.matches("\"file\"").count())?;
     strict_json::parse(&text).map_err(|e| SceneError::Json {
         path: path.into(),
         line: e.line(),
@@ -96,11 +133,14 @@ pub fn describe(path: &Path) -> Result<SceneDesc, SceneError> {
     let json = read_json(path)?;
     let base = path.parent().unwrap_or(Path::new("."));
     let field = Fields { path };
-    if moer_lite::looks_like(&json) {
+    // Counted before any placement is made.
+    let desc = if moer_lite::looks_like(&json) {
         moer_lite::describe(&json, base, &field)
     } else {
         scene_file::describe(&json, base, &field)
-    }
+    }?;
+    check_placements(path, desc.meshes.len())?;
+    Ok(desc)
 }
 
 /// Typed reading of JSON values, with errors naming the field (`camera.transform.position`).
