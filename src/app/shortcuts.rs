@@ -49,7 +49,10 @@ pub const MOUSE: &[(&str, &str)] = &[
     ("Right or middle drag", "Pan"),
     ("Wheel", "Zoom"),
     ("Hover", "Exact counts of the pixel's ray"),
-    ("Click", "Pin the pixel's ray: its traversal step by step (Ray window)"),
+    (
+        "Ctrl+click",
+        "Pin the pixel's ray: its traversal step by step (Ray window); with the Ray window open, a plain click too",
+    ),
     (
         "Shift+click",
         "Select the node of a drawn box's edge, else the leaf the pixel's ray hits (Tree and Node windows)",

@@ -48,7 +48,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         let d = response.drag_delta();
         out.push(Action::Pan { dx: d.x, dy: d.y, height: rect.height() });
     }
-    // A click (no drag) pins the ray of the pixel under it; a shift-click selects its hit's leaf.
+    // A Ctrl-click (Cmd on a Mac), or a click while the Ray window is open (picking rays), pins
+    // the ray of the pixel under it: a plain click elsewhere (dismissing a message, bringing the
+    // window to the front) does nothing. A shift-click selects its hit's leaf.
     if response.clicked() {
         if let (Some(pos), Some(shown)) = (response.interact_pointer_pos(), &app.shown) {
             if let Some((x, y)) = pixel_at(&shown.frame, rect, pos) {
@@ -59,7 +61,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                         Some(n) => out.push(Action::SelectNode(n)),
                         None => out.push(Action::SelectPixelNode(x, y)),
                     }
-                } else {
+                } else if ui.input(|i| i.modifiers.command) || app.ray_window || !app.pins.pinned.is_empty() {
                     out.push(Action::PinPixel(x, y));
                 }
             }
@@ -302,8 +304,12 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
 pub const HISTOGRAM_BINS: usize = 32;
 
 fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, histogram: bool, out: &mut Actions) {
+    // Anchored by its lower-left corner and kept inside the viewport: it grows upwards as its
+    // note and histogram need, never over the status bar below.
     egui::Area::new(ui.scope_id().with("heatmap-legend"))
-        .fixed_pos(rect.left_bottom() + Vec2::new(12.0, -158.0))
+        .pivot(egui::Align2::LEFT_BOTTOM)
+        .fixed_pos(rect.left_bottom() + Vec2::new(12.0, -12.0))
+        .constrain_to(rect)
         .order(egui::Order::Foreground)
         .show(ui.ctx(), |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
@@ -408,20 +414,24 @@ fn histogram_bars(
 pub const MESSAGES_SHOWN: usize = 3;
 
 /// Errors (until dismissed) and notes (for a few seconds) across the top of the viewport, the
-/// newest `MESSAGES_SHOWN`. They are part of the viewport itself, drawn over the image but under
-/// every window, so they never hide a window; each wraps inside the viewport with its Dismiss
-/// button below the text, so the button stays on screen.
+/// newest `MESSAGES_SHOWN`, one per topic (`BvhscopeApp::message`). Always on top, over windows
+/// too (one hidden behind a window was never read); each wraps inside the viewport with its
+/// Dismiss button below the text, and a click anywhere on one dismisses it.
 fn messages(app: &BvhscopeApp, ui: &mut egui::Ui, rect: Rect, out: &mut Actions) {
     if app.messages.is_empty() {
         return;
     }
-    let mut dismiss = None;
     let margin = 8.0;
     let width = (rect.width().min(560.0) - 24.0 - 2.0 * margin).max(60.0);
-    let area = Rect::from_min_max(rect.left_top() + Vec2::new(12.0, 12.0), rect.right_bottom());
-    let mut child =
-        ui.new_child(egui::UiBuilder::new().max_rect(area).layout(egui::Layout::top_down(egui::Align::LEFT)));
-    let ui = &mut child;
+    egui::Area::new(ui.scope_id().with("messages"))
+        .fixed_pos(rect.left_top() + Vec2::new(12.0, 12.0))
+        .constrain_to(rect)
+        .order(egui::Order::Foreground)
+        .show(ui.ctx(), |ui| message_list(app, ui, width, margin, out));
+}
+
+fn message_list(app: &BvhscopeApp, ui: &mut egui::Ui, width: f32, margin: f32, out: &mut Actions) {
+    let mut dismiss = None;
     ui.set_max_width(width + 2.0 * margin);
     let first = app.messages.len().saturating_sub(MESSAGES_SHOWN);
     if first > 0 {
@@ -440,7 +450,7 @@ fn messages(app: &BvhscopeApp, ui: &mut egui::Ui, rect: Rect, out: &mut Actions)
             MessageKind::Warning => (Color32::from_rgb(110, 80, 10), "Warning"),
             MessageKind::Info => (Color32::from_rgb(24, 60, 100), "Note"),
         };
-        egui::Frame::new().fill(fill).inner_margin(margin).corner_radius(4.0).show(ui, |ui| {
+        let shown = egui::Frame::new().fill(fill).inner_margin(margin).corner_radius(4.0).show(ui, |ui| {
             ui.set_max_width(width);
             let text = egui::RichText::new(format!("{title}: {}", m.text)).color(Color32::WHITE);
             ui.add(egui::Label::new(text).wrap());
@@ -448,6 +458,10 @@ fn messages(app: &BvhscopeApp, ui: &mut egui::Ui, rect: Rect, out: &mut Actions)
                 dismiss = Some(i);
             }
         });
+        // A click anywhere on a message dismisses it (and pins no ray under it).
+        if ui.interact(shown.response.rect, ui.scope_id().with(("message", i)), egui::Sense::click()).clicked() {
+            dismiss = Some(i);
+        }
         ui.add_space(4.0);
     }
     out.extend(dismiss.map(Action::Dismiss));

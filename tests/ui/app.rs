@@ -13,6 +13,7 @@ mod app_gpu;
 mod app_grade;
 mod app_look;
 mod app_replay;
+mod app_room;
 mod app_scenes;
 mod app_truth;
 

@@ -7,18 +7,20 @@ use super::*;
 
 /// A click (press and release without moving) at a screen position.
 fn click_at(h: &mut Harness<'_, BvhscopeApp>, pos: egui::Pos2) {
+    click_with(h, pos, egui::Modifiers::NONE)
+}
+
+/// A click holding `modifiers`.
+fn click_with(h: &mut Harness<'_, BvhscopeApp>, pos: egui::Pos2, modifiers: egui::Modifiers) {
     let input = h.input_mut();
+    input.events.push(egui::Event::ModifiersChanged(modifiers));
     input.events.push(egui::Event::PointerMoved(pos));
-    let button = |pressed| egui::Event::PointerButton {
-        pos,
-        button: egui::PointerButton::Primary,
-        pressed,
-        modifiers: egui::Modifiers::NONE,
-    };
+    let button = |pressed| egui::Event::PointerButton { pos, button: egui::PointerButton::Primary, pressed, modifiers };
     input.events.push(button(true));
     h.step();
     h.input_mut().events.push(button(false));
     h.run_steps(3);
+    h.input_mut().events.push(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
 }
 
 /// The frame pixel under a screen position of the viewport (as the viewport maps it).
@@ -28,8 +30,9 @@ fn pixel_under(app: &BvhscopeApp, pos: egui::Pos2) -> (u32, u32) {
     ((u * f.width() as f32) as u32, (v * f.height() as f32) as u32)
 }
 
-/// Clicking a pixel of a heatmap pins its ray: its counts and hit are the heatmap's and the hover
-/// read-out's for that pixel (the frame's counters), and the Ray window steps through it.
+/// Ctrl-clicking a pixel of a heatmap pins its ray (a plain click does not, until the Ray window
+/// is open): its counts and hit are the heatmap's and the hover read-out's for that pixel (the
+/// frame's counters), and the Ray window steps through it.
 #[test]
 fn clicking_a_pixel_pins_its_ray_and_the_ray_window_steps_through_it() {
     let mut h = harness();
@@ -49,8 +52,10 @@ fn clicking_a_pixel_pins_its_ray_and_the_ray_window_steps_through_it() {
         r.min + egui::vec2((x as f32 + 0.5) / w as f32 * r.width(), (y as f32 + 0.5) / hh as f32 * r.height())
     };
     click_at(&mut h, pos);
+    assert!(h.state().pins.pinned.is_empty() && !h.state().ray_window, "a plain click pins nothing");
+    click_with(&mut h, pos, egui::Modifiers::COMMAND);
     let app = h.state();
-    assert_eq!(app.pins.pinned.len(), 1, "the click pinned a ray");
+    assert_eq!(app.pins.pinned.len(), 1, "the Ctrl-click pinned a ray");
     let r = &app.pins.pinned[0];
     let (x, y) = pixel_under(app, pos);
     assert_eq!(r.pixel, Some((x, y)));
@@ -98,7 +103,8 @@ fn clicking_a_pixel_pins_its_ray_and_the_ray_window_steps_through_it() {
     run_until(&mut h, "the last step", |a| a.pins.step + 1 == a.pins.pinned[0].len());
     assert!(!h.state().pins.playing, "playing stops at the last step");
 
-    // A neighbouring pixel, pinned too: both are listed to compare; the newer one is selected.
+    // A neighbouring pixel, pinned too by a plain click now the Ray window is open (picking):
+    // both are listed to compare; the newer one is selected.
     click_at(&mut h, pos + egui::vec2(1.0, 0.0));
     assert_eq!(h.state().pins.pinned.len(), 2);
     assert_eq!(h.state().pins.selected, 1);

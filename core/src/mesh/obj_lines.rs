@@ -78,8 +78,14 @@ pub(super) fn first_bad_face(text: &str, which: Option<Corner>) -> Option<(usize
                         }
                         let count = counts[slot];
                         let resolved = if idx < 0 { count + idx + 1 } else { idx };
-                        if idx == 0 || resolved < 1 || resolved > count {
-                            let what = ["vertex", "texture coordinate", "normal"][slot];
+                        let what = ["vertex", "texture coordinate", "normal"][slot];
+                        if idx == 0 {
+                            return Some((
+                                n,
+                                format!("face refers to {what} 0: OBJ indices start at 1 (or count back from -1)"),
+                            ));
+                        }
+                        if resolved < 1 || resolved > count {
                             return Some((
                                 n,
                                 format!("face refers to {what} {idx}, but only {count} are declared before this line"),

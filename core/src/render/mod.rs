@@ -10,14 +10,16 @@ mod exact_stats;
 mod frame;
 mod incoherent;
 pub mod legend;
+mod ray_summary;
 mod raycast;
 mod views;
 pub mod warp;
 
 pub use camera::{Camera, CameraError, RayGen, RayGenParts, UpAxis};
 pub use colormap::ColorMap;
-pub use frame::{Frame, FramePool, FromHitsError, PixelSample, RaySummary};
+pub use frame::{Frame, FramePool, FromHitsError, PixelSample};
 pub use incoherent::incoherent_rays;
 pub use legend::{draw_legend, legend_height};
+pub use ray_summary::RaySummary;
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
 pub use views::{full_size, grid_values, histogram, hottest, metric_stats, view_image, HeatRange, Legend, View};

@@ -107,7 +107,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             if let Some(t) = imported {
                 let text = format!("imported: {}", t.name());
                 let tip = format!(
-                    "The BVH read from {}, traced as written. {} defects, {} warnings (View ▸ Imported BVH…)",
+                    "The BVH read from {}, traced as written. {} defects, {} warnings (View › Imported BVH…)",
                     t.path.display(),
                     t.defects(),
                     t.findings.len() - t.defects()

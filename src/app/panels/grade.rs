@@ -76,7 +76,7 @@ fn chosen(app: &BvhscopeApp, r: &GradeReport, ui: &mut egui::Ui) {
                     ui.label(format!("A = imported: {} ({d} defects as checked here), B = {b}.", t.name()));
                 }
                 (Some(t), false) => {
-                    ui.weak(format!("imported: {}; View ▸ Compare side by side… sets it against SAH.", t.name()));
+                    ui.weak(format!("imported: {}; View › Compare side by side… sets it against SAH.", t.name()));
                 }
                 (None, _) => {
                     ui.weak("no longer shown: choose them again to show their tree.");

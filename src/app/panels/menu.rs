@@ -116,7 +116,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             if ui
                 .add_enabled(app.import.tree.is_some(), egui::Button::new("Imported BVH…"))
                 .on_hover_text("The checker's findings of the imported BVH")
-                .on_disabled_hover_text("No BVH is imported: File ▸ Open BVH…")
+                .on_disabled_hover_text("No BVH is imported: File › Open BVH…")
                 .clicked()
             {
                 out.push(Action::ShowImported(true));
@@ -124,7 +124,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             if ui
                 .add_enabled(app.grade.report.is_some(), egui::Button::new("Grade report…"))
                 .on_hover_text("The class of the grade report opened")
-                .on_disabled_hover_text("No grade report is open: File ▸ Open grade report…")
+                .on_disabled_hover_text("No grade report is open: File › Open grade report…")
                 .clicked()
             {
                 out.push(Action::ShowGrade(true));

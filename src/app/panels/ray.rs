@@ -1,4 +1,5 @@
-//! The Ray window: the pinned rays (a click on the image pins its pixel's ray; one can also be
+//! The Ray window: the pinned rays (a Ctrl-click on the image, or a click while this window is
+//! open, pins its pixel's ray; one can also be
 //! typed), and the selected one's traversal step by step: the numbered steps indented by depth,
 //! hit green and miss red, a step slider with play, pause and step buttons, the stack at the
 //! current step, and the counts, the same as the hover read-out's and `bvhscope trace`'s.
@@ -40,7 +41,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
             ui.separator();
             typed_ray(app, ui, out);
             let Some(r) = rays.current() else {
-                ui.weak("Click a pixel of the image to pin its ray, or type one above.");
+                ui.weak("Click a pixel of the image to pin its ray (Ctrl-click while this window is closed), or type one above.");
                 return;
             };
             ui.separator();

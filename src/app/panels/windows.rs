@@ -30,17 +30,19 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
 
     let Some(window) = &app.path_window else { return };
     let mut text = window.text.clone();
-    let title = match window.pick {
-        Pick::Open => "Open a mesh",
-        Pick::SavePng => "Save the view as PNG",
-        Pick::SaveStatsCsv => "Export statistics (CSV)",
-        Pick::SaveStatsJson => "Export statistics (JSON)",
-        Pick::SaveScene => "Save the scene",
-        Pick::SaveCounts => "Export counts (CSV)",
-        Pick::OpenBvh => "Import a BVH dump for this mesh",
-        Pick::SaveBvh => "Export the BVH as a dump",
-        Pick::SaveAnimation => "Export the replay as an animation (.gif or .png)",
-        Pick::OpenGradeReport => "Open a grade report (its grade.json or its folder)",
+    // A short title (the window is as wide as its path field: a long title was cut off), and what
+    // the file must be on a line of its own.
+    let (title, what) = match window.pick {
+        Pick::Open => ("Open a mesh", "A mesh (.obj) or a scene (.json)"),
+        Pick::SavePng => ("Save the view", "As a PNG image (.png)"),
+        Pick::SaveStatsCsv => ("Export statistics", "As CSV (.csv)"),
+        Pick::SaveStatsJson => ("Export statistics", "As JSON (.json)"),
+        Pick::SaveScene => ("Save the scene", "As a bvhscope scene file (.json)"),
+        Pick::SaveCounts => ("Export counts", "Per pixel, as CSV (.csv)"),
+        Pick::OpenBvh => ("Import a BVH", "A bvhscope-bvh dump for this mesh (.json, .json.gz or .txt)"),
+        Pick::SaveBvh => ("Export the BVH", "As a bvhscope-bvh dump (.json, .json.gz or .txt)"),
+        Pick::SaveAnimation => ("Export the replay", "As an animation (.gif or .png)"),
+        Pick::OpenGradeReport => ("Open a grade report", "Its grade.json, or its folder"),
     };
     let mut keep = true;
     let mut chosen = None;
@@ -48,6 +50,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         if let Some(note) = &window.note {
             ui.label(note);
         }
+        ui.label(what);
         let label = ui.label("Path");
         let edit = ui.add(egui::TextEdit::singleline(&mut text).desired_width(420.0)).labelled_by(label.id);
         // The field takes the keyboard when the window opens: what is typed goes into it, and

@@ -30,7 +30,7 @@ pub fn sbvh_text(ins: &Inspection) -> Option<String> {
         "no spatial planes: overlap not above α".to_string()
     };
     Some(format!(
-        "SBVH here        {what}; object split's overlap {:.2e} of the root's area; {priced}; {} extra references left",
+        "SBVH here: {what}; object split's overlap {:.2e} of the root's area; {priced}; {} extra references left",
         e.overlap_ratio, e.budget
     ))
 }

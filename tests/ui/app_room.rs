@@ -1,0 +1,65 @@
+//! The app from the front of a room (issue 48, the parts done): the heatmap legend never covers
+//! the status bar, messages come one per topic and go when the scene changes or on a click, and
+//! a plain click on the image pins no ray until the Ray window is open. A module of the `app_ui`
+//! test binary (`app.rs`).
+
+use super::*;
+
+/// The legend grows upwards from the viewport's lower-left corner, inside the viewport: its
+/// lowest line is above the status bar's "last full frame".
+#[test]
+fn the_legend_stays_inside_the_viewport() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.get_by_label("Nodes visited").click();
+    run_until(&mut h, "the heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+    h.run_steps(3);
+    let viewport = h.state().viewport_rect;
+    let legend = h.get_by_label_contains("Legend: ").rect();
+    // (The statistics say "last full frame" too: the status bar's is the lowest.)
+    let status = h
+        .get_all_by_label_contains("last full frame")
+        .map(|n| n.rect())
+        .max_by(|a, b| a.min.y.total_cmp(&b.min.y))
+        .unwrap();
+    assert!(viewport.contains_rect(legend), "{legend:?} inside {viewport:?}");
+    assert!(legend.max.y < status.min.y, "the legend {legend:?} above the status bar {status:?}");
+}
+
+/// One message per topic: a second note replaces the first, the same warning twice is shown
+/// once; a click on a message dismisses it; a new scene clears the old scene's messages.
+#[test]
+fn messages_come_one_per_topic_and_go_with_their_scene() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    let app = h.state_mut();
+    app.messages.clear();
+    app.message(MessageKind::Info, "first note");
+    app.message(MessageKind::Info, "second note");
+    app.message(MessageKind::Warning, "alice.json: her tree keeps a far triangle");
+    app.message(MessageKind::Warning, "alice.json: her tree keeps a far triangle, again");
+    app.message(MessageKind::Warning, "bob.json: another warning");
+    let texts: Vec<&str> = h.state().messages.iter().map(|m| m.text.as_str()).collect();
+    assert_eq!(texts, ["second note", "alice.json: her tree keeps a far triangle, again", "bob.json: another warning"]);
+    h.run_steps(2);
+    // A click on the message's text (not its button) dismisses it.
+    let at = h.get_by_label_contains("another warning").rect().center();
+    h.input_mut().events.push(egui::Event::PointerMoved(at));
+    let button = |pressed| egui::Event::PointerButton {
+        pos: at,
+        button: egui::PointerButton::Primary,
+        pressed,
+        modifiers: egui::Modifiers::NONE,
+    };
+    h.input_mut().events.push(button(true));
+    h.step();
+    h.input_mut().events.push(button(false));
+    h.run_steps(3);
+    assert!(h.state().pins.pinned.is_empty(), "the click pinned no ray");
+    assert_eq!(h.state().messages.len(), 2, "{:?}", h.state().messages.iter().map(|m| &m.text).collect::<Vec<_>>());
+    // A scene opened: the old scene's messages are gone.
+    let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, torus.clone()));
+    run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus.clone()) && idle(a));
+    assert!(h.state().messages.iter().all(|m| !m.text.contains("alice") && !m.text.contains("note")));
+}
