@@ -181,7 +181,10 @@ impl BvhscopeApp {
             A::OpenPath => self.path_window = Some(PathWindow::new(Pick::Open, String::new(), None)),
             // Loads in the background; the current scene stays until it has loaded.
             A::OpenFile(path) => self.jobs.load(path),
-            A::ShowBuiltin => self.set_scene(Arc::new(Scene::builtin())),
+            A::ShowBuiltin => {
+                self.messages.clear();
+                self.set_scene(Arc::new(Scene::builtin()))
+            }
             A::SavePng => self.jobs.pick_file(Pick::SavePng, &export::default_name(self, "png")),
             A::SavePngTyped => {
                 let name = export::default_name(self, "png");

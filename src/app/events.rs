@@ -15,6 +15,9 @@ impl BvhscopeApp {
                 if r.degenerate_skipped > 0 {
                     text += &format!(" ({} degenerate triangles skipped)", r.degenerate_skipped);
                 }
+                // The messages were about the scene before (a student's warning, a check's
+                // note): a new scene starts with its own.
+                self.messages.clear();
                 self.message(MessageKind::Info, text);
                 self.set_scene(scene);
                 if let Some(dump) = self.pending_import.take() {

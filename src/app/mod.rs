@@ -227,17 +227,14 @@ impl BvhscopeApp {
         app
     }
 
-    /// Show a message. One per topic: a note replaces the note before it (notes are of the moment),
-    /// and a message whose text is already shown, or that is about the same file or thing (the
-    /// words before its first ": "), replaces that one, so the same warning never piles up.
+    /// Show a message. One per topic: a message whose text is already shown, or of the same kind
+    /// about the same file or thing (the words before its first ": "), replaces that one, so the
+    /// same warning never piles up.
     pub fn message(&mut self, kind: MessageKind, text: impl Into<String>) {
         let text = text.into();
         let topic = |t: &str| t.split_once(": ").map_or(t.to_string(), |(head, _)| head.to_string());
         let this = topic(&text);
-        self.messages.retain(|m| {
-            let same_note = kind == MessageKind::Info && m.kind == MessageKind::Info;
-            !(same_note || m.text == text || (m.kind == kind && topic(&m.text) == this))
-        });
+        self.messages.retain(|m| !(m.text == text || (m.kind == kind && topic(&m.text) == this)));
         self.messages.push(Message { kind, text, at: Instant::now() });
         if self.messages.len() > MESSAGES_KEPT {
             self.messages.remove(0);
@@ -245,8 +242,6 @@ impl BvhscopeApp {
     }
 
     fn set_scene(&mut self, scene: Arc<Scene>) {
-        // The messages were about the scene before (a student's warning, a check's note): gone.
-        self.messages.clear();
         for w in &scene.warnings {
             self.message(MessageKind::Warning, format!("{}: {w}", scene.title()));
         }

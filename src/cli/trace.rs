@@ -347,7 +347,9 @@ impl StepOut for Listing<'_> {
         self.steps += 1;
         if self.json() {
             let sep = if self.steps == 1 { "\n    " } else { ",\n    " };
-            let text = format!("{sep}{}", serde_json::to_string(&step).expect("plain data serialises"));
+            // Through a value, as the app's steps are serialised (f32s written as the f64s they are).
+            let value = serde_json::to_value(&step).expect("plain data serialises");
+            let text = format!("{sep}{value}");
             self.write(&text);
             return;
         }

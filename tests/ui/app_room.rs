@@ -34,13 +34,13 @@ fn messages_come_one_per_topic_and_go_with_their_scene() {
     run_until(&mut h, "the first frame", idle);
     let app = h.state_mut();
     app.messages.clear();
-    app.message(MessageKind::Info, "first note");
-    app.message(MessageKind::Info, "second note");
+    app.message(MessageKind::Info, "Saved a.png");
+    app.message(MessageKind::Info, "Saved a.png");
     app.message(MessageKind::Warning, "alice.json: her tree keeps a far triangle");
     app.message(MessageKind::Warning, "alice.json: her tree keeps a far triangle, again");
     app.message(MessageKind::Warning, "bob.json: another warning");
     let texts: Vec<&str> = h.state().messages.iter().map(|m| m.text.as_str()).collect();
-    assert_eq!(texts, ["second note", "alice.json: her tree keeps a far triangle, again", "bob.json: another warning"]);
+    assert_eq!(texts, ["Saved a.png", "alice.json: her tree keeps a far triangle, again", "bob.json: another warning"]);
     h.run_steps(2);
     // A click on the message's text (not its button) dismisses it.
     let at = h.get_by_label_contains("another warning").rect().center();
@@ -61,5 +61,6 @@ fn messages_come_one_per_topic_and_go_with_their_scene() {
     let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, torus.clone()));
     run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus.clone()) && idle(a));
-    assert!(h.state().messages.iter().all(|m| !m.text.contains("alice") && !m.text.contains("note")));
+    assert!(h.state().messages.iter().all(|m| !m.text.contains("alice") && !m.text.contains("a.png")));
+    assert!(h.state().messages.iter().any(|m| m.text.starts_with("Opened torus.obj")), "the new scene's own");
 }

@@ -87,7 +87,7 @@ fn a_threshold_and_a_selection_never_outlive_their_scale_or_tree() {
 
 /// Messages: the newest three are shown, the older fold into one line that dismisses them.
 #[test]
-fn messages_are_few_and_under_the_windows() {
+fn messages_are_few() {
     let mut h = harness();
     run_until(&mut h, "the first frame", idle);
     for i in 0..6 {
