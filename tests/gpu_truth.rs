@@ -144,7 +144,7 @@ fn walks_past_the_step_budget_are_finished_on_the_cpu_never_taken_for_misses() {
     let bvh = Bvh::build(&mesh, &sah);
     let scene = SceneBvh::Single { bvh: AnyBvh::Binary(bvh), mesh: Arc::new(mesh.clone()), imported: None };
     let (tree, _) = GpuTree::new(&gpu, &scene, GpuNodes::Binary).unwrap();
-    let last = [rays.last().unwrap().clone()];
+    let last = [*rays.last().unwrap()];
     let t = tree.walk(&gpu, Rays::List(&last), TraceOptions::default(), true).unwrap();
     assert!(t.hits[0].is_some() && t.cpu_finished == 1, "the issue's ray hits: {:?}", t.hits[0]);
 

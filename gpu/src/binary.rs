@@ -107,7 +107,7 @@ impl GpuBinaryBvh {
     /// `trace` with the walk's stack forced into global memory (tests of the deep-tree path on a
     /// shallow tree).
     pub fn trace_with_global_stack(&self, gpu: &Gpu, rays: Rays, opts: GpuTraceOptions) -> Result<GpuTrace, GpuError> {
-        let stack = Stack::Global(self.depth.max(1).min(crate::trace::STEP_BUDGET));
+        let stack = Stack::Global(self.depth.clamp(1, crate::trace::STEP_BUDGET));
         KERNELS.run(gpu, &[&self.nodes, &self.tris, &self.prim_ids], None, stack, rays, opts)
     }
 }

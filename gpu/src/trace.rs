@@ -56,7 +56,7 @@ impl Rays<'_> {
     pub fn ray(&self, i: usize) -> Ray {
         match self {
             Rays::Camera(c) => c.ray_gen().pixel_ray(i as u32 % c.width, i as u32 / c.width),
-            Rays::List(r) => r[i].clone(),
+            Rays::List(r) => r[i],
         }
     }
 }

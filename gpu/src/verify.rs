@@ -51,11 +51,12 @@ pub fn problem(bvh: &Bvh, mesh: &Mesh) -> Option<String> {
         if node.is_leaf() {
             let (f, c) = (node.index as usize, node.count as usize);
             if bvh.nodes.len() > 1 || c > 0 {
-                for s in f..f + c {
-                    if std::mem::replace(&mut covered[s], true) {
+                for (s, (slot, tri)) in covered[f..f + c].iter_mut().zip(&bvh.tris[f..f + c]).enumerate() {
+                    let s = f + s;
+                    if std::mem::replace(slot, true) {
                         return Some(format!("leaf slot {s} is in two leaves (node {i}'s among them)"));
                     }
-                    if !b.contains_box(&Aabb::from_points(&bvh.tris[s])) {
+                    if !b.contains_box(&Aabb::from_points(tri)) {
                         return Some(format!("leaf node {i}'s box does not hold its triangle in slot {s}"));
                     }
                 }
