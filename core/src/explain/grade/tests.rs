@@ -66,15 +66,21 @@ fn a_rubric_is_read_field_by_field_and_a_mistake_names_the_file_and_the_field() 
     assert!(err("{\n\"rays\": 1,\n}").starts_with("lab1/rubric.json: line 3:"));
 }
 
+/// The smallest dump (text form): what discovery takes for a dump.
+pub(super) const TINY_DUMP: &str = "bvhscope-bvh 1\nprimitives 0\nnode 0 0 0 1 1 1 leaf 0 1\n";
+
+/// Write `text` at `rel` below `d`, its folders made.
+pub(super) fn put(d: &Path, rel: &str, text: &str) {
+    let p = d.join(rel);
+    std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+    std::fs::write(p, text).unwrap();
+}
+
 #[test]
 fn a_submission_is_a_file_or_a_folder_holding_one_dump() {
     let d = tmp("discover");
-    let dump = "bvhscope-bvh 1\nprimitives 0\nnode 0 0 0 1 1 1 leaf 0 1\n";
-    let write = |rel: &str, text: &str| {
-        let p = d.join(rel);
-        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
-        std::fs::write(p, text).unwrap();
-    };
+    let dump = TINY_DUMP;
+    let write = |rel: &str, text: &str| put(&d, rel, text);
     write("alice.json.gz", "x");
     write("alice/bvh.txt", dump);
     write("bob/notes.txt", "my notes");
@@ -170,7 +176,7 @@ fn the_epo_of_a_tree_whose_boxes_all_overlap_is_refused_not_waited_for() {
 }
 
 /// A tiny class's settings: a 48x32 frame, few rays, the default rubric.
-fn small_setup<'a>(mesh: &'a crate::mesh::Mesh, mesh_path: &'a Path) -> Setup<'a> {
+pub(super) fn small_setup<'a>(mesh: &'a crate::mesh::Mesh, mesh_path: &'a Path) -> Setup<'a> {
     Setup {
         mesh,
         mesh_path,

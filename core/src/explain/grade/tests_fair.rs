@@ -75,19 +75,7 @@ fn keeping(dump: &BvhDump, t: u32, lo: [f32; 3], hi: [f32; 3]) -> BvhDump {
 }
 
 fn setup<'a>(mesh: &'a Mesh, mesh_path: &'a Path) -> Setup<'a> {
-    Setup {
-        mesh,
-        mesh_path,
-        given_path: mesh_path,
-        camera: crate::render::Camera::framing(&mesh.bounds(), 48, 32),
-        rays: 2000,
-        time_rays: 256,
-        trace: Default::default(),
-        params: Default::default(),
-        dump_limit: 1 << 26,
-        max_seconds: 60.0,
-        rubric: Rubric::default(),
-    }
+    super::tests::small_setup(mesh, mesh_path)
 }
 
 fn grade(setup: &Setup, dir: &Path, names: &[&str]) -> Vec<GradeRow> {
@@ -210,12 +198,8 @@ fn wrong_mesh_only_when_the_dump_is_of_another_mesh() {
 #[test]
 fn a_folder_of_notes_is_no_dump_and_a_class_folder_is_its_entries() {
     let d = tmp("folders");
-    let dump = "bvhscope-bvh 1\nprimitives 0\nnode 0 0 0 1 1 1 leaf 0 1\n";
-    let write = |rel: &str, text: &str| {
-        let p = d.join(rel);
-        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
-        std::fs::write(p, text).unwrap();
-    };
+    let dump = super::tests::TINY_DUMP;
+    let write = |rel: &str, text: &str| super::tests::put(&d, rel, text);
     write("class/ana/bvh.txt", dump);
     write("class/ben/README.txt", "my tree is in the attic\n");
     write("class/cy.json", "{}");
