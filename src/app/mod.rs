@@ -14,6 +14,7 @@ pub mod gpu;
 mod grade_view;
 mod import_view;
 mod jobs;
+mod messages;
 mod node_view;
 mod orbit;
 mod overlay;
@@ -225,20 +226,6 @@ impl BvhscopeApp {
         app.jobs.probe_gpu();
         app.reconcile();
         app
-    }
-
-    /// Show a message. One per topic: a message whose text is already shown, or of the same kind
-    /// about the same file or thing (the words before its first ": "), replaces that one, so the
-    /// same warning never piles up.
-    pub fn message(&mut self, kind: MessageKind, text: impl Into<String>) {
-        let text = text.into();
-        let topic = |t: &str| t.split_once(": ").map_or(t.to_string(), |(head, _)| head.to_string());
-        let this = topic(&text);
-        self.messages.retain(|m| !(m.text == text || (m.kind == kind && topic(&m.text) == this)));
-        self.messages.push(Message { kind, text, at: Instant::now() });
-        if self.messages.len() > MESSAGES_KEPT {
-            self.messages.remove(0);
-        }
     }
 
     fn set_scene(&mut self, scene: Arc<Scene>) {
