@@ -297,3 +297,82 @@ fn generate_knot_file(name: &str) -> PathBuf {
     bvhscope::mesh::write_obj(&m, &mut text).unwrap();
     temp_file(name, std::str::from_utf8(&text).unwrap())
 }
+
+/// One yardstick in the app too: a dump that keeps the mesh's far zero-area triangle (its root box
+/// forty times the knot's height) is measured on the mesh's box, as `check`'s table measures it,
+/// so its SAH cost is above the tight tree's, not flattered by its larger root.
+#[test]
+fn an_imported_tree_is_measured_on_the_meshs_box() {
+    // The knot and one zero-area triangle far above it.
+    let knot = bvhscope::mesh::generate::torus_knot(2, 3, 0.3, 96, 8);
+    let mut text = Vec::new();
+    bvhscope::mesh::write_obj(&knot, &mut text).unwrap();
+    let v = knot.positions.len();
+    text.extend(format!("v 0 40 0\nv 1 40 0\nv 2 40 0\nf {} {} {}\n", v + 1, v + 2, v + 3).bytes());
+    let mesh = temp_file("far-degenerate.obj", std::str::from_utf8(&text).unwrap());
+    let tight = temp_file("far-tight.json", "");
+    let args = [s("export-bvh"), s(mesh.display()), s("--strategy"), s("midpoint"), s("-o"), s(tight.display())];
+    bvhscope::cli::run(words(&args)).unwrap();
+    // The far triangle (the file's last) put in the highest leaf, its box and its ancestors' grown.
+    let mut d: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&tight).unwrap()).unwrap();
+    let far = knot.triangle_count() as u64;
+    let nodes = d["nodes"].as_array().unwrap().clone();
+    let leaf = (0..nodes.len())
+        .filter(|&i| nodes[i].get("first").is_some())
+        .max_by(|&a, &b| nodes[a]["max"][1].as_f64().unwrap().total_cmp(&nodes[b]["max"][1].as_f64().unwrap()))
+        .unwrap();
+    let at = nodes[leaf]["first"].as_u64().unwrap() + nodes[leaf]["count"].as_u64().unwrap();
+    d["primitives"].as_array_mut().unwrap().insert(at as usize, far.into());
+    let mut parent = vec![usize::MAX; nodes.len()];
+    for (i, n) in nodes.iter().enumerate() {
+        for k in n["children"].as_array().into_iter().flatten() {
+            parent[k.as_u64().unwrap() as usize] = i;
+        }
+    }
+    for n in d["nodes"].as_array_mut().unwrap() {
+        if n["first"].as_u64().is_some_and(|f| f >= at) {
+            n["first"] = (n["first"].as_u64().unwrap() + 1).into();
+        }
+    }
+    d["nodes"][leaf]["count"] = (nodes[leaf]["count"].as_u64().unwrap() + 1).into();
+    let mut i = leaf;
+    loop {
+        let hi = d["nodes"][i]["max"][1].as_f64().unwrap().max(40.0);
+        d["nodes"][i]["max"][1] = hi.into();
+        let hx = d["nodes"][i]["max"][0].as_f64().unwrap().max(2.0);
+        d["nodes"][i]["max"][0] = hx.into();
+        if i == 0 {
+            break;
+        }
+        i = parent[i];
+    }
+    let kept = temp_file("far-kept.json", &d.to_string());
+
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.state_mut().act(Action::Picked(Pick::Open, mesh.clone()));
+    run_until(&mut h, "the mesh", |a| a.scene.source == SceneSource::File(mesh.clone()) && idle(a));
+    h.input_mut().dropped_files.push(Arc::new(Dropped(kept.clone())));
+    run_until(&mut h, "the imported tree", shows_imported);
+    let app_sah = h.state().current_bvh().unwrap().stats.sah_cost;
+    // `check`'s table: the imported tree's row, and bvhscope's midpoint tree in its layout.
+    let args =
+        [s("check"), s(mesh.display()), s("--bvh"), s(kept.display()), s("--rays"), s(0), s("--format"), s("json")];
+    let Command::Check(check_args) = words(&args) else { panic!("check") };
+    let (json, _) = bvhscope::cli::check::output(&check_args).unwrap();
+    let cli: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let row = |name: &str| {
+        cli["quality"].as_array().unwrap().iter().find(|r| r["name"].as_str().unwrap().starts_with(name)).unwrap()
+            ["sah_cost"]
+            .as_f64()
+            .unwrap()
+    };
+    let (cli_sah, midpoint) = (row("imported"), row("Midpoint"));
+    assert!((app_sah - cli_sah).abs() <= 1e-9 * cli_sah, "the app's {app_sah} is check's {cli_sah}");
+    assert!(cli_sah > midpoint, "the kept triangle costs its box: {cli_sah} against the tight tree's {midpoint}");
+    assert!(cli["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|f| f["text"].as_str().unwrap().starts_with("the root box is larger")));
+}
