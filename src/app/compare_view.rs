@@ -49,6 +49,10 @@ pub struct CompareImages {
     pub b_frame: Arc<Frame>,
     pub view: crate::render::View,
     pub colormap: crate::render::ColorMap,
+    /// The range asked for (`HeatRange`) and the difference's fixed ±range, if any: the images
+    /// are made again when either changes.
+    pub range: crate::render::HeatRange,
+    pub diff_range: Option<f32>,
     pub a: egui::TextureHandle,
     pub b: egui::TextureHandle,
     /// The difference (heatmaps only), its values and legend.

@@ -22,6 +22,8 @@ impl BvhscopeApp {
                 && Arc::ptr_eq(&c.b_frame, &b.frame)
                 && c.view == view
                 && c.colormap == colormap
+                && c.range == shown.style.range
+                && c.diff_range == self.settings.diff_ranges.get(&view).copied()
             {
                 return Some(c.clone());
             }
@@ -45,8 +47,9 @@ impl BvhscopeApp {
             l.title += " (A and B on one scale; min, mean, max of A)";
         }
         let (img_b, _) = view_image(&b.frame, view, colormap, range, cost);
+        let diff_range = self.settings.diff_ranges.get(&view).copied();
         let diff = diff::difference(&shown.frame, &b.frame, view, cost).map(|d| {
-            let (img, legend) = diff::difference_image(shown.frame.width(), &d, view, None);
+            let (img, legend) = diff::difference_image(shown.frame.width(), &d, view, diff_range);
             (texture("compare-diff", img), d, legend)
         });
         let images = Arc::new(compare_view::CompareImages {
@@ -54,6 +57,8 @@ impl BvhscopeApp {
             b_frame: b.frame.clone(),
             view,
             colormap,
+            range: shown.style.range,
+            diff_range,
             a: texture("compare-a", img_a),
             b: texture("compare-b", img_b),
             diff,

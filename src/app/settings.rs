@@ -30,6 +30,10 @@ pub struct Settings {
     /// cleared when a scene is opened, whose scale is its own too, so not saved either.
     #[serde(skip)]
     pub fixed_ranges: HashMap<View, (f32, f32)>,
+    /// Compare's difference B − A on a fixed ±range (as `render --difference --range -R:R`);
+    /// `None`: its own 99th percentile. Per view, cleared with the scene as `fixed_ranges`.
+    #[serde(skip)]
+    pub diff_ranges: HashMap<View, f32>,
     /// Which axis of the mesh points up (the orbit and the default camera follow it).
     pub up_axis: UpAxis,
     pub show_boxes: bool,
@@ -63,6 +67,7 @@ impl Default for Settings {
             view: View::Normals,
             colormap: ColorMap::Viridis,
             fixed_ranges: HashMap::new(),
+            diff_ranges: HashMap::new(),
             up_axis: UpAxis::Y,
             show_boxes: false,
             box_depth: 3,

@@ -4,6 +4,7 @@
 //! test binary (`app.rs`).
 
 use super::*;
+use egui::accesskit::Role;
 
 /// The legend grows upwards from the viewport's lower-left corner, inside the viewport: its
 /// lowest line is above the status bar's "last full frame".
@@ -63,4 +64,47 @@ fn messages_come_one_per_topic_and_go_with_their_scene() {
     run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus.clone()) && idle(a));
     assert!(h.state().messages.iter().all(|m| !m.text.contains("alice") && !m.text.contains("a.png")));
     assert!(h.state().messages.iter().any(|m| m.text.starts_with("Opened torus.obj")), "the new scene's own");
+}
+
+/// Side by side, "Fix the current range" takes the pair's one scale (A's alone clipped B's hottest
+/// pixels); in the difference mode the difference's ±range is fixed, and its legend follows.
+#[test]
+fn compare_ranges_are_fixed_on_the_shared_scale_and_the_difference_too() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    let mut s = h.state().settings.clone();
+    s.build.strategy = SplitStrategy::Midpoint;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    h.state_mut().act(Action::View(2));
+    run_until(&mut h, "the midpoint heatmap", |a| {
+        idle(a)
+            && a.shown
+                .as_ref()
+                .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
+    });
+    h.get_by_role_and_label(Role::Button, "View").click();
+    h.run_steps(2);
+    h.get_by_label("Compare side by side…").click();
+    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a));
+    h.run_steps(2);
+    let ctx = h.ctx.clone();
+    let shared = h.state().compare_images(&ctx).unwrap().legend.as_ref().map(|l| (l.range_min, l.range_max)).unwrap();
+    let own = h.state().shown.as_ref().unwrap().legend.as_ref().map(|l| l.range_max).unwrap();
+    assert!(shared.1 > own, "B's hottest pixel is above A's here ({} > {own}): the case that clipped", shared.1);
+    h.get_by_label("Fix the current range").click();
+    h.run_steps(2);
+    let view = h.state().settings.view;
+    assert_eq!(h.state().settings.fixed_ranges.get(&view).copied(), Some((shared.0, shared.1.max(shared.0 + 1.0))));
+    // The difference: its range fixed at ±3, and its legend says so.
+    h.get_by_label("Difference B - A").click();
+    h.run_steps(2);
+    h.get_by_label("Fixed difference range (±)").click();
+    h.run_steps(2);
+    *h.state_mut().settings.diff_ranges.get_mut(&view).expect("fixed") = 3.0;
+    let ctx2 = ctx.clone();
+    run_until(&mut h, "the difference on ±3", move |a| {
+        idle(a) && a.compare_images(&ctx2).is_some_and(|c| c.diff_range == Some(3.0))
+    });
+    let diff = h.state().compare_images(&ctx).unwrap().diff.as_ref().unwrap().2.clone();
+    assert_eq!((diff.range_min, diff.range_max), (-3.0, 3.0));
 }

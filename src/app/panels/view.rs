@@ -27,7 +27,14 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let max_depth = app.current_bvh().map_or(0, |b| b.bottom_max_depth());
     // The top level's depth, when two levels are built.
     let top_depth = app.current_bvh().and_then(|b| b.top_stats.as_ref()).map(|s| s.max_depth);
-    let legend_range = app.shown.as_ref().and_then(|s| s.legend.as_ref()).map(|l| (l.range_min, l.range_max));
+    // The range on screen: side by side, the pair's one scale (A's alone would clip B's hottest
+    // pixels); the difference's is its own ±range (below).
+    let compared = app.compare_images(ui.ctx());
+    let difference = app.compare.mode == crate::app::CompareMode::Difference;
+    let pair_range = compared.as_ref().filter(|_| !difference).and_then(|c| c.legend.as_ref());
+    let legend_range =
+        pair_range.or(app.shown.as_ref().and_then(|s| s.legend.as_ref())).map(|l| (l.range_min, l.range_max));
+    let diff_legend = compared.as_ref().filter(|_| difference).and_then(|c| c.diff.as_ref()).map(|d| d.2.range_max);
     let cost = super::stats::combined_cost_text(app.settings.build.cost);
     let s = &mut edited;
     gpu_choices(app, ui, s);
@@ -103,13 +110,31 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 range.1 = range.0 + 1.0;
             }
         }
-        if let Some((lo, hi)) = legend_range {
+        if let Some((lo, hi)) = legend_range.filter(|_| !difference) {
             if ui
                 .button("Fix the current range")
-                .on_hover_text("Keep this scale for this view, to compare strategies on the same colours")
+                .on_hover_text("Keep this scale for this view, to compare strategies on the same colours (side by side: the pair's one scale)")
                 .clicked()
             {
                 s.fixed_ranges.insert(view, (lo, hi.max(lo + 1.0)));
+            }
+        }
+        // The difference B − A (Compare): its own ±range, fixable as `render --difference --range`.
+        if difference {
+            let mut fixed = s.diff_ranges.contains_key(&view);
+            if ui
+                .checkbox(&mut fixed, "Fixed difference range (±)")
+                .on_hover_text("Off: ± the 99th percentile of this difference's values. On: this ±range for this view, as bvhscope render --difference … --range -R:R")
+                .changed()
+            {
+                if fixed {
+                    s.diff_ranges.insert(view, diff_legend.unwrap_or(10.0).abs().max(1.0));
+                } else {
+                    s.diff_ranges.remove(&view);
+                }
+            }
+            if let Some(r) = s.diff_ranges.get_mut(&view) {
+                ui.add(egui::DragValue::new(r).speed(0.5).range(0.001..=f32::MAX).prefix("± "));
             }
         }
     });
