@@ -100,22 +100,7 @@ fn the_build_replay_traces_the_partial_tree() {
 /// strategy the same as A's the difference is zero everywhere; changing A rebuilds only A.
 #[test]
 fn two_strategies_side_by_side_and_their_difference() {
-    let mut h = harness();
-    run_until(&mut h, "the first frame", idle);
-    let mut s = h.state().settings.clone();
-    s.build.strategy = SplitStrategy::Midpoint;
-    h.state_mut().act(Action::Edit(Box::new(s)));
-    h.state_mut().act(Action::View(2));
-    run_until(&mut h, "midpoint's heatmap", |a| {
-        idle(a)
-            && a.shown
-                .as_ref()
-                .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
-    });
-    h.get_by_role_and_label(Role::Button, "View").click();
-    h.run_steps(2);
-    h.get_by_label("Compare side by side…").click();
-    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a));
+    let mut h = midpoint_against_sah();
     let ctx = h.ctx.clone();
     let b_bvh = {
         let app = h.state();

@@ -4,7 +4,6 @@
 //! test binary (`app.rs`).
 
 use super::*;
-use egui::accesskit::Role;
 
 /// The legend grows upwards from the viewport's lower-left corner, inside the viewport: its
 /// lowest line is above the status bar's "last full frame".
@@ -70,22 +69,7 @@ fn messages_come_one_per_topic_and_go_with_their_scene() {
 /// pixels); in the difference mode the difference's ±range is fixed, and its legend follows.
 #[test]
 fn compare_ranges_are_fixed_on_the_shared_scale_and_the_difference_too() {
-    let mut h = harness();
-    run_until(&mut h, "the first frame", idle);
-    let mut s = h.state().settings.clone();
-    s.build.strategy = SplitStrategy::Midpoint;
-    h.state_mut().act(Action::Edit(Box::new(s)));
-    h.state_mut().act(Action::View(2));
-    run_until(&mut h, "the midpoint heatmap", |a| {
-        idle(a)
-            && a.shown
-                .as_ref()
-                .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
-    });
-    h.get_by_role_and_label(Role::Button, "View").click();
-    h.run_steps(2);
-    h.get_by_label("Compare side by side…").click();
-    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a));
+    let mut h = midpoint_against_sah();
     h.run_steps(2);
     let ctx = h.ctx.clone();
     let shared = h.state().compare_images(&ctx).unwrap().legend.as_ref().map(|l| (l.range_min, l.range_max)).unwrap();

@@ -108,3 +108,28 @@ pub fn with_strategy(h: &mut Harness<'_, BvhscopeApp>, s: bvhscope::bvh::SplitSt
     settings.build.strategy = s;
     h.state_mut().act(bvhscope::app::Action::Edit(Box::new(settings)));
 }
+
+/// The built-in scene's midpoint tree (A) against SAH binned (B), side by side on the nodes-visited
+/// heatmap, both frames there.
+pub fn midpoint_against_sah() -> Harness<'static, BvhscopeApp> {
+    use bvhscope::app::Action;
+    use bvhscope::bvh::SplitStrategy;
+    use egui_kittest::kittest::Queryable;
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    let mut s = h.state().settings.clone();
+    s.build.strategy = SplitStrategy::Midpoint;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    h.state_mut().act(Action::View(2));
+    run_until(&mut h, "midpoint's heatmap", |a| {
+        idle(a)
+            && a.shown
+                .as_ref()
+                .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
+    });
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "View").click();
+    h.run_steps(2);
+    h.get_by_label("Compare side by side…").click();
+    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a));
+    h
+}
