@@ -93,11 +93,8 @@ impl Finding {
 }
 
 /// Order `findings` most serious first (`Finding::severity`), keeping the order among equals:
-/// the first defect is the root cause a student fixes first (`grade`'s "first cause"). A dump of
-/// another mesh (`wrong_mesh`, the first finding when there is one) stays first: every defect
-/// after it follows from it.
-pub fn by_severity(findings: &mut [Finding], wrong_mesh_first: bool) {
-    let findings = if wrong_mesh_first && !findings.is_empty() { &mut findings[1..] } else { findings };
+/// the first defect is the root cause a student fixes first (`grade`'s "first cause").
+pub fn by_severity(findings: &mut [Finding]) {
     findings.sort_by(|a, b| {
         let (ka, kb) = (a.severity(), b.severity());
         ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
@@ -287,7 +284,7 @@ pub fn check(
 ) -> Result<Checked, Cancelled> {
     let (out, tree) = match check_structure(s) {
         Ok(traced) => traced,
-        Err(findings) => return Ok(Checked::untraced(findings, s)),
+        Err(findings) => return Ok(Checked::untraced(findings)),
     };
     // Built only once the tree can be traced: past 4,096 triangles it is a whole SAH build.
     let reference = Reference::of(s.mesh);
@@ -308,14 +305,28 @@ pub fn check_with(
 ) -> Result<Checked, Cancelled> {
     match check_structure(s) {
         Ok((out, tree)) => check_rays_of(s, out, tree, reference, camera, rays, opts, control),
-        Err(findings) => Ok(Checked::untraced(findings, s)),
+        Err(findings) => Ok(Checked::untraced(findings)),
     }
 }
 
 impl Checked {
-    fn untraced(mut findings: Vec<Finding>, s: &Subject) -> Checked {
-        by_severity(&mut findings, wrong_mesh(s).is_some());
-        Checked { findings, tree: None, wrong_pixels: Vec::new(), reference: None, rays: 0 }
+    fn untraced(findings: TreeFindings) -> Checked {
+        Checked { findings: findings.ordered(), tree: None, wrong_pixels: Vec::new(), reference: None, rays: 0 }
+    }
+}
+
+/// A dump's findings before they are ordered: the wrong-mesh line, if any, kept apart so it stays
+/// first (every defect after it follows from it), and the rest.
+struct TreeFindings {
+    wrong_mesh: Option<Finding>,
+    rest: Vec<Finding>,
+}
+
+impl TreeFindings {
+    /// The wrong-mesh line, then the rest most serious first (`by_severity`).
+    fn ordered(mut self) -> Vec<Finding> {
+        by_severity(&mut self.rest);
+        self.wrong_mesh.into_iter().chain(self.rest).collect()
     }
 }
 
@@ -323,17 +334,16 @@ impl Checked {
 type Traced = (AnyBvh, Imported);
 
 /// The tree's findings, and the tree to trace; `Err` with the findings when it cannot be traced.
-fn check_structure(s: &Subject) -> Result<(Vec<Finding>, Traced), Vec<Finding>> {
-    let mut out: Vec<Finding> = wrong_mesh(s).into_iter().collect();
-    out.extend(check_tree(s.dump, s.mesh));
-    if out.iter().any(|f| f.group == Group::Structure && f.defect) {
+fn check_structure(s: &Subject) -> Result<(TreeFindings, Traced), TreeFindings> {
+    let mut out = TreeFindings { wrong_mesh: wrong_mesh(s), rest: check_tree(s.dump, s.mesh) };
+    if out.rest.iter().any(|f| f.group == Group::Structure && f.defect) {
         return Err(out);
     }
     match import(s.dump, s.mesh, s.dump_path) {
         Ok(tree) => Ok((out, tree)),
         Err(why) => {
             // Not a warning: a tree bvhscope cannot trace is a tree nobody can see is right.
-            out.push(defect(Group::Rays, None, None, format!("the tree cannot be traced: {why}")));
+            out.rest.push(defect(Group::Rays, None, None, format!("the tree cannot be traced: {why}")));
             Err(out)
         }
     }
@@ -343,7 +353,7 @@ fn check_structure(s: &Subject) -> Result<(Vec<Finding>, Traced), Vec<Finding>> 
 #[allow(clippy::too_many_arguments)]
 fn check_rays_of(
     s: &Subject,
-    mut out: Vec<Finding>,
+    mut out: TreeFindings,
     (bvh, imported): (AnyBvh, Imported),
     reference: &Reference,
     camera: &crate::render::Camera,
@@ -362,16 +372,15 @@ fn check_rays_of(
             .iter()
             .map(|&i| format!("node {i} ({} triangles)", s.dump.nodes[i as usize].count.unwrap_or(0)))
             .collect();
-        out.push(f);
+        out.rest.push(f);
     }
     let set = RaySet::checking(s.mesh, camera, rays);
     let wrong = wrong_rays(&bvh, s.mesh, reference, &set, opts, control)?;
     if let Some(f) = wrong.finding(set.len()) {
-        out.push(f);
+        out.rest.push(f);
     }
-    by_severity(&mut out, wrong_mesh(s).is_some());
     Ok(Checked {
-        findings: out,
+        findings: out.ordered(),
         tree: Some((bvh, imported)),
         wrong_pixels: wrong.pixels,
         reference: None,
