@@ -186,7 +186,7 @@ impl Jobs {
     /// `CHECK_RAYS` random rays and `camera`'s primary rays. The check waits for the scene's own
     /// load, build and first full frame (`primary`, `shown_scene`) and is not among the jobs a
     /// build waits for: a dump whose check takes minutes (every box the root's) never holds the
-    /// mesh's image back.
+    /// mesh's image back, nor any build or frame asked for while it runs (its own thread pool).
     pub fn import(&mut self, path: PathBuf, scene: Arc<Scene>, scene_id: u64, camera: Camera, trace: TraceOptions) {
         let job = self.start(format!("Checking {}", path.display()));
         let (send, control) = (self.sender(job.id), job.control.clone());
@@ -209,7 +209,13 @@ impl Jobs {
                 }
                 std::thread::sleep(Duration::from_millis(20));
             }
-            let tree = import_tree(path, &scene, scene_id, &camera, trace, &control);
+            // On a pool of its own, half the cores: in rayon's shared pool a check of minutes
+            // would keep every worker busy and starve a build or frame asked for meanwhile.
+            let threads = std::thread::available_parallelism().map_or(1, |n| (n.get() / 2).max(1));
+            let tree = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+                Ok(pool) => pool.install(|| import_tree(path, &scene, scene_id, &camera, trace, &control)),
+                Err(_) => import_tree(path, &scene, scene_id, &camera, trace, &control),
+            };
             send(JobEvent::Imported(tree.map(Box::new)));
         });
         self.import = Some(job);
