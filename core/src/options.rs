@@ -6,7 +6,7 @@
 use crate::bvh::{Layout, Limits, Param, ParamLimits, ParamValue, Preset, SplitStrategy, TraversalOrder};
 use crate::geometry::TriangleTest;
 use crate::render::warp::WarpSize;
-use crate::render::{ColorMap, UpAxis, View};
+use crate::render::{ColorMap, PairView, UpAxis, View};
 
 /// One value of a choice: what it is called where.
 #[derive(Clone, Copy, Debug)]
@@ -294,6 +294,28 @@ const PRESETS: [Named<Preset>; 2] = [
 ];
 choice!(Preset, PRESETS, 2);
 
+const PAIR_VIEWS: [Named<PairView>; 3] = [
+    Named {
+        value: PairView::Halves,
+        name: "halves",
+        label: "Halves",
+        help: "A's heatmap on the left half, B's on the right, on one colour scale",
+    },
+    Named {
+        value: PairView::Wipe,
+        name: "wipe",
+        label: "Wipe",
+        help: "A left of a line, B right of it (the app's line is dragged; the command line's is --wipe)",
+    },
+    Named {
+        value: PairView::Difference,
+        name: "difference",
+        label: "Difference B - A",
+        help: "B's count minus A's per pixel: blue where B does less work, red where it does more",
+    },
+];
+choice!(PairView, PAIR_VIEWS, 3);
+
 /// A build parameter as users see it: its names, label and help. Its limits and default are the
 /// builder's (`Param::limits`); which strategies read it is the strategy's (`SplitStrategy::reads`).
 #[derive(Clone, Copy, Debug)]
@@ -444,52 +466,5 @@ pub const TOP_MAX_LEAF_SIZE: Number<u32> = Number {
 };
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn check<T: Choice + std::fmt::Debug>() {
-        for (i, n) in T::TABLE.iter().enumerate() {
-            assert_eq!(T::from_name(n.name), Some(n.value));
-            assert!(T::TABLE[..i].iter().all(|m| m.name != n.name && m.value != n.value), "{:?} twice", n.value);
-            assert!(!n.help.is_empty() && !n.label.is_empty());
-            assert!(n.name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-'), "{}", n.name);
-        }
-        assert_eq!(T::from_name("no such thing"), None);
-    }
-
-    #[test]
-    fn every_choice_is_named_once_and_found_by_its_name() {
-        check::<SplitStrategy>();
-        check::<Layout>();
-        check::<TraversalOrder>();
-        check::<TriangleTest>();
-        check::<View>();
-        check::<ColorMap>();
-        check::<UpAxis>();
-        check::<Preset>();
-        assert_eq!(SplitStrategy::ALL.len(), STRATEGIES.len());
-        assert_eq!(View::ALL[2], View::Visits);
-    }
-
-    #[test]
-    fn the_handout_help_states_the_leaf_size_the_preset_uses() {
-        let leaf = format!("max leaf size {}", Preset::HANDOUT_MAX_LEAF_SIZE);
-        assert!(Preset::Handout.help().contains(&leaf));
-    }
-
-    #[test]
-    fn every_build_parameter_is_named_once_and_parses_its_default() {
-        for (i, o) in BUILD_PARAMS.iter().enumerate() {
-            assert!(BUILD_PARAMS[..i].iter().all(|p| p.param != o.param && p.name != o.name && p.key != o.key));
-            assert_eq!(o.key, o.name.replace('-', "_"), "{}: the key is the name in snake case", o.name);
-            assert_eq!(o.param.option().name, o.name);
-            let d = o.limits().default_value();
-            assert_eq!(o.parse(&d.to_string()), Ok(d));
-            assert_eq!(o.from_json(&ParamOption::to_json(d)), Ok(d));
-            assert!(o.help_line().contains(&o.limits().range_text()));
-        }
-        assert_eq!(BUILD_PARAMS.len(), Param::ALL.len());
-        assert!(Param::MaxLeafSize.option().parse("0").is_err() && Param::MaxLeafSize.option().parse("256").is_err());
-        assert!(Param::TraversalCost.option().parse("nan").is_err());
-    }
-}
+#[path = "options_tests.rs"]
+mod tests;

@@ -136,7 +136,7 @@ pub enum Action {
         layout: crate::bvh::Layout,
         trace: crate::bvh::TraceOptions,
     },
-    CompareMode(super::CompareMode),
+    CompareMode(super::PairView),
     /// Where the wipe line is, 0 (left) to 1 (right).
     Wipe(f32),
     /// Open (or close) the Replay window: the viewport shows the tree after some splits.
@@ -167,6 +167,8 @@ pub enum Action {
     Hottest {
         next: bool,
     },
+    /// Put the selected pinned ray's `bvhscope trace` command on the clipboard.
+    CopyTraceCommand,
 }
 
 /// Where panels put the actions they emit during one frame.
@@ -438,6 +440,17 @@ impl BvhscopeApp {
                     self.jobs.speedup(s.bvh.clone(), s.camera, s.trace);
                 }
             }
+            A::CopyTraceCommand => match self.pins.current().and_then(|r| r.command.clone()) {
+                Some(cmd) => {
+                    self.message(MessageKind::Info, "Copied the pinned ray's trace command to the clipboard");
+                    self.clipboard = Some(cmd);
+                }
+                None if self.pins.current().is_some() => self.message(
+                    MessageKind::Info,
+                    "The built-in scene has no file to name on the command line: open a mesh to copy its trace command",
+                ),
+                None => self.message(MessageKind::Info, "Pin a ray first (Ctrl+click on the image)"),
+            },
             A::DismissEarlier(n) => {
                 self.messages.drain(..n.min(self.messages.len()));
             }

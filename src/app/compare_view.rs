@@ -6,30 +6,8 @@
 //! strategy rebuilds only A.
 
 use crate::bvh::{Layout, SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
-use crate::render::{Camera, Frame, Legend, RaySummary};
+use crate::render::{Camera, Frame, Legend, PairView, RaySummary};
 use std::sync::Arc;
-
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum CompareMode {
-    /// A on the left half, B on the right.
-    #[default]
-    Halves,
-    /// A left of a draggable line, B right of it.
-    Wipe,
-    /// B − A per pixel through a diverging colour map.
-    Difference,
-}
-
-impl CompareMode {
-    pub const ALL: [CompareMode; 3] = [CompareMode::Halves, CompareMode::Wipe, CompareMode::Difference];
-    pub fn label(self) -> &'static str {
-        match self {
-            CompareMode::Halves => "Halves",
-            CompareMode::Wipe => "Wipe",
-            CompareMode::Difference => "Difference B - A",
-        }
-    }
-}
 
 /// B: its build and its frame of one camera.
 pub struct CompareB {
@@ -69,7 +47,7 @@ pub struct CompareView {
     pub layout: crate::bvh::Layout,
     /// How B is traversed (order and triangle test).
     pub trace: TraceOptions,
-    pub mode: CompareMode,
+    pub mode: PairView,
     /// Where the wipe line is, from 0 (left) to 1 (right).
     pub wipe: f32,
     pub b: Option<CompareB>,
@@ -84,7 +62,7 @@ impl Default for CompareView {
             max_leaf_size: p.max_leaf_size,
             layout: p.layout,
             trace: TraceOptions::default(),
-            mode: CompareMode::Halves,
+            mode: PairView::Halves,
             wipe: 0.5,
             b: None,
         }

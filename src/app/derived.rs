@@ -9,7 +9,7 @@ impl BvhscopeApp {
     /// The side-by-side images (A's and B's on one scale, and their difference), once both frames
     /// of one camera are there (cached for the pair and the view).
     pub fn compare_images(&self, ctx: &egui::Context) -> Option<Arc<compare_view::CompareImages>> {
-        use crate::render::{diff, metric_stats, view_image, HeatRange};
+        use crate::render::diff;
         if !self.compare.on {
             return None;
         }
@@ -28,28 +28,15 @@ impl BvhscopeApp {
                 return Some(c.clone());
             }
         }
-        // One scale for both: the fixed range if set, else from the lower minimum to the higher maximum.
-        let range = match shown.style.range {
-            HeatRange::Fixed { min, max } => HeatRange::Fixed { min, max },
-            HeatRange::Auto if view.is_heatmap() => {
-                let (a0, a1, _) = metric_stats(&shown.frame, view, cost);
-                let (b0, b1, _) = metric_stats(&b.frame, view, cost);
-                HeatRange::Fixed { min: a0.min(b0), max: a1.max(b1) }
-            }
-            HeatRange::Auto => HeatRange::Auto,
-        };
         let texture = |name: &str, img: image::RgbImage| {
             let c = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
             ctx.load_texture(name, c, egui::TextureOptions::NEAREST)
         };
-        let (img_a, mut legend) = view_image(&shown.frame, view, colormap, range, cost);
-        if let Some(l) = &mut legend {
-            l.title += " (A and B on one scale; min, mean, max of A)";
-        }
-        let (img_b, _) = view_image(&b.frame, view, colormap, range, cost);
+        let style = self.pair_style(shown);
+        let (img_a, img_b, legend) = crate::render::pair::pair_images(&shown.frame, &b.frame, &style);
         let diff_range = self.settings.diff_ranges.get(&view).copied();
         let diff = diff::difference(&shown.frame, &b.frame, view, cost).map(|d| {
-            let (img, legend) = diff::difference_image(shown.frame.width(), &d, view, diff_range);
+            let (img, legend) = diff::difference_image(shown.frame.width(), &d, view, style.diff_range);
             (texture("compare-diff", img), d, legend)
         });
         let images = Arc::new(compare_view::CompareImages {
@@ -66,6 +53,13 @@ impl BvhscopeApp {
         });
         *cache = Some(images.clone());
         Some(images)
+    }
+
+    /// How the pair on screen is drawn: `shown`'s view, colour map and range, the difference's range.
+    pub fn pair_style(&self, shown: &Shown) -> crate::render::pair::PairStyle {
+        let s = shown.style;
+        let diff_range = self.settings.diff_ranges.get(&s.view).copied().into();
+        crate::render::pair::PairStyle { view: s.view, colormap: s.colormap, cost: s.cost, range: s.range, diff_range }
     }
 
     /// A mask over `shown`'s frame that dims every pixel whose hit is not a triangle of `node`'s

@@ -16,6 +16,15 @@ pub enum StatsFormat {
 pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
     let scene: String = app.scene.title().chars().map(|c| if c.is_alphanumeric() { c } else { '-' }).collect();
     let strategy = app.settings.build.strategy.name();
+    // Side by side, the name says both builds and how the pair is shown.
+    if let Some((_, b)) = shown_pair(app) {
+        let pair = format!("bvhscope-{scene}-{strategy}-vs-{}", b.build.bvh.strategy.name());
+        match ext {
+            "png" => return format!("{pair}-{}-{}.png", app.settings.view.name(), app.compare.mode.name()),
+            "counts" => return format!("{pair}-{}-difference.csv", app.settings.view.name()),
+            _ => {}
+        }
+    }
     match ext {
         "png" => format!("bvhscope-{scene}-{strategy}-{}.png", app.settings.view.name()),
         "counts" => format!("bvhscope-{scene}-{strategy}-counts.csv"),
@@ -52,7 +61,34 @@ pub fn check_output(app: &BvhscopeApp, pick: Pick, path: &Path) -> Result<(), St
     crate::files::refuse_inputs(path, &inputs).map_err(|e| e.to_string())
 }
 
+/// Compare's pair as it is on screen: A's frame (complete) and B's of the same camera; `None`
+/// outside Compare or while B is not there yet.
+fn shown_pair(app: &BvhscopeApp) -> Option<(&super::Shown, &super::compare_view::CompareB)> {
+    if !app.compare.on {
+        return None;
+    }
+    let shown = app.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none())?;
+    let b = app.compare.b.as_ref().filter(|b| b.camera == shown.camera && b.scene_id == app.scene_id)?;
+    Some((shown, b))
+}
+
+/// Compare's pair, or why it cannot be written yet.
+fn pair_on_screen(app: &BvhscopeApp) -> Result<(&super::Shown, &super::compare_view::CompareB), String> {
+    shown_pair(app).ok_or_else(|| "B is not traced yet: save once both builds are on screen".to_string())
+}
+
+/// The view as PNG: in Compare what is on screen (halves, wipe or difference, with its legend,
+/// as `render --against … --pair-view` writes it), else the frame with its legend.
 pub fn save_png(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
+    if app.compare.on {
+        let (shown, b) = pair_on_screen(app)?;
+        let subject = format!("{}: A {}, B {}", app.scene.title(), shown.build_label, b.bvh.label());
+        let style = app.pair_style(shown);
+        let (mode, wipe) = (app.compare.mode, app.compare.wipe);
+        let img = crate::render::pair::pair_picture(&shown.frame, &b.frame, mode, wipe, &style, &subject)
+            .ok_or("the difference is of heatmaps: choose a heatmap view")?;
+        return crate::files::write_png(path, &img).map_err(|e| e.to_string());
+    }
     let shown = app.shown.as_ref().ok_or("nothing rendered yet")?;
     let s = shown.style;
     let (img, mut legend) = view_image(&shown.frame, s.view, s.colormap, s.range, s.cost);
@@ -162,8 +198,16 @@ pub fn stats_text(app: &BvhscopeApp, format: StatsFormat) -> Result<String, Stri
 }
 
 /// The counts behind the heatmap of the full frame on screen, one row per pixel (the format of
-/// `bvhscope render --counts`).
+/// `bvhscope render --counts`); in Compare the pair's, x, y, a, b, b_minus_a (`render --against
+/// … --difference`).
 pub fn save_counts(app: &BvhscopeApp, path: &Path) -> Result<(), String> {
+    if app.compare.on {
+        let (shown, b) = pair_on_screen(app)?;
+        let s = shown.style;
+        let text = crate::render::pair::difference_csv(&shown.frame, &b.frame, s.view, s.cost)
+            .ok_or("the pair's counts are of heatmaps: choose a heatmap view")?;
+        return crate::files::write_bytes(path, text.as_bytes()).map_err(|e| e.to_string());
+    }
     let shown = app.shown.as_ref().ok_or("nothing rendered yet")?;
     let text = shown.frame.counts_csv().ok_or("the frame is still refining; export once it is complete")?;
     crate::files::write_bytes(path, text.as_bytes()).map_err(|e| e.to_string())

@@ -29,9 +29,11 @@ mod viewport;
 
 pub use figures::{MeasuredRays, Message, MessageKind, PathWindow, Shown, StrategyFigures};
 
+pub use crate::render::PairView;
 pub use crate::scene::{Scene, SceneSource};
 pub use action::{Action, Actions};
-pub use compare_view::{CompareMode, CompareView};
+pub use compare_view::CompareView;
+pub use export::default_name;
 pub use grade_view::GradeView;
 pub use import_view::{ImportView, ImportedTree};
 pub use jobs::Pick;
@@ -119,6 +121,8 @@ pub struct BvhscopeApp {
     pub hottest: Option<usize>,
     /// A dump to import once the scene being loaded is there.
     pending_import: Option<PathBuf>,
+    /// Text to put on the clipboard at the end of this frame (the clipboard is the context's).
+    pub clipboard: Option<String>,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     box_cache: std::cell::RefCell<Option<BoxCache>>,
     overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
@@ -190,6 +194,7 @@ impl BvhscopeApp {
             shown: None,
             last_full_frame: None,
             messages: Vec::new(),
+            clipboard: None,
             show_help: false,
             path_window: None,
             pins: RayView::default(),
@@ -478,6 +483,9 @@ impl eframe::App for BvhscopeApp {
             }
             self.reconcile();
             ctx.request_repaint();
+        }
+        if let Some(text) = self.clipboard.take() {
+            ctx.copy_text(text);
         }
         if self.jobs.is_busy() {
             // Keep progress indicators moving; results also wake the UI themselves.

@@ -40,6 +40,11 @@ pub const SHORTCUTS: &[(KeyboardShortcut, Action, &str)] = &[
         Action::NodeStep(NodeStep::Sibling),
         "Node: select the sibling",
     ),
+    (
+        KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::C),
+        Action::CopyTraceCommand,
+        "Copy the pinned ray's trace command",
+    ),
     (KeyboardShortcut::new(Modifiers::NONE, Key::F1), Action::Help, "This help"),
 ];
 

@@ -152,7 +152,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     messages(app, ui, full, out);
     if let Some(shown) = &app.shown {
         let compare_legend = compared.as_ref().and_then(|c| match app.compare.mode {
-            super::CompareMode::Difference => c.diff.as_ref().map(|d| d.2.clone()),
+            super::PairView::Difference => c.diff.as_ref().map(|d| d.2.clone()),
             _ => c.legend.clone(),
         });
         // The histogram is of the image's own values: not drawn for a side-by-side pair.
@@ -178,7 +178,7 @@ fn draw_compare(
     c: &super::compare_view::CompareImages,
     out: &mut Actions,
 ) {
-    use super::CompareMode;
+    use super::PairView;
     let label = |p: Pos2, align: egui::Align2, text: String| {
         let g = painter.layout_no_wrap(text, egui::FontId::proportional(14.0), Color32::WHITE);
         let r = align.anchor_size(p, g.size()).expand(4.0);
@@ -189,7 +189,7 @@ fn draw_compare(
     let a_label = app.shown.as_ref().map_or(String::new(), |s| s.build_label.clone());
     let full = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
     match app.compare.mode {
-        CompareMode::Difference => match &c.diff {
+        PairView::Difference => match &c.diff {
             Some((tex, _, _)) => {
                 painter.image(tex.id(), rect, full, Color32::WHITE);
                 label(
@@ -205,7 +205,7 @@ fn draw_compare(
             ),
         },
         mode => {
-            let split = if mode == CompareMode::Wipe { app.compare.wipe } else { 0.5 };
+            let split = if mode == PairView::Wipe { app.compare.wipe } else { 0.5 };
             let x = rect.left() + rect.width() * split;
             let (left, right) = (
                 Rect::from_min_max(rect.min, Pos2::new(x, rect.max.y)),
@@ -224,7 +224,7 @@ fn draw_compare(
             );
             label(rect.left_top() + Vec2::new(8.0, 8.0), egui::Align2::LEFT_TOP, format!("A: {a_label}"));
             label(rect.right_top() + Vec2::new(-8.0, 8.0), egui::Align2::RIGHT_TOP, format!("B: {b_label}"));
-            if mode == CompareMode::Wipe {
+            if mode == PairView::Wipe {
                 // The line's handle: drag it (over the image a drag orbits).
                 let handle = Rect::from_center_size(Pos2::new(x, rect.center().y), Vec2::new(14.0, rect.height()));
                 let r = ui.interact(handle, ui.scope_id().with("compare-wipe"), Sense::drag());

@@ -6,7 +6,7 @@ use super::{load_mesh, progress, CliError};
 use crate::bvh::SceneBvh;
 use crate::files::file_name;
 use crate::render::{
-    draw_legend, render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, RenderSettings, View,
+    draw_legend, render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, PairView, RenderSettings, View,
 };
 use crate::work::WorkControl;
 use clap::Args;
@@ -62,6 +62,20 @@ pub struct RenderArgs {
     /// With --against: also write the difference as CSV, one row per pixel: x, y, a, b, b_minus_a.
     #[arg(long, value_name = "FILE.csv", requires = "against")]
     pub difference: Option<PathBuf>,
+    /// With --against: what the PNG shows, as the app's Compare shows it (its Save view writes
+    /// the same file).
+    #[arg(long, value_parser = super::args::choice::<PairView>(), default_value = "difference", requires = "against")]
+    pub pair_view: PairView,
+    /// With --pair-view wipe: where the line is, from 0 (the left edge) to 1 (the right).
+    #[arg(long, value_parser = parse_wipe, default_value = "0.5", requires = "against")]
+    pub wipe: f32,
+}
+
+fn parse_wipe(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(w) if (0.0..=1.0).contains(&w) => Ok(w),
+        _ => Err(format!("'{s}' is not a place from 0 (the left edge) to 1 (the right)")),
+    }
 }
 
 fn parse_percentile(s: &str) -> Result<f32, String> {
@@ -143,8 +157,9 @@ fn run_against(
     label_a: &str,
     against: crate::bvh::SplitStrategy,
 ) -> Result<(), CliError> {
-    use crate::render::diff::{difference, difference_image, tally, DiffRange};
-    if !a.view.is_heatmap() {
+    use crate::render::diff::{difference, tally, DiffRange};
+    use crate::render::pair::{difference_csv, pair_picture, PairStyle};
+    if !a.view.is_heatmap() && (a.pair_view == PairView::Difference || a.difference.is_some()) {
         return Err(CliError::Usage(
             "--against compares two builds' heatmaps: add --view visits, tri-tests or cost".into(),
         ));
@@ -155,40 +170,43 @@ fn run_against(
     let (bvh_b, _) = device::build_scene(gpu, loaded, &params_b)?;
     let frame_b = frame_of(a, gpu, &bvh_b, camera, settings, "rendering the second build")?;
     let cost = params_a.bvh.cost;
-    let d = difference(frame_a, &frame_b, a.view, cost).expect("two complete counted frames of one camera");
     if let Some(path) = &a.difference {
-        // Each pixel's value (a warp view's is its group's), as the difference has them.
-        let values_a = crate::render::grid_values(frame_a, a.view, cost);
-        let values_b = crate::render::grid_values(&frame_b, a.view, cost);
-        let mut w = csv::Writer::from_writer(Vec::new());
-        let _ = w.write_record(["x", "y", "a", "b", "b_minus_a"]);
-        for (i, v) in d.iter().enumerate() {
-            let (x, y) = (i as u32 % camera.width, i as u32 / camera.width);
-            let (va, vb) = (values_a[i], values_b[i]);
-            let _ = w.write_record([x.to_string(), y.to_string(), va.to_string(), vb.to_string(), v.to_string()]);
-        }
-        let bytes = w.into_inner().expect("writing to memory");
-        crate::files::write_bytes(path, &bytes)?;
+        let text = difference_csv(frame_a, &frame_b, a.view, cost).expect("two complete counted frames of one camera");
+        crate::files::write_bytes(path, text.as_bytes())?;
     }
-    let range = match (a.range, a.percentile) {
-        (Some((lo, hi)), _) => DiffRange::Fixed(lo.abs().max(hi.abs())),
-        (None, p) => DiffRange::Percentile(p.unwrap_or(crate::render::diff::DEFAULT_PERCENTILE)),
+    let style = PairStyle {
+        view: a.view,
+        colormap: a.colormap,
+        cost,
+        range: a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max }),
+        diff_range: match (a.range, a.percentile) {
+            (Some((lo, hi)), _) => DiffRange::Fixed(lo.abs().max(hi.abs())),
+            (None, p) => DiffRange::Percentile(p.unwrap_or(crate::render::diff::DEFAULT_PERCENTILE)),
+        },
     };
-    let (img, mut legend) = difference_image(camera.width, &d, a.view, range);
-    legend.subject = format!("{}: A {label_a}, B {}", file_name(&a.mesh), params_b.label());
-    let img = draw_legend(&img, &legend);
+    let subject = format!("{}: A {label_a}, B {}", file_name(&a.mesh), bvh_b.label());
+    let img = pair_picture(frame_a, &frame_b, a.pair_view, a.wipe, &style, &subject)
+        .expect("two complete frames of one camera, counted for a heatmap");
     crate::files::write_png(&a.output, &img)?;
-    let (less, same, more) = tally(&d);
-    eprintln!(
-        "wrote {} ({}x{} difference of {}, B {} minus A {}: B does less work at {less} pixels, the same at {same}, more at {more}; mean {:.3})",
-        a.output.display(),
-        camera.width,
-        camera.height,
-        a.view.label().to_lowercase(),
-        params_b.label(),
-        label_a,
-        legend.mean
-    );
+    let (w, h, b_label) = (camera.width, camera.height, bvh_b.label());
+    match difference(frame_a, &frame_b, a.view, cost) {
+        Some(d) => {
+            let (less, same, more) = tally(&d);
+            let mean = d.iter().map(|&v| v as f64).sum::<f64>() / d.len().max(1) as f64;
+            eprintln!(
+                "wrote {} ({w}x{h} {} of {}, B {b_label} against A {label_a}: B does less work at {less} pixels, the same at {same}, more at {more}; mean B - A {mean:.3})",
+                a.output.display(),
+                a.pair_view.label().to_lowercase(),
+                a.view.label().to_lowercase(),
+            )
+        }
+        None => eprintln!(
+            "wrote {} ({w}x{h} {} of {}, A {label_a} and B {b_label})",
+            a.output.display(),
+            a.pair_view.label().to_lowercase(),
+            a.view.label().to_lowercase()
+        ),
+    }
     Ok(())
 }
 

@@ -131,7 +131,7 @@ fn two_strategies_side_by_side_and_their_difference() {
     // Modes: the wipe line drags; the difference mode.
     h.get_by_label("Wipe").click();
     h.run_steps(2);
-    assert_eq!(h.state().compare.mode, bvhscope::app::CompareMode::Wipe);
+    assert_eq!(h.state().compare.mode, bvhscope::render::PairView::Wipe);
     let line = h.get_by_label("Wipe line").rect();
     let (from, to) = (line.center(), line.center() - egui::vec2(120.0, 0.0));
     h.input_mut().events.push(egui::Event::PointerMoved(from));
@@ -156,7 +156,7 @@ fn two_strategies_side_by_side_and_their_difference() {
     assert!(h.state().compare.wipe < 0.45, "dragged left: {}", h.state().compare.wipe);
     h.get_by_label("Difference B - A").click();
     h.run_steps(2);
-    assert_eq!(h.state().compare.mode, bvhscope::app::CompareMode::Difference);
+    assert_eq!(h.state().compare.mode, bvhscope::render::PairView::Difference);
 
     // A changes: only A is rebuilt, B is kept.
     let mut s = h.state().settings.clone();

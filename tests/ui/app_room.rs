@@ -92,3 +92,61 @@ fn compare_ranges_are_fixed_on_the_shared_scale_and_the_difference_too() {
     let diff = h.state().compare_images(&ctx).unwrap().diff.as_ref().unwrap().2.clone();
     assert_eq!((diff.range_min, diff.range_max), (-3.0, 3.0));
 }
+
+/// In Compare, File ▸ Save view writes what is on screen (halves, wipe, difference, each with its
+/// legend) and Export counts the pair's numbers (x, y, a, b, b_minus_a), each byte for byte what
+/// `render --against … --pair-view … --difference` writes for the same camera; the names say so.
+#[test]
+fn compare_exports_are_what_the_screen_shows_byte_for_byte_the_clis() {
+    use bvhscope::app::{PairView, Pick};
+    let mut h = harness();
+    let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
+    open(&mut h, &torus);
+    with_strategy(&mut h, SplitStrategy::Midpoint);
+    h.state_mut().act(Action::View(2));
+    run_until(&mut h, "midpoint's heatmap", |a| {
+        idle(a)
+            && a.shown
+                .as_ref()
+                .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
+    });
+    h.state_mut().act(Action::Compare(true));
+    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a));
+    assert_eq!(h.state().compare.strategy, SplitStrategy::SahBinned);
+    let camera = h.state().shown.as_ref().unwrap().camera;
+    let cli = |pair: &str, wipe: f32, png: &Path, csv: &Path| {
+        let mut args = vec![s("render"), s(torus.display()), s("--strategy"), s("midpoint"), s("--view"), s("visits")];
+        args.extend(camera_words(&camera));
+        args.extend([s("--against"), s("sah"), s("--pair-view"), s(pair), s("--wipe"), s(wipe)]);
+        args.extend([s("--difference"), s(csv.display()), s("-o"), s(png.display())]);
+        bvhscope::cli::run(words(&args)).unwrap();
+    };
+    let mut written = Vec::new();
+    for (mode, pair, wipe) in
+        [(PairView::Halves, "halves", 0.5), (PairView::Wipe, "wipe", 0.3), (PairView::Difference, "difference", 0.5)]
+    {
+        h.state_mut().act(Action::CompareMode(mode));
+        h.state_mut().compare.wipe = wipe;
+        h.run_steps(2);
+        let name = bvhscope::app::default_name(h.state(), "png");
+        assert!(name.contains("midpoint-vs-sah") && name.ends_with(&format!("visits-{pair}.png")), "{name}");
+        let app_png = temp_file(&format!("app-{pair}.png"), "");
+        h.state_mut().act(Action::Picked(Pick::SavePng, app_png.clone()));
+        let (cli_png, cli_csv) = (temp_file(&format!("cli-{pair}.png"), ""), temp_file(&format!("cli-{pair}.csv"), ""));
+        cli(pair, wipe, &cli_png, &cli_csv);
+        let bytes = std::fs::read(&app_png).unwrap();
+        assert!(bytes == std::fs::read(&cli_png).unwrap(), "{pair}: the app's PNG is the CLI's");
+        written.push(bytes);
+        if mode == PairView::Difference {
+            let name = bvhscope::app::default_name(h.state(), "counts");
+            assert!(name.ends_with("midpoint-vs-sah-visits-difference.csv"), "{name}");
+            let app_csv = temp_file("app-pair.csv", "");
+            h.state_mut().act(Action::Picked(Pick::SaveCounts, app_csv.clone()));
+            let text = std::fs::read_to_string(&app_csv).unwrap();
+            assert!(text.starts_with("x,y,a,b,b_minus_a\n"), "{}", &text[..40.min(text.len())]);
+            assert_eq!(text, std::fs::read_to_string(&cli_csv).unwrap(), "the app's pair counts are the CLI's");
+        }
+    }
+    // The halves and the difference are different pictures (the export follows the screen).
+    assert!(written[0] != written[1] && written[0] != written[2] && written[1] != written[2]);
+}

@@ -2,9 +2,10 @@
 //! and the figures of A, B and B − A: the trees' and the frame's per-ray work, as the statistics
 //! panel gives them for A.
 
-use crate::app::{Action, Actions, BvhscopeApp, CompareMode};
+use crate::app::{Action, Actions, BvhscopeApp};
 use crate::bvh::{Layout, SplitStrategy, TraversalOrder};
 use crate::options::Choice;
+use crate::render::PairView;
 
 pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
     let c = &app.compare;
@@ -52,7 +53,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                 out.push(Action::CompareB { max_leaf_size: leaf, layout, trace });
             }
             ui.horizontal(|ui| {
-                for m in CompareMode::ALL {
+                for m in PairView::ALL {
                     if ui.radio(c.mode == m, m.label()).clicked() {
                         out.push(Action::CompareMode(m));
                     }

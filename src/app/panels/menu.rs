@@ -68,11 +68,16 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             if ui.button("Export statistics as JSON…").clicked() {
                 out.push(Action::ExportStatsJson);
             }
-            if ui
-                .button("Export counts as CSV…")
-                .on_hover_text("One row per pixel: x, y, nodes visited, box tests, leaves, triangle tests, hit triangle (-1: miss); the numbers the heatmaps colour")
-                .clicked()
-            {
+            let counts = if app.compare.on {
+                ui.button("Export the pair's counts as CSV…").on_hover_text(
+                    "One row per pixel: x, y, A's value, B's value, B - A of the heatmap's metric (render --against … --difference)",
+                )
+            } else {
+                ui.button("Export counts as CSV…").on_hover_text(
+                    "One row per pixel: x, y, nodes visited, box tests, leaves, triangle tests, hit triangle (-1: miss); the numbers the heatmaps colour",
+                )
+            };
+            if counts.clicked() {
                 out.push(Action::ExportCounts);
             }
             if ui

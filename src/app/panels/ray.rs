@@ -85,7 +85,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
                     under + &st.iter().map(|(n, t)| format!("{n} @ {t:.3}")).collect::<Vec<_>>().join(", ")
                 }
             };
-            command_line(r, ui);
+            command_line(r, ui, out);
             // The step shown, whole and wrapped (the list below keeps one line a step).
             if let Some(s) = r.named.get(k) {
                 ui.add(egui::Label::new(egui::RichText::new(format!("Step {}: {}", k + 1, s.brief())).strong()).wrap());
@@ -151,11 +151,12 @@ fn legend(ui: &mut egui::Ui) {
 }
 
 /// The `bvhscope trace` command that prints this ray's steps, to copy into a terminal or a report.
-fn command_line(r: &crate::app::ray_view::PinnedRay, ui: &mut egui::Ui) {
+fn command_line(r: &crate::app::ray_view::PinnedRay, ui: &mut egui::Ui, out: &mut Actions) {
     ui.horizontal(|ui| match &r.command {
         Some(cmd) => {
-            if ui.button("Copy trace command").on_hover_text(cmd.as_str()).clicked() {
-                ui.ctx().copy_text(cmd.clone());
+            let tip = format!("{cmd}\n(Ctrl+Shift+C)");
+            if ui.button("Copy trace command").on_hover_text(tip).clicked() {
+                out.push(Action::CopyTraceCommand);
             }
             ui.weak("the same steps on the command line (bvhscope trace)");
         }

@@ -30,7 +30,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     // The range on screen: side by side, the pair's one scale (A's alone would clip B's hottest
     // pixels); the difference's is its own ±range (below).
     let compared = app.compare_images(ui.ctx());
-    let difference = app.compare.mode == crate::app::CompareMode::Difference;
+    let difference = app.compare.mode == crate::render::PairView::Difference;
     let pair_range = compared.as_ref().filter(|_| !difference).and_then(|c| c.legend.as_ref());
     let legend_range =
         pair_range.or(app.shown.as_ref().and_then(|s| s.legend.as_ref())).map(|l| (l.range_min, l.range_max));
