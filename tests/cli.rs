@@ -130,7 +130,7 @@ fn a_scene_renders_and_reports_two_levels() {
     std::fs::write(
         &scene,
         format!(
-            r#"{{"note": "three tents", "meshes": [
+            r#"{{"note": "Three tents. Two of one file, moved and turned.", "meshes": [
                 {{"file": "{0}"}},
                 {{"file": "{0}", "transform": {{"translate": [3, 0, 0], "rotate": {{"axis": [0, 1, 0], "degrees": 30}}}}}},
                 {{"file": "{0}", "transform": {{"translate": [-3, 0, 0], "scale": 0.5}}}}]}}"#,
@@ -144,7 +144,8 @@ fn a_scene_renders_and_reports_two_levels() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("3 placements of 1 meshes: 12 triangles as placed, 4 stored"), "{text}");
     assert!(text.contains("top level       Midpoint"), "{text}");
-    assert!(String::from_utf8_lossy(&out.stderr).contains("three tents"), "the scene's note is shown");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("Three tents. Two of one file, moved and turned."), "stats shows the whole note: {err}");
 
     let png = tmp("tents-top.png");
     let out =
@@ -152,6 +153,9 @@ fn a_scene_renders_and_reports_two_levels() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("top-level nodes visited per ray"), "{err}");
+    // Other commands print the note's first sentence and where the rest is.
+    assert!(err.contains("about this scene: Three tents. (the whole note: bvhscope stats"), "{err}");
+    assert!(!err.contains("moved and turned"), "{err}");
     assert!(image::open(&png).is_ok());
 
     let out = bvhscope(&["render", s, "--top-strategy", "sah", "-o", png.to_str().unwrap()]);

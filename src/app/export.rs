@@ -118,7 +118,7 @@ fn rows(app: &BvhscopeApp) -> Vec<(&'static str, StrategyFigures)> {
 /// The statistics rows as CSV (RFC 4180, written by the `csv` crate, so a label with a comma is
 /// quoted): one record per strategy; per-ray fields are empty while not yet measured.
 pub fn stats_csv(rows: &[(&str, StrategyFigures)]) -> String {
-    const HEADER: [&str; 20] = [
+    const HEADER: [&str; 24] = [
         "which",
         "strategy",
         "triangles",
@@ -139,6 +139,10 @@ pub fn stats_csv(rows: &[(&str, StrategyFigures)]) -> String {
         "root_box_mean_nodes_visited",
         "root_box_mean_box_tests",
         "root_box_mean_triangle_tests",
+        "frame_ms",
+        "one_thread_tree_ms",
+        "one_thread_linear_ms",
+        "speedup_over_linear",
     ];
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(HEADER).expect("writing CSV to memory");
@@ -169,7 +173,15 @@ pub fn stats_csv(rows: &[(&str, StrategyFigures)]) -> String {
                 format!("{:.3}", r.root_mean_box_tests),
                 format!("{:.3}", r.root_mean_triangle_tests),
             ]),
-            None => rec.resize(HEADER.len(), String::new()),
+            None => rec.resize(HEADER.len() - 4, String::new()),
+        }
+        // Measured or empty: the frame's time (every core), the lab's speed-up (one thread).
+        rec.push(f.frame_ms.map_or(String::new(), |ms| format!("{ms:.3}")));
+        match &f.speedup {
+            Some(t) => {
+                rec.extend([format!("{:.3}", t.tree_ms), format!("{:.3}", t.linear_ms), format!("{:.2}", t.speedup)])
+            }
+            None => rec.extend([String::new(), String::new(), String::new()]),
         }
         w.write_record(&rec).expect("writing CSV to memory");
     }
@@ -187,7 +199,8 @@ pub fn stats_text(app: &BvhscopeApp, format: StatsFormat) -> Result<String, Stri
                 .iter()
                 .map(|(which, f)| {
                     let rays = f.rays.map(|r| serde_json::json!({ "summary": r.summary, "camera": r.camera, "trace": r.trace }));
-                    serde_json::json!({ "which": which, "strategy": f.label, "build_ms": f.build_ms, "tree": f.stats, "rays": rays })
+                    let speedup = f.speedup.as_ref().map(|t| serde_json::json!({ "rays": t.rays, "one_thread_tree_ms": t.tree_ms, "one_thread_linear_ms": t.linear_ms, "linear_sampled": t.linear_sampled, "speedup_over_linear": t.speedup }));
+                    serde_json::json!({ "which": which, "strategy": f.label, "build_ms": f.build_ms, "frame_ms": f.frame_ms, "speedup": speedup, "tree": f.stats, "rays": rays })
                 })
                 .collect();
             let v = serde_json::json!({ "scene": app.scene.title(), "triangles": app.scene.report.triangles, "strategies": items });
@@ -296,6 +309,14 @@ mod tests {
                     stats: stats.clone(),
                     build_ms: 1.25,
                     rays: Some(measured),
+                    frame_ms: Some(41.5),
+                    speedup: Some(crate::explain::timing::Speedup {
+                        rays: 3072,
+                        tree_ms: 2.0,
+                        linear_ms: 90.0,
+                        linear_sampled: None,
+                        speedup: 45.0,
+                    }),
                 },
             ),
             (
@@ -305,6 +326,8 @@ mod tests {
                     stats,
                     build_ms: 0.5,
                     rays: None,
+                    frame_ms: None,
+                    speedup: None,
                 },
             ),
         ];
@@ -323,5 +346,9 @@ mod tests {
         assert_eq!(field(&records[0], "rays_in_root_box"), "1000");
         assert_eq!(field(&records[1], "mean_nodes_visited"), "", "not measured is empty, not 0");
         assert_eq!(field(&records[1], "build_ms"), "0.500");
+        assert_eq!(field(&records[0], "frame_ms"), "41.500");
+        assert_eq!(field(&records[0], "speedup_over_linear"), "45.00");
+        assert_eq!(field(&records[0], "one_thread_linear_ms"), "90.000");
+        assert_eq!(field(&records[1], "speedup_over_linear"), "", "not timed is empty");
     }
 }

@@ -51,6 +51,10 @@ pub struct StrategyFigures {
     /// The whole build, every level.
     pub build_ms: f64,
     pub rays: Option<MeasuredRays>,
+    /// The last full frame's time (ms, every core), where it was of this tree.
+    pub frame_ms: Option<f64>,
+    /// This tree timed against the linear scan on the frame (one thread), where it was.
+    pub speedup: Option<crate::explain::timing::Speedup>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -424,7 +424,21 @@ impl BvhscopeApp {
             },
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
             rays: self.rays,
+            frame_ms: self
+                .last_full_frame
+                .filter(|_| self.shown.as_ref().is_some_and(|s| Arc::ptr_eq(&s.bvh, &b.bvh)))
+                .map(|d| d.as_secs_f64() * 1e3),
+            speedup: self.fresh_speedup().map(|t| t.speedup),
         })
+    }
+
+    /// The timing against the linear scan of the tree, camera and traversal on screen, if there
+    /// is one (an older tree's or camera's is stale).
+    pub fn fresh_speedup(&self) -> Option<&jobs::Timed> {
+        let shown = self.shown.as_ref()?;
+        self.speedup
+            .as_ref()
+            .filter(|t| Arc::ptr_eq(&t.bvh, &shown.bvh) && t.camera == shown.camera && t.trace == shown.trace)
     }
 
     /// B's figures for the statistics panel's second column, while comparing side by side.
@@ -435,6 +449,8 @@ impl BvhscopeApp {
             stats: b.stats.clone(),
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
             rays: Some(MeasuredRays { summary: b.summary, camera: b.camera, trace: b.trace }),
+            frame_ms: None,
+            speedup: None,
         })
     }
 

@@ -128,8 +128,15 @@ pub enum CliError {
     Defects(usize),
 }
 
-/// Load a mesh or a scene with a spinner when it takes over a second, and print what was skipped.
+/// Load a mesh or a scene with a spinner when it takes over a second, and print what was skipped
+/// and the first sentence of the scene's note.
 pub(crate) fn load_mesh(path: &Path) -> Result<Scene, CliError> {
+    load_noted(path, false)
+}
+
+/// `load_mesh`, with the scene's whole note (`stats`, the command that describes a scene; a
+/// paragraph before every render's one line of output buried that line).
+pub(crate) fn load_noted(path: &Path, whole_note: bool) -> Result<Scene, CliError> {
     let label = format!("loading {}", path.display());
     let loaded = progress::with_spinner(&label, || Scene::open(path))?;
     if loaded.report.degenerate_skipped > 0 {
@@ -143,9 +150,20 @@ pub(crate) fn load_mesh(path: &Path) -> Result<Scene, CliError> {
         eprintln!("warning: {}: {w}", path.display());
     }
     if let Some(note) = loaded.desc.as_ref().and_then(|s| s.note.as_ref()) {
-        eprintln!("about this scene: {note}");
+        match first_sentence(note) {
+            Some(first) if !whole_note => {
+                eprintln!("about this scene: {first} (the whole note: bvhscope stats {})", path.display())
+            }
+            _ => eprintln!("about this scene: {note}"),
+        }
     }
     Ok(loaded)
+}
+
+/// The text up to its first full stop followed by a space, if there is more after it.
+fn first_sentence(text: &str) -> Option<&str> {
+    let end = text.find(". ")?;
+    Some(&text[..=end])
 }
 
 /// Build what `build` asks for over a loaded file; for two levels an OBJ is one placement of

@@ -3,7 +3,7 @@
 
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
 use super::device::{self, GpuBuild, GpuTree};
-use super::{load_mesh, progress, CliError};
+use super::{load_noted, progress, CliError};
 use crate::bvh::{epo, Hierarchy, RayCounters, SceneBvh, TreeStats, TreeView};
 use crate::render::warp::{WarpSize, WarpSummary, WarpView, WarpWork};
 use crate::render::{render, Camera, RaySummary, RenderSettings};
@@ -112,7 +112,7 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
 /// What `run` prints (the app's tests compare it with the build panel and statistics).
 pub fn output(a: &StatsArgs) -> Result<String, CliError> {
     let gpu = device::open(&a.device)?;
-    let loaded = load_mesh(&a.mesh)?;
+    let loaded = load_noted(&a.mesh, true)?;
     let mut params = a.build.params(loaded.build.as_ref());
     let trace = a.build.trace();
     if gpu.is_some() {

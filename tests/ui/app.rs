@@ -243,9 +243,24 @@ fn the_view_and_the_statistics_can_be_exported() {
     let rec = reader.records().next().unwrap().unwrap();
     assert_eq!(rec.len(), header.len());
     assert_eq!((&rec[0], &rec[1]), ("current", "SAH binned, wide4"), "{text}");
+    // The lab's figures: the frame's time, and, once timed, the speed-up over linear search.
+    let field = |rec: &csv::StringRecord, name: &str| rec[header.iter().position(|h| h == name).unwrap()].to_string();
+    let frame_ms = h.state().last_full_frame.unwrap().as_secs_f64() * 1e3;
+    assert_eq!(field(&rec, "frame_ms"), format!("{frame_ms:.3}"));
+    assert_eq!(field(&rec, "speedup_over_linear"), "", "not timed yet");
+    h.state_mut().act(Action::TimeLinear(true));
+    run_until(&mut h, "the timing against the linear scan", |a| a.fresh_speedup().is_some());
+    h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveStatsCsv, csv.clone()));
+    let timed = h.state().fresh_speedup().unwrap().speedup;
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let rec = reader.records().next().unwrap().unwrap();
+    assert_eq!(field(&rec, "speedup_over_linear"), format!("{:.2}", timed.speedup), "{text}");
+    assert_eq!(field(&rec, "one_thread_linear_ms"), format!("{:.3}", timed.linear_ms), "{text}");
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["strategies"][0]["tree"]["nodes"], h.state().current_bvh().unwrap().stats.nodes);
-    assert_eq!(h.query_all_by_label_contains("Note: Saved").count(), 3, "each save is confirmed on screen");
+    h.run_steps(3);
+    assert_eq!(h.query_all_by_label_contains("Note: Saved").count(), 3, "each file saved is confirmed on screen, once");
 }
 
 #[test]

@@ -342,11 +342,7 @@ fn speedup(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions) 
         ui.ctx().request_repaint_after(std::time::Duration::from_millis(100));
         return;
     }
-    let fresh = app
-        .speedup
-        .as_ref()
-        .filter(|t| std::sync::Arc::ptr_eq(&t.bvh, &shown.bvh) && t.camera == shown.camera && t.trace == shown.trace);
-    match fresh {
+    match app.fresh_speedup() {
         Some(t) => {
             let s = &t.speedup;
             let sampled = s.linear_sampled.map_or(String::new(), |n| format!(" (projected from {n} rays)"));
