@@ -4,6 +4,7 @@
 //! what to rebuild and what to re-render (the egui demo app's split of state and UI).
 
 use super::node_view::{Metric, Step as NodeStep};
+use super::settings::{PRESENT_SCALE, UI_SCALES};
 use super::{export, BvhscopeApp, MessageKind, PathWindow, Pick, PinnedRay, RayView, Settings};
 use crate::bvh::{Preset, SplitStrategy};
 use crate::render::{ColorMap, UpAxis, View};
@@ -169,6 +170,14 @@ pub enum Action {
     },
     /// Put the selected pinned ray's `bvhscope trace` command on the clipboard.
     CopyTraceCommand,
+    /// Presenting to a room: large text, large plots (View › Present), or the other way (F5).
+    Present(bool),
+    TogglePresent,
+    /// The screen's scale: set, or a step of 10 % up or down (Ctrl +/−).
+    UiScale(f32),
+    UiScaleBy(i32),
+    /// The docked layout as a fresh start has it.
+    ResetLayout,
 }
 
 /// Where panels put the actions they emit during one frame.
@@ -451,6 +460,16 @@ impl BvhscopeApp {
                 ),
                 None => self.message(MessageKind::Info, "Pin a ray first (Ctrl+click on the image)"),
             },
+            A::Present(on) => self.settings.present = on,
+            A::TogglePresent => self.settings.present = !self.settings.present,
+            A::UiScale(s) => self.settings.ui_scale = s.clamp(*UI_SCALES.start(), *UI_SCALES.end()),
+            A::UiScaleBy(steps) => {
+                // From the scale on screen, so a step while presenting starts at 150 %.
+                let s = ((self.settings.zoom() * 10.0).round() + steps as f32) / 10.0;
+                self.settings.ui_scale = s.clamp(*UI_SCALES.start(), *UI_SCALES.end());
+                self.settings.present &= self.settings.ui_scale >= PRESENT_SCALE;
+            }
+            A::ResetLayout => self.dock = Some(super::dock::default_layout()),
             A::DismissEarlier(n) => {
                 self.messages.drain(..n.min(self.messages.len()));
             }

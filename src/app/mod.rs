@@ -6,6 +6,7 @@
 mod action;
 mod compare_view;
 mod derived;
+pub mod dock;
 mod events;
 mod explain_overlay;
 mod export;
@@ -82,6 +83,9 @@ pub fn run(options: AppOptions) -> Result<(), String> {
         .map_err(|e| format!("cannot open the window: {e}"))
 }
 
+/// Where the docked layout is saved (beside the settings, under `eframe::APP_KEY`).
+const DOCK_KEY: &str = "bvhscope-dock";
+
 pub struct BvhscopeApp {
     pub settings: Settings,
     pub scene: Arc<Scene>,
@@ -123,6 +127,8 @@ pub struct BvhscopeApp {
     pending_import: Option<PathBuf>,
     /// Text to put on the clipboard at the end of this frame (the clipboard is the context's).
     pub clipboard: Option<String>,
+    /// The docked layout (saved with the settings); out of the app only while it is drawn.
+    pub dock: Option<dock::Layout>,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     box_cache: std::cell::RefCell<Option<BoxCache>>,
     overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
@@ -195,6 +201,12 @@ impl BvhscopeApp {
             last_full_frame: None,
             messages: Vec::new(),
             clipboard: None,
+            dock: Some(
+                cc.storage
+                    .and_then(|s| eframe::get_value::<dock::Layout>(s, DOCK_KEY))
+                    .filter(dock::valid)
+                    .unwrap_or_else(dock::default_layout),
+            ),
             show_help: false,
             path_window: None,
             pins: RayView::default(),
@@ -484,6 +496,13 @@ impl BvhscopeApp {
 impl eframe::App for BvhscopeApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        // The screen's scale is a setting (saved; Ctrl +/− and View › Present change it), not
+        // egui's own keyboard zoom, which the shortcuts replace.
+        ctx.options_mut(|o| o.zoom_with_keyboard = false);
+        let zoom = self.settings.zoom();
+        if (ctx.zoom_factor() - zoom).abs() > 1e-3 {
+            ctx.set_zoom_factor(zoom);
+        }
         let mut actions = Actions::new();
         self.handle_input(&ctx, &mut actions);
         // The panels see the state as it is after the input's actions.
@@ -511,5 +530,8 @@ impl eframe::App for BvhscopeApp {
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         eframe::set_value(storage, eframe::APP_KEY, &self.settings);
+        if let Some(layout) = &self.dock {
+            eframe::set_value(storage, DOCK_KEY, layout);
+        }
     }
 }

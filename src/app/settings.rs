@@ -53,6 +53,28 @@ pub struct Settings {
     /// The node format the GPU walks.
     pub gpu_nodes: GpuNodes,
     pub recent_files: Vec<PathBuf>,
+    /// The size of everything on screen (Ctrl +/−; 1: egui's own).
+    pub ui_scale: f32,
+    /// Presenting to a room (View › Present): everything at least `PRESENT_SCALE`, the Node
+    /// view's plots half its tile tall.
+    pub present: bool,
+}
+
+/// Presenting: text of at least 18 px (egui's body text is 12.5 px at scale 1).
+pub const PRESENT_SCALE: f32 = 1.5;
+/// The sizes Ctrl +/− choose among.
+pub const UI_SCALES: std::ops::RangeInclusive<f32> = 0.75..=2.5;
+
+impl Settings {
+    /// The scale the screen is drawn at.
+    pub fn zoom(&self) -> f32 {
+        let s = self.ui_scale.clamp(*UI_SCALES.start(), *UI_SCALES.end());
+        if self.present {
+            s.max(PRESENT_SCALE)
+        } else {
+            s
+        }
+    }
 }
 
 impl Default for Settings {
@@ -78,6 +100,8 @@ impl Default for Settings {
             device: Device::Cpu,
             gpu_nodes: GpuNodes::Binary,
             recent_files: Vec::new(),
+            ui_scale: 1.0,
+            present: false,
         }
     }
 }

@@ -131,13 +131,13 @@ fn a_typed_ray_is_pinned_and_a_bad_one_is_refused() {
         (h.state().settings.view, h.state().settings.show_boxes, h.state().settings.build.strategy);
     h.state_mut().act(Action::ShowRayWindow);
     h.run_steps(2);
-    h.get_by_label("Origin").click();
+    focus_label(&mut h, "Origin");
     h.run_steps(1);
     type_keys(&mut h, "0, 0.3, 10");
-    h.get_by_label("Direction").click();
+    focus_label(&mut h, "Direction");
     h.run_steps(1);
     type_keys(&mut h, "0 0 -1");
-    h.get_by_label("Pin typed ray").click();
+    click_label(&mut h, "Pin typed ray");
     h.run_steps(3);
     let app = h.state();
     // "3" (the nodes-visited view's key) typed into a field fires no shortcut.
@@ -237,9 +237,9 @@ fn a_node_is_selected_from_the_tree_the_icicle_and_the_viewport() {
     h.get_by_label_contains("Axis x: ");
 
     // The tree's rows: open the root, select its right child.
-    h.get_by_label("+").click();
+    click_label(&mut h, "+");
     h.run_steps(2);
-    h.get_by_label_contains("node 2 · d1").click();
+    click_label_containing(&mut h, "node 2 · d1");
     run_until(&mut h, "node 2's inspection", |a| a.nodes.inspection.as_ref().is_some_and(|i| i.node == 2));
     {
         let app = h.state();

@@ -48,8 +48,7 @@ pub(super) fn graded_class(tag: &str) -> PathBuf {
 /// The chosen student's tree on screen, against B, with nothing left running.
 pub(super) fn student_shown(a: &BvhscopeApp) -> bool {
     a.grade.pending.is_none()
-        && a.compare.b.is_some()
-        && idle(a)
+        && pair_shown(a)
         && a.jobs.compare.is_none()
         && a.jobs.wrong.is_none()
         && a.shown.as_ref().is_some_and(|s| s.bvh.import().is_some())
@@ -70,7 +69,7 @@ fn a_grade_report_shows_a_student_against_sah_or_why_not() {
         h.get_by_label(label);
     }
 
-    h.get_by_label("ada").click();
+    click_label(&mut h, "ada");
     run_until(&mut h, "ada's tree against SAH binned", student_shown);
     {
         let app = h.state();
@@ -92,7 +91,7 @@ fn a_grade_report_shows_a_student_against_sah_or_why_not() {
     }
     h.get_by_label_contains("A = imported: ada.txt (0 defects as checked here), B = SAH binned");
 
-    h.get_by_label("cy").click();
+    click_label(&mut h, "cy");
     run_until(&mut h, "cy's reason", |a| a.grade.why_not.is_some() && idle(a));
     let app = h.state();
     assert!(app.import.tree.is_none() && !app.import.on && !app.compare.on, "nothing imported");

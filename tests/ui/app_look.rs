@@ -119,3 +119,53 @@ fn look_gpu_frame() {
     });
     save(&mut h, "app-gpu-ploc");
 }
+
+/// The app as a room sees it (issue 48): at 1280×720, at scale 1 and presenting (150 %), the
+/// Node view on the knot-on-floor's root, a ray walked through midpoint's tree, and Compare's
+/// difference; every view a tile beside the image.
+#[test]
+#[ignore]
+fn look_projector() {
+    for present in [false, true] {
+        let suffix = if present { "-present" } else { "" };
+        let projector = || {
+            Harness::builder()
+                .with_size(egui::vec2(1280.0, 720.0))
+                .wgpu()
+                .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()))
+        };
+        let scene = root().join("scenes/knot-on-floor.json");
+        // The Node view.
+        let mut h = projector();
+        h.state_mut().act(Action::Present(present));
+        open(&mut h, &scene);
+        h.state_mut().act(Action::ShowTree(true));
+        h.state_mut().act(Action::SelectNode(0));
+        run_until(&mut h, "the root's inspection", |a| {
+            a.nodes.inspection.as_ref().is_some_and(|i| i.node == 0) && a.nodes.visits.is_some()
+        });
+        save(&mut h, &format!("projector-node{suffix}"));
+        // A ray's walk through midpoint's tree.
+        let mut h = projector();
+        h.state_mut().act(Action::Present(present));
+        open(&mut h, &scene);
+        with_strategy(&mut h, bvhscope::bvh::SplitStrategy::Midpoint);
+        run_until(&mut h, "midpoint's frame", |a| {
+            idle(a) && a.current_bvh().is_some_and(|b| b.bvh.label().starts_with("Midpoint"))
+        });
+        let (w, hgt) = h.state().viewport_pixels();
+        h.state_mut().act(Action::PinPixel(w / 2, hgt / 3));
+        for _ in 0..10 {
+            h.step();
+        }
+        h.state_mut().act(Action::RayStep(12));
+        save(&mut h, &format!("projector-ray{suffix}"));
+        // Compare: midpoint against SAH binned, the difference of nodes visited.
+        h.state_mut().act(Action::UnpinAll);
+        h.state_mut().act(Action::View(2));
+        h.state_mut().act(Action::Compare(true));
+        h.state_mut().act(Action::CompareMode(bvhscope::render::PairView::Difference));
+        run_until(&mut h, "B", pair_shown);
+        save(&mut h, &format!("projector-compare{suffix}"));
+    }
+}

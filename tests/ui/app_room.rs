@@ -111,7 +111,7 @@ fn compare_exports_are_what_the_screen_shows_byte_for_byte_the_clis() {
                 .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
     });
     h.state_mut().act(Action::Compare(true));
-    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a));
+    run_until(&mut h, "B", pair_shown);
     assert_eq!(h.state().compare.strategy, SplitStrategy::SahBinned);
     let camera = h.state().shown.as_ref().unwrap().camera;
     let cli = |pair: &str, wipe: f32, png: &Path, csv: &Path| {

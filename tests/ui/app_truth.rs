@@ -44,7 +44,7 @@ fn bs_epo_is_shown() {
     let mut h = harness();
     open(&mut h, &root().join("assets/torus.obj"));
     h.state_mut().act(Action::Compare(true));
-    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a) && a.jobs.compare.is_none());
+    run_until(&mut h, "B", |a| pair_shown(a) && a.jobs.compare.is_none());
     let b = h.state().compare_figures().unwrap();
     let epo = b.stats.epo.expect("B's EPO");
     let tree = h.state().compare.b.as_ref().unwrap().bvh.binary_tree().unwrap();
@@ -211,7 +211,7 @@ fn the_node_window_gives_the_split_cost_term_by_term() {
     let m = ins.markers.iter().find(|(s, _)| *s == own).and_then(|(_, m)| *m).expect("this tree's split");
     let terms = m.terms(ins.sah).text();
     assert!(h.query_all_by_label_contains(&format!("(this tree's split): {terms}")).count() >= 1, "{terms}");
-    h.get_by_label("One cost scale for the three axes").click();
+    click_label(&mut h, "One cost scale for the three axes");
     h.step();
     assert!(h.state().nodes.shared_scale);
 }

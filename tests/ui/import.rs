@@ -147,7 +147,7 @@ fn a_dropped_dump_is_checked_and_traced_by_every_view() {
 
     // Side by side: B, SAH's build, against the imported tree.
     h.state_mut().act(Action::Compare(true));
-    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a) && a.jobs.compare.is_none());
+    run_until(&mut h, "B", |a| pair_shown(a) && a.jobs.compare.is_none());
     assert!(h.state().compare_images(&h.ctx.clone()).is_some());
     assert!(h.query_all_by_label_contains("imported: broken.json").count() >= 1);
     h.state_mut().act(Action::Compare(false));

@@ -16,7 +16,12 @@ pub fn harness() -> Harness<'static, BvhscopeApp> {
 /// Step the app until `done` holds (background jobs report asynchronously).
 pub fn run_until(h: &mut Harness<'_, BvhscopeApp>, what: &str, done: impl Fn(&BvhscopeApp) -> bool) {
     let start = Instant::now();
+    let mut told = Instant::now();
     while !done(h.state()) {
+        if told.elapsed() > Duration::from_secs(30) {
+            told = Instant::now();
+            eprintln!("still waiting for {what}: {}", state_line(h.state()));
+        }
         // A guard against a hang, not a timing: CI's 2 cores under a parallel test run took over
         // two minutes for an import's check (debug build) when the app was not stuck.
         assert!(start.elapsed() < Duration::from_secs(600), "timed out waiting for {what}");
@@ -27,8 +32,53 @@ pub fn run_until(h: &mut Harness<'_, BvhscopeApp>, what: &str, done: impl Fn(&Bv
     h.step();
 }
 
+/// What a long wait is waiting on: the jobs running, the image's size, the frames' cameras.
+fn state_line(a: &BvhscopeApp) -> String {
+    let j = &a.jobs;
+    let running = [
+        ("load", j.load.is_some()),
+        ("build", j.build.is_some()),
+        ("render", j.render.is_some()),
+        ("compare", j.compare.is_some()),
+        ("import", j.import.is_some()),
+        ("wrong", j.wrong.is_some()),
+    ];
+    let running: Vec<&str> = running.iter().filter(|r| r.1).map(|r| r.0).collect();
+    let shown = a.shown.as_ref().map(|s| (s.camera.width, s.camera.height, s.frame.is_complete()));
+    let b = a.compare.b.as_ref().map(|b| (b.camera.width, b.camera.height));
+    format!("jobs {running:?}, viewport {:?}, shown {shown:?}, B {b:?}, pending {}", a.viewport_pixels(), a.grade.pending.is_some())
+}
+
 pub fn idle(app: &BvhscopeApp) -> bool {
     app.current_bvh().is_some() && !app.jobs.is_busy() && app.shown.as_ref().is_some_and(|s| s.frame.is_complete())
+}
+
+/// Click the widget labelled `label` wherever its tile has scrolled it (a view's tile scrolls, and
+/// a simulated pointer lands where the widget is drawn): by the accessibility action, as a screen
+/// reader clicks.
+pub fn click_label(h: &mut Harness<'_, BvhscopeApp>, label: &str) {
+    use egui_kittest::kittest::Queryable;
+    h.get_by_label(label).click_accesskit();
+    h.run_steps(2);
+}
+
+/// `click_label` for the widget whose label contains `part`.
+pub fn click_label_containing(h: &mut Harness<'_, BvhscopeApp>, part: &str) {
+    use egui_kittest::kittest::Queryable;
+    h.get_by_label_contains(part).click_accesskit();
+    h.run_steps(2);
+}
+
+/// Give the text field labelled `label` the keyboard, wherever its tile has scrolled it.
+pub fn focus_label(h: &mut Harness<'_, BvhscopeApp>, label: &str) {
+    use egui_kittest::kittest::Queryable;
+    h.get_by_label(label).focus();
+    h.run_steps(2);
+}
+
+/// Compare's pair on screen: B traced on A's camera, both frames complete, nothing running.
+pub fn pair_shown(a: &BvhscopeApp) -> bool {
+    idle(a) && a.compare.b.as_ref().is_some_and(|b| a.shown.as_ref().is_some_and(|s| s.camera == b.camera))
 }
 
 pub fn temp_file(name: &str, text: &str) -> PathBuf {
@@ -130,6 +180,6 @@ pub fn midpoint_against_sah() -> Harness<'static, BvhscopeApp> {
     h.get_by_role_and_label(egui::accesskit::Role::Button, "View").click();
     h.run_steps(2);
     h.get_by_label("Compare side by side…").click();
-    run_until(&mut h, "B", |a| a.compare.b.is_some() && idle(a));
+    run_until(&mut h, "B", pair_shown);
     h
 }

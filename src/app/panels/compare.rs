@@ -7,98 +7,98 @@ use crate::bvh::{Layout, SplitStrategy, TraversalOrder};
 use crate::options::Choice;
 use crate::render::PairView;
 
-pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+/// Whether the view is open (its tile shown).
+pub fn is_open(app: &BvhscopeApp) -> bool {
+    app.compare.on
+}
+
+/// The view's contents, in its tile (`panels::tiles`).
+pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let c = &app.compare;
     if !c.on {
         return;
     }
-    let mut open = true;
-    egui::Window::new("Compare")
-        .open(&mut open)
-        // Over the build panel, clear of the image's labels and legend.
-        .default_size([280.0, 300.0])
-        .default_pos(ctx.content_rect().left_top() + egui::vec2(4.0, 330.0))
-        .show(ctx, |ui| {
-            ui.horizontal(|ui| {
-                ui.label("B: split by");
-                egui::ComboBox::from_id_salt("compare-strategy").selected_text(c.strategy.label()).show_ui(ui, |ui| {
-                    for s in SplitStrategy::ALL {
-                        if ui.selectable_label(c.strategy == s, s.label()).on_hover_text(s.named().help).clicked() {
-                            out.push(Action::CompareStrategy(s));
-                        }
-                    }
-                });
-                ui.weak("(the rest as A)");
-            });
-            // B's leaf size, layout and traversal.
-            let (mut leaf, mut layout, mut trace) = (c.max_leaf_size, c.layout, c.trace);
-            let (n, l) = (crate::bvh::Param::MaxLeafSize.option(), crate::bvh::params::MAX_LEAF_SIZE);
-            let mut changed = ui
-                .add(egui::Slider::new(&mut leaf, l.min..=l.max).text("B's max leaf size"))
-                .on_hover_text(n.help)
-                .changed();
-            ui.horizontal(|ui| {
-                for l in Layout::ALL {
-                    changed |= ui.radio_value(&mut layout, l, l.label()).changed();
+    ui.horizontal(|ui| {
+        ui.label("B: split by");
+        egui::ComboBox::from_id_salt("compare-strategy").selected_text(c.strategy.label()).show_ui(ui, |ui| {
+            for s in SplitStrategy::ALL {
+                if ui.selectable_label(c.strategy == s, s.label()).on_hover_text(s.named().help).clicked() {
+                    out.push(Action::CompareStrategy(s));
                 }
-                ui.separator();
-                for o in TraversalOrder::ALL {
-                    changed |= ui
-                        .radio_value(&mut trace.order, o, o.label())
-                        .on_hover_text("B's traversal order (binary layout)")
-                        .changed();
-                }
-            });
-            if changed {
-                out.push(Action::CompareB { max_leaf_size: leaf, layout, trace });
             }
-            ui.horizontal(|ui| {
-                for m in PairView::ALL {
-                    if ui.radio(c.mode == m, m.label()).clicked() {
-                        out.push(Action::CompareMode(m));
-                    }
-                }
-            });
-            let a = app.current_figures();
-            let b = c.b.as_ref().filter(|b| b.scene_id == app.scene_id && b.build == c.build_for(app.wanted_build()));
-            let (Some(a), Some(b)) = (a, b) else {
-                ui.weak(
-                    app.jobs
-                        .compare
-                        .as_ref()
-                        .map_or("B follows once A's image is done…".to_string(), |j| format!("{}…", j.label)),
-                );
-                return;
-            };
-            let same_camera = app.rays.as_ref().is_some_and(|r| r.camera == b.camera);
-            egui::Grid::new("compare-figures").num_columns(4).striped(true).show(ui, |ui| {
-                for h in ["", "A", "B", "B - A"] {
-                    ui.strong(h);
-                }
-                ui.end_row();
-                let mut row = |name: &str, va: f64, vb: f64, digits: usize| {
-                    ui.label(name);
-                    ui.label(format!("{va:.digits$}"));
-                    ui.label(format!("{vb:.digits$}"));
-                    ui.label(format!("{:+.digits$}", vb - va));
-                    ui.end_row();
-                };
-                row("Nodes", a.stats.nodes as f64, b.stats.nodes as f64, 0);
-                row("SAH cost", a.stats.sah_cost, b.stats.sah_cost, 2);
-                if let (Some(ra), true) = (a.rays.as_ref(), same_camera) {
-                    let (sa, sb) = (&ra.summary, &b.summary);
-                    row("Nodes visited / ray", sa.mean_nodes_visited, sb.mean_nodes_visited, 2);
-                    row("Box tests / ray", sa.mean_box_tests, sb.mean_box_tests, 2);
-                    row("Triangle tests / ray", sa.mean_triangle_tests, sb.mean_triangle_tests, 2);
-                }
-            });
-            ui.weak(format!(
-                "A: {}. B: {}. Per-ray figures over all the frame's primary rays, one camera.",
-                a.label,
-                b.bvh.label()
-            ));
         });
-    if !open {
-        out.push(Action::Compare(false));
+        ui.weak("(the rest as A)");
+    });
+    // B's leaf size, layout and traversal.
+    let (mut leaf, mut layout, mut trace) = (c.max_leaf_size, c.layout, c.trace);
+    let (n, l) = (crate::bvh::Param::MaxLeafSize.option(), crate::bvh::params::MAX_LEAF_SIZE);
+    let mut changed = ui
+        .add(egui::Slider::new(&mut leaf, l.min..=l.max).text("B's max leaf size"))
+        .on_hover_text(n.help)
+        .changed();
+    ui.horizontal(|ui| {
+        for l in Layout::ALL {
+            changed |= ui.radio_value(&mut layout, l, l.label()).changed();
+        }
+        ui.separator();
+        for o in TraversalOrder::ALL {
+            changed |= ui
+                .radio_value(&mut trace.order, o, o.label())
+                .on_hover_text("B's traversal order (binary layout)")
+                .changed();
+        }
+    });
+    if changed {
+        out.push(Action::CompareB { max_leaf_size: leaf, layout, trace });
     }
+    ui.horizontal(|ui| {
+        for m in PairView::ALL {
+            if ui.radio(c.mode == m, m.label()).clicked() {
+                out.push(Action::CompareMode(m));
+            }
+        }
+    });
+    let a = app.current_figures();
+    let b = c.b.as_ref().filter(|b| b.scene_id == app.scene_id && b.build == c.build_for(app.wanted_build()));
+    let (Some(a), Some(b)) = (a, b) else {
+        ui.weak(
+            app.jobs
+                .compare
+                .as_ref()
+                .map_or("B follows once A's image is done…".to_string(), |j| format!("{}…", j.label)),
+        );
+        return;
+    };
+    let same_camera = app.rays.as_ref().is_some_and(|r| r.camera == b.camera);
+    egui::Grid::new("compare-figures").num_columns(4).striped(true).show(ui, |ui| {
+        for h in ["", "A", "B", "B - A"] {
+            ui.strong(h);
+        }
+        ui.end_row();
+        let mut row = |name: &str, va: f64, vb: f64, digits: usize| {
+            ui.label(name);
+            ui.label(format!("{va:.digits$}"));
+            ui.label(format!("{vb:.digits$}"));
+            ui.label(format!("{:+.digits$}", vb - va));
+            ui.end_row();
+        };
+        row("Nodes", a.stats.nodes as f64, b.stats.nodes as f64, 0);
+        row("SAH cost", a.stats.sah_cost, b.stats.sah_cost, 2);
+        if let (Some(ra), true) = (a.rays.as_ref(), same_camera) {
+            let (sa, sb) = (&ra.summary, &b.summary);
+            row("Nodes visited / ray", sa.mean_nodes_visited, sb.mean_nodes_visited, 2);
+            row("Box tests / ray", sa.mean_box_tests, sb.mean_box_tests, 2);
+            row("Triangle tests / ray", sa.mean_triangle_tests, sb.mean_triangle_tests, 2);
+        }
+    });
+    ui.weak(format!(
+        "A: {}. B: {}. Per-ray figures over all the frame's primary rays, one camera.",
+        a.label,
+        b.bvh.label()
+    ));
+}
+
+/// What closing the view's tile asks for.
+pub fn close() -> Action {
+    Action::Compare(false)
 }

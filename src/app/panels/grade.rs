@@ -20,28 +20,27 @@ fn verdict_color(v: Verdict) -> egui::Color32 {
     }
 }
 
-pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+/// Whether the view is open (its tile shown).
+pub fn is_open(app: &BvhscopeApp) -> bool {
+    app.grade.window && app.grade.report.is_some()
+}
+
+/// The view's contents, in its tile (`panels::tiles`).
+pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let Some(r) = app.grade.report.as_ref().filter(|_| app.grade.window) else { return };
-    let mut open = true;
-    egui::Window::new("Grade report")
-        .open(&mut open)
-        // Over the Build panel, above the Compare window and clear of the Imported BVH window and
-        // the viewport's legend, which choosing a student brings: all stay readable.
-        .default_size([470.0, 290.0])
-        .default_pos(ctx.content_rect().left_top() + egui::vec2(8.0, 40.0))
-        .show(ctx, |ui| {
-            ui.label(egui::RichText::new(r.file.display().to_string()).strong());
-            ui.label(format!("{} students over {}, ranked by {}.", r.students.len(), r.mesh_given, r.rank_by));
-            if let Err(missing) = &r.mesh {
-                ui.colored_label(RED, missing);
-            }
-            chosen(app, r, ui);
-            ui.separator();
-            egui::ScrollArea::vertical().auto_shrink([false, true]).show(ui, |ui| students(app, r, ui, out));
-        });
-    if !open {
-        out.push(Action::ShowGrade(false));
+    ui.label(egui::RichText::new(r.file.display().to_string()).strong());
+    ui.label(format!("{} students over {}, ranked by {}.", r.students.len(), r.mesh_given, r.rank_by));
+    if let Err(missing) = &r.mesh {
+        ui.colored_label(RED, missing);
     }
+    chosen(app, r, ui);
+    ui.separator();
+    egui::ScrollArea::vertical().auto_shrink([false, true]).show(ui, |ui| students(app, r, ui, out));
+}
+
+/// What closing the view's tile asks for.
+pub fn close() -> Action {
+    Action::ShowGrade(false)
 }
 
 /// What choosing the student led to: their tree shown, on its way, or why not.

@@ -10,85 +10,86 @@ use crate::explain::check::Group;
 /// million findings; the CLI lists them all).
 const SHOWN_PER_GROUP: usize = 200;
 
-pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+/// Whether the view is open (its tile shown).
+pub fn is_open(app: &BvhscopeApp) -> bool {
+    app.import.window && app.import.tree.as_ref().is_some_and(|t| t.scene_id == app.scene_id)
+}
+
+/// The view's contents, in its tile (`panels::tiles`).
+pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let Some(t) = app.import.tree.as_ref().filter(|t| t.scene_id == app.scene_id && app.import.window) else {
         return;
     };
-    let mut open = true;
-    egui::Window::new("Imported BVH")
-        .open(&mut open)
-        .default_size([420.0, 380.0])
-        .default_pos(ctx.content_rect().right_top() + egui::vec2(-780.0, 60.0))
-        .show(ctx, |ui| {
-            let d = t.defects();
-            ui.label(egui::RichText::new(t.path.display().to_string()).strong());
-            let verdict = if d == 0 { "is correct" } else { "has defects" };
-            ui.label(format!("{d} defects, {} warnings: the BVH {verdict}.", t.findings.len() - d));
-            match &t.bvh {
-                Ok(_) => {
-                    let mut on = app.import.on;
-                    if ui
-                        .checkbox(&mut on, "Show the imported tree")
-                        .on_hover_text("Every view traces it; off: the strategy chosen in the Build panel")
-                        .changed()
-                    {
-                        out.push(Action::UseImported(on));
-                    }
-                }
-                Err(why) => {
-                    ui.colored_label(egui::Color32::from_rgb(230, 120, 90), format!("Not traced: {why}."));
-                }
+    let d = t.defects();
+    ui.label(egui::RichText::new(t.path.display().to_string()).strong());
+    let verdict = if d == 0 { "is correct" } else { "has defects" };
+    ui.label(format!("{d} defects, {} warnings: the BVH {verdict}.", t.findings.len() - d));
+    match &t.bvh {
+        Ok(_) => {
+            let mut on = app.import.on;
+            if ui
+                .checkbox(&mut on, "Show the imported tree")
+                .on_hover_text("Every view traces it; off: the strategy chosen in the Build panel")
+                .changed()
+            {
+                out.push(Action::UseImported(on));
             }
-            wrong_pixels(app, ui, out);
-            ui.weak(format!(
-                "Rays: the frame's primary rays and {} random ones, against the linear scan. bvhscope check MESH --bvh FILE prints the same findings.",
-                t.rays
-            ));
-            ui.separator();
-            egui::ScrollArea::vertical().auto_shrink([false, true]).show(ui, |ui| {
-                for g in Group::ALL {
-                    let here: Vec<_> = t.findings.iter().filter(|f| f.group == g).collect();
-                    if here.is_empty() {
-                        continue;
-                    }
-                    let d = here.iter().filter(|f| f.defect).count();
-                    let title = format!("{} ({d} defects, {} warnings)", g.label(), here.len() - d);
-                    egui::CollapsingHeader::new(title).default_open(true).show(ui, |ui| {
-                        for f in here.iter().take(SHOWN_PER_GROUP) {
-                            let color = if f.defect {
-                                egui::Color32::from_rgb(235, 110, 90)
-                            } else {
-                                egui::Color32::from_rgb(220, 190, 90)
+        }
+        Err(why) => {
+            ui.colored_label(egui::Color32::from_rgb(230, 120, 90), format!("Not traced: {why}."));
+        }
+    }
+    wrong_pixels(app, ui, out);
+    ui.weak(format!(
+        "Rays: the frame's primary rays and {} random ones, against the linear scan. bvhscope check MESH --bvh FILE prints the same findings.",
+        t.rays
+    ));
+    ui.separator();
+    egui::ScrollArea::vertical().auto_shrink([false, true]).show(ui, |ui| {
+        for g in Group::ALL {
+            let here: Vec<_> = t.findings.iter().filter(|f| f.group == g).collect();
+            if here.is_empty() {
+                continue;
+            }
+            let d = here.iter().filter(|f| f.defect).count();
+            let title = format!("{} ({d} defects, {} warnings)", g.label(), here.len() - d);
+            egui::CollapsingHeader::new(title).default_open(true).show(ui, |ui| {
+                for f in here.iter().take(SHOWN_PER_GROUP) {
+                    let color = if f.defect {
+                        egui::Color32::from_rgb(235, 110, 90)
+                    } else {
+                        egui::Color32::from_rgb(220, 190, 90)
+                    };
+                    let line = f.line(crate::explain::check::LISTED);
+                    let text = egui::RichText::new(format!("{} {line}", if f.defect { "defect:" } else { "warning:" })).color(color);
+                    let action = f.node.map(Action::SelectDumpNode).or(f.triangle.map(Action::SelectTriangle));
+                    match action {
+                        Some(a) => {
+                            let what = match (f.node, f.triangle) {
+                                (Some(n), _) => format!("Select node {n} in the tree view"),
+                                (None, Some(tri)) => format!("Select the leaf of triangle {tri}"),
+                                _ => String::new(),
                             };
-                            let line = f.line(crate::explain::check::LISTED);
-                            let text = egui::RichText::new(format!("{} {line}", if f.defect { "defect:" } else { "warning:" })).color(color);
-                            let action = f.node.map(Action::SelectDumpNode).or(f.triangle.map(Action::SelectTriangle));
-                            match action {
-                                Some(a) => {
-                                    let what = match (f.node, f.triangle) {
-                                        (Some(n), _) => format!("Select node {n} in the tree view"),
-                                        (None, Some(tri)) => format!("Select the leaf of triangle {tri}"),
-                                        _ => String::new(),
-                                    };
-                                    if ui.link(text).on_hover_text(what).clicked() {
-                                        out.push(a);
-                                    }
-                                }
-                                None => {
-                                    ui.label(text);
-                                }
+                            if ui.link(text).on_hover_text(what).clicked() {
+                                out.push(a);
                             }
                         }
-                        if here.len() > SHOWN_PER_GROUP {
-                            ui.weak(format!("… and {} more (bvhscope check lists them all)", here.len() - SHOWN_PER_GROUP));
+                        None => {
+                            ui.label(text);
                         }
-                    });
+                    }
+                }
+                if here.len() > SHOWN_PER_GROUP {
+                    ui.weak(format!("… and {} more (bvhscope check lists them all)", here.len() - SHOWN_PER_GROUP));
                 }
             });
-        });
-    if !open {
-        out.push(Action::ShowImported(false));
-    }
+        }
+    });
+}
+
+/// What closing the view's tile asks for.
+pub fn close() -> Action {
+    Action::ShowImported(false)
 }
 
 /// The wrong pixels of the image on screen, and the red mask's switch.

@@ -137,6 +137,31 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             if ui.button("Compare side by side…").on_hover_text("B, another strategy's build, next to A on the same camera and scale").clicked() {
                 out.push(Action::Compare(true));
             }
+            ui.separator();
+            let mut present = app.settings.present;
+            let f5 = shortcut_text(ui.ctx(), &Action::TogglePresent);
+            if ui
+                .checkbox(&mut present, format!("Present ({f5})"))
+                .on_hover_text("For a room: everything at 150 % or more (text of 18 px and up), the Node view's plots half its tile tall, every figure written out")
+                .changed()
+            {
+                out.push(Action::Present(present));
+            }
+            ui.horizontal(|ui| {
+                ui.label(format!("Size {:.0} %", 100.0 * app.settings.zoom()));
+                if ui.small_button("−").on_hover_text(shortcut_text(ui.ctx(), &Action::UiScaleBy(-1))).clicked() {
+                    out.push(Action::UiScaleBy(-1));
+                }
+                if ui.small_button("+").on_hover_text(shortcut_text(ui.ctx(), &Action::UiScaleBy(1))).clicked() {
+                    out.push(Action::UiScaleBy(1));
+                }
+                if ui.small_button("100 %").clicked() {
+                    out.push(Action::UiScale(1.0));
+                }
+            });
+            if ui.button("Reset the layout").on_hover_text("The image, the panels and the views where a fresh start puts them").clicked() {
+                out.push(Action::ResetLayout);
+            }
         });
         ui.menu_button("Help", |ui| {
             let shortcut = shortcut_text(ui.ctx(), &Action::Help);

@@ -10,6 +10,7 @@ pub mod ray;
 pub mod replay;
 pub mod stats;
 pub mod status;
+pub mod tiles;
 pub mod tree;
 pub mod view;
 pub mod windows;
@@ -42,30 +43,6 @@ pub fn show_all(app: &mut super::BvhscopeApp, ui: &mut egui::Ui, out: &mut super
     let ctx = ui.ctx().clone();
     egui::Panel::top("menu").show(ui, |ui| menu::show(app, ui, out));
     egui::Panel::bottom("status").show(ui, |ui| status::show(app, ui));
-    // The side panels keep the width they have (the user's, remembered by egui's memory):
-    // their contents wrap, scroll or clip inside it and never widen them, so the viewport,
-    // and with it the camera's aspect, stays as it is when the figures change.
-    egui::Panel::left("controls").resizable(true).default_size(290.0).size_range(200.0..=640.0).show(ui, |ui| {
-        fixed_width(ui, |ui| {
-            build::show(app, ui, out);
-            ui.separator();
-            view::show(app, ui, out);
-        })
-    });
-    egui::Panel::right("statistics")
-        .resizable(true)
-        .default_size(340.0)
-        .size_range(220.0..=720.0)
-        .show(ui, |ui| fixed_width(ui, |ui| stats::show(app, ui, out)));
-    egui::CentralPanel::default()
-        .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(12)))
-        .show(ui, |ui| super::viewport::show(app, ui, out));
+    egui::CentralPanel::default().frame(egui::Frame::NONE).show(ui, |ui| tiles::show(app, ui, out));
     windows::show(app, &ctx, out);
-    ray::show(app, &ctx, out);
-    tree::show(app, &ctx, out);
-    node::show(app, &ctx, out);
-    replay::show(app, &ctx, out);
-    compare::show(app, &ctx, out);
-    imported::show(app, &ctx, out);
-    grade::show(app, &ctx, out);
 }

@@ -24,109 +24,115 @@ pub fn strategy_color(s: SplitStrategy) -> Color32 {
     }
 }
 
-pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+/// Whether the view is open (its tile shown).
+pub fn is_open(app: &BvhscopeApp) -> bool {
+    app.nodes.window && app.nodes.selected.is_some()
+}
+
+/// The view's contents, in its tile (`panels::tiles`).
+pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let nodes = &app.nodes;
     let (Some(node), true) = (nodes.selected, nodes.window) else { return };
-    let mut open = true;
-    egui::Window::new("Node")
-        .open(&mut open)
-        // Over the statistics panel, so the image stays in view.
-        .default_size([440.0, 760.0])
-        .default_pos(ctx.content_rect().right_top() + egui::vec2(-450.0, 40.0))
-        .vscroll(true)
-        .show(ctx, |ui| {
-            let bvh = app.current_bvh().map(|b| b.bvh.clone());
-            let Some(e) = nodes.current(bvh.as_ref()) else {
-                ui.weak("Preparing the tree…");
-                return;
-            };
-            // The breadcrumb: the root down to the node, each a button.
-            let path = e.hierarchy.path(node);
-            ui.horizontal_wrapped(|ui| {
-                ui.label("Path:");
-                let skip = path.len().saturating_sub(14);
-                if skip > 0 {
-                    ui.weak("0 > … >");
-                }
-                for &a in &path[skip..] {
-                    if ui.selectable_label(a == node, a.to_string()).on_hover_text(format!("Select node {a}")).clicked() {
-                        out.push(Action::SelectNode(a));
-                    }
-                }
-            });
-            ui.horizontal(|ui| {
-                for (label, step, key) in [
-                    ("Parent", NodeStep::Parent, "Up"),
-                    ("Left child", NodeStep::Left, "Left"),
-                    ("Right child", NodeStep::Right, "Right"),
-                    ("Sibling", NodeStep::Sibling, "Down"),
-                ] {
-                    let enabled = nodes.step(step).is_some();
-                    let b = ui.add_enabled(enabled, egui::Button::new(label));
-                    if b.on_hover_text(format!("Key: Alt+{key}")).clicked() {
-                        out.push(Action::NodeStep(step));
-                    }
-                }
-            });
-            ui.separator();
-            let Some(ins) = nodes.inspection.as_ref().filter(|i| i.node == node) else {
-                ui.weak(format!("Inspecting node {node}…"));
-                return;
-            };
-            let visits = nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
-            let visits = visits.map(|v| (v.counts[node as usize], v.camera.width, v.camera.height));
-            figures(ui, ins, ins.epo_share, visits);
-            let imported = e.bvh.import();
-            if let Some(names) = imported {
-                let d = crate::explain::inspect::text::dump_text(names.dump_of_binary_node(node));
-                ui.label(format!("Imported from {}: dump node {d}.", names.name))
-                    .on_hover_text("The node's id in the dump; bvhscope inspect MESH --bvh DUMP --node ID takes that id");
+    let bvh = app.current_bvh().map(|b| b.bvh.clone());
+    let Some(e) = nodes.current(bvh.as_ref()) else {
+        ui.weak("Preparing the tree…");
+        return;
+    };
+    // The breadcrumb: the root down to the node, each a button.
+    let path = e.hierarchy.path(node);
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Path:");
+        let skip = path.len().saturating_sub(14);
+        if skip > 0 {
+            ui.weak("0 > … >");
+        }
+        for &a in &path[skip..] {
+            if ui.selectable_label(a == node, a.to_string()).on_hover_text(format!("Select node {a}")).clicked() {
+                out.push(Action::SelectNode(a));
             }
-            let layout = e.bvh.build_params().bvh.layout;
-            if imported.is_none() {
-                if let Some(g) = crate::bvh::wide::wide_group_in(layout, &e.tree.nodes, &e.hierarchy.parent, node) {
-                    ui.label(crate::explain::inspect::text::wide_group_text(node, &g)).on_hover_text(
-                        "A wide layout collapses the binary tree: a wide node takes the children of a binary node and, while it has fewer than four (or eight), opens the largest interior one",
-                    );
-                }
+        }
+    });
+    ui.horizontal(|ui| {
+        for (label, step, key) in [
+            ("Parent", NodeStep::Parent, "Up"),
+            ("Left child", NodeStep::Left, "Left"),
+            ("Right child", NodeStep::Right, "Right"),
+            ("Sibling", NodeStep::Sibling, "Down"),
+        ] {
+            let enabled = nodes.step(step).is_some();
+            let b = ui.add_enabled(enabled, egui::Button::new(label));
+            if b.on_hover_text(format!("Key: Alt+{key}")).clicked() {
+                out.push(Action::NodeStep(step));
             }
-            ui.separator();
-            // An imported tree has no strategy of bvhscope's: its own split is drawn as its cost.
-            let own = imported.is_none().then_some(e.tree.params.strategy);
-            if ins.triangles < 2 {
-                ui.weak("One triangle: nothing to split.");
-            } else {
-                let whose = match (own, ins.own_cost) {
-                    (Some(s), _) => format!("this tree's strategy is {}", s.label()),
-                    (None, Some(c)) => format!("this tree's own split costs {c:.3} (the red line)"),
-                    (None, None) => "this imported node is a leaf".into(),
-                };
-                ui.label(format!(
-                    "SAH cost of splitting these {} triangles at each plane (C_trav + C_isect (A_L n_L + A_R n_R) / A); {whose}.",
-                    ins.triangles
-                ));
-                if let Some(line) = crate::explain::inspect::text::sbvh_text(ins) {
-                    ui.label(line).on_hover_text(
-                        "Stich et al. 2009: the SBVH prices spatial splits (which cut triangles straddling the plane) only where the object split's two boxes overlap by more than α of the root's area, while its budget of extra references lasts",
-                    );
-                }
-                let mut shared = app.nodes.shared_scale;
-                if ui
-                    .checkbox(&mut shared, "One cost scale for the three axes")
-                    .on_hover_text("Draw x, y and z on the same cost range, so their costs compare across plots")
-                    .changed()
-                {
-                    out.push(Action::SharedCostScale(shared));
-                }
-                let range = shared.then(|| cost_range(ins));
-                for axis in 0..3 {
-                    curve_plot(ui, ins, axis, own, range);
-                }
-            }
-        });
-    if !open {
-        out.push(Action::ShowTree(false));
+        }
+    });
+    ui.separator();
+    let Some(ins) = nodes.inspection.as_ref().filter(|i| i.node == node) else {
+        ui.weak(format!("Inspecting node {node}…"));
+        return;
+    };
+    let visits = nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
+    let visits = visits.map(|v| (v.counts[node as usize], v.camera.width, v.camera.height));
+    figures(ui, ins, ins.epo_share, visits);
+    let imported = e.bvh.import();
+    if let Some(names) = imported {
+        let d = crate::explain::inspect::text::dump_text(names.dump_of_binary_node(node));
+        ui.label(format!("Imported from {}: dump node {d}.", names.name))
+            .on_hover_text("The node's id in the dump; bvhscope inspect MESH --bvh DUMP --node ID takes that id");
     }
+    let layout = e.bvh.build_params().bvh.layout;
+    if imported.is_none() {
+        if let Some(g) = crate::bvh::wide::wide_group_in(layout, &e.tree.nodes, &e.hierarchy.parent, node) {
+            ui.label(crate::explain::inspect::text::wide_group_text(node, &g)).on_hover_text(
+                "A wide layout collapses the binary tree: a wide node takes the children of a binary node and, while it has fewer than four (or eight), opens the largest interior one",
+            );
+        }
+    }
+    ui.separator();
+    // An imported tree has no strategy of bvhscope's: its own split is drawn as its cost.
+    let own = imported.is_none().then_some(e.tree.params.strategy);
+    if ins.triangles >= 2 {
+        planes(ui, ins, own);
+        ui.separator();
+    }
+    // Presenting, each plot is half the tile tall (a back row reads its curves).
+    let present = app.settings.present;
+    let height = if present { (ui.clip_rect().height() * 0.5).max(PLOT_HEIGHT) } else { PLOT_HEIGHT };
+    if ins.triangles < 2 {
+        ui.weak("One triangle: nothing to split.");
+    } else {
+        let whose = match (own, ins.own_cost) {
+            (Some(s), _) => format!("this tree's strategy is {}", s.label()),
+            (None, Some(c)) => format!("this tree's own split costs {c:.3} (the red line)"),
+            (None, None) => "this imported node is a leaf".into(),
+        };
+        ui.label(format!(
+            "SAH cost of splitting these {} triangles at each plane (C_trav + C_isect (A_L n_L + A_R n_R) / A); {whose}.",
+            ins.triangles
+        ));
+        if let Some(line) = crate::explain::inspect::text::sbvh_text(ins) {
+            ui.label(line).on_hover_text(
+                "Stich et al. 2009: the SBVH prices spatial splits (which cut triangles straddling the plane) only where the object split's two boxes overlap by more than α of the root's area, while its budget of extra references lasts",
+            );
+        }
+        let mut shared = app.nodes.shared_scale;
+        if ui
+            .checkbox(&mut shared, "One cost scale for the three axes")
+            .on_hover_text("Draw x, y and z on the same cost range, so their costs compare across plots")
+            .changed()
+        {
+            out.push(Action::SharedCostScale(shared));
+        }
+        let range = shared.then(|| cost_range(ins));
+        for axis in 0..3 {
+            curve_plot(ui, ins, axis, own, range, Size { height, present });
+        }
+    }
+}
+
+/// What closing the view's tile asks for.
+pub fn close() -> Action {
+    Action::ShowTree(false)
 }
 
 fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<(u32, u32, u32)>) {
@@ -153,16 +159,34 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<(u32, u
         row("As a leaf", format!("{:.3}", ins.leaf_cost), "What making it a leaf would cost: C_isect × triangles");
         let visits = visits.map_or("…".into(), |(v, w, h)| format!("{v} of the {w}×{h} frame's primary rays"));
         row("Visits", visits, "Primary rays of the frame on screen that entered it (a binary traversal of the same rays; `bvhscope inspect --size WxH` counts the same frame)");
+    });
+}
+
+/// Where each strategy puts its plane here, and every term of its cost, written out (as
+/// `bvhscope inspect` prints them; nothing only on hover, for a room to read).
+fn planes(ui: &mut egui::Ui, ins: &Inspection, own: Option<SplitStrategy>) {
+    ui.label("Where each strategy splits these triangles: C_trav + C_isect (A_L/A n_L + A_R/A n_R)");
+    egui::Grid::new("node-planes").num_columns(7).striped(true).show(ui, |ui| {
+        for head in ["Strategy", "Plane", "n_L", "n_R", "A_L/A", "A_R/A", "Cost"] {
+            ui.strong(head);
+        }
+        ui.end_row();
         for (s, m) in &ins.markers {
-            let text = match m {
-                Some(m) => format!("{} = {:.4}: {} | {}, cost {:.3}", AXES[m.axis as usize], m.position, m.left, m.right, m.cost),
-                None => crate::explain::inspect::text::no_split_text(*s).into(),
-            };
-            ui.label(egui::RichText::new(s.label()).color(strategy_color(*s)));
+            let name = if Some(*s) == own { format!("{} (this tree)", s.label()) } else { s.label().to_string() };
+            ui.label(egui::RichText::new(name).color(strategy_color(*s)));
             match m {
-                Some(m) => ui.label(text).on_hover_text(m.terms(ins.sah).text()),
-                None => ui.label(text),
-            };
+                Some(m) => {
+                    ui.label(format!("{} = {}", AXES[m.axis as usize], m.position));
+                    ui.label(m.left.to_string());
+                    ui.label(m.right.to_string());
+                    ui.label(format!("{:.3}", m.area_left));
+                    ui.label(format!("{:.3}", m.area_right));
+                    ui.label(format!("{:.3}", m.cost));
+                }
+                None => {
+                    ui.label(crate::explain::inspect::text::no_split_text(*s));
+                }
+            }
             ui.end_row();
         }
     });
@@ -212,6 +236,23 @@ const PLOT_HEIGHT: f32 = 170.0;
 /// Width of the legend beside each plot (the curves stay uncovered).
 const LEGEND_WIDTH: f32 = 150.0;
 
+/// How large a plot is drawn: its height, and whether its notes are full size (presenting).
+#[derive(Clone, Copy)]
+struct Size {
+    height: f32,
+    present: bool,
+}
+
+impl Size {
+    fn note(self, text: String) -> egui::RichText {
+        if self.present {
+            egui::RichText::new(text)
+        } else {
+            egui::RichText::new(text).small()
+        }
+    }
+}
+
 /// The lowest and highest cost drawn on any axis's plot: the shared scale.
 fn cost_range(ins: &Inspection) -> (f32, f32) {
     let mut lo = ins.leaf_cost.min(ins.own_cost.unwrap_or(f32::INFINITY));
@@ -242,6 +283,7 @@ fn curve_plot(
     axis: usize,
     own: Option<SplitStrategy>,
     shared: Option<(f32, f32)>,
+    size: Size,
 ) {
     let (sweep, binned, spatial) = (&ins.sweep[axis], &ins.binned[axis], &ins.spatial[axis]);
     let cuts = if spatial.is_empty() { String::new() } else { format!(", {} spatial planes", spatial.len()) };
@@ -264,7 +306,7 @@ fn curve_plot(
     ui.horizontal(|ui| {
         let width = (ui.available_width() - LEGEND_WIDTH - 8.0).max(160.0);
         let mut plot = Plot::new(("node-curve", axis))
-            .height(PLOT_HEIGHT)
+            .height(size.height)
             .width(width)
             .allow_scroll(false)
             .show_axes(true)
@@ -310,7 +352,7 @@ fn curve_plot(
                 ui.horizontal(|ui| {
                     let (r, _) = ui.allocate_exact_size(egui::vec2(14.0, 10.0), egui::Sense::hover());
                     ui.painter().rect_filled(r, 2.0, color);
-                    ui.label(egui::RichText::new(text).small());
+                    ui.label(size.note(text));
                 });
             };
             swatch(ui, strategy_color(SplitStrategy::SahSweep), format!("{sweep_name}: every plane"));
@@ -336,7 +378,7 @@ fn curve_plot(
         .map(|p| (p.position, p.terms(ins.sah), "the plane under the pointer"))
         .or(chosen.map(|(x, t)| (x, t, "this tree's split")));
     if let Some((x, t, what)) = shown {
-        ui.label(egui::RichText::new(format!("At {} = {x:.4} ({what}): {}", AXES[axis], t.text())).small())
+        ui.label(size.note(format!("At {} = {x:.4} ({what}): {}", AXES[axis], t.text())))
             .on_hover_text("C_trav + C_isect·(A_L/A)·n_L + C_isect·(A_R/A)·n_R: the traversal step, then each side's triangle tests weighted by the chance a ray entering the node enters that side");
     }
 }

@@ -25,79 +25,79 @@ fn step_color(kind: &StepKind) -> Option<Color32> {
     }
 }
 
-pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+/// Whether the view is open (its tile shown).
+pub fn is_open(app: &BvhscopeApp) -> bool {
+    !app.pins.pinned.is_empty() || app.ray_window
+}
+
+/// The view's contents, in its tile (`panels::tiles`).
+pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let rays = &app.pins;
     if rays.pinned.is_empty() && !app.ray_window {
         return;
     }
-    let mut open = true;
-    egui::Window::new("Ray")
-        .open(&mut open)
-        // Over the statistics panel, so the image and the ray drawn on it stay in view.
-        .default_size([640.0, 560.0])
-        .default_pos(ctx.content_rect().right_top() + egui::vec2(-450.0, 40.0))
-        .show(ctx, |ui| {
-            pinned_list(app, ui, out);
-            ui.separator();
-            typed_ray(app, ui, out);
-            let Some(r) = rays.current() else {
-                ui.weak("Click a pixel of the image to pin its ray (Ctrl-click while this window is closed), or type one above.");
-                return;
-            };
-            ui.separator();
-            let n = r.len();
-            let k = rays.step.min(n.saturating_sub(1));
-            ui.horizontal(|ui| {
-                if ui.button("First").on_hover_text("The first step").clicked() {
-                    out.push(Action::RayStep(0));
-                }
-                if ui.button("Back").on_hover_text("One step back").clicked() {
-                    out.push(Action::RayStepBy(-1));
-                }
-                let (label, tip) = if rays.playing { ("Pause", "Stop playing") } else { ("Play", "Play the steps one after another") };
-                if ui.button(label).on_hover_text(tip).clicked() {
-                    out.push(Action::RayPlay(!rays.playing));
-                }
-                if ui.button("Step").on_hover_text("One step forward").clicked() {
-                    out.push(Action::RayStepBy(1));
-                }
-                if ui.button("Last").on_hover_text("The last step").clicked() {
-                    out.push(Action::RayStep(n.saturating_sub(1)));
-                }
-                let mut step = k + 1;
-                let slider = egui::Slider::new(&mut step, 1..=n.max(1)).text(format!("of {n}"));
-                if ui.add(slider).on_hover_text("The step the viewport shows").changed() {
-                    out.push(Action::RayStep(step - 1));
-                }
-            });
-            if rays.playing {
-                let due = rays.last_tick.is_none_or(|t| t.elapsed() >= PLAY_STEP);
-                if due {
-                    out.push(Action::RayStepBy(1));
-                }
-                ctx.request_repaint_after(PLAY_STEP);
-            }
-            let stack = r.trace.steps[..=k.min(n.saturating_sub(1))].iter().rev().find_map(|s| s.stack());
-            let stack_text = match stack {
-                Some(([], _)) | None => "empty".to_string(),
-                Some((st, below)) => {
-                    let under = if below > 0 { format!("… {below} more, ") } else { String::new() };
-                    under + &st.iter().map(|(n, t)| format!("{n} @ {t:.3}")).collect::<Vec<_>>().join(", ")
-                }
-            };
-            command_line(r, ui, out);
-            // The step shown, whole and wrapped (the list below keeps one line a step).
-            if let Some(s) = r.named.get(k) {
-                ui.add(egui::Label::new(egui::RichText::new(format!("Step {}: {}", k + 1, s.brief())).strong()).wrap());
-            }
-            ui.add(egui::Label::new(format!("Stack (bottom first): {stack_text}")).wrap())
-                .on_hover_text("What the traversal stack holds after this step: each node with the distance at which the ray enters its box");
-            legend(ui);
-            steps_list(app, ui, out, k);
-        });
-    if !open {
-        out.push(Action::UnpinAll);
+    pinned_list(app, ui, out);
+    ui.separator();
+    typed_ray(app, ui, out);
+    let Some(r) = rays.current() else {
+        ui.weak("Click a pixel of the image to pin its ray (Ctrl-click while this window is closed), or type one above.");
+        return;
+    };
+    ui.separator();
+    let n = r.len();
+    let k = rays.step.min(n.saturating_sub(1));
+    ui.horizontal(|ui| {
+        if ui.button("First").on_hover_text("The first step").clicked() {
+            out.push(Action::RayStep(0));
+        }
+        if ui.button("Back").on_hover_text("One step back").clicked() {
+            out.push(Action::RayStepBy(-1));
+        }
+        let (label, tip) = if rays.playing { ("Pause", "Stop playing") } else { ("Play", "Play the steps one after another") };
+        if ui.button(label).on_hover_text(tip).clicked() {
+            out.push(Action::RayPlay(!rays.playing));
+        }
+        if ui.button("Step").on_hover_text("One step forward").clicked() {
+            out.push(Action::RayStepBy(1));
+        }
+        if ui.button("Last").on_hover_text("The last step").clicked() {
+            out.push(Action::RayStep(n.saturating_sub(1)));
+        }
+        let mut step = k + 1;
+        let slider = egui::Slider::new(&mut step, 1..=n.max(1)).text(format!("of {n}"));
+        if ui.add(slider).on_hover_text("The step the viewport shows").changed() {
+            out.push(Action::RayStep(step - 1));
+        }
+    });
+    if rays.playing {
+        let due = rays.last_tick.is_none_or(|t| t.elapsed() >= PLAY_STEP);
+        if due {
+            out.push(Action::RayStepBy(1));
+        }
+        ui.ctx().request_repaint_after(PLAY_STEP);
     }
+    let stack = r.trace.steps[..=k.min(n.saturating_sub(1))].iter().rev().find_map(|s| s.stack());
+    let stack_text = match stack {
+        Some(([], _)) | None => "empty".to_string(),
+        Some((st, below)) => {
+            let under = if below > 0 { format!("… {below} more, ") } else { String::new() };
+            under + &st.iter().map(|(n, t)| format!("{n} @ {t:.3}")).collect::<Vec<_>>().join(", ")
+        }
+    };
+    command_line(r, ui, out);
+    // The step shown, whole and wrapped (the list below keeps one line a step).
+    if let Some(s) = r.named.get(k) {
+        ui.add(egui::Label::new(egui::RichText::new(format!("Step {}: {}", k + 1, s.brief())).strong()).wrap());
+    }
+    ui.add(egui::Label::new(format!("Stack (bottom first): {stack_text}")).wrap())
+        .on_hover_text("What the traversal stack holds after this step: each node with the distance at which the ray enters its box");
+    legend(ui);
+    steps_list(app, ui, out, k);
+}
+
+/// What closing the view's tile asks for.
+pub fn close() -> Action {
+    Action::UnpinAll
 }
 
 /// The pinned rays, each with its counts and hit, to select, compare and unpin.

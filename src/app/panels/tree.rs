@@ -13,70 +13,70 @@ use egui::{Color32, Pos2, Rect, RichText, Sense, Stroke};
 const ICICLE_ROWS: u32 = 14;
 const ICICLE_ROW_HEIGHT: f32 = 12.0;
 
-pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
+/// Whether the view is open (its tile shown).
+pub fn is_open(app: &BvhscopeApp) -> bool {
+    app.nodes.window
+}
+
+/// The view's contents, in its tile (`panels::tiles`).
+pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     if !app.nodes.window {
         return;
     }
-    let mut open = true;
-    egui::Window::new("Tree")
-        .open(&mut open)
-        // Over the build panel's lower half, so the image stays in view.
-        .default_size([420.0, 420.0])
-        .default_pos(ctx.content_rect().left_bottom() + egui::vec2(8.0, -470.0))
-        .show(ctx, |ui| {
-            let bvh = app.current_bvh().map(|b| b.bvh.clone());
-            let Some(e) = app.nodes.current(bvh.as_ref()) else {
-                let why = if app.built.as_ref().is_some_and(|b| b.top_stats.is_some()) {
-                    "The tree view shows one BVH; this scene is built as two levels (uncheck Two levels)."
-                } else {
-                    "Preparing the tree…"
-                };
-                ui.weak(why);
-                return;
-            };
-            let (cut, twice) = references(e);
-            let refs = if cut > 0 {
-                format!(" (references: spatial splits cut {cut} triangles among several leaves, and the counts below count each part)")
-            } else {
-                String::new()
-            };
-            ui.label(format!(
-                "The binary tree as built: {} nodes, {} triangles{refs}. Shift-click the image to select a pixel's leaf, or a drawn box's edge.",
-                e.tree.nodes.len(),
-                e.tree.prim_ids.len()
-            ));
-            if !twice.is_empty() {
-                let shown: Vec<String> = twice.iter().take(4).cloned().collect();
-                let more = if twice.len() > 4 { format!(", … ({} in all)", twice.len()) } else { String::new() };
-                ui.colored_label(
-                    egui::Color32::from_rgb(220, 190, 90),
-                    format!("Warning: {}{more}: each is tested twice by every ray that reaches its leaf.", shown.join(", ")),
-                );
-            }
-            let visits = app.nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
-            ui.horizontal(|ui| {
-                ui.label("Colour by");
-                egui::ComboBox::from_id_salt("icicle-metric").selected_text(app.nodes.metric.label()).show_ui(
-                    ui,
-                    |ui| {
-                        for m in Metric::ALL {
-                            if ui.selectable_label(app.nodes.metric == m, m.label()).on_hover_text(m.help()).clicked() {
-                                out.push(Action::SetMetric(m));
-                            }
-                        }
-                    },
-                );
-                if app.nodes.metric == Metric::Visits && visits.is_none() {
-                    ui.weak("counting…");
-                }
-            });
-            icicle(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), out);
-            ui.separator();
-            rows(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), out);
-        });
-    if !open {
-        out.push(Action::ShowTree(false));
+    let bvh = app.current_bvh().map(|b| b.bvh.clone());
+    let Some(e) = app.nodes.current(bvh.as_ref()) else {
+        let why = if app.built.as_ref().is_some_and(|b| b.top_stats.is_some()) {
+            "The tree view shows one BVH; this scene is built as two levels (uncheck Two levels)."
+        } else {
+            "Preparing the tree…"
+        };
+        ui.weak(why);
+        return;
+    };
+    let (cut, twice) = references(e);
+    let refs = if cut > 0 {
+        format!(" (references: spatial splits cut {cut} triangles among several leaves, and the counts below count each part)")
+    } else {
+        String::new()
+    };
+    ui.label(format!(
+        "The binary tree as built: {} nodes, {} triangles{refs}. Shift-click the image to select a pixel's leaf, or a drawn box's edge.",
+        e.tree.nodes.len(),
+        e.tree.prim_ids.len()
+    ));
+    if !twice.is_empty() {
+        let shown: Vec<String> = twice.iter().take(4).cloned().collect();
+        let more = if twice.len() > 4 { format!(", … ({} in all)", twice.len()) } else { String::new() };
+        ui.colored_label(
+            egui::Color32::from_rgb(220, 190, 90),
+            format!("Warning: {}{more}: each is tested twice by every ray that reaches its leaf.", shown.join(", ")),
+        );
     }
+    let visits = app.nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
+    ui.horizontal(|ui| {
+        ui.label("Colour by");
+        egui::ComboBox::from_id_salt("icicle-metric").selected_text(app.nodes.metric.label()).show_ui(
+            ui,
+            |ui| {
+                for m in Metric::ALL {
+                    if ui.selectable_label(app.nodes.metric == m, m.label()).on_hover_text(m.help()).clicked() {
+                        out.push(Action::SetMetric(m));
+                    }
+                }
+            },
+        );
+        if app.nodes.metric == Metric::Visits && visits.is_none() {
+            ui.weak("counting…");
+        }
+    });
+    icicle(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), out);
+    ui.separator();
+    rows(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), out);
+}
+
+/// What closing the view's tile asks for.
+pub fn close() -> Action {
+    Action::ShowTree(false)
 }
 
 /// A node's value of the metric (`None`: not known yet).
