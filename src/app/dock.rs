@@ -90,7 +90,8 @@ fn share(tiles: &mut Tiles<Pane>, container: TileId, shares: &[(TileId, f32)]) {
 /// A saved layout is used when it holds every pane exactly once (one saved by an older version
 /// may lack a view added since); else the default.
 pub fn valid(layout: &Layout) -> bool {
-    let panes: Vec<Pane> = layout.tiles.tiles().filter_map(|t| if let Tile::Pane(p) = t { Some(*p) } else { None }).collect();
+    let panes: Vec<Pane> =
+        layout.tiles.tiles().filter_map(|t| if let Tile::Pane(p) = t { Some(*p) } else { None }).collect();
     layout.root.is_some() && panes.len() == Pane::ALL.len() && Pane::ALL.iter().all(|p| panes.contains(p))
 }
 

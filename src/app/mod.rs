@@ -268,9 +268,6 @@ impl BvhscopeApp {
         // A new mesh has its own heatmap scale.
         self.settings.fixed_ranges.clear();
         self.settings.diff_ranges.clear();
-        if let Some(note) = scene.desc.as_ref().and_then(|d| d.note.as_ref()) {
-            self.message(MessageKind::Info, format!("{}: {note}", scene.title()));
-        }
         self.scene = scene;
         self.scene_id += 1;
         self.previous = None;

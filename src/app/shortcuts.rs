@@ -45,7 +45,11 @@ pub const SHORTCUTS: &[(KeyboardShortcut, Action, &str)] = &[
         Action::CopyTraceCommand,
         "Copy the pinned ray's trace command",
     ),
-    (KeyboardShortcut::new(Modifiers::NONE, Key::F5), Action::TogglePresent, "Present: large text and plots (again: off)"),
+    (
+        KeyboardShortcut::new(Modifiers::NONE, Key::F5),
+        Action::TogglePresent,
+        "Present: large text and plots (again: off)",
+    ),
     (KeyboardShortcut::new(Modifiers::COMMAND, Key::Plus), Action::UiScaleBy(1), "Larger (10 % a step)"),
     (KeyboardShortcut::new(Modifiers::COMMAND, Key::Equals), Action::UiScaleBy(1), "Larger (as Ctrl++)"),
     (KeyboardShortcut::new(Modifiers::COMMAND, Key::Minus), Action::UiScaleBy(-1), "Smaller"),

@@ -150,7 +150,7 @@ pub(crate) fn load_noted(path: &Path, whole_note: bool) -> Result<Scene, CliErro
         eprintln!("warning: {}: {w}", path.display());
     }
     if let Some(note) = loaded.desc.as_ref().and_then(|s| s.note.as_ref()) {
-        match first_sentence(note) {
+        match crate::explain::words::first_sentence(note) {
             Some(first) if !whole_note => {
                 eprintln!("about this scene: {first} (the whole note: bvhscope stats {})", path.display())
             }
@@ -158,12 +158,6 @@ pub(crate) fn load_noted(path: &Path, whole_note: bool) -> Result<Scene, CliErro
         }
     }
     Ok(loaded)
-}
-
-/// The text up to its first full stop followed by a space, if there is more after it.
-fn first_sentence(text: &str) -> Option<&str> {
-    let end = text.find(". ")?;
-    Some(&text[..=end])
 }
 
 /// Build what `build` asks for over a loaded file; for two levels an OBJ is one placement of

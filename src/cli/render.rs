@@ -196,14 +196,14 @@ fn run_against(
             eprintln!(
                 "wrote {} ({w}x{h} {} of {}, B {b_label} against A {label_a}: B does less work at {less} pixels, the same at {same}, more at {more}; mean B - A {mean:.3})",
                 a.output.display(),
-                a.pair_view.label().to_lowercase(),
+                a.pair_view.name(),
                 a.view.label().to_lowercase(),
             )
         }
         None => eprintln!(
             "wrote {} ({w}x{h} {} of {}, A {label_a} and B {b_label})",
             a.output.display(),
-            a.pair_view.label().to_lowercase(),
+            a.pair_view.name(),
             a.view.label().to_lowercase()
         ),
     }

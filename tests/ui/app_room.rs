@@ -150,3 +150,75 @@ fn compare_exports_are_what_the_screen_shows_byte_for_byte_the_clis() {
     // The halves and the difference are different pictures (the export follows the screen).
     assert!(written[0] != written[1] && written[0] != written[2] && written[1] != written[2]);
 }
+
+/// The docked layout: with the Ray, Tree, Node and Compare views all open, each is a tile
+/// beside or below the image, none over it; a view closed hides its tile and the image takes
+/// the room back.
+#[test]
+fn every_view_is_a_tile_beside_the_image_never_over_it() {
+    use bvhscope::app::dock::Pane;
+    let mut h = midpoint_against_sah();
+    let act = |h: &mut egui_kittest::Harness<'_, BvhscopeApp>, a: Action| h.state_mut().act(a);
+    act(&mut h, Action::ShowTree(true));
+    act(&mut h, Action::SelectNode(0));
+    act(&mut h, Action::ShowRayWindow);
+    h.run_steps(4);
+    let rect = |h: &egui_kittest::Harness<'_, BvhscopeApp>, p: Pane| {
+        let layout = h.state().dock.as_ref().unwrap();
+        let id = layout.tiles.find_pane(&p).unwrap();
+        layout.is_visible_in_layout(id).then(|| layout.tiles.rect(id)).flatten()
+    };
+    let image = rect(&h, Pane::Image).expect("the image's tile");
+    for p in [Pane::Controls, Pane::Statistics, Pane::Ray, Pane::Node, Pane::Tree, Pane::Compare] {
+        let r = rect(&h, p).unwrap_or_else(|| panic!("{p:?} is open: its tile is shown"));
+        let shared = r.intersect(image);
+        assert!(shared.width() <= 1.0 || shared.height() <= 1.0, "{p:?} {r:?} over the image {image:?}");
+    }
+    assert!(image.expand(1.0).contains_rect(h.state().viewport_rect), "the viewport is the image's tile");
+    // Closed: the tile goes, the image grows.
+    act(&mut h, Action::ShowTree(false));
+    act(&mut h, Action::Compare(false));
+    h.run_steps(4);
+    assert!(rect(&h, Pane::Tree).is_none() && rect(&h, Pane::Compare).is_none());
+    assert!(rect(&h, Pane::Image).unwrap().height() > image.height() + 50.0, "the image takes the room back");
+}
+
+/// Presenting: View › Present (F5) draws everything at 150 % (egui's body text, 12.5 points,
+/// 18.75 pixels on screen); Ctrl +/− step the scale by 10 %, Ctrl+0 sets it back; the Node view
+/// writes every strategy's plane and cost in a table, as `inspect` prints them.
+#[test]
+fn presenting_draws_everything_larger_and_the_node_view_writes_its_planes_out() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    h.key_press(egui::Key::F5);
+    h.run_steps(3);
+    assert!(h.state().settings.present);
+    assert_eq!(h.ctx.zoom_factor(), 1.5);
+    let body = h.ctx.global_style().text_styles[&egui::TextStyle::Body].size * h.ctx.zoom_factor();
+    assert!(body >= 18.0, "body text {body} px");
+    h.key_press(egui::Key::F5);
+    h.run_steps(2);
+    assert_eq!(h.ctx.zoom_factor(), 1.0);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Plus);
+    h.run_steps(2);
+    assert!((h.ctx.zoom_factor() - 1.1).abs() < 1e-4, "{}", h.ctx.zoom_factor());
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Num0);
+    h.run_steps(2);
+    assert_eq!(h.ctx.zoom_factor(), 1.0);
+    // The Node view's planes, each strategy's on a row of its own, nothing only on hover.
+    h.state_mut().act(Action::Present(true));
+    h.state_mut().act(Action::ShowTree(true));
+    h.state_mut().act(Action::SelectNode(0));
+    run_until(&mut h, "the root's inspection", |a| a.nodes.inspection.as_ref().is_some_and(|i| i.node == 0));
+    h.run_steps(3);
+    for head in ["n_L", "n_R", "A_L/A", "A_R/A", "Cost"] {
+        h.get_by_label(head);
+    }
+    let ins = h.state().nodes.inspection.clone().unwrap();
+    for (_, m) in &ins.markers {
+        if let Some(m) = m {
+            assert!(h.query_all_by_label(&format!("{:.3}", m.area_left)).count() >= 1);
+            assert!(h.query_all_by_label(&format!("{:.3}", m.cost)).count() >= 1, "{}", m.cost);
+        }
+    }
+}

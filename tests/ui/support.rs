@@ -46,7 +46,11 @@ fn state_line(a: &BvhscopeApp) -> String {
     let running: Vec<&str> = running.iter().filter(|r| r.1).map(|r| r.0).collect();
     let shown = a.shown.as_ref().map(|s| (s.camera.width, s.camera.height, s.frame.is_complete()));
     let b = a.compare.b.as_ref().map(|b| (b.camera.width, b.camera.height));
-    format!("jobs {running:?}, viewport {:?}, shown {shown:?}, B {b:?}, pending {}", a.viewport_pixels(), a.grade.pending.is_some())
+    format!(
+        "jobs {running:?}, viewport {:?}, shown {shown:?}, B {b:?}, pending {}",
+        a.viewport_pixels(),
+        a.grade.pending.is_some()
+    )
 }
 
 pub fn idle(app: &BvhscopeApp) -> bool {

@@ -53,6 +53,13 @@ pub fn shell_word(s: &str) -> String {
 /// ray is given as numbers (each written so it reads back to the same `f32`), not as a pixel, so
 /// the window's size does not matter.
 /// An imported tree's trace names its dump (`--bvh`) instead of the build.
+/// The text up to its first full stop followed by a space, if more follows it (a scene's note
+/// in one line: the command line and the app show the rest on asking).
+pub fn first_sentence(text: &str) -> Option<&str> {
+    let end = text.find(". ")?;
+    Some(&text[..=end])
+}
+
 pub fn trace_command(path: &Path, ray: &Ray, build: &SceneBuild, opts: TraceOptions, dump: Option<&Path>) -> String {
     let v = |v: Vec3| format!("{},{},{}", v.x, v.y, v.z);
     let mut words = vec!["bvhscope trace".to_string(), shell_word(&path.display().to_string())];

@@ -32,10 +32,8 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     // B's leaf size, layout and traversal.
     let (mut leaf, mut layout, mut trace) = (c.max_leaf_size, c.layout, c.trace);
     let (n, l) = (crate::bvh::Param::MaxLeafSize.option(), crate::bvh::params::MAX_LEAF_SIZE);
-    let mut changed = ui
-        .add(egui::Slider::new(&mut leaf, l.min..=l.max).text("B's max leaf size"))
-        .on_hover_text(n.help)
-        .changed();
+    let mut changed =
+        ui.add(egui::Slider::new(&mut leaf, l.min..=l.max).text("B's max leaf size")).on_hover_text(n.help).changed();
     ui.horizontal(|ui| {
         for l in Layout::ALL {
             changed |= ui.radio_value(&mut layout, l, l.label()).changed();

@@ -61,7 +61,8 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                         egui::Color32::from_rgb(220, 190, 90)
                     };
                     let line = f.line(crate::explain::check::LISTED);
-                    let text = egui::RichText::new(format!("{} {line}", if f.defect { "defect:" } else { "warning:" })).color(color);
+                    let text = egui::RichText::new(format!("{} {line}", if f.defect { "defect:" } else { "warning:" }))
+                        .color(color);
                     let action = f.node.map(Action::SelectDumpNode).or(f.triangle.map(Action::SelectTriangle));
                     match action {
                         Some(a) => {

@@ -303,8 +303,13 @@ fn curve_plot(
     let markers: Vec<(SplitStrategy, crate::explain::inspect::Marker)> =
         ins.markers.iter().filter_map(|(s, m)| m.filter(|m| m.axis as usize == axis).map(|m| (*s, m))).collect();
     let mut hovered = None;
-    ui.horizontal(|ui| {
-        let width = (ui.available_width() - LEGEND_WIDTH - 8.0).max(160.0);
+    // The legend beside the plot where the tile is wide enough, else below it (a narrow tile,
+    // or a presenter's large text).
+    let beside = ui.available_width() > 3.0 * LEGEND_WIDTH;
+    let layout =
+        if beside { egui::Layout::left_to_right(egui::Align::Min) } else { egui::Layout::top_down(egui::Align::Min) };
+    ui.with_layout(layout, |ui| {
+        let width = if beside { (ui.available_width() - LEGEND_WIDTH - 8.0).max(160.0) } else { ui.available_width() };
         let mut plot = Plot::new(("node-curve", axis))
             .height(size.height)
             .width(width)
@@ -345,9 +350,11 @@ fn curve_plot(
             }
             hovered = p.pointer_coordinate().and_then(|c| nearest(sweep, c.x).copied());
         });
-        // The legend beside the plot, one line per name.
+        // The legend, one line per name.
         ui.vertical(|ui| {
-            ui.set_width(LEGEND_WIDTH);
+            if beside {
+                ui.set_width(LEGEND_WIDTH);
+            }
             let swatch = |ui: &mut egui::Ui, color: Color32, text: String| {
                 ui.horizontal(|ui| {
                     let (r, _) = ui.allocate_exact_size(egui::vec2(14.0, 10.0), egui::Sense::hover());

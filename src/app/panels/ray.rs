@@ -40,7 +40,9 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.separator();
     typed_ray(app, ui, out);
     let Some(r) = rays.current() else {
-        ui.weak("Click a pixel of the image to pin its ray (Ctrl-click while this window is closed), or type one above.");
+        ui.weak(
+            "Click a pixel of the image to pin its ray (Ctrl-click while this window is closed), or type one above.",
+        );
         return;
     };
     ui.separator();
@@ -53,7 +55,8 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         if ui.button("Back").on_hover_text("One step back").clicked() {
             out.push(Action::RayStepBy(-1));
         }
-        let (label, tip) = if rays.playing { ("Pause", "Stop playing") } else { ("Play", "Play the steps one after another") };
+        let (label, tip) =
+            if rays.playing { ("Pause", "Stop playing") } else { ("Play", "Play the steps one after another") };
         if ui.button(label).on_hover_text(tip).clicked() {
             out.push(Action::RayPlay(!rays.playing));
         }
@@ -89,8 +92,9 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     if let Some(s) = r.named.get(k) {
         ui.add(egui::Label::new(egui::RichText::new(format!("Step {}: {}", k + 1, s.brief())).strong()).wrap());
     }
-    ui.add(egui::Label::new(format!("Stack (bottom first): {stack_text}")).wrap())
-        .on_hover_text("What the traversal stack holds after this step: each node with the distance at which the ray enters its box");
+    ui.add(egui::Label::new(format!("Stack (bottom first): {stack_text}")).wrap()).on_hover_text(
+        "What the traversal stack holds after this step: each node with the distance at which the ray enters its box",
+    );
     legend(ui);
     steps_list(app, ui, out, k);
 }

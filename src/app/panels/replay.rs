@@ -76,7 +76,9 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         out.push(Action::ReplayStep(kk));
     }
     if view.playing {
-        if view.last_tick.is_none_or(|t| t.elapsed() >= PLAY_STEP) && app.shown.as_ref().is_some_and(|s| s.frame.is_complete()) {
+        if view.last_tick.is_none_or(|t| t.elapsed() >= PLAY_STEP)
+            && app.shown.as_ref().is_some_and(|s| s.frame.is_complete())
+        {
             out.push(Action::ReplayStep(view.next_play_step()));
         }
         ui.ctx().request_repaint_after(PLAY_STEP);
@@ -89,7 +91,9 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             let morton = view.morton.as_ref().and_then(|m| crate::explain::replay_film::morton_text(m, r, newest));
             let plane = match (view.newest.as_ref().filter(|(n, _, _)| *n == newest), &morton) {
                 (_, Some(t)) => format!(" at {t},"),
-                (Some((_, Some(m), _)), _) => format!(" on {axis} at {axis} = {:.4} (split cost {:.2})", m.position, m.cost),
+                (Some((_, Some(m), _)), _) => {
+                    format!(" on {axis} at {axis} = {:.4} (split cost {:.2})", m.position, m.cost)
+                }
                 _ => format!(" on {axis}"),
             };
             ui.label(format!(
@@ -99,7 +103,9 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 r.sah[k]
             ));
             // The binned SAH: the cost at each of that node's bins' planes on the chosen axis.
-            if let Some((_, Some(m), bins)) = view.newest.as_ref().filter(|(n, _, b)| *n == newest && !b[node.axis as usize].is_empty()) {
+            if let Some((_, Some(m), bins)) =
+                view.newest.as_ref().filter(|(n, _, b)| *n == newest && !b[node.axis as usize].is_empty())
+            {
                 let a = node.axis as usize;
                 let pts: PlotPoints = bins[a].iter().map(|p| [p.position as f64, p.cost as f64]).collect();
                 Plot::new("replay-bins")

@@ -195,8 +195,20 @@ pub fn combined_cost_text(c: SahCost) -> String {
 
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions) {
     ui.heading("Statistics");
+    // The scene's note: its first sentence, the rest on asking (a paragraph pushed the figures
+    // out of a projector's view).
     if let Some(note) = app.scene.desc.as_ref().and_then(|d| d.note.as_ref()) {
-        ui.label(egui::RichText::new(note).italics());
+        match crate::explain::words::first_sentence(note) {
+            Some(first) => {
+                ui.label(egui::RichText::new(first).italics());
+                egui::CollapsingHeader::new("About this scene").id_salt("scene-note").show(ui, |ui| {
+                    ui.label(egui::RichText::new(&note[first.len()..]).italics());
+                });
+            }
+            None => {
+                ui.label(egui::RichText::new(note).italics());
+            }
+        }
         ui.add_space(4.0);
     }
     let r = &app.scene.report;

@@ -55,16 +55,13 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let visits = app.nodes.visits.as_ref().filter(|v| std::sync::Arc::ptr_eq(&v.explained, e));
     ui.horizontal(|ui| {
         ui.label("Colour by");
-        egui::ComboBox::from_id_salt("icicle-metric").selected_text(app.nodes.metric.label()).show_ui(
-            ui,
-            |ui| {
-                for m in Metric::ALL {
-                    if ui.selectable_label(app.nodes.metric == m, m.label()).on_hover_text(m.help()).clicked() {
-                        out.push(Action::SetMetric(m));
-                    }
+        egui::ComboBox::from_id_salt("icicle-metric").selected_text(app.nodes.metric.label()).show_ui(ui, |ui| {
+            for m in Metric::ALL {
+                if ui.selectable_label(app.nodes.metric == m, m.label()).on_hover_text(m.help()).clicked() {
+                    out.push(Action::SetMetric(m));
                 }
-            },
-        );
+            }
+        });
         if app.nodes.metric == Metric::Visits && visits.is_none() {
             ui.weak("counting…");
         }
