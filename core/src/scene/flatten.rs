@@ -4,7 +4,7 @@
 
 use super::{SceneDesc, SceneError};
 use crate::geometry::Aabb;
-use crate::mesh::{load_obj, LoadReport, Mesh, MeshGroup};
+use crate::mesh::{load_mesh, LoadReport, Mesh, MeshGroup};
 use glam::Affine3A;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -68,7 +68,7 @@ pub fn load_instances(scene_path: &Path, desc: &SceneDesc) -> Result<(SceneInsta
         let k = match index.get(&m.file) {
             Some(&k) => k,
             None => {
-                let (mesh, r) = load_obj(&m.file).map_err(|e| {
+                let (mesh, r) = load_mesh(&m.file).map_err(|e| {
                     let hint = match (&e, &m.if_missing) {
                         (crate::mesh::MeshError::NotFound { .. }, Some(hint)) => format!(" ({hint})"),
                         _ => String::new(),

@@ -10,7 +10,7 @@
 use super::{describe, flatten, load_instances, SceneDesc, SceneError, SceneInstances};
 use crate::bvh::{BuildParams, SceneBuild, SceneBvh};
 use crate::geometry::Aabb;
-use crate::mesh::{generate, load_obj, LoadReport, Mesh};
+use crate::mesh::{generate, load_mesh, LoadReport, Mesh};
 use crate::render::Camera;
 use crate::work::{Cancelled, WorkControl};
 use std::path::{Path, PathBuf};
@@ -64,12 +64,13 @@ impl From<Cancelled> for SceneBuildError {
 }
 
 impl Scene {
-    /// Open an OBJ, or a scene file (`.json`: bvhscope's format or Moer-lite's).
+    /// Open a mesh (OBJ, PLY, OFF or STL: `mesh::load_mesh`), or a scene file (`.json`:
+    /// bvhscope's format or Moer-lite's).
     pub fn open(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
         let is_scene = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
         if !is_scene {
-            let (mesh, report) = load_obj(path)?;
+            let (mesh, report) = load_mesh(path)?;
             return Ok(Scene::of_mesh(mesh, report, SceneSource::File(path.into())));
         }
         let start = std::time::Instant::now();

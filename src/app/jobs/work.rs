@@ -339,7 +339,14 @@ impl Jobs {
             let dialog = rfd::AsyncFileDialog::new();
             let fut = async move {
                 match pick {
-                    Pick::Open => dialog.add_filter("Meshes and scenes", &["obj", "OBJ", "json"]).pick_file().await,
+                    Pick::Open => {
+                        let mut kinds: Vec<String> = crate::mesh::MeshFormat::EXTENSIONS
+                            .iter()
+                            .flat_map(|e| [e.to_string(), e.to_uppercase()])
+                            .collect();
+                        kinds.push("json".into());
+                        dialog.add_filter("Meshes (OBJ, PLY, OFF, STL) and scenes", &kinds).pick_file().await
+                    }
                     Pick::SaveScene => {
                         dialog.add_filter("bvhscope scene", &["json"]).set_file_name(&name).save_file().await
                     }

@@ -1,0 +1,89 @@
+//! STL, as CAD and 3D printing write it: binary (an 80-byte header, a little-endian triangle
+//! count, 50 bytes a triangle: its normal, three corners, two attribute bytes) or ASCII (`solid`,
+//! then `facet normal … outer loop vertex … ×3 endloop endfacet`, `endsolid`). Which one is told
+//! by the content: a binary file is exactly as long as its count says, whatever its header's
+//! first word (many binary files start with "solid" too). STL stores each triangle's corners
+//! apart: the mesh has three vertices a triangle, the file's triangles in its order.
+
+use super::formats::{bad, capacity, finish};
+use super::{LoadReport, Mesh, MeshError};
+use glam::Vec3;
+use std::path::Path;
+
+/// Whether `bytes` are a binary STL: 84 bytes of header and count, then the count's 50-byte records.
+pub(crate) fn is_binary(bytes: &[u8]) -> bool {
+    bytes.len() >= 84 && {
+        let n = u32::from_le_bytes(bytes[80..84].try_into().expect("four bytes")) as u64;
+        bytes.len() as u64 == 84 + 50 * n
+    }
+}
+
+pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), MeshError> {
+    if is_binary(bytes) {
+        return binary(path, bytes);
+    }
+    if bytes.contains(&0) || !bytes.trim_ascii_start().starts_with(b"solid") {
+        let n = if bytes.len() >= 84 {
+            u32::from_le_bytes(bytes[80..84].try_into().expect("four bytes")) as u64
+        } else {
+            0
+        };
+        return Err(bad(
+            path,
+            "the file",
+            format!(
+                "neither ASCII STL (it does not start with 'solid') nor binary STL ({} bytes, where a binary STL of the {n} triangles its header counts has {})",
+                bytes.len(),
+                84 + 50 * n
+            ),
+        ));
+    }
+    ascii(path, &String::from_utf8_lossy(bytes))
+}
+
+fn binary(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), MeshError> {
+    let records = &bytes[84..];
+    let mut positions = Vec::with_capacity(records.len() / 50 * 3);
+    let f = |b: &[u8], k: usize| f32::from_le_bytes(b[4 * k..4 * k + 4].try_into().expect("four bytes"));
+    for r in records.chunks_exact(50) {
+        for c in 0..3 {
+            let k = 3 + 3 * c;
+            positions.push(Vec3::new(f(r, k), f(r, k + 1), f(r, k + 2)));
+        }
+    }
+    let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+    finish(path, positions, Vec::new(), triangles)
+}
+
+fn ascii(path: &Path, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
+    let mut positions = Vec::with_capacity(capacity(u64::MAX, text.len(), 40));
+    let mut in_facet = 0usize;
+    for (i, line) in text.lines().enumerate() {
+        let mut w = line.split_whitespace();
+        match w.next() {
+            Some("vertex") => {
+                let mut xyz = [0f32; 3];
+                for (k, x) in xyz.iter_mut().enumerate() {
+                    let t = w.next().unwrap_or("");
+                    *x = t.parse().map_err(|_| {
+                        bad(path, format!("line {}", i + 1), format!("vertex coordinate {k} '{t}' is not a number"))
+                    })?;
+                }
+                positions.push(Vec3::from_array(xyz));
+                in_facet += 1;
+            }
+            Some("endfacet") => {
+                if in_facet != 3 {
+                    return Err(bad(path, format!("line {}", i + 1), format!("a facet of {in_facet} vertices, not 3")));
+                }
+                in_facet = 0;
+            }
+            _ => {}
+        }
+    }
+    if in_facet != 0 || positions.len() % 3 != 0 {
+        return Err(bad(path, "the file", "ends inside a facet"));
+    }
+    let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+    finish(path, positions, Vec::new(), triangles)
+}
