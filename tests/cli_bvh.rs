@@ -201,7 +201,7 @@ fn render_through_an_imported_tree() {
         "the same counts at every pixel"
     );
     let err = run(&["--bvh", &p(&dump), "--against", "sah", "--difference", &p(&d), "-o", &p(&png)]);
-    assert!(err.contains("minus A imported: render-bvh.json"), "{err}");
+    assert!(err.contains("against A imported: render-bvh.json"), "{err}");
 
     // A 4-wide tree: exported, it checks clean with the same row as SAH's own 4-wide tree, and
     // traces pixel for pixel as that tree; a trace names its leaves by the dump's ids.
