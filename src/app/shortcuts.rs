@@ -71,7 +71,7 @@ pub const MOUSE: &[(&str, &str)] = &[
         "Shift+click",
         "Select the node of a drawn box's edge, else the leaf the pixel's ray hits (Tree and Node windows)",
     ),
-    ("Drop a mesh or scene", "Open it (.obj, .ply, .off, .stl, a scene's .json)"),
+    ("Drop a mesh or scene", "Open it (.obj, .ply, .off, .stl, .gltf, .glb, a scene's .json)"),
 ];
 
 /// A shortcut as the Help window and the menus show it: modifiers by name, keys by their symbol

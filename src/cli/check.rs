@@ -201,7 +201,7 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[QualityRow], list
 
 #[derive(Args, Debug)]
 pub struct ExportArgs {
-    /// The mesh (.obj, .ply, .off or .stl). The tree written is the binary one unless --layout wide4 or wide8 is given.
+    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene). The tree written is the binary one unless --layout wide4 or wide8 is given.
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The mesh (.obj, .ply, .off or .stl) or scene (.json: bvhscope's or Moer-lite's).
+    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene) or scene (.json: bvhscope's or Moer-lite's).
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,

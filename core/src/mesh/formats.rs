@@ -22,7 +22,7 @@ pub enum MeshFormat {
 
 impl MeshFormat {
     /// The file name endings each format is known by (the open dialog's filter).
-    pub const EXTENSIONS: [&'static str; 4] = ["obj", "ply", "off", "stl"];
+    pub const EXTENSIONS: [&'static str; 6] = ["obj", "ply", "off", "stl", "gltf", "glb"];
 
     /// The format of `bytes` read from `path`: by content where the format has a mark, else by
     /// the name's ending, else OBJ.
@@ -48,6 +48,13 @@ impl MeshFormat {
 pub fn load_mesh(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
     let start = Instant::now();
+    if super::is_gltf(path) {
+        return Err(bad(
+            path,
+            "the file",
+            "a glTF file is a scene of its own (its nodes place its meshes): open it as the scene, not as one mesh",
+        ));
+    }
     let bytes = read_user_file(path)?;
     let (mesh, mut report) = match MeshFormat::of(path, &bytes) {
         MeshFormat::Obj => return load_obj(path),

@@ -3,6 +3,7 @@
 mod error;
 mod formats;
 pub mod generate;
+mod gltf;
 #[allow(clippy::module_inception)]
 mod mesh;
 mod obj;
@@ -16,6 +17,7 @@ mod surface;
 
 pub use error::{MeshError, MAX_COORDINATE};
 pub use formats::{load_mesh, MeshFormat};
+pub use gltf::{is_gltf, load_gltf, GltfScene};
 pub use mesh::{Mesh, MeshGroup, SurfaceInteraction};
 pub(crate) use obj::decode_text;
 pub use obj::{load_obj, parse_obj, read_user_file, write_obj, LoadReport};

@@ -68,6 +68,16 @@ impl Scene {
     /// bvhscope's format or Moer-lite's).
     pub fn open(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
+        if crate::mesh::is_gltf(path) {
+            // A glTF's nodes place its meshes: a scene of placements, as a scene file's are.
+            let start = std::time::Instant::now();
+            let g = crate::mesh::load_gltf(path)?;
+            let instances =
+                SceneInstances { meshes: g.meshes.into_iter().map(Arc::new).collect(), placements: g.placements };
+            let mut scene = Scene::of_placements(path, instances, g.report, start)?;
+            scene.warnings = g.warnings;
+            return Ok(scene);
+        }
         let is_scene = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
         if !is_scene {
             let (mesh, report) = load_mesh(path)?;
@@ -75,7 +85,20 @@ impl Scene {
         }
         let start = std::time::Instant::now();
         let desc = describe(path)?;
-        let (instances, mut report) = load_instances(path, &desc)?;
+        let (instances, report) = load_instances(path, &desc)?;
+        let mut scene = Scene::of_placements(path, instances, report, start)?;
+        (scene.camera, scene.build, scene.warnings) = (desc.camera, desc.build, desc.warnings.clone());
+        scene.desc = Some(desc);
+        Ok(scene)
+    }
+
+    /// A scene of `instances` read from `path` (a scene file, a glTF), its report completed.
+    fn of_placements(
+        path: &Path,
+        instances: SceneInstances,
+        mut report: LoadReport,
+        start: std::time::Instant,
+    ) -> Result<Scene, SceneError> {
         let bounds = instances.placed_bounds().ok_or_else(|| SceneError::Field {
             path: path.into(),
             field: "meshes".into(),
@@ -100,10 +123,10 @@ impl Scene {
             source: SceneSource::File(path.into()),
             report,
             geometry: Geometry::Placed { instances, bounds, flat: Default::default() },
-            camera: desc.camera,
-            build: desc.build,
-            warnings: desc.warnings.clone(),
-            desc: Some(desc),
+            camera: None,
+            build: None,
+            warnings: Vec::new(),
+            desc: None,
         })
     }
 

@@ -345,7 +345,7 @@ impl Jobs {
                             .flat_map(|e| [e.to_string(), e.to_uppercase()])
                             .collect();
                         kinds.push("json".into());
-                        dialog.add_filter("Meshes (OBJ, PLY, OFF, STL) and scenes", &kinds).pick_file().await
+                        dialog.add_filter("Meshes (OBJ, PLY, OFF, STL, glTF) and scenes", &kinds).pick_file().await
                     }
                     Pick::SaveScene => {
                         dialog.add_filter("bvhscope scene", &["json"]).set_file_name(&name).save_file().await
