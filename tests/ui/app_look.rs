@@ -169,3 +169,42 @@ fn look_projector() {
         save(&mut h, &format!("projector-compare{suffix}"));
     }
 }
+
+/// The README's pictures of the main views in the docked layout (each redrawn when the layout
+/// changed): the knot on the floor's normals with midpoint's boxes at depth 7 in front of the
+/// surface; its nodes-visited heatmap on 0..30 after switching from midpoint to SAH binned;
+/// midpoint against SAH binned side by side and as the difference.
+#[test]
+#[ignore]
+fn look_main_views() {
+    use bvhscope::bvh::SplitStrategy;
+    let scene = root().join("scenes/knot-on-floor.json");
+    let mut h = looking();
+    open(&mut h, &scene);
+    let mut s = h.state().settings.clone();
+    (s.build.strategy, s.build.layout) = (SplitStrategy::Midpoint, bvhscope::bvh::Layout::Binary);
+    (s.show_boxes, s.box_depth, s.boxes_in_front) = (true, 7, true);
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    run_until(&mut h, "midpoint's boxes", |a| {
+        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.label().starts_with("Midpoint"))
+    });
+    save(&mut h, "app-normals-boxes");
+    let mut s = h.state().settings.clone();
+    s.show_boxes = false;
+    s.view = bvhscope::render::View::Visits;
+    s.fixed_ranges.insert(bvhscope::render::View::Visits, (0.0, 30.0));
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    run_until(&mut h, "midpoint's heatmap", midpoint_heatmap_shown);
+    with_strategy(&mut h, SplitStrategy::SahBinned);
+    run_until(&mut h, "SAH binned's heatmap", |a| {
+        idle(a) && a.previous.is_some() && a.current_bvh().is_some_and(|b| b.bvh.label().starts_with("SAH binned"))
+    });
+    save(&mut h, "app-heatmap-legend");
+    with_strategy(&mut h, SplitStrategy::Midpoint);
+    run_until(&mut h, "midpoint's heatmap", midpoint_heatmap_shown);
+    h.state_mut().act(Action::Compare(true));
+    run_until(&mut h, "B", pair_shown);
+    save(&mut h, "app-compare-halves");
+    h.state_mut().act(Action::CompareMode(bvhscope::render::PairView::Difference));
+    save(&mut h, "app-compare-difference");
+}

@@ -104,12 +104,7 @@ fn compare_exports_are_what_the_screen_shows_byte_for_byte_the_clis() {
     open(&mut h, &torus);
     with_strategy(&mut h, SplitStrategy::Midpoint);
     h.state_mut().act(Action::View(2));
-    run_until(&mut h, "midpoint's heatmap", |a| {
-        idle(a)
-            && a.shown
-                .as_ref()
-                .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
-    });
+    run_until(&mut h, "midpoint's heatmap", midpoint_heatmap_shown);
     h.state_mut().act(Action::Compare(true));
     run_until(&mut h, "B", pair_shown);
     assert_eq!(h.state().compare.strategy, SplitStrategy::SahBinned);

@@ -163,6 +163,14 @@ pub fn with_strategy(h: &mut Harness<'_, BvhscopeApp>, s: bvhscope::bvh::SplitSt
     h.state_mut().act(bvhscope::app::Action::Edit(Box::new(settings)));
 }
 
+/// Midpoint's tree on screen as a heatmap (with its legend), nothing running.
+pub fn midpoint_heatmap_shown(a: &BvhscopeApp) -> bool {
+    idle(a)
+        && a.shown.as_ref().is_some_and(|s| {
+            s.legend.is_some() && s.bvh.build_params().bvh.strategy == bvhscope::bvh::SplitStrategy::Midpoint
+        })
+}
+
 /// The built-in scene's midpoint tree (A) against SAH binned (B), side by side on the nodes-visited
 /// heatmap, both frames there.
 pub fn midpoint_against_sah() -> Harness<'static, BvhscopeApp> {
@@ -175,12 +183,7 @@ pub fn midpoint_against_sah() -> Harness<'static, BvhscopeApp> {
     s.build.strategy = SplitStrategy::Midpoint;
     h.state_mut().act(Action::Edit(Box::new(s)));
     h.state_mut().act(Action::View(2));
-    run_until(&mut h, "midpoint's heatmap", |a| {
-        idle(a)
-            && a.shown
-                .as_ref()
-                .is_some_and(|s| s.legend.is_some() && s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
-    });
+    run_until(&mut h, "midpoint's heatmap", midpoint_heatmap_shown);
     h.get_by_role_and_label(egui::accesskit::Role::Button, "View").click();
     h.run_steps(2);
     h.get_by_label("Compare side by side…").click();

@@ -6,7 +6,7 @@
 //! skipped with a warning. A mesh's triangles are numbered primitive by primitive, in the file's
 //! order; a mesh's index is its place among the file's meshes that hold triangles.
 
-use super::formats::{bad, finish};
+use super::assemble::{bad, finish};
 use super::{read_user_file, LoadReport, Mesh, MeshError};
 use glam::{Affine3A, Mat4, Vec3};
 use std::path::Path;

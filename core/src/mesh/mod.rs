@@ -1,5 +1,6 @@
 //! The triangle mesh we render, and loading it from OBJ, PLY, OFF and STL files (`formats`).
 
+mod assemble;
 mod error;
 mod formats;
 pub mod generate;

@@ -4,7 +4,7 @@
 //! counts, the vertices (x y z and what the prefixes add), and the faces (n i₀ … iₙ₋₁, colour
 //! values after them ignored). `#` starts a comment. Faces are fan-triangulated as OBJ's are.
 
-use super::formats::{bad, capacity, fan, finish};
+use super::assemble::{bad, capacity, fan, finish};
 use super::{LoadReport, Mesh, MeshError};
 use glam::Vec3;
 use std::path::Path;

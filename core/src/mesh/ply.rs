@@ -6,7 +6,7 @@
 //! restart, unrolled with alternating winding. Triangles are numbered in the file's order: the
 //! faces', then the strips', element by element as the header lists them.
 
-use super::formats::{bad, capacity, fan, finish};
+use super::assemble::{bad, capacity, fan, finish};
 use super::{LoadReport, Mesh, MeshError};
 use glam::Vec3;
 use std::path::Path;

@@ -5,7 +5,7 @@
 //! first word (many binary files start with "solid" too). STL stores each triangle's corners
 //! apart: the mesh has three vertices a triangle, the file's triangles in its order.
 
-use super::formats::{bad, capacity, finish};
+use super::assemble::{bad, capacity, finish};
 use super::{LoadReport, Mesh, MeshError};
 use glam::Vec3;
 use std::path::Path;

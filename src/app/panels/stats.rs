@@ -282,6 +282,10 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions)
                     // The difference of the rows that are one number (a percentage's too).
                     let num = |v: &Option<String>| v.as_deref().and_then(|t| t.trim_end_matches(" %").parse::<f64>().ok());
                     match (num(&a), num(&b)) {
+                        // Counts (nodes, leaves) differ by whole numbers: no decimals for them.
+                        (Some(x), Some(y)) if [&a, &b].iter().all(|v| v.as_deref().is_some_and(|t| t.parse::<i64>().is_ok())) => {
+                            ui.label(format!("{:+}", (y - x) as i64))
+                        }
                         (Some(x), Some(y)) => ui.label(format!("{:+.2}", y - x)),
                         _ => ui.label(""),
                     };

@@ -1,0 +1,88 @@
+//! What the mesh readers of other formats than OBJ share (`ply.rs`, `off.rs`, `stl.rs`,
+//! `gltf.rs`): their one kind of error, the mesh put together from a file's vertices and
+//! triangles with the checks the OBJ reader makes, fan triangulation, and the bound on what a
+//! header's count may reserve.
+
+use super::{LoadReport, Mesh, MeshError, MeshGroup, MAX_COORDINATE};
+use crate::geometry::triangle::double_area;
+use glam::Vec3;
+use std::path::Path;
+
+/// A reader's error: the file, where in it (`element`: "vertex 12", "face 3", "line 40"), what.
+pub(crate) fn bad(path: &Path, element: impl std::fmt::Display, message: impl std::fmt::Display) -> MeshError {
+    MeshError::Parse { path: path.into(), line: None, message: format!("{element}: {message}") }
+}
+
+/// A mesh from a file's vertices (normals: none, or one per vertex) and its triangles in file
+/// order: every index checked, zero-area triangles left out (each kept one keeps its number in
+/// the file), coordinates checked as the OBJ reader checks them.
+pub(crate) fn finish(
+    path: &Path,
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    file_triangles: Vec<[u32; 3]>,
+) -> Result<(Mesh, LoadReport), MeshError> {
+    let n = positions.len();
+    if let Some((t, i)) =
+        file_triangles.iter().enumerate().find_map(|(t, tri)| tri.iter().find(|&&i| i as usize >= n).map(|&i| (t, i)))
+    {
+        return Err(bad(path, format!("triangle {t}"), format!("refers to vertex {i}, but only {n} are declared")));
+    }
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(MeshError::NonFinite { path: path.into(), line: None, what: "a vertex position" });
+    }
+    if positions.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+        return Err(MeshError::TooLarge { path: path.into(), line: None });
+    }
+    if normals.iter().any(|v| !v.is_finite()) {
+        return Err(MeshError::NonFinite { path: path.into(), line: None, what: "a vertex normal" });
+    }
+    let (mut triangles, mut numbers) =
+        (Vec::with_capacity(file_triangles.len()), Vec::with_capacity(file_triangles.len()));
+    for (i, t) in file_triangles.iter().enumerate() {
+        if double_area(&t.map(|k| positions[k as usize])) != 0.0 {
+            triangles.push(*t);
+            numbers.push(i as u32);
+        }
+    }
+    let degenerate = file_triangles.len() - triangles.len();
+    if triangles.is_empty() {
+        return Err(MeshError::NoTriangles { path: path.into(), degenerate });
+    }
+    let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
+    let report = LoadReport {
+        path: path.into(),
+        vertices: n,
+        triangles: triangles.len(),
+        degenerate_skipped: degenerate,
+        groups: 1,
+        has_normals: !normals.is_empty(),
+        has_uvs: false,
+        load_time: Default::default(),
+    };
+    let count = triangles.len() as u32;
+    let mesh = Mesh {
+        groups: vec![MeshGroup { name: name.clone(), triangles: 0..count }],
+        name,
+        positions,
+        normals,
+        uvs: Vec::new(),
+        triangles,
+        file_numbers: numbers,
+        file_triangles: file_triangles.len(),
+    };
+    Ok((mesh, report))
+}
+
+/// Fan-triangulate a polygon (as the OBJ reader does: (0, i, i + 1)).
+pub(crate) fn fan(polygon: &[u32], out: &mut Vec<[u32; 3]>) {
+    for i in 1..polygon.len().saturating_sub(1) {
+        out.push([polygon[0], polygon[i], polygon[i + 1]]);
+    }
+}
+
+/// At most `claimed` items, and no more than `bytes` of the file could hold at `least` bytes an
+/// item: what a reader reserves, so a header's count never allocates beyond the file.
+pub(crate) fn capacity(claimed: u64, bytes: usize, least: usize) -> usize {
+    (claimed as usize).min(bytes / least.max(1) + 1)
+}
