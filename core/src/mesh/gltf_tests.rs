@@ -1,6 +1,8 @@
 //! The glTF reader on files written here: one mesh placed by three nodes opens as three
 //! placements of one mesh (the hierarchy's transforms composed); a GLB of the torus gives the
-//! OBJ's triangles; a buffer shorter than it says is one message naming it.
+//! OBJ's triangles, tree and image; a `.gltf` with its buffer beside it, 16-bit indices, an
+//! unindexed primitive and a skipped one of points; a buffer shorter than it says is one
+//! message naming it.
 
 use super::*;
 use crate::mesh::generate;
@@ -115,4 +117,55 @@ fn a_short_buffer_is_one_message_naming_it() {
         Ok(_) => panic!("a short buffer loaded"),
     };
     assert!(e.starts_with(&path.display().to_string()) && e.contains("buffer 0"), "{e}");
+}
+
+#[test]
+fn a_glb_opens_with_the_objs_triangles_tree_and_image() {
+    let m = generate::torus(1.0, 0.35, 12, 8);
+    let mut obj = Vec::new();
+    crate::mesh::write_obj(&m, &mut obj).unwrap();
+    let (reference, _) = crate::mesh::load_mesh(write("torus-ref.obj", &obj)).unwrap();
+    let (json, bin) = document(&m, None, r#"[{"mesh": 0}]"#, "[0]");
+    let scene = crate::scene::Scene::open(write("torus-scene.glb", &glb(&json, &bin))).unwrap();
+    let flat = scene.flat_mesh().unwrap();
+    let corners = |m: &Mesh| m.triangles.iter().map(|t| t.map(|i| m.positions[i as usize])).collect::<Vec<_>>();
+    assert_eq!(corners(&flat), corners(&reference));
+    let p = crate::bvh::BuildParams::default();
+    let camera = crate::render::Camera::framing(&reference.bounds(), 48, 32);
+    let settings = crate::render::RenderSettings { count: true, ..Default::default() };
+    let look = |m: &Mesh| {
+        let bvh = crate::bvh::AnyBvh::build(m, &p);
+        let nodes = bvh.binary_tree(m).nodes.len();
+        (nodes, crate::render::render(&bvh, m, &camera, &settings).counts_csv().unwrap())
+    };
+    assert_eq!(look(&flat), look(&reference), "the same tree and the same image");
+}
+
+/// A `.gltf` whose buffer is a file beside it (its name with a space, %20 in the URI), u16
+/// indices, a second primitive without indices, a third of points (skipped, with a warning).
+#[test]
+fn a_gltf_with_its_buffer_beside_it_short_indices_an_unindexed_primitive_and_points() {
+    let mut bin = Vec::new();
+    for p in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]] {
+        for c in p {
+            bin.extend(c.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        bin.extend(i.to_le_bytes());
+    }
+    write("quad data.bin", &bin);
+    let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}, {"attributes": {"POSITION": 2}},
+                                   {"attributes": {"POSITION": 0}, "mode": 0}]}],
+        "buffers": [{"uri": "quad%20data.bin", "byteLength": 60}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+                      {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]}"#;
+    let g = load_gltf(&write("quad.gltf", json.as_bytes())).unwrap();
+    assert_eq!(g.meshes.len(), 1);
+    assert_eq!(g.meshes[0].triangles, vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]]);
+    assert_eq!(g.warnings.len(), 1, "{:?}", g.warnings);
+    assert!(g.warnings[0].contains("primitive 2") && g.warnings[0].contains("Points"), "{:?}", g.warnings);
 }
