@@ -1,7 +1,7 @@
 //! The GPU path shared by the command line and the app: which device traces, the node format it
 //! walks, the trees built on the GPU (lbvh and ploc, core's trees node for node, with their phases
-//! timed) and a tree uploaded for tracing. The command line's flags and messages over it are in
-//! `cli::device`, the app's jobs in `app::gpu`.
+//! timed) and a tree uploaded for tracing. The command line's flags (their names too) and messages
+//! over it are in `cli::device`, the app's jobs in `app::gpu`.
 
 use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, RayCounters, SceneBvh, SplitStrategy, TraceOptions};
 use crate::mesh::Mesh;
@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Where rays are traced: the CPU (the renderer of `core`) or the GPU (`bvhscope-gpu`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Device {
     #[default]
@@ -20,7 +20,7 @@ pub enum Device {
 }
 
 /// The node format the GPU walks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum GpuNodes {
     /// The binary tree as built: core's 32-byte nodes, byte for byte.

@@ -143,3 +143,32 @@ impl GpuTree {
         Ok((frame, t))
     }
 }
+
+/// The flags' names of the GPU path's choices: `gpu_path` knows nothing of flags.
+impl clap::ValueEnum for crate::gpu_path::Device {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[crate::gpu_path::Device::Cpu, crate::gpu_path::Device::Gpu]
+    }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(match self {
+            crate::gpu_path::Device::Cpu => "cpu",
+            crate::gpu_path::Device::Gpu => "gpu",
+        }))
+    }
+}
+
+impl clap::ValueEnum for GpuNodes {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[GpuNodes::Binary, GpuNodes::Cwbvh]
+    }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        let (name, help) = match self {
+            GpuNodes::Binary => ("binary", "The binary tree as built: core's 32-byte nodes, byte for byte"),
+            GpuNodes::Cwbvh => (
+                "cwbvh",
+                "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree",
+            ),
+        };
+        Some(clap::builder::PossibleValue::new(name).help(help))
+    }
+}

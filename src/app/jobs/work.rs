@@ -367,7 +367,7 @@ impl Jobs {
                     }
                 }
             };
-            let path = pollster_block_on(fut).map(|h| h.path().to_path_buf());
+            let path = pollster::block_on(fut).map(|h| h.path().to_path_buf());
             send(JobEvent::Picked { pick, path, took: start.elapsed() });
         });
     }
@@ -403,24 +403,4 @@ fn import_tree(
             .map_or("it cannot be traced".into(), |f| f.line(crate::explain::check::LISTED))),
     };
     Ok(ImportedTree { path, scene_id, bvh, findings, rays: CHECK_RAYS, reference })
-}
-
-/// Run a future to completion on this thread (rfd's dialogs are futures).
-fn pollster_block_on<F: std::future::Future>(fut: F) -> F::Output {
-    use std::task::{Context, Poll, Wake, Waker};
-    struct ThreadWaker(std::thread::Thread);
-    impl Wake for ThreadWaker {
-        fn wake(self: Arc<Self>) {
-            self.0.unpark();
-        }
-    }
-    let waker = Waker::from(Arc::new(ThreadWaker(std::thread::current())));
-    let mut cx = Context::from_waker(&waker);
-    let mut fut = std::pin::pin!(fut);
-    loop {
-        match fut.as_mut().poll(&mut cx) {
-            Poll::Ready(v) => return v,
-            Poll::Pending => std::thread::park(),
-        }
-    }
 }

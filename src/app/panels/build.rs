@@ -141,7 +141,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.label("Layout");
     // On the GPU the tree is built binary and traced in the GPU's own node format (View ▸ GPU
     // nodes): the CPU's layout choice would show one thing and trace another.
-    let gpu = s.device == crate::cli::Device::Gpu;
+    let gpu = s.device == crate::gpu_path::Device::Gpu;
     ui.add_enabled_ui(!on && !gpu, |ui| radios(ui, &mut s.build.layout));
     if on {
         ui.weak("The imported tree keeps its own layout and leaves.");
