@@ -305,7 +305,7 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         let _ = writeln!(o, "reinsertion     {} (in the build time)", r.summary());
     }
     let _ = writeln!(o, "nodes           {} ({} interior, {} leaves)", s.nodes, s.interior_nodes, s.leaves);
-    if s.references != s.triangles || params.strategy == crate::bvh::SplitStrategy::Sbvh {
+    if s.references != s.triangles || params.strategy.splits_references() {
         let _ = writeln!(
             o,
             "references      {} ({:.3} per triangle; {} spatial splits cut triangles)",

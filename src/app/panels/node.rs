@@ -11,17 +11,21 @@ use egui_plot::{HLine, Line, LineStyle, Plot, PlotPoints, VLine};
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
-/// Each strategy's marker colour.
+/// Each strategy's marker colour: the strategies' table order picks it, so a strategy added to
+/// the table has its own without naming it here.
 pub fn strategy_color(s: SplitStrategy) -> Color32 {
-    match s {
-        SplitStrategy::Midpoint => Color32::from_rgb(240, 120, 60),
-        SplitStrategy::EqualCount => Color32::from_rgb(200, 120, 230),
-        SplitStrategy::SahBinned => Color32::from_rgb(90, 200, 250),
-        SplitStrategy::SahSweep => Color32::from_rgb(120, 230, 120),
-        SplitStrategy::Lbvh => Color32::from_rgb(240, 120, 200),
-        SplitStrategy::Ploc => Color32::from_rgb(160, 140, 255),
-        SplitStrategy::Sbvh => Color32::from_rgb(250, 220, 80),
-    }
+    const PALETTE: [Color32; 8] = [
+        Color32::from_rgb(240, 120, 60),
+        Color32::from_rgb(200, 120, 230),
+        Color32::from_rgb(90, 200, 250),
+        Color32::from_rgb(120, 230, 120),
+        Color32::from_rgb(240, 120, 200),
+        Color32::from_rgb(160, 140, 255),
+        Color32::from_rgb(250, 220, 80),
+        Color32::from_rgb(110, 220, 200),
+    ];
+    let k = SplitStrategy::ALL.iter().position(|&x| x == s).unwrap_or(0);
+    PALETTE[k % PALETTE.len()]
 }
 
 /// Whether the view is open (its tile shown).
@@ -396,6 +400,14 @@ const OWN_COLOR: Color32 = Color32::from_rgb(240, 80, 70);
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_strategy_has_a_colour_of_its_own() {
+        let colours: Vec<Color32> = SplitStrategy::ALL.iter().map(|&s| strategy_color(s)).collect();
+        for (i, c) in colours.iter().enumerate() {
+            assert!(!colours[..i].contains(c), "{:?} shares its colour", SplitStrategy::ALL[i]);
+        }
+    }
 
     #[test]
     fn a_long_curve_is_thinned_keeping_its_minimum_and_order() {
