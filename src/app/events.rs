@@ -88,7 +88,8 @@ impl BvhscopeApp {
             JobEvent::Built { scene_id, result: Err(SceneBuildError::Scene(e)), .. } if scene_id == self.scene_id => {
                 self.message(MessageKind::Error, e.to_string());
             }
-            JobEvent::Built { .. } => {}
+            // A cancelled build, another scene's, or one the GPU failed (its message is `GpuFailed`'s).
+            JobEvent::Built { .. } | JobEvent::NotBuilt => {}
             JobEvent::Pass(pass) => self.show_pass(ctx, pass),
             JobEvent::Picked { pick, path: Some(path), .. } => self.act(Action::Picked(pick, path)),
             JobEvent::Picked { pick, path: None, took } => {

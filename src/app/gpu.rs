@@ -122,21 +122,21 @@ impl GpuJobs {
         }))
     }
 
-    /// The build job's work: lbvh and ploc on `gpu` (when given), the rest on the CPU. A GPU
-    /// failure is the second value; the build then gives no tree (the CPU builds it next).
+    /// The build job's work: lbvh and ploc on `gpu` (when given), the rest on the CPU. `Err`:
+    /// the GPU failed, why (no tree; the CPU builds it next).
     pub fn build(
         &self,
         scene: &Scene,
         params: &SceneBuild,
         control: &WorkControl,
         gpu: Option<&Gpu>,
-    ) -> (Result<Arc<SceneBvh>, SceneBuildError>, Option<String>) {
+    ) -> Result<Result<Arc<SceneBvh>, SceneBuildError>, String> {
         let Some(gpu) = gpu.filter(|_| params.top.is_none()) else {
-            return (scene.build(params, control).map(Arc::new), None);
+            return Ok(scene.build(params, control).map(Arc::new));
         };
         let mesh = match scene.flat_mesh() {
             Ok(m) => m,
-            Err(e) => return (Err(SceneBuildError::Scene(e)), None),
+            Err(e) => return Ok(Err(SceneBuildError::Scene(e))),
         };
         match build_on_gpu(gpu, &mesh, &params.bvh) {
             Ok(Some((bvh, phases))) => {
@@ -144,10 +144,10 @@ impl GpuJobs {
                 let mut built = self.built.lock().unwrap_or_else(|p| p.into_inner());
                 built.retain(|(b, _)| b.strong_count() > 0);
                 built.push((Arc::downgrade(&bvh), phases));
-                (Ok(bvh), None)
+                Ok(Ok(bvh))
             }
-            Ok(None) => (scene.build(params, control).map(Arc::new), None),
-            Err(e) => (Err(SceneBuildError::Cancelled), Some(format!("The GPU build failed: {e}"))),
+            Ok(None) => Ok(scene.build(params, control).map(Arc::new)),
+            Err(e) => Err(format!("The GPU build failed: {e}")),
         }
     }
 }

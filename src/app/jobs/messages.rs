@@ -114,6 +114,9 @@ pub enum JobEvent {
         params: SceneBuild,
         result: Result<Arc<SceneBvh>, SceneBuildError>,
     },
+    /// The build ended without a tree because the GPU failed (`GpuFailed` says why, and the CPU
+    /// builds it next): not a cancellation, which it used to be reported as.
+    NotBuilt,
     Pass(PassOutput),
     /// A dump read and checked for scene `scene_id`, or why it cannot be read.
     Imported(Result<Box<ImportedTree>, String>),

@@ -205,7 +205,7 @@ impl Jobs {
             }
             match &event {
                 JobEvent::Loaded(_) if current(&self.load) => self.load = None,
-                JobEvent::Built { .. } if current(&self.build) => self.build = None,
+                JobEvent::Built { .. } | JobEvent::NotBuilt if current(&self.build) => self.build = None,
                 JobEvent::Pass(p) if current(&self.render) => {
                     if p.info.stride == 1 {
                         self.render = None;

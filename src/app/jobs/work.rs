@@ -49,11 +49,13 @@ impl Jobs {
             while others.load(std::sync::atomic::Ordering::SeqCst) > 0 && !control.is_cancelled() {
                 std::thread::sleep(Duration::from_millis(1));
             }
-            let (result, gpu_failed) = gpu_jobs.build(&scene, &params, &control, gpu.as_deref());
-            if let Some(why) = gpu_failed {
-                send(JobEvent::GpuFailed(why));
+            match gpu_jobs.build(&scene, &params, &control, gpu.as_deref()) {
+                Ok(result) => send(JobEvent::Built { scene_id, params, result }),
+                Err(why) => {
+                    send(JobEvent::GpuFailed(why));
+                    send(JobEvent::NotBuilt);
+                }
             }
-            send(JobEvent::Built { scene_id, params, result });
         });
         self.build = Some(job);
         self.last_build = Some((params, scene_id));
