@@ -10,11 +10,7 @@ impl BvhscopeApp {
     /// of one camera are there (cached for the pair and the view).
     pub fn compare_images(&self, ctx: &egui::Context) -> Option<Arc<compare_view::CompareImages>> {
         use crate::render::diff;
-        if !self.compare.on {
-            return None;
-        }
-        let shown = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none())?;
-        let b = self.compare.b.as_ref().filter(|b| b.camera == shown.camera && b.scene_id == self.scene_id)?;
+        let (shown, b) = self.shown_pair()?;
         let (view, colormap, cost) = (shown.style.view, shown.style.colormap, shown.style.cost);
         let mut cache = self.compare_cache.borrow_mut();
         if let Some(c) = cache.as_ref() {
@@ -53,6 +49,17 @@ impl BvhscopeApp {
         });
         *cache = Some(images.clone());
         Some(images)
+    }
+
+    /// Compare's pair as it is on screen: A's frame (complete) and B's of the same camera; `None`
+    /// outside Compare or while B is not there yet (the images and the exports both ask).
+    pub(super) fn shown_pair(&self) -> Option<(&Shown, &compare_view::CompareB)> {
+        if !self.compare.on {
+            return None;
+        }
+        let shown = self.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none())?;
+        let b = self.compare.b.as_ref().filter(|b| b.camera == shown.camera && b.scene_id == self.scene_id)?;
+        Some((shown, b))
     }
 
     /// How the pair on screen is drawn: `shown`'s view, colour map and range, the difference's range.

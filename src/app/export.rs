@@ -17,7 +17,7 @@ pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
     let scene: String = app.scene.title().chars().map(|c| if c.is_alphanumeric() { c } else { '-' }).collect();
     let strategy = app.settings.build.strategy.name();
     // Side by side, the name says both builds and how the pair is shown.
-    if let Some((_, b)) = shown_pair(app) {
+    if let Some((_, b)) = app.shown_pair() {
         let pair = format!("bvhscope-{scene}-{strategy}-vs-{}", b.build.bvh.strategy.name());
         match ext {
             "png" => return format!("{pair}-{}-{}.png", app.settings.view.name(), app.compare.mode.name()),
@@ -61,20 +61,9 @@ pub fn check_output(app: &BvhscopeApp, pick: Pick, path: &Path) -> Result<(), St
     crate::files::refuse_inputs(path, &inputs).map_err(|e| e.to_string())
 }
 
-/// Compare's pair as it is on screen: A's frame (complete) and B's of the same camera; `None`
-/// outside Compare or while B is not there yet.
-fn shown_pair(app: &BvhscopeApp) -> Option<(&super::Shown, &super::compare_view::CompareB)> {
-    if !app.compare.on {
-        return None;
-    }
-    let shown = app.shown.as_ref().filter(|s| s.frame.is_complete() && s.partial.is_none())?;
-    let b = app.compare.b.as_ref().filter(|b| b.camera == shown.camera && b.scene_id == app.scene_id)?;
-    Some((shown, b))
-}
-
 /// Compare's pair, or why it cannot be written yet.
 fn pair_on_screen(app: &BvhscopeApp) -> Result<(&super::Shown, &super::compare_view::CompareB), String> {
-    shown_pair(app).ok_or_else(|| "B is not traced yet: save once both builds are on screen".to_string())
+    app.shown_pair().ok_or_else(|| "B is not traced yet: save once both builds are on screen".to_string())
 }
 
 /// The view as PNG: in Compare what is on screen (halves, wipe or difference, with its legend,

@@ -171,6 +171,10 @@ fn malformed_files_name_the_file_the_element_and_the_problem() {
     cut.truncate(cut.len() - 5);
     let t = error("cut.ply", &cut);
     assert!(t.contains("face") && t.contains("ends"), "{t}");
+    let mut cut = stl_binary(&mesh(), b"solid but binary");
+    cut.truncate(cut.len() - 50);
+    let t = error("cut.stl", &cut);
+    assert!(t.contains("holds binary data, so it is not ASCII STL") && t.contains("cut short?"), "{t}");
     let t = error("nothing.stl", &[7u8; 200]);
     assert!(t.contains("neither ASCII STL") && t.contains("binary STL"), "{t}");
     let t = error("short.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n");

@@ -22,17 +22,20 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
     if is_binary(bytes) {
         return binary(path, bytes);
     }
-    if bytes.contains(&0) || !bytes.trim_ascii_start().starts_with(b"solid") {
+    let solid = bytes.trim_ascii_start().starts_with(b"solid");
+    if bytes.contains(&0) || !solid {
         let n = if bytes.len() >= 84 {
             u32::from_le_bytes(bytes[80..84].try_into().expect("four bytes")) as u64
         } else {
             0
         };
+        // Binary data that does not add up, or text that is not STL's: say which it looked like.
+        let why = if solid { "it holds binary data, so it is not ASCII STL" } else { "it does not start with 'solid'" };
         return Err(bad(
             path,
             "the file",
             format!(
-                "neither ASCII STL (it does not start with 'solid') nor binary STL ({} bytes, where a binary STL of the {n} triangles its header counts has {})",
+                "neither ASCII STL ({why}) nor binary STL ({} bytes, where a binary STL of the {n} triangles its header counts has {}: cut short?)",
                 bytes.len(),
                 84 + 50 * n
             ),
