@@ -33,6 +33,9 @@ pub enum Family {
     /// Embree with packets or streams (built only where Embree is found).
     #[cfg_attr(not(embree), allow(dead_code))]
     EmbreePackets,
+    /// tinybvh's BVH8_CPU with single rays (built only where AVX2 was enabled at compile time).
+    #[cfg_attr(not(target_feature = "avx2"), allow(dead_code))]
+    TinyBvh,
 }
 
 pub struct Built {

@@ -16,7 +16,9 @@
 //! Tuning: `BENCH_TRAVERSAL_COST=c` and `BENCH_MAX_LEAF=n` build our trees with that SAH traversal
 //! cost and leaf size; `BENCH_EMBREE_ISA=avx2` asks Embree for its kernels of another CPU,
 //! `BENCH_EMBREE_ROBUST=1` for its robust mode.
-//! Embree 3 is raced when `build.rs` found it (Debian: libembree-dev).
+//! Embree 3 is raced when `build.rs` found it (Debian: libembree-dev); tinybvh's BVH8_CPU (the
+//! `tinybvh-rs` crate) when the bench is built with AVX2 enabled: `RUSTFLAGS="-C target-cpu=native"
+//! CARGO_TARGET_DIR=target/native cargo bench --bench versus`.
 
 mod contenders;
 mod counts;
@@ -26,6 +28,7 @@ mod ratios;
 mod rays;
 mod scaling;
 mod scenes;
+mod tinybvh;
 
 use bvhscope::bvh::Layout;
 use bvhscope::mesh::Mesh;
@@ -397,7 +400,8 @@ fn main() {
     contenders.extend(contenders::obvhs_all());
     contenders.push(contenders::bvh_crate());
     contenders.extend(embree::all());
-    if let Some(n) = embree::notice() {
+    contenders.extend(tinybvh::all());
+    for n in [embree::notice(), tinybvh::notice()].into_iter().flatten() {
         eprintln!("notice: {n}");
     }
     // BENCH_ONLY=a,b keeps contenders whose name contains one of the words (for quick iteration).
@@ -463,6 +467,7 @@ fn main() {
         print!("{t}");
         out += &t;
         closing += &ratios::ratios(mesh, &rows);
+        closing += &tinybvh::cwbvh_line(mesh);
         closing += &counting_overhead(mesh, &s, &one);
     }
     println!("\n{closing}");

@@ -41,6 +41,11 @@ pub fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
         let embree_any = best(rows, |r| matches!(r.family, Some(Family::Embree | Family::EmbreePackets)), key);
         line(&format!("{label} best single-ray/embree-rtcIntersect1"), our_single, embree_single, key);
         line(&format!("{label} best/embree-best"), our_best, embree_any, key);
+        let tinybvh = best(rows, is(Family::TinyBvh), key);
+        line(&format!("{label} best single-ray/tinybvh-BVH8_CPU"), our_single, tinybvh, key);
+        let fastest = rows.iter().find(|r| r.name == "bvhscope fastest (BVH8)");
+        line(&format!("{label} fastest/embree-rtcIntersect1"), fastest, embree_single, key);
+        line(&format!("{label} fastest/tinybvh-BVH8_CPU"), fastest, tinybvh, key);
         for our in ["bvhscope sah (BVH2)", "bvhscope sah (BVH2, 8×8 packets)"] {
             let a = rows.iter().find(|r| r.name == our);
             let label = format!("{label} sah-BVH2{}/bvh-crate", if our.contains("packets") { "-packets" } else { "" });
@@ -68,10 +73,14 @@ pub fn ratios(mesh: &Mesh, rows: &[Row]) -> String {
             b.sah.unwrap_or(f64::NAN)
         );
     }
-    let single_embree = |r: &Row| r.family == Some(Family::Embree);
-    for r in rows.iter().filter(|r| (ours(r) || single_embree(r)) && !r.name.contains("packets")) {
+    let single_other = |r: &Row| matches!(r.family, Some(Family::Embree | Family::TinyBvh));
+    for r in rows.iter().filter(|r| (ours(r) || single_other(r)) && !r.name.contains("packets")) {
         if let Some(b) = r.bytes {
-            let what = if single_embree(r) { "what the device allocates" } else { "nodes + leaves" };
+            let what = match r.family {
+                Some(Family::Embree) => "what the device allocates",
+                Some(Family::TinyBvh) => "BVH8_CPU's nodes and four-triangle leaves",
+                _ => "nodes + leaves",
+            };
             let _ = writeln!(o, "memory {name}: {} {:.1} bytes per triangle ({what})", r.name, b);
         }
     }
