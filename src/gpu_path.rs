@@ -187,7 +187,8 @@ impl GpuTree {
     pub fn cpu_counts(&self, cpu: &SceneBvh, camera: &Camera, trace: TraceOptions) -> Vec<RayCounters> {
         match self {
             GpuTree::Binary(..) => {
-                let settings = crate::render::RenderSettings { trace, count: true, progressive: false };
+                let settings =
+                    crate::render::RenderSettings { trace, count: true, progressive: false, secondary: None };
                 let frame = crate::render::render(cpu, cpu, camera, &settings);
                 frame.traced().map(|(_, c)| c).collect()
             }

@@ -6,7 +6,7 @@
 use crate::bvh::{Layout, Limits, Param, ParamLimits, ParamValue, Preset, SplitStrategy, TraversalOrder};
 use crate::geometry::TriangleTest;
 use crate::render::warp::WarpSize;
-use crate::render::{ColorMap, PairView, UpAxis, View};
+use crate::render::{ColorMap, PairView, RayKind, UpAxis, View};
 
 /// One value of a choice: what it is called where.
 #[derive(Clone, Copy, Debug)]
@@ -315,6 +315,34 @@ const PAIR_VIEWS: [Named<PairView>; 3] = [
     },
 ];
 choice!(PairView, PAIR_VIEWS, 3);
+
+const RAY_KINDS: [Named<RayKind>; 4] = [
+    Named {
+        value: RayKind::Primary,
+        name: "primary",
+        label: "Primary",
+        help: "the camera's rays, closest hit: the most coherent rays there are",
+    },
+    Named {
+        value: RayKind::Shadow,
+        name: "shadow",
+        label: "Shadow",
+        help: "from each hit to a point light (above the camera unless given), any hit",
+    },
+    Named {
+        value: RayKind::Ao,
+        name: "ao",
+        label: "Ambient occlusion",
+        help: "cosine-weighted hemisphere rays from each hit, 10% of the scene's diagonal long unless given, any hit",
+    },
+    Named {
+        value: RayKind::Bounce,
+        name: "bounce",
+        label: "Diffuse bounce",
+        help: "one cosine-weighted diffuse bounce from each hit, closest hit: the most incoherent",
+    },
+];
+choice!(RayKind, RAY_KINDS, 4);
 
 /// A build parameter as users see it: its names, label and help. Its limits and default are the
 /// builder's (`Param::limits`); which strategies read it is the strategy's (`SplitStrategy::reads`).

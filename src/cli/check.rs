@@ -81,7 +81,7 @@ fn quality(
 ) -> QualityRow {
     // Every row against the mesh's box, the imported tree's too (`TreeStats::against`).
     let s = TreeStats::against(bvh, &mesh.bounds());
-    let f = render(bvh, mesh, camera, &RenderSettings { trace, count: true, progressive: false });
+    let f = render(bvh, mesh, camera, &RenderSettings { trace, count: true, progressive: false, secondary: None });
     let r = f.ray_summary();
     QualityRow {
         name,

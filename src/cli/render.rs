@@ -225,7 +225,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         None => device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
     };
     let count = a.view.is_heatmap() || a.counts.is_some();
-    let settings = RenderSettings { trace: a.build.trace(), count, progressive: false };
+    let settings = RenderSettings { trace: a.build.trace(), count, progressive: false, secondary: None };
     let total = camera.width as u64 * camera.height as u64;
     let frame = frame_of(a, gpu.as_ref(), &bvh, &camera, &settings, "rendering")?;
     // What A is called in captions: the build, or the imported file.

@@ -218,7 +218,7 @@ fn trace_rays(
             (*camera, frame.ray_summary(), warp)
         }
         None => {
-            let settings = RenderSettings { trace, count: true, progressive: false };
+            let settings = RenderSettings { trace, count: true, progressive: false, secondary: None };
             let frame = progress::with_spinner("tracing the frame", || render(bvh, bvh, camera, &settings));
             let warp = Warp { size: a.warp, gpu: None, cpu: Warp::of(camera, a.warp, &counts(&frame)) };
             (*camera, frame.ray_summary(), warp)

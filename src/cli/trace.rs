@@ -131,7 +131,12 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
                     "--hottest ranks a heatmap's work: --view visits, tri-tests or cost".into(),
                 ));
             }
-            let settings = crate::render::RenderSettings { trace: a.build.trace(), count: true, progressive: false };
+            let settings = crate::render::RenderSettings {
+                trace: a.build.trace(),
+                count: true,
+                progressive: false,
+                secondary: None,
+            };
             let frame = match &on_gpu {
                 Some((g, (tree, mesh))) => tree.frame(g, mesh, &camera, settings.trace, true)?.0,
                 None => super::progress::with_spinner("tracing the frame", || {

@@ -26,7 +26,7 @@ fn assert_gpu_frame_is_the_cpus(h: &Harness<'_, BvhscopeApp>) {
     let s = h.state().shown.as_ref().expect("a frame on screen");
     assert!(s.gpu.is_some() && s.frame.is_complete() && s.frame.counted(), "a complete counted GPU frame");
     assert_eq!(s.bvh.build_params().bvh.layout, Layout::Binary, "the GPU walks the binary tree");
-    let settings = RenderSettings { trace: s.trace, count: true, progressive: false };
+    let settings = RenderSettings { trace: s.trace, count: true, progressive: false, secondary: None };
     let cpu = render(&*s.bvh, &*s.bvh, &s.camera, &settings);
     let (w, h) = (s.camera.width, s.camera.height);
     assert!(w * h > 100_000, "a full-resolution frame ({w}x{h})");

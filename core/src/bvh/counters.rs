@@ -151,6 +151,17 @@ impl RayCounters {
         instances_entered: 0,
     };
 
+    /// Add another ray's counts (a pixel's secondary rays are summed; saturating, so a sum never wraps).
+    pub fn add(&mut self, o: &RayCounters) {
+        self.nodes_visited = self.nodes_visited.saturating_add(o.nodes_visited);
+        self.box_tests = self.box_tests.saturating_add(o.box_tests);
+        self.leaves_visited = self.leaves_visited.saturating_add(o.leaves_visited);
+        self.triangle_tests = self.triangle_tests.saturating_add(o.triangle_tests);
+        self.top_nodes_visited = self.top_nodes_visited.saturating_add(o.top_nodes_visited);
+        self.top_box_tests = self.top_box_tests.saturating_add(o.top_box_tests);
+        self.instances_entered = self.instances_entered.saturating_add(o.instances_entered);
+    }
+
     /// Nodes visited in the bottom level (a single BVH's nodes are all bottom level).
     pub fn bottom_nodes_visited(&self) -> u32 {
         self.nodes_visited - self.top_nodes_visited

@@ -85,7 +85,7 @@ pub fn film(
     subject: &str,
     control: &WorkControl,
 ) -> Result<ReplayFilm, Cancelled> {
-    let settings = RenderSettings { trace: s.trace, count: true, progressive: false };
+    let settings = RenderSettings { trace: s.trace, count: true, progressive: false, secondary: None };
     let ks = steps(replay.splits(), s.frames);
     // Each step's metric per pixel; then one colour scale for all of them.
     let pass = WorkControl::new();

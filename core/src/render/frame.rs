@@ -8,6 +8,7 @@
 //! (BENCHMARKS.md, "The frame regression, located"); larger views pass that limit whatever the
 //! layout, so the render job keeps dropped frames' storage for its next frame.
 
+use super::secondary::{RayKind, SecondarySpec};
 use crate::bvh::RayCounters;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -51,8 +52,15 @@ pub struct Frame {
     step: u32,
     /// Row by row over the stored grid.
     samples: Vec<PixelSample>,
-    /// One per stored sample when the render counted, else empty.
+    /// One per stored sample when the render counted, else empty. In a frame of secondary rays,
+    /// the sum over the pixel's secondary rays (none where the primary ray missed).
     counters: Vec<RayCounters>,
+    /// What the counters are of: `Primary`, or the secondary rays traced from each hit.
+    kind: RayKind,
+    /// Secondary rays traced from each pixel whose primary ray hit (0 in a primary frame).
+    per_hit: u32,
+    /// In a counted frame of secondary rays, the primary rays' own counters; else empty.
+    primary: Vec<RayCounters>,
     /// Where the storage goes when the frame is dropped.
     pool: FramePool,
 }
@@ -77,7 +85,55 @@ impl Frame {
                 counters.par_extend(rayon::iter::repeat_n(RayCounters::ZERO, n));
             }
         });
-        Self { width, height, stride: 0, step: 1, samples, counters, pool: pool.clone() }
+        Self {
+            width,
+            height,
+            stride: 0,
+            step: 1,
+            samples,
+            counters,
+            kind: RayKind::Primary,
+            per_hit: 0,
+            primary: Vec::new(),
+            pool: pool.clone(),
+        }
+    }
+
+    /// The frame as one of `spec`'s secondary rays (set by the renderer before it traces; a
+    /// counted one gets room for the primary rays' own counters).
+    pub(super) fn set_secondary(&mut self, spec: &SecondarySpec) {
+        self.kind = spec.kind;
+        self.per_hit = spec.rays_per_hit();
+        if self.counted() && spec.kind.is_secondary() {
+            self.primary = vec![RayCounters::ZERO; self.counters.len()];
+        }
+    }
+
+    /// What the counters are of, and the secondary rays per hit pixel (0 for primary rays).
+    pub fn ray_kind(&self) -> (RayKind, u32) {
+        (self.kind, self.per_hit)
+    }
+
+    /// A heatmap's value at a traced pixel: the metric of its ray, or in a frame of secondary
+    /// rays the mean over the pixel's secondary rays; `None` where a frame of secondary rays
+    /// has none (the primary ray missed), which the views mark as such, never as zero.
+    #[inline]
+    pub fn value(&self, view: super::View, s: &PixelSample, c: &RayCounters, cost: crate::bvh::SahCost) -> Option<f32> {
+        match self.per_hit {
+            0 => Some(view.metric(c, cost)),
+            _ if !s.is_hit() => None,
+            n => Some(view.metric(c, cost) / n as f32),
+        }
+    }
+
+    /// The primary ray's own counters behind `sample(x, y)` in a counted frame of secondary
+    /// rays; in a primary frame, `counters(x, y)`.
+    pub fn primary_counters(&self, x: u32, y: u32) -> RayCounters {
+        if self.primary.is_empty() {
+            return self.counters(x, y);
+        }
+        let s = self.stride.max(1);
+        self.primary.get(self.grid_index(x / s, y / s)).copied().unwrap_or(RayCounters::ZERO)
     }
 
     pub fn width(&self) -> u32 {
@@ -190,6 +246,15 @@ impl Frame {
         if self.counted() {
             self.gather(&mut counters, RayCounters::ZERO, |(_, c)| c);
         }
+        // The primary rays' counters of the traced pixels, in the snapshot's order (small: only
+        // frames of secondary rays have them).
+        let primary = match self.primary.is_empty() {
+            true => Vec::new(),
+            false => (0..rows)
+                .flat_map(|gy| (0..cols).map(move |gx| (gx, gy)))
+                .map(|(gx, gy)| self.primary[self.grid_index(gx, gy)])
+                .collect(),
+        };
         let pool = self.pool.clone();
         Frame {
             width: self.width,
@@ -198,6 +263,9 @@ impl Frame {
             step: self.stride,
             samples,
             counters,
+            kind: self.kind,
+            per_hit: self.per_hit,
+            primary,
             pool,
         }
     }
@@ -229,13 +297,24 @@ impl Frame {
         (&mut self.samples, &mut self.counters)
     }
 
+    /// `slots_mut` with the primary rays' counters of a counted frame of secondary rays (empty
+    /// otherwise).
+    pub(super) fn slots_with_primary_mut(&mut self) -> (&mut [PixelSample], &mut [RayCounters], &mut [RayCounters]) {
+        debug_assert_eq!(self.step, 1, "only the working frame is traced into");
+        (&mut self.samples, &mut self.counters, &mut self.primary)
+    }
+
     /// The counts behind the heatmaps, as CSV: a header, then one row per pixel, row by row:
     /// `x,y,nodes_visited,box_tests,leaves_visited,triangle_tests,hit_triangle` (pixels 0-based
-    /// from the top left, `-1` for a miss). `None` unless the frame is complete and counted.
+    /// from the top left, `-1` for a miss). In a frame of secondary rays (`secondary_counts_csv`)
+    /// the counts are of the pixel's secondary rays. `None` unless the frame is complete and counted.
     pub fn counts_csv(&self) -> Option<String> {
         use std::fmt::Write;
         if !self.counted() || self.full_samples().is_none() {
             return None;
+        }
+        if self.kind.is_secondary() {
+            return Some(self.secondary_counts_csv());
         }
         let mut o = String::from("x,y,nodes_visited,box_tests,leaves_visited,triangle_tests,hit_triangle\n");
         for y in 0..self.height {
@@ -247,6 +326,24 @@ impl Frame {
             }
         }
         Some(o)
+    }
+
+    /// `counts_csv` of a frame of secondary rays: `x,y,rays,nodes_visited,box_tests,
+    /// leaves_visited,triangle_tests,hits,hit_triangle,primary_nodes_visited,primary_triangle_tests`:
+    /// the pixel's secondary rays (0 where the primary ray missed), the sums of their counts,
+    /// then the primary ray's triangle and own counts. Sums, not means: exact in integers.
+    fn secondary_counts_csv(&self) -> String {
+        use std::fmt::Write;
+        let mut o = String::from("x,y,rays,nodes_visited,box_tests,leaves_visited,triangle_tests,hit_triangle,primary_nodes_visited,primary_triangle_tests\n");
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let (s, c, p) = (self.sample(x, y), self.counters(x, y), self.primary_counters(x, y));
+                let (hit, rays) = if s.is_hit() { (s.prim as i64, self.per_hit) } else { (-1, 0) };
+                let (n, b, l, t) = (c.nodes_visited, c.box_tests, c.leaves_visited, c.triangle_tests);
+                let _ = writeln!(o, "{x},{y},{rays},{n},{b},{l},{t},{hit},{},{}", p.nodes_visited, p.triangle_tests);
+            }
+        }
+        o
     }
 
     /// Hit mask, row by row (true = hit), at full resolution.

@@ -13,6 +13,7 @@ pub mod legend;
 pub mod pair;
 mod ray_summary;
 mod raycast;
+pub mod secondary;
 mod views;
 pub mod warp;
 
@@ -24,4 +25,7 @@ pub use legend::{draw_legend, legend_height};
 pub use pair::PairView;
 pub use ray_summary::RaySummary;
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
-pub use views::{full_size, grid_values, histogram, hottest, metric_stats, view_image, HeatRange, Legend, View};
+pub use secondary::{RayKind, SecondaryRays, SecondarySpec};
+pub use views::{
+    full_size, grid_values, histogram, hottest, metric_stats, view_image, HeatRange, Legend, View, NO_RAYS,
+};

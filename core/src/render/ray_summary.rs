@@ -53,7 +53,12 @@ impl Frame {
     /// box) lets more rays in; over its own root box those rays' cheap walks would dilute its
     /// means and rank it ahead of a better tree. For a tree whose root box is the mesh's it is
     /// `ray_summary`.
+    /// A frame of secondary rays has its own yardstick: every secondary ray leaves the surface,
+    /// inside every tree's root box, so its summary is `ray_summary`.
     pub fn ray_summary_in(&self, camera: &super::Camera, yardstick: &crate::geometry::Aabb) -> RaySummary {
+        if self.ray_kind().0.is_secondary() {
+            return self.ray_summary();
+        }
         let (mut s, root) = self.summed();
         let gen = camera.ray_gen();
         let step = self.stride.max(1);
@@ -75,13 +80,22 @@ impl Frame {
     }
 
     /// The summary's all-ray figures, and the sums of nodes, box tests and triangle tests over
-    /// the rays that entered the root box (their count in `root_rays`).
+    /// the rays that entered the root box (their count in `root_rays`). In a frame of secondary
+    /// rays the rays are the secondary rays (`per_hit` from each pixel whose camera ray hit, their
+    /// counts summed in the pixel's counters), `hits` the pixels whose camera ray hit, and the
+    /// maxima those of a pixel's mean.
     fn summed(&self) -> (RaySummary, [u64; 3]) {
         let mut s = RaySummary::default();
         let (mut nodes, mut boxes, mut tris, mut top, mut inst) = (0u64, 0u64, 0u64, 0u64, 0u64);
         let mut root = [0u64; 3];
+        let per_hit = self.ray_kind().1;
         for (p, c) in self.traced() {
-            s.rays += 1;
+            let rays = match per_hit {
+                0 => 1,
+                _ if !p.is_hit() => continue,
+                n => n,
+            };
+            s.rays += rays as u64;
             s.hits += p.is_hit() as u64;
             nodes += c.nodes_visited as u64;
             boxes += c.box_tests as u64;
@@ -89,13 +103,13 @@ impl Frame {
             top += c.top_nodes_visited as u64;
             inst += c.instances_entered as u64;
             if c.nodes_visited > 0 {
-                s.root_rays += 1;
+                s.root_rays += rays as u64;
                 root[0] += c.nodes_visited as u64;
                 root[1] += c.box_tests as u64;
                 root[2] += c.triangle_tests as u64;
             }
-            s.max_nodes_visited = s.max_nodes_visited.max(c.nodes_visited);
-            s.max_triangle_tests = s.max_triangle_tests.max(c.triangle_tests);
+            s.max_nodes_visited = s.max_nodes_visited.max(c.nodes_visited / rays);
+            s.max_triangle_tests = s.max_triangle_tests.max(c.triangle_tests / rays);
         }
         let n = s.rays.max(1) as f64;
         s.mean_nodes_visited = nodes as f64 / n;

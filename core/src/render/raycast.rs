@@ -7,6 +7,7 @@
 //! pixels of the pass's grid; with counters on (the heatmaps, and the app, which counts for its
 //! hover read-out) every ray is traced alone.
 
+use super::secondary::SecondaryRays;
 use super::{Camera, Frame, FramePool, PixelSample};
 use crate::bvh::packet::{packet_position, PACKET, PACKET_SIDE};
 use crate::bvh::{Accelerator, Hit, NoStats, RayCounters, TraceOptions, TraversalStats};
@@ -27,6 +28,9 @@ pub struct RenderSettings {
     pub count: bool,
     /// Coarse passes first; off, a single full-resolution pass.
     pub progressive: bool,
+    /// Secondary rays traced from every hit (`render::secondary`), resolved for the scene and the
+    /// camera; the counters are then theirs. `None`: primary rays only.
+    pub secondary: Option<SecondaryRays>,
 }
 
 /// Reported after each finished pass.
@@ -70,14 +74,18 @@ pub fn render_progressive<A: Accelerator, M: Surface + ?Sized>(
     let start = Instant::now();
     control.set_total(camera.width as u64 * camera.height as u64);
     let mut frame = Frame::new_in(frames, camera.width, camera.height, settings.count);
+    if let Some(sec) = &settings.secondary {
+        frame.set_secondary(&sec.spec);
+    }
     let strides: &[u32] = if settings.progressive { &PASS_STRIDES } else { &[1] };
     let mut previous = 0u32;
     for &stride in strides {
         let t = Instant::now();
-        let pass = Pass { accel, mesh, camera, trace: settings.trace, stride, previous, control };
+        let secondary = settings.secondary.filter(|s| s.spec.kind.is_secondary());
+        let pass = Pass { accel, mesh, camera, trace: settings.trace, secondary, stride, previous, control };
         let rays = if settings.count {
             pass.trace::<RayCounters>(&mut frame)
-        } else if accel.traces_packets() {
+        } else if accel.traces_packets() && secondary.is_none() {
             pass.trace_packets(&mut frame)
         } else {
             pass.trace::<NoStats>(&mut frame)
@@ -120,6 +128,7 @@ struct Pass<'a, A, M: ?Sized> {
     mesh: &'a M,
     camera: &'a Camera,
     trace: TraceOptions,
+    secondary: Option<SecondaryRays>,
     stride: u32,
     previous: u32,
     control: &'a WorkControl,
@@ -128,11 +137,12 @@ struct Pass<'a, A, M: ?Sized> {
 impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
     /// Trace the pass ray by ray, counting into `S`; returns the rays traced.
     fn trace<S: TraversalStats + Default + Into<RayCounters>>(&self, frame: &mut Frame) -> u64 {
-        let Pass { accel, mesh, camera, trace, stride, previous, control } = *self;
+        let Pass { accel, mesh, camera, trace, secondary, stride, previous, control } = *self;
         let gen = camera.ray_gen();
+        let width = camera.width as u64;
         for_each_piece(frame, control, |piece| {
             let mut traced = 0u64;
-            let Piece { y0, x0, x1, mut samples, mut counters } = piece;
+            let Piece { y0, x0, x1, mut samples, mut counters, mut primary } = piece;
             // Tile by tile across the piece: neighbouring rays walk the same nodes.
             for t0 in (x0..x1).step_by(TILE as usize) {
                 for dy in (0..samples.len() as u32).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
@@ -145,9 +155,24 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
                         let mut stats = S::default();
                         let hit = accel.closest_hit(&mut ray, trace, &mut stats);
                         let i = (x - x0) as usize;
-                        samples[dy as usize][i] = sample(mesh, &ray, hit);
+                        let s = sample(mesh, &ray, hit);
+                        samples[dy as usize][i] = s;
+                        let mut counted: RayCounters = stats.into();
+                        if let Some(sec) = secondary.as_ref() {
+                            if let Some(p) = primary.get_mut(dy as usize) {
+                                p[i] = counted;
+                            }
+                            // A missed pixel has no secondary rays: its value is marked, not zero.
+                            counted = RayCounters::default();
+                            if s.is_hit() {
+                                // The hit point: the primary ray's direction is unit length.
+                                let point = ray.origin() + ray.dir() * s.t;
+                                let pixel = y as u64 * width + x as u64;
+                                counted = sec.trace::<A, S>(accel, trace, pixel, point, s.normal, ray.dir()).0;
+                            }
+                        }
                         if let Some(c) = counters.get_mut(dy as usize) {
-                            c[i] = stats.into();
+                            c[i] = counted;
                         }
                         traced += 1;
                     }
@@ -173,6 +198,8 @@ struct Piece<'a> {
     x1: u32,
     samples: Vec<&'a mut [PixelSample]>,
     counters: Vec<&'a mut [RayCounters]>,
+    /// The primary rays' own counters in a counted frame of secondary rays (else no rows).
+    primary: Vec<&'a mut [RayCounters]>,
 }
 
 /// Run `trace_piece` on each piece of each band of `TILE` rows in parallel (rayon: the bands, and
@@ -182,16 +209,19 @@ struct Piece<'a> {
 fn for_each_piece(frame: &mut Frame, control: &WorkControl, trace_piece: impl Fn(Piece) -> u64 + Sync) -> u64 {
     let w = frame.width() as usize;
     let band = w * TILE as usize;
-    let (samples, counters) = frame.slots_mut();
+    let (samples, counters, primary) = frame.slots_with_primary_mut();
     if w == 0 {
         return 0;
     }
     let bands = samples.len().div_ceil(band);
-    let counter_bands: Vec<&mut [RayCounters]> = if counters.is_empty() {
-        (0..bands).map(|_| Default::default()).collect()
-    } else {
-        counters.chunks_mut(band).collect()
-    };
+    fn bands_of(c: &mut [RayCounters], bands: usize, band: usize) -> Vec<&mut [RayCounters]> {
+        if c.is_empty() {
+            (0..bands).map(|_| Default::default()).collect()
+        } else {
+            c.chunks_mut(band).collect()
+        }
+    }
+    let counter_bands = bands_of(counters, bands, band).into_iter().zip(bands_of(primary, bands, band));
     // Each row cut at the pieces' columns, the cuts dealt to the pieces.
     fn cut<T>(band: &mut [T], w: usize) -> Vec<Vec<&mut [T]>> {
         let mut pieces: Vec<Vec<&mut [T]>> = Vec::new();
@@ -208,16 +238,18 @@ fn for_each_piece(frame: &mut Frame, control: &WorkControl, trace_piece: impl Fn
     crate::parallel::region(|| {
         samples
             .par_chunks_mut(band)
-            .zip(counter_bands)
+            .zip(counter_bands.collect::<Vec<_>>())
             .enumerate()
-            .map(|(b, (samples, counters))| {
+            .map(|(b, (samples, (counters, primary)))| {
                 let mut counters = cut(counters, w).into_iter();
+                let mut primary = cut(primary, w).into_iter();
                 let pieces: Vec<Piece> = (cut(samples, w).into_iter().enumerate())
                     .map(|(k, samples)| {
                         let x0 = k as u32 * PIECE_COLUMNS;
                         let x1 = (x0 + PIECE_COLUMNS).min(w as u32);
                         let counters = counters.next().unwrap_or_default();
-                        Piece { y0: b as u32 * TILE, x0, x1, samples, counters }
+                        let primary = primary.next().unwrap_or_default();
+                        Piece { y0: b as u32 * TILE, x0, x1, samples, counters, primary }
                     })
                     .collect();
                 pieces
@@ -253,7 +285,7 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
     /// its grid (fewer rows where the band is shorter), listed in `packet_position` order, leaving
     /// out the pixels an earlier pass traced.
     fn trace_packets(&self, frame: &mut Frame) -> u64 {
-        let Pass { accel, mesh, camera, trace, stride, previous, control } = *self;
+        let Pass { accel, mesh, camera, trace, stride, previous, control, .. } = *self;
         let gen = camera.ray_gen();
         let span = PACKET_SIDE * stride;
         for_each_piece(frame, control, |piece| {

@@ -138,7 +138,7 @@ pub fn metric_stats(frame: &Frame, view: View, cost: SahCost) -> (f32, f32, f64)
             let rows: Vec<u32> = (0..traced_size(frame).1).collect();
             exact_stats(&rows, 4, |rows, acc| {
                 for &gy in rows {
-                    frame.grid_row(gy).for_each(|(_, c)| acc.add(view.metric(&c, cost)));
+                    frame.grid_row(gy).filter_map(|(s, c)| frame.value(view, s, &c, cost)).for_each(|v| acc.add(v));
                 }
             })
         }
@@ -232,7 +232,7 @@ pub fn view_image(
             let scale = if hi > lo { 1.0 / (hi - lo) } else { 0.0 };
             let colour = |v: f32| colormap.map((v - lo) * scale);
             let img = match view.warp() {
-                None => grid_image(frame, |_, c| colour(view.metric(&c, cost))),
+                None => grid_image(frame, |s, c| frame.value(view, s, &c, cost).map_or(NO_RAYS, colour)),
                 Some(_) => {
                     let (w, h) = traced_size(frame);
                     let rgb = grid_values(frame, view, cost).into_iter().flat_map(colour).collect();
@@ -240,12 +240,21 @@ pub fn view_image(
                 }
             };
             let title = view.legend_title();
+            let note = match frame.ray_kind() {
+                (kind, n) if kind.is_secondary() => format!(
+                    "mean over the {n} {} ray{} from each pixel's hit; grey: the camera ray missed, no {} rays",
+                    kind.name(),
+                    if n == 1 { "" } else { "s" },
+                    kind.name()
+                ),
+                _ => String::new(),
+            };
             (
                 img,
                 Some(Legend {
                     title,
                     subject: String::new(),
-                    note: String::new(),
+                    note,
                     colormap,
                     range_min: lo,
                     range_max: hi,
@@ -281,14 +290,20 @@ pub fn grid_values(frame: &Frame, view: View, cost: SahCost) -> Vec<f32> {
                 _ => groups.efficiency_image(),
             }
         }
-        _ => frame.traced().map(|(_, c)| view.metric(&c, cost)).collect(),
+        // A pixel without secondary rays counts as no work here (the hottest pixel, a
+        // difference); the images mark it apart (`NO_RAYS`).
+        _ => frame.traced().map(|(s, c)| frame.value(view, s, &c, cost).unwrap_or(0.0)).collect(),
     }
 }
+
+/// The colour of a pixel of a frame of secondary rays whose camera ray missed: it has no
+/// secondary rays, which is not the same as rays that cost nothing.
+pub const NO_RAYS: [u8; 3] = [96, 96, 96];
 
 /// `grid_values` one by one; a per-ray view's without collecting them.
 fn values(frame: &Frame, view: View, cost: SahCost) -> impl Iterator<Item = f32> + '_ {
     let grouped = view.warp().map(|_| grid_values(frame, view, cost));
-    let per_ray = grouped.is_none().then(|| frame.traced().map(move |(_, c)| view.metric(&c, cost)));
+    let per_ray = grouped.is_none().then(|| frame.traced().filter_map(move |(s, c)| frame.value(view, s, &c, cost)));
     grouped.into_iter().flatten().chain(per_ray.into_iter().flatten())
 }
 

@@ -91,7 +91,7 @@ impl Jobs {
             }
             // Always count: the heatmaps and the hover read-out need the counters, and counting
             // costs little next to shading.
-            let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive };
+            let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive, secondary: None };
             let on_pass = |frame: Frame, info: PassInfo| {
                 let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
@@ -152,7 +152,7 @@ impl Jobs {
                     Err(_) => return,
                 },
             };
-            let settings = RenderSettings { trace, count: true, progressive: false };
+            let settings = RenderSettings { trace, count: true, progressive: false, secondary: None };
             let mut last = None;
             let _ = render_passes(&*bvh, &*bvh, &camera, &settings, &frames, &control, |frame, _| last = Some(frame));
             if let Some(frame) = last.filter(|f| f.is_complete()) {

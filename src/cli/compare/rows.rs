@@ -96,7 +96,7 @@ pub fn compare_rows(
     let (frames, traces) = (pool(threads), pool(Some(threads.unwrap_or(1))));
     let rays = camera.width as f64 * camera.height as f64;
     let trace = build.trace();
-    let plain = RenderSettings { trace, count: false, progressive: false };
+    let plain = RenderSettings { trace, count: false, progressive: false, secondary: None };
     let counting = RenderSettings { count: true, ..plain };
     let mut rows = Vec::new();
     let mut root_rays = 0;

@@ -220,7 +220,7 @@ pub fn measure(
         Some(Err(why)) => (None, Some(why)),
         None => (None, Some("not measured: no binary tree".into())),
     };
-    let settings = RenderSettings { trace, count: true, progressive: false };
+    let settings = RenderSettings { trace, count: true, progressive: false, secondary: None };
     let frame = render_progressive(tree, mesh, camera, &settings, &Default::default(), control, |_, _| {})?;
     let r = frame.ray_summary_in(camera, &yardstick);
     let q = Quality {
