@@ -28,6 +28,8 @@ pub struct RenderArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub view_args: ViewArgs,
+    #[command(flatten)]
+    pub rays: super::rays::RayArgs,
     /// Colour map of heatmaps.
     #[arg(long, value_parser = super::args::choice::<ColorMap>(), default_value = "viridis")]
     pub colormap: ColorMap,
@@ -36,7 +38,9 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_range, allow_hyphen_values = true)]
     pub range: Option<(f32, f32)>,
     /// Also write the counts behind the heatmap, one CSV row per pixel: x, y (0-based, from the
-    /// top left), nodes_visited, box_tests, leaves_visited, triangle_tests, hit_triangle (-1: miss).
+    /// top left), nodes_visited, box_tests, leaves_visited, triangle_tests, hit_triangle (-1: miss);
+    /// with secondary rays: x, y, rays, their summed counts, hit_triangle, and the primary ray's
+    /// nodes_visited and triangle_tests.
     #[arg(long, value_name = "FILE.csv")]
     pub counts: Option<PathBuf>,
     /// Compare with a second build that differs only in its split strategy: the PNG shows the
@@ -76,6 +80,15 @@ fn parse_wipe(s: &str) -> Result<f32, String> {
         Ok(w) if (0.0..=1.0).contains(&w) => Ok(w),
         _ => Err(format!("'{s}' is not a place from 0 (the left edge) to 1 (the right)")),
     }
+}
+
+/// The GPU's walks are of camera rays: secondary rays would need their hit points and any-hit
+/// walks in the shaders, which they do not have, so the GPU says so instead of answering wrong.
+pub(super) fn gpu_traces_primary_only(kind: crate::render::RayKind) -> CliError {
+    CliError::Usage(format!(
+        "the GPU path traces primary rays only: --ray-kind {} runs on the CPU (leave out --device gpu)",
+        kind.name()
+    ))
 }
 
 fn parse_percentile(s: &str) -> Result<f32, String> {
@@ -224,8 +237,13 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         Some(path) => a.dump_limit.import(&loaded, path)?,
         None => device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
     };
+    let kind = a.rays.one("render")?;
+    if gpu.is_some() && kind.is_secondary() {
+        return Err(gpu_traces_primary_only(kind));
+    }
     let count = a.view.is_heatmap() || a.counts.is_some();
-    let settings = RenderSettings { trace: a.build.trace(), count, progressive: false, secondary: None };
+    let secondary = a.rays.secondary(kind, &loaded.bounds(), &camera);
+    let settings = RenderSettings { trace: a.build.trace(), count, progressive: false, secondary };
     let total = camera.width as u64 * camera.height as u64;
     let frame = frame_of(a, gpu.as_ref(), &bvh, &camera, &settings, "rendering")?;
     // What A is called in captions: the build, or the imported file.
@@ -251,6 +269,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let (img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
     if let Some(l) = &mut legend {
         l.subject = format!("{}, {label_a}", file_name(&a.mesh));
+        if let Some(sec) = &secondary {
+            l.subject = format!("{}, {}", l.subject, sec.spec.describe());
+        }
     }
     if let (Some(bins), Some(l)) = (a.histogram, &legend) {
         let counts = crate::render::histogram(&frame, a.view, params.cost, l.range_min, l.range_max, bins as usize);

@@ -6,7 +6,7 @@ use super::device::{self, GpuBuild, GpuTree};
 use super::{load_noted, progress, CliError};
 use crate::bvh::{epo, Hierarchy, RayCounters, SceneBvh, TreeStats, TreeView};
 use crate::render::warp::{WarpSize, WarpSummary, WarpView, WarpWork};
-use crate::render::{render, Camera, RaySummary, RenderSettings};
+use crate::render::{render, Camera, RaySummary, RenderSettings, SecondaryRays, SecondarySpec};
 use clap::{Args, ValueEnum};
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -32,6 +32,8 @@ pub struct StatsArgs {
     /// The frame whose primary rays are counted (camera and size as `render` takes them).
     #[command(flatten)]
     pub view_args: ViewArgs,
+    #[command(flatten)]
+    pub rays: super::rays::RayArgs,
     /// Only the tree's statistics: trace no rays.
     #[arg(long)]
     pub no_rays: bool,
@@ -79,18 +81,32 @@ impl Warp {
 }
 
 /// The per-ray block of the text output.
-fn format_rays(camera: &Camera, trace: &crate::bvh::TraceOptions, r: &RaySummary) -> String {
+fn format_rays(camera: &Camera, trace: &crate::bvh::TraceOptions, spec: &SecondarySpec, r: &RaySummary) -> String {
     let mut o = String::new();
     let _ = writeln!(o, "traversal       {} order, {} test", trace.order.label(), trace.test.label());
-    let _ = writeln!(
-        o,
-        "rays            {}x{} primary rays: {} ({:.1}%) enter the root box, {} hit",
-        camera.width,
-        camera.height,
-        r.root_rays,
-        100.0 * r.root_fraction(),
-        r.hits
-    );
+    if spec.kind.is_secondary() {
+        let _ = writeln!(
+            o,
+            "rays            {}x{} pixels, {} camera rays hit; from each, {}: {} rays, {} ({:.1}%) enter the root box",
+            camera.width,
+            camera.height,
+            r.hits,
+            spec.describe(),
+            r.rays,
+            r.root_rays,
+            100.0 * r.root_fraction(),
+        );
+    } else {
+        let _ = writeln!(
+            o,
+            "rays            {}x{} primary rays: {} ({:.1}%) enter the root box, {} hit",
+            camera.width,
+            camera.height,
+            r.root_rays,
+            100.0 * r.root_fraction(),
+            r.hits
+        );
+    }
     let _ = writeln!(
         o,
         "  in root box   per ray: nodes visited {:.2}, box tests {:.2}, triangle tests {:.2}",
@@ -121,24 +137,31 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
     }
     let (bvh, gpu_build) = device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?;
     let report = &loaded.report;
+    let kind = a.rays.one("stats")?;
+    if gpu.is_some() && kind.is_secondary() && !a.no_rays {
+        return Err(super::render::gpu_traces_primary_only(kind));
+    }
+    let spec = a.rays.spec(kind);
     let rays = if a.no_rays {
         None
     } else {
         let camera = a.view_args.camera(&loaded.bounds(), loaded.camera.as_ref())?;
-        Some(trace_rays(a, gpu.as_ref(), &bvh, &camera)?)
+        let secondary = a.rays.secondary(kind, &loaded.bounds(), &camera);
+        Some(trace_rays(a, gpu.as_ref(), &bvh, &camera, secondary)?)
     };
     let rays_json = rays.as_ref().map(|(camera, summary, warp)| {
         let device = gpu.as_ref().map(|g| serde_json::json!({ "adapter": g.name(), "nodes": a.device.nodes() }));
         serde_json::json!({
-            "camera": camera, "trace": trace, "summary": summary, "device": a.device.device, "gpu": device,
-            "warp": warp.json(),
+            "camera": camera, "trace": trace, "ray_kind": spec, "summary": summary, "device": a.device.device,
+            "gpu": device, "warp": warp.as_ref().map(Warp::json),
         })
     });
     let mut rays_text = rays.as_ref().map_or(String::new(), |(camera, r, warp)| {
         let on = gpu.as_ref().map_or(String::new(), |g| {
             format!("device          GPU, {} nodes: {}\n", a.device.nodes().name(), g.name())
         });
-        format!("{on}{}{}", format_rays(camera, &trace, r), warp.text())
+        let warp = warp.as_ref().map_or(String::new(), Warp::text);
+        format!("{on}{}{warp}", format_rays(camera, &trace, &spec, r))
     });
     if let Some(b) = &gpu_build {
         rays_text = format!("GPU build       {}\n{rays_text}", b.text());
@@ -201,7 +224,8 @@ fn trace_rays(
     gpu: Option<&bvhscope_gpu::Gpu>,
     bvh: &SceneBvh,
     camera: &Camera,
-) -> Result<(Camera, RaySummary, Warp), CliError> {
+    secondary: Option<SecondaryRays>,
+) -> Result<(Camera, RaySummary, Option<Warp>), CliError> {
     let trace = a.build.trace();
     let counts = |f: &crate::render::Frame| f.traced().map(|(_, c)| c).collect::<Vec<_>>();
     Ok(match gpu {
@@ -215,12 +239,17 @@ fn trace_rays(
                 gpu: Some(Warp::of(camera, a.warp, &counts(&frame))),
                 cpu: Warp::of(camera, a.warp, &cpu),
             };
-            (*camera, frame.ray_summary(), warp)
+            (*camera, frame.ray_summary(), Some(warp))
         }
         None => {
-            let settings = RenderSettings { trace, count: true, progressive: false, secondary: None };
+            let settings = RenderSettings { trace, count: true, progressive: false, secondary };
             let frame = progress::with_spinner("tracing the frame", || render(bvh, bvh, camera, &settings));
-            let warp = Warp { size: a.warp, gpu: None, cpu: Warp::of(camera, a.warp, &counts(&frame)) };
+            // A warp is of camera rays side by side on screen; a pixel's secondary rays are not.
+            let warp = secondary.is_none().then(|| Warp {
+                size: a.warp,
+                gpu: None,
+                cpu: Warp::of(camera, a.warp, &counts(&frame)),
+            });
             (*camera, frame.ray_summary(), warp)
         }
     })

@@ -5,6 +5,7 @@
 pub mod check;
 pub mod grade;
 pub mod inspect;
+pub mod ray_kinds;
 pub mod replay;
 pub mod replay_film;
 pub mod timing;

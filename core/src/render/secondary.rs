@@ -156,6 +156,26 @@ impl SecondaryRays {
         })
     }
 
+    /// Every secondary ray of a complete frame of primary rays on `camera` (its pixels row by
+    /// row, each hit pixel's `rays`): the rays a heatmap of this kind traces, as a list, so a
+    /// table can count and time each tree on exactly them.
+    pub fn frame_rays(&self, frame: &super::Frame, camera: &Camera) -> Vec<Ray> {
+        assert!(frame.is_complete() && frame.width() == camera.width, "a complete frame of this camera");
+        let gen = camera.ray_gen();
+        let mut out = Vec::new();
+        for y in 0..camera.height {
+            for x in 0..camera.width {
+                let s = frame.sample(x, y);
+                if s.is_hit() {
+                    let ray = gen.pixel_ray(x, y);
+                    let pixel = y as u64 * camera.width as u64 + x as u64;
+                    out.extend(self.rays(pixel, ray.origin() + ray.dir() * s.t, s.normal, ray.dir()));
+                }
+            }
+        }
+        out
+    }
+
     /// Trace one pixel's secondary rays (`rays`), counting into `S`: the counters summed over the
     /// rays and how many of them hit something.
     #[allow(clippy::too_many_arguments)]

@@ -16,6 +16,7 @@
 
 mod csv;
 mod gpu;
+mod kinds;
 mod rows;
 
 pub use csv::{rows_csv, rows_csv_with_gpu};
@@ -48,6 +49,10 @@ pub struct CompareArgs {
     pub device: DeviceArgs,
     #[command(flatten)]
     pub view_args: ViewArgs,
+    /// With a secondary kind or `all`: a second table, every tree on the rays of each kind (the
+    /// camera's always first), and how well the SAH cost and EPO rank the trees for each.
+    #[command(flatten)]
+    pub rays: crate::cli::rays::RayArgs,
     #[arg(long, value_enum, default_value = "markdown")]
     pub format: CompareFormat,
     /// Frames timed per strategy, and builds (the medians are reported; builds stop early once
@@ -71,7 +76,18 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
         // Refused before the CPU rows are measured, not after.
         crate::cli::device::check_traceable(&a.build.scene_build(a.build.params(scene)), a.build.trace())?;
     }
-    let (rows, setup) = compare_rows(mesh, &camera, &a.build, scene, a.runs, a.threads, Duration::from_secs(10));
+    let secondary = a.rays.kinds().iter().any(|k| k.is_secondary());
+    if gpu.is_some() && secondary {
+        let kind = a.rays.kinds().into_iter().find(|k| k.is_secondary()).expect("one is secondary");
+        return Err(crate::cli::render::gpu_traces_primary_only(kind));
+    }
+    let trace = a.build.trace();
+    let mut kinds = secondary.then(|| {
+        let cost = a.build.params(scene).cost;
+        kinds::KindsTable::new(mesh, &camera, &a.rays, trace, cost)
+    });
+    let (rows, setup) =
+        compare_rows(mesh, &camera, &a.build, scene, a.runs, a.threads, Duration::from_secs(10), kinds.as_mut());
     let linear_ms = rows.last().map_or(0.0, |r| r.trace_ms);
     let formats = a.device.gpu_nodes.map_or(vec![GpuNodes::Binary, GpuNodes::Cwbvh], |n| vec![n]);
     let gpu_rows = match &gpu {
@@ -79,13 +95,18 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
         None => None,
     };
     let rays = setup.rays;
-    let trace = a.build.trace();
     let mut o = String::new();
     match a.format {
         CompareFormat::Json => {
             let v = serde_json::json!({
                 "mesh": a.mesh, "triangles": mesh.triangle_count(), "width": camera.width, "height": camera.height,
                 "setup": setup, "trace": trace, "preset": a.build.preset, "rows": rows,
+                "ray_kinds": kinds.as_ref().map(|k| serde_json::json!({
+                    "cells": k.cells,
+                    "spearman": k.correlations().iter().map(|(kind, sah, epo)| serde_json::json!({
+                        "kind": kind, "sah_cost": sah, "epo": epo,
+                    })).collect::<Vec<_>>(),
+                })),
                 "gpu": gpu.as_ref().zip(gpu_rows.as_ref()).map(|(g, (r, n))| serde_json::json!({
                     "adapter": g.name(), "software": g.is_software(), "incoherent_rays": n, "rows": r,
                 })),
@@ -156,6 +177,10 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
             }
             if let (Some(g), Some((r, n))) = (&gpu, &gpu_rows) {
                 o += &gpu::markdown(g, r, &camera, *n, a.runs, trace);
+            }
+            if let Some(k) = &kinds {
+                let _ = writeln!(o, "\n## Every strategy on every ray kind\n");
+                o += &k.markdown(setup.trace_threads);
             }
         }
     }

@@ -64,7 +64,7 @@ const BUDGET_MS: f64 = 1000.0;
 /// The median of up to `runs` timings by `time` (ms), or of fewer once they pass `BUDGET_MS` in
 /// all, so that a slow mesh's table still comes in minutes. Past the budget, one more run when the
 /// count is even: the median of two would be the slower, often the first, cold one.
-fn budgeted_median(runs: u32, mut time: impl FnMut() -> f64) -> f64 {
+pub(super) fn budgeted_median(runs: u32, mut time: impl FnMut() -> f64) -> f64 {
     let mut times = vec![time()];
     while times.len() < runs as usize && (times.iter().sum::<f64>() < BUDGET_MS || times.len().is_multiple_of(2)) {
         times.push(time());
@@ -83,7 +83,9 @@ fn pool(n: Option<u32>) -> rayon::ThreadPool {
 }
 
 /// Build and measure every strategy and the linear scan. Builds and frames run on `threads` (all
-/// cores when `None`), the single-ray trace timing on `threads` (one when `None`).
+/// cores when `None`), the single-ray trace timing on `threads` (one when `None`). `kinds`, when
+/// given, measures every tree on its rays of each kind too.
+#[allow(clippy::too_many_arguments)]
 pub fn compare_rows(
     mesh: &crate::mesh::Mesh,
     camera: &Camera,
@@ -92,6 +94,7 @@ pub fn compare_rows(
     runs: u32,
     threads: Option<u32>,
     linear_budget: Duration,
+    mut kinds: Option<&mut super::kinds::KindsTable>,
 ) -> (Vec<CompareRow>, CompareSetup) {
     let (frames, traces) = (pool(threads), pool(Some(threads.unwrap_or(1))));
     let rays = camera.width as f64 * camera.height as f64;
@@ -148,8 +151,8 @@ pub fn compare_rows(
                 })
             })
         });
-        rows.push(CompareRow {
-            name,
+        let row = CompareRow {
+            name: name.clone(),
             build_ms: Some(build_ms),
             nodes: stats.nodes,
             max_depth: stats.max_depth,
@@ -167,7 +170,13 @@ pub fn compare_rows(
             speedup_over_linear: 0.0,
             sampled_rays: None,
             fallback_splits: stats.fallback_splits,
-        });
+        };
+        if let Some(k) = kinds.as_deref_mut() {
+            progress::with_spinner(&step("tracing every ray kind through"), || {
+                k.measure(&bvh, &row, layout == layouts[0], runs, (&frames, &traces))
+            });
+        }
+        rows.push(row);
     }
     let linear = LinearScan::new(mesh);
     let ((linear_ms, sampled), (frame_ms, _)) = progress::with_spinner("timing the linear scan", || {
@@ -202,6 +211,9 @@ pub fn compare_rows(
     });
     for r in &mut rows {
         r.speedup_over_linear = linear_ms / r.trace_ms;
+    }
+    if let Some(k) = kinds {
+        k.finish(mesh, linear_budget, &traces);
     }
     let setup = CompareSetup {
         trace_threads: traces.current_num_threads(),
