@@ -18,6 +18,8 @@ pub struct CompareB {
     pub frame: Arc<Frame>,
     pub camera: Camera,
     pub trace: TraceOptions,
+    /// The secondary rays it traced, as A's frame did (`None`: camera rays).
+    pub secondary: Option<crate::render::SecondaryRays>,
     pub summary: RaySummary,
 }
 

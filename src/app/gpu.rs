@@ -176,6 +176,10 @@ impl BvhscopeApp {
                 "two levels are traced on the CPU (the GPU traces one BVH)".into()
             }
             Probe::Found(_) if self.replay.window => "the build replay's partial trees are traced on the CPU".into(),
+            Probe::Found(_) if self.settings.rays.kind.is_secondary() => format!(
+                "{} rays are traced on the CPU (the GPU's walks are of camera rays)",
+                self.settings.rays.kind.label().to_lowercase()
+            ),
             Probe::Found(_) => return None,
         })
     }

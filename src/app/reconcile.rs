@@ -43,11 +43,15 @@ impl BvhscopeApp {
             return;
         }
         let build = self.compare.build_for(self.wanted_build());
-        let wanted = (build, self.scene_id, shown.camera, self.compare.trace);
-        let have = self.compare.b.as_ref().is_some_and(|b| (b.build, b.scene_id, b.camera, b.trace) == wanted);
+        // B traces A's rays: the same secondary rays from the same hits.
+        let secondary = self.secondary_rays(&shown.camera);
+        let wanted = (build, self.scene_id, shown.camera, self.compare.trace, secondary);
+        let have =
+            self.compare.b.as_ref().is_some_and(|b| (b.build, b.scene_id, b.camera, b.trace, b.secondary) == wanted);
         if !have && self.jobs.last_compare != Some(wanted) {
             let keep = self.compare.b.as_ref().filter(|b| b.scene_id == self.scene_id).map(|b| b.bvh.clone());
-            self.jobs.compare(self.scene.clone(), self.scene_id, build, keep, shown.camera, self.compare.trace);
+            let (camera, trace) = (shown.camera, self.compare.trace);
+            self.jobs.compare(self.scene.clone(), self.scene_id, build, keep, camera, trace, secondary);
         }
     }
 
@@ -147,6 +151,13 @@ impl BvhscopeApp {
         }
     }
 
+    /// The secondary rays the settings ask for, on `camera` over the scene's bounds (as the
+    /// command line resolves `--ray-kind` over the loaded scene's): `None` for camera rays.
+    pub(super) fn secondary_rays(&self, camera: &crate::render::Camera) -> Option<crate::render::SecondaryRays> {
+        let spec = self.settings.rays;
+        spec.kind.is_secondary().then(|| crate::render::SecondaryRays::new(spec, &self.scene.bounds(), camera))
+    }
+
     /// Start a render when what the viewport would show (camera, image size, BVH, view)
     /// differs from the last render asked for.
     pub(super) fn ensure_render(&mut self) {
@@ -157,14 +168,16 @@ impl BvhscopeApp {
             return;
         }
         let Some(built) = self.current_bvh().filter(|_| w > 0 && h > 0) else { return };
+        let camera = self.orbit.camera(w, h);
         let req = jobs::RenderRequest {
             bvh: built.bvh.clone(),
-            camera: self.orbit.camera(w, h),
+            camera,
             trace: self.settings.trace,
             style: self.view_style(),
             progressive: self.settings.progressive,
             partial: self.replay_partial(),
             gpu: self.gpu_for_frames(),
+            secondary: self.secondary_rays(&camera),
         };
         if req.camera.validate().is_ok() && !self.jobs.last_render.as_ref().is_some_and(|last| last.same_as(&req)) {
             self.jobs.render(req);

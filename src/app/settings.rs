@@ -2,7 +2,7 @@
 
 use crate::bvh::{BuildParams, Layout, Preset, TraceOptions};
 use crate::gpu_path::{Device, GpuNodes};
-use crate::render::{ColorMap, HeatRange, UpAxis, View};
+use crate::render::{ColorMap, HeatRange, SecondarySpec, UpAxis, View};
 use std::collections::HashMap;
 use std::path::PathBuf;
 
@@ -24,6 +24,9 @@ pub struct Settings {
     pub top_box_depth: u32,
     pub trace: TraceOptions,
     pub view: View,
+    /// Which rays the heatmaps count: the camera's, or shadow, ao or bounce rays from its hits
+    /// (the CLI's `--ray-kind`, `--samples`, `--ao-length`, `--light`, `--seed`).
+    pub rays: SecondarySpec,
     pub colormap: ColorMap,
     /// Fixed heatmap ranges, per view (a view without one uses its frame's own min..max). Each
     /// view has its own because their scales differ (nodes visited 0..60, combined cost 0..250);
@@ -87,6 +90,7 @@ impl Default for Settings {
             top_box_depth: 1,
             trace: TraceOptions::default(),
             view: View::Normals,
+            rays: SecondarySpec::default(),
             colormap: ColorMap::Viridis,
             fixed_ranges: HashMap::new(),
             diff_ranges: HashMap::new(),

@@ -12,6 +12,7 @@ mod app_explain;
 mod app_gpu;
 mod app_grade;
 mod app_look;
+mod app_rays;
 mod app_replay;
 mod app_room;
 mod app_scenes;

@@ -51,7 +51,8 @@ pub const DEFAULT_SEED: u64 = 0x5EC0_4DA7_2026;
 
 /// What secondary rays to trace: the kind and its parameters. `Copy`, so render settings that
 /// carry it stay plain values.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct SecondarySpec {
     pub kind: RayKind,
     /// Rays per hit pixel for `Ao` and `Bounce` (a shadow ray is one per light).

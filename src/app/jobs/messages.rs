@@ -37,6 +37,8 @@ pub struct RenderRequest {
     pub partial: Option<Arc<PartialBvh>>,
     /// Trace on this GPU instead of the CPU (`app::gpu`).
     pub gpu: Option<GpuRender>,
+    /// Secondary rays from each hit, resolved for the scene and camera (`None`: camera rays).
+    pub secondary: Option<crate::render::SecondaryRays>,
 }
 
 impl RenderRequest {
@@ -47,6 +49,7 @@ impl RenderRequest {
             && self.trace == o.trace
             && self.style == o.style
             && self.progressive == o.progressive
+            && self.secondary == o.secondary
             && match (&self.partial, &o.partial) {
                 (Some(a), Some(b)) => Arc::ptr_eq(a, b),
                 (None, None) => true,

@@ -52,7 +52,7 @@ pub struct Jobs {
     /// Reading a grade report.
     pub grade: Option<Running>,
     /// What the last compare job was asked for.
-    pub last_compare: Option<(SceneBuild, u64, Camera, TraceOptions)>,
+    pub last_compare: Option<(SceneBuild, u64, Camera, TraceOptions, Option<crate::render::SecondaryRays>)>,
     pub picking: Option<Pick>,
     /// The last render started (to tell whether a new one is needed).
     pub last_render: Option<RenderRequest>,

@@ -91,7 +91,8 @@ impl Jobs {
             }
             // Always count: the heatmaps and the hover read-out need the counters, and counting
             // costs little next to shading.
-            let settings = RenderSettings { trace: r.trace, count: true, progressive: r.progressive, secondary: None };
+            let settings =
+                RenderSettings { trace: r.trace, count: true, progressive: r.progressive, secondary: r.secondary };
             let on_pass = |frame: Frame, info: PassInfo| {
                 let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
@@ -138,6 +139,7 @@ impl Jobs {
         have: Option<Arc<SceneBvh>>,
         camera: Camera,
         trace: TraceOptions,
+        secondary: Option<crate::render::SecondaryRays>,
     ) {
         if let Some(old) = self.compare.take() {
             old.control.cancel();
@@ -152,7 +154,7 @@ impl Jobs {
                     Err(_) => return,
                 },
             };
-            let settings = RenderSettings { trace, count: true, progressive: false, secondary: None };
+            let settings = RenderSettings { trace, count: true, progressive: false, secondary };
             let mut last = None;
             let _ = render_passes(&*bvh, &*bvh, &camera, &settings, &frames, &control, |frame, _| last = Some(frame));
             if let Some(frame) = last.filter(|f| f.is_complete()) {
@@ -161,12 +163,13 @@ impl Jobs {
                 let (epo, epo_error) = (epo.as_ref().map(|e| e.value), epo.as_ref().and_then(|e| e.error()));
                 let stats = crate::bvh::TreeStats { epo, epo_error, ..crate::bvh::TreeStats::of(bvh.tree()) };
                 let summary = frame.ray_summary();
-                let b = CompareB { scene_id, build, bvh, stats, frame: Arc::new(frame), camera, trace, summary };
+                let frame = Arc::new(frame);
+                let b = CompareB { scene_id, build, bvh, stats, frame, camera, trace, secondary, summary };
                 send(JobEvent::Compared(Box::new(b)));
             }
         });
         self.compare = Some(job);
-        self.last_compare = Some((build, scene_id, camera, trace));
+        self.last_compare = Some((build, scene_id, camera, trace, secondary));
     }
 
     /// Count, per node, the visits of `camera`'s primary rays (a running count is cancelled).

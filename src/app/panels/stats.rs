@@ -304,8 +304,13 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions)
         }
     });
     let c = current.stats.sah_constants;
+    let spec = app.settings.rays;
+    let which = match spec.kind.is_secondary() {
+        true => format!("the {} from the hits of the last full frame", spec.describe()),
+        false => "the primary rays of the last full frame".to_string(),
+    };
     ui.weak(format!(
-        "Per-ray figures: the primary rays of the last full frame that enter the root box, unless a row says all rays. SAH cost with C_trav = {}, C_isect = {}.",
+        "Per-ray figures: {which} that enter the root box, unless a row says all rays. SAH cost with C_trav = {}, C_isect = {}.",
         c.traversal, c.intersection
     ))
     .on_hover_text(combined_cost_text(c));

@@ -4,8 +4,9 @@
 use crate::app::gpu::Probe;
 use crate::app::{Action, Actions, BoxLevel, BvhscopeApp};
 use crate::gpu_path::{Device, GpuNodes};
+use crate::render::secondary::MAX_SAMPLES;
 use crate::render::warp::WarpSize;
-use crate::render::{ColorMap, UpAxis, View};
+use crate::render::{ColorMap, RayKind, UpAxis, View};
 
 /// What a view shows, for its tooltip: its help, and for combined cost the constants in use.
 fn view_tip(v: View, cost: &str) -> String {
@@ -56,6 +57,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             }
         }
     });
+    ray_kind(ui, s);
     if let Some(lanes) = s.view.warp() {
         let mut wide = lanes == WarpSize::W64;
         ui.checkbox(&mut wide, "64 lanes per warp (AMD wave64)")
@@ -199,6 +201,40 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     if edited != app.settings {
         out.push(Action::Edit(Box::new(edited)));
     }
+}
+
+/// Which rays the heatmaps count, beside the view: the kind and, for ao and bounces, rays per
+/// pixel (and the ao rays' length). The same rays as `bvhscope render --ray-kind` for the seed.
+fn ray_kind(ui: &mut egui::Ui, s: &mut crate::app::Settings) {
+    let r = &mut s.rays;
+    ui.horizontal(|ui| {
+        let label = ui.label("Rays");
+        egui::ComboBox::from_id_salt("ray_kind")
+            .selected_text(r.kind.label())
+            .show_ui(ui, |ui| {
+                for k in RayKind::ALL {
+                    ui.selectable_value(&mut r.kind, k, k.label()).on_hover_text(k.help());
+                }
+            })
+            .response
+            .labelled_by(label.id)
+            .on_hover_text("Which rays the heatmaps count: the camera's, or rays from each of its hits (bvhscope render --ray-kind). A pixel's value is the mean over its rays; grey pixels: the camera ray missed.");
+        if matches!(r.kind, RayKind::Ao | RayKind::Bounce) {
+            ui.add(egui::DragValue::new(&mut r.samples).range(1..=MAX_SAMPLES).suffix(" per pixel"))
+                .on_hover_text("Rays per pixel (--samples)");
+        }
+        if r.kind == RayKind::Ao {
+            let mut percent = r.ao_length * 100.0;
+            // Written back only when dragged: percent / 100 need not give back the same float.
+            if ui
+                .add(egui::DragValue::new(&mut percent).range(0.1..=100.0).speed(0.5).suffix(" % long"))
+                .on_hover_text("Length of the ao rays, as a share of the scene's diagonal (--ao-length)")
+                .changed()
+            {
+                r.ao_length = percent / 100.0;
+            }
+        }
+    });
 }
 
 /// "Trace on: CPU / GPU": the GPU greyed, with the reason on hover, until an adapter is found.

@@ -1,0 +1,60 @@
+//! Secondary rays in the app (issue 50): the ray kind beside the view; the app's ambient-occlusion
+//! counts are `render --ray-kind ao --counts`'s, pixel for pixel (the same seed, the same rays);
+//! the side by side traces B on A's rays; the statistics are `stats --ray-kind ao`'s.
+
+use super::support::*;
+use bvhscope::app::Action;
+use bvhscope::render::{RayKind, SecondarySpec};
+use egui_kittest::kittest::Queryable;
+
+#[test]
+fn the_apps_ao_counts_are_the_command_lines() {
+    let mut h = harness();
+    let torus = root().join("assets/torus.obj");
+    open(&mut h, &torus);
+    // The kind is chosen beside the view.
+    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Rays").click();
+    h.run_steps(2);
+    h.get_by_label("Ambient occlusion").click();
+    h.run_steps(1);
+    assert_eq!(h.state().settings.rays.kind, RayKind::Ao);
+    assert_eq!(h.state().settings.rays, SecondarySpec { kind: RayKind::Ao, ..SecondarySpec::default() });
+    h.state_mut().act(Action::View(2));
+    let ao_shown = |a: &bvhscope::app::BvhscopeApp| {
+        idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some() && s.frame.ray_kind().0 == RayKind::Ao)
+    };
+    run_until(&mut h, "the ao heatmap", ao_shown);
+    let (camera, app_counts, legend) = {
+        let shown = h.state().shown.as_ref().unwrap();
+        (shown.camera, shown.frame.counts_csv().unwrap(), shown.legend.clone().unwrap())
+    };
+    assert!(legend.note.contains("camera ray missed"), "{}", legend.note);
+    let csv = temp_file("ao-counts.csv", "");
+    let mut args = vec![s("render"), s(torus.display()), s("--view"), s("visits"), s("--ray-kind"), s("ao")];
+    args.extend(camera_words(&camera));
+    args.extend([s("--counts"), s(csv.display()), s("-o"), s(temp_file("ao.png", "").display())]);
+    bvhscope::cli::run(words(&args)).unwrap();
+    let cli = std::fs::read_to_string(&csv).unwrap();
+    assert!(cli.starts_with("x,y,rays,"), "secondary counts: {}", &cli[..60]);
+    assert_eq!(app_counts, cli, "the app's ao counts are render --ray-kind ao --counts'");
+
+    // The statistics are stats --ray-kind ao's.
+    let rays = h.state().rays.unwrap().summary;
+    let mut args = vec![s("stats"), s(torus.display()), s("--ray-kind"), s("ao"), s("--format"), s("json")];
+    args.extend(camera_words(&camera));
+    let bvhscope::cli::Command::Stats(a) = words(&args) else { panic!("stats") };
+    let v: serde_json::Value = serde_json::from_str(&bvhscope::cli::stats::output(&a).unwrap()).unwrap();
+    let cli = &v["rays"]["summary"];
+    assert_eq!(cli["rays"], rays.rays);
+    assert_eq!(cli["mean_nodes_visited"].as_f64().unwrap(), rays.mean_nodes_visited);
+
+    // Side by side, B traces A's ao rays: its frame is of ao rays too, from the same hits.
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "View").click();
+    h.run_steps(2);
+    h.get_by_label("Compare side by side…").click();
+    run_until(&mut h, "B", pair_shown);
+    let b = h.state().compare.b.as_ref().unwrap().frame.clone();
+    let a = h.state().shown.as_ref().unwrap().frame.clone();
+    assert_eq!(b.ray_kind(), a.ray_kind());
+    assert_eq!(b.ray_summary().rays, a.ray_summary().rays, "the same hits, the same number of rays");
+}
