@@ -115,4 +115,15 @@ pub trait Accelerator: Sync {
             *hit = self.closest_hit(ray, opts, &mut super::NoStats);
         }
     }
+
+    /// Whether each of up to `PACKET` rays hits anything within its interval (`occluded[k]` for
+    /// `rays[k]`), the same as `any_hit` on each: shadow and ambient-occlusion rays of a block of
+    /// pixels. BVHs trace them as one packet that lets each ray go at its first hit
+    /// (`bvh::packet`); the default traces them one by one. Uncounted, as `closest_hits`.
+    fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
+        assert!(rays.len() <= PACKET && occluded.len() == rays.len(), "a packet holds at most {PACKET} rays");
+        for (ray, o) in rays.iter().zip(occluded) {
+            *o = self.any_hit(ray, opts, &mut super::NoStats);
+        }
+    }
 }

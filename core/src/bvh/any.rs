@@ -87,6 +87,15 @@ impl Accelerator for AnyBvh {
             AnyBvh::Wide8(w) => w.closest_hits(rays, hits, opts),
         }
     }
+
+    #[inline]
+    fn any_hits(&self, rays: &[crate::geometry::Ray], occluded: &mut [bool], opts: TraceOptions) {
+        match self {
+            AnyBvh::Binary(b) => b.any_hits(rays, occluded, opts),
+            AnyBvh::Wide(w) => w.any_hits(rays, occluded, opts),
+            AnyBvh::Wide8(w) => w.any_hits(rays, occluded, opts),
+        }
+    }
 }
 
 impl TreeView for AnyBvh {

@@ -180,6 +180,14 @@ impl Accelerator for SceneBvh {
             SceneBvh::TwoLevel { bvh: t, .. } => t.closest_hits(rays, hits, opts),
         }
     }
+
+    #[inline]
+    fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
+        match self {
+            SceneBvh::Single { bvh: b, .. } => b.any_hits(rays, occluded, opts),
+            SceneBvh::TwoLevel { bvh: t, .. } => t.any_hits(rays, occluded, opts),
+        }
+    }
 }
 
 impl SceneBvh {

@@ -359,4 +359,8 @@ impl Accelerator for Bvh {
     fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
         crate::bvh::packet::closest_hits_packet(self, rays, hits, opts)
     }
+
+    fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
+        crate::bvh::packet::any_hits_packet(self, rays, occluded, opts)
+    }
 }

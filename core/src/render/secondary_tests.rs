@@ -135,6 +135,44 @@ fn any_hit_walks_of_every_layout_answer_as_the_linear_scan_does() {
     }
 }
 
+/// Packets of any-hit rays (`Accelerator::any_hits`: the packet walk letting each ray go at its
+/// first hit) answer as the linear scan does, in packets of every size the walk sees: the
+/// adversarial set in its order (mixed directions), and a frame's ao and shadow rays block by
+/// block (coherent origins).
+#[test]
+fn any_hit_packets_of_every_layout_answer_as_the_linear_scan_does() {
+    let mesh = knot();
+    let linear = LinearScan::new(&mesh);
+    let opts = crate::bvh::TraceOptions { test: TriangleTest::Watertight, ..Default::default() };
+    for layout in Layout::ALL {
+        for strategy in [SplitStrategy::Midpoint, SplitStrategy::SahBinned] {
+            let tree = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
+            assert!(tree.traces_packets());
+            let mut rays = adversarial(&mesh, &tree);
+            let cam = camera(&mesh);
+            let frame = render(&tree, &mesh, &cam, &RenderSettings::default());
+            for kind in [RayKind::Shadow, RayKind::Ao] {
+                let sec = SecondaryRays::new(spec(kind), &mesh.bounds(), &cam);
+                rays.extend(sec.frame_rays(&frame, &cam));
+            }
+            let (mut occluded, mut packets) = (0, 0);
+            for size in [64, 37, 1] {
+                for chunk in rays.chunks(size) {
+                    let mut got = vec![false; chunk.len()];
+                    tree.any_hits(chunk, &mut got, opts);
+                    packets += 1;
+                    for (r, g) in chunk.iter().zip(&got) {
+                        let want = linear.any_hit(r, opts, &mut NoStats);
+                        assert_eq!(*g, want, "{layout:?} {strategy:?} packet of {size}: {r:?}");
+                        occluded += want as usize;
+                    }
+                }
+            }
+            assert!(occluded > 300 && occluded < 3 * rays.len() - 300, "both answers: {occluded} in {packets} packets");
+        }
+    }
+}
+
 #[test]
 fn a_frame_of_secondary_rays_counts_its_rays_and_marks_missed_pixels() {
     let mesh = knot();

@@ -14,6 +14,9 @@
 //! it would get alone (the same distance; between triangles hit at exactly the same distance either
 //! may be reported).
 //!
+//! Any-hit packets (`any_hits_packet`: shadow and ambient-occlusion rays of a block of pixels)
+//! walk the same way, each ray leaving at its first hit.
+//!
 //! Packets are for the renderer's uncounted views of primary rays (`bvhscope render` of normals or
 //! depth): heatmaps, and the app, which always counts for its hover read-out, trace single rays.
 //! Incoherent rays defeat both shortcuts (they are slower in packets than alone, BENCHMARKS.md,
@@ -154,8 +157,11 @@ const STACK: usize = 7 * TRAVERSAL_STACK_SIZE + 8;
 /// four boxes, then to the following groups one by one. At a leaf every group from its first one
 /// tests the leaf's triangles with the group's triangle test (bit for bit the single-ray test), so
 /// each ray gets the hit it would get alone. `kernel` makes and tests the packet's groups (`G` of them).
+///
+/// With `ANY` (any-hit queries: shadow and ambient-occlusion rays) a ray leaves the walk at its
+/// first hit (`Packet::retire_hits`), and the walk ends once every ray has one.
 #[inline(always)]
-fn walk<B: PacketTree, T: TriangleIntersector, K: PacketLanes<T>, const G: usize>(
+fn walk<B: PacketTree, T: TriangleIntersector, K: PacketLanes<T>, const G: usize, const ANY: bool>(
     kernel: K,
     bvh: &B,
     rays: &mut [Ray],
@@ -232,6 +238,9 @@ fn walk<B: PacketTree, T: TriangleIntersector, K: PacketLanes<T>, const G: usize
         } else {
             let (lo, hi, start, count) = bvh.leaf(cur);
             if bvh.with_leaf(start, count, |tris| packet.leaf_groups(first, lo, hi, tris, start)) {
+                if ANY && packet.retire_hits() {
+                    break;
+                }
                 t_far = packet.t_far();
             }
         }
@@ -249,6 +258,24 @@ pub(super) fn closest_hits_packet<B: PacketTree>(
     hits: &mut [Option<Hit>],
     opts: TraceOptions,
 ) {
+    packet::<B, false>(bvh, rays, hits, opts)
+}
+
+/// Whether each of up to `PACKET` coherent rays hits anything within its interval (`occluded[k]`
+/// for `rays[k]`), the same as `any_hit` on each: the packet walk with any-hit queries.
+pub(super) fn any_hits_packet<B: PacketTree>(bvh: &B, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
+    assert!(rays.len() <= PACKET && occluded.len() == rays.len(), "a packet holds at most {PACKET} rays");
+    let Some(&first) = rays.first() else { return };
+    let mut copy = [first; PACKET];
+    copy[..rays.len()].copy_from_slice(rays);
+    let mut hits = [None; PACKET];
+    packet::<B, true>(bvh, &mut copy[..rays.len()], &mut hits[..rays.len()], opts);
+    for (o, h) in occluded.iter_mut().zip(&hits) {
+        *o = h.is_some();
+    }
+}
+
+fn packet<B: PacketTree, const ANY: bool>(bvh: &B, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
     assert!(rays.len() <= PACKET && hits.len() == rays.len(), "a packet holds at most {PACKET} rays");
     hits.fill(None);
     if rays.is_empty() || bvh.prim_ids().is_empty() {
@@ -260,10 +287,10 @@ pub(super) fn closest_hits_packet<B: PacketTree>(
         if bvh.simd() == Simd::Avx512 {
             if let Some(k) = crate::geometry::avx512::Avx512::detect() {
                 // SAFETY: `detect` found AVX-512F/VL and the AVX2 set.
-                return unsafe { walk_avx512::<B, T>(k, bvh, rays, hits) };
+                return unsafe { walk_avx512::<B, T, ANY>(k, bvh, rays, hits) };
             }
         }
-        walk::<B, T, _, GROUPS>(Four, bvh, rays, hits)
+        walk::<B, T, _, GROUPS, ANY>(Four, bvh, rays, hits)
     })
 }
 
@@ -273,13 +300,13 @@ pub(super) fn closest_hits_packet<B: PacketTree>(
 /// The CPU must have these features: `k` proves it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx2,fma,popcnt,bmi1,bmi2,lzcnt")]
-unsafe fn walk_avx512<B: PacketTree, T: TriangleIntersector>(
+unsafe fn walk_avx512<B: PacketTree, T: TriangleIntersector, const ANY: bool>(
     k: crate::geometry::avx512::Avx512,
     bvh: &B,
     rays: &mut [Ray],
     hits: &mut [Option<Hit>],
 ) {
-    walk::<B, T, _, { PACKET / 16 }>(lanes::Sixteen(k), bvh, rays, hits)
+    walk::<B, T, _, { PACKET / 16 }, ANY>(lanes::Sixteen(k), bvh, rays, hits)
 }
 
 #[cfg(test)]

@@ -26,6 +26,8 @@ pub(super) struct Packet<'r, T: TriangleIntersector, K: PacketLanes<T>, const G:
     /// Each ray's nearest hit so far (bit k of `hit_mask` set): leaf-order triangle and barycentrics.
     best: [MaybeUninit<(u32, TriangleHit)>; PACKET],
     hit_mask: u64,
+    /// Any-hit walks: the rays that have left the walk with their hit (`retire_hits`).
+    retired: u64,
 }
 
 impl<'r, T: TriangleIntersector, K: PacketLanes<T>, const G: usize> Packet<'r, T, K, G> {
@@ -51,6 +53,7 @@ impl<'r, T: TriangleIntersector, K: PacketLanes<T>, const G: usize> Packet<'r, T
                 prepared_mask: _,
                 best: _,
                 hit_mask: _,
+                retired: _,
             } = p;
         };
         let p = slot.as_mut_ptr();
@@ -66,6 +69,7 @@ impl<'r, T: TriangleIntersector, K: PacketLanes<T>, const G: usize> Packet<'r, T
             addr_of_mut!((*p).frustum).write(RayInterval::OFF);
             addr_of_mut!((*p).prepared_mask).write(0);
             addr_of_mut!((*p).hit_mask).write(0);
+            addr_of_mut!((*p).retired).write(0);
             slot.assume_init_mut()
         };
         for g in 0..n_groups {
@@ -141,6 +145,29 @@ impl<'r, T: TriangleIntersector, K: PacketLanes<T>, const G: usize> Packet<'r, T
             best[k].write(((first + i) as u32, h));
             *hit_mask |= 1 << k;
         })
+    }
+
+    /// Any-hit walks: every ray that found a hit since the last call leaves the walk (its `t_max`
+    /// becomes −∞, as a padding lane's, so none of its box or triangle tests passes again) and its
+    /// group takes that. True when every ray of the packet has a hit: the walk can stop.
+    pub(super) fn retire_hits(&mut self) -> bool {
+        let mut new = self.hit_mask & !self.retired;
+        self.retired |= new;
+        let (n, kernel) = (K::N, self.kernel);
+        let mut touched = 0u64;
+        while new != 0 {
+            let k = new.trailing_zeros() as usize;
+            new &= new - 1;
+            self.rays[k].t_max = f32::NEG_INFINITY;
+            touched |= 1 << (k / n);
+        }
+        while touched != 0 {
+            let g = touched.trailing_zeros() as usize;
+            touched &= touched - 1;
+            // SAFETY: a ray of group g hit, so g < n_groups: `new_in` wrote it.
+            kernel.refresh(unsafe { self.groups[g].assume_init_mut() }, self.rays, n * g);
+        }
+        self.retired.count_ones() as usize == self.rays.len()
     }
 
     /// Each ray's closest hit, with the mesh's triangle index (`prim_ids` maps leaf order to it).

@@ -301,6 +301,10 @@ impl Accelerator for WideBvh {
     fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
         crate::bvh::packet::closest_hits_packet(self, rays, hits, opts)
     }
+
+    fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
+        crate::bvh::packet::any_hits_packet(self, rays, occluded, opts)
+    }
 }
 
 impl WideBvh<8> {
@@ -382,5 +386,9 @@ impl Accelerator for WideBvh<8> {
 
     fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
         crate::bvh::packet::closest_hits_packet(self, rays, hits, opts)
+    }
+
+    fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
+        crate::bvh::packet::any_hits_packet(self, rays, occluded, opts)
     }
 }
