@@ -97,6 +97,9 @@ pub enum Action {
 
     /// Pin the ray of pixel (x, y) of the image on screen (0-based, from the top left).
     PinPixel(u32, u32),
+    /// Pin secondary ray `k` of pixel (x, y) (the View panel's ray kind, from its camera ray's
+    /// hit), to walk it.
+    PinSecondary(u32, u32, usize),
     /// Pin the ray typed in the Ray window.
     PinTyped,
     /// The Ray window's typed origin and direction changed.
@@ -343,6 +346,17 @@ impl BvhscopeApp {
                 if x < s.camera.width && y < s.camera.height {
                     let ray = s.camera.ray_gen().pixel_ray(x, y);
                     self.pins.pin(PinnedRay::new(s.bvh.clone(), ray, s.trace, Some((x, y)), &self.scene.source));
+                }
+            }
+            A::PinSecondary(x, y, k) => {
+                let Some(s) = self.shown.as_ref().filter(|s| s.partial.is_none()) else { return };
+                let Some(sec) = self.secondary_rays(&s.camera) else { return };
+                let rays = sec.pixel_rays(&*s.bvh, &*s.bvh, &s.camera, s.trace, (x, y)).unwrap_or_default();
+                if let Some(&ray) = rays.get(k) {
+                    let of =
+                        super::ray_view::SecondaryOf { spec: sec.spec, camera: s.camera, index: k, of: rays.len() };
+                    let source = &self.scene.source;
+                    self.pins.pin(PinnedRay::of(s.bvh.clone(), ray, s.trace, Some((x, y)), source, Some(of)));
                 }
             }
             A::PinTyped => match (self.pins.typed_ray(), self.current_bvh()) {

@@ -3,7 +3,7 @@
 //! stand in its steps. Each pinned ray keeps the BVH it was traced through, so the same pixel can
 //! be pinned under two strategies and compared.
 
-use crate::bvh::{trace_ray, Hit, NodeId, RayCounters, SceneBvh, StepKind, Trace, TraceLevel, TraceOptions};
+use crate::bvh::{trace_query_into, Hit, NodeId, RayCounters, SceneBvh, StepKind, Trace, TraceLevel, TraceOptions};
 use crate::geometry::Ray;
 use crate::scene::SceneSource;
 use glam::Vec3;
@@ -29,6 +29,17 @@ pub struct PinnedRay {
     /// The `bvhscope trace` command that traces this ray through the same build (the scene's
     /// file named; none for the built-in scene, which has no file).
     pub command: Option<String>,
+    /// An any-hit walk (a shadow or ambient-occlusion ray): it stops at the first hit found.
+    pub any: bool,
+}
+
+/// Which of a pixel's secondary rays a pinned ray is.
+#[derive(Clone, Copy, Debug)]
+pub struct SecondaryOf {
+    pub spec: crate::render::SecondarySpec,
+    pub camera: crate::render::Camera,
+    pub index: usize,
+    pub of: usize,
 }
 
 impl PinnedRay {
@@ -39,19 +50,45 @@ impl PinnedRay {
         pixel: Option<(u32, u32)>,
         source: &SceneSource,
     ) -> Self {
-        let (hit, trace) = trace_ray(&*bvh, &ray, opts);
-        let at = match pixel {
+        Self::of(bvh, ray, opts, pixel, source, None)
+    }
+
+    /// Secondary ray `of.index` of `pixel` (from its camera ray's hit): walked as its kind asks,
+    /// any hit for shadow and ao rays.
+    pub fn of(
+        bvh: Arc<SceneBvh>,
+        ray: Ray,
+        opts: TraceOptions,
+        pixel: Option<(u32, u32)>,
+        source: &SceneSource,
+        secondary: Option<SecondaryOf>,
+    ) -> Self {
+        let any = secondary.is_some_and(|s| s.spec.kind.any_hit());
+        let (hit, trace) = trace_query_into(&*bvh, &ray, opts, any, Trace::new());
+        let mut at = match pixel {
             Some((x, y)) => format!("pixel {x}, {y}"),
             None => "typed ray".to_string(),
         };
+        if let Some(s) = &secondary {
+            at += &format!(" · {} ray {} of {}", s.spec.kind.name(), s.index, s.of);
+        }
         let label = format!("{at} · {}", bvh.label());
         let counts = trace.counts();
-        let command = match source {
-            SceneSource::File(path) => {
+        let command = match (source, secondary, pixel) {
+            (SceneSource::File(path), Some(s), Some(p)) => Some(crate::explain::words::secondary_trace_command(
+                path,
+                &s.camera,
+                p,
+                &s.spec,
+                s.index,
+                &bvh.build_params(),
+                opts,
+            )),
+            (SceneSource::File(path), _, _) => {
                 let dump = bvh.import().map(|i| i.path.as_path());
                 Some(crate::explain::words::trace_command(path, &ray, &bvh.build_params(), opts, dump))
             }
-            SceneSource::Builtin => None,
+            (SceneSource::Builtin, ..) => None,
         };
         // An imported tree's nodes by the dump's ids and its triangles by the file's numbers, as
         // `bvhscope trace --bvh` prints them.
@@ -59,7 +96,7 @@ impl PinnedRay {
             (SceneBvh::Single { mesh, .. }, Some(i)) => trace.steps.iter().map(|s| i.rename(s, mesh)).collect(),
             _ => trace.steps.clone(),
         };
-        Self { label, pixel, ray, bvh, opts, hit, trace, named, counts, command }
+        Self { label, pixel, ray, bvh, opts, hit, trace, named, counts, command, any }
     }
 
     pub fn len(&self) -> usize {

@@ -5,7 +5,7 @@
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
 use super::device::{self, GpuTree};
 use super::{load_mesh, CliError};
-use crate::bvh::{trace_ray_into, RayCounters, SceneBvh, StepKind, StepOut, Trace, TraceLevel, TraceStep};
+use crate::bvh::{trace_query_into, RayCounters, SceneBvh, StepKind, StepOut, Trace, TraceLevel, TraceStep};
 use crate::geometry::Ray;
 use clap::{Args, ValueEnum};
 use glam::Vec3;
@@ -45,6 +45,13 @@ pub struct TraceArgs {
     /// The camera whose pixel is traced (as `render` takes it).
     #[command(flatten)]
     pub view_args: ViewArgs,
+    /// With a secondary kind the walk is of one of the pixel's secondary rays (from its camera
+    /// ray's hit, as the heatmap traces them; --hottest ranks that heatmap).
+    #[command(flatten)]
+    pub rays: super::rays::RayArgs,
+    /// Which of the pixel's secondary rays to walk (0-based; the listing names them all).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub secondary: u32,
     #[arg(long, value_enum, default_value = "text")]
     pub format: TraceFormat,
     /// Trace through a BVH written by another program (bvhscope-bvh, as `check` reads it) instead
@@ -108,6 +115,16 @@ pub fn output(a: &TraceArgs) -> Result<String, CliError> {
 /// The listing written to `out` as the walk goes.
 pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError> {
     let gpu = device::open(&a.device)?;
+    let kind = a.rays.one("trace")?;
+    if gpu.is_some() && kind.is_secondary() {
+        return Err(super::render::gpu_traces_primary_only(kind));
+    }
+    if kind.is_secondary() && a.ray.is_some() {
+        return Err(CliError::Usage(format!(
+            "--ray-kind {} starts at a pixel's hit: give --pixel or --hottest, not --ray",
+            kind.name()
+        )));
+    }
     let scene = load_mesh(&a.mesh)?;
     let mut params = a.build.params(scene.build.as_ref());
     if gpu.is_some() {
@@ -135,7 +152,7 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
                 trace: a.build.trace(),
                 count: true,
                 progressive: false,
-                secondary: None,
+                secondary: a.rays.secondary(kind, &scene.bounds(), &camera),
             };
             let frame = match &on_gpu {
                 Some((g, (tree, mesh))) => tree.frame(g, mesh, &camera, settings.trace, true)?.0,
@@ -160,7 +177,11 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
                     camera.width, camera.height
                 )));
             }
-            (camera.ray_gen().pixel_ray(x, y), serde_json::json!({ "pixel": [x, y], "camera": camera }))
+            let source = serde_json::json!({ "pixel": [x, y], "camera": camera });
+            match a.rays.secondary(kind, &scene.bounds(), &camera) {
+                None => (camera.ray_gen().pixel_ray(x, y), source),
+                Some(sec) => secondary_ray(a, &bvh, &camera, &sec, (x, y), source)?,
+            }
         }
         (None, None) => unreachable!("clap requires --pixel or --ray"),
     };
@@ -198,12 +219,74 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
     let mut sink = Listing::new(out, &head);
     sink.rename = names;
     sink.start(None);
-    let (mut hit, trace) = trace_ray_into(&bvh, &ray, opts, Trace::into(sink, a.max_steps));
+    let (mut hit, trace) = trace_query_into(&bvh, &ray, opts, kind.any_hit(), Trace::into(sink, a.max_steps));
     if let (SceneBvh::Single { mesh, imported: Some(_), .. }, true, Some(h)) = (&bvh, a.bvh.is_some(), hit.as_mut()) {
         h.prim = mesh.file_number(h.prim);
     }
     let (counts, dropped) = (trace.counts(), trace.dropped());
     trace.steps.end(hit, counts, dropped, None)
+}
+
+/// Pixel (x, y)'s secondary ray `a.secondary`, and the listing's source: the pixel, and each of
+/// its secondary rays with its hit and counts (the walk is of the one chosen).
+fn secondary_ray(
+    a: &TraceArgs,
+    bvh: &SceneBvh,
+    camera: &crate::render::Camera,
+    sec: &crate::render::SecondaryRays,
+    (x, y): (u32, u32),
+    mut source: serde_json::Value,
+) -> Result<(Ray, serde_json::Value), CliError> {
+    let opts = a.build.trace();
+    let kind = sec.spec.kind;
+    let rays = sec.pixel_rays(bvh, bvh, camera, opts, (x, y)).ok_or_else(|| {
+        CliError::Usage(format!("pixel {x},{y}: its camera ray misses the mesh, so it has no {} rays", kind.name()))
+    })?;
+    let n = a.secondary as usize;
+    let ray = *rays.get(n).ok_or_else(|| {
+        CliError::Usage(format!("--secondary {n}: pixel {x},{y} has {} {} rays (0-based)", rays.len(), kind.name()))
+    })?;
+    let listed: Vec<serde_json::Value> = rays
+        .iter()
+        .map(|r| {
+            let mut c = RayCounters::ZERO;
+            let hit = match kind.any_hit() {
+                true => crate::bvh::Accelerator::any_hit(bvh, r, opts, &mut c),
+                false => crate::bvh::Accelerator::closest_hit(bvh, &mut r.clone(), opts, &mut c).is_some(),
+            };
+            serde_json::json!({
+                "origin": r.origin().to_array(), "dir": r.dir().to_array(), "length": r.t_max, "hit": hit,
+                "nodes_visited": c.nodes_visited, "triangle_tests": c.triangle_tests,
+            })
+        })
+        .collect();
+    source["secondary"] = serde_json::json!({
+        "kind": kind.name(), "describe": sec.spec.describe(), "walked": n, "rays": listed,
+    });
+    Ok((ray, source))
+}
+
+/// The text listing's lines for a pixel's secondary rays: which is walked, and each one's hit
+/// and counts.
+fn secondary_text(sec: &serde_json::Value) -> String {
+    let rays = sec["rays"].as_array().map_or(&[][..], |r| r.as_slice());
+    let walked = sec["walked"].as_u64().unwrap_or(0) as usize;
+    let mut o = format!(
+        "secondary       {}: ray {walked} of {} (0-based) walked below\n",
+        sec["describe"].as_str().unwrap_or(""),
+        rays.len()
+    );
+    for (i, r) in rays.iter().enumerate() {
+        let mark = if i == walked { "▶" } else { " " };
+        let _ = writeln!(
+            o,
+            "  {mark} ray {i:<3}     {}, nodes visited {}, triangle tests {}",
+            if r["hit"].as_bool() == Some(true) { "hit " } else { "miss" },
+            r["nodes_visited"],
+            r["triangle_tests"]
+        );
+    }
+    o
 }
 
 /// What the listing of one ray says before and around its steps.
@@ -266,8 +349,14 @@ impl<'a> Listing<'a> {
         }
         let (o3, d3) = (h.ray.origin(), h.ray.dir());
         let mut o = format!(
-            "ray             origin ({}, {}, {}), direction ({}, {}, {})\n",
-            o3.x, o3.y, o3.z, d3.x, d3.y, d3.z
+            "ray             origin ({}, {}, {}), direction ({}, {}, {}){}\n",
+            o3.x,
+            o3.y,
+            o3.z,
+            d3.x,
+            d3.y,
+            d3.z,
+            if h.ray.t_max.is_finite() { format!(", length {}", h.ray.t_max) } else { String::new() }
         );
         if let Some((x, y)) = h.a.pixel.or(h.hot).filter(|_| h.a.ray.is_none()) {
             let rank = h.a.hottest.map_or(String::new(), |k| {
@@ -278,6 +367,9 @@ impl<'a> Listing<'a> {
                 )
             });
             let _ = writeln!(o, "pixel           {x},{y}{rank}");
+        }
+        if let Some(sec) = h.source.get("secondary") {
+            o += &secondary_text(sec);
         }
         let _ = writeln!(o, "build           {}", h.build_label);
         let _ = writeln!(o, "traversal       {} order, {} test", h.opts.order.label(), h.opts.test.label());

@@ -48,6 +48,30 @@ fn the_apps_ao_counts_are_the_command_lines() {
     assert_eq!(cli["rays"], rays.rays);
     assert_eq!(cli["mean_nodes_visited"].as_f64().unwrap(), rays.mean_nodes_visited);
 
+    // The Ray window: a pixel's ao rays, one of them pinned and walked as `trace --ray-kind ao
+    // --secondary 2` walks it (its command, run, gives the same steps and counts).
+    let (x, y) = {
+        let f = &h.state().shown.as_ref().unwrap().frame;
+        let y = f.height() / 2;
+        (0..f.width()).map(|x| (x, y)).find(|&(x, y)| f.sample(x, y).is_hit()).expect("the torus is in view")
+    };
+    h.state_mut().act(Action::PinPixel(x, y));
+    h.run_steps(2);
+    h.get_by_label_contains(&format!("Pixel {x}, {y}'s ambient occlusion rays"));
+    h.get_by_label("ray 2").click();
+    h.run_steps(2);
+    let r = h.state().pins.current().unwrap();
+    assert!(r.any && r.label.contains("ao ray 2 of 4"), "{}", r.label);
+    let cmd = r.command.clone().expect("a file's ray has a command");
+    let words: Vec<&str> = cmd.split_whitespace().chain(["--format", "json"]).collect();
+    let cli = bvhscope::cli::Cli::from_words(&words).unwrap_or_else(|e| panic!("{cmd}: {e}"));
+    let Some(bvhscope::cli::Command::Trace(args)) = cli.command else { panic!("{cmd}: not a trace") };
+    let json: serde_json::Value = serde_json::from_str(&bvhscope::cli::trace::output(&args).unwrap()).unwrap();
+    assert_eq!(json["counts"]["nodes_visited"], r.counts.nodes_visited, "{cmd}");
+    assert_eq!(json["counts"]["triangle_tests"], r.counts.triangle_tests, "{cmd}");
+    assert_eq!(json["steps"], serde_json::to_value(&r.trace.steps).unwrap(), "step by step");
+    assert_eq!(json["ray"]["from"]["secondary"]["walked"], 2);
+
     // Side by side, B traces A's ao rays: its frame is of ao rays too, from the same hits.
     h.get_by_role_and_label(egui::accesskit::Role::Button, "View").click();
     h.run_steps(2);

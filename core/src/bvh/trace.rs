@@ -489,3 +489,21 @@ pub fn trace_ray_into<A: Accelerator + ?Sized, O: StepOut>(
     let hit = accel.closest_hit(&mut ray.clone(), opts, &mut trace);
     (hit, trace)
 }
+
+/// `trace_ray_into` for a query: the closest hit, or with `any` (shadow and ambient-occlusion
+/// rays) the first hit the walk finds, where it stops.
+pub fn trace_query_into<A: Accelerator + ?Sized, O: StepOut>(
+    accel: &A,
+    ray: &Ray,
+    opts: TraceOptions,
+    any: bool,
+    mut trace: Trace<O>,
+) -> (Option<Hit>, Trace<O>) {
+    if !any {
+        return trace_ray_into(accel, ray, opts, trace);
+    }
+    let mut r = *ray;
+    let hit =
+        super::accel::dispatch!(opts, |T, BY_DISTANCE| accel.trace::<T, BY_DISTANCE, true, _>(&mut r, &mut trace));
+    (hit, trace)
+}

@@ -78,6 +78,32 @@ pub fn trace_command(path: &Path, ray: &Ray, build: &SceneBuild, opts: TraceOpti
     words.join(" ")
 }
 
+/// The `bvhscope trace` command that walks secondary ray `index` of pixel `pixel` on `camera`
+/// (a secondary ray starts at the pixel's hit, so it is named by the pixel, the camera and the
+/// rays' settings, not as numbers), through `build` over the scene file at `path`.
+pub fn secondary_trace_command(
+    path: &Path,
+    camera: &crate::render::Camera,
+    (x, y): (u32, u32),
+    spec: &crate::render::SecondarySpec,
+    index: usize,
+    build: &SceneBuild,
+    opts: TraceOptions,
+) -> String {
+    let v = |v: Vec3| format!("{},{},{}", v.x, v.y, v.z);
+    let mut words = vec!["bvhscope trace".to_string(), shell_word(&path.display().to_string())];
+    words.push(format!("--pixel {x},{y}"));
+    words.push(format!("--camera {}:{}:{}", v(camera.position), v(camera.look_at), v(camera.up)));
+    words.push(format!("--fov {} --size {}x{}", camera.vfov_deg, camera.width, camera.height));
+    words.push(format!("--ray-kind {} --samples {} --ao-length {}", spec.kind.name(), spec.samples, spec.ao_length));
+    if let Some(l) = spec.light {
+        words.push(format!("--light {}", v(l)));
+    }
+    words.push(format!("--seed {} --secondary {index}", spec.seed));
+    words.extend(build_flags(build, opts));
+    words.join(" ")
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

@@ -177,6 +177,23 @@ impl SecondaryRays {
         out
     }
 
+    /// Pixel (x, y)'s secondary rays on `camera`, from its camera ray's hit as the renderer finds
+    /// it (the same hit, normal and seed): `None` when the camera ray misses.
+    pub fn pixel_rays<A: Accelerator + ?Sized, M: crate::mesh::Surface + ?Sized>(
+        &self,
+        accel: &A,
+        surface: &M,
+        camera: &Camera,
+        opts: TraceOptions,
+        (x, y): (u32, u32),
+    ) -> Option<Vec<Ray>> {
+        let mut ray = camera.ray_gen().pixel_ray(x, y);
+        let hit = accel.closest_hit(&mut ray, opts, &mut crate::bvh::NoStats);
+        let s = super::raycast::sample(surface, &ray, hit);
+        let pixel = y as u64 * camera.width as u64 + x as u64;
+        s.is_hit().then(|| self.rays(pixel, ray.origin() + ray.dir() * s.t, s.normal, ray.dir()).collect())
+    }
+
     /// Trace one pixel's secondary rays (`rays`), counting into `S`: the counters summed over the
     /// rays and how many of them hit something.
     #[allow(clippy::too_many_arguments)]

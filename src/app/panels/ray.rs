@@ -131,6 +131,34 @@ fn pinned_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
     });
     ui.weak("Click another pixel (or the same one after changing the strategy) to compare.");
+    secondary_rays(app, ui, out);
+}
+
+/// With a secondary ray kind in the View panel: the selected pixel's rays of that kind, each
+/// a button that pins it to walk (as `bvhscope trace --pixel … --ray-kind … --secondary K`).
+fn secondary_rays(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
+    let spec = app.settings.rays;
+    let Some((x, y)) = app.pins.current().and_then(|r| r.pixel).filter(|_| spec.kind.is_secondary()) else {
+        return;
+    };
+    let hit =
+        app.shown.as_ref().is_some_and(|s| x < s.camera.width && y < s.camera.height && s.frame.sample(x, y).is_hit());
+    if !hit {
+        ui.weak(format!("Pixel {x}, {y}: its camera ray missed, so it has no {} rays.", spec.kind.name()));
+        return;
+    }
+    ui.label(format!("Pixel {x}, {y}'s {} rays:", spec.kind.label().to_lowercase())).on_hover_text(spec.describe());
+    // Rows of eight: the tile scrolls sideways, so a wrapped row would not wrap.
+    let n = spec.rays_per_hit().min(32) as usize;
+    for row in (0..n).step_by(8) {
+        ui.horizontal(|ui| {
+            for k in row..(row + 8).min(n) {
+                if ui.small_button(format!("ray {k}")).on_hover_text("Pin this ray to walk it step by step").clicked() {
+                    out.push(Action::PinSecondary(x, y, k));
+                }
+            }
+        });
+    }
 }
 
 /// What the viewport's colours mean, in those colours.
