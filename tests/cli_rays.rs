@@ -1,0 +1,133 @@
+//! Secondary rays on the command line (issue 50): `render --ray-kind ao --counts` and `trace
+//! --secondary` tell the same story pixel by pixel; `stats` counts the kind's rays; `compare
+//! --ray-kind all` measures every tree on every kind, with the rank correlations under it; what a
+//! kind cannot do is refused in one line.
+
+mod cli_support;
+
+use cli_support::{bvhscope, tmp};
+use std::path::PathBuf;
+
+fn knot() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/knot.obj")
+}
+
+fn ok(args: &[&str]) -> std::process::Output {
+    let out = bvhscope(args);
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    serde_json::from_slice(&ok(args).stdout).unwrap()
+}
+
+/// A pixel's row of the ao counts file is the sum of its ao rays walked one by one by `trace`;
+/// pixels whose camera ray missed have no rays and say so.
+#[test]
+fn render_counts_of_ao_rays_are_the_sums_of_the_pixels_walked_rays() {
+    let mesh = knot();
+    let (csv, png) = (tmp("ao-counts.csv"), tmp("ao.png"));
+    let m = mesh.to_str().unwrap();
+    let common = ["--size", "32x24", "--layout", "binary", "--ray-kind", "ao", "--samples", "3"];
+    let mut args =
+        vec!["render", m, "--view", "visits", "--counts", csv.to_str().unwrap(), "-o", png.to_str().unwrap()];
+    args.extend(common);
+    let out = ok(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("wrote"), "{err}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("x,y,rays,nodes_visited,box_tests,leaves_visited,triangle_tests,hit_triangle,primary_nodes_visited,primary_triangle_tests")
+    );
+    let rows: Vec<Vec<i64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), 32 * 24);
+    let (hit, missed): (Vec<_>, Vec<_>) = rows.iter().partition(|r| r[7] >= 0);
+    assert!(!hit.is_empty() && !missed.is_empty());
+    assert!(missed.iter().all(|r| r[2] == 0 && r[3] == 0), "a missed pixel has no secondary rays");
+    assert!(hit.iter().all(|r| r[2] == 3 && r[8] > 0), "three rays per hit pixel, and the camera ray's own counts");
+    for r in hit.iter().step_by(11) {
+        let pixel = format!("{},{}", r[0], r[1]);
+        let (mut nodes, mut tris) = (0, 0);
+        for k in 0..3 {
+            let k = k.to_string();
+            let mut args = vec!["trace", m, "--pixel", &pixel, "--secondary", &k, "--format", "json"];
+            args.extend(common);
+            let v = json(&args);
+            nodes += v["counts"]["nodes_visited"].as_i64().unwrap();
+            tris += v["counts"]["triangle_tests"].as_i64().unwrap();
+            assert_eq!(v["ray"]["from"]["secondary"]["rays"].as_array().unwrap().len(), 3);
+        }
+        assert_eq!((nodes, tris), (r[3], r[6]), "pixel {pixel}");
+    }
+}
+
+#[test]
+fn stats_counts_the_kinds_rays_and_compare_measures_every_tree_on_every_kind() {
+    let mesh = knot();
+    let m = mesh.to_str().unwrap();
+    let v = json(&["stats", m, "--size", "32x24", "--ray-kind", "bounce", "--samples", "2", "--format", "json"]);
+    let s = &v["rays"]["summary"];
+    assert_eq!(s["rays"].as_u64().unwrap(), 2 * s["hits"].as_u64().unwrap());
+    assert_eq!(v["rays"]["ray_kind"]["samples"], 2);
+    assert!(v["rays"]["warp"].is_null(), "no warp figures for secondary rays");
+
+    let v = json(&[
+        "compare",
+        m,
+        "--size",
+        "32x24",
+        "--runs",
+        "1",
+        "--layout",
+        "binary",
+        "--ray-kind",
+        "all",
+        "--format",
+        "json",
+    ]);
+    let rows = v["rows"].as_array().unwrap();
+    let k = &v["ray_kinds"];
+    let cells = k["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), rows.len() * 4, "every tree and the linear scan on every kind");
+    for row in rows {
+        let name = row["name"].as_str().unwrap();
+        let of = |kind: &str| cells.iter().find(|c| c["row"] == name && c["kind"] == kind).unwrap();
+        // The primary rays are the table's own: the same work per ray.
+        let p = of("primary");
+        assert!((p["nodes_per_ray"].as_f64().unwrap() - row["nodes_per_ray"].as_f64().unwrap()).abs() < 1e-9, "{name}");
+        for kind in ["shadow", "ao", "bounce"] {
+            let c = of(kind);
+            assert!(c["rays"].as_u64().unwrap() > 0 && c["mrays_per_s"].as_f64().unwrap() > 0.0, "{name} {kind}");
+        }
+    }
+    let spearman = k["spearman"].as_array().unwrap();
+    assert_eq!(spearman.len(), 4);
+    for s in spearman {
+        let r = s["sah_cost"].as_f64().expect("seven trees ranked");
+        assert!((-1.0..=1.0).contains(&r));
+    }
+    let out = ok(&["compare", m, "--size", "32x24", "--runs", "1", "--layout", "binary", "--ray-kind", "ao"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("| strategy | primary | ao |"), "{text}");
+    assert!(text.contains("Spearman rank correlation"), "{text}");
+}
+
+#[test]
+fn what_a_kind_cannot_do_is_refused_in_one_line() {
+    let mesh = knot();
+    let m = mesh.to_str().unwrap();
+    for (args, says) in [
+        (vec!["render", m, "--ray-kind", "all"], "--ray-kind all is for compare"),
+        (vec!["trace", m, "--ray", "0,0,5:0,0,-1", "--ray-kind", "shadow"], "give --pixel or --hottest"),
+        (vec!["trace", m, "--pixel", "0,0", "--size", "32x24", "--ray-kind", "ao"], "its camera ray misses"),
+        (vec!["render", m, "--ray-kind", "ao", "--samples", "0"], "--samples"),
+    ] {
+        let out = bvhscope(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+}
