@@ -91,11 +91,17 @@ mod linked {
     impl Tracer for Bvh8Cpu {
         #[inline]
         fn trace(&self, r: &RaySpec) -> bool {
-            let mut ray = Ray::new(r.origin.to_array(), r.dir.to_array());
-            self.0.intersect(&mut ray);
-            ray.hit.t < INFINITE
+            let mut ray = Aligned(Ray::new(r.origin.to_array(), r.dir.to_array()));
+            self.0.intersect(&mut ray.0);
+            ray.0.hit.t < INFINITE
         }
     }
+
+    /// tinybvh's C++ `Ray` is 64-byte aligned and its AVX2 walk loads it as such; the crate's
+    /// Rust `Ray` is aligned to 16 only, and a ray on the stack at an address 16 past a cache line
+    /// made the walk fault. Held in this, every ray sits where the C++ code expects it.
+    #[repr(C, align(64))]
+    struct Aligned(Ray);
 
     pub fn contender(hq: bool) -> Contender {
         Contender {

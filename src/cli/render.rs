@@ -270,7 +270,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     if let Some(l) = &mut legend {
         l.subject = format!("{}, {label_a}", file_name(&a.mesh));
         if let Some(sec) = &secondary {
-            l.subject = format!("{}, {}", l.subject, sec.spec.describe());
+            l.subject = format!("{}, {} rays", l.subject, sec.spec.kind.name());
         }
     }
     if let (Some(bins), Some(l)) = (a.histogram, &legend) {

@@ -242,10 +242,9 @@ pub fn view_image(
             let title = view.legend_title();
             let note = match frame.ray_kind() {
                 (kind, n) if kind.is_secondary() => format!(
-                    "mean over the {n} {} ray{} from each pixel's hit; grey: the camera ray missed, no {} rays",
+                    "mean of {n} {} ray{} per hit; grey: camera ray missed",
                     kind.name(),
                     if n == 1 { "" } else { "s" },
-                    kind.name()
                 ),
                 _ => String::new(),
             };
