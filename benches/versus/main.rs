@@ -417,6 +417,7 @@ fn main() {
     meshes.extend(scenes::shared("beast.obj"));
     meshes.extend(scenes::shared("spot.obj"));
     meshes.extend(scenes::shared("cow.obj"));
+    meshes.push(scenes::needles());
     meshes.push(scenes::knot_field());
     meshes.push(scenes::teapot_in_stadium());
     if !quick || app_only {

@@ -29,6 +29,14 @@ pub fn teapot_in_stadium() -> Mesh {
     m
 }
 
+/// 40,000 long thin crossing triangles (`generate::needles`, seed 37 as `write_epo_meshes`
+/// writes it): boxes that overlap everywhere, where walks differ most on incoherent rays.
+pub fn needles() -> Mesh {
+    let mut m = generate::needles(40_000, 37);
+    m.name = "needles 40k".into();
+    m
+}
+
 /// A generated mesh of 2.1 million triangles.
 pub fn big_knot() -> Mesh {
     let mut m = generate::torus_knot(3, 5, 0.12, 8192, 128);

@@ -68,6 +68,12 @@ impl KindRays {
         Self { kind: RayKind::Primary, rays: rays.map(|(x, y)| gen.pixel_ray(x, y)).collect() }
     }
 
+    /// At most `max` of the rays, evenly spread over the list (all of them when there are fewer).
+    pub fn spread_to(&self, max: usize) -> Self {
+        let n = self.rays.len().min(max);
+        Self { kind: self.kind, rays: (0..n).map(|k| self.rays[self.spread(k, n)]).collect() }
+    }
+
     /// Trace ray `i` as its kind asks (any hit for shadow and ao rays), counting into `stats`.
     #[inline]
     fn trace<A: Accelerator + ?Sized, S: crate::bvh::TraversalStats>(

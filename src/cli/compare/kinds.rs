@@ -12,6 +12,12 @@ use crate::render::{render, Camera, RayKind, RenderSettings};
 use std::fmt::Write;
 use std::time::Duration;
 
+/// The most secondary rays of one kind each tree is counted and timed on: a frame's ao rays on a
+/// dense mesh are millions, each dearer than a camera ray, and fourteen trees times four kinds of
+/// them would take many minutes; an evenly spread quarter million ranks the trees as well, and
+/// the table says when it is a sample.
+const MAX_SECONDARY_RAYS: usize = 1 << 18;
+
 /// One strategy × kind: the work per ray and the speed.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct KindCell {
@@ -59,7 +65,15 @@ impl KindsTable {
             .into_iter()
             .map(|kind| match args.secondary(kind, &mesh.bounds(), camera) {
                 None => (KindRays::primary(camera), "the camera's rays, one per pixel (closest hit)".to_string()),
-                Some(sec) => (KindRays { kind, rays: sec.frame_rays(&hits, camera) }, sec.spec.describe()),
+                Some(sec) => {
+                    let all = KindRays { kind, rays: sec.frame_rays(&hits, camera) };
+                    let (list, of) = (all.spread_to(MAX_SECONDARY_RAYS), all.rays.len());
+                    let note = match list.rays.len() < of {
+                        true => format!(" (an evenly spread {} of the frame's {of})", list.rays.len()),
+                        false => String::new(),
+                    };
+                    (list, format!("{}{note}", sec.spec.describe()))
+                }
             })
             .unzip();
         Self { lists, described, trace, cost, cells: Vec::new(), ranked: Vec::new() }
