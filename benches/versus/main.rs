@@ -417,11 +417,15 @@ fn main() {
     meshes.extend(scenes::shared("beast.obj"));
     meshes.extend(scenes::shared("spot.obj"));
     meshes.extend(scenes::shared("cow.obj"));
-    meshes.push(scenes::needles());
     meshes.push(scenes::knot_field());
     meshes.push(scenes::teapot_in_stadium());
     if !quick || app_only {
         meshes.push(scenes::big_knot());
+    }
+    // The needle soup's walks visit hundreds of nodes a ray: about a minute per contender, so
+    // only in the full run (or asked for by name with BENCH_MESH=needles).
+    if !quick || std::env::var("BENCH_MESH").is_ok_and(|m| m.contains("needles")) {
+        meshes.push(scenes::needles());
     }
     if app_only {
         println!("{}", app_figures(&meshes, &all));
