@@ -131,3 +131,44 @@ fn what_a_kind_cannot_do_is_refused_in_one_line() {
         assert!(err.contains(says), "{args:?}: {err}");
     }
 }
+
+/// `grade --ray-kind ao`: the heatmaps are of ao rays (their missed pixels grey), the page says
+/// so, and the figures and ranks stay the camera rays' (the same as without it).
+#[test]
+fn grade_draws_its_heatmaps_of_the_kind_and_keeps_its_figures() {
+    let mesh = knot();
+    let m = mesh.to_str().unwrap();
+    let dump = tmp("grade-ao-sah.json");
+    ok(&["export-bvh", m, "-o", dump.to_str().unwrap()]);
+    let small = ["--size", "32x24", "--rays", "300", "--time-rays", "64"];
+    let run = |out: &str, extra: &[&str]| {
+        let out = tmp(out);
+        let mut args = vec!["grade", m, dump.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        args.extend(small);
+        args.extend(extra);
+        ok(&args);
+        out
+    };
+    let (plain, ao) = (run("grade-plain", &[]), run("grade-ao", &["--ray-kind", "ao"]));
+    let html = std::fs::read_to_string(ao.join("grade.html")).unwrap();
+    assert!(html.contains("Heatmaps: nodes visited per ray of the ambient-occlusion rays"), "the page names the rays");
+    assert!(!std::fs::read_to_string(plain.join("grade.html")).unwrap().contains("Heatmaps: nodes visited per ray"));
+    let figures = |dir: &PathBuf| {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("grade.json")).unwrap()).unwrap();
+        let row = &v["students"][0];
+        (row["quality"]["nodes_per_ray"].clone(), row["quality"]["sah_cost"].clone(), row["rank"].clone())
+    };
+    assert_eq!(figures(&plain), figures(&ao), "the figures are the camera rays'");
+    // The heatmap: a missed pixel's corner is grey, where the camera-ray heatmap has its colour of 0.
+    let image = |dir: &PathBuf| {
+        let file = std::fs::read_dir(dir.join("images"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.to_string_lossy().ends_with("-visits.png"))
+            .expect("a heatmap");
+        image::open(file).unwrap().to_rgb8()
+    };
+    assert_eq!(image(&ao).get_pixel(0, 0).0, [96, 96, 96], "the camera ray missed: grey");
+    assert_ne!(image(&plain).get_pixel(0, 0).0, [96, 96, 96]);
+}

@@ -54,6 +54,10 @@ pub struct GradeArgs {
     /// else 480x270).
     #[command(flatten)]
     pub view_args: ViewArgs,
+    /// The heatmaps' rays: with a secondary kind the images show those rays' work from each hit;
+    /// the figures and the ranks stay the camera rays'.
+    #[command(flatten)]
+    pub ray_kind: super::rays::RayArgs,
     /// How the references are built and every tree traversed (their strategies are the rubric's).
     #[command(flatten)]
     pub build: BuildArgs,
@@ -132,6 +136,7 @@ pub fn run(a: &GradeArgs) -> Result<(), CliError> {
         dump_limit: a.dump_limit.bytes(&mesh),
         max_seconds: a.max_seconds,
         rubric,
+        secondary: a.ray_kind.secondary(a.ray_kind.one("grade")?, &scene.bounds(), &camera),
     };
     let start = std::time::Instant::now();
     let refs = progress::with_spinner("building and timing the reference trees", || References::new(&setup));

@@ -175,7 +175,7 @@ fn measured(
         AnyBvh::Binary(b) => Some(b),
         AnyBvh::Wide(_) | AnyBvh::Wide8(_) => imported.binary.as_ref().map(|(b, _)| b.as_ref()),
     };
-    let (q, frame) = measure(tree, binary, setup.mesh, &setup.camera, setup.trace, control)?;
+    let (q, frame) = measure(tree, binary, setup.mesh, &setup.camera, setup.trace, setup.secondary, control)?;
     control.check()?;
     // Timed in the same rounds as bvhscope's SAH tree: the ratio survives a busy machine.
     let (ns, versus_time, sah_speedup) = refs.time_against_sah(tree, layout, setup, control)?;

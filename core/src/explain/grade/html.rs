@@ -113,6 +113,13 @@ fn head(setup: &Setup, graded: &Graded) -> String {
         t.linear_rays,
         num(t.linear_ns_per_ray / 1e3, 1)
     );
+    if let Some(s) = &setup.secondary {
+        let _ = writeln!(
+            o,
+            "<p class=\"setup\">Heatmaps: nodes visited per ray of the {} from each pixel's hit (the mean of a pixel's rays; grey where the camera ray missed). The figures and the ranks are of the camera's rays.</p>",
+            esc(&s.spec.describe())
+        );
+    }
     let _ = writeln!(
         o,
         "<p class=\"setup\"><b>Ranked by</b> {} (correct submissions only).",

@@ -27,6 +27,7 @@ pub fn document(setup: &Setup, graded: &Graded) -> Value {
         "trace": setup.trace,
         "timing": graded.references.timing,
         "heatmap_scales": scales,
+        "heatmap_rays": setup.secondary.map(|s| s.spec),
         "max_seconds": setup.max_seconds,
         "rubric_file": setup.rubric.file.as_ref().map(|p| p.to_string_lossy()),
         "rubric": setup.rubric.to_json(),

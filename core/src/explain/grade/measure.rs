@@ -202,13 +202,15 @@ pub fn epo_bounded(bvh: &Bvh) -> Result<f64, String> {
 /// Everything of `tree` but its time: statistics, EPO (of `binary`, the binary tree behind it),
 /// and the counted frame on `camera` (returned too, for its heatmap), the SAH cost and the
 /// per-ray figures against the mesh's box. `control` may stop the
-/// frame between bands.
+/// frame between bands. With `secondary`, the frame returned for the heatmap is of those rays (a
+/// second frame); the figures stay the camera rays'.
 pub fn measure(
     tree: &AnyBvh,
     binary: Option<&Bvh>,
     mesh: &Mesh,
     camera: &Camera,
     trace: TraceOptions,
+    secondary: Option<crate::render::SecondaryRays>,
     control: &WorkControl,
 ) -> Result<(Quality, Frame), Cancelled> {
     // One yardstick for every tree of the class: the mesh's box (what its triangles span), not
@@ -241,6 +243,13 @@ pub fn measure(
         trace_ns_per_ray: 0.0,
         speedup_over_linear: 0.0,
         memory_bytes: s.memory_bytes,
+    };
+    let frame = match secondary {
+        None => frame,
+        Some(s) => {
+            let settings = RenderSettings { secondary: Some(s), ..settings };
+            render_progressive(tree, mesh, camera, &settings, &Default::default(), control, |_, _| {})?
+        }
     };
     Ok((q, frame))
 }

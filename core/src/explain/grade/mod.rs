@@ -95,6 +95,9 @@ pub struct Setup<'a> {
     /// The most time one submission may take; past it, its row says so and the class goes on.
     pub max_seconds: f64,
     pub rubric: Rubric,
+    /// The heatmaps' rays after the camera's (`--ray-kind`): the figures and the ranks stay of
+    /// the camera's rays, the one yardstick; only the images show these. `None`: camera rays.
+    pub secondary: Option<crate::render::SecondaryRays>,
 }
 
 /// What the checker and the rubric say of a submission.

@@ -87,7 +87,9 @@ impl References {
                 AnyBvh::Binary(b) => Some(b),
                 AnyBvh::Wide(_) | AnyBvh::Wide8(_) => binarised.as_deref(),
             };
-            let Ok((q, frame)) = measure(&tree, binary, setup.mesh, &setup.camera, setup.trace, &control) else {
+            let Ok((q, frame)) =
+                measure(&tree, binary, setup.mesh, &setup.camera, setup.trace, setup.secondary, &control)
+            else {
                 unreachable!("nobody else holds this control")
             };
             visits_max = visits_max.max(frame.ray_summary().max_nodes_visited as f32);

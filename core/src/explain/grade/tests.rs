@@ -189,6 +189,7 @@ pub(super) fn small_setup<'a>(mesh: &'a crate::mesh::Mesh, mesh_path: &'a Path) 
         dump_limit: 1 << 26,
         max_seconds: 60.0,
         rubric: Rubric::default(),
+        secondary: None,
     }
 }
 
