@@ -177,13 +177,7 @@ fn the_pinned_rays_trace_command_prints_the_same_walk() {
         idle(a) && a.shown.as_ref().is_some_and(|s| s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
     });
     // The pixel of the frame's first hit, near its middle row.
-    let (x, y) = {
-        let f = &h.state().shown.as_ref().unwrap().frame;
-        let y = f.height() / 2;
-        (0..f.width()).map(|x| (x, y)).find(|&(x, y)| f.sample(x, y).is_hit()).expect("the torus is in view")
-    };
-    h.state_mut().act(Action::PinPixel(x, y));
-    h.run_steps(2);
+    pin_first_hit(&mut h);
     h.get_by_label("Copy trace command");
     let r = &h.state().pins.pinned[0];
     let cmd = r.command.clone().expect("a file's ray has a command");

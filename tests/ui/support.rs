@@ -190,3 +190,16 @@ pub fn midpoint_against_sah() -> Harness<'static, BvhscopeApp> {
     run_until(&mut h, "B", pair_shown);
     h
 }
+
+/// Pin the ray of the frame's first hit pixel on its middle row (as a click on the image does);
+/// its pixel.
+pub fn pin_first_hit(h: &mut Harness<'_, BvhscopeApp>) -> (u32, u32) {
+    let (x, y) = {
+        let f = &h.state().shown.as_ref().unwrap().frame;
+        let y = f.height() / 2;
+        (0..f.width()).map(|x| (x, y)).find(|&(x, y)| f.sample(x, y).is_hit()).expect("the mesh is in view")
+    };
+    h.state_mut().act(bvhscope::app::Action::PinPixel(x, y));
+    h.run_steps(2);
+    (x, y)
+}

@@ -35,7 +35,7 @@ pub use params::{BuildParams, BuildReport, Layout, Limits, Param, ParamLimits, P
 pub use preset::Preset;
 pub use scene_bvh::{SceneBuild, SceneBvh};
 pub use stats::{fmt_ms, TreeStats};
-pub use trace::{trace_query_into, trace_ray, trace_ray_into, NodeId, StepKind, StepOut, Trace, TraceLevel, TraceStep};
+pub use trace::{trace_query_into, trace_ray, NodeId, StepKind, StepOut, Trace, TraceLevel, TraceStep};
 pub use tree::{NodeKind, TreeNode, TreeView};
 pub use two_level::TwoLevelBvh;
 pub use wide::WideBvh;

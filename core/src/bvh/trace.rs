@@ -476,22 +476,12 @@ fn shown(stack: &[(NodeId, f32)]) -> (Vec<(NodeId, f32)>, u32) {
 
 /// Trace `ray`'s closest hit through `accel` with `opts`, recording every step.
 pub fn trace_ray<A: Accelerator + ?Sized>(accel: &A, ray: &Ray, opts: TraceOptions) -> (Option<Hit>, Trace) {
-    trace_ray_into(accel, ray, opts, Trace::new())
+    trace_query_into(accel, ray, opts, false, Trace::new())
 }
 
-/// `trace_ray` with the steps given to `trace`'s output as the walk makes them.
-pub fn trace_ray_into<A: Accelerator + ?Sized, O: StepOut>(
-    accel: &A,
-    ray: &Ray,
-    opts: TraceOptions,
-    mut trace: Trace<O>,
-) -> (Option<Hit>, Trace<O>) {
-    let hit = accel.closest_hit(&mut ray.clone(), opts, &mut trace);
-    (hit, trace)
-}
-
-/// `trace_ray_into` for a query: the closest hit, or with `any` (shadow and ambient-occlusion
-/// rays) the first hit the walk finds, where it stops.
+/// `trace_ray` for a query, with the steps given to `trace`'s output as the walk makes them: the
+/// closest hit, or with `any` (shadow and ambient-occlusion rays) the first hit the walk finds,
+/// where it stops.
 pub fn trace_query_into<A: Accelerator + ?Sized, O: StepOut>(
     accel: &A,
     ray: &Ray,
@@ -499,11 +489,12 @@ pub fn trace_query_into<A: Accelerator + ?Sized, O: StepOut>(
     any: bool,
     mut trace: Trace<O>,
 ) -> (Option<Hit>, Trace<O>) {
-    if !any {
-        return trace_ray_into(accel, ray, opts, trace);
-    }
     let mut r = *ray;
-    let hit =
-        super::accel::dispatch!(opts, |T, BY_DISTANCE| accel.trace::<T, BY_DISTANCE, true, _>(&mut r, &mut trace));
+    let hit = match any {
+        false => accel.closest_hit(&mut r, opts, &mut trace),
+        true => {
+            super::accel::dispatch!(opts, |T, BY_DISTANCE| accel.trace::<T, BY_DISTANCE, true, _>(&mut r, &mut trace))
+        }
+    };
     (hit, trace)
 }

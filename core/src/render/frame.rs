@@ -8,30 +8,10 @@
 //! (BENCHMARKS.md, "The frame regression, located"); larger views pass that limit whatever the
 //! layout, so the render job keeps dropped frames' storage for its next frame.
 
+use super::sample::PixelSample;
 use super::secondary::{RayKind, SecondarySpec};
 use crate::bvh::RayCounters;
-use glam::Vec3;
 use rayon::prelude::*;
-
-/// What one primary ray found.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PixelSample {
-    /// Hit distance (the ray direction is unit length, so this is the distance to the camera);
-    /// `f32::INFINITY` for a miss.
-    pub t: f32,
-    /// Shading normal at the hit (world space), zero for a miss.
-    pub normal: Vec3,
-    /// The mesh's triangle index, `u32::MAX` for a miss.
-    pub prim: u32,
-}
-
-impl PixelSample {
-    pub const MISS: PixelSample = PixelSample { t: f32::INFINITY, normal: Vec3::ZERO, prim: u32::MAX };
-
-    pub fn is_hit(&self) -> bool {
-        self.prim != u32::MAX
-    }
-}
 
 /// A frame being refined. Until the last pass, only every `stride`-th pixel in x and y has been
 /// traced; `sample` returns the traced pixel covering a given one, so a coarse frame can be shown.
@@ -400,7 +380,7 @@ impl Frame {
         samples.par_chunks_mut(width as usize).zip(hits.par_chunks(width as usize)).enumerate().for_each(
             |(y, (row, hits))| {
                 for (x, (s, hit)) in row.iter_mut().zip(hits).enumerate() {
-                    *s = super::raycast::sample(mesh, &gen.pixel_ray(x as u32, y as u32), *hit);
+                    *s = PixelSample::of(mesh, &gen.pixel_ray(x as u32, y as u32), *hit);
                 }
             },
         );

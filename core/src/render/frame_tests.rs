@@ -1,6 +1,7 @@
 //! The frame's tests: passes, samples and counts.
 
 use super::*;
+use glam::Vec3;
 
 /// A frame after a pass of `stride`, each traced pixel's sample naming its pixel.
 fn traced_frame(w: u32, h: u32, stride: u32, counted: bool) -> Frame {

@@ -13,18 +13,20 @@ pub mod legend;
 pub mod pair;
 mod ray_summary;
 mod raycast;
+mod sample;
 pub mod secondary;
 mod views;
 pub mod warp;
 
 pub use camera::{Camera, CameraError, RayGen, RayGenParts, UpAxis};
 pub use colormap::ColorMap;
-pub use frame::{Frame, FramePool, FromHitsError, PixelSample};
+pub use frame::{Frame, FramePool, FromHitsError};
 pub use incoherent::incoherent_rays;
 pub use legend::{draw_legend, legend_height};
 pub use pair::PairView;
 pub use ray_summary::RaySummary;
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
+pub use sample::PixelSample;
 pub use secondary::{RayKind, SecondaryRays, SecondarySpec};
 pub use views::{
     full_size, grid_values, histogram, hottest, metric_stats, view_image, HeatRange, Legend, View, NO_RAYS,

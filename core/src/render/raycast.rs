@@ -10,8 +10,7 @@
 use super::secondary::SecondaryRays;
 use super::{Camera, Frame, FramePool, PixelSample};
 use crate::bvh::packet::{packet_position, PACKET, PACKET_SIDE};
-use crate::bvh::{Accelerator, Hit, NoStats, RayCounters, TraceOptions, TraversalStats};
-use crate::geometry::Ray;
+use crate::bvh::{Accelerator, NoStats, RayCounters, TraceOptions, TraversalStats};
 use crate::mesh::Surface;
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
@@ -155,7 +154,7 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
                         let mut stats = S::default();
                         let hit = accel.closest_hit(&mut ray, trace, &mut stats);
                         let i = (x - x0) as usize;
-                        let s = sample(mesh, &ray, hit);
+                        let s = PixelSample::of(mesh, &ray, hit);
                         samples[dy as usize][i] = s;
                         let mut counted: RayCounters = stats.into();
                         if let Some(sec) = secondary.as_ref() {
@@ -268,18 +267,6 @@ fn for_each_piece(frame: &mut Frame, control: &WorkControl, trace_piece: impl Fn
     })
 }
 
-/// The pixel a ray's closest hit (or miss) shows (also what `Frame::from_hits` makes of hits
-/// traced elsewhere).
-pub(super) fn sample(surface: &(impl Surface + ?Sized), ray: &Ray, hit: Option<Hit>) -> PixelSample {
-    match hit {
-        Some(hit) => {
-            let normal = surface.shading_normal(ray, hit.prim, hit.triangle_hit());
-            PixelSample { t: hit.t, normal, prim: hit.prim }
-        }
-        None => PixelSample::MISS,
-    }
-}
-
 impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
     /// `trace` without counters, in packets: the pass's pixels grouped in blocks of 8×8 pixels of
     /// its grid (fewer rows where the band is shorter), listed in `packet_position` order, leaving
@@ -314,7 +301,7 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
                     let hits = &mut hits[..rays.len()];
                     accel.closest_hits(&mut rays, hits, trace);
                     for ((ray, hit), &(dy, i)) in rays.iter().zip(hits.iter()).zip(&pixels) {
-                        samples[dy][i] = sample(mesh, ray, *hit);
+                        samples[dy][i] = PixelSample::of(mesh, ray, *hit);
                     }
                     traced += rays.len() as u64;
                 }

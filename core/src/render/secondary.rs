@@ -189,7 +189,7 @@ impl SecondaryRays {
     ) -> Option<Vec<Ray>> {
         let mut ray = camera.ray_gen().pixel_ray(x, y);
         let hit = accel.closest_hit(&mut ray, opts, &mut crate::bvh::NoStats);
-        let s = super::raycast::sample(surface, &ray, hit);
+        let s = super::PixelSample::of(surface, &ray, hit);
         let pixel = y as u64 * camera.width as u64 + x as u64;
         s.is_hit().then(|| self.rays(pixel, ray.origin() + ray.dir() * s.t, s.normal, ray.dir()).collect())
     }

@@ -6,7 +6,7 @@ use crate::app::{Action, Actions, BoxLevel, BvhscopeApp};
 use crate::gpu_path::{Device, GpuNodes};
 use crate::render::secondary::MAX_SAMPLES;
 use crate::render::warp::WarpSize;
-use crate::render::{ColorMap, RayKind, UpAxis, View};
+use crate::render::{RayKind, UpAxis, View};
 
 /// What a view shows, for its tooltip: its help, and for combined cost the constants in use.
 fn view_tip(v: View, cost: &str) -> String {
@@ -57,7 +57,6 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             }
         }
     });
-    ray_kind(ui, s);
     if let Some(lanes) = s.view.warp() {
         let mut wide = lanes == WarpSize::W64;
         ui.checkbox(&mut wide, "64 lanes per warp (AMD wave64)")
@@ -75,19 +74,14 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
     }
     ui.add_enabled_ui(s.view.is_heatmap(), |ui| {
+        // The rays share the colour map's row: the panel must not grow taller for them.
         ui.horizontal(|ui| {
-            let label = ui.label("Colour map");
-            egui::ComboBox::from_id_salt("colormap")
-                .selected_text(s.colormap.label())
-                .show_ui(ui, |ui| {
-                    for c in ColorMap::ALL {
-                        ui.selectable_value(&mut s.colormap, c, c.label());
-                    }
-                })
-                .response
-                .labelled_by(label.id)
+            combo(ui, "Colour map", &mut s.colormap)
                 .on_hover_text("Perceptual colour maps: equal steps in value look like equal steps in colour");
+            ui.add_space(8.0);
+            combo(ui, "Rays", &mut s.rays.kind).on_hover_text("Which rays the heatmaps count: the camera's, or rays from each of its hits (bvhscope render --ray-kind). A pixel's value is the mean over its rays; grey pixels: the camera ray missed.");
         });
+        ray_numbers(ui, &mut s.rays);
         let view = s.view;
         let mut auto = !s.fixed_ranges.contains_key(&view);
         if ui
@@ -203,31 +197,38 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     }
 }
 
-/// Which rays the heatmaps count, beside the view: the kind and, for ao and bounces, rays per
-/// pixel (and the ao rays' length). The same rays as `bvhscope render --ray-kind` for the seed.
-fn ray_kind(ui: &mut egui::Ui, s: &mut crate::app::Settings) {
-    let r = &mut s.rays;
+/// A labelled combo box of a choice from the option tables (`options::Choice`): its labels, each
+/// with its help on hover.
+fn combo<T: crate::options::Choice>(ui: &mut egui::Ui, label: &str, value: &mut T) -> egui::Response {
+    // Salted by its text, not by the label's id: an auto id moves when widgets before it come
+    // and go, and the open list would close.
+    let salt = label;
+    let label = ui.label(label);
+    egui::ComboBox::from_id_salt(salt)
+        .selected_text(value.named().label)
+        .show_ui(ui, |ui| {
+            for n in T::TABLE {
+                ui.selectable_value(value, n.value, n.label).on_hover_text(n.help);
+            }
+        })
+        .response
+        .labelled_by(label.id)
+}
+
+/// For ao rays and bounces, beside the ray kind: rays per pixel (and the ao rays' length). The
+/// same rays as `bvhscope render --ray-kind` for the seed.
+fn ray_numbers(ui: &mut egui::Ui, r: &mut crate::render::SecondarySpec) {
+    if !matches!(r.kind, RayKind::Ao | RayKind::Bounce) {
+        return;
+    }
     ui.horizontal(|ui| {
-        let label = ui.label("Rays");
-        egui::ComboBox::from_id_salt("ray_kind")
-            .selected_text(r.kind.label())
-            .show_ui(ui, |ui| {
-                for k in RayKind::ALL {
-                    ui.selectable_value(&mut r.kind, k, k.label()).on_hover_text(k.help());
-                }
-            })
-            .response
-            .labelled_by(label.id)
-            .on_hover_text("Which rays the heatmaps count: the camera's, or rays from each of its hits (bvhscope render --ray-kind). A pixel's value is the mean over its rays; grey pixels: the camera ray missed.");
-        if matches!(r.kind, RayKind::Ao | RayKind::Bounce) {
-            ui.add(egui::DragValue::new(&mut r.samples).range(1..=MAX_SAMPLES).suffix(" per pixel"))
-                .on_hover_text("Rays per pixel (--samples)");
-        }
+        ui.add(egui::DragValue::new(&mut r.samples).range(1..=MAX_SAMPLES).suffix(" rays per pixel"))
+            .on_hover_text("Rays per pixel (--samples)");
         if r.kind == RayKind::Ao {
             let mut percent = r.ao_length * 100.0;
             // Written back only when dragged: percent / 100 need not give back the same float.
             if ui
-                .add(egui::DragValue::new(&mut percent).range(0.1..=100.0).speed(0.5).suffix(" % long"))
+                .add(egui::DragValue::new(&mut percent).range(0.1..=100.0).speed(0.5).suffix(" % of the diagonal long"))
                 .on_hover_text("Length of the ao rays, as a share of the scene's diagonal (--ao-length)")
                 .changed()
             {

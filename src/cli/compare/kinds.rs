@@ -2,7 +2,7 @@
 //! the same rays of each kind, and how well the SAH cost and EPO rank the trees for each kind
 //! (`explain::ray_kinds`).
 
-use super::rows::{budgeted_median, CompareRow};
+use super::rows::{budgeted_median, CompareRow, PerTree};
 use crate::bvh::{AnyBvh, BuildParams, LinearScan, SahCost, TraceOptions};
 use crate::cli::progress;
 use crate::cli::rays::RayArgs;
@@ -95,53 +95,6 @@ impl KindsTable {
         }
     }
 
-    /// Count `bvh` on every list (on the frames' pool) and time it (median of up to `runs`, on
-    /// the traces' pool). `first_layout`: its row joins the ranking.
-    pub fn measure(
-        &mut self,
-        bvh: &AnyBvh,
-        row: &CompareRow,
-        first_layout: bool,
-        runs: u32,
-        pools: (&rayon::ThreadPool, &rayon::ThreadPool),
-    ) {
-        for list in &self.lists {
-            let n = list.rays.len();
-            let work = pools.0.install(|| list.count(bvh, self.trace, n));
-            let t = pools.1.install(|| budgeted_median(runs, || ms(list.time(bvh, self.trace, n))));
-            let cell = self.cell(&row.name, list, work, t / 1e3 / n.max(1) as f64, None);
-            self.cells.push(cell);
-        }
-        if let (true, Some(sah), Some(epo)) = (first_layout, row.sah_cost, row.epo) {
-            self.ranked.push((row.name.clone(), sah, epo));
-        }
-    }
-
-    /// The linear scan's cells, each list timed and counted within `budget` in all, then every
-    /// cell's speed-up over it.
-    pub fn finish(&mut self, mesh: &crate::mesh::Mesh, budget: Duration, traces: &rayon::ThreadPool) {
-        let linear = LinearScan::new(mesh);
-        let each = budget / self.lists.len().max(1) as u32;
-        let mut linear_cells = Vec::new();
-        for list in &self.lists {
-            let (per_ray, n) =
-                progress::with_spinner(&format!("timing the linear scan on {} rays", list.kind.name()), || {
-                    traces.install(|| list.time_per_ray_within(&linear, self.trace, each))
-                });
-            let work = list.count(&linear, self.trace, n);
-            let sampled = (n < list.rays.len()).then_some(n);
-            linear_cells.push(self.cell("Linear scan", list, work, per_ray, sampled));
-        }
-        for c in &mut self.cells {
-            let l = linear_cells.iter().find(|l| l.kind == c.kind).expect("every kind has its linear cell");
-            c.speedup_over_linear = c.mrays_per_s / l.mrays_per_s.max(1e-12);
-        }
-        for l in &mut linear_cells {
-            l.speedup_over_linear = 1.0;
-        }
-        self.cells.extend(linear_cells);
-    }
-
     /// Per kind: Spearman's rank correlation of the measured cost per ray with the SAH cost and
     /// with the EPO, over the ranked rows.
     pub fn correlations(&self) -> Vec<(&'static str, Option<f64>, Option<f64>)> {
@@ -215,6 +168,55 @@ impl KindsTable {
             let _ = writeln!(o, "- {kind}: SAH cost {}, EPO {}", fmt(sah), fmt(epo));
         }
         o
+    }
+}
+
+impl PerTree for KindsTable {
+    /// Count `bvh` on every list (on the frames' pool) and time it (median of up to `runs`, on
+    /// the traces' pool). `first_layout`: its row joins the ranking.
+    fn tree(
+        &mut self,
+        bvh: &AnyBvh,
+        row: &CompareRow,
+        first_layout: bool,
+        runs: u32,
+        pools: (&rayon::ThreadPool, &rayon::ThreadPool),
+    ) {
+        for list in &self.lists {
+            let n = list.rays.len();
+            let work = pools.0.install(|| list.count(bvh, self.trace, n));
+            let t = pools.1.install(|| budgeted_median(runs, || ms(list.time(bvh, self.trace, n))));
+            let cell = self.cell(&row.name, list, work, t / 1e3 / n.max(1) as f64, None);
+            self.cells.push(cell);
+        }
+        if let (true, Some(sah), Some(epo)) = (first_layout, row.sah_cost, row.epo) {
+            self.ranked.push((row.name.clone(), sah, epo));
+        }
+    }
+
+    /// The linear scan's cells, each list timed and counted within `budget` in all, then every
+    /// cell's speed-up over it.
+    fn done(&mut self, mesh: &crate::mesh::Mesh, budget: Duration, traces: &rayon::ThreadPool) {
+        let linear = LinearScan::new(mesh);
+        let each = budget / self.lists.len().max(1) as u32;
+        let mut linear_cells = Vec::new();
+        for list in &self.lists {
+            let (per_ray, n) =
+                progress::with_spinner(&format!("timing the linear scan on {} rays", list.kind.name()), || {
+                    traces.install(|| list.time_per_ray_within(&linear, self.trace, each))
+                });
+            let work = list.count(&linear, self.trace, n);
+            let sampled = (n < list.rays.len()).then_some(n);
+            linear_cells.push(self.cell("Linear scan", list, work, per_ray, sampled));
+        }
+        for c in &mut self.cells {
+            let l = linear_cells.iter().find(|l| l.kind == c.kind).expect("every kind has its linear cell");
+            c.speedup_over_linear = c.mrays_per_s / l.mrays_per_s.max(1e-12);
+        }
+        for l in &mut linear_cells {
+            l.speedup_over_linear = 1.0;
+        }
+        self.cells.extend(linear_cells);
     }
 }
 

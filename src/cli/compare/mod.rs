@@ -86,8 +86,16 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
         let cost = a.build.params(scene).cost;
         kinds::KindsTable::new(mesh, &camera, &a.rays, trace, cost)
     });
-    let (rows, setup) =
-        compare_rows(mesh, &camera, &a.build, scene, a.runs, a.threads, Duration::from_secs(10), kinds.as_mut());
+    let (rows, setup) = compare_rows(
+        mesh,
+        &camera,
+        &a.build,
+        scene,
+        a.runs,
+        a.threads,
+        Duration::from_secs(10),
+        kinds.as_mut().map(|k| k as &mut (dyn rows::PerTree + Send)),
+    );
     let linear_ms = rows.last().map_or(0.0, |r| r.trace_ms);
     let formats = a.device.gpu_nodes.map_or(vec![GpuNodes::Binary, GpuNodes::Cwbvh], |n| vec![n]);
     let gpu_rows = match &gpu {

@@ -8,6 +8,23 @@ use crate::explain::timing::{ms, time_linear, trace_rays};
 use crate::render::{render, Camera, RenderSettings};
 use std::time::{Duration, Instant};
 
+/// More measured of every tree while the rows are made (`compare --ray-kind`'s table), each tree
+/// while it is built, so no tree is kept.
+pub trait PerTree {
+    /// `bvh`, the tree of `row`; `first_layout`: of the first layout compared. `pools`: the
+    /// frames' and the single-ray traces'.
+    fn tree(
+        &mut self,
+        bvh: &AnyBvh,
+        row: &CompareRow,
+        first_layout: bool,
+        runs: u32,
+        pools: (&rayon::ThreadPool, &rayon::ThreadPool),
+    );
+    /// After the last tree: the linear scan's measures within `budget`.
+    fn done(&mut self, mesh: &crate::mesh::Mesh, budget: Duration, traces: &rayon::ThreadPool);
+}
+
 /// One row of the table.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct CompareRow {
@@ -94,7 +111,7 @@ pub fn compare_rows(
     runs: u32,
     threads: Option<u32>,
     linear_budget: Duration,
-    mut kinds: Option<&mut super::kinds::KindsTable>,
+    mut kinds: Option<&mut (dyn PerTree + Send)>,
 ) -> (Vec<CompareRow>, CompareSetup) {
     let (frames, traces) = (pool(threads), pool(Some(threads.unwrap_or(1))));
     let rays = camera.width as f64 * camera.height as f64;
@@ -173,7 +190,7 @@ pub fn compare_rows(
         };
         if let Some(k) = kinds.as_deref_mut() {
             progress::with_spinner(&step("tracing every ray kind through"), || {
-                k.measure(&bvh, &row, layout == layouts[0], runs, (&frames, &traces))
+                k.tree(&bvh, &row, layout == layouts[0], runs, (&frames, &traces))
             });
         }
         rows.push(row);
@@ -213,7 +230,7 @@ pub fn compare_rows(
         r.speedup_over_linear = linear_ms / r.trace_ms;
     }
     if let Some(k) = kinds {
-        k.finish(mesh, linear_budget, &traces);
+        k.done(mesh, linear_budget, &traces);
     }
     let setup = CompareSetup {
         trace_threads: traces.current_num_threads(),
