@@ -278,6 +278,14 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
         }
         ui.end_row();
         if frame.counted() {
+            // A frame of secondary rays: its counts are the sums over the pixel's rays (the
+            // heatmap shows their mean), and the camera ray's own follow.
+            let (kind, per_hit) = frame.ray_kind();
+            let rays = if kind.is_secondary() && s.is_hit() {
+                format!(" ({per_hit} {} rays)", kind.name())
+            } else {
+                String::new()
+            };
             let c = frame.counters(x, y);
             for (name, v) in [
                 ("Nodes visited", c.nodes_visited),
@@ -286,7 +294,13 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
                 ("Triangle tests", c.triangle_tests),
             ] {
                 ui.label(name);
-                ui.label(v.to_string());
+                ui.label(format!("{v}{rays}"));
+                ui.end_row();
+            }
+            if kind.is_secondary() {
+                let p = frame.primary_counters(x, y);
+                ui.label("Camera ray");
+                ui.label(format!("{} nodes, {} triangle tests", p.nodes_visited, p.triangle_tests));
                 ui.end_row();
             }
         }
