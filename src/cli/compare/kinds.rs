@@ -2,7 +2,7 @@
 //! the same rays of each kind, and how well the SAH cost and EPO rank the trees for each kind
 //! (`explain::ray_kinds`).
 
-use super::rows::{budgeted_median, CompareRow, PerTree};
+use super::rows::{budgeted_median, PerTree, Tree};
 use crate::bvh::{AnyBvh, BuildParams, LinearScan, SahCost, TraceOptions};
 use crate::cli::progress;
 use crate::cli::rays::RayArgs;
@@ -174,14 +174,8 @@ impl KindsTable {
 impl PerTree for KindsTable {
     /// Count `bvh` on every list (on the frames' pool) and time it (median of up to `runs`, on
     /// the traces' pool). `first_layout`: its row joins the ranking.
-    fn tree(
-        &mut self,
-        bvh: &AnyBvh,
-        row: &CompareRow,
-        first_layout: bool,
-        runs: u32,
-        pools: (&rayon::ThreadPool, &rayon::ThreadPool),
-    ) {
+    fn tree(&mut self, t: Tree<'_>) {
+        let Tree { bvh, row, first_layout, runs, pools } = t;
         for list in &self.lists {
             let n = list.rays.len();
             let work = pools.0.install(|| list.count(bvh, self.trace, n));

@@ -11,18 +11,19 @@ use std::time::{Duration, Instant};
 /// More measured of every tree while the rows are made (`compare --ray-kind`'s table), each tree
 /// while it is built, so no tree is kept.
 pub trait PerTree {
-    /// `bvh`, the tree of `row`; `first_layout`: of the first layout compared. `pools`: the
-    /// frames' and the single-ray traces'.
-    fn tree(
-        &mut self,
-        bvh: &AnyBvh,
-        row: &CompareRow,
-        first_layout: bool,
-        runs: u32,
-        pools: (&rayon::ThreadPool, &rayon::ThreadPool),
-    );
+    fn tree(&mut self, t: Tree<'_>);
     /// After the last tree: the linear scan's measures within `budget`.
     fn done(&mut self, mesh: &crate::mesh::Mesh, budget: Duration, traces: &rayon::ThreadPool);
+}
+
+/// A tree as `PerTree` is given it: `bvh`, the tree of `row`; `first_layout`: of the first layout
+/// compared; `runs` as `--runs`; `pools`: the frames' and the single-ray traces'.
+pub struct Tree<'a> {
+    pub bvh: &'a AnyBvh,
+    pub row: &'a CompareRow,
+    pub first_layout: bool,
+    pub runs: u32,
+    pub pools: (&'a rayon::ThreadPool, &'a rayon::ThreadPool),
 }
 
 /// One row of the table.
@@ -190,7 +191,13 @@ pub fn compare_rows(
         };
         if let Some(k) = kinds.as_deref_mut() {
             progress::with_spinner(&step("tracing every ray kind through"), || {
-                k.tree(&bvh, &row, layout == layouts[0], runs, (&frames, &traces))
+                k.tree(Tree {
+                    bvh: &bvh,
+                    row: &row,
+                    first_layout: layout == layouts[0],
+                    runs,
+                    pools: (&frames, &traces),
+                })
             });
         }
         rows.push(row);
