@@ -250,10 +250,7 @@ fn secondary_ray(
         .iter()
         .map(|r| {
             let mut c = RayCounters::ZERO;
-            let hit = match kind.any_hit() {
-                true => crate::bvh::Accelerator::any_hit(bvh, r, opts, &mut c),
-                false => crate::bvh::Accelerator::closest_hit(bvh, &mut r.clone(), opts, &mut c).is_some(),
-            };
+            let hit = kind.trace(bvh, r, opts, &mut c);
             serde_json::json!({
                 "origin": r.origin().to_array(), "dir": r.dir().to_array(), "length": r.t_max, "hit": hit,
                 "nodes_visited": c.nodes_visited, "triangle_tests": c.triangle_tests,

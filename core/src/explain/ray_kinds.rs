@@ -83,12 +83,7 @@ impl KindRays {
         opts: TraceOptions,
         stats: &mut S,
     ) -> bool {
-        let mut ray = self.rays[i];
-        if self.kind.any_hit() {
-            accel.any_hit(&ray, opts, stats)
-        } else {
-            accel.closest_hit(&mut ray, opts, stats).is_some()
-        }
+        self.kind.trace(accel, &self.rays[i], opts, stats)
     }
 
     /// The work of every ray of the list (or of `n` evenly spread ones), summed.

@@ -38,6 +38,22 @@ impl RayKind {
     pub fn any_hit(self) -> bool {
         matches!(self, RayKind::Shadow | RayKind::Ao)
     }
+
+    /// Trace `ray` as the kind asks (any hit for shadow and ao rays, else the closest), counting
+    /// into `stats`: whether it hit. The one place a kind's query is chosen.
+    #[inline]
+    pub fn trace<A: Accelerator + ?Sized, S: TraversalStats>(
+        self,
+        accel: &A,
+        ray: &Ray,
+        opts: TraceOptions,
+        stats: &mut S,
+    ) -> bool {
+        match self.any_hit() {
+            true => accel.any_hit(ray, opts, stats),
+            false => accel.closest_hit(&mut ray.clone(), opts, stats).is_some(),
+        }
+    }
 }
 
 /// Rays per pixel of ambient occlusion and bounces unless told otherwise.
@@ -207,13 +223,9 @@ impl SecondaryRays {
         dir: Vec3,
     ) -> (RayCounters, u32) {
         let (mut sum, mut hits) = (RayCounters::ZERO, 0);
-        for mut ray in self.rays(pixel, point, normal, dir) {
+        for ray in self.rays(pixel, point, normal, dir) {
             let mut s = S::default();
-            let hit = if self.spec.kind.any_hit() {
-                accel.any_hit(&ray, opts, &mut s)
-            } else {
-                accel.closest_hit(&mut ray, opts, &mut s).is_some()
-            };
+            let hit = self.spec.kind.trace(accel, &ray, opts, &mut s);
             sum.add(&s.into());
             hits += hit as u32;
         }
