@@ -1,6 +1,7 @@
 //! A profiling driver: traces the bunny's primary and incoherent rays with the wide SAH BVH on
 //! one thread, many times over, for `perf record` / `valgrind --tool=callgrind`.
 //! `cargo run --release --example profile_trace -- [binary|wide4|wide8] [primary|incoherent|build|frame]`
+//! (`PRESET=fastest`: the `fastest` preset's tree and trace options instead)
 //! (`TIME=n`: also the plain closest-hit traversal of all rays, n times, with its median)
 //! (`frame` with `PARTS=1` also splits the app's frame into counting, passes and snapshots;
 //! `primary` with `PACKET=1` also times 8×8 packets, with `PACKET=only` nothing else).
@@ -23,7 +24,11 @@ fn main() {
     let what = args.get(2).map_or("primary", |s| s.as_str());
     let path = args.get(3).map_or("../shared/models/stanford-bunny.obj", |s| s.as_str());
     let (mesh, _) = load_obj(path).unwrap_or_else(|e| panic!("{e}"));
-    let mut params = BuildParams { layout, ..BuildParams::default() };
+    // `PRESET=fastest`: the `fastest` preset's build and trace options (the layout argument is ignored).
+    let fastest = std::env::var("PRESET").is_ok_and(|p| p == "fastest");
+    let mut params =
+        if fastest { bvhscope::bvh::Preset::Fastest.build() } else { BuildParams { layout, ..BuildParams::default() } };
+    let opts = if fastest { bvhscope::bvh::Preset::Fastest.trace() } else { TraceOptions::default() };
     if let Ok(c) = std::env::var("COST") {
         params.cost.traversal = c.parse().expect("COST is a number");
     }
@@ -125,19 +130,33 @@ fn main() {
                 let t = Instant::now();
                 for r in &rays {
                     let mut r = *r;
-                    std::hint::black_box(bvh.closest_hit(&mut r, TraceOptions::default(), &mut NoStats));
+                    std::hint::black_box(bvh.closest_hit(&mut r, opts, &mut NoStats));
                 }
                 rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6
             })
             .collect();
         times.sort_by(f64::total_cmp);
         println!("{layout:?} {what}: median {:.2} MRays/s of {n}", times[n / 2]);
+        // The same rays walked with the heatmaps' counters (what the app's frame traces).
+        let mut counted: Vec<f64> = (0..n)
+            .map(|_| {
+                let t = Instant::now();
+                for r in &rays {
+                    let (mut r, mut c) = (*r, bvhscope::bvh::RayCounters::default());
+                    std::hint::black_box(bvh.closest_hit(&mut r, opts, &mut c));
+                    std::hint::black_box(c);
+                }
+                rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6
+            })
+            .collect();
+        counted.sort_by(f64::total_cmp);
+        println!("{layout:?} {what}, counted: median {:.2} MRays/s of {n}", counted[n / 2]);
     }
     let mut c = bvhscope::bvh::RayCounters::default();
     for r in &rays {
         let mut r = *r;
         let mut one = bvhscope::bvh::RayCounters::default();
-        bvh.closest_hit(&mut r, TraceOptions::default(), &mut one);
+        bvh.closest_hit(&mut r, opts, &mut one);
         c.nodes_visited += one.nodes_visited;
         c.box_tests += one.box_tests;
         c.leaves_visited += one.leaves_visited;
@@ -172,12 +191,12 @@ fn main() {
                     };
                     packet.clear();
                     packet.extend((0..PACKET as u32).map(|k| rays[index(k)]));
-                    bvh.closest_hits(&mut packet, &mut out, TraceOptions::default());
+                    bvh.closest_hits(&mut packet, &mut out, opts);
                     hits += out.iter().filter(|h| h.is_some()).count();
                     if round == 0 {
                         for (k, h) in out.iter().enumerate() {
                             let mut r = rays[index(k as u32)];
-                            let want = bvh.closest_hit(&mut r, TraceOptions::default(), &mut NoStats);
+                            let want = bvh.closest_hit(&mut r, opts, &mut NoStats);
                             differ += (want.map(|h| h.t) != h.map(|h| h.t)) as usize;
                         }
                     }
@@ -196,7 +215,7 @@ fn main() {
     for _ in 0..5 {
         for r in &rays {
             let mut r = *r;
-            hits += bvh.closest_hit(&mut r, TraceOptions::default(), &mut NoStats).is_some() as usize;
+            hits += bvh.closest_hit(&mut r, opts, &mut NoStats).is_some() as usize;
         }
     }
     let secs = t.elapsed().as_secs_f64();
