@@ -375,18 +375,21 @@ fn main() {
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Packets));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Packets));
     contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide8, Tracing::Packets));
-    // The fastest preset (8-wide, SAH traversal cost 3), as the app's and CLI's `--preset fastest`.
+    // The fastest preset (8-wide; leaves of up to 16 with AVX-512, else 4), as the app's and CLI's
+    // `--preset fastest` on this CPU.
     let fastest = bvhscope::bvh::Preset::Fastest.build();
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Plain));
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Packets));
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Counting));
     // Where the CPU has AVX-512, the same tree with the AVX2 kernels forced, in the same run, and
-    // trees of larger leaves (one AVX-512 pass tests sixteen triangles; BENCHMARKS.md, "AVX-512").
+    // trees of other leaf sizes: the preset's tree on AVX2 machines (leaves ≤ 4), and ≤ 32
+    // (BENCHMARKS.md, "The fastest preset by kernel family").
     if bvhscope::cpu::Simd::detected() > bvhscope::cpu::Simd::Avx2 {
         let avx2 = Some(bvhscope::cpu::Simd::Avx2);
         contenders.push(contenders::ours_with_kernels("fastest", fastest, Tracing::Plain, avx2));
         contenders.push(contenders::ours_with_kernels("fastest", fastest, Tracing::Packets, avx2));
-        for (leaf, cost) in [(16, 10.0), (32, 12.0)] {
+        let others = [bvhscope::bvh::Preset::fastest_leaves(bvhscope::cpu::Simd::Avx2), (32, 12.0)];
+        for (leaf, cost) in others {
             let cost = bvhscope::bvh::SahCost { traversal: cost, ..fastest.cost };
             let p = bvhscope::bvh::BuildParams { max_leaf_size: leaf, cost, ..fastest };
             let label = format!("fastest, leaves {leaf}");

@@ -180,7 +180,7 @@ fn fastest_traversal_is_one_click_and_stats_agrees() {
     });
     let settings = &h.state().settings;
     assert!(settings.is_preset(bvhscope::bvh::Preset::Fastest));
-    assert_eq!(settings.build.cost.traversal, bvhscope::bvh::Preset::FASTEST_TRAVERSAL_COST);
+    assert_eq!(settings.build.cost.traversal, bvhscope::bvh::Preset::Fastest.build().cost.traversal);
     assert!(!settings.two_level);
     h.get_by_label("Fastest traversal (on)");
     h.get_by_label("SAH binned, wide8");

@@ -8,11 +8,16 @@
 //! size to the student, so the preset states the value it uses.
 //!
 //! `Fastest` is the tree bvhscope traces fastest on a CPU: binned SAH collapsed into 8-wide nodes
-//! (eight boxes per AVX2 pass), leaves of up to four triangles tested in one SIMD pass, so the SAH
-//! is told that a traversal step costs three triangle tests (`FASTEST_TRAVERSAL_COST`): leaves
-//! grow towards four triangles and the tree has fewer nodes. BENCHMARKS.md has the measurements.
+//! (eight boxes per AVX2 pass), its leaves as large as one SIMD pass of the CPU's kernel family
+//! tests (`Preset::fastest_leaves`): up to sixteen triangles where the CPU has AVX-512, four
+//! elsewhere. The SAH is told that a traversal step costs as much as that many triangle tests
+//! would (10 or 3), so leaves grow towards that size and the tree has fewer nodes. On AVX-512 the
+//! sixteen-triangle leaves were as fast or faster on every mesh of `versus` (primary single rays
+//! 0.98–1.14×, incoherent 1.02–1.15×, at 46–49 bytes per triangle instead of 60–68: BENCHMARKS.md,
+//! "The fastest preset by kernel family"); with AVX2 only, a leaf of sixteen takes four passes.
 
 use super::{BuildParams, Layout, SahCost, SplitStrategy, TraceOptions, TraversalOrder};
+use crate::cpu::Simd;
 use crate::geometry::TriangleTest;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -24,12 +29,20 @@ pub enum Preset {
 impl Preset {
     /// The handout preset's leaf size: small, as a first BVH's leaves usually are.
     pub const HANDOUT_MAX_LEAF_SIZE: u32 = 4;
-    /// The fastest preset's SAH traversal cost, relative to one triangle test (bunny, 8-wide,
-    /// incoherent rays: 1 → 2.54, 2 → 2.82, 3 → 2.91, 4 → 2.82 MRays/s on one thread).
-    pub const FASTEST_TRAVERSAL_COST: f32 = 3.0;
+    /// The fastest preset's largest leaf and SAH traversal cost (relative to one triangle test)
+    /// for a kernel family: sixteen triangles, one AVX-512 pass (cost 10: BENCH_KERNEL_LEAVES's
+    /// best of 8, 10 and 12), or four, one pass of four lanes (cost 3: bunny, 8-wide, incoherent
+    /// rays, 1 → 2.54, 2 → 2.82, 3 → 2.91, 4 → 2.82 MRays/s on one thread).
+    pub fn fastest_leaves(simd: Simd) -> (u32, f32) {
+        match simd {
+            Simd::Avx512 => (16, 10.0),
+            Simd::Scalar | Simd::Simd4 | Simd::Avx2 => (4, 3.0),
+        }
+    }
 
     /// The build parameters the preset sets (the bins stay at their defaults; the SAH constants
-    /// too but for the fastest preset's traversal cost).
+    /// too but for the fastest preset's traversal cost). The fastest preset's depend on the kernel
+    /// family this process traces with (`Simd::chosen`), so one machine always builds one tree.
     pub fn build(self) -> BuildParams {
         match self {
             Preset::Handout => BuildParams {
@@ -38,13 +51,16 @@ impl Preset {
                 max_leaf_size: Self::HANDOUT_MAX_LEAF_SIZE,
                 ..BuildParams::default()
             },
-            Preset::Fastest => BuildParams {
-                strategy: SplitStrategy::SahBinned,
-                layout: Layout::Wide8,
-                max_leaf_size: 4,
-                cost: SahCost { traversal: Self::FASTEST_TRAVERSAL_COST, ..SahCost::default() },
-                ..BuildParams::default()
-            },
+            Preset::Fastest => {
+                let (max_leaf_size, traversal) = Self::fastest_leaves(Simd::chosen());
+                BuildParams {
+                    strategy: SplitStrategy::SahBinned,
+                    layout: Layout::Wide8,
+                    max_leaf_size,
+                    cost: SahCost { traversal, ..SahCost::default() },
+                    ..BuildParams::default()
+                }
+            }
         }
     }
 
