@@ -1,7 +1,7 @@
 //! The GPU path shared by the command line and the app: which device traces, the node format it
 //! walks, the trees built on the GPU (lbvh and ploc, core's trees node for node, with their phases
 //! timed) and a tree uploaded for tracing. The command line's flags (their names too) and messages
-//! over it are in `cli::device`, the app's jobs in `app::gpu`.
+//! over it are in `cli::device`, the app's GPU jobs in `app::jobs::gpu` and its choice in `app::state::gpu`.
 
 use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, RayCounters, SceneBvh, SplitStrategy, TraceOptions};
 use crate::mesh::Mesh;

@@ -11,7 +11,7 @@ use clap::{Args, ValueEnum};
 use std::fmt::Write;
 use std::path::PathBuf;
 
-/// How `stats` prints (`--format`); the app's stats files are `app::export::StatsFormat`.
+/// How `stats` prints (`--format`); the app's stats files are `app::StatsFormat`.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum StatsOutput {
     Text,

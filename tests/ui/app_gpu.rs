@@ -5,7 +5,7 @@
 //! under `CI=true`.
 
 use super::support::*;
-use bvhscope::app::gpu::Probe;
+use bvhscope::app::Probe;
 use bvhscope::app::{Action, BvhscopeApp};
 use bvhscope::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
 use bvhscope::cli::Device;

@@ -91,7 +91,7 @@ fn look_grade_report() {
 #[test]
 #[ignore]
 fn look_gpu_frame() {
-    use bvhscope::app::gpu::Probe;
+    use bvhscope::app::Probe;
     let mut h = looking();
     run_until(&mut h, "the first frame", idle);
     run_until(&mut h, "the look for a GPU", |a| !matches!(a.jobs.gpu.probe, Probe::Looking));

@@ -151,7 +151,7 @@ fn compare_exports_are_what_the_screen_shows_byte_for_byte_the_clis() {
 /// the room back.
 #[test]
 fn every_view_is_a_tile_beside_the_image_never_over_it() {
-    use bvhscope::app::dock::Pane;
+    use bvhscope::app::Pane;
     let mut h = midpoint_against_sah();
     let act = |h: &mut egui_kittest::Harness<'_, BvhscopeApp>, a: Action| h.state_mut().act(a);
     act(&mut h, Action::ShowTree(true));

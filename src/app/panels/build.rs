@@ -1,7 +1,7 @@
 //! The build panel: strategy and its parameters, traversal order and triangle test. Any change
 //! rebuilds (or re-renders) in the background.
 
-use crate::app::{Action, Actions, BvhscopeApp};
+use crate::app::state::{Action, Actions, BvhscopeApp};
 use crate::bvh::{BuildParams, Param, ParamLimits, ParamValue, Preset, SplitStrategy};
 use crate::options::{Choice, ParamOption, BUILD_PARAMS, TOP_MAX_LEAF_SIZE};
 

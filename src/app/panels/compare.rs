@@ -2,7 +2,7 @@
 //! and the figures of A, B and B − A: the trees' and the frame's per-ray work, as the statistics
 //! panel gives them for A.
 
-use crate::app::{Action, Actions, BvhscopeApp};
+use crate::app::state::{Action, Actions, BvhscopeApp};
 use crate::bvh::{Layout, SplitStrategy, TraversalOrder};
 use crate::options::Choice;
 use crate::render::PairView;

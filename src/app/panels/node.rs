@@ -3,7 +3,8 @@
 //! splitting its triangles at every candidate plane (the exact sweep as a line, the binned SAH's
 //! bins as steps), with where each strategy puts its plane and the cost of a leaf.
 
-use crate::app::{Action, Actions, BvhscopeApp, NodeStep};
+use crate::app::state::{Action, Actions, BvhscopeApp};
+use crate::app::views::NodeStep;
 use crate::bvh::SplitStrategy;
 use crate::explain::inspect::{CurvePoint, Inspection};
 use egui::Color32;

@@ -51,7 +51,7 @@ pub struct Settings {
     /// What the image is rendered at: the viewport's size, or a scene file's film (its camera's
     /// size and aspect, letterboxed in the viewport), so the figures are the scene's frame's.
     pub film: Film,
-    /// Where frames are traced (and lbvh, ploc built): the CPU or the GPU (`app::gpu`).
+    /// Where frames are traced (and lbvh, ploc built): the CPU or the GPU (`app::state::gpu`).
     pub device: Device,
     /// The node format the GPU walks.
     pub gpu_nodes: GpuNodes,
