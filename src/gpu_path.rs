@@ -3,7 +3,7 @@
 //! timed) and a tree uploaded for tracing. The command line's flags (their names too) and messages
 //! over it are in `cli::device`, the app's GPU jobs in `app::jobs::gpu` and its choice in `app::state::gpu`.
 
-use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, RayCounters, SceneBvh, SplitStrategy, TraceOptions};
+use crate::bvh::{AnyBvh, BuildParams, Bvh, RayCounters, SceneBvh, SplitStrategy, TraceOptions};
 use crate::mesh::Mesh;
 use crate::render::Camera;
 use bvhscope_gpu::{Cwbvh, Gpu, GpuBinaryBvh, GpuBuildTimings, GpuCwbvh, GpuError, GpuLbvh, GpuPloc, GpuTrace, Rays};
@@ -81,15 +81,6 @@ impl GpuBuild {
     }
 }
 
-/// Lay a built binary tree out as `layout` asks (as `AnyBvh::build` does after its build).
-fn lay_out(bvh: Bvh, layout: Layout) -> AnyBvh {
-    match layout {
-        Layout::Binary => AnyBvh::Binary(bvh),
-        Layout::Wide4 => AnyBvh::Wide(crate::bvh::WideBvh::from_binary(bvh)),
-        Layout::Wide8 => AnyBvh::Wide8(crate::bvh::WideBvh::collapse(bvh)),
-    }
-}
-
 /// Whether the GPU builds `strategy` (lbvh and ploc; the others are built on the CPU).
 pub fn builds_on_gpu(strategy: SplitStrategy) -> bool {
     matches!(strategy, SplitStrategy::Lbvh | SplitStrategy::Ploc)
@@ -103,12 +94,7 @@ pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Opti
         SplitStrategy::Ploc => GpuPloc::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
         _ => Ok(None),
     }?;
-    Ok(built.map(|(mut bvh, timings)| {
-        if params.reinsert_passes > 0 {
-            bvh.report.reinsertion = Some(crate::bvh::reinsert::optimise(&mut bvh, params.reinsert_passes));
-        }
-        (lay_out(bvh, params.layout), GpuBuild { strategy, timings })
-    }))
+    Ok(built.map(|(bvh, timings)| (AnyBvh::finish(bvh), GpuBuild { strategy, timings })))
 }
 
 /// A tree on the GPU in the node format asked for, with its CPU form: the CPU walks of the same
