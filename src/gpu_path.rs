@@ -3,9 +3,10 @@
 //! timed) and a tree uploaded for tracing. The command line's flags (their names too) and messages
 //! over it are in `cli::device`, the app's GPU jobs in `app::jobs::gpu` and its choice in `app::state::gpu`.
 
-use crate::bvh::{AnyBvh, BuildParams, Bvh, RayCounters, SceneBvh, SplitStrategy, TraceOptions};
+use crate::bvh::{AnyBvh, BuildParams, Bvh, RayCounters, SceneBuild, SceneBvh, SplitStrategy, TraceOptions};
 use crate::mesh::Mesh;
 use crate::render::Camera;
+use crate::scene::{Scene, SceneError};
 use bvhscope_gpu::{Cwbvh, Gpu, GpuBinaryBvh, GpuBuildTimings, GpuCwbvh, GpuError, GpuLbvh, GpuPloc, GpuTrace, Rays};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -81,12 +82,39 @@ impl GpuBuild {
     }
 }
 
-/// Whether the GPU builds `strategy` (lbvh and ploc; the others are built on the CPU).
-pub fn builds_on_gpu(strategy: SplitStrategy) -> bool {
-    matches!(strategy, SplitStrategy::Lbvh | SplitStrategy::Ploc)
+/// Whether the GPU builds `build`: lbvh or ploc over one level. Everything else is built on the
+/// CPU; the command line and the app both ask here.
+pub fn builds_on_gpu(build: &SceneBuild) -> bool {
+    build.top.is_none() && matches!(build.bvh.strategy, SplitStrategy::Lbvh | SplitStrategy::Ploc)
 }
 
-/// `gpu_build` without a spinner (the app's build job).
+/// Why a build on the GPU gave no tree: the scene's triangles could not be gathered, or the GPU
+/// failed.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuBuildError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+}
+
+/// `build` over `scene`'s triangles on `gpu` when the GPU builds it (`builds_on_gpu`), finished
+/// as a build on the CPU is; `None`: the CPU builds this one.
+pub fn build_scene_on_gpu(
+    gpu: &Gpu,
+    scene: &Scene,
+    build: &SceneBuild,
+) -> Result<Option<(SceneBvh, GpuBuild)>, GpuBuildError> {
+    if !builds_on_gpu(build) {
+        return Ok(None);
+    }
+    let mesh = scene.flat_mesh()?;
+    let built = build_on_gpu(gpu, &mesh, &build.bvh)?;
+    Ok(built.map(|(bvh, phases)| (SceneBvh::Single { bvh, mesh, imported: None }, phases)))
+}
+
+/// lbvh or ploc over `mesh` on `gpu`, finished as a build on the CPU is (`AnyBvh::finish`);
+/// `None` for the strategies only the CPU builds.
 pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<(AnyBvh, GpuBuild)>, GpuError> {
     let strategy = params.strategy;
     let built = match strategy {

@@ -9,7 +9,9 @@
 use super::args::{BuildArgs, DeviceArgs};
 use super::{progress, CliError};
 use crate::bvh::{AnyBvh, BuildParams, Layout, SceneBuild, SceneBvh, TraceOptions};
-pub use crate::gpu_path::{build_on_gpu, builds_on_gpu, GpuBuild, GpuNodes, GpuTree};
+pub use crate::gpu_path::{
+    build_on_gpu, build_scene_on_gpu, builds_on_gpu, GpuBuild, GpuBuildError, GpuNodes, GpuTree,
+};
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame};
 use crate::scene::Scene;
@@ -96,17 +98,21 @@ pub fn gpu_build(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<
     progress::with_spinner(&label, || build_on_gpu(gpu, mesh, params)).map_err(gpu_error)
 }
 
-/// Build what `build` asks for: lbvh and ploc of one level on the GPU when there is one, anything
-/// else on the CPU (`cli::build_scene`).
+/// Build what `build` asks for: on the GPU when there is one and it builds this
+/// (`gpu_path::builds_on_gpu`), else on the CPU (`cli::build_scene`).
 pub fn build_scene(
     gpu: Option<&Gpu>,
     scene: &Scene,
     build: &SceneBuild,
 ) -> Result<(SceneBvh, Option<GpuBuild>), CliError> {
-    if let (Some(gpu), None) = (gpu, build.top) {
-        let mesh = scene.flat_mesh()?;
-        if let Some((bvh, phases)) = gpu_build(gpu, &mesh, &build.bvh)? {
-            return Ok((SceneBvh::Single { bvh, mesh, imported: None }, Some(phases)));
+    if let Some(gpu) = gpu.filter(|_| builds_on_gpu(build)) {
+        let label = format!("building the BVH ({} on the GPU)", build.bvh.strategy.label());
+        let built = progress::with_spinner(&label, || build_scene_on_gpu(gpu, scene, build)).map_err(|e| match e {
+            GpuBuildError::Scene(e) => e.into(),
+            GpuBuildError::Gpu(e) => gpu_error(e),
+        })?;
+        if let Some((bvh, phases)) = built {
+            return Ok((bvh, Some(phases)));
         }
     }
     Ok((super::build_scene(scene, build)?, None))

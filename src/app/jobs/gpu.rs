@@ -5,7 +5,7 @@
 //! `state::gpu`; its answers (`JobEvent::GpuProbed`, `GpuFailed`) are handled in `update`.
 use super::messages::{GpuRender, JobEvent, PassOutput, RenderRequest};
 use crate::bvh::{SceneBuild, SceneBvh};
-use crate::gpu_path::{build_on_gpu, GpuBuild, GpuNodes, GpuTree};
+use crate::gpu_path::{build_scene_on_gpu, GpuBuild, GpuBuildError, GpuNodes, GpuTree};
 use crate::mesh::Mesh;
 use crate::render::{view_image, Frame, PassInfo};
 use crate::scene::{Scene, SceneBuildError};
@@ -123,23 +123,20 @@ impl GpuJobs {
         control: &WorkControl,
         gpu: Option<&Gpu>,
     ) -> Result<Result<Arc<SceneBvh>, SceneBuildError>, String> {
-        let Some(gpu) = gpu.filter(|_| params.top.is_none()) else {
+        let Some(gpu) = gpu else {
             return Ok(scene.build(params, control).map(Arc::new));
         };
-        let mesh = match scene.flat_mesh() {
-            Ok(m) => m,
-            Err(e) => return Ok(Err(SceneBuildError::Scene(e))),
-        };
-        match build_on_gpu(gpu, &mesh, &params.bvh) {
+        match build_scene_on_gpu(gpu, scene, params) {
             Ok(Some((bvh, phases))) => {
-                let bvh = Arc::new(SceneBvh::Single { bvh, mesh, imported: None });
+                let bvh = Arc::new(bvh);
                 let mut built = self.built.lock().unwrap_or_else(|p| p.into_inner());
                 built.retain(|(b, _)| b.strong_count() > 0);
                 built.push((Arc::downgrade(&bvh), phases));
                 Ok(Ok(bvh))
             }
             Ok(None) => Ok(scene.build(params, control).map(Arc::new)),
-            Err(e) => Err(format!("The GPU build failed: {e}")),
+            Err(GpuBuildError::Scene(e)) => Ok(Err(SceneBuildError::Scene(e))),
+            Err(GpuBuildError::Gpu(e)) => Err(format!("The GPU build failed: {e}")),
         }
     }
 }

@@ -52,7 +52,7 @@ impl BvhscopeApp {
     /// The GPU that builds `build`: when frames are traced on it and it builds the strategy.
     pub fn gpu_for_building(&self, build: &SceneBuild) -> Option<Arc<Gpu>> {
         let g = self.gpu_for_frames()?;
-        (build.top.is_none() && builds_on_gpu(build.bvh.strategy)).then_some(g.gpu)
+        builds_on_gpu(build).then_some(g.gpu)
     }
 
     /// Whether the BVH was built where `build` should be now (on the GPU or not).
