@@ -20,24 +20,83 @@ pub enum Device {
     Gpu,
 }
 
-/// The node format the GPU walks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
+/// The node format the GPU walks (its names and help: its row of `GPU_NODES`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GpuNodes {
-    /// The binary tree as built: core's 32-byte nodes, byte for byte.
     #[default]
     Binary,
-    /// Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree.
     Cwbvh,
 }
 
+/// One node format's names: the value a flag and the saved settings take, the label messages,
+/// tables and the app show, the help the flag and the app's button give.
+pub struct GpuNodesRow {
+    pub nodes: GpuNodes,
+    pub value: &'static str,
+    pub label: &'static str,
+    pub help: &'static str,
+}
+
+/// Every node format the GPU walks, one row each: the command line, the app and `compare` read
+/// them here.
+pub const GPU_NODES: [GpuNodesRow; 2] = [
+    GpuNodesRow {
+        nodes: GpuNodes::Binary,
+        value: "binary",
+        label: "binary",
+        help: "The binary tree as built: core's 32-byte nodes, byte for byte",
+    },
+    GpuNodesRow {
+        nodes: GpuNodes::Cwbvh,
+        value: "cwbvh",
+        label: "CWBVH",
+        help: "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree; \
+               its counts are those of its own walk",
+    },
+];
+
 impl GpuNodes {
+    /// Every format, in the table's order.
+    pub const ALL: [GpuNodes; GPU_NODES.len()] = {
+        let mut all = [GpuNodes::Binary; GPU_NODES.len()];
+        let mut i = 0;
+        while i < all.len() {
+            all[i] = GPU_NODES[i].nodes;
+            i += 1;
+        }
+        all
+    };
+
+    /// This format's row of `GPU_NODES`.
+    pub fn row(self) -> &'static GpuNodesRow {
+        GPU_NODES.iter().find(|r| r.nodes == self).expect("every node format has a row (a test checks)")
+    }
+
     /// How messages and tables name the format.
     pub fn name(self) -> &'static str {
-        match self {
-            GpuNodes::Binary => "binary",
-            GpuNodes::Cwbvh => "CWBVH",
-        }
+        self.row().label
+    }
+
+    /// The format a flag's or the settings' value names.
+    pub fn from_value(value: &str) -> Option<GpuNodes> {
+        GPU_NODES.iter().find(|r| r.value == value).map(|r| r.nodes)
+    }
+}
+
+/// Saved by its row's value.
+impl serde::Serialize for GpuNodes {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.row().value)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for GpuNodes {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let value = String::deserialize(d)?;
+        GpuNodes::from_value(&value).ok_or_else(|| {
+            let values: Vec<&str> = GPU_NODES.iter().map(|r| r.value).collect();
+            serde::de::Error::custom(format!("unknown GPU node format \"{value}\" (expected {})", values.join(", ")))
+        })
     }
 }
 
@@ -214,5 +273,22 @@ impl GpuTree {
                     .collect()
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every node format has one row, and its value reads back as it.
+    #[test]
+    fn every_gpu_node_format_has_one_row_and_reads_back() {
+        for nodes in [GpuNodes::Binary, GpuNodes::Cwbvh] {
+            assert_eq!(GPU_NODES.iter().filter(|r| r.nodes == nodes).count(), 1, "{nodes:?}");
+            let saved = serde_json::to_string(&nodes).unwrap();
+            assert_eq!(serde_json::from_str::<GpuNodes>(&saved).unwrap(), nodes);
+        }
+        assert_eq!(serde_json::to_string(&GpuNodes::Cwbvh).unwrap(), "\"cwbvh\"");
+        assert!(serde_json::from_str::<GpuNodes>("\"wide\"").is_err());
     }
 }

@@ -165,16 +165,10 @@ impl clap::ValueEnum for crate::gpu_path::Device {
 
 impl clap::ValueEnum for GpuNodes {
     fn value_variants<'a>() -> &'a [Self] {
-        &[GpuNodes::Binary, GpuNodes::Cwbvh]
+        &GpuNodes::ALL
     }
     fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        let (name, help) = match self {
-            GpuNodes::Binary => ("binary", "The binary tree as built: core's 32-byte nodes, byte for byte"),
-            GpuNodes::Cwbvh => (
-                "cwbvh",
-                "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree",
-            ),
-        };
-        Some(clap::builder::PossibleValue::new(name).help(help))
+        let row = self.row();
+        Some(clap::builder::PossibleValue::new(row.value).help(row.help))
     }
 }

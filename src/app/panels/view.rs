@@ -3,7 +3,7 @@
 
 use crate::app::jobs::Probe;
 use crate::app::state::{Action, Actions, BoxLevel, BvhscopeApp, Film, Settings};
-use crate::gpu_path::{Device, GpuNodes};
+use crate::gpu_path::{Device, GPU_NODES};
 use crate::render::secondary::MAX_SAMPLES;
 use crate::render::warp::WarpSize;
 use crate::render::{RayKind, UpAxis, View};
@@ -268,11 +268,9 @@ fn gpu_choices(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
     }
     ui.horizontal(|ui| {
         ui.label("GPU nodes");
-        ui.radio_value(&mut s.gpu_nodes, GpuNodes::Binary, "binary")
-            .on_hover_text("The binary tree as built: core's 32-byte nodes, byte for byte");
-        ui.radio_value(&mut s.gpu_nodes, GpuNodes::Cwbvh, "CWBVH").on_hover_text(
-            "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree; its counts are those of its own walk",
-        );
+        for row in &GPU_NODES {
+            ui.radio_value(&mut s.gpu_nodes, row.nodes, row.label).on_hover_text(row.help);
+        }
     });
     if let Some(why) = app.gpu_blocked() {
         ui.label(format!("Traced on the CPU: {why}"));
