@@ -4,6 +4,14 @@
 
 use crate::device::{Gpu, GpuError};
 
+/// The WGSL every module that reads triangles starts with (`shaders/prelude.wgsl`: `Tri`).
+const PRELUDE: &str = include_str!("shaders/prelude.wgsl");
+
+/// A module's source: the prelude, then `parts` in order.
+pub(crate) fn module(parts: &[&str]) -> String {
+    std::iter::once(PRELUDE).chain(parts.iter().copied()).collect::<Vec<_>>().join("\n")
+}
+
 /// How a kernel sees one binding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Bind {

@@ -201,15 +201,14 @@ impl Kernels {
             Stack::Private(n) => include_str!("shaders/stack_private.wgsl").replace("{STACK_SIZE}", &n.to_string()),
             Stack::Global(_) => include_str!("shaders/stack_global.wgsl").to_string(),
         };
-        [
+        crate::kernel::module(&[
             include_str!("shaders/common.wgsl"),
             include_str!("shaders/triangle.wgsl"),
             edge,
             &stack_src,
             self.walk_source,
             include_str!("shaders/entry.wgsl"),
-        ]
-        .join("\n")
+        ])
     }
 
     fn get(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Arc<Kernel>, GpuError> {
