@@ -141,10 +141,35 @@ impl GpuBuild {
     }
 }
 
-/// Whether the GPU builds `build`: lbvh or ploc over one level. Everything else is built on the
-/// CPU; the command line and the app both ask here.
+/// How a builder on the GPU builds: core's tree, node for node, with its phases timed.
+type BuildOnGpu = fn(&Gpu, &Mesh, &BuildParams) -> Result<(Bvh, GpuBuildTimings), GpuError>;
+
+/// A builder on the GPU: the strategy it builds and how.
+pub struct GpuBuilderRow {
+    pub strategy: SplitStrategy,
+    build: BuildOnGpu,
+}
+
+/// Every strategy the GPU builds, one row each; the rest are built on the CPU. The help texts
+/// name them from here (`gpu_built`).
+pub const GPU_BUILDERS: [GpuBuilderRow; 2] = [
+    GpuBuilderRow { strategy: SplitStrategy::Lbvh, build: |gpu, mesh, p| GpuLbvh::new(gpu)?.build(gpu, mesh, p) },
+    GpuBuilderRow { strategy: SplitStrategy::Ploc, build: |gpu, mesh, p| GpuPloc::new(gpu)?.build(gpu, mesh, p) },
+];
+
+/// The strategies the GPU builds, in words: "lbvh and ploc".
+pub fn gpu_built() -> String {
+    let names: Vec<&str> = GPU_BUILDERS.iter().map(|r| r.strategy.name()).collect();
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => names.concat(),
+    }
+}
+
+/// Whether the GPU builds `build`: a strategy of `GPU_BUILDERS`, over one level. Everything else
+/// is built on the CPU; the command line and the app both ask here.
 pub fn builds_on_gpu(build: &SceneBuild) -> bool {
-    build.top.is_none() && matches!(build.bvh.strategy, SplitStrategy::Lbvh | SplitStrategy::Ploc)
+    build.top.is_none() && GPU_BUILDERS.iter().any(|r| r.strategy == build.bvh.strategy)
 }
 
 /// Why a build on the GPU gave no tree: the scene's triangles could not be gathered, or the GPU
@@ -172,16 +197,13 @@ pub fn build_scene_on_gpu(
     Ok(built.map(|(bvh, phases)| (SceneBvh::Single { bvh, mesh, imported: None }, phases)))
 }
 
-/// lbvh or ploc over `mesh` on `gpu`, finished as a build on the CPU is (`AnyBvh::finish`);
-/// `None` for the strategies only the CPU builds.
+/// `params.strategy` over `mesh` on `gpu` by its row of `GPU_BUILDERS`, finished as a build on
+/// the CPU is (`AnyBvh::finish`); `None` for the strategies only the CPU builds.
 pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<(AnyBvh, GpuBuild)>, GpuError> {
     let strategy = params.strategy;
-    let built = match strategy {
-        SplitStrategy::Lbvh => GpuLbvh::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
-        SplitStrategy::Ploc => GpuPloc::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
-        _ => Ok(None),
-    }?;
-    Ok(built.map(|(bvh, timings)| (AnyBvh::finish(bvh), GpuBuild { strategy, timings })))
+    let Some(row) = GPU_BUILDERS.iter().find(|r| r.strategy == strategy) else { return Ok(None) };
+    let (bvh, timings) = (row.build)(gpu, mesh, params)?;
+    Ok(Some((AnyBvh::finish(bvh), GpuBuild { strategy, timings })))
 }
 
 /// A tree on the GPU in the node format asked for, with its CPU form: the CPU walks of the same

@@ -142,16 +142,24 @@ impl BuildArgs {
 /// `trace` take (the GPU path's rules are in `cli::device`).
 #[derive(Args, Debug, Clone, Default)]
 pub struct DeviceArgs {
-    /// Trace the rays on the CPU or on the GPU (wgpu compute shaders: Vulkan, Metal, DX12; Mesa's
-    /// lavapipe too). On the GPU the per-pixel counts are the CPU's for the binary layout, the
-    /// strategies lbvh and ploc are built there too, and only the watertight test and one level
-    /// run; with no GPU adapter the command fails (it never falls back to the CPU).
-    #[arg(long, value_enum, default_value = "cpu")]
+    /// Trace the rays on the CPU or on the GPU (its help: `device_help`).
+    #[arg(long, value_enum, default_value = "cpu", help = device_help())]
     pub device: Device,
     /// With --device gpu: the node format walked, the binary tree as built or its compressed
     /// 8-wide form (CWBVH) [default: binary].
     #[arg(long, value_enum, value_name = "FORMAT")]
     pub gpu_nodes: Option<GpuNodes>,
+}
+
+/// `--device`'s help, naming the strategies the GPU builds from its table.
+fn device_help() -> String {
+    format!(
+        "Trace the rays on the CPU or on the GPU (wgpu compute shaders: Vulkan, Metal, DX12; Mesa's lavapipe \
+         too). On the GPU the per-pixel counts are the CPU's for the binary layout, the strategies {} are built \
+         there too, and only the watertight test and one level run; with no GPU adapter the command fails (it \
+         never falls back to the CPU).",
+        crate::gpu_path::gpu_built()
+    )
 }
 
 impl DeviceArgs {

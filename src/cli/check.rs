@@ -205,8 +205,8 @@ pub struct ExportArgs {
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
-    /// With --device gpu the strategies lbvh and ploc are built on the GPU (the same tree as the
-    /// CPU's, node for node); the others are built on the CPU either way.
+    /// With --device gpu the strategies the GPU builds (`gpu_path::GPU_BUILDERS`) are built there
+    /// (the same tree as the CPU's, node for node); the others on the CPU either way.
     #[command(flatten)]
     pub device: super::args::DeviceArgs,
     /// The file to write: .json (JSON), .json.gz (gzip-compressed JSON) or .txt (the text form).
@@ -234,7 +234,8 @@ pub fn export(a: &ExportArgs) -> Result<(), CliError> {
         None => None,
     };
     if gpu.is_some() && built.is_none() {
-        eprintln!("note: the GPU builds lbvh and ploc; {} is built on the CPU", params.strategy.name());
+        let on_gpu = crate::gpu_path::gpu_built();
+        eprintln!("note: the GPU builds {on_gpu}; {} is built on the CPU", params.strategy.name());
     }
     let bvh = built.unwrap_or_else(|| AnyBvh::build(&mesh, &params));
     let dump = BvhDump::of_any(&bvh, &mesh, Some(name));

@@ -412,7 +412,8 @@ fn gpu_lines(app: &BvhscopeApp, ui: &mut egui::Ui) {
             }
         }
         if let Some(b) = built {
-            ui.label("GPU build").on_hover_text("lbvh and ploc built on the GPU: the phases, as bvhscope stats --device gpu prints them (PLOC: emission is its clustering, boxes the host's layout)");
+            let on_gpu = crate::gpu_path::gpu_built();
+            ui.label("GPU build").on_hover_text(format!("{on_gpu} built on the GPU: the phases, as bvhscope stats --device gpu prints them (PLOC: emission is its clustering, boxes the host's layout)"));
             ui.add(egui::Label::new(b.text()).wrap());
             ui.end_row();
         }

@@ -242,7 +242,7 @@ fn ray_numbers(ui: &mut egui::Ui, r: &mut crate::render::SecondarySpec) {
 fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
     let probe = &app.jobs.gpu.probe;
     ui.label("Trace on").on_hover_text(
-        "Where the frames are traced: the CPU, or the GPU (wgpu compute shaders) at full resolution in one pass, with the same per-pixel counts as the CPU's binary layout (bvhscope render --device gpu). With the GPU, the tree is built in the binary layout and lbvh and ploc are built on the GPU too.",
+        format!("Where the frames are traced: the CPU, or the GPU (wgpu compute shaders) at full resolution in one pass, with the same per-pixel counts as the CPU's binary layout (bvhscope render --device gpu). With the GPU, the tree is built in the binary layout and {} are built on the GPU too.", crate::gpu_path::gpu_built()),
     );
     ui.radio_value(&mut s.device, Device::Cpu, "CPU");
     let why = match probe {
