@@ -48,10 +48,6 @@ pub struct SceneDesc {
 
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    #[error("{}: no such file", .path.display())]
-    NotFound { path: PathBuf },
-    #[error("{}: cannot read: {source}", .path.display())]
-    Io { path: PathBuf, source: std::io::Error },
     #[error("{}: line {line}: not valid JSON: {message}", .path.display())]
     Json { path: PathBuf, line: usize, message: String },
     #[error("{}: {field}: {message}", .path.display())]
@@ -111,11 +107,7 @@ fn read_json(path: &Path) -> Result<serde_json::Value, SceneError> {
             });
         }
     }
-    let bytes = crate::mesh::read_user_file(path).map_err(|e| match e {
-        MeshError::NotFound { path } => SceneError::NotFound { path },
-        MeshError::Io { path, source } => SceneError::Io { path, source },
-        other => SceneError::Mesh(other),
-    })?;
+    let bytes = crate::mesh::read_user_file(path)?;
     let text = crate::mesh::decode_text(path, &bytes)?;
     // Every placement names its file: counted in the text, before a JSON value is made of it.
     check_placements(path, text.matches("\"file\"").count())?;
