@@ -14,6 +14,7 @@ mod node;
 pub mod packet;
 pub mod params;
 mod preset;
+pub mod reach;
 mod scene_bvh;
 mod stack;
 mod stats;
