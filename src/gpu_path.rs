@@ -3,7 +3,7 @@
 //! timed) and a tree uploaded for tracing. The command line's flags (their names too) and messages
 //! over it are in `cli::device`, the app's GPU jobs in `app::jobs::gpu` and its choice in `app::state::gpu`.
 
-use crate::bvh::{AnyBvh, BuildParams, Bvh, RayCounters, SceneBuild, SceneBvh, SplitStrategy, TraceOptions};
+use crate::bvh::{AnyBvh, BuildParams, Bvh, RayCounters, SceneBuild, SceneBvh, Strategy, TraceOptions};
 use crate::mesh::Mesh;
 use crate::render::Camera;
 use crate::scene::{Scene, SceneError};
@@ -103,7 +103,7 @@ impl<'de> serde::Deserialize<'de> for GpuNodes {
 /// A build made on the GPU: which builder, and how long each phase took.
 #[derive(Clone, Copy, Debug)]
 pub struct GpuBuild {
-    pub strategy: SplitStrategy,
+    pub strategy: Strategy,
     pub timings: GpuBuildTimings,
 }
 
@@ -114,9 +114,7 @@ impl GpuBuild {
         let t = &self.timings;
         let ms = |d: std::time::Duration| format!("{:.2}", d.as_secs_f64() * 1e3);
         let (emission, boxes) = match self.strategy {
-            SplitStrategy::Ploc => {
-                (format!("clustering {} ({} rounds)", ms(t.emission), t.rounds), "layout on the host")
-            }
+            Strategy::Ploc => (format!("clustering {} ({} rounds)", ms(t.emission), t.rounds), "layout on the host"),
             _ => (format!("emission {}", ms(t.emission)), "boxes"),
         };
         format!(
@@ -146,15 +144,15 @@ type BuildOnGpu = fn(&Gpu, &Mesh, &BuildParams) -> Result<(Bvh, GpuBuildTimings)
 
 /// A builder on the GPU: the strategy it builds and how.
 pub struct GpuBuilderRow {
-    pub strategy: SplitStrategy,
+    pub strategy: Strategy,
     build: BuildOnGpu,
 }
 
 /// Every strategy the GPU builds, one row each; the rest are built on the CPU. The help texts
 /// name them from here (`gpu_built`).
 pub const GPU_BUILDERS: [GpuBuilderRow; 2] = [
-    GpuBuilderRow { strategy: SplitStrategy::Lbvh, build: |gpu, mesh, p| GpuLbvh::new(gpu)?.build(gpu, mesh, p) },
-    GpuBuilderRow { strategy: SplitStrategy::Ploc, build: |gpu, mesh, p| GpuPloc::new(gpu)?.build(gpu, mesh, p) },
+    GpuBuilderRow { strategy: Strategy::Lbvh, build: |gpu, mesh, p| GpuLbvh::new(gpu)?.build(gpu, mesh, p) },
+    GpuBuilderRow { strategy: Strategy::Ploc, build: |gpu, mesh, p| GpuPloc::new(gpu)?.build(gpu, mesh, p) },
 ];
 
 /// The strategies the GPU builds, in words: "lbvh and ploc".

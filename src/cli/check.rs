@@ -5,7 +5,7 @@
 
 use super::args::{BuildArgs, DumpLimit, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{epo, AnyBvh, BuildParams, Layout, SplitStrategy, TreeStats, TreeView};
+use crate::bvh::{epo, AnyBvh, BuildParams, Layout, Strategy, TreeStats, TreeView};
 use crate::dump::BvhDump;
 use crate::explain::check::{check, Finding, Group, Subject, FINDINGS_LISTED, LISTED, MAX_RAYS};
 use crate::render::{render, RenderSettings};
@@ -131,7 +131,7 @@ pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
         table.push(quality(names.label(), t, &mesh, &camera, trace));
         // bvhscope's trees in the imported one's layout.
         let layout = t.params().layout;
-        for s in SplitStrategy::ALL {
+        for s in Strategy::ALL {
             let b = AnyBvh::build(&mesh, &BuildParams { strategy: s, layout, ..BuildParams::default() });
             table.push(quality(format!("{}, {}", s.label(), layout.name()), &b, &mesh, &camera, trace));
         }

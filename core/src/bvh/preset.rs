@@ -12,7 +12,7 @@
 //! is told that a traversal step costs three triangle tests (`FASTEST_TRAVERSAL_COST`): leaves
 //! grow towards four triangles and the tree has fewer nodes. BENCHMARKS.md has the measurements.
 
-use super::{BuildParams, Layout, SahCost, SplitStrategy, TraceOptions, TraversalOrder};
+use super::{BuildParams, Layout, SahCost, Strategy, TraceOptions, TraversalOrder};
 use crate::geometry::TriangleTest;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -33,13 +33,13 @@ impl Preset {
     pub fn build(self) -> BuildParams {
         match self {
             Preset::Handout => BuildParams {
-                strategy: SplitStrategy::Midpoint,
+                strategy: Strategy::Midpoint,
                 layout: Layout::Binary,
                 max_leaf_size: Self::HANDOUT_MAX_LEAF_SIZE,
                 ..BuildParams::default()
             },
             Preset::Fastest => BuildParams {
-                strategy: SplitStrategy::SahBinned,
+                strategy: Strategy::SahBinned,
                 layout: Layout::Wide8,
                 max_leaf_size: 4,
                 cost: SahCost { traversal: Self::FASTEST_TRAVERSAL_COST, ..SahCost::default() },

@@ -130,7 +130,7 @@ pub enum Action {
 
     /// Side by side: show B (another strategy's build) next to A.
     Compare(bool),
-    CompareStrategy(crate::bvh::SplitStrategy),
+    CompareStrategy(crate::bvh::Strategy),
     /// B's leaf size, layout and traversal.
     CompareB {
         max_leaf_size: u32,

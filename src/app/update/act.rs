@@ -6,7 +6,7 @@ use crate::app::jobs::Pick;
 use crate::app::state::dock;
 use crate::app::state::{Action, BvhscopeApp, MessageKind, PathWindow, Settings, PRESENT_SCALE, UI_SCALES};
 use crate::app::views::{PinnedRay, RayView, SecondaryOf};
-use crate::bvh::SplitStrategy;
+use crate::bvh::Strategy;
 use crate::render::{ColorMap, View};
 use crate::scene::Scene;
 use std::sync::Arc;
@@ -139,8 +139,8 @@ impl BvhscopeApp {
             }
             A::NextStrategy => {
                 self.import.on = false;
-                let i = SplitStrategy::ALL.iter().position(|s| *s == self.settings.build.strategy).unwrap_or(0);
-                self.settings.build.strategy = SplitStrategy::ALL[(i + 1) % SplitStrategy::ALL.len()];
+                let i = Strategy::ALL.iter().position(|s| *s == self.settings.build.strategy).unwrap_or(0);
+                self.settings.build.strategy = Strategy::ALL[(i + 1) % Strategy::ALL.len()];
             }
             A::NextColormap => {
                 let i = ColorMap::ALL.iter().position(|c| *c == self.settings.colormap).unwrap_or(0);

@@ -5,7 +5,7 @@
 //! out), the median of `--runs` runs after one untimed run that compiles the kernels.
 
 use super::rows::CompareRow;
-use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SceneBvh, SplitStrategy, TraceOptions, TreeStats, TreeView};
+use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SceneBvh, Strategy, TraceOptions, TreeStats, TreeView};
 use crate::cli::args::BuildArgs;
 use crate::cli::device::{self, GpuTree};
 use crate::cli::{progress, CliError};
@@ -58,7 +58,7 @@ pub fn gpu_rows(
     let pixels = camera.width as usize * camera.height as usize;
     let incoherent = crate::render::incoherent_rays(mesh, pixels, 1);
     let mut rows = Vec::new();
-    for strategy in SplitStrategy::ALL {
+    for strategy in Strategy::ALL {
         let params = build.params_with(scene, strategy, Layout::Binary);
         let (bvh, built_on_gpu) = match device::gpu_build(gpu, mesh, &params)? {
             Some((bvh, _)) => (bvh, true),

@@ -21,7 +21,7 @@
 //! bvhscope's SAH tree in the same layout (0.10: at most 10 % above it).
 
 use super::{GradeError, Quality, RankBy, VersusSah};
-use crate::bvh::SplitStrategy;
+use crate::bvh::Strategy;
 use crate::explain::check::Group;
 use crate::json::Fields;
 use glam::Vec3;
@@ -88,7 +88,7 @@ pub struct Rubric {
     /// The checks whose defects fail a submission (structure always: a tree with structure
     /// defects cannot be traced).
     pub required: Vec<Group>,
-    pub references: Vec<SplitStrategy>,
+    pub references: Vec<Strategy>,
     pub rank_by: RankBy,
     pub good: Good,
 }
@@ -106,7 +106,7 @@ impl Default for Rubric {
             rays: None,
             time_rays: None,
             required: Group::ALL.to_vec(),
-            references: vec![SplitStrategy::SahBinned, SplitStrategy::Midpoint],
+            references: vec![Strategy::SahBinned, Strategy::Midpoint],
             rank_by: RankBy::SahCost,
             good: Good { sah_cost_within: Some(0.10), ..Good::default() },
         }
@@ -188,8 +188,7 @@ impl Rubric {
             }
         }
         if let Some(v) = root.get("references") {
-            r.references =
-                f.list(v, "references", SplitStrategy::from_name, &SplitStrategy::ALL.map(|s| s.name()).join(", "))?;
+            r.references = f.list(v, "references", Strategy::from_name, &Strategy::ALL.map(|s| s.name()).join(", "))?;
         }
         if let Some(v) = root.get("rank_by") {
             let names = RankBy::ALL.map(|r| r.name()).join(", ");
