@@ -98,24 +98,17 @@ pub fn gpu_build(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<
     progress::with_spinner(&label, || build_on_gpu(gpu, mesh, params)).map_err(gpu_error)
 }
 
-/// Build what `build` asks for: on the GPU when there is one and it builds this
-/// (`gpu_path::builds_on_gpu`), else on the CPU (`cli::build_scene`).
-pub fn build_scene(
-    gpu: Option<&Gpu>,
-    scene: &Scene,
-    build: &SceneBuild,
-) -> Result<(SceneBvh, Option<GpuBuild>), CliError> {
-    if let Some(gpu) = gpu.filter(|_| builds_on_gpu(build)) {
-        let label = format!("building the BVH ({} on the GPU)", build.bvh.strategy.label());
-        let built = progress::with_spinner(&label, || build_scene_on_gpu(gpu, scene, build)).map_err(|e| match e {
-            GpuBuildError::Scene(e) => e.into(),
-            GpuBuildError::Gpu(e) => gpu_error(e),
-        })?;
-        if let Some((bvh, phases)) = built {
-            return Ok((bvh, Some(phases)));
-        }
+/// `build` on the GPU with a spinner, when the GPU builds it (`gpu_path::builds_on_gpu`); `None`:
+/// the CPU builds it (`cli::build_scene`).
+pub fn gpu_build_scene(gpu: &Gpu, scene: &Scene, build: &SceneBuild) -> Result<Option<(SceneBvh, GpuBuild)>, CliError> {
+    if !builds_on_gpu(build) {
+        return Ok(None);
     }
-    Ok((super::build_scene(scene, build)?, None))
+    let label = format!("building the BVH ({} on the GPU)", build.bvh.strategy.label());
+    progress::with_spinner(&label, || build_scene_on_gpu(gpu, scene, build)).map_err(|e| match e {
+        GpuBuildError::Scene(e) => e.into(),
+        GpuBuildError::Gpu(e) => gpu_error(e),
+    })
 }
 
 /// The command line's spinners and errors over the GPU path's tree.

@@ -180,7 +180,7 @@ fn run_against(
     let params_a = *params_a;
     let params_b =
         crate::bvh::SceneBuild { bvh: crate::bvh::BuildParams { strategy: against, ..params_a.bvh }, ..params_a };
-    let (bvh_b, _) = device::build_scene(gpu, loaded, &params_b)?;
+    let (bvh_b, _) = super::build_scene(gpu, loaded, &params_b)?;
     let frame_b = frame_of(a, gpu, &bvh_b, camera, settings, "rendering the second build")?;
     let cost = params_a.bvh.cost;
     if let Some(path) = &a.difference {
@@ -235,7 +235,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     let bvh = match &a.bvh {
         Some(path) => a.dump_limit.import(&loaded, path)?,
-        None => device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
+        None => super::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
     };
     let kind = a.rays.one("render")?;
     if gpu.is_some() && kind.is_secondary() {
