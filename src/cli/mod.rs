@@ -5,6 +5,7 @@ mod args;
 pub mod check;
 mod compare;
 pub mod device;
+mod export_bvh;
 mod grade;
 pub mod inspect;
 mod progress;
@@ -102,7 +103,7 @@ pub enum Command {
     /// 1: defects, 2: unreadable).
     Check(check::CheckArgs),
     /// Write a built-in strategy's binary tree in the bvhscope-bvh format.
-    ExportBvh(check::ExportArgs),
+    ExportBvh(export_bvh::ExportBvhArgs),
     /// Grade a class: check every student's BVH dump, measure it next to bvhscope's trees, rank
     /// them, and write a report folder (HTML, CSV, JSON).
     Grade(grade::GradeArgs),
@@ -204,7 +205,7 @@ pub fn run(command: Command) -> Result<(), CliError> {
         Command::Inspect(a) => inspect::run(&a),
         Command::Replay(a) => replay::run(&a),
         Command::Check(a) => check::run(&a),
-        Command::ExportBvh(a) => check::export(&a),
+        Command::ExportBvh(a) => export_bvh::run(&a),
         Command::Grade(a) => grade::run(&a),
         Command::Stats(a) => stats::run(&a),
         Command::Compare(a) => compare::run(&a),
