@@ -235,6 +235,15 @@ impl GpuTree {
         Ok((uploaded, mesh.clone()))
     }
 
+    /// How many nodes of its own the format made from the binary tree (`None`: the binary tree's
+    /// own nodes are walked).
+    pub fn own_nodes(&self) -> Option<usize> {
+        match self {
+            GpuTree::Binary(..) => None,
+            GpuTree::Cwbvh(cw, _) => Some(cw.nodes.len()),
+        }
+    }
+
     pub fn nodes(&self) -> GpuNodes {
         match self {
             GpuTree::Binary(..) => GpuNodes::Binary,

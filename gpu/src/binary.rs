@@ -17,7 +17,7 @@ pub struct GpuBinaryBvh {
     stack: Stack,
 }
 
-pub(crate) const KERNELS: Kernels = Kernels::new("binary", include_str!("shaders/binary.wgsl"));
+pub(crate) const KERNELS: Kernels = Kernels::new("binary", "binary.wgsl");
 
 /// The deepest leaf's depth (edges from the root) of a well-formed binary tree, or why the tree
 /// cannot be walked: a child or triangle range out of bounds, or a node reached twice (a cycle or

@@ -4,12 +4,11 @@
 
 use crate::device::{Gpu, GpuError};
 
-/// The WGSL every module that reads triangles starts with (`shaders/prelude.wgsl`: `Tri`).
-const PRELUDE: &str = include_str!("shaders/prelude.wgsl");
-
-/// A module's source: the prelude, then `parts` in order.
+/// A module's source: the prelude every module starts with (`shaders/prelude.wgsl`: `Tri`), then
+/// `parts` in order.
 pub(crate) fn module(parts: &[&str]) -> String {
-    std::iter::once(PRELUDE).chain(parts.iter().copied()).collect::<Vec<_>>().join("\n")
+    let prelude = crate::shaders::source("prelude.wgsl");
+    std::iter::once(prelude).chain(parts.iter().copied()).collect::<Vec<_>>().join("\n")
 }
 
 /// How a kernel sees one binding.

@@ -125,7 +125,7 @@ pub(crate) fn triangle_floats(mesh: &Mesh) -> Vec<[f32; 9]> {
 
 /// The LBVH's WGSL module: the builders' boxes, then its kernels.
 pub(crate) fn source() -> String {
-    crate::kernel::module(&[include_str!("shaders/boxes.wgsl"), include_str!("shaders/lbvh.wgsl")])
+    crate::kernel::module(&[crate::shaders::source("boxes.wgsl"), crate::shaders::source("lbvh.wgsl")])
 }
 
 /// Decode `lbvh.wgsl`'s `ordered` words.

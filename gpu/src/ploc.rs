@@ -39,7 +39,7 @@ const KERNELS: [(&str, &[u32]); 5] = [
 
 /// The PLOC module: the builders' boxes, then its kernels.
 pub(crate) fn source() -> String {
-    crate::kernel::module(&[include_str!("shaders/boxes.wgsl"), include_str!("shaders/ploc.wgsl")])
+    crate::kernel::module(&[crate::shaders::source("boxes.wgsl"), crate::shaders::source("ploc.wgsl")])
 }
 
 /// The buffers of a PLOC build over `n` triangles (besides the Morton order's).

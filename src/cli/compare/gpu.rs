@@ -72,10 +72,7 @@ pub fn gpu_rows(
         let scene_bvh = SceneBvh::Single { bvh, mesh: mesh.clone(), imported: None };
         for &format in nodes {
             let (tree, _) = GpuTree::upload(gpu, &scene_bvh, format)?;
-            let cw_nodes = match &tree {
-                GpuTree::Cwbvh(cw, _) => Some(cw.nodes.len()),
-                GpuTree::Binary(..) => None,
-            };
+            let cw_nodes = tree.own_nodes();
             let label = format!("timing {} ({} nodes) on the GPU", strategy.label(), format.name());
             let measured = progress::with_spinner(&label, || -> Result<_, CliError> {
                 let mut out = Vec::new();
