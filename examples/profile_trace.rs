@@ -36,7 +36,7 @@ fn main() {
         params.sah_bins = b.parse().expect("BINS is a number");
     }
     if std::env::var("SWEEP").is_ok() {
-        params.strategy = bvhscope::bvh::SplitStrategy::SahSweep;
+        params.strategy = bvhscope::bvh::Strategy::SahSweep;
     }
     if let Ok(l) = std::env::var("LEAF") {
         params.max_leaf_size = l.parse().expect("LEAF is a number");

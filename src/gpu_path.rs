@@ -1,11 +1,12 @@
 //! The GPU path shared by the command line and the app: which device traces, the node format it
 //! walks, the trees built on the GPU (lbvh and ploc, core's trees node for node, with their phases
 //! timed) and a tree uploaded for tracing. The command line's flags (their names too) and messages
-//! over it are in `cli::device`, the app's jobs in `app::gpu`.
+//! over it are in `cli::device`, the app's GPU jobs in `app::jobs::gpu` and its choice in `app::state::gpu`.
 
-use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, RayCounters, SceneBvh, SplitStrategy, TraceOptions};
+use crate::bvh::{AnyBvh, BuildParams, Bvh, RayCounters, SceneBuild, SceneBvh, Strategy, TraceOptions};
 use crate::mesh::Mesh;
 use crate::render::Camera;
+use crate::scene::{Scene, SceneError};
 use bvhscope_gpu::{Cwbvh, Gpu, GpuBinaryBvh, GpuBuildTimings, GpuCwbvh, GpuError, GpuLbvh, GpuPloc, GpuTrace, Rays};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -19,31 +20,90 @@ pub enum Device {
     Gpu,
 }
 
-/// The node format the GPU walks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
+/// The node format the GPU walks (its names and help: its row of `GPU_NODES`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GpuNodes {
-    /// The binary tree as built: core's 32-byte nodes, byte for byte.
     #[default]
     Binary,
-    /// Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree.
     Cwbvh,
 }
 
+/// One node format's names: the value a flag and the saved settings take, the label messages,
+/// tables and the app show, the help the flag and the app's button give.
+pub struct GpuNodesRow {
+    pub nodes: GpuNodes,
+    pub value: &'static str,
+    pub label: &'static str,
+    pub help: &'static str,
+}
+
+/// Every node format the GPU walks, one row each: the command line, the app and `compare` read
+/// them here.
+pub const GPU_NODES: [GpuNodesRow; 2] = [
+    GpuNodesRow {
+        nodes: GpuNodes::Binary,
+        value: "binary",
+        label: "binary",
+        help: "The binary tree as built: core's 32-byte nodes, byte for byte",
+    },
+    GpuNodesRow {
+        nodes: GpuNodes::Cwbvh,
+        value: "cwbvh",
+        label: "CWBVH",
+        help: "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree; \
+               its counts are those of its own walk",
+    },
+];
+
 impl GpuNodes {
+    /// Every format, in the table's order.
+    pub const ALL: [GpuNodes; GPU_NODES.len()] = {
+        let mut all = [GpuNodes::Binary; GPU_NODES.len()];
+        let mut i = 0;
+        while i < all.len() {
+            all[i] = GPU_NODES[i].nodes;
+            i += 1;
+        }
+        all
+    };
+
+    /// This format's row of `GPU_NODES`.
+    pub fn row(self) -> &'static GpuNodesRow {
+        GPU_NODES.iter().find(|r| r.nodes == self).expect("every node format has a row (a test checks)")
+    }
+
     /// How messages and tables name the format.
     pub fn name(self) -> &'static str {
-        match self {
-            GpuNodes::Binary => "binary",
-            GpuNodes::Cwbvh => "CWBVH",
-        }
+        self.row().label
+    }
+
+    /// The format a flag's or the settings' value names.
+    pub fn from_value(value: &str) -> Option<GpuNodes> {
+        GPU_NODES.iter().find(|r| r.value == value).map(|r| r.nodes)
+    }
+}
+
+/// Saved by its row's value.
+impl serde::Serialize for GpuNodes {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.row().value)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for GpuNodes {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let value = String::deserialize(d)?;
+        GpuNodes::from_value(&value).ok_or_else(|| {
+            let values: Vec<&str> = GPU_NODES.iter().map(|r| r.value).collect();
+            serde::de::Error::custom(format!("unknown GPU node format \"{value}\" (expected {})", values.join(", ")))
+        })
     }
 }
 
 /// A build made on the GPU: which builder, and how long each phase took.
 #[derive(Clone, Copy, Debug)]
 pub struct GpuBuild {
-    pub strategy: SplitStrategy,
+    pub strategy: Strategy,
     pub timings: GpuBuildTimings,
 }
 
@@ -54,9 +114,7 @@ impl GpuBuild {
         let t = &self.timings;
         let ms = |d: std::time::Duration| format!("{:.2}", d.as_secs_f64() * 1e3);
         let (emission, boxes) = match self.strategy {
-            SplitStrategy::Ploc => {
-                (format!("clustering {} ({} rounds)", ms(t.emission), t.rounds), "layout on the host")
-            }
+            Strategy::Ploc => (format!("clustering {} ({} rounds)", ms(t.emission), t.rounds), "layout on the host"),
             _ => (format!("emission {}", ms(t.emission)), "boxes"),
         };
         format!(
@@ -81,34 +139,69 @@ impl GpuBuild {
     }
 }
 
-/// Lay a built binary tree out as `layout` asks (as `AnyBvh::build` does after its build).
-fn lay_out(bvh: Bvh, layout: Layout) -> AnyBvh {
-    match layout {
-        Layout::Binary => AnyBvh::Binary(bvh),
-        Layout::Wide4 => AnyBvh::Wide(crate::bvh::WideBvh::from_binary(bvh)),
-        Layout::Wide8 => AnyBvh::Wide8(crate::bvh::WideBvh::collapse(bvh)),
+/// How a builder on the GPU builds: core's tree, node for node, with its phases timed.
+type BuildOnGpu = fn(&Gpu, &Mesh, &BuildParams) -> Result<(Bvh, GpuBuildTimings), GpuError>;
+
+/// A builder on the GPU: the strategy it builds and how.
+pub struct GpuBuilderRow {
+    pub strategy: Strategy,
+    build: BuildOnGpu,
+}
+
+/// Every strategy the GPU builds, one row each; the rest are built on the CPU. The help texts
+/// name them from here (`gpu_built`).
+pub const GPU_BUILDERS: [GpuBuilderRow; 2] = [
+    GpuBuilderRow { strategy: Strategy::Lbvh, build: |gpu, mesh, p| GpuLbvh::new(gpu)?.build(gpu, mesh, p) },
+    GpuBuilderRow { strategy: Strategy::Ploc, build: |gpu, mesh, p| GpuPloc::new(gpu)?.build(gpu, mesh, p) },
+];
+
+/// The strategies the GPU builds, in words: "lbvh and ploc".
+pub fn gpu_built() -> String {
+    let names: Vec<&str> = GPU_BUILDERS.iter().map(|r| r.strategy.name()).collect();
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => names.concat(),
     }
 }
 
-/// Whether the GPU builds `strategy` (lbvh and ploc; the others are built on the CPU).
-pub fn builds_on_gpu(strategy: SplitStrategy) -> bool {
-    matches!(strategy, SplitStrategy::Lbvh | SplitStrategy::Ploc)
+/// Whether the GPU builds `build`: a strategy of `GPU_BUILDERS`, over one level. Everything else
+/// is built on the CPU; the command line and the app both ask here.
+pub fn builds_on_gpu(build: &SceneBuild) -> bool {
+    build.top.is_none() && GPU_BUILDERS.iter().any(|r| r.strategy == build.bvh.strategy)
 }
 
-/// `gpu_build` without a spinner (the app's build job).
+/// Why a build on the GPU gave no tree: the scene's triangles could not be gathered, or the GPU
+/// failed.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuBuildError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+}
+
+/// `build` over `scene`'s triangles on `gpu` when the GPU builds it (`builds_on_gpu`), finished
+/// as a build on the CPU is; `None`: the CPU builds this one.
+pub fn build_scene_on_gpu(
+    gpu: &Gpu,
+    scene: &Scene,
+    build: &SceneBuild,
+) -> Result<Option<(SceneBvh, GpuBuild)>, GpuBuildError> {
+    if !builds_on_gpu(build) {
+        return Ok(None);
+    }
+    let mesh = scene.flat_mesh()?;
+    let built = build_on_gpu(gpu, &mesh, &build.bvh)?;
+    Ok(built.map(|(bvh, phases)| (SceneBvh::Single { bvh, mesh, imported: None }, phases)))
+}
+
+/// `params.strategy` over `mesh` on `gpu` by its row of `GPU_BUILDERS`, finished as a build on
+/// the CPU is (`AnyBvh::finish`); `None` for the strategies only the CPU builds.
 pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<(AnyBvh, GpuBuild)>, GpuError> {
     let strategy = params.strategy;
-    let built = match strategy {
-        SplitStrategy::Lbvh => GpuLbvh::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
-        SplitStrategy::Ploc => GpuPloc::new(gpu).and_then(|b| b.build(gpu, mesh, params)).map(Some),
-        _ => Ok(None),
-    }?;
-    Ok(built.map(|(mut bvh, timings)| {
-        if params.reinsert_passes > 0 {
-            bvh.report.reinsertion = Some(crate::bvh::reinsert::optimise(&mut bvh, params.reinsert_passes));
-        }
-        (lay_out(bvh, params.layout), GpuBuild { strategy, timings })
-    }))
+    let Some(row) = GPU_BUILDERS.iter().find(|r| r.strategy == strategy) else { return Ok(None) };
+    let (bvh, timings) = (row.build)(gpu, mesh, params)?;
+    Ok(Some((AnyBvh::finish(bvh), GpuBuild { strategy, timings })))
 }
 
 /// A tree on the GPU in the node format asked for, with its CPU form: the CPU walks of the same
@@ -140,6 +233,15 @@ impl GpuTree {
             }
         };
         Ok((uploaded, mesh.clone()))
+    }
+
+    /// How many nodes of its own the format made from the binary tree (`None`: the binary tree's
+    /// own nodes are walked).
+    pub fn own_nodes(&self) -> Option<usize> {
+        match self {
+            GpuTree::Binary(..) => None,
+            GpuTree::Cwbvh(cw, _) => Some(cw.nodes.len()),
+        }
     }
 
     pub fn nodes(&self) -> GpuNodes {
@@ -200,5 +302,22 @@ impl GpuTree {
                     .collect()
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every node format has one row, and its value reads back as it.
+    #[test]
+    fn every_gpu_node_format_has_one_row_and_reads_back() {
+        for nodes in [GpuNodes::Binary, GpuNodes::Cwbvh] {
+            assert_eq!(GPU_NODES.iter().filter(|r| r.nodes == nodes).count(), 1, "{nodes:?}");
+            let saved = serde_json::to_string(&nodes).unwrap();
+            assert_eq!(serde_json::from_str::<GpuNodes>(&saved).unwrap(), nodes);
+        }
+        assert_eq!(serde_json::to_string(&GpuNodes::Cwbvh).unwrap(), "\"cwbvh\"");
+        assert!(serde_json::from_str::<GpuNodes>("\"wide\"").is_err());
     }
 }

@@ -1,5 +1,6 @@
 //! Every kind of bad mesh file gives its own error naming the file, never a panic.
 
+use bvhscope::files::FileError;
 use bvhscope::mesh::{load_obj, MeshError};
 use std::path::PathBuf;
 
@@ -22,13 +23,13 @@ fn load_err(path: &PathBuf) -> MeshError {
 #[test]
 fn missing_file() {
     let p = std::env::temp_dir().join("bvhscope-definitely-missing.obj");
-    assert!(matches!(load_err(&p), MeshError::NotFound { .. }));
+    assert!(matches!(load_err(&p), MeshError::File(FileError::NotFound { .. })));
 }
 
 #[test]
 fn directory() {
     let p = std::env::temp_dir();
-    assert!(matches!(load_err(&p), MeshError::IsDirectory { .. }));
+    assert!(matches!(load_err(&p), MeshError::File(FileError::IsDirectory { .. })));
 }
 
 #[test]
@@ -129,7 +130,7 @@ fn latin1_names_and_comments_are_decoded_and_the_geometry_loads() {
 fn a_fifo_or_a_device_is_refused_at_once() {
     for dev in ["/dev/zero", "/dev/urandom", "/dev/null"] {
         let e = load_err(&PathBuf::from(dev));
-        assert!(matches!(e, MeshError::NotRegular { .. }), "{dev}: {e}");
+        assert!(matches!(e, MeshError::File(FileError::NotRegular { .. })), "{dev}: {e}");
         assert!(e.to_string().contains("character device"), "{e}");
     }
     let fifo = std::env::temp_dir().join(format!("bvhscope-fifo-{}.obj", std::process::id()));

@@ -88,7 +88,7 @@ fn stats_and_compare_print_their_tables() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     let rows = v["rows"].as_array().unwrap();
-    let strategies = bvhscope::bvh::SplitStrategy::ALL.len();
+    let strategies = bvhscope::bvh::Strategy::ALL.len();
     let layouts = bvhscope::bvh::Layout::ALL.len();
     assert_eq!(rows.len(), layouts * strategies + 1, "every strategy in every layout, and the linear scan");
     assert_eq!(rows[0]["name"], "Midpoint (binary)");
@@ -117,7 +117,7 @@ fn stats_and_compare_print_their_tables() {
         "wide4",
     ]);
     let csv = String::from_utf8_lossy(&out.stdout);
-    let strategies = bvhscope::bvh::SplitStrategy::ALL.len();
+    let strategies = bvhscope::bvh::Strategy::ALL.len();
     assert_eq!(csv.lines().count(), strategies + 2, "header, every strategy in the chosen layout, linear: {csv}");
     assert!(csv.starts_with("strategy,build_ms"));
 }
@@ -219,7 +219,7 @@ fn compare_times_single_rays_and_writes_csv_a_reader_parses() {
     let mut r = csv::Reader::from_reader(&out.stdout[..]);
     let header = r.headers().unwrap().clone();
     let records: Vec<csv::StringRecord> = r.records().map(|r| r.unwrap()).collect();
-    let strategies = bvhscope::bvh::SplitStrategy::ALL.len();
+    let strategies = bvhscope::bvh::Strategy::ALL.len();
     assert_eq!(records.len(), strategies + 1, "every strategy in the preset's binary layout, and the linear scan");
     let col = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name} in {header:?}"));
     for rec in &records {
@@ -266,7 +266,7 @@ fn a_heatmap_png_names_its_mesh_strategy_and_layout() {
         &{
             let mesh = bvhscope::mesh::load_obj(&t).unwrap().0;
             let p = bvhscope::bvh::BuildParams {
-                strategy: bvhscope::bvh::SplitStrategy::Midpoint,
+                strategy: bvhscope::bvh::Strategy::Midpoint,
                 layout: bvhscope::bvh::Layout::Binary,
                 ..Default::default()
             };

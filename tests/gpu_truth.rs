@@ -6,7 +6,7 @@
 //! thousands of identical centroids, and a broken tree is refused before anyone uses it.
 
 use bvhscope::bvh::{
-    Accelerator, AnyBvh, BuildParams, Bvh, BvhNode, Layout, RayCounters, SceneBvh, SplitStrategy, TraceOptions,
+    Accelerator, AnyBvh, BuildParams, Bvh, BvhNode, Layout, RayCounters, SceneBvh, Strategy, TraceOptions,
     TraversalOrder,
 };
 use bvhscope::geometry::{Ray, TriangleTest};
@@ -188,7 +188,7 @@ fn moller_trumbore_and_the_split_axis_order_run_on_the_gpu_as_on_the_cpu() {
     let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);
     let camera = Camera::framing(&mesh.bounds(), 32, 24);
     let incoherent = bvhscope::render::incoherent_rays(&mesh, 2000, 1);
-    for strategy in [SplitStrategy::SahBinned, SplitStrategy::Midpoint] {
+    for strategy in [Strategy::SahBinned, Strategy::Midpoint] {
         for nodes in [GpuNodes::Binary, GpuNodes::Cwbvh] {
             let bvh = || Bvh::build(&mesh, &BuildParams { strategy, layout: Layout::Binary, ..Default::default() });
             agrees(&gpu, "knot", bvh(), mesh.clone(), Rays::Camera(&camera), nodes, &ALL_TRACES);
@@ -217,7 +217,7 @@ fn gpu_builders_make_the_cpus_tree_on_identical_centroids() {
     for (name, mesh) in
         [("5k identical", identical(5000)), ("20k identical", identical(20_000)), ("8k turned", turned(8000))]
     {
-        for strategy in [SplitStrategy::Lbvh, SplitStrategy::Ploc] {
+        for strategy in [Strategy::Lbvh, Strategy::Ploc] {
             for leaf in [1, 4] {
                 let params =
                     BuildParams { strategy, layout: Layout::Binary, max_leaf_size: leaf, ..Default::default() };
@@ -239,7 +239,7 @@ fn gpu_builders_make_the_cpus_tree_on_identical_centroids() {
 #[test]
 fn a_broken_gpu_tree_is_named_never_used() {
     let mesh = identical(64);
-    let good = Bvh::build(&mesh, &BuildParams { strategy: SplitStrategy::Lbvh, ..Default::default() });
+    let good = Bvh::build(&mesh, &BuildParams { strategy: Strategy::Lbvh, ..Default::default() });
     assert_eq!(bvhscope_gpu::verify::problem(&good, &mesh), None);
     let mut cycle = good.clone();
     let inner = cycle.nodes.iter().rposition(|n| !n.is_leaf() && n.index > 1).unwrap();

@@ -3,7 +3,7 @@
 
 mod common;
 
-use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy, TraceOptions, TraversalOrder};
+use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, Strategy, TraceOptions, TraversalOrder};
 use bvhscope::render::{render, view_image, Camera, ColorMap, HeatRange, RenderSettings, View};
 use glam::Vec3;
 
@@ -28,7 +28,7 @@ fn moer_lite_scene_matches_linear_for_every_strategy() {
     assert!(hits > 50_000, "the monkey covers a good part of the frame ({hits} pixels)");
     let (ref_img, _) = view_image(&reference, View::Normals, ColorMap::Viridis, HeatRange::Auto, Default::default());
 
-    for (strategy, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| Layout::ALL.map(|l| (s, l))) {
+    for (strategy, layout) in Strategy::ALL.into_iter().flat_map(|s| Layout::ALL.map(|l| (s, l))) {
         let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
         // The wide layout always visits the nearest child first; one order is enough there.
         let orders: &[TraversalOrder] =

@@ -6,7 +6,7 @@
 mod common;
 
 use bvhscope::bvh::{
-    trace_ray, Accelerator, AnyBvh, BuildParams, Layout, NodeId, RayCounters, SceneBuild, SplitStrategy, StepKind,
+    trace_ray, Accelerator, AnyBvh, BuildParams, Layout, NodeId, RayCounters, SceneBuild, StepKind, Strategy,
     TraceLevel, TraceOptions, TraceStep, TraversalOrder,
 };
 use bvhscope::geometry::{Ray, TriangleTest};
@@ -99,7 +99,7 @@ fn check_order(steps: &[TraceStep], ray: &Ray, order: TraversalOrder, axis_of: O
 
 fn check_mesh(name: &str, mesh: &Mesh, n: usize) {
     let rays = rays(mesh, n);
-    for strategy in SplitStrategy::ALL {
+    for strategy in Strategy::ALL {
         for layout in Layout::ALL {
             let bvh = AnyBvh::build(mesh, &BuildParams { strategy, layout, ..BuildParams::default() });
             for order in [TraversalOrder::SplitAxisSign, TraversalOrder::EntryDistance] {

@@ -4,7 +4,7 @@
 
 mod common;
 
-use bvhscope::bvh::{AnyBvh, BuildParams, Layout, SplitStrategy};
+use bvhscope::bvh::{AnyBvh, BuildParams, Layout, Strategy};
 use bvhscope::render::{render, Camera, RenderSettings};
 use bvhscope::scene::load_any;
 use std::path::Path;
@@ -23,7 +23,7 @@ fn scene(name: &str) -> Option<bvhscope::scene::Scene> {
 }
 
 /// Nodes visited per ray in the root box, and triangle tests, for `strategy` from `camera`.
-fn work(l: &bvhscope::scene::Scene, strategy: SplitStrategy, camera: &Camera) -> (f64, f64) {
+fn work(l: &bvhscope::scene::Scene, strategy: Strategy, camera: &Camera) -> (f64, f64) {
     let p = BuildParams { strategy, layout: Layout::Binary, ..BuildParams::default() };
     let mesh = l.flat_mesh().unwrap();
     let bvh = AnyBvh::build(&mesh, &p);
@@ -39,14 +39,14 @@ fn at(camera: &Camera, width: u32, height: u32) -> Camera {
 fn in_the_stadium_midpoint_visits_fewer_nodes_than_sah_but_not_from_outside() {
     let Some(l) = scene("teapot-in-stadium.json") else { return };
     let inside = at(l.camera.as_ref().unwrap(), 320, 180);
-    let (mid, _) = work(&l, SplitStrategy::Midpoint, &inside);
-    let (sah, _) = work(&l, SplitStrategy::SahBinned, &inside);
-    let (equal, _) = work(&l, SplitStrategy::EqualCount, &inside);
+    let (mid, _) = work(&l, Strategy::Midpoint, &inside);
+    let (sah, _) = work(&l, Strategy::SahBinned, &inside);
+    let (equal, _) = work(&l, Strategy::EqualCount, &inside);
     assert!(sah > 1.1 * mid, "from inside, SAH {sah:.1} visits more than midpoint {mid:.1}");
     assert!(equal > 1.8 * mid, "equal count {equal:.1} about twice midpoint {mid:.1}");
     let outside = Camera { position: glam::Vec3::new(0.0, 300.0, 400.0), look_at: glam::Vec3::ZERO, ..inside };
-    let (mid, _) = work(&l, SplitStrategy::Midpoint, &outside);
-    let (sah, _) = work(&l, SplitStrategy::SahBinned, &outside);
+    let (mid, _) = work(&l, Strategy::Midpoint, &outside);
+    let (sah, _) = work(&l, Strategy::SahBinned, &outside);
     assert!((sah - mid).abs() < 0.1 * mid, "from outside about equal: SAH {sah:.1}, midpoint {mid:.1}");
 }
 
@@ -63,11 +63,10 @@ fn on_the_floor_sah_visits_half_the_nodes_of_midpoint_in_both_layouts() {
                 .ray_summary()
                 .root_mean_nodes_visited
         };
-        let (mid, sah, equal) =
-            (visits(SplitStrategy::Midpoint), visits(SplitStrategy::SahBinned), visits(SplitStrategy::EqualCount));
+        let (mid, sah, equal) = (visits(Strategy::Midpoint), visits(Strategy::SahBinned), visits(Strategy::EqualCount));
         assert!(mid > 1.8 * sah, "{layout:?}: midpoint {mid:.2} against SAH {sah:.2}");
         assert!(equal > mid, "{layout:?}: equal count {equal:.2} worse still than midpoint {mid:.2}");
     }
-    let (mid, sah) = (work(&l, SplitStrategy::Midpoint, &camera), work(&l, SplitStrategy::SahBinned, &camera));
+    let (mid, sah) = (work(&l, Strategy::Midpoint, &camera), work(&l, Strategy::SahBinned, &camera));
     assert!(mid.1 > sah.1, "and more triangle tests: {mid:?} {sah:?}");
 }

@@ -6,7 +6,7 @@
 
 mod common;
 
-use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SceneBuild, SplitStrategy};
+use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SceneBuild, Strategy};
 use bvhscope::mesh::{generate, write_obj};
 use bvhscope::render::{render, Camera, RenderSettings};
 use bvhscope::scene::{describe, load_any, SceneError};
@@ -105,7 +105,7 @@ fn every_scene_builds_everywhere_and_hits_what_the_linear_scan_hits() {
         let hits = reference.iter().filter(|&&h| h).count();
         assert!(hits * 20 >= reference.len(), "{n}: the camera sees the scene ({hits} of {} pixels)", reference.len());
         let base = loaded.build.unwrap_or_default();
-        for strategy in SplitStrategy::ALL {
+        for strategy in Strategy::ALL {
             for layout in Layout::ALL {
                 let bvh = AnyBvh::build(mesh, &BuildParams { strategy, layout, ..base });
                 common::check_any(&bvh, mesh);

@@ -3,7 +3,7 @@
 use crate::rays::RaySpec;
 use bvhscope::bvh::packet::PACKET;
 use bvhscope::bvh::{
-    Accelerator, AnyBvh, BuildParams, Layout, NoStats, RayCounters, SplitStrategy, TraceOptions, TreeStats,
+    Accelerator, AnyBvh, BuildParams, Layout, NoStats, RayCounters, Strategy, TraceOptions, TreeStats,
 };
 use bvhscope::cpu::Simd;
 use bvhscope::geometry::{intersect_triangle, Ray, TriangleTest};
@@ -116,7 +116,7 @@ fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(bv
 /// The plain and the counting traversal of one SAH tree (built twice: the build is deterministic),
 /// for the alternated overhead measurement in `main.rs`.
 pub fn plain_and_counting(mesh: &Mesh, layout: Layout) -> [Box<dyn Tracer>; 2] {
-    let params = BuildParams { layout, ..BuildParams::with_strategy(SplitStrategy::SahBinned) };
+    let params = BuildParams { layout, ..BuildParams::with_strategy(Strategy::SahBinned) };
     [tracer::<NoStats>(AnyBvh::build(mesh, &params)), tracer::<RayCounters>(AnyBvh::build(mesh, &params))]
 }
 
@@ -129,7 +129,7 @@ pub enum Tracing {
 }
 
 /// Our BVH with one strategy and layout (default parameters), traced as `tracing` says.
-pub fn ours(strategy: SplitStrategy, layout: Layout, tracing: Tracing) -> Contender {
+pub fn ours(strategy: Strategy, layout: Layout, tracing: Tracing) -> Contender {
     let params = BuildParams { layout, ..BuildParams::with_strategy(strategy) };
     ours_with(strategy.name(), params, tracing)
 }
@@ -159,7 +159,7 @@ pub fn ours_with_kernels(label: &str, params: BuildParams, tracing: Tracing, sim
     Contender {
         name,
         family: Family::Ours,
-        slow_build: params.strategy == SplitStrategy::SahSweep,
+        slow_build: params.strategy == Strategy::SahSweep,
         build: Box::new(move |mesh| {
             let t = Instant::now();
             let mut params = params;

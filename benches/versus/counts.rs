@@ -4,7 +4,7 @@
 //! `RayCounters` sink, on the binary layout (the tree as built).
 
 use crate::rays::RaySpec;
-use bvhscope::bvh::{Accelerator, BuildParams, Bvh, Layout, RayCounters, SplitStrategy, TraceOptions, TreeStats};
+use bvhscope::bvh::{Accelerator, BuildParams, Bvh, Layout, RayCounters, Strategy, TraceOptions, TreeStats};
 use bvhscope::geometry::Ray;
 use bvhscope::mesh::Mesh;
 use rayon::prelude::*;
@@ -30,7 +30,7 @@ pub fn table(mesh: &Mesh, primary: &[RaySpec], incoherent: &[RaySpec]) -> String
     let _ = writeln!(o, "\n#### Work per ray, {} (binary layout, `RayCounters`)\n", mesh.name);
     let _ = writeln!(o, "| strategy | references / triangle | SAH cost | primary nodes | primary tri tests | primary nodes + tri tests | incoherent nodes | incoherent tri tests | incoherent nodes + tri tests |");
     let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for strategy in SplitStrategy::ALL {
+    for strategy in Strategy::ALL {
         let params = BuildParams { strategy, layout: Layout::Binary, ..BuildParams::default() };
         let bvh = Bvh::build(mesh, &params);
         let stats = TreeStats::of(&bvh);

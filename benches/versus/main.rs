@@ -250,7 +250,7 @@ fn median_ms(n: usize, mut f: impl FnMut()) -> f64 {
 /// default wide layout, all threads), load + SAH build of the 2M-triangle mesh from an OBJ file,
 /// and a strategy switch (a rebuild) on it.
 fn app_figures(meshes: &[Mesh], all: &ThreadPool) -> String {
-    use bvhscope::bvh::{AnyBvh, BuildParams, SplitStrategy};
+    use bvhscope::bvh::{AnyBvh, BuildParams, Strategy};
     use bvhscope::render::{render, render_passes, view_image, Camera, ColorMap, HeatRange, RenderSettings, View};
     let mut o = String::from("\n### App figures (all threads)\n\n");
     if let Some(bunny) = meshes.iter().find(|m| m.name.contains("bunny")) {
@@ -317,7 +317,7 @@ fn app_figures(meshes: &[Mesh], all: &ThreadPool) -> String {
             let _ = std::fs::remove_file(&path);
         }
         let mesh = big;
-        for s in [SplitStrategy::Midpoint, SplitStrategy::SahBinned] {
+        for s in [Strategy::Midpoint, Strategy::SahBinned] {
             let t = Instant::now();
             std::hint::black_box(all.install(|| AnyBvh::build(mesh, &BuildParams::with_strategy(s))));
             let _ = writeln!(
@@ -366,15 +366,15 @@ fn main() {
     }
 
     let mut contenders = vec![];
-    use bvhscope::bvh::{Layout, SplitStrategy};
+    use bvhscope::bvh::{Layout, Strategy};
     for layout in Layout::ALL {
-        for strategy in SplitStrategy::ALL {
+        for strategy in Strategy::ALL {
             contenders.push(contenders::ours(strategy, layout, Tracing::Plain));
         }
     }
-    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Packets));
-    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Packets));
-    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide8, Tracing::Packets));
+    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Binary, Tracing::Packets));
+    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Wide4, Tracing::Packets));
+    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Wide8, Tracing::Packets));
     // The fastest preset (8-wide; leaves of up to 16 with AVX-512, else 4), as the app's and CLI's
     // `--preset fastest` on this CPU.
     let fastest = bvhscope::bvh::Preset::Fastest.build();
@@ -397,9 +397,9 @@ fn main() {
             contenders.push(contenders::ours_with(&label, p, Tracing::Packets));
         }
     }
-    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Binary, Tracing::Counting));
-    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide4, Tracing::Counting));
-    contenders.push(contenders::ours(SplitStrategy::SahBinned, Layout::Wide8, Tracing::Counting));
+    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Binary, Tracing::Counting));
+    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Wide4, Tracing::Counting));
+    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Wide8, Tracing::Counting));
     contenders.extend(contenders::obvhs_all());
     contenders.push(contenders::bvh_crate());
     contenders.extend(embree::all());

@@ -16,7 +16,7 @@
 //! turns so that the machine's drift falls on all of them); `BENCH_SCALING_ONLY=frame,png` keeps
 //! the phases whose names contain a word.
 
-use bvhscope::bvh::{epo, AnyBvh, BuildParams, Bvh, Hierarchy, Layout, SplitStrategy};
+use bvhscope::bvh::{epo, AnyBvh, BuildParams, Bvh, Hierarchy, Layout, Strategy};
 use bvhscope::mesh::{load_obj, Mesh};
 use bvhscope::render::{draw_legend, render, view_image, Camera, ColorMap, HeatRange, RenderSettings, View};
 use bvhscope_core::parallel::measure_serial;
@@ -85,7 +85,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> Duration {
 fn phases<'a>(path: &'a PathBuf, mesh: &'a Mesh, sah: &'a Bvh, frame_bvh: &'a AnyBvh) -> Vec<Phase<'a>> {
     let phase = |name: &str, work: Work<'a>| Phase { name: name.into(), work, measured: true };
     let mut v = vec![phase("OBJ load", Box::new(move || timed(|| load_obj(path).expect("loading the mesh"))))];
-    for s in SplitStrategy::ALL {
+    for s in Strategy::ALL {
         let params = BuildParams { strategy: s, layout: Layout::Binary, ..Default::default() };
         v.push(phase(&format!("build {}", s.name()), Box::new(move || timed(|| Bvh::build(mesh, &params)))));
     }

@@ -7,7 +7,7 @@
 //! times loading it and building it with each strategy (binary layout) on 1 and 2 threads, 3 runs each,
 //! with the time each spends outside parallel regions (`bvhscope_core::parallel::serial`), and
 //! projects the speed-up on 16 threads from it with Amdahl's law.
-use bvhscope_core::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
+use bvhscope_core::bvh::{BuildParams, Bvh, Layout, Strategy};
 use bvhscope_core::mesh::{load_obj, write_obj};
 use bvhscope_core::parallel::measure_serial;
 use std::time::{Duration, Instant};
@@ -29,9 +29,9 @@ fn main() {
             let threads: Vec<usize> =
                 arg(2).unwrap_or("1,2").split(',').map(|t| t.parse().expect("a thread count")).collect();
             let runs: usize = arg(3).map_or(3, |r| r.parse().expect("a run count"));
-            let strategies: Vec<SplitStrategy> = match arg(4) {
-                Some(list) => list.split(',').map(|s| SplitStrategy::from_name(s).expect("a strategy")).collect(),
-                None => SplitStrategy::ALL.to_vec(),
+            let strategies: Vec<Strategy> = match arg(4) {
+                Some(list) => list.split(',').map(|s| Strategy::from_name(s).expect("a strategy")).collect(),
+                None => Strategy::ALL.to_vec(),
             };
             time(path, &threads, runs, &strategies);
         }
@@ -66,7 +66,7 @@ fn cpu_time() -> Duration {
     Duration::from_millis(ticks * 10)
 }
 
-fn time(path: &str, threads: &[usize], runs: usize, strategies: &[SplitStrategy]) {
+fn time(path: &str, threads: &[usize], runs: usize, strategies: &[Strategy]) {
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     println!("machine: {cores} hardware threads; {runs} runs each, medians");
     let mut rows: Rows = Vec::new();

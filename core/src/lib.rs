@@ -12,6 +12,7 @@ pub mod dump;
 pub mod explain;
 pub mod files;
 pub mod geometry;
+pub mod json;
 pub mod mesh;
 pub mod options;
 pub mod parallel;

@@ -3,7 +3,7 @@
 //! limits and the default. The CLI, the build panel and the scene-file reader all read these
 //! tables, so none of them can accept a value the others refuse.
 
-use crate::bvh::{Layout, Limits, Param, ParamLimits, ParamValue, Preset, SplitStrategy, TraversalOrder};
+use crate::bvh::{Layout, Limits, Param, ParamLimits, ParamValue, Preset, Strategy, TraversalOrder};
 use crate::geometry::TriangleTest;
 use crate::render::warp::WarpSize;
 use crate::render::{ColorMap, PairView, RayKind, UpAxis, View};
@@ -72,51 +72,51 @@ macro_rules! choice {
     };
 }
 
-const STRATEGIES: [Named<SplitStrategy>; 7] = [
+const STRATEGIES: [Named<Strategy>; 7] = [
     Named {
-        value: SplitStrategy::Midpoint,
+        value: Strategy::Midpoint,
         name: "midpoint",
         label: "Midpoint",
         help: "split the widest axis of the centroid bounds in the middle; fast, poor on uneven meshes",
     },
     Named {
-        value: SplitStrategy::EqualCount,
+        value: Strategy::EqualCount,
         name: "equal-count",
         label: "Equal count",
         help: "split at the median centroid of the widest axis; balanced tree, ignores box sizes",
     },
     Named {
-        value: SplitStrategy::SahBinned,
+        value: Strategy::SahBinned,
         name: "sah",
         label: "SAH binned",
         help: "surface area heuristic over bins on all axes; near-best trees, fast to build",
     },
     Named {
-        value: SplitStrategy::SahSweep,
+        value: Strategy::SahSweep,
         name: "sah-sweep",
         label: "SAH sweep",
         help: "surface area heuristic tried between every pair of centroids; exact, slowest to build",
     },
     Named {
-        value: SplitStrategy::Lbvh,
+        value: Strategy::Lbvh,
         name: "lbvh",
         label: "LBVH (Morton)",
         help: "linear BVH: centroids sorted by Morton code, split where the code's top differing bit flips; fastest to build, blocky trees",
     },
     Named {
-        value: SplitStrategy::Ploc,
+        value: Strategy::Ploc,
         name: "ploc",
         label: "PLOC",
         help: "bottom-up: clusters in Morton order merge with their nearest neighbour (smallest joint box) within a search radius; SAH-like trees, fast parallel build",
     },
     Named {
-        value: SplitStrategy::Sbvh,
+        value: Strategy::Sbvh,
         name: "sbvh",
         label: "SBVH (spatial splits)",
         help: "binned SAH that may also cut triangles at a plane (Stich et al. 2009): less overlap, fewer tests per ray, more references and a slower build",
     },
 ];
-choice!(SplitStrategy, STRATEGIES, 7);
+choice!(Strategy, STRATEGIES, 7);
 
 const LAYOUTS: [Named<Layout>; 3] = [
     Named {
@@ -345,7 +345,7 @@ const RAY_KINDS: [Named<RayKind>; 4] = [
 choice!(RayKind, RAY_KINDS, 4);
 
 /// A build parameter as users see it: its names, label and help. Its limits and default are the
-/// builder's (`Param::limits`); which strategies read it is the strategy's (`SplitStrategy::reads`).
+/// builder's (`Param::limits`); which strategies read it is the strategy's (`Strategy::reads`).
 #[derive(Clone, Copy, Debug)]
 pub struct ParamOption {
     pub param: Param,

@@ -14,7 +14,7 @@ fn check<T: Choice + std::fmt::Debug>() {
 
 #[test]
 fn every_choice_is_named_once_and_found_by_its_name() {
-    check::<SplitStrategy>();
+    check::<Strategy>();
     check::<Layout>();
     check::<TraversalOrder>();
     check::<TriangleTest>();
@@ -23,7 +23,7 @@ fn every_choice_is_named_once_and_found_by_its_name() {
     check::<UpAxis>();
     check::<Preset>();
     check::<PairView>();
-    assert_eq!(SplitStrategy::ALL.len(), STRATEGIES.len());
+    assert_eq!(Strategy::ALL.len(), STRATEGIES.len());
     assert_eq!(View::ALL[2], View::Visits);
 }
 

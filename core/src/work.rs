@@ -67,3 +67,60 @@ impl WorkControl {
         }
     }
 }
+
+/// Whether the work a watcher watches has ended (`watched`).
+pub struct Ended<'a>(&'a AtomicBool);
+
+impl Ended<'_> {
+    /// Sleep `tick`, then whether the work has ended (returned or panicked).
+    pub fn after(&self, tick: std::time::Duration) -> bool {
+        std::thread::sleep(tick);
+        self.0.load(Ordering::Acquire)
+    }
+}
+
+/// Sets the flag when dropped: when the work returns, and when it panics (the scope then waits
+/// for the watcher, which must stop, before the panic goes on).
+struct EndOnDrop<'a>(&'a AtomicBool);
+
+impl Drop for EndOnDrop<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Release);
+    }
+}
+
+/// Run `work` on this thread while `watcher` runs on a thread of its own, told through `Ended`
+/// when the work has ended, so it never outlives the work, not even one that panics (the panic
+/// is passed on once the watcher has stopped). The CLI's progress bars and the grader's
+/// deadline are such watchers.
+pub fn watched<T>(watcher: impl FnOnce(&Ended) + Send, work: impl FnOnce() -> T) -> T {
+    let ended = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        s.spawn(|| watcher(&Ended(&ended)));
+        let _end = EndOnDrop(&ended);
+        work()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    /// The watcher sees the work end, and a panic in the work is passed on once the watcher has
+    /// stopped, never waited for.
+    #[test]
+    fn the_watcher_stops_when_the_work_ends_even_by_a_panic() {
+        let ticks = AtomicU64::new(0);
+        let watch = |ended: &Ended| {
+            while !ended.after(Duration::from_millis(1)) {
+                ticks.fetch_add(1, Ordering::Relaxed);
+            }
+        };
+        assert_eq!(watched(watch, || 7), 7);
+        let r = std::panic::catch_unwind(|| watched(watch, || -> u32 { panic!("the work failed") }));
+        assert!(r.is_err());
+        // A watcher that stops first leaves the work to run on.
+        assert_eq!(watched(|_| {}, || 8), 8);
+    }
+}

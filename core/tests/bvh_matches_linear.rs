@@ -4,9 +4,9 @@
 
 mod common;
 
+use bvhscope_core::bvh;
 use bvhscope_core::bvh::{
-    Accelerator, AnyBvh, BuildParams, Layout, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions,
-    TraversalOrder, TreeView,
+    Accelerator, AnyBvh, BuildParams, Layout, LinearScan, NoStats, RayCounters, TraceOptions, TraversalOrder, TreeView,
 };
 use bvhscope_core::cpu::Simd;
 use bvhscope_core::geometry::{Ray, TriangleTest};
@@ -83,7 +83,7 @@ fn check_ray(mesh: &Mesh, bvhs: &[AnyBvh], linear: &LinearScan, ray: Ray) {
 
 /// Every strategy in both layouts: default parameters, plus odd ones (leaf size 1 and 7, few bins).
 fn build_all(mesh: &Mesh) -> Vec<AnyBvh> {
-    SplitStrategy::ALL
+    bvh::Strategy::ALL
         .into_iter()
         .flat_map(|s| {
             [
@@ -227,13 +227,13 @@ fn identical_triangles_build_a_bounded_tree() {
     let n = 1_000_000u32;
     let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
     let mesh = Mesh::from_triangles("same", positions, vec![[0, 1, 2]; n as usize]);
-    for (s, layout) in SplitStrategy::ALL.into_iter().flat_map(|s| Layout::ALL.map(|l| (s, l))) {
+    for (s, layout) in bvh::Strategy::ALL.into_iter().flat_map(|s| Layout::ALL.map(|l| (s, l))) {
         let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(s) });
         let stats = bvhscope_core::bvh::TreeStats::of(&bvh);
         assert!(stats.max_depth < bvhscope_core::bvh::TRAVERSAL_STACK_SIZE as u32, "{s:?} depth {}", stats.max_depth);
         assert!(stats.leaf_size_histogram.len() <= 5, "{s:?} leaf sizes");
         // Equal count always separates; PLOC merges and never splits, so nothing falls back.
-        if !matches!(s, SplitStrategy::EqualCount | SplitStrategy::Ploc) {
+        if !matches!(s, bvh::Strategy::EqualCount | bvh::Strategy::Ploc) {
             assert!(stats.fallback_splits > 0, "{s:?} must report its fallback splits");
         }
         let mut r = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
@@ -258,7 +258,7 @@ fn exponentially_spaced_triangles_stay_within_the_stack_depth() {
     let linear = LinearScan::new(&mesh);
     let bvhs: Vec<AnyBvh> = Layout::ALL
         .map(|layout| {
-            let p = BuildParams { max_leaf_size: 1, layout, ..BuildParams::with_strategy(SplitStrategy::Midpoint) };
+            let p = BuildParams { max_leaf_size: 1, layout, ..BuildParams::with_strategy(bvh::Strategy::Midpoint) };
             AnyBvh::build(&mesh, &p)
         })
         .into();
@@ -310,7 +310,7 @@ fn shared_cases() -> &'static [SharedCase] {
         .into_iter()
         .map(|name| {
             let mesh = common::shared_mesh(name).unwrap();
-            let bvhs: Vec<AnyBvh> = SplitStrategy::ALL
+            let bvhs: Vec<AnyBvh> = bvh::Strategy::ALL
                 .into_iter()
                 .flat_map(|s| Layout::ALL.map(|layout| BuildParams { layout, ..BuildParams::with_strategy(s) }))
                 .map(|p| AnyBvh::build(&mesh, &p))

@@ -5,7 +5,7 @@
 mod counting;
 
 use bvhscope_core::bvh::{
-    Accelerator, AnyBvh, BuildParams, Bvh, Layout, LinearScan, SplitStrategy, TraceOptions, TraversalOrder, WideBvh,
+    Accelerator, AnyBvh, BuildParams, Bvh, Layout, LinearScan, Strategy, TraceOptions, TraversalOrder, WideBvh,
 };
 use bvhscope_core::geometry::{Ray, TriangleTest};
 use bvhscope_core::mesh::Mesh;
@@ -107,7 +107,7 @@ fn corridor_rays() -> [Ray; 4] {
 #[test]
 fn the_corridor_of_one_triangle_leaves_counts_exactly() {
     let mesh = corridor();
-    for strategy in [SplitStrategy::Midpoint, SplitStrategy::EqualCount] {
+    for strategy in [Strategy::Midpoint, Strategy::EqualCount] {
         let (binary, wide) = both_layouts(&mesh, BuildParams { strategy, ..params() });
         assert_eq!(binary.nodes.len(), 15, "{strategy:?}");
         assert_eq!(binary_leaves(&binary), (0..8).map(|k| (3, vec![k])).collect::<Vec<_>>(), "{strategy:?}");

@@ -2,7 +2,7 @@
 
 mod common;
 
-use bvhscope_core::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SplitStrategy};
+use bvhscope_core::bvh::{AnyBvh, BuildParams, Layout, LinearScan, Strategy};
 use bvhscope_core::render::{render, RenderSettings};
 use bvhscope_core::scene::{load_any, parse_scene_file, write_scene_file, SceneError};
 use bvhscope_core::work::WorkControl;
@@ -64,7 +64,7 @@ fn moer_lite_scene_hit_mask_equals_linear_search() {
     let mesh = loaded.flat_mesh().unwrap();
     let reference = render(&LinearScan::new(&mesh), &*mesh, &cam, &settings).hit_mask();
     assert!(reference.iter().filter(|&&h| h).count() > 50_000);
-    for s in SplitStrategy::ALL {
+    for s in Strategy::ALL {
         let bvh = AnyBvh::build(&mesh, &BuildParams::with_strategy(s));
         assert_eq!(render(&bvh, &*mesh, &cam, &settings).hit_mask(), reference, "{s:?}");
     }
@@ -91,7 +91,7 @@ fn our_scene_file_round_trips_and_places_meshes() {
     let moved = flat.triangle(1);
     assert!((moved[1] - Vec3::new(10.0, 2.0, 0.0)).length() < 1e-5, "{moved:?}");
     let build = loaded.build.unwrap();
-    assert_eq!((build.strategy, build.max_leaf_size), (SplitStrategy::Midpoint, 2));
+    assert_eq!((build.strategy, build.max_leaf_size), (Strategy::Midpoint, 2));
     let cam = loaded.camera.unwrap();
     assert_eq!((cam.width, cam.height, cam.vfov_deg), (64, 48, 30.0));
 

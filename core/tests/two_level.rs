@@ -3,7 +3,7 @@
 
 mod common;
 
-use bvhscope_core::bvh::{AnyBvh, BuildParams, Layout, SplitStrategy, TwoLevelBvh};
+use bvhscope_core::bvh::{AnyBvh, BuildParams, Layout, Strategy, TwoLevelBvh};
 use bvhscope_core::mesh::{generate, Mesh};
 use bvhscope_core::render::{render, Camera, Frame, RenderSettings};
 use bvhscope_core::scene::{flatten, load_any, SceneInstances};
@@ -14,7 +14,7 @@ use std::sync::Arc;
 
 fn every_params() -> Vec<BuildParams> {
     let mut v = Vec::new();
-    for strategy in SplitStrategy::ALL {
+    for strategy in Strategy::ALL {
         for layout in Layout::ALL {
             v.push(BuildParams { strategy, layout, ..BuildParams::default() });
         }

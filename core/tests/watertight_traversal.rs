@@ -7,9 +7,8 @@
 
 mod common;
 
-use bvhscope_core::bvh::{
-    Accelerator, AnyBvh, BuildParams, Hit, Layout, LinearScan, NoStats, SplitStrategy, TraceOptions,
-};
+use bvhscope_core::bvh;
+use bvhscope_core::bvh::{Accelerator, AnyBvh, BuildParams, Hit, Layout, LinearScan, NoStats, TraceOptions};
 use bvhscope_core::bvh::{TraversalOrder, TreeView};
 use bvhscope_core::geometry::{Ray, TriangleTest};
 use bvhscope_core::mesh::Mesh;
@@ -25,7 +24,7 @@ fn all_options() -> Vec<TraceOptions> {
 
 /// Every strategy in both layouts, with leaves of 1 and 4 (small leaves make more boxes touch).
 fn build_all(mesh: &Mesh) -> Vec<AnyBvh> {
-    SplitStrategy::ALL
+    bvh::Strategy::ALL
         .into_iter()
         .flat_map(|s| [1, 4].map(move |leaf| (s, leaf)))
         .flat_map(|(s, leaf)| {

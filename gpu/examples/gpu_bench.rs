@@ -13,7 +13,7 @@
 //! benches/versus traces them, seed 1). Each figure is the best of `reps` runs of submit-to-completion time;
 //! read-backs are not timed.
 
-use bvhscope_core::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
+use bvhscope_core::bvh::{BuildParams, Bvh, Layout, Strategy};
 use bvhscope_core::mesh::{generate, load_obj, Mesh};
 use bvhscope_core::render::{incoherent_rays, Camera};
 use bvhscope_gpu::{
@@ -139,7 +139,7 @@ fn run() -> Result<(), String> {
             }
         }
         let lbvh = GpuLbvh::new(&gpu).map_err(|e| e.to_string())?;
-        let params = BuildParams { strategy: SplitStrategy::Lbvh, layout: Layout::Binary, ..BuildParams::default() };
+        let params = BuildParams { strategy: Strategy::Lbvh, layout: Layout::Binary, ..BuildParams::default() };
         lbvh.build(&gpu, mesh, &params).map_err(|e| e.to_string())?;
         let mut t = lbvh.build(&gpu, mesh, &params).map_err(|e| e.to_string())?.1;
         for _ in 1..a.reps {
@@ -165,7 +165,7 @@ fn run() -> Result<(), String> {
             cpu.nodes.len()
         );
         let ploc = GpuPloc::new(&gpu).map_err(|e| e.to_string())?;
-        let params = BuildParams { strategy: SplitStrategy::Ploc, ..params };
+        let params = BuildParams { strategy: Strategy::Ploc, ..params };
         ploc.build(&gpu, mesh, &params).map_err(|e| e.to_string())?;
         let (g, t) = ploc.build(&gpu, mesh, &params).map_err(|e| e.to_string())?;
         let start = Instant::now();

@@ -4,7 +4,9 @@
 
 use crate::device::{Gpu, GpuError};
 use crate::trace::{GpuTrace, GpuTraceOptions, Kernels, Rays, Stack};
+use bvhscope_core::bvh::reach::{reach, Fault};
 use bvhscope_core::bvh::Bvh;
+use std::ops::ControlFlow;
 
 /// A binary BVH uploaded to one GPU.
 pub struct GpuBinaryBvh {
@@ -15,7 +17,7 @@ pub struct GpuBinaryBvh {
     stack: Stack,
 }
 
-pub(crate) const KERNELS: Kernels = Kernels::new("binary", include_str!("shaders/binary.wgsl"));
+pub(crate) const KERNELS: Kernels = Kernels::new("binary", "binary.wgsl");
 
 /// The deepest leaf's depth (edges from the root) of a well-formed binary tree, or why the tree
 /// cannot be walked: a child or triangle range out of bounds, or a node reached twice (a cycle or
@@ -32,32 +34,27 @@ pub fn checked_depth(bvh: &Bvh) -> Result<u32, GpuError> {
     if bvh.prim_ids.is_empty() {
         return Ok(0);
     }
-    let n = bvh.nodes.len();
-    let mut seen = vec![false; n];
-    let mut stack = vec![(0usize, 0u32)];
-    let mut depth = 0;
-    seen[0] = true;
-    while let Some((i, d)) = stack.pop() {
-        let node = &bvh.nodes[i];
-        depth = depth.max(d);
-        if node.is_leaf() {
-            if node.index as usize + node.count as usize > bvh.tris.len() {
-                return bad(format!("leaf {i} holds triangles past the last ({})", bvh.tris.len()));
-            }
-            continue;
+    let nodes = &bvh.nodes;
+    let children = |i: usize, k: usize| (!nodes[i].is_leaf() && k < 2).then(|| nodes[i].index.wrapping_add(k as u32));
+    let mut fault = None;
+    let walked = reach(nodes.len(), children, |f| {
+        fault = Some(f);
+        ControlFlow::Break(())
+    });
+    match fault {
+        Some(Fault::PastEnd { from, child }) => {
+            return bad(format!("node {from}'s child {child} is past the last node"))
         }
-        let left = node.index as usize;
-        if left + 1 >= n {
-            return bad(format!("node {i}'s children {left}, {} are past the last node", left + 1));
-        }
-        for c in [left, left + 1] {
-            if std::mem::replace(&mut seen[c], true) {
-                return bad(format!("node {c} is reached twice"));
-            }
-            stack.push((c, d + 1));
+        Some(Fault::Again { node, .. }) => return bad(format!("node {node} is reached twice")),
+        None => {}
+    }
+    let reached_leaves = nodes.iter().enumerate().filter(|&(i, n)| walked.reached[i] && n.is_leaf());
+    for (i, leaf) in reached_leaves {
+        if leaf.index as usize + leaf.count as usize > bvh.tris.len() {
+            return bad(format!("leaf {i} holds triangles past the last ({})", bvh.tris.len()));
         }
     }
-    Ok(depth)
+    Ok(walked.depth)
 }
 
 /// A node's 32 bytes as the GPU reads them (core's `BvhNode` field by field, little-endian).

@@ -4,6 +4,13 @@
 
 use crate::device::{Gpu, GpuError};
 
+/// A module's source: the prelude every module starts with (`shaders/prelude.wgsl`: `Tri`), then
+/// `parts` in order.
+pub(crate) fn module(parts: &[&str]) -> String {
+    let prelude = crate::shaders::source("prelude.wgsl");
+    std::iter::once(prelude).chain(parts.iter().copied()).collect::<Vec<_>>().join("\n")
+}
+
 /// How a kernel sees one binding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Bind {

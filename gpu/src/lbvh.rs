@@ -15,7 +15,7 @@ use crate::kernel::{Bind, Kernel};
 use crate::scan::Scan;
 use crate::sort::RadixSort;
 use bvhscope_core::bvh::params::MAX_LEAF_SIZE;
-use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, SplitStrategy};
+use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, Strategy};
 use bvhscope_core::geometry::Aabb;
 use bvhscope_core::mesh::Mesh;
 use std::sync::Arc;
@@ -125,7 +125,7 @@ pub(crate) fn triangle_floats(mesh: &Mesh) -> Vec<[f32; 9]> {
 
 /// The LBVH's WGSL module: the builders' boxes, then its kernels.
 pub(crate) fn source() -> String {
-    [include_str!("shaders/boxes.wgsl"), include_str!("shaders/lbvh.wgsl")].join("\n")
+    crate::kernel::module(&[crate::shaders::source("boxes.wgsl"), crate::shaders::source("lbvh.wgsl")])
 }
 
 /// Decode `lbvh.wgsl`'s `ordered` words.
@@ -247,7 +247,7 @@ impl GpuLbvh {
     /// caller, as `Bvh::build` runs it after any builder).
     pub fn build(&self, gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<(Bvh, GpuBuildTimings), GpuError> {
         let params = BuildParams {
-            strategy: SplitStrategy::Lbvh,
+            strategy: Strategy::Lbvh,
             max_leaf_size: MAX_LEAF_SIZE.clamp(params.max_leaf_size),
             ..*params
         };

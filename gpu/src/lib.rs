@@ -12,6 +12,7 @@ mod kernel;
 mod lbvh;
 mod ploc;
 mod scan;
+mod shaders;
 mod shaders_valid;
 mod sort;
 mod trace;

@@ -10,7 +10,7 @@ use crate::kernel::{Bind, Kernel};
 use crate::lbvh::{morton_sizes, GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
 use crate::scan::Scan;
 use bvhscope_core::bvh::params::{MAX_LEAF_SIZE, PLOC_RADIUS, TRAVERSAL_COST};
-use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, SahCost, SplitStrategy};
+use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, SahCost, Strategy};
 use bvhscope_core::geometry::Aabb;
 use bvhscope_core::mesh::Mesh;
 use glam::Vec3;
@@ -39,7 +39,7 @@ const KERNELS: [(&str, &[u32]); 5] = [
 
 /// The PLOC module: the builders' boxes, then its kernels.
 pub(crate) fn source() -> String {
-    [include_str!("shaders/boxes.wgsl"), include_str!("shaders/ploc.wgsl")].join("\n")
+    crate::kernel::module(&[crate::shaders::source("boxes.wgsl"), crate::shaders::source("ploc.wgsl")])
 }
 
 /// The buffers of a PLOC build over `n` triangles (besides the Morton order's).
@@ -191,7 +191,7 @@ impl GpuPloc {
     /// the host, `download` the read-back of the clustered tree and the triangles' gathering.
     pub fn build(&self, gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<(Bvh, GpuBuildTimings), GpuError> {
         let mut params = BuildParams {
-            strategy: SplitStrategy::Ploc,
+            strategy: Strategy::Ploc,
             max_leaf_size: MAX_LEAF_SIZE.clamp(params.max_leaf_size),
             ploc_radius: PLOC_RADIUS.clamp(params.ploc_radius),
             ..*params

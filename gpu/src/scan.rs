@@ -24,7 +24,7 @@ pub(crate) struct Scan {
 
 impl Scan {
     pub(crate) fn new(gpu: &Gpu) -> Result<Scan, GpuError> {
-        let src = include_str!("shaders/scan.wgsl");
+        let src = crate::shaders::source("scan.wgsl");
         let binds = [Bind::Uniform, Bind::ReadWrite, Bind::ReadWrite];
         let k = |entry: &'static str| {
             gpu.compiled(format!("scan {entry}"), || Kernel::new(gpu, entry, src, entry, &binds, &[]))

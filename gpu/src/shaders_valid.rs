@@ -1,4 +1,5 @@
-//! Every WGSL module this crate compiles, parsed and validated by naga (the compiler wgpu runs)
+//! Every WGSL module this crate compiles (the walks and builders of `shaders::WALKS` and
+//! `shaders::BUILDS`, the sort's and the scan's kernels), parsed and validated by naga (the compiler wgpu runs)
 //! without any adapter: a machine with no GPU at all still checks the shaders.
 
 #[cfg(test)]
@@ -16,20 +17,19 @@ mod tests {
 
     #[test]
     fn every_shader_variant_parses_and_validates() {
-        for (format, kernels) in [("binary", &crate::binary::KERNELS), ("cwbvh", &crate::cwbvh::gpu::KERNELS)] {
+        for kernels in crate::shaders::WALKS {
             for f64 in [true, false] {
                 for stack in [Stack::Private(32), Stack::Private(128), Stack::Global(1000)] {
-                    validate(&format!("{format} {stack:?} f64={f64}"), &kernels.source(f64, stack), f64);
+                    validate(&format!("{} {stack:?} f64={f64}", kernels.walk_file), &kernels.source(f64, stack), f64);
                 }
             }
         }
-        for (name, src) in
-            [("scan", include_str!("shaders/scan.wgsl")), ("radix_sort", include_str!("shaders/radix_sort.wgsl"))]
-        {
-            validate(name, src, false);
+        for file in ["scan.wgsl", "radix_sort.wgsl"] {
+            validate(file, crate::shaders::source(file), false);
         }
-        validate("lbvh", &crate::lbvh::source(), false);
-        validate("ploc", &crate::ploc::source(), false);
+        for (file, source) in crate::shaders::BUILDS {
+            validate(file, &source(), false);
+        }
     }
 
     /// Without doubles, a module that uses them is refused: the check can fail.

@@ -33,7 +33,7 @@ pub(crate) struct SortScratch {
 
 impl RadixSort {
     pub(crate) fn new(gpu: &Gpu) -> Result<RadixSort, GpuError> {
-        let src = include_str!("shaders/radix_sort.wgsl");
+        let src = crate::shaders::source("radix_sort.wgsl");
         let binds = [Bind::Uniform, Bind::Read, Bind::Read, Bind::ReadWrite, Bind::ReadWrite, Bind::ReadWrite];
         let k = |entry: &'static str| {
             gpu.compiled(format!("sort {entry}"), || Kernel::new(gpu, entry, src, entry, &binds, &[]))

@@ -5,6 +5,7 @@
 
 use crate::device::{Gpu, GpuError};
 use crate::kernel::{Bind, Kernel};
+use crate::shaders::source;
 use bvhscope_core::bvh::{Hit, RayCounters, TraversalOrder};
 use bvhscope_core::geometry::{Ray, TriangleTest};
 use bvhscope_core::render::Camera;
@@ -185,31 +186,31 @@ impl Stack {
 /// variant and options, once each.
 pub(crate) struct Kernels {
     format: &'static str,
-    walk_source: &'static str,
+    /// Its walk's file in `shaders/` (a row of `shaders::SHADERS`).
+    pub(crate) walk_file: &'static str,
 }
 
 impl Kernels {
-    pub(crate) const fn new(format: &'static str, walk_source: &'static str) -> Kernels {
-        Kernels { format, walk_source }
+    pub(crate) const fn new(format: &'static str, walk_file: &'static str) -> Kernels {
+        Kernels { format, walk_file }
     }
 
     /// The whole module: shared parts, the adapter's edge fallback (doubles or not), the stack,
     /// the walk, the entries.
     pub(crate) fn source(&self, f64: bool, stack: Stack) -> String {
-        let edge = if f64 { include_str!("shaders/edge_f64.wgsl") } else { include_str!("shaders/edge_f32.wgsl") };
+        let edge = if f64 { source("edge_f64.wgsl") } else { source("edge_f32.wgsl") };
         let stack_src = match stack {
-            Stack::Private(n) => include_str!("shaders/stack_private.wgsl").replace("{STACK_SIZE}", &n.to_string()),
-            Stack::Global(_) => include_str!("shaders/stack_global.wgsl").to_string(),
+            Stack::Private(n) => source("stack_private.wgsl").replace("{STACK_SIZE}", &n.to_string()),
+            Stack::Global(_) => source("stack_global.wgsl").to_string(),
         };
-        [
-            include_str!("shaders/common.wgsl"),
-            include_str!("shaders/triangle.wgsl"),
+        crate::kernel::module(&[
+            source("common.wgsl"),
+            source("triangle.wgsl"),
             edge,
             &stack_src,
-            self.walk_source,
-            include_str!("shaders/entry.wgsl"),
-        ]
-        .join("\n")
+            source(self.walk_file),
+            source("entry.wgsl"),
+        ])
     }
 
     fn get(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Arc<Kernel>, GpuError> {

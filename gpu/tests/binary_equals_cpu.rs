@@ -5,7 +5,7 @@
 
 mod common;
 
-use bvhscope_core::bvh::{BuildParams, Bvh, BvhNode, Hit, Layout, RayCounters, SplitStrategy, TraversalOrder};
+use bvhscope_core::bvh::{BuildParams, Bvh, BvhNode, Hit, Layout, RayCounters, Strategy, TraversalOrder};
 use bvhscope_core::geometry::{Aabb, Ray};
 use bvhscope_core::mesh::Mesh;
 use bvhscope_core::render::Camera;
@@ -13,14 +13,8 @@ use bvhscope_gpu::{GpuBinaryBvh, GpuTraceOptions, Rays};
 use common::*;
 use glam::Vec3;
 
-const STRATEGIES: [SplitStrategy; 6] = [
-    SplitStrategy::Midpoint,
-    SplitStrategy::EqualCount,
-    SplitStrategy::SahBinned,
-    SplitStrategy::Lbvh,
-    SplitStrategy::Ploc,
-    SplitStrategy::Sbvh,
-];
+const STRATEGIES: [Strategy; 6] =
+    [Strategy::Midpoint, Strategy::EqualCount, Strategy::SahBinned, Strategy::Lbvh, Strategy::Ploc, Strategy::Sbvh];
 
 fn opts(order: TraversalOrder) -> GpuTraceOptions {
     GpuTraceOptions { order, ..GpuTraceOptions::default() }
@@ -70,7 +64,7 @@ fn plain_walks_find_the_counted_walks_hits_and_the_global_stack_the_private_ones
     let Some(gpu) = gpu() else { return };
     let mesh = exact_mesh();
     let rays = exact_rays();
-    let bvh = build(&mesh, SplitStrategy::SahBinned, 4);
+    let bvh = build(&mesh, Strategy::SahBinned, 4);
     let g = GpuBinaryBvh::upload(&gpu, &bvh).unwrap();
     assert!(!g.global_stack());
     let counted = g.trace(&gpu, Rays::List(&rays), GpuTraceOptions::default()).unwrap();
@@ -128,7 +122,7 @@ fn a_tree_deeper_than_the_private_stack_is_walked_with_the_cpus_results() {
 #[test]
 fn an_empty_mesh_is_missed_with_one_box_test_and_a_broken_tree_is_refused() {
     let Some(gpu) = gpu() else { return };
-    let empty = build(&Mesh::from_triangles("empty", vec![], vec![]), SplitStrategy::SahBinned, 4);
+    let empty = build(&Mesh::from_triangles("empty", vec![], vec![]), Strategy::SahBinned, 4);
     let g = GpuBinaryBvh::upload(&gpu, &empty).unwrap();
     let rays = [Ray::new(Vec3::ZERO, Vec3::X), Ray::new(Vec3::splat(f32::NAN), Vec3::X)];
     let t = g.trace(&gpu, Rays::List(&rays), GpuTraceOptions::default()).unwrap();
@@ -136,7 +130,7 @@ fn an_empty_mesh_is_missed_with_one_box_test_and_a_broken_tree_is_refused() {
     let one_box = RayCounters { box_tests: 1, ..RayCounters::ZERO };
     assert_eq!(t.counters, [one_box, one_box]);
 
-    let mut broken = build(&exact_mesh(), SplitStrategy::SahBinned, 4);
+    let mut broken = build(&exact_mesh(), Strategy::SahBinned, 4);
     let last = broken.nodes.len() as u32;
     broken.nodes[0].index = last - 1;
     let e = GpuBinaryBvh::upload(&gpu, &broken).err().expect("refused");
@@ -182,7 +176,7 @@ fn camera_frames_equal_the_cpus_frames() {
     let mesh = exact_mesh();
     let cam = Camera::framing(&mesh.bounds(), 64, 48);
     let rays = camera_rays(&cam);
-    for strategy in [SplitStrategy::SahBinned, SplitStrategy::Lbvh] {
+    for strategy in [Strategy::SahBinned, Strategy::Lbvh] {
         let bvh = build(&mesh, strategy, 4);
         let g = GpuBinaryBvh::upload(&gpu, &bvh).unwrap();
         for order in ORDERS {
@@ -205,7 +199,7 @@ fn shared_meshes_equal_the_cpu_on_nearly_every_ray_and_the_rest_are_explained() 
     let Some(gpu) = gpu() else { return };
     for name in ["stanford-bunny.obj", "spot.obj", "suzanne.obj"] {
         let Some(mesh) = shared_mesh(name) else { return };
-        let bvh = build(&mesh, SplitStrategy::SahBinned, 4);
+        let bvh = build(&mesh, Strategy::SahBinned, 4);
         let g = GpuBinaryBvh::upload(&gpu, &bvh).unwrap();
         let cam = Camera::framing(&mesh.bounds(), 96, 72);
         let primary = camera_rays(&cam);
@@ -233,7 +227,7 @@ fn shared_meshes_equal_the_cpu_on_nearly_every_ray_and_the_rest_are_explained() 
 #[test]
 fn explain_accepts_a_nearby_rays_answer_and_refuses_a_wrong_one() {
     let mesh = exact_mesh();
-    let bvh = build(&mesh, SplitStrategy::SahBinned, 4);
+    let bvh = build(&mesh, Strategy::SahBinned, 4);
     let order = TraversalOrder::EntryDistance;
     // Aimed exactly at the vertex (1, 1, 1) from above: rays a few ulps away meet the
     // neighbouring triangles.
@@ -259,7 +253,7 @@ fn without_doubles_no_ray_misses_what_the_cpu_hits() {
     assert!(!gpu.has_f64());
     let mesh = exact_mesh();
     let rays = exact_rays();
-    let bvh = build(&mesh, SplitStrategy::SahBinned, 4);
+    let bvh = build(&mesh, Strategy::SahBinned, 4);
     let g = GpuBinaryBvh::upload(&gpu, &bvh).unwrap();
     let t = g.trace(&gpu, Rays::List(&rays), GpuTraceOptions::default()).unwrap();
     let (hits, _) = cpu_trace(&bvh, &rays, TraversalOrder::EntryDistance);
@@ -281,7 +275,7 @@ fn small_buffer_limits_split_the_rays_into_batches_or_refuse_them() {
         .unwrap()
     };
     let mesh = exact_mesh();
-    let bvh = build(&mesh, SplitStrategy::SahBinned, 4);
+    let bvh = build(&mesh, Strategy::SahBinned, 4);
     let cam = Camera::framing(&mesh.bounds(), 64, 48);
     let rays = camera_rays(&cam);
     let gpu = small(40_000);

@@ -4,15 +4,15 @@
 
 mod common;
 
-use bvhscope_core::bvh::{Bvh, Hit, RayCounters, SplitStrategy, TraversalOrder};
+use bvhscope_core::bvh::{Bvh, Hit, RayCounters, Strategy, TraversalOrder};
 use bvhscope_core::geometry::{intersect_triangle, Aabb, Ray, TriangleTest};
 use bvhscope_core::mesh::Mesh;
 use bvhscope_core::render::Camera;
 use bvhscope_gpu::{Cwbvh, GpuCwbvh, GpuTraceOptions, Rays};
 use common::*;
 
-const STRATEGIES: [SplitStrategy; 5] =
-    [SplitStrategy::Midpoint, SplitStrategy::SahBinned, SplitStrategy::Lbvh, SplitStrategy::Ploc, SplitStrategy::Sbvh];
+const STRATEGIES: [Strategy; 5] =
+    [Strategy::Midpoint, Strategy::SahBinned, Strategy::Lbvh, Strategy::Ploc, Strategy::Sbvh];
 
 /// The tree's shape: every binary leaf once as a leaf record, every decoded child box holding the
 /// binary node it stands for (checked by walking both trees together), groups contiguous.
@@ -122,7 +122,7 @@ fn a_deep_chain_and_an_empty_mesh_convert_and_trace() {
         })
         .collect();
     let mesh = Mesh::from_triangles("chain", positions, (0..n).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect());
-    let bvh = build(&mesh, SplitStrategy::Midpoint, 1);
+    let bvh = build(&mesh, Strategy::Midpoint, 1);
     let w = Cwbvh::from_bvh(&bvh).unwrap();
     check_structure(&bvh, &w);
     let g = GpuCwbvh::upload(&gpu, &w).unwrap();
@@ -131,7 +131,7 @@ fn a_deep_chain_and_an_empty_mesh_convert_and_trace() {
     let t = g.trace(&gpu, Rays::List(&rays), GpuTraceOptions::default()).unwrap();
     assert_eq!(compare("chain", &bvh, &w, &rays, &t.hits, &t.counters), 0);
 
-    let empty = build(&Mesh::from_triangles("empty", vec![], vec![]), SplitStrategy::SahBinned, 4);
+    let empty = build(&Mesh::from_triangles("empty", vec![], vec![]), Strategy::SahBinned, 4);
     let w = Cwbvh::from_bvh(&empty).unwrap();
     let g = GpuCwbvh::upload(&gpu, &w).unwrap();
     let t = g.trace(&gpu, Rays::List(&rays[..2]), GpuTraceOptions::default()).unwrap();
@@ -150,7 +150,7 @@ fn shared_meshes_and_camera_frames_match_the_cpu_walk() {
         }
     }
     for (name, mesh) in meshes {
-        let bvh = build(&mesh, SplitStrategy::SahBinned, 4);
+        let bvh = build(&mesh, Strategy::SahBinned, 4);
         let w = Cwbvh::from_bvh(&bvh).unwrap();
         check_structure(&bvh, &w);
         let g = GpuCwbvh::upload(&gpu, &w).unwrap();

@@ -7,7 +7,7 @@
 mod common;
 
 use bvhscope_core::bvh::morton::MortonOrder;
-use bvhscope_core::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
+use bvhscope_core::bvh::{BuildParams, Bvh, Layout, Strategy};
 use bvhscope_core::dump::BvhDump;
 use bvhscope_core::explain::check::check_tree;
 use bvhscope_core::mesh::{generate, Mesh};
@@ -16,7 +16,7 @@ use common::*;
 use glam::Vec3;
 
 fn params(max_leaf_size: u32) -> BuildParams {
-    BuildParams { strategy: SplitStrategy::Lbvh, max_leaf_size, layout: Layout::Binary, ..BuildParams::default() }
+    BuildParams { strategy: Strategy::Lbvh, max_leaf_size, layout: Layout::Binary, ..BuildParams::default() }
 }
 
 /// Whether core's tree keeps equal codes in triangle order (its sort is stable on this mesh).

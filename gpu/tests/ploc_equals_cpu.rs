@@ -5,7 +5,7 @@
 mod common;
 
 use bvhscope_core::bvh::morton::MortonOrder;
-use bvhscope_core::bvh::{BuildParams, Bvh, Layout, SplitStrategy, TreeStats};
+use bvhscope_core::bvh::{BuildParams, Bvh, Layout, Strategy, TreeStats};
 use bvhscope_core::dump::BvhDump;
 use bvhscope_core::explain::check::check_tree;
 use bvhscope_core::mesh::{generate, Mesh};
@@ -15,7 +15,7 @@ use glam::Vec3;
 
 fn params(max_leaf_size: u32, ploc_radius: u32) -> BuildParams {
     BuildParams {
-        strategy: SplitStrategy::Ploc,
+        strategy: Strategy::Ploc,
         max_leaf_size,
         ploc_radius,
         layout: Layout::Binary,
@@ -27,10 +27,8 @@ fn params(max_leaf_size: u32, ploc_radius: u32) -> BuildParams {
 /// on the code alone; small meshes are sorted stably): computed from core's LBVH, whose leaf order
 /// is that sort.
 fn cpu_sort_is_stable(mesh: &Mesh) -> bool {
-    let lbvh = Bvh::build(
-        mesh,
-        &BuildParams { strategy: SplitStrategy::Lbvh, layout: Layout::Binary, ..BuildParams::default() },
-    );
+    let lbvh =
+        Bvh::build(mesh, &BuildParams { strategy: Strategy::Lbvh, layout: Layout::Binary, ..BuildParams::default() });
     let Some(order) = MortonOrder::of(&lbvh) else { return true };
     (1..order.codes.len()).all(|i| order.codes[i] != order.codes[i - 1] || lbvh.prim_ids[i] > lbvh.prim_ids[i - 1])
 }

@@ -3,7 +3,7 @@
 
 mod common;
 
-use bvhscope_core::bvh::{RayCounters, SplitStrategy, TraversalOrder};
+use bvhscope_core::bvh::{RayCounters, Strategy, TraversalOrder};
 use bvhscope_core::geometry::TriangleTest;
 use bvhscope_core::render::Camera;
 use bvhscope_gpu::{Cwbvh, GpuBinaryBvh, GpuCwbvh, GpuTraceOptions, Rays, WarpSize, WarpView, WarpWork};
@@ -13,7 +13,7 @@ use common::*;
 fn gpu_and_cpu_counts_give_the_same_warp_view() {
     let Some(gpu) = gpu() else { return };
     let mesh = shared_mesh("stanford-bunny.obj").unwrap_or_else(exact_mesh);
-    let bvh = build(&mesh, SplitStrategy::SahBinned, 4);
+    let bvh = build(&mesh, Strategy::SahBinned, 4);
     let cam = Camera::framing(&mesh.bounds(), 80, 60);
     let primary = camera_rays(&cam);
     let incoherent = incoherent_rays(&mesh, 4096, 3);

@@ -1,9 +1,7 @@
 //! Arguments shared by the subcommands. Every value list, help line, limit and default comes from
 //! the core's option tables (`crate::options`), which the app's panels and scene files read too.
 
-use crate::bvh::{
-    BuildParams, Layout, Param, ParamValue, Preset, SceneBuild, SplitStrategy, TraceOptions, TraversalOrder,
-};
+use crate::bvh::{BuildParams, Layout, Param, ParamValue, Preset, SceneBuild, Strategy, TraceOptions, TraversalOrder};
 use crate::geometry::{Aabb, TriangleTest};
 use crate::gpu_path::{Device, GpuNodes};
 use crate::options::{Choice, Number, BUILD_PARAMS, TOP_MAX_LEAF_SIZE};
@@ -59,8 +57,8 @@ pub struct BuildArgs {
     #[arg(long, value_parser = choice::<Preset>())]
     pub preset: Option<Preset>,
     /// Split strategy [default: sah].
-    #[arg(long, short, value_parser = choice::<SplitStrategy>())]
-    pub strategy: Option<SplitStrategy>,
+    #[arg(long, short, value_parser = choice::<Strategy>())]
+    pub strategy: Option<Strategy>,
     #[command(flatten)]
     pub numbers: ParamArgs,
     /// Node layout for traversal [default: wide4; `compare` shows both unless one is given].
@@ -78,8 +76,8 @@ pub struct BuildArgs {
     #[arg(long)]
     pub two_level: bool,
     /// Split strategy of the top level [default: --strategy].
-    #[arg(long, value_parser = choice::<SplitStrategy>(), requires = "two_level")]
-    pub top_strategy: Option<SplitStrategy>,
+    #[arg(long, value_parser = choice::<Strategy>(), requires = "two_level")]
+    pub top_strategy: Option<Strategy>,
     #[arg(long, default_value_t = TOP_MAX_LEAF_SIZE.limits.default, value_parser = whole(&TOP_MAX_LEAF_SIZE), help = format!("{} ({})", TOP_MAX_LEAF_SIZE.help, TOP_MAX_LEAF_SIZE.limits.range_text()), requires = "two_level")]
     pub top_max_leaf_size: u32,
 }
@@ -103,7 +101,7 @@ impl BuildArgs {
     }
 
     /// `params` with the strategy and layout given (`compare` goes through them all).
-    pub fn params_with(&self, scene: Option<&BuildParams>, strategy: SplitStrategy, layout: Layout) -> BuildParams {
+    pub fn params_with(&self, scene: Option<&BuildParams>, strategy: Strategy, layout: Layout) -> BuildParams {
         let mut p = BuildParams { strategy, layout, ..self.base(scene) };
         for &(param, v) in &self.numbers.0 {
             param.set(&mut p, v);
@@ -142,16 +140,24 @@ impl BuildArgs {
 /// `trace` take (the GPU path's rules are in `cli::device`).
 #[derive(Args, Debug, Clone, Default)]
 pub struct DeviceArgs {
-    /// Trace the rays on the CPU or on the GPU (wgpu compute shaders: Vulkan, Metal, DX12; Mesa's
-    /// lavapipe too). On the GPU the per-pixel counts are the CPU's for the binary layout, the
-    /// strategies lbvh and ploc are built there too, and only the watertight test and one level
-    /// run; with no GPU adapter the command fails (it never falls back to the CPU).
-    #[arg(long, value_enum, default_value = "cpu")]
+    /// Trace the rays on the CPU or on the GPU (its help: `device_help`).
+    #[arg(long, value_enum, default_value = "cpu", help = device_help())]
     pub device: Device,
     /// With --device gpu: the node format walked, the binary tree as built or its compressed
     /// 8-wide form (CWBVH) [default: binary].
     #[arg(long, value_enum, value_name = "FORMAT")]
     pub gpu_nodes: Option<GpuNodes>,
+}
+
+/// `--device`'s help, naming the strategies the GPU builds from its table.
+fn device_help() -> String {
+    format!(
+        "Trace the rays on the CPU or on the GPU (wgpu compute shaders: Vulkan, Metal, DX12; Mesa's lavapipe \
+         too). On the GPU the per-pixel counts are the CPU's for the binary layout, the strategies {} are built \
+         there too, and only the watertight test and one level run; with no GPU adapter the command fails (it \
+         never falls back to the CPU).",
+        crate::gpu_path::gpu_built()
+    )
 }
 
 impl DeviceArgs {
@@ -301,7 +307,7 @@ mod tests {
             #[command(flatten)]
             b: BuildArgs,
         }
-        let scene = BuildParams { strategy: SplitStrategy::EqualCount, max_leaf_size: 2, ..BuildParams::default() };
+        let scene = BuildParams { strategy: Strategy::EqualCount, max_leaf_size: 2, ..BuildParams::default() };
         let parse = |args: &[&str]| T::parse_from([&["t"], args].concat()).b;
         let plain = parse(&[]);
         assert_eq!(plain.params(None), BuildParams::default());
@@ -313,9 +319,9 @@ mod tests {
         assert_eq!(handout.compare_layouts(), vec![Layout::Binary]);
         let mine = parse(&["--preset", "handout", "--max-leaf-size", "8", "--triangle-test", "watertight"]);
         let p = mine.params(None);
-        assert_eq!((p.strategy, p.layout, p.max_leaf_size), (SplitStrategy::Midpoint, Layout::Binary, 8));
+        assert_eq!((p.strategy, p.layout, p.max_leaf_size), (Strategy::Midpoint, Layout::Binary, 8));
         assert_eq!(mine.trace(), TraceOptions { test: TriangleTest::Watertight, ..Preset::Handout.trace() });
-        assert_eq!(parse(&["-s", "sah-sweep"]).params(Some(&scene)).strategy, SplitStrategy::SahSweep);
+        assert_eq!(parse(&["-s", "sah-sweep"]).params(Some(&scene)).strategy, Strategy::SahSweep);
         assert_eq!(parse(&[]).compare_layouts(), Layout::ALL.to_vec());
     }
 
@@ -340,7 +346,7 @@ mod tests {
             }
         }
         // Every number away from its default, each within its limits.
-        let mut p = BuildParams { strategy: SplitStrategy::Sbvh, layout: Layout::Binary, ..BuildParams::default() };
+        let mut p = BuildParams { strategy: Strategy::Sbvh, layout: Layout::Binary, ..BuildParams::default() };
         for o in &BUILD_PARAMS {
             let v = match o.limits() {
                 crate::bvh::ParamLimits::Whole(l) => ParamValue::Whole(if l.default == l.max { l.min } else { l.max }),

@@ -1,11 +1,11 @@
 //! `bvhscope check MESH --bvh FILE`: a BVH written by another program, checked against the mesh
 //! and the linear scan (`explain::check`), then set next to bvhscope's strategies on the same mesh.
-//! Exit 0: correct (warnings allowed); 1: defects; 2: the input cannot be read.
-//! `bvhscope export-bvh MESH -o FILE`: a built-in strategy's tree in the same format.
+//! Exit 0: correct (warnings allowed); 1: defects; 2: the input cannot be read. (`export-bvh`,
+//! which writes a built-in strategy's tree in that format, is `export_bvh.rs`.)
 
 use super::args::{BuildArgs, DumpLimit, ViewArgs};
 use super::{load_mesh, progress, CliError};
-use crate::bvh::{epo, AnyBvh, BuildParams, Layout, SplitStrategy, TreeStats, TreeView};
+use crate::bvh::{epo, AnyBvh, BuildParams, Strategy, TreeStats, TreeView};
 use crate::dump::BvhDump;
 use crate::explain::check::{check, Finding, Group, Subject, FINDINGS_LISTED, LISTED, MAX_RAYS};
 use crate::render::{render, RenderSettings};
@@ -131,7 +131,7 @@ pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
         table.push(quality(names.label(), t, &mesh, &camera, trace));
         // bvhscope's trees in the imported one's layout.
         let layout = t.params().layout;
-        for s in SplitStrategy::ALL {
+        for s in Strategy::ALL {
             let b = AnyBvh::build(&mesh, &BuildParams { strategy: s, layout, ..BuildParams::default() });
             table.push(quality(format!("{}, {}", s.label(), layout.name()), &b, &mesh, &camera, trace));
         }
@@ -197,48 +197,4 @@ fn text(path: &std::path::Path, findings: &[Finding], table: &[QualityRow], list
         }
     }
     o
-}
-
-#[derive(Args, Debug)]
-pub struct ExportArgs {
-    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene). The tree written is the binary one unless --layout wide4 or wide8 is given.
-    pub mesh: PathBuf,
-    #[command(flatten)]
-    pub build: BuildArgs,
-    /// With --device gpu the strategies lbvh and ploc are built on the GPU (the same tree as the
-    /// CPU's, node for node); the others are built on the CPU either way.
-    #[command(flatten)]
-    pub device: super::args::DeviceArgs,
-    /// The file to write: .json (JSON), .json.gz (gzip-compressed JSON) or .txt (the text form).
-    #[arg(long, short)]
-    pub output: PathBuf,
-}
-
-/// `export-bvh`: the binary tree as built, in the bvhscope-bvh format.
-pub fn export(a: &ExportArgs) -> Result<(), CliError> {
-    // Before anything is built: a name that says no dump format, an output that is the mesh.
-    BvhDump::written_as(&a.output).map_err(CliError::Usage)?;
-    crate::files::refuse_inputs(&a.output, &[(&a.mesh, "the mesh")])?;
-    if a.device.gpu_nodes.is_some() {
-        return Err(CliError::Usage("--gpu-nodes is the format the GPU traces; export-bvh writes no GPU nodes".into()));
-    }
-    let gpu = super::device::open(&a.device)?;
-    let scene = load_mesh(&a.mesh)?;
-    let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(format!("{}: {e}", a.mesh.display())))?;
-    // The binary tree unless --layout wide4 or wide8 asks for a wide one.
-    let layout = a.build.layout.unwrap_or(Layout::Binary);
-    let params = BuildParams { layout, ..a.build.params(scene.build.as_ref()) };
-    let name = crate::files::file_name(&a.mesh);
-    let built = match &gpu {
-        Some(g) => super::device::gpu_build(g, &mesh, &params)?.map(|(bvh, _)| bvh),
-        None => None,
-    };
-    if gpu.is_some() && built.is_none() {
-        eprintln!("note: the GPU builds lbvh and ploc; {} is built on the CPU", params.strategy.name());
-    }
-    let bvh = built.unwrap_or_else(|| AnyBvh::build(&mesh, &params));
-    let dump = BvhDump::of_any(&bvh, &mesh, Some(name));
-    dump.write(&a.output).map_err(|e| CliError::Usage(e.to_string()))?;
-    eprintln!("wrote {} ({} nodes, {} primitives)", a.output.display(), dump.nodes.len(), dump.primitives.len());
-    Ok(())
 }

@@ -9,7 +9,9 @@
 use super::args::{BuildArgs, DeviceArgs};
 use super::{progress, CliError};
 use crate::bvh::{AnyBvh, BuildParams, Layout, SceneBuild, SceneBvh, TraceOptions};
-pub use crate::gpu_path::{build_on_gpu, builds_on_gpu, GpuBuild, GpuNodes, GpuTree};
+pub use crate::gpu_path::{
+    build_on_gpu, build_scene_on_gpu, builds_on_gpu, GpuBuild, GpuBuildError, GpuNodes, GpuTree,
+};
 use crate::mesh::Mesh;
 use crate::render::{Camera, Frame};
 use crate::scene::Scene;
@@ -96,20 +98,17 @@ pub fn gpu_build(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Option<
     progress::with_spinner(&label, || build_on_gpu(gpu, mesh, params)).map_err(gpu_error)
 }
 
-/// Build what `build` asks for: lbvh and ploc of one level on the GPU when there is one, anything
-/// else on the CPU (`cli::build_scene`).
-pub fn build_scene(
-    gpu: Option<&Gpu>,
-    scene: &Scene,
-    build: &SceneBuild,
-) -> Result<(SceneBvh, Option<GpuBuild>), CliError> {
-    if let (Some(gpu), None) = (gpu, build.top) {
-        let mesh = scene.flat_mesh()?;
-        if let Some((bvh, phases)) = gpu_build(gpu, &mesh, &build.bvh)? {
-            return Ok((SceneBvh::Single { bvh, mesh, imported: None }, Some(phases)));
-        }
+/// `build` on the GPU with a spinner, when the GPU builds it (`gpu_path::builds_on_gpu`); `None`:
+/// the CPU builds it (`cli::build_scene`).
+pub fn gpu_build_scene(gpu: &Gpu, scene: &Scene, build: &SceneBuild) -> Result<Option<(SceneBvh, GpuBuild)>, CliError> {
+    if !builds_on_gpu(build) {
+        return Ok(None);
     }
-    Ok((super::build_scene(scene, build)?, None))
+    let label = format!("building the BVH ({} on the GPU)", build.bvh.strategy.label());
+    progress::with_spinner(&label, || build_scene_on_gpu(gpu, scene, build)).map_err(|e| match e {
+        GpuBuildError::Scene(e) => e.into(),
+        GpuBuildError::Gpu(e) => gpu_error(e),
+    })
 }
 
 /// The command line's spinners and errors over the GPU path's tree.
@@ -159,16 +158,10 @@ impl clap::ValueEnum for crate::gpu_path::Device {
 
 impl clap::ValueEnum for GpuNodes {
     fn value_variants<'a>() -> &'a [Self] {
-        &[GpuNodes::Binary, GpuNodes::Cwbvh]
+        &GpuNodes::ALL
     }
     fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        let (name, help) = match self {
-            GpuNodes::Binary => ("binary", "The binary tree as built: core's 32-byte nodes, byte for byte"),
-            GpuNodes::Cwbvh => (
-                "cwbvh",
-                "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree",
-            ),
-        };
-        Some(clap::builder::PossibleValue::new(name).help(help))
+        let row = self.row();
+        Some(clap::builder::PossibleValue::new(row.value).help(row.help))
     }
 }

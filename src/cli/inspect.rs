@@ -231,7 +231,7 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     let params = a.build.params(scene.build.as_ref());
     let built = match &a.bvh {
         Some(path) => a.dump_limit.import(&scene, path)?,
-        None => build_scene(&scene, &a.build.scene_build(params))?,
+        None => build_scene(None, &scene, &a.build.scene_build(params))?.0,
     };
     let SceneBvh::Single { bvh, .. } = &built else { unreachable!("one level was asked for") };
     let tree = built.binary_tree().expect("a single BVH has a binary tree");

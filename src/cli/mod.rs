@@ -5,6 +5,7 @@ mod args;
 pub mod check;
 mod compare;
 pub mod device;
+mod export_bvh;
 mod grade;
 pub mod inspect;
 mod progress;
@@ -102,7 +103,7 @@ pub enum Command {
     /// 1: defects, 2: unreadable).
     Check(check::CheckArgs),
     /// Write a built-in strategy's binary tree in the bvhscope-bvh format.
-    ExportBvh(check::ExportArgs),
+    ExportBvh(export_bvh::ExportBvhArgs),
     /// Grade a class: check every student's BVH dump, measure it next to bvhscope's trees, rank
     /// them, and write a report folder (HTML, CSV, JSON).
     Grade(grade::GradeArgs),
@@ -161,12 +162,22 @@ pub(crate) fn load_noted(path: &Path, whole_note: bool) -> Result<Scene, CliErro
     Ok(loaded)
 }
 
-/// Build what `build` asks for over a loaded file; for two levels an OBJ is one placement of
-/// itself. One level over a scene too large to flatten is refused (`Scene::check_one_level`),
-/// before anything is allocated.
-pub(crate) fn build_scene(scene: &Scene, build: &crate::bvh::SceneBuild) -> Result<crate::bvh::SceneBvh, CliError> {
+/// Build what `build` asks for over a loaded file: on `gpu` when there is one and it builds this
+/// (`gpu_path::builds_on_gpu`; the phases come back too), else on the CPU, where for two levels
+/// an OBJ is one placement of itself. One level over a scene too large to flatten is refused
+/// (`Scene::check_one_level`), before anything is allocated.
+pub(crate) fn build_scene(
+    gpu: Option<&bvhscope_gpu::Gpu>,
+    scene: &Scene,
+    build: &crate::bvh::SceneBuild,
+) -> Result<(crate::bvh::SceneBvh, Option<device::GpuBuild>), CliError> {
     if build.top.is_none() {
         scene.check_one_level().map_err(|e| CliError::Usage(format!("{e} (--two-level)")))?;
+    }
+    if let Some(gpu) = gpu {
+        if let Some(built) = device::gpu_build_scene(gpu, scene, build)? {
+            return Ok((built.0, Some(built.1)));
+        }
     }
     let label = if build.top.is_some() { "building the two-level BVH" } else { "building the BVH" };
     progress::with_spinner(label, || match scene.build(build, &crate::work::WorkControl::new()) {
@@ -174,6 +185,7 @@ pub(crate) fn build_scene(scene: &Scene, build: &crate::bvh::SceneBuild) -> Resu
         Err(SceneBuildError::Scene(e)) => Err(e.into()),
         Err(SceneBuildError::Cancelled) => unreachable!("nobody else holds this control"),
     })
+    .map(|bvh| (bvh, None))
 }
 
 impl From<SceneError> for CliError {
@@ -193,7 +205,7 @@ pub fn run(command: Command) -> Result<(), CliError> {
         Command::Inspect(a) => inspect::run(&a),
         Command::Replay(a) => replay::run(&a),
         Command::Check(a) => check::run(&a),
-        Command::ExportBvh(a) => check::export(&a),
+        Command::ExportBvh(a) => export_bvh::run(&a),
         Command::Grade(a) => grade::run(&a),
         Command::Stats(a) => stats::run(&a),
         Command::Compare(a) => compare::run(&a),

@@ -3,7 +3,6 @@
 
 use crate::work::WorkControl;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 const SHOW_AFTER: Duration = Duration::from_secs(1);
@@ -19,24 +18,12 @@ pub fn with_spinner<T: Send>(label: &str, work: impl FnOnce() -> T + Send) -> T 
     watch(label, None, work)
 }
 
-/// Sets `finished` when dropped: when the work returns, and when it panics (the scope then waits
-/// for the display thread, which must stop, before the panic goes on to end the process).
-struct Finish<'a>(&'a AtomicBool);
-
-impl Drop for Finish<'_> {
-    fn drop(&mut self) {
-        self.0.store(true, Ordering::Release);
-    }
-}
-
 fn watch<T: Send>(label: &str, bar: Option<&WorkControl>, work: impl FnOnce() -> T + Send) -> T {
-    let finished = AtomicBool::new(false);
-    std::thread::scope(|s| {
-        s.spawn(|| {
+    crate::work::watched(
+        |ended| {
             let start = Instant::now();
             let mut pb: Option<ProgressBar> = None;
-            while !finished.load(Ordering::Acquire) {
-                std::thread::sleep(TICK);
+            while !ended.after(TICK) {
                 if pb.is_none() && start.elapsed() >= SHOW_AFTER {
                     let p = match bar {
                         Some(c) => ProgressBar::new(c.total()).with_style(
@@ -62,10 +49,9 @@ fn watch<T: Send>(label: &str, bar: Option<&WorkControl>, work: impl FnOnce() ->
             if let Some(p) = pb {
                 p.finish_and_clear();
             }
-        });
-        let _finish = Finish(&finished);
-        work()
-    })
+        },
+        work,
+    )
 }
 
 #[cfg(test)]

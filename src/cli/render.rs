@@ -46,8 +46,8 @@ pub struct RenderArgs {
     /// Compare with a second build that differs only in its split strategy: the PNG shows the
     /// difference of the heatmap's metric, this strategy's minus the build's, per pixel (blue:
     /// less work, red: more; --range MIN:MAX sets ±max(|MIN|, |MAX|)).
-    #[arg(long, value_parser = super::args::choice::<crate::bvh::SplitStrategy>(), value_name = "STRATEGY")]
-    pub against: Option<crate::bvh::SplitStrategy>,
+    #[arg(long, value_parser = super::args::choice::<crate::bvh::Strategy>(), value_name = "STRATEGY")]
+    pub against: Option<crate::bvh::Strategy>,
     /// Print the heatmap's histogram as CSV (`bin_low,bin_high,pixels`): BINS equal bins over the
     /// legend's range, the bars under the app's legend (which has 32).
     #[arg(long, value_name = "BINS", value_parser = clap::value_parser!(u32).range(1..=10000))]
@@ -168,7 +168,7 @@ fn run_against(
     frame_a: &crate::render::Frame,
     params_a: &crate::bvh::SceneBuild,
     label_a: &str,
-    against: crate::bvh::SplitStrategy,
+    against: crate::bvh::Strategy,
 ) -> Result<(), CliError> {
     use crate::render::diff::{difference, tally, DiffRange};
     use crate::render::pair::{difference_csv, pair_picture, PairStyle};
@@ -180,7 +180,7 @@ fn run_against(
     let params_a = *params_a;
     let params_b =
         crate::bvh::SceneBuild { bvh: crate::bvh::BuildParams { strategy: against, ..params_a.bvh }, ..params_a };
-    let (bvh_b, _) = device::build_scene(gpu, loaded, &params_b)?;
+    let (bvh_b, _) = super::build_scene(gpu, loaded, &params_b)?;
     let frame_b = frame_of(a, gpu, &bvh_b, camera, settings, "rendering the second build")?;
     let cost = params_a.bvh.cost;
     if let Some(path) = &a.difference {
@@ -235,7 +235,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     let bvh = match &a.bvh {
         Some(path) => a.dump_limit.import(&loaded, path)?,
-        None => device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
+        None => super::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
     };
     let kind = a.rays.one("render")?;
     if gpu.is_some() && kind.is_secondary() {

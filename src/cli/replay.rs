@@ -57,7 +57,7 @@ pub fn output(a: &ReplayArgs) -> Result<String, CliError> {
     crate::files::refuse_inputs(&a.output, &[(&a.mesh, "the mesh")])?;
     let scene = load_mesh(&a.mesh)?;
     let params = a.build.params(scene.build.as_ref());
-    let SceneBvh::Single { bvh, mesh, .. } = build_scene(&scene, &a.build.scene_build(params))? else {
+    let (SceneBvh::Single { bvh, mesh, .. }, _) = build_scene(None, &scene, &a.build.scene_build(params))? else {
         unreachable!("one level was asked for")
     };
     if params.layout != Layout::Binary {

@@ -11,7 +11,7 @@ use clap::{Args, ValueEnum};
 use std::fmt::Write;
 use std::path::PathBuf;
 
-/// How `stats` prints (`--format`); the app's stats files are `app::export::StatsFormat`.
+/// How `stats` prints (`--format`); the app's stats files are `app::StatsFormat`.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum StatsOutput {
     Text,
@@ -135,7 +135,7 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
         params = device::gpu_params(&a.build, loaded.build.as_ref(), params)?;
         device::check_traceable(&a.build.scene_build(params), trace)?;
     }
-    let (bvh, gpu_build) = device::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?;
+    let (bvh, gpu_build) = super::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?;
     let report = &loaded.report;
     let kind = a.rays.one("stats")?;
     if gpu.is_some() && kind.is_secondary() && !a.no_rays {

@@ -133,7 +133,7 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
     }
     let bvh = match &a.bvh {
         Some(path) => a.dump_limit.import(&scene, path)?,
-        None => device::build_scene(gpu.as_ref(), &scene, &a.build.scene_build(params))?.0,
+        None => super::build_scene(gpu.as_ref(), &scene, &a.build.scene_build(params))?.0,
     };
     let on_gpu = match &gpu {
         Some(g) => Some((g, GpuTree::upload(g, &bvh, a.device.nodes())?)),

@@ -19,7 +19,7 @@ mod app_scenes;
 mod app_truth;
 
 use bvhscope::app::{Action, AppOptions, BvhscopeApp, MessageKind, SceneSource};
-use bvhscope::bvh::SplitStrategy;
+use bvhscope::bvh::Strategy;
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -50,7 +50,7 @@ fn choosing_another_strategy_rebuilds_and_changes_the_node_count() {
     h.run_steps(3);
     h.get_by_label("Midpoint").click();
     run_until(&mut h, "the midpoint build", |a| {
-        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint) && idle(a)
+        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == Strategy::Midpoint) && idle(a)
     });
     let after = h.state().current_bvh().unwrap().stats.nodes;
     assert_ne!(before, after, "midpoint and SAH trees differ in size here");
@@ -73,9 +73,9 @@ fn switching_back_before_a_build_finishes_cancels_it() {
         h.state_mut().act(Action::Edit(Box::new(s)));
         h.state_mut().reconcile();
     };
-    choose(&mut h, SplitStrategy::Midpoint);
+    choose(&mut h, Strategy::Midpoint);
     assert!(h.state().jobs.build.is_some(), "the midpoint build runs");
-    choose(&mut h, SplitStrategy::SahBinned);
+    choose(&mut h, Strategy::SahBinned);
     assert!(h.state().jobs.build.is_none(), "the midpoint build is cancelled");
     run_until(&mut h, "quiet", idle);
     for _ in 0..20 {
@@ -83,7 +83,7 @@ fn switching_back_before_a_build_finishes_cancels_it() {
         std::thread::sleep(Duration::from_millis(5));
     }
     let b = h.state().current_bvh().unwrap();
-    assert_eq!(b.bvh.build_params().bvh.strategy, SplitStrategy::SahBinned);
+    assert_eq!(b.bvh.build_params().bvh.strategy, Strategy::SahBinned);
     assert_eq!(b.stats.nodes, sah_nodes);
     assert!(h.state().previous.is_none(), "no strategy the user did not keep appears as 'before'");
 }
@@ -105,7 +105,7 @@ fn the_reconciler_re_renders_for_a_view_and_rebuilds_for_a_strategy() {
     edit(&mut h, &|s| s.view = bvhscope::render::View::Visits);
     assert!(h.state().jobs.build.is_none() && h.state().jobs.render.is_some(), "a view re-renders only");
     run_until(&mut h, "the heatmap", idle);
-    edit(&mut h, &|s| s.build.strategy = SplitStrategy::Midpoint);
+    edit(&mut h, &|s| s.build.strategy = Strategy::Midpoint);
     assert!(h.state().jobs.build.is_some(), "a strategy rebuilds");
 }
 
@@ -351,7 +351,7 @@ fn the_viewport_keeps_its_width_when_the_figures_change() {
 fn before_figures_from_another_camera_are_marked_stale() {
     let mut h = harness();
     run_until(&mut h, "the first build", idle);
-    h.state_mut().settings.build.strategy = SplitStrategy::Midpoint;
+    h.state_mut().settings.build.strategy = Strategy::Midpoint;
     run_until(&mut h, "the midpoint build", |a| a.previous.is_some() && a.rays.is_some() && idle(a));
     assert!(h.query_by_label("stale").is_none(), "same camera: the figures compare");
     // Orbit: the next frame's rays are others; the figures from before are not comparable.
@@ -445,7 +445,7 @@ fn handout_mode_is_one_click() {
     run_until(&mut h, "the first build", idle);
     h.get_by_label("Handout mode").click();
     run_until(&mut h, "the handout build", |a| {
-        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint) && idle(a)
+        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == Strategy::Midpoint) && idle(a)
     });
     let s = &h.state().settings;
     assert!(s.is_preset(bvhscope::bvh::Preset::Handout));

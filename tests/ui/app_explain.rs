@@ -167,14 +167,14 @@ fn the_pinned_rays_trace_command_prints_the_same_walk() {
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::Open, torus.clone()));
     run_until(&mut h, "the torus", |a| a.scene.source == SceneSource::File(torus.clone()) && idle(a));
     let mut s = h.state().settings.clone();
-    s.build.strategy = SplitStrategy::Midpoint;
+    s.build.strategy = Strategy::Midpoint;
     s.build.layout = Layout::Binary;
     s.build.max_leaf_size = 2;
     s.trace.order = TraversalOrder::SplitAxisSign;
     s.trace.test = TriangleTest::MollerTrumbore;
     h.state_mut().act(Action::Edit(Box::new(s)));
     run_until(&mut h, "the midpoint build", |a| {
-        idle(a) && a.shown.as_ref().is_some_and(|s| s.bvh.build_params().bvh.strategy == SplitStrategy::Midpoint)
+        idle(a) && a.shown.as_ref().is_some_and(|s| s.bvh.build_params().bvh.strategy == Strategy::Midpoint)
     });
     // The pixel of the frame's first hit, near its middle row.
     pin_first_hit(&mut h);
@@ -332,11 +332,11 @@ fn the_node_inspector_and_bvhscope_inspect_agree() {
     for (s, m) in &ins.markers {
         let j = &v["markers"][bvhscope::options::Choice::named(*s).name];
         // LBVH and PLOC price no plane at a node; the SBVH (its own driver) does.
-        if !s.splits_top_down() && *s != bvhscope::bvh::SplitStrategy::Sbvh {
+        if !s.splits_top_down() && *s != bvhscope::bvh::Strategy::Sbvh {
             assert!(m.is_none() && j.is_null(), "{s:?} prices no plane, in both");
             continue;
         }
-        if m.is_none() && *s == bvhscope::bvh::SplitStrategy::Sbvh {
+        if m.is_none() && *s == bvhscope::bvh::Strategy::Sbvh {
             assert!(j.is_null(), "the SBVH makes a leaf here, in both");
             continue;
         }

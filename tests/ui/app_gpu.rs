@@ -5,9 +5,9 @@
 //! under `CI=true`.
 
 use super::support::*;
-use bvhscope::app::gpu::Probe;
+use bvhscope::app::Probe;
 use bvhscope::app::{Action, BvhscopeApp};
-use bvhscope::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
+use bvhscope::bvh::{BuildParams, Bvh, Layout, Strategy};
 use bvhscope::cli::Device;
 use bvhscope::render::{render, RenderSettings, View};
 use egui_kittest::kittest::Queryable;
@@ -70,7 +70,7 @@ fn the_gpu_toggle_traces_frames_with_the_cpus_counts_and_builds_lbvh_there() {
     assert_gpu_frame_is_the_cpus(&h);
 
     // LBVH is built on the GPU: core's tree node for node, with its phases in the statistics.
-    edit(&mut h, |s| s.build.strategy = SplitStrategy::Lbvh);
+    edit(&mut h, |s| s.build.strategy = Strategy::Lbvh);
     let lbvh_on_gpu =
         |a: &BvhscopeApp| on_gpu(a) && a.current_bvh().is_some_and(|b| a.jobs.gpu.build_of(&b.bvh).is_some());
     run_until(&mut h, "lbvh built and traced on the GPU", lbvh_on_gpu);
@@ -79,7 +79,7 @@ fn the_gpu_toggle_traces_frames_with_the_cpus_counts_and_builds_lbvh_there() {
     let bvhscope::bvh::SceneBvh::Single { bvh: bvhscope::bvh::AnyBvh::Binary(gpu_tree), mesh, .. } = &*bvh else {
         panic!("one binary BVH")
     };
-    let params = BuildParams { strategy: SplitStrategy::Lbvh, layout: Layout::Binary, ..gpu_tree.params };
+    let params = BuildParams { strategy: Strategy::Lbvh, layout: Layout::Binary, ..gpu_tree.params };
     let cpu_tree = Bvh::build(mesh, &params);
     assert!(gpu_tree.nodes == cpu_tree.nodes && gpu_tree.prim_ids == cpu_tree.prim_ids, "the CPU's LBVH");
     h.get_by_label("GPU build");

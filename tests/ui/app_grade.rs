@@ -5,7 +5,7 @@
 
 use super::support::*;
 use bvhscope::app::{Action, BvhscopeApp, MessageKind, SceneSource};
-use bvhscope::bvh::{Layout, SplitStrategy};
+use bvhscope::bvh::{Layout, Strategy};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use std::path::{Path, PathBuf};
@@ -80,7 +80,7 @@ fn a_grade_report_shows_a_student_against_sah_or_why_not() {
         assert_eq!(t.defects(), 0, "checked again: correct");
         assert!(app.import.on && app.compare.on);
         let b = app.compare.b.as_ref().unwrap();
-        assert_eq!((b.build.bvh.strategy, b.build.bvh.layout), (SplitStrategy::SahBinned, Layout::Binary));
+        assert_eq!((b.build.bvh.strategy, b.build.bvh.layout), (Strategy::SahBinned, Layout::Binary));
         assert_eq!(app.settings.trace, r.trace);
         let c = app.shown.as_ref().unwrap().camera;
         assert_eq!(

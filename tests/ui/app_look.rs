@@ -91,13 +91,13 @@ fn look_grade_report() {
 #[test]
 #[ignore]
 fn look_gpu_frame() {
-    use bvhscope::app::gpu::Probe;
+    use bvhscope::app::Probe;
     let mut h = looking();
     run_until(&mut h, "the first frame", idle);
     run_until(&mut h, "the look for a GPU", |a| !matches!(a.jobs.gpu.probe, Probe::Looking));
     let mut s = h.state().settings.clone();
     s.view = bvhscope::render::View::Visits;
-    s.build.strategy = bvhscope::bvh::SplitStrategy::Lbvh;
+    s.build.strategy = bvhscope::bvh::Strategy::Lbvh;
     s.device = bvhscope::cli::Device::Gpu;
     h.state_mut().act(Action::Edit(Box::new(s)));
     h.state_mut().reconcile();
@@ -109,7 +109,7 @@ fn look_gpu_frame() {
     save(&mut h, "app-gpu-lbvh");
     // PLOC's rounds on the GPU too (its phases: clustering, the layout on the host).
     let mut s = h.state().settings.clone();
-    s.build.strategy = bvhscope::bvh::SplitStrategy::Ploc;
+    s.build.strategy = bvhscope::bvh::Strategy::Ploc;
     h.state_mut().act(Action::Edit(Box::new(s)));
     h.state_mut().reconcile();
     run_until(&mut h, "ploc built and traced on the GPU", |a| {
@@ -149,7 +149,7 @@ fn look_projector() {
         let mut h = projector();
         h.state_mut().act(Action::Present(present));
         open(&mut h, &scene);
-        with_strategy(&mut h, bvhscope::bvh::SplitStrategy::Midpoint);
+        with_strategy(&mut h, bvhscope::bvh::Strategy::Midpoint);
         run_until(&mut h, "midpoint's frame", |a| {
             idle(a) && a.current_bvh().is_some_and(|b| b.bvh.label().starts_with("Midpoint"))
         });
@@ -177,12 +177,12 @@ fn look_projector() {
 #[test]
 #[ignore]
 fn look_main_views() {
-    use bvhscope::bvh::SplitStrategy;
+    use bvhscope::bvh::Strategy;
     let scene = root().join("scenes/knot-on-floor.json");
     let mut h = looking();
     open(&mut h, &scene);
     let mut s = h.state().settings.clone();
-    (s.build.strategy, s.build.layout) = (SplitStrategy::Midpoint, bvhscope::bvh::Layout::Binary);
+    (s.build.strategy, s.build.layout) = (Strategy::Midpoint, bvhscope::bvh::Layout::Binary);
     (s.show_boxes, s.box_depth, s.boxes_in_front) = (true, 7, true);
     h.state_mut().act(Action::Edit(Box::new(s)));
     run_until(&mut h, "midpoint's boxes", |a| {
@@ -195,12 +195,12 @@ fn look_main_views() {
     s.fixed_ranges.insert(bvhscope::render::View::Visits, (0.0, 30.0));
     h.state_mut().act(Action::Edit(Box::new(s)));
     run_until(&mut h, "midpoint's heatmap", midpoint_heatmap_shown);
-    with_strategy(&mut h, SplitStrategy::SahBinned);
+    with_strategy(&mut h, Strategy::SahBinned);
     run_until(&mut h, "SAH binned's heatmap", |a| {
         idle(a) && a.previous.is_some() && a.current_bvh().is_some_and(|b| b.bvh.label().starts_with("SAH binned"))
     });
     save(&mut h, "app-heatmap-legend");
-    with_strategy(&mut h, SplitStrategy::Midpoint);
+    with_strategy(&mut h, Strategy::Midpoint);
     run_until(&mut h, "midpoint's heatmap", midpoint_heatmap_shown);
     h.state_mut().act(Action::Compare(true));
     run_until(&mut h, "B", pair_shown);

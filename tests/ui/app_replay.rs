@@ -160,21 +160,21 @@ fn two_strategies_side_by_side_and_their_difference() {
 
     // A changes: only A is rebuilt, B is kept.
     let mut s = h.state().settings.clone();
-    s.build.strategy = SplitStrategy::EqualCount;
+    s.build.strategy = Strategy::EqualCount;
     h.state_mut().act(Action::Edit(Box::new(s)));
     run_until(&mut h, "equal count as A", |a| {
         idle(a)
             && a.jobs.compare.is_none()
-            && a.shown.as_ref().is_some_and(|s| s.bvh.build_params().bvh.strategy == SplitStrategy::EqualCount)
+            && a.shown.as_ref().is_some_and(|s| s.bvh.build_params().bvh.strategy == Strategy::EqualCount)
     });
     assert!(Arc::ptr_eq(&h.state().compare.b.as_ref().unwrap().bvh, &b_bvh), "B was not rebuilt");
 
     // B the same as A: no difference anywhere.
-    h.state_mut().act(Action::CompareStrategy(SplitStrategy::EqualCount));
+    h.state_mut().act(Action::CompareStrategy(Strategy::EqualCount));
     run_until(&mut h, "B as equal count", |a| {
         idle(a)
             && a.jobs.compare.is_none()
-            && a.compare.b.as_ref().is_some_and(|b| b.build.bvh.strategy == SplitStrategy::EqualCount)
+            && a.compare.b.as_ref().is_some_and(|b| b.build.bvh.strategy == Strategy::EqualCount)
     });
     {
         let app = h.state();

@@ -102,12 +102,12 @@ fn compare_exports_are_what_the_screen_shows_byte_for_byte_the_clis() {
     let mut h = harness();
     let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/torus.obj");
     open(&mut h, &torus);
-    with_strategy(&mut h, SplitStrategy::Midpoint);
+    with_strategy(&mut h, Strategy::Midpoint);
     h.state_mut().act(Action::View(2));
     run_until(&mut h, "midpoint's heatmap", midpoint_heatmap_shown);
     h.state_mut().act(Action::Compare(true));
     run_until(&mut h, "B", pair_shown);
-    assert_eq!(h.state().compare.strategy, SplitStrategy::SahBinned);
+    assert_eq!(h.state().compare.strategy, Strategy::SahBinned);
     let camera = h.state().shown.as_ref().unwrap().camera;
     let cli = |pair: &str, wipe: f32, png: &Path, csv: &Path| {
         let mut args = vec![s("render"), s(torus.display()), s("--strategy"), s("midpoint"), s("--view"), s("visits")];
@@ -151,7 +151,7 @@ fn compare_exports_are_what_the_screen_shows_byte_for_byte_the_clis() {
 /// the room back.
 #[test]
 fn every_view_is_a_tile_beside_the_image_never_over_it() {
-    use bvhscope::app::dock::Pane;
+    use bvhscope::app::Pane;
     let mut h = midpoint_against_sah();
     let act = |h: &mut egui_kittest::Harness<'_, BvhscopeApp>, a: Action| h.state_mut().act(a);
     act(&mut h, Action::ShowTree(true));

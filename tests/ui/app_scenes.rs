@@ -24,7 +24,7 @@ fn a_scene_file_brings_its_camera_and_settings_and_can_be_saved_back() {
     h.input_mut().dropped_files.push(Arc::new(Dropped(scene.clone())));
     run_until(&mut h, "the scene", |a| a.scene.report.triangles == 8 && idle(a));
     let app = h.state();
-    assert_eq!(app.settings.build.strategy, SplitStrategy::Midpoint, "the scene's BVH settings");
+    assert_eq!(app.settings.build.strategy, Strategy::Midpoint, "the scene's BVH settings");
     assert_eq!(app.settings.build.layout, bvhscope::bvh::Layout::Binary);
     let cam = app.orbit.camera(320, 200);
     assert!((cam.position - glam::Vec3::new(3.0, 2.0, 6.0)).length() < 1e-4, "the scene's camera: {}", cam.position);
@@ -34,7 +34,7 @@ fn a_scene_file_brings_its_camera_and_settings_and_can_be_saved_back() {
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveScene, saved.clone()));
     let back = bvhscope::scene::load_any(&saved).expect("the saved scene loads");
     assert_eq!(back.placed_triangles(), 8);
-    assert_eq!(back.build.unwrap().strategy, SplitStrategy::Midpoint);
+    assert_eq!(back.build.unwrap().strategy, Strategy::Midpoint);
     assert!((back.camera.unwrap().position - cam.position).length() < 1e-4);
 }
 

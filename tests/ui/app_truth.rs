@@ -4,7 +4,7 @@
 
 use super::support::*;
 use bvhscope::app::{Action, BvhscopeApp, Film, MessageKind};
-use bvhscope::bvh::SplitStrategy;
+use bvhscope::bvh::Strategy;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use std::path::PathBuf;
@@ -74,9 +74,9 @@ fn a_threshold_and_a_selection_never_outlive_their_scale_or_tree() {
 
     h.state_mut().act(Action::SelectNode(2));
     run_until(&mut h, "the selection", |a| a.nodes.selected == Some(2));
-    with_strategy(&mut h, SplitStrategy::EqualCount);
+    with_strategy(&mut h, Strategy::EqualCount);
     run_until(&mut h, "the equal-count tree", |a| {
-        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::EqualCount) && idle(a)
+        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == Strategy::EqualCount) && idle(a)
     });
     assert_eq!(h.state().nodes.selected, None, "another tree: its node 2 is another node");
     h.state_mut().act(Action::SelectNode(1));

@@ -4,7 +4,7 @@
 mod support;
 
 use bvhscope::app::{Action, Pick, SceneSource};
-use bvhscope::bvh::SplitStrategy;
+use bvhscope::bvh::Strategy;
 use bvhscope::cli::{Cli, Command};
 use egui_kittest::kittest::Queryable;
 use std::path::{Path, PathBuf};
@@ -33,9 +33,8 @@ fn ploc_with_reinsertion_shows_what_stats_prints() {
     h.state_mut().act(Action::Edit(Box::new(s)));
     run_until(&mut h, "PLOC with reinsertion", |a| {
         idle(a)
-            && a.current_bvh().is_some_and(|b| {
-                b.bvh.build_params().bvh.strategy == SplitStrategy::Ploc && b.stats.reinsertion.is_some()
-            })
+            && a.current_bvh()
+                .is_some_and(|b| b.bvh.build_params().bvh.strategy == Strategy::Ploc && b.stats.reinsertion.is_some())
     });
     let (stats, r) = {
         let b = h.state().current_bvh().unwrap();
@@ -70,7 +69,7 @@ fn ploc_with_reinsertion_shows_what_stats_prints() {
     h.run_steps(2);
     h.get_by_label("LBVH (Morton)").click();
     run_until(&mut h, "LBVH", |a| {
-        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::Lbvh)
+        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == Strategy::Lbvh)
     });
     h.state_mut().act(Action::SelectNode(0));
     run_until(&mut h, "the root's inspection", |a| a.nodes.inspection.is_some() && idle(a));
@@ -90,7 +89,7 @@ fn sbvh_shows_its_references_as_stats_and_inspect_print_them() {
         idle(a)
             && a.current_bvh().is_some_and(|b| {
                 let p = b.bvh.build_params().bvh;
-                p.strategy == SplitStrategy::Sbvh && p.sbvh_growth == 50
+                p.strategy == Strategy::Sbvh && p.sbvh_growth == 50
             })
     });
     let stats = h.state().current_bvh().unwrap().stats.clone();
@@ -142,7 +141,7 @@ fn the_lbvh_replay_names_each_split_by_its_morton_bit_as_replay_prints_it() {
     run_until(&mut h, "LBVH", |a| {
         idle(a)
             && a.current_bvh().is_some_and(|b| {
-                b.bvh.build_params().bvh.strategy == SplitStrategy::Lbvh
+                b.bvh.build_params().bvh.strategy == Strategy::Lbvh
                     && b.bvh.build_params().bvh.layout == bvhscope::bvh::Layout::Binary
             })
     });
@@ -172,7 +171,7 @@ fn the_lbvh_replay_names_each_split_by_its_morton_bit_as_replay_prints_it() {
 fn fastest_traversal_is_one_click_and_stats_agrees() {
     let (mut h, torus) = open_with("torus.obj", "SAH binned");
     run_until(&mut h, "the SAH build", |a| {
-        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::SahBinned)
+        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == Strategy::SahBinned)
     });
     h.get_by_label("Fastest traversal").click();
     run_until(&mut h, "the fastest build", |a| {

@@ -280,12 +280,11 @@ fn a_slow_import_check_never_holds_the_meshs_own_build_and_image_back() {
     assert!(h.state().jobs.import.is_some() && h.state().import.tree.is_none(), "the check is still running");
     // A strategy changed now builds and shows without waiting for the check.
     let mut s = h.state().settings.clone();
-    s.build.strategy = bvhscope::bvh::SplitStrategy::Midpoint;
+    s.build.strategy = bvhscope::bvh::Strategy::Midpoint;
     h.state_mut().act(Action::Edit(Box::new(s)));
     run_until(&mut h, "the midpoint tree's frame", |a| {
         idle(a)
-            && a.current_bvh()
-                .is_some_and(|b| b.bvh.build_params().bvh.strategy == bvhscope::bvh::SplitStrategy::Midpoint)
+            && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == bvhscope::bvh::Strategy::Midpoint)
     });
     assert!(h.state().import.tree.is_none(), "the check is still running");
 }

@@ -157,7 +157,7 @@ pub fn open(h: &mut Harness<'_, BvhscopeApp>, file: &Path) {
 }
 
 /// Switch the build panel's strategy to `s`.
-pub fn with_strategy(h: &mut Harness<'_, BvhscopeApp>, s: bvhscope::bvh::SplitStrategy) {
+pub fn with_strategy(h: &mut Harness<'_, BvhscopeApp>, s: bvhscope::bvh::Strategy) {
     let mut settings = h.state().settings.clone();
     settings.build.strategy = s;
     h.state_mut().act(bvhscope::app::Action::Edit(Box::new(settings)));
@@ -167,7 +167,7 @@ pub fn with_strategy(h: &mut Harness<'_, BvhscopeApp>, s: bvhscope::bvh::SplitSt
 pub fn midpoint_heatmap_shown(a: &BvhscopeApp) -> bool {
     idle(a)
         && a.shown.as_ref().is_some_and(|s| {
-            s.legend.is_some() && s.bvh.build_params().bvh.strategy == bvhscope::bvh::SplitStrategy::Midpoint
+            s.legend.is_some() && s.bvh.build_params().bvh.strategy == bvhscope::bvh::Strategy::Midpoint
         })
 }
 
@@ -175,12 +175,12 @@ pub fn midpoint_heatmap_shown(a: &BvhscopeApp) -> bool {
 /// heatmap, both frames there.
 pub fn midpoint_against_sah() -> Harness<'static, BvhscopeApp> {
     use bvhscope::app::Action;
-    use bvhscope::bvh::SplitStrategy;
+    use bvhscope::bvh::Strategy;
     use egui_kittest::kittest::Queryable;
     let mut h = harness();
     run_until(&mut h, "the first frame", idle);
     let mut s = h.state().settings.clone();
-    s.build.strategy = SplitStrategy::Midpoint;
+    s.build.strategy = Strategy::Midpoint;
     h.state_mut().act(Action::Edit(Box::new(s)));
     h.state_mut().act(Action::View(2));
     run_until(&mut h, "midpoint's heatmap", midpoint_heatmap_shown);

@@ -5,7 +5,7 @@ mod support;
 use support::*;
 
 use bvhscope::app::Action;
-use bvhscope::bvh::SplitStrategy;
+use bvhscope::bvh::Strategy;
 
 /// A build started while the previous frame still renders waits for the render to stop, and
 /// nothing renders while it runs: its time is the build's alone, as `stats` measures it (with the
@@ -19,8 +19,8 @@ fn the_build_time_is_the_builds_alone() {
     h.state_mut().act(Action::Orbit(40.0, 0.0));
     h.step();
     assert!(h.state().jobs.render.is_some(), "a render runs");
-    assert_ne!(h.state().settings.build.strategy, SplitStrategy::EqualCount);
-    with_strategy(&mut h, SplitStrategy::EqualCount);
+    assert_ne!(h.state().settings.build.strategy, Strategy::EqualCount);
+    with_strategy(&mut h, Strategy::EqualCount);
     // The render stops for the build, and nothing renders while it runs.
     h.state_mut().reconcile();
     assert!(h.state().jobs.build.is_some() && h.state().jobs.render.is_none(), "the render was stopped for the build");
@@ -29,7 +29,7 @@ fn the_build_time_is_the_builds_alone() {
         h.step();
     }
     run_until(&mut h, "the equal-count build", |a| {
-        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == SplitStrategy::EqualCount) && idle(a)
+        a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == Strategy::EqualCount) && idle(a)
     });
     // What the build's clock measured is the build: a positive time, taken by the build job itself
     // (not compared with a timing here: the project measures speed in benchmarks, not tests).

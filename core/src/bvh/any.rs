@@ -42,14 +42,28 @@ impl AnyBvh {
         Self::build_counted(mesh, params, control)
     }
 
-    /// Build, advancing `control` without setting its total (`Bvh::build_counted`).
+    /// Build, advancing `control` without setting its total (`Bvh::build_counted`, which ends
+    /// with `Bvh::finish`).
     pub(crate) fn build_counted(mesh: &Mesh, params: &BuildParams, control: &WorkControl) -> Result<AnyBvh, Cancelled> {
-        let bvh = Bvh::build_counted(mesh, params, control)?;
-        Ok(match params.layout {
+        Ok(Self::laid_out(Bvh::build_counted(mesh, params, control)?))
+    }
+
+    /// The steps after a builder that made `bvh` elsewhere (the GPU's): the reinsertion and the
+    /// layout its parameters ask for, as after a build here.
+    pub fn finish(bvh: Bvh) -> AnyBvh {
+        match bvh.finish(&WorkControl::new()) {
+            Ok(b) => Self::laid_out(b),
+            Err(Cancelled) => unreachable!("nobody else holds this control"),
+        }
+    }
+
+    /// A finished binary tree laid out as its parameters say: as it is, or collapsed 4 or 8 wide.
+    fn laid_out(bvh: Bvh) -> AnyBvh {
+        match bvh.params.layout {
             Layout::Binary => AnyBvh::Binary(bvh),
             Layout::Wide4 => AnyBvh::Wide(WideBvh::from_binary(bvh)),
             Layout::Wide8 => AnyBvh::Wide8(WideBvh::collapse(bvh)),
-        })
+        }
     }
 
     fn tree(&self) -> &dyn TreeView {

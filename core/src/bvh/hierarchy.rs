@@ -326,7 +326,7 @@ impl Out<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{BuildParams, Layout, SplitStrategy};
+    use crate::bvh::{BuildParams, Layout, Strategy};
     use crate::mesh::generate::{grid_of, torus_knot};
 
     /// The parallel reading of a big tree is `serial_of`'s, on 1 and 4 threads, with cut
@@ -334,7 +334,7 @@ mod tests {
     #[test]
     fn a_big_tree_read_in_parallel_is_read_as_on_one_thread() {
         let mesh = grid_of(&torus_knot(2, 3, 0.3, 200, 40), 3);
-        for strategy in [SplitStrategy::SahBinned, SplitStrategy::Sbvh] {
+        for strategy in [Strategy::SahBinned, Strategy::Sbvh] {
             let params = BuildParams {
                 strategy,
                 layout: Layout::Binary,
@@ -345,7 +345,7 @@ mod tests {
             let bvh = Bvh::build(&mesh, &params);
             assert!(bvh.nodes.len() >= PARALLEL_MIN && well_formed(&bvh), "{strategy:?}");
             let serial = Hierarchy::serial_of(&bvh);
-            if strategy == SplitStrategy::Sbvh {
+            if strategy == Strategy::Sbvh {
                 assert!(!serial.other_slots.is_empty(), "the SBVH cut some triangles");
             }
             for threads in [1, 4] {

@@ -14,6 +14,7 @@ mod node;
 pub mod packet;
 pub mod params;
 mod preset;
+pub mod reach;
 mod scene_bvh;
 mod stack;
 mod stats;
@@ -25,7 +26,7 @@ pub mod wide;
 
 pub use accel::{Accelerator, Hit, TraceOptions, TraversalOrder};
 pub use any::AnyBvh;
-pub use builders::strategy::{Builder, SplitStrategy};
+pub use builders::strategy::{Builder, Strategy};
 pub use builders::{lbvh, morton, reinsert, sbvh, split};
 pub use counters::{NoStats, RayCounters, TraversalStats};
 pub use hierarchy::Hierarchy;

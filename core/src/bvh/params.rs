@@ -2,7 +2,7 @@
 //! constants, the layout, and the report of the phases. The builder owns each number's limits and
 //! default (`Param`); `crate::options` gives them their names, labels and help for users.
 
-use super::SplitStrategy;
+use super::Strategy;
 use std::time::Duration;
 
 /// A number's limits (inclusive) and default, as the builder accepts it.
@@ -41,7 +41,7 @@ impl<T: PartialOrd + Copy> Limits<T> {
 }
 
 /// A number of a build that users set. Which strategies read which is the strategy's to say
-/// (`SplitStrategy::reads`).
+/// (`Strategy::reads`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Param {
     /// Most triangles in a leaf (the node format's count field would take 65535; trees with leaves
@@ -238,7 +238,7 @@ pub enum Layout {
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct BuildParams {
-    pub strategy: SplitStrategy,
+    pub strategy: Strategy,
     /// Most triangles in a leaf (default 4). The SAH strategies may stop earlier when a leaf is
     /// cheaper than a split; no strategy makes a larger leaf.
     pub max_leaf_size: u32,
@@ -261,7 +261,7 @@ pub struct BuildParams {
 impl Default for BuildParams {
     fn default() -> Self {
         Self {
-            strategy: SplitStrategy::SahBinned,
+            strategy: Strategy::SahBinned,
             max_leaf_size: MAX_LEAF_SIZE.default,
             sah_bins: SAH_BINS.default,
             cost: SahCost::default(),
@@ -275,7 +275,7 @@ impl Default for BuildParams {
 }
 
 impl BuildParams {
-    pub fn with_strategy(strategy: SplitStrategy) -> Self {
+    pub fn with_strategy(strategy: Strategy) -> Self {
         Self { strategy, ..Self::default() }
     }
 }

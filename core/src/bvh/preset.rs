@@ -16,7 +16,7 @@
 //! 0.98–1.14×, incoherent 1.02–1.15×, at 46–49 bytes per triangle instead of 60–68: BENCHMARKS.md,
 //! "The fastest preset by kernel family"); with AVX2 only, a leaf of sixteen takes four passes.
 
-use super::{BuildParams, Layout, SahCost, SplitStrategy, TraceOptions, TraversalOrder};
+use super::{BuildParams, Layout, SahCost, Strategy, TraceOptions, TraversalOrder};
 use crate::cpu::Simd;
 use crate::geometry::TriangleTest;
 
@@ -46,7 +46,7 @@ impl Preset {
     pub fn build(self) -> BuildParams {
         match self {
             Preset::Handout => BuildParams {
-                strategy: SplitStrategy::Midpoint,
+                strategy: Strategy::Midpoint,
                 layout: Layout::Binary,
                 max_leaf_size: Self::HANDOUT_MAX_LEAF_SIZE,
                 ..BuildParams::default()
@@ -54,7 +54,7 @@ impl Preset {
             Preset::Fastest => {
                 let (max_leaf_size, traversal) = Self::fastest_leaves(Simd::chosen());
                 BuildParams {
-                    strategy: SplitStrategy::SahBinned,
+                    strategy: Strategy::SahBinned,
                     layout: Layout::Wide8,
                     max_leaf_size,
                     cost: SahCost { traversal, ..SahCost::default() },

@@ -244,7 +244,7 @@ pub fn top_leaf_sizes(top: &TopLevel) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions};
+    use crate::bvh::{LinearScan, NoStats, RayCounters, Strategy, TraceOptions};
     use crate::mesh::generate::torus;
 
     /// A torus placed four times (one of them rotated and scaled), and the same scene flattened.
@@ -276,7 +276,7 @@ mod tests {
     fn two_level_hits_agree_with_the_linear_scan_of_the_flattened_scene() {
         let (m, placements, flat) = scene();
         let linear = LinearScan::new(&flat);
-        for strategy in SplitStrategy::ALL {
+        for strategy in Strategy::ALL {
             let p = BuildParams::with_strategy(strategy);
             let two = TwoLevelBvh::build(&[&m], &placements, &p, &p, &WorkControl::new()).unwrap();
             assert_eq!(two.bottom.len(), 1, "one BVH for the one mesh");

@@ -167,7 +167,7 @@ const FAST_FRONTIER: u32 = 8;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{BuildParams, Layout, LinearScan, NoStats, RayCounters, SplitStrategy, TraceOptions, TreeStats};
+    use crate::bvh::{BuildParams, Layout, LinearScan, NoStats, RayCounters, Strategy, TraceOptions, TreeStats};
     use crate::mesh::generate;
     use glam::Vec3;
 
@@ -198,7 +198,7 @@ mod tests {
     #[test]
     fn the_fast_frontier_counts_and_hits_as_testing_every_triangle() {
         let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);
-        for strategy in [SplitStrategy::SahBinned, SplitStrategy::Midpoint, SplitStrategy::Sbvh] {
+        for strategy in [Strategy::SahBinned, Strategy::Midpoint, Strategy::Sbvh] {
             let params = BuildParams { strategy, layout: Layout::Binary, ..BuildParams::default() };
             let tree = Arc::new(Bvh::build(&mesh, &params));
             let replay = Replay::of(tree.clone());
@@ -225,7 +225,7 @@ mod tests {
     #[test]
     fn partial_trees_are_correct_and_the_last_is_the_finished_tree() {
         let mesh = generate::torus_knot(2, 3, 0.3, 64, 8);
-        for strategy in SplitStrategy::ALL {
+        for strategy in Strategy::ALL {
             let tree = Arc::new(Bvh::build(
                 &mesh,
                 &BuildParams { strategy, layout: Layout::Binary, ..BuildParams::default() },

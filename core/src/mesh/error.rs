@@ -1,20 +1,17 @@
 //! Why a mesh could not be loaded: one error type, every message starting with the file name and,
 //! where known, the line.
 
+use crate::files::FileError;
 use std::fmt;
 use std::path::PathBuf;
 
 /// Why a mesh could not be loaded. Every message starts with the file name.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    #[error("{}: no such file", .path.display())]
-    NotFound { path: PathBuf },
-    #[error("{}: is a directory, not a file", .path.display())]
-    IsDirectory { path: PathBuf },
-    #[error("{}: is {what}, not a regular file", .path.display())]
-    NotRegular { path: PathBuf, what: &'static str },
-    #[error("{}: cannot read: {source}", .path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    /// The file could not be opened or read (not found, a directory, not a regular file, an I/O
+    /// error): the file services' own error.
+    #[error(transparent)]
+    File(#[from] FileError),
     #[error("{}: line {line}: not a text file (binary data: a NUL byte)", .path.display())]
     NotText { path: PathBuf, line: usize },
     #[error("{}{}: {message}", .path.display(), LineSuffix(*.line))]

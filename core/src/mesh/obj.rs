@@ -52,17 +52,12 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError>
 /// program writes.
 pub fn read_user_file(path: &Path) -> Result<Vec<u8>, MeshError> {
     use crate::files::FileError;
-    let metadata = crate::files::regular(path).map_err(|e| match e {
-        FileError::NotFound { path } => MeshError::NotFound { path },
-        FileError::IsDirectory { path } => MeshError::IsDirectory { path },
-        FileError::NotRegular { path, what } => MeshError::NotRegular { path, what },
-        FileError::Read { path, source } => MeshError::Io { path, source },
-        // `regular` reports only the four above.
-        e => MeshError::Io { path: path.into(), source: std::io::Error::other(e.to_string()) },
-    })?;
-    read_file(path, metadata.len() as usize).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => MeshError::NotFound { path: path.into() },
-        _ => MeshError::Io { path: path.into(), source: e },
+    let metadata = crate::files::regular(path)?;
+    read_file(path, metadata.len() as usize).map_err(|e| {
+        MeshError::File(match e.kind() {
+            std::io::ErrorKind::NotFound => FileError::NotFound { path: path.into() },
+            _ => FileError::Read { path: path.into(), source: e },
+        })
     })
 }
 

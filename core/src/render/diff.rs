@@ -103,11 +103,11 @@ pub fn tally(d: &[f32]) -> (usize, usize, usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{AnyBvh, BuildParams, SplitStrategy};
+    use crate::bvh::{AnyBvh, BuildParams, Strategy};
     use crate::mesh::generate;
     use crate::render::{render, Camera, RenderSettings, UpAxis};
 
-    fn frame(strategy: SplitStrategy) -> Frame {
+    fn frame(strategy: Strategy) -> Frame {
         let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);
         let bvh = AnyBvh::build(&mesh, &BuildParams::with_strategy(strategy));
         let camera = Camera::framing_up(&mesh.bounds(), 64, 48, UpAxis::Y, 45.0);
@@ -135,8 +135,7 @@ mod tests {
     #[test]
     fn identical_builds_differ_nowhere_and_others_pixel_by_pixel() {
         let cost = SahCost::default();
-        let (a, a2, b) =
-            (frame(SplitStrategy::Midpoint), frame(SplitStrategy::Midpoint), frame(SplitStrategy::SahBinned));
+        let (a, a2, b) = (frame(Strategy::Midpoint), frame(Strategy::Midpoint), frame(Strategy::SahBinned));
         let same = difference(&a, &a2, View::Visits, cost).unwrap();
         assert!(same.iter().all(|&v| v == 0.0));
         let (img, legend) = difference_image(a.width(), &same, View::Visits, None);

@@ -3,7 +3,7 @@
 //! frame of secondary rays whose counters are its rays' sums and whose missed pixels are marked.
 
 use super::*;
-use crate::bvh::{AnyBvh, BuildParams, Layout, LinearScan, NoStats, SplitStrategy, TreeNode, TreeView};
+use crate::bvh::{AnyBvh, BuildParams, Layout, LinearScan, NoStats, Strategy, TreeNode, TreeView};
 use crate::geometry::TriangleTest;
 use crate::mesh::{generate, Mesh};
 use crate::render::{render, view_image, ColorMap, HeatRange, RenderSettings, View};
@@ -119,7 +119,7 @@ fn any_hit_walks_of_every_layout_answer_as_the_linear_scan_does() {
     let mesh = knot();
     let linear = LinearScan::new(&mesh);
     for layout in Layout::ALL {
-        for strategy in [SplitStrategy::Midpoint, SplitStrategy::SahBinned, SplitStrategy::Sbvh] {
+        for strategy in [Strategy::Midpoint, Strategy::SahBinned, Strategy::Sbvh] {
             let tree = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
             let rays = adversarial(&mesh, &tree);
             assert!(rays.len() > 1000);
@@ -145,7 +145,7 @@ fn any_hit_packets_of_every_layout_answer_as_the_linear_scan_does() {
     let linear = LinearScan::new(&mesh);
     let opts = crate::bvh::TraceOptions { test: TriangleTest::Watertight, ..Default::default() };
     for layout in Layout::ALL {
-        for strategy in [SplitStrategy::Midpoint, SplitStrategy::SahBinned] {
+        for strategy in [Strategy::Midpoint, Strategy::SahBinned] {
             let tree = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
             assert!(tree.traces_packets());
             let mut rays = adversarial(&mesh, &tree);

@@ -70,7 +70,9 @@ pub fn load_instances(scene_path: &Path, desc: &SceneDesc) -> Result<(SceneInsta
             None => {
                 let (mesh, r) = load_mesh(&m.file).map_err(|e| {
                     let hint = match (&e, &m.if_missing) {
-                        (crate::mesh::MeshError::NotFound { .. }, Some(hint)) => format!(" ({hint})"),
+                        (crate::mesh::MeshError::File(crate::files::FileError::NotFound { .. }), Some(hint)) => {
+                            format!(" ({hint})")
+                        }
                         _ => String::new(),
                     };
                     SceneError::Field {

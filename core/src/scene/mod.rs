@@ -8,8 +8,6 @@ mod moer_lite;
 mod open;
 mod scene_file;
 /// Also the grader's rubric reader's (`explain::grade::rubric`): one check for every JSON a person writes.
-pub(crate) mod strict_json;
-
 pub use flatten::{flatten, load_instances, SceneInstances};
 pub use open::{load_any, Geometry, Scene, SceneBuildError, SceneSource, MAX_FLAT_TRIANGLES};
 pub use scene_file::{parse_scene_file, write_scene_file};
@@ -50,10 +48,6 @@ pub struct SceneDesc {
 
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    #[error("{}: no such file", .path.display())]
-    NotFound { path: PathBuf },
-    #[error("{}: cannot read: {source}", .path.display())]
-    Io { path: PathBuf, source: std::io::Error },
     #[error("{}: line {line}: not valid JSON: {message}", .path.display())]
     Json { path: PathBuf, line: usize, message: String },
     #[error("{}: {field}: {message}", .path.display())]
@@ -113,15 +107,11 @@ fn read_json(path: &Path) -> Result<serde_json::Value, SceneError> {
             });
         }
     }
-    let bytes = crate::mesh::read_user_file(path).map_err(|e| match e {
-        MeshError::NotFound { path } => SceneError::NotFound { path },
-        MeshError::Io { path, source } => SceneError::Io { path, source },
-        other => SceneError::Mesh(other),
-    })?;
+    let bytes = crate::mesh::read_user_file(path)?;
     let text = crate::mesh::decode_text(path, &bytes)?;
     // Every placement names its file: counted in the text, before a JSON value is made of it.
     check_placements(path, text.matches("\"file\"").count())?;
-    strict_json::parse(&text).map_err(|e| SceneError::Json {
+    crate::json::parse(&text).map_err(|e| SceneError::Json {
         path: path.into(),
         line: e.line(),
         message: e.to_string(),
@@ -132,7 +122,7 @@ fn read_json(path: &Path) -> Result<serde_json::Value, SceneError> {
 pub fn describe(path: &Path) -> Result<SceneDesc, SceneError> {
     let json = read_json(path)?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let field = Fields { path };
+    let field = fields(path);
     // Counted before any placement is made.
     let desc = if moer_lite::looks_like(&json) {
         moer_lite::describe(&json, base, &field)
@@ -143,76 +133,13 @@ pub fn describe(path: &Path) -> Result<SceneDesc, SceneError> {
     Ok(desc)
 }
 
-/// Typed reading of JSON values, with errors naming the field (`camera.transform.position`).
-pub(crate) struct Fields<'a> {
-    path: &'a Path,
-}
+/// Typed reading of a scene file's JSON values, with errors naming the field
+/// (`camera.transform.position`).
+pub(crate) type Fields<'a> = crate::json::Fields<'a, SceneError>;
 
-impl Fields<'_> {
-    pub fn err(&self, field: &str, message: impl Into<String>) -> SceneError {
-        SceneError::Field { path: self.path.into(), field: field.to_string(), message: message.into() }
-    }
-
-    pub fn number(&self, v: &serde_json::Value, field: &str) -> Result<f32, SceneError> {
-        match v.as_f64() {
-            Some(x) if x.is_finite() => Ok(x as f32),
-            _ => Err(self.err(field, format!("expected a number, found {}", kind(v)))),
-        }
-    }
-
-    pub fn vec3(&self, v: &serde_json::Value, field: &str) -> Result<Vec3, SceneError> {
-        match v.as_array() {
-            Some(a) if a.len() == 3 => {
-                let c: Result<Vec<f32>, _> =
-                    a.iter().enumerate().map(|(i, x)| self.number(x, &format!("{field}[{i}]"))).collect();
-                let c = c?;
-                Ok(Vec3::new(c[0], c[1], c[2]))
-            }
-            _ => Err(self.err(field, format!("expected [x, y, z], found {}", kind(v)))),
-        }
-    }
-
-    /// An image size `[width, height]`, whole numbers 1..=16384.
-    pub fn size(&self, v: &serde_json::Value, field: &str) -> Result<(u32, u32), SceneError> {
-        let dims: Option<Vec<u64>> = v.as_array().and_then(|a| a.iter().map(|x| x.as_u64()).collect());
-        match dims.as_deref() {
-            Some(&[w, h]) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w as u32, h as u32)),
-            _ => Err(self.err(field, "expected [width, height], whole numbers 1..=16384")),
-        }
-    }
-
-    /// A required member of an object.
-    pub fn get<'v>(
-        &self,
-        v: &'v serde_json::Value,
-        parent: &str,
-        key: &str,
-    ) -> Result<&'v serde_json::Value, SceneError> {
-        let field = join(parent, key);
-        match v.as_object() {
-            Some(o) => o.get(key).ok_or_else(|| self.err(&field, "missing")),
-            None => Err(self.err(parent, format!("expected an object, found {}", kind(v)))),
-        }
-    }
-}
-
-pub(crate) fn join(parent: &str, key: &str) -> String {
-    if parent.is_empty() {
-        key.to_string()
-    } else {
-        format!("{parent}.{key}")
-    }
-}
-
-pub(crate) fn kind(v: &serde_json::Value) -> &'static str {
-    match v {
-        serde_json::Value::Null => "null",
-        serde_json::Value::Bool(_) => "a boolean",
-        serde_json::Value::Number(_) => "a number",
-        serde_json::Value::String(_) => "a string",
-        serde_json::Value::Array(_) => "an array",
-        serde_json::Value::Object(_) => "an object",
-    }
+/// The fields of the scene file `path`.
+pub(crate) fn fields(path: &Path) -> Fields<'_> {
+    Fields::new(path, |path, field, message| SceneError::Field { path: path.into(), field: field.into(), message })
 }
 
 /// A mesh path from a scene file: relative paths are relative to the scene file's folder.

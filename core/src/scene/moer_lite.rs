@@ -6,7 +6,8 @@
 //! so its camera carries over unchanged. Analytic shapes are not tessellated yet: they are named
 //! in a warning and the rest of the scene loads.
 
-use super::{join, kind, resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
+use super::{resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
+use crate::json::{join, kind};
 use crate::render::Camera;
 use glam::Vec3;
 use std::path::Path;
@@ -37,17 +38,13 @@ pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Res
     camera.validate().map_err(|e| f.err("camera", e.to_string()))?;
 
     let shapes = f.get(f.get(json, "", "scene")?, "scene", "shapes")?;
-    let list =
-        shapes.as_array().ok_or_else(|| f.err("scene.shapes", format!("expected an array, found {}", kind(shapes))))?;
+    let list = f.array(shapes, "scene.shapes")?;
     let mut desc = SceneDesc { camera: Some(camera), ..Default::default() };
     let mut skipped = Vec::new();
     for (i, s) in list.iter().enumerate() {
         let field = format!("scene.shapes[{i}]");
-        let ty = f.get(s, &field, "type")?;
-        let ty = ty
-            .as_str()
-            .ok_or_else(|| f.err(&join(&field, "type"), format!("expected a string, found {}", kind(ty))))?;
-        match ty {
+        let ty = f.text(f.get(s, &field, "type")?, &join(&field, "type"))?;
+        match ty.as_str() {
             "triangle" => {}
             "sphere" | "parallelogram" | "disk" | "cylinder" | "cone" | "cube" => {
                 skipped.push(format!("{field} ({ty})"));

@@ -2,32 +2,24 @@
 //! settings to start with. The README documents the format; every field is checked and an error
 //! names it (`meshes[1].transform.rotate.degrees: expected a number, found a string`).
 
-use super::{join, kind, resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
+use super::{fields, resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
 use crate::bvh::BuildParams;
+use crate::json::{join, kind};
 use crate::render::Camera;
 use glam::{Affine3A, Mat4, Vec3};
 use std::path::Path;
 
 pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Result<SceneDesc, SceneError> {
-    let root =
-        json.as_object().ok_or_else(|| f.err("(top level)", format!("expected an object, found {}", kind(json))))?;
-    for key in root.keys() {
-        if !["camera", "meshes", "bvh", "note", "comment"].contains(&key.as_str()) {
-            return Err(f.err(key, "unknown field (expected camera, meshes, bvh, note, comment)"));
-        }
-    }
+    let root = f.object(json, "(top level)")?;
+    f.known(root, "", &["camera", "meshes", "bvh", "note", "comment"])?;
     let camera = root.get("camera").map(|c| camera(c, f)).transpose()?;
     let meshes_json = f.get(json, "", "meshes")?;
-    let list = meshes_json
-        .as_array()
-        .ok_or_else(|| f.err("meshes", format!("expected an array, found {}", kind(meshes_json))))?;
+    let list = f.array(meshes_json, "meshes")?;
     let mut meshes = Vec::new();
     for (i, m) in list.iter().enumerate() {
         let field = format!("meshes[{i}]");
         if let Some(o) = m.as_object() {
-            if let Some(key) = o.keys().find(|k| !["file", "transform", "if_missing"].contains(&k.as_str())) {
-                return Err(f.err(&join(&field, key), "unknown field (expected file, transform, if_missing)"));
-            }
+            f.known(o, &field, &["file", "transform", "if_missing"])?;
         }
         let file = f.get(m, &field, "file")?;
         let file = file
@@ -37,16 +29,12 @@ pub(super) fn describe(json: &serde_json::Value, base: &Path, f: &Fields) -> Res
             Some(t) => transform(t, &join(&field, "transform"), f)?,
             None => Affine3A::IDENTITY,
         };
-        let if_missing = m.get("if_missing").map(|v| text(v, &join(&field, "if_missing"), f)).transpose()?;
+        let if_missing = m.get("if_missing").map(|v| f.text(v, &join(&field, "if_missing"))).transpose()?;
         meshes.push(SceneMesh { file: resolve(base, file), transform, if_missing });
     }
     let build = root.get("bvh").map(|b| bvh(b, f)).transpose()?;
-    let note = root.get("note").map(|v| text(v, "note", f)).transpose()?;
+    let note = root.get("note").map(|v| f.text(v, "note")).transpose()?;
     Ok(SceneDesc { camera, meshes, build, note, warnings: Vec::new() })
-}
-
-fn text(v: &serde_json::Value, field: &str, f: &Fields) -> Result<String, SceneError> {
-    v.as_str().map(str::to_string).ok_or_else(|| f.err(field, format!("expected a string, found {}", kind(v))))
 }
 
 fn camera(c: &serde_json::Value, f: &Fields) -> Result<Camera, SceneError> {
@@ -72,7 +60,7 @@ fn camera(c: &serde_json::Value, f: &Fields) -> Result<Camera, SceneError> {
 /// `{"translate": [..], "rotate": {"axis": [..], "degrees": a}, "scale": s | [..]}` or
 /// `{"matrix": [[4 numbers] × 4]}` (row-major, last row 0 0 0 1).
 fn transform(t: &serde_json::Value, field: &str, f: &Fields) -> Result<Affine3A, SceneError> {
-    let o = t.as_object().ok_or_else(|| f.err(field, format!("expected an object, found {}", kind(t))))?;
+    let o = f.object(t, field)?;
     if let Some(m) = o.get("matrix") {
         if o.len() > 1 {
             return Err(f.err(field, "give either matrix or translate/rotate/scale, not both"));
@@ -137,7 +125,7 @@ fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
     fn choice<T: Choice>(v: &serde_json::Value, field: &str, f: &Fields) -> Result<T, SceneError> {
         v.as_str().and_then(T::from_name).ok_or_else(|| f.err(field, format!("expected one of {}", T::names())))
     }
-    let o = b.as_object().ok_or_else(|| f.err("bvh", format!("expected an object, found {}", kind(b))))?;
+    let o = f.object(b, "bvh")?;
     let mut p = BuildParams::default();
     for (key, v) in o {
         let field = join("bvh", key);
@@ -159,12 +147,12 @@ fn bvh(b: &serde_json::Value, f: &Fields) -> Result<BuildParams, SceneError> {
 
 /// Parse a scene file's text (for tests and tools; `path` names it in errors and anchors paths).
 pub fn parse_scene_file(path: &Path, text: &str) -> Result<SceneDesc, SceneError> {
-    let json: serde_json::Value = super::strict_json::parse(text).map_err(|e| SceneError::Json {
+    let json: serde_json::Value = crate::json::parse(text).map_err(|e| SceneError::Json {
         path: path.into(),
         line: e.line(),
         message: e.to_string(),
     })?;
-    describe(&json, path.parent().unwrap_or(Path::new(".")), &Fields { path })
+    describe(&json, path.parent().unwrap_or(Path::new(".")), &fields(path))
 }
 
 /// A scene file for a camera, the meshes (paths written as given) and BVH settings.

@@ -2,7 +2,7 @@
 //! triangles, and running one ray both ways (closest and any hit).
 #![allow(dead_code)]
 
-use bvhscope_core::bvh::{Accelerator, BuildParams, RayCounters, SplitStrategy, TraceOptions, TraversalOrder};
+use bvhscope_core::bvh::{Accelerator, BuildParams, RayCounters, Strategy, TraceOptions, TraversalOrder};
 use bvhscope_core::geometry::{Ray, TriangleTest};
 use bvhscope_core::mesh::Mesh;
 use glam::Vec3;
@@ -12,7 +12,7 @@ pub const TESTS: [TriangleTest; 2] = [TriangleTest::Watertight, TriangleTest::Mo
 
 /// Midpoint splits, one triangle per leaf: the tree follows from the centroids alone.
 pub fn params() -> BuildParams {
-    BuildParams { strategy: SplitStrategy::Midpoint, max_leaf_size: 1, ..BuildParams::default() }
+    BuildParams { strategy: Strategy::Midpoint, max_leaf_size: 1, ..BuildParams::default() }
 }
 
 /// A triangle in the plane z = `z` with its centroid at (`x`, 0, `z`): corners (x ∓ 0.5, -0.5) and

@@ -5,7 +5,7 @@ use crate::binary::triangle_floats;
 use crate::device::{Gpu, GpuError};
 use crate::trace::{GpuTrace, GpuTraceOptions, Kernels, Rays, Stack};
 
-pub(crate) const KERNELS: Kernels = Kernels::new("cwbvh", include_str!("../shaders/cwbvh.wgsl"));
+pub(crate) const KERNELS: Kernels = Kernels::new("cwbvh", "cwbvh.wgsl");
 
 /// A compressed wide BVH on one GPU.
 pub struct GpuCwbvh {

@@ -274,15 +274,9 @@ mod tests {
     /// leaf size; a leaf slot names the binary leaf's own triangles.
     #[test]
     fn decoded_boxes_hold_the_binary_boxes_they_stand_for() {
-        use bvhscope_core::bvh::{BuildParams, Layout, SplitStrategy};
+        use bvhscope_core::bvh::{BuildParams, Layout, Strategy};
         let mesh = bvhscope_core::mesh::generate::torus_knot(2, 3, 0.3, 96, 8);
-        for strategy in [
-            SplitStrategy::Midpoint,
-            SplitStrategy::SahBinned,
-            SplitStrategy::Lbvh,
-            SplitStrategy::Ploc,
-            SplitStrategy::Sbvh,
-        ] {
+        for strategy in [Strategy::Midpoint, Strategy::SahBinned, Strategy::Lbvh, Strategy::Ploc, Strategy::Sbvh] {
             for max_leaf_size in [1, 4, 12] {
                 let params = BuildParams { strategy, max_leaf_size, layout: Layout::Binary, ..BuildParams::default() };
                 let bvh = Bvh::build(&mesh, &params);

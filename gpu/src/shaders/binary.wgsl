@@ -15,8 +15,7 @@ struct Node {
     info: u32,
 }
 
-// A triangle's three vertices in leaf order, 36 bytes (core's Bvh::tris).
-struct Tri { v: array<f32, 9> }
+// `Tri`, a triangle's three vertices in leaf order: prelude.wgsl.
 
 @group(0) @binding(5) var<storage, read> nodes: array<Node>;
 @group(0) @binding(6) var<storage, read> tris: array<Tri>;

@@ -1,7 +1,5 @@
-// Boxes of the builders (lbvh.wgsl, ploc.wgsl): triangles as nine floats, boxes as two corners,
-// and their unions with a min and max that are the same every time.
-
-struct Tri { v: array<f32, 9> }
+// Boxes of the builders (lbvh.wgsl, ploc.wgsl): boxes as two corners of the triangles (`Tri`,
+// nine floats: prelude.wgsl), and their unions with a min and max that are the same every time.
 
 struct KBox { lo: array<f32, 3>, hi: array<f32, 3> }
 

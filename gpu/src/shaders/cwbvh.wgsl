@@ -6,7 +6,7 @@
 
 // An 80-byte node as 20 words (gpu/src/cwbvh/mod.rs documents the bytes).
 struct CNode { w: array<u32, 20> }
-struct Tri { v: array<f32, 9> }
+// `Tri`: prelude.wgsl.
 
 @group(0) @binding(5) var<storage, read> cnodes: array<CNode>;
 // (first triangle, count) per leaf.

@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use bvhscope_core::bvh::{
-    Accelerator, BuildParams, Bvh, Hit, Layout, RayCounters, SplitStrategy, TraceOptions, TraversalOrder,
+    Accelerator, BuildParams, Bvh, Hit, Layout, RayCounters, Strategy, TraceOptions, TraversalOrder,
 };
 use bvhscope_core::geometry::{Ray, TriangleTest};
 use bvhscope_core::mesh::Mesh;
@@ -115,7 +115,7 @@ pub fn exact_rays() -> Vec<Ray> {
     rays
 }
 
-pub fn build(mesh: &Mesh, strategy: SplitStrategy, max_leaf_size: u32) -> Bvh {
+pub fn build(mesh: &Mesh, strategy: Strategy, max_leaf_size: u32) -> Bvh {
     Bvh::build(mesh, &BuildParams { strategy, max_leaf_size, layout: Layout::Binary, ..BuildParams::default() })
 }
 

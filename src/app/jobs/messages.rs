@@ -1,9 +1,9 @@
 //! What goes to the app's jobs and what comes back from them: the render request and its pass,
 //! the events on the one channel, what a file dialog was opened for.
 
-use crate::app::compare_view::CompareB;
-use crate::app::import_view::{ImportedTree, WrongPixels};
-use crate::app::node_view::{Explained, FrameVisits};
+use crate::app::views::compare::CompareB;
+use crate::app::views::import::{ImportedTree, WrongPixels};
+use crate::app::views::node::{Explained, FrameVisits};
 use crate::bvh::{SahCost, SceneBuild, SceneBvh, TraceOptions};
 use crate::explain::inspect::Inspection;
 use crate::explain::replay::PartialBvh;
@@ -35,7 +35,7 @@ pub struct RenderRequest {
     pub progressive: bool,
     /// The build replay's partial tree of `bvh` (a single BVH) to trace instead of it.
     pub partial: Option<Arc<PartialBvh>>,
-    /// Trace on this GPU instead of the CPU (`app::gpu`).
+    /// Trace on this GPU instead of the CPU (`jobs::gpu`).
     pub gpu: Option<GpuRender>,
     /// Secondary rays from each hit, resolved for the scene and camera (`None`: camera rays).
     pub secondary: Option<crate::render::SecondaryRays>,
@@ -166,4 +166,17 @@ impl GpuRender {
     pub fn same_as(&self, o: &GpuRender) -> bool {
         Arc::ptr_eq(&self.gpu, &o.gpu) && self.nodes == o.nodes
     }
+}
+
+/// Frames of the app's replay animation and how long each shows (`bvhscope replay`'s defaults).
+pub const FILM_FRAMES: u32 = 24;
+pub const FILM_DELAY_MS: u16 = 400;
+
+/// The replay's animation to write (`update::export::film_request`).
+pub struct FilmRequest {
+    pub replay: std::sync::Arc<crate::explain::replay::Replay>,
+    pub mesh: std::sync::Arc<crate::mesh::Mesh>,
+    pub camera: crate::render::Camera,
+    pub settings: crate::explain::replay_film::FilmSettings,
+    pub subject: String,
 }

@@ -2,9 +2,9 @@
 //! and report over one channel; the UI thread only polls. Starting a job of a kind cancels the
 //! running one of that kind, and results of superseded jobs are dropped by id.
 
-use super::compare_view::CompareB;
-use super::import_view::{ImportedTree, WrongPixels, CHECK_RAYS};
-use super::node_view::{Explained, FrameVisits};
+use crate::app::views::compare::CompareB;
+use crate::app::views::import::{ImportedTree, WrongPixels, CHECK_RAYS};
+use crate::app::views::node::{Explained, FrameVisits};
 use crate::bvh::{SceneBuild, SceneBvh, TraceOptions};
 use crate::render::{render_passes, view_image, Camera, Frame, FramePool, PassInfo, RenderSettings};
 use crate::scene::Scene;
@@ -14,9 +14,11 @@ use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+mod gpu;
 pub mod messages;
 mod work;
 
+pub use gpu::Probe;
 pub use messages::*;
 
 /// A job in flight.
@@ -35,7 +37,7 @@ pub struct Jobs {
     pub load: Option<Running>,
     pub build: Option<Running>,
     pub render: Option<Running>,
-    /// The node explainer's background work (`node_view`): preparing the tree, counting the
+    /// The node explainer's background work (`views::node`): preparing the tree, counting the
     /// frame's visits, inspecting the selected node. Each started only when nothing above runs.
     pub explain: Option<Running>,
     pub visits: Option<Running>,
@@ -69,8 +71,8 @@ pub struct Jobs {
     /// keeps the mesh's own build and first image waiting.
     primary: Arc<std::sync::atomic::AtomicUsize>,
     pub shown_scene: Arc<std::sync::atomic::AtomicU64>,
-    /// The GPU the render and build jobs may use, and what they keep on it (`app::gpu`).
-    pub gpu: super::gpu::GpuJobs,
+    /// The GPU the render and build jobs may use, and what they keep on it (`jobs::gpu`).
+    pub gpu: gpu::GpuJobs,
 }
 
 /// Counts a job among `Jobs::others` while it lives.
@@ -123,7 +125,7 @@ impl Jobs {
 
     /// Look for a GPU adapter in the background (once, at start).
     pub fn probe_gpu(&self) {
-        super::gpu::probe(self.sender(0));
+        gpu::probe(self.sender(0));
     }
 
     fn start(&mut self, label: String) -> Running {

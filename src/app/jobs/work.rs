@@ -260,7 +260,7 @@ impl Jobs {
 
     /// Write the replay's animation to `path` (`bvhscope replay`'s film, the same frames and
     /// file), with progress; a newer export replaces a running one.
-    pub fn film(&mut self, r: crate::app::export::FilmRequest, path: PathBuf) {
+    pub fn film(&mut self, r: FilmRequest, path: PathBuf) {
         if let Some(old) = self.film.take() {
             old.control.cancel();
         }
@@ -273,7 +273,7 @@ impl Jobs {
             let Ok(f) = film(&r.replay, &r.mesh, &r.camera, &r.settings, &r.subject, &control) else {
                 return send(JobEvent::Filmed(Err("Writing the replay was cancelled".into())));
             };
-            let delay = crate::app::export::FILM_DELAY_MS;
+            let delay = FILM_DELAY_MS;
             let result = crate::render::animation::write_animation(&path, &f.images, delay)
                 .map(|()| {
                     let fewer = if f.images.len() < r.settings.frames as usize {

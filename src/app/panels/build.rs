@@ -1,8 +1,8 @@
 //! The build panel: strategy and its parameters, traversal order and triangle test. Any change
 //! rebuilds (or re-renders) in the background.
 
-use crate::app::{Action, Actions, BvhscopeApp};
-use crate::bvh::{BuildParams, Param, ParamLimits, ParamValue, Preset, SplitStrategy};
+use crate::app::state::{Action, Actions, BvhscopeApp};
+use crate::bvh::{BuildParams, Param, ParamLimits, ParamValue, Preset, Strategy};
 use crate::options::{Choice, ParamOption, BUILD_PARAMS, TOP_MAX_LEAF_SIZE};
 
 /// The reinsertion the current single BVH's build made, if any.
@@ -69,7 +69,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 egui::ComboBox::from_id_salt("top-strategy")
                     .selected_text(s.top_build.strategy.label())
                     .show_ui(ui, |ui| {
-                        for k in SplitStrategy::ALL {
+                        for k in Strategy::ALL {
                             ui.selectable_value(&mut s.top_build.strategy, k, k.label()).on_hover_text(k.help());
                         }
                     })
@@ -98,7 +98,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         .selected_text(selected)
         .width(200.0)
         .show_ui(ui, |ui| {
-            for k in SplitStrategy::ALL {
+            for k in Strategy::ALL {
                 if ui.selectable_label(!on && s.build.strategy == k, k.label()).on_hover_text(k.help()).clicked() {
                     s.build.strategy = k;
                     out.push(Action::UseImported(false));

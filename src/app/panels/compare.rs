@@ -2,8 +2,8 @@
 //! and the figures of A, B and B − A: the trees' and the frame's per-ray work, as the statistics
 //! panel gives them for A.
 
-use crate::app::{Action, Actions, BvhscopeApp};
-use crate::bvh::{Layout, SplitStrategy, TraversalOrder};
+use crate::app::state::{Action, Actions, BvhscopeApp};
+use crate::bvh::{Layout, Strategy, TraversalOrder};
 use crate::options::Choice;
 use crate::render::PairView;
 
@@ -21,7 +21,7 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.horizontal(|ui| {
         ui.label("B: split by");
         egui::ComboBox::from_id_salt("compare-strategy").selected_text(c.strategy.label()).show_ui(ui, |ui| {
-            for s in SplitStrategy::ALL {
+            for s in Strategy::ALL {
                 if ui.selectable_label(c.strategy == s, s.label()).on_hover_text(s.named().help).clicked() {
                     out.push(Action::CompareStrategy(s));
                 }

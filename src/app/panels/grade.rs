@@ -1,10 +1,10 @@
 //! The Grade report window: a class's grade.json (`bvhscope grade`) as its students in the
 //! report's order, each with their rank, verdict, and either their SAH cost against bvhscope's
 //! SAH tree or, when their tree could not be traced, why. Choosing one shows their tree against
-//! SAH binned (`grade_view`), or only the reason; what the choice led to is said above the list.
+//! SAH binned (`update::grade`), or only the reason; what the choice led to is said above the list.
 
-use crate::app::grade_view::Pending;
-use crate::app::{Action, Actions, BvhscopeApp};
+use crate::app::state::{Action, Actions, BvhscopeApp};
+use crate::app::views::Pending;
 use crate::explain::grade::{GradeReport, Verdict};
 
 /// Characters of a reason shown in the list (the whole of it on hover, and for the student chosen).

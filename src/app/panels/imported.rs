@@ -3,7 +3,7 @@
 //! counted), each finding that names a node or a triangle a link that selects it; the wrong pixels
 //! of the view on screen; and the switch between the imported tree and the built strategy.
 
-use crate::app::{Action, Actions, BvhscopeApp};
+use crate::app::state::{Action, Actions, BvhscopeApp};
 use crate::explain::check::Group;
 
 /// Findings listed per group before "… and N more" (a broken dump of a million nodes can have a

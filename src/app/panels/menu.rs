@@ -1,7 +1,7 @@
 //! The menu bar: File (open, recent, built-in scene, export), View, Help.
 
-use crate::app::shortcuts::{shortcut_text as format_shortcut, SHORTCUTS};
-use crate::app::{Action, Actions, BvhscopeApp};
+use crate::app::state::shortcuts::{shortcut_text as format_shortcut, SHORTCUTS};
+use crate::app::state::{Action, Actions, BvhscopeApp};
 use crate::render::View;
 
 fn shortcut_text(ctx: &egui::Context, action: &Action) -> String {

@@ -3,8 +3,9 @@
 //! splitting its triangles at every candidate plane (the exact sweep as a line, the binned SAH's
 //! bins as steps), with where each strategy puts its plane and the cost of a leaf.
 
-use crate::app::{Action, Actions, BvhscopeApp, NodeStep};
-use crate::bvh::SplitStrategy;
+use crate::app::state::{Action, Actions, BvhscopeApp};
+use crate::app::views::NodeStep;
+use crate::bvh::Strategy;
 use crate::explain::inspect::{CurvePoint, Inspection};
 use egui::Color32;
 use egui_plot::{HLine, Line, LineStyle, Plot, PlotPoints, VLine};
@@ -13,7 +14,7 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// Each strategy's marker colour: the strategies' table order picks it, so a strategy added to
 /// the table has its own without naming it here.
-pub fn strategy_color(s: SplitStrategy) -> Color32 {
+pub fn strategy_color(s: Strategy) -> Color32 {
     const PALETTE: [Color32; 8] = [
         Color32::from_rgb(240, 120, 60),
         Color32::from_rgb(200, 120, 230),
@@ -24,7 +25,7 @@ pub fn strategy_color(s: SplitStrategy) -> Color32 {
         Color32::from_rgb(250, 220, 80),
         Color32::from_rgb(110, 220, 200),
     ];
-    let k = SplitStrategy::ALL.iter().position(|&x| x == s).unwrap_or(0);
+    let k = Strategy::ALL.iter().position(|&x| x == s).unwrap_or(0);
     PALETTE[k % PALETTE.len()]
 }
 
@@ -168,7 +169,7 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<(u32, u
 
 /// Where each strategy puts its plane here, and every term of its cost, written out (as
 /// `bvhscope inspect` prints them; nothing only on hover, for a room to read).
-fn planes(ui: &mut egui::Ui, ins: &Inspection, own: Option<SplitStrategy>) {
+fn planes(ui: &mut egui::Ui, ins: &Inspection, own: Option<Strategy>) {
     ui.label("Where each strategy splits these triangles: C_trav + C_isect (A_L/A n_L + A_R/A n_R)");
     egui::Grid::new("node-planes").num_columns(7).striped(true).show(ui, |ui| {
         for head in ["Strategy", "Plane", "n_L", "n_R", "A_L/A", "A_R/A", "Cost"] {
@@ -285,7 +286,7 @@ fn curve_plot(
     ui: &mut egui::Ui,
     ins: &Inspection,
     axis: usize,
-    own: Option<SplitStrategy>,
+    own: Option<Strategy>,
     shared: Option<(f32, f32)>,
     size: Size,
 ) {
@@ -303,8 +304,8 @@ fn curve_plot(
         return;
     }
     let (sweep_name, binned_name, spatial_name) =
-        (SplitStrategy::SahSweep.label(), SplitStrategy::SahBinned.label(), SplitStrategy::Sbvh.label());
-    let markers: Vec<(SplitStrategy, crate::explain::inspect::Marker)> =
+        (Strategy::SahSweep.label(), Strategy::SahBinned.label(), Strategy::Sbvh.label());
+    let markers: Vec<(Strategy, crate::explain::inspect::Marker)> =
         ins.markers.iter().filter_map(|(s, m)| m.filter(|m| m.axis as usize == axis).map(|m| (*s, m))).collect();
     let mut hovered = None;
     // The legend beside the plot where the tile is wide enough, else below it (a narrow tile,
@@ -327,11 +328,11 @@ fn curve_plot(
         }
         plot.show(ui, |p| {
             let line: PlotPoints = thinned(sweep).into_iter().map(|q| [q.position as f64, q.cost as f64]).collect();
-            p.line(Line::new(sweep_name, line).color(strategy_color(SplitStrategy::SahSweep)).width(1.5));
+            p.line(Line::new(sweep_name, line).color(strategy_color(Strategy::SahSweep)).width(1.5));
             if !binned.is_empty() {
                 p.line(
                     Line::new(binned_name, PlotPoints::from(steps(binned)))
-                        .color(strategy_color(SplitStrategy::SahBinned))
+                        .color(strategy_color(Strategy::SahBinned))
                         .width(1.0)
                         .style(LineStyle::dashed_loose()),
                 );
@@ -339,7 +340,7 @@ fn curve_plot(
             if !spatial.is_empty() {
                 p.line(
                     Line::new(spatial_name, PlotPoints::from(steps(spatial)))
-                        .color(strategy_color(SplitStrategy::Sbvh))
+                        .color(strategy_color(Strategy::Sbvh))
                         .width(1.0)
                         .style(LineStyle::dashed_dense()),
                 );
@@ -366,12 +367,12 @@ fn curve_plot(
                     ui.label(size.note(text));
                 });
             };
-            swatch(ui, strategy_color(SplitStrategy::SahSweep), format!("{sweep_name}: every plane"));
+            swatch(ui, strategy_color(Strategy::SahSweep), format!("{sweep_name}: every plane"));
             if !binned.is_empty() {
-                swatch(ui, strategy_color(SplitStrategy::SahBinned), format!("{binned_name}: its bins"));
+                swatch(ui, strategy_color(Strategy::SahBinned), format!("{binned_name}: its bins"));
             }
             if !spatial.is_empty() {
-                swatch(ui, strategy_color(SplitStrategy::Sbvh), format!("{spatial_name}: spatial"));
+                swatch(ui, strategy_color(Strategy::Sbvh), format!("{spatial_name}: spatial"));
             }
             swatch(ui, LEAF_COLOR, "as a leaf".into());
             if let (None, Some(_)) = (own, ins.own_cost) {
@@ -403,9 +404,9 @@ mod tests {
 
     #[test]
     fn every_strategy_has_a_colour_of_its_own() {
-        let colours: Vec<Color32> = SplitStrategy::ALL.iter().map(|&s| strategy_color(s)).collect();
+        let colours: Vec<Color32> = Strategy::ALL.iter().map(|&s| strategy_color(s)).collect();
         for (i, c) in colours.iter().enumerate() {
-            assert!(!colours[..i].contains(c), "{:?} shares its colour", SplitStrategy::ALL[i]);
+            assert!(!colours[..i].contains(c), "{:?} shares its colour", Strategy::ALL[i]);
         }
     }
 

@@ -4,7 +4,7 @@
 //! hit green and miss red, a step slider with play, pause and step buttons, the stack at the
 //! current step, and the counts, the same as the hover read-out's and `bvhscope trace`'s.
 
-use crate::app::{Action, Actions, BvhscopeApp};
+use crate::app::state::{Action, Actions, BvhscopeApp};
 use crate::bvh::{StepKind, TraceLevel};
 use egui::{Color32, RichText};
 use std::time::Duration;
@@ -163,7 +163,7 @@ fn secondary_rays(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
 
 /// What the viewport's colours mean, in those colours.
 fn legend(ui: &mut egui::Ui) {
-    let c = &crate::app::explain_overlay::RAY_COLORS;
+    let c = &super::explain_overlay::RAY_COLORS;
     ui.horizontal_wrapped(|ui| {
         ui.spacing_mut().item_spacing.x = 8.0;
         ui.weak("In the image:");
@@ -183,7 +183,7 @@ fn legend(ui: &mut egui::Ui) {
 }
 
 /// The `bvhscope trace` command that prints this ray's steps, to copy into a terminal or a report.
-fn command_line(r: &crate::app::ray_view::PinnedRay, ui: &mut egui::Ui, out: &mut Actions) {
+fn command_line(r: &crate::app::views::PinnedRay, ui: &mut egui::Ui, out: &mut Actions) {
     ui.horizontal(|ui| match &r.command {
         Some(cmd) => {
             let tip = format!("{cmd}\n(Ctrl+Shift+C)");

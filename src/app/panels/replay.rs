@@ -3,7 +3,7 @@
 //! nodes acting as leaves) and draws the frontier's boxes with the newest split's two children
 //! highlighted; a plot shows the partial tree's SAH cost against the number of splits.
 
-use crate::app::{Action, Actions, BvhscopeApp};
+use crate::app::state::{Action, Actions, BvhscopeApp};
 use egui::Color32;
 use egui_plot::{Line, Plot, PlotPoints, VLine};
 use std::time::Duration;

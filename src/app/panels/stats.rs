@@ -1,7 +1,7 @@
 //! The statistics panel: the current strategy's tree and per-ray figures, next to the strategy
 //! shown before it, and the leaf-size histogram. Every row says what it counts in its tooltip.
 
-use crate::app::{BuiltBvh, BvhscopeApp, StrategyFigures};
+use crate::app::state::{Action, Actions, BuiltBvh, BvhscopeApp, StrategyFigures};
 use crate::bvh::{fmt_ms, SahCost, TreeView};
 use crate::render::RaySummary;
 use egui_plot::{Bar, BarChart, Plot};
@@ -129,7 +129,7 @@ fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<&RaySummary>) {
     } else {
         ui.weak("The tree rows above describe the top level, whose leaves hold placements.");
     }
-    let width = super::grid_column_width(ui, 2);
+    let width = super::layout::grid_column_width(ui, 2);
     egui::Grid::new("two-level").num_columns(2).striped(true).max_col_width(width).show(ui, |ui| {
         ui.label("Placements / meshes")
             .on_hover_text("Placements in the scene file, and the distinct meshes they place");
@@ -167,7 +167,7 @@ fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<&RaySummary>) {
         }
     });
     ui.label("Each mesh's BVH (built once)");
-    let width = super::grid_column_width(ui, 5);
+    let width = super::layout::grid_column_width(ui, 5);
     egui::Grid::new("bottom-level").num_columns(5).striped(true).max_col_width(width).show(ui, |ui| {
         for h in ["Mesh", "Triangles", "Nodes", "Depth", "SAH cost"] {
             ui.strong(h);
@@ -193,7 +193,7 @@ pub fn combined_cost_text(c: SahCost) -> String {
     )
 }
 
-pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions) {
+pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.heading("Statistics");
     // The scene's note: its first sentence, the rest on asking (a paragraph pushed the figures
     // out of a projector's view).
@@ -236,7 +236,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions)
         });
         return;
     };
-    crate::app::gpu::show_in_statistics(app, ui);
+    gpu_lines(app, ui);
     // Side by side, the second column is B and a third gives B − A; otherwise it is the strategy
     // shown before this one.
     let b = app.compare_figures();
@@ -252,7 +252,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions)
     };
     let columns = if comparing { 4 } else { 3 };
     // Four columns share the width (a long label such as an imported file's wraps within its own).
-    let width = if comparing { super::grid_column_width(ui, columns) } else { 0.4 * ui.available_width() };
+    let width = if comparing { super::layout::grid_column_width(ui, columns) } else { 0.4 * ui.available_width() };
     egui::Grid::new("bvh-stats").num_columns(columns).striped(true).max_col_width(width).show(ui, |ui| {
         ui.label("");
         ui.strong(&current.label);
@@ -336,8 +336,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions)
 
 /// The speed-up over linear search the lab asks for: on demand (the scan of a big mesh takes
 /// seconds), single rays on one thread, as `bvhscope compare`'s trace column times them.
-fn speedup(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions) {
-    use crate::app::Action;
+fn speedup(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.add_space(6.0);
     ui.label("Speed-up over linear search").on_hover_text(
         "The frame's primary rays traced one at a time on one thread, closest hit, no shading: through this BVH, and through a linear scan of every triangle (on a spread sample when the whole frame would take over 10 s). bvhscope compare prints the same column",
@@ -386,4 +385,38 @@ fn speedup(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut crate::app::Actions) 
             }
         }
     }
+}
+
+/// The statistics panel's GPU lines: where the frame on screen was traced, and the GPU build's
+/// phases of the current BVH when it was built there (what `bvhscope stats --device gpu` prints).
+fn gpu_lines(app: &BvhscopeApp, ui: &mut egui::Ui) {
+    let built = app.current_bvh().and_then(|b| app.jobs.gpu.build_of(&b.bvh));
+    let traced = app.shown.as_ref().filter(|s| s.gpu.is_some());
+    if built.is_none() && traced.is_none() {
+        return;
+    }
+    egui::Grid::new("gpu-stats").num_columns(2).striped(true).show(ui, |ui| {
+        if let Some(s) = traced {
+            let nodes = s.gpu.as_ref().map_or("", |g| g.nodes.name());
+            ui.label("Traced on").on_hover_text("The frame on screen was traced on this GPU, in one pass at full resolution; its counts are those of bvhscope render --device gpu");
+            ui.label(format!("GPU, {nodes} nodes"))
+                .on_hover_text(s.gpu.as_ref().map_or(String::new(), |g| g.gpu.name()));
+            ui.end_row();
+            if s.cpu_finished > 0 {
+                ui.label("Finished on the CPU").on_hover_text(format!(
+                    "Rays whose GPU walk reached the step budget ({} steps a walk: nodes, stack pops and triangle tests) and were finished by the same walk on the CPU: every hit and count is the CPU walk's",
+                    bvhscope_gpu::STEP_BUDGET
+                ));
+                ui.label(format!("{} of {} rays", s.cpu_finished, s.frame.width() as u64 * s.frame.height() as u64));
+                ui.end_row();
+            }
+        }
+        if let Some(b) = built {
+            let on_gpu = crate::gpu_path::gpu_built();
+            ui.label("GPU build").on_hover_text(format!("{on_gpu} built on the GPU: the phases, as bvhscope stats --device gpu prints them (PLOC: emission is its clustering, boxes the host's layout)"));
+            ui.add(egui::Label::new(b.text()).wrap());
+            ui.end_row();
+        }
+    });
+    ui.add_space(6.0);
 }

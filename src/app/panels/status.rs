@@ -1,6 +1,6 @@
 //! The status line: resolution reached, rays per second, last full frame, and running jobs.
 
-use crate::app::BvhscopeApp;
+use crate::app::state::BvhscopeApp;
 
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui) {
     ui.horizontal(|ui| {

@@ -2,9 +2,10 @@
 //! open, its contents, what closing it asks for), and the egui_tiles behaviour that draws each
 //! tile: the image, the Build and View panels, the statistics, the views.
 
-use super::{build, compare, fixed_width, grade, imported, node, ray, replay, stats, tree, view};
-use crate::app::dock::{self, Pane};
-use crate::app::{Action, Actions, BvhscopeApp};
+use super::layout::fixed_width;
+use super::{build, compare, grade, imported, node, ray, replay, stats, tree, view, viewport};
+use crate::app::state::dock::{self, Pane};
+use crate::app::state::{Action, Actions, BvhscopeApp};
 
 /// An explain view as the layout knows it.
 pub struct View {
@@ -56,7 +57,7 @@ impl egui_tiles::Behavior<Pane> for Tiles<'_> {
         match *pane {
             Pane::Image => {
                 ui.painter().rect_filled(ui.max_rect(), 0.0, egui::Color32::from_gray(12));
-                crate::app::viewport::show(app, ui, out);
+                viewport::show(app, ui, out);
             }
             // The panels keep the width of their tile: their contents wrap, scroll or clip
             // inside it and never widen it, so the image, and with it the camera's aspect,

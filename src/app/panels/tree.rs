@@ -4,8 +4,8 @@
 //! the viewport (shift-click: the pixel's leaf) or in the Node window's breadcrumb selects the
 //! same node everywhere.
 
-use crate::app::node_view::{Explained, Metric, NodeView};
-use crate::app::{Action, Actions, BvhscopeApp};
+use crate::app::state::{Action, Actions, BvhscopeApp};
+use crate::app::views::node::{Explained, Metric, NodeView};
 use crate::render::ColorMap;
 use egui::{Color32, Pos2, Rect, RichText, Sense, Stroke};
 
@@ -214,7 +214,7 @@ fn rows(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u32]
 /// How many triangles spatial splits cut among several leaves, and the triangles referenced twice
 /// in one leaf ("triangle 928 is referenced twice (leaf 17)", by the file's triangle numbers and,
 /// for an imported tree, the dump's node ids), which is no split but a duplicate.
-pub fn references(e: &crate::app::node_view::Explained) -> (usize, Vec<String>) {
+pub fn references(e: &Explained) -> (usize, Vec<String>) {
     let h = &e.hierarchy;
     let (mut cut, mut twice) = (0, Vec::new());
     let names = e.bvh.import();

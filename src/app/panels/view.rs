@@ -1,9 +1,9 @@
 //! The view panel: what the image shows, heatmap colours and range, the up axis, and the node-box
 //! overlay.
 
-use crate::app::gpu::Probe;
-use crate::app::{Action, Actions, BoxLevel, BvhscopeApp};
-use crate::gpu_path::{Device, GpuNodes};
+use crate::app::jobs::Probe;
+use crate::app::state::{Action, Actions, BoxLevel, BvhscopeApp, Film, Settings};
+use crate::gpu_path::{Device, GPU_NODES};
 use crate::render::secondary::MAX_SAMPLES;
 use crate::render::warp::WarpSize;
 use crate::render::{RayKind, UpAxis, View};
@@ -141,9 +141,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         ui.label("Film").on_hover_text(
             "The image's size: the viewport's, or the scene file's camera size (letterboxed), so the statistics are those of the scene's frame, as bvhscope stats SCENE counts them",
         );
-        ui.radio_value(&mut s.film, crate::app::Film::Viewport, "viewport");
+        ui.radio_value(&mut s.film, Film::Viewport, "viewport");
         let label = scene.map_or("the scene's (none)".to_string(), |(w, h)| format!("the scene's {w}×{h}"));
-        ui.add_enabled_ui(scene.is_some(), |ui| ui.radio_value(&mut s.film, crate::app::Film::Scene, label));
+        ui.add_enabled_ui(scene.is_some(), |ui| ui.radio_value(&mut s.film, Film::Scene, label));
     });
     ui.horizontal(|ui| {
         ui.label("Up axis").on_hover_text(
@@ -239,10 +239,10 @@ fn ray_numbers(ui: &mut egui::Ui, r: &mut crate::render::SecondarySpec) {
 }
 
 /// "Trace on: CPU / GPU": the GPU greyed, with the reason on hover, until an adapter is found.
-fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut crate::app::Settings) {
+fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
     let probe = &app.jobs.gpu.probe;
     ui.label("Trace on").on_hover_text(
-        "Where the frames are traced: the CPU, or the GPU (wgpu compute shaders) at full resolution in one pass, with the same per-pixel counts as the CPU's binary layout (bvhscope render --device gpu). With the GPU, the tree is built in the binary layout and lbvh and ploc are built on the GPU too.",
+        format!("Where the frames are traced: the CPU, or the GPU (wgpu compute shaders) at full resolution in one pass, with the same per-pixel counts as the CPU's binary layout (bvhscope render --device gpu). With the GPU, the tree is built in the binary layout and {} are built on the GPU too.", crate::gpu_path::gpu_built()),
     );
     ui.radio_value(&mut s.device, Device::Cpu, "CPU");
     let why = match probe {
@@ -262,17 +262,15 @@ fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut crate::app::Settings) 
 }
 
 /// With the GPU chosen: its node format, and why it does not trace now if it does not.
-fn gpu_choices(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut crate::app::Settings) {
+fn gpu_choices(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
     if s.device != Device::Gpu {
         return;
     }
     ui.horizontal(|ui| {
         ui.label("GPU nodes");
-        ui.radio_value(&mut s.gpu_nodes, GpuNodes::Binary, "binary")
-            .on_hover_text("The binary tree as built: core's 32-byte nodes, byte for byte");
-        ui.radio_value(&mut s.gpu_nodes, GpuNodes::Cwbvh, "CWBVH").on_hover_text(
-            "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree; its counts are those of its own walk",
-        );
+        for row in &GPU_NODES {
+            ui.radio_value(&mut s.gpu_nodes, row.nodes, row.label).on_hover_text(row.help);
+        }
     });
     if let Some(why) = app.gpu_blocked() {
         ui.label(format!("Traced on the CPU: {why}"));

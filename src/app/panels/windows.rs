@@ -1,7 +1,8 @@
 //! Floating windows: Help (shortcuts), and the path field used when no file dialog is available.
 
-use crate::app::shortcuts::{shortcut_text, MOUSE, SHORTCUTS};
-use crate::app::{Action, Actions, BvhscopeApp, Pick};
+use crate::app::jobs::Pick;
+use crate::app::state::shortcuts::{shortcut_text, MOUSE, SHORTCUTS};
+use crate::app::state::{Action, Actions, BvhscopeApp};
 use std::path::PathBuf;
 
 pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {

@@ -5,7 +5,7 @@
 //! out), the median of `--runs` runs after one untimed run that compiles the kernels.
 
 use super::rows::CompareRow;
-use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SceneBvh, SplitStrategy, TraceOptions, TreeStats, TreeView};
+use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SceneBvh, Strategy, TraceOptions, TreeStats, TreeView};
 use crate::cli::args::BuildArgs;
 use crate::cli::device::{self, GpuTree};
 use crate::cli::{progress, CliError};
@@ -58,7 +58,7 @@ pub fn gpu_rows(
     let pixels = camera.width as usize * camera.height as usize;
     let incoherent = crate::render::incoherent_rays(mesh, pixels, 1);
     let mut rows = Vec::new();
-    for strategy in SplitStrategy::ALL {
+    for strategy in Strategy::ALL {
         let params = build.params_with(scene, strategy, Layout::Binary);
         let (bvh, built_on_gpu) = match device::gpu_build(gpu, mesh, &params)? {
             Some((bvh, _)) => (bvh, true),
@@ -72,10 +72,7 @@ pub fn gpu_rows(
         let scene_bvh = SceneBvh::Single { bvh, mesh: mesh.clone(), imported: None };
         for &format in nodes {
             let (tree, _) = GpuTree::upload(gpu, &scene_bvh, format)?;
-            let cw_nodes = match &tree {
-                GpuTree::Cwbvh(cw, _) => Some(cw.nodes.len()),
-                GpuTree::Binary(..) => None,
-            };
+            let cw_nodes = tree.own_nodes();
             let label = format!("timing {} ({} nodes) on the GPU", strategy.label(), format.name());
             let measured = progress::with_spinner(&label, || -> Result<_, CliError> {
                 let mut out = Vec::new();

@@ -97,7 +97,7 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
         kinds.as_mut().map(|k| k as &mut (dyn rows::PerTree + Send)),
     );
     let linear_ms = rows.last().map_or(0.0, |r| r.trace_ms);
-    let formats = a.device.gpu_nodes.map_or(vec![GpuNodes::Binary, GpuNodes::Cwbvh], |n| vec![n]);
+    let formats = a.device.gpu_nodes.map_or(GpuNodes::ALL.to_vec(), |n| vec![n]);
     let gpu_rows = match &gpu {
         Some(g) => Some(gpu::gpu_rows(g, &mesh_arc, &camera, &a.build, scene, a.runs, &formats, linear_ms)?),
         None => None,

@@ -1,7 +1,7 @@
 //! The table's rows: every strategy built and measured on the same primary rays, next to a
 //! linear scan of all triangles (how, in `compare`'s module comment).
 
-use crate::bvh::{epo, AnyBvh, BuildParams, Hierarchy, LinearScan, SplitStrategy, TreeStats, TreeView};
+use crate::bvh::{epo, AnyBvh, BuildParams, Hierarchy, LinearScan, Strategy, TreeStats, TreeView};
 use crate::cli::args::BuildArgs;
 use crate::cli::progress;
 use crate::explain::timing::{ms, time_linear, trace_rays};
@@ -123,9 +123,9 @@ pub fn compare_rows(
     let mut root_rays = 0;
     let mut epo_of = std::collections::HashMap::new();
     let layouts = build.compare_layouts();
-    let rows_to_make = SplitStrategy::ALL.len() * layouts.len();
+    let rows_to_make = Strategy::ALL.len() * layouts.len();
     for (row, (strategy, layout)) in
-        SplitStrategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))).enumerate()
+        Strategy::ALL.into_iter().flat_map(|s| layouts.iter().map(move |&l| (s, l))).enumerate()
     {
         let params = build.params_with(scene, strategy, layout);
         let name = format!("{} ({})", strategy.label(), layout.name());

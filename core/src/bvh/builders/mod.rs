@@ -60,7 +60,7 @@ impl Bvh {
         let n = mesh.triangle_count();
         if params.strategy.follows_morton_order() {
             let progress = Progress { control, levels: progress_levels(n, &params) };
-            return Self::finish(lbvh::build_mesh(mesh, &params, &progress)?, control);
+            return lbvh::build_mesh(mesh, &params, &progress)?.finish(control);
         }
         let make = |i: usize| {
             let tri = mesh.triangle(i as u32);
@@ -86,17 +86,18 @@ impl Bvh {
             (prim_ids, tris)
         });
         report.reorder_time = t2.elapsed();
-        Self::finish(Bvh { nodes, prim_ids, tris, params, report }, control)
+        Bvh { nodes, prim_ids, tris, params, report }.finish(control)
     }
 
-    /// The reinsertion after a build, if asked for.
-    fn finish(mut bvh: Bvh, control: &WorkControl) -> Result<Bvh, Cancelled> {
-        let passes = bvh.params.reinsert_passes;
+    /// The step after any builder (here, or the GPU's): the reinsertion its parameters ask for.
+    /// Laying it out follows (`AnyBvh::finish`).
+    pub fn finish(mut self, control: &WorkControl) -> Result<Bvh, Cancelled> {
+        let passes = self.params.reinsert_passes;
         if passes > 0 {
             control.check()?;
-            bvh.report.reinsertion = Some(reinsert::optimise(&mut bvh, passes));
+            self.report.reinsertion = Some(reinsert::optimise(&mut self, passes));
         }
-        Ok(bvh)
+        Ok(self)
     }
 }
 

@@ -197,7 +197,7 @@ impl MortonOrder {
 mod morton_order_tests {
     use super::MortonOrder;
     use crate::bvh::Hierarchy;
-    use crate::bvh::{BuildParams, Bvh, Layout, SplitStrategy};
+    use crate::bvh::{BuildParams, Bvh, Layout, Strategy};
     use crate::mesh::generate;
 
     /// The leaf order of an LBVH tree is its Morton order, and every split of the tree (not a
@@ -205,7 +205,7 @@ mod morton_order_tests {
     #[test]
     fn an_lbvh_trees_leaf_order_is_its_morton_order_and_splits_follow_it() {
         let mesh = generate::torus_knot(2, 3, 0.3, 256, 12);
-        let params = BuildParams { strategy: SplitStrategy::Lbvh, layout: Layout::Binary, ..Default::default() };
+        let params = BuildParams { strategy: Strategy::Lbvh, layout: Layout::Binary, ..Default::default() };
         let bvh = Bvh::build(&mesh, &params);
         let order = MortonOrder::of(&bvh).expect("an LBVH tree");
         assert_eq!(order.centroids.len(), bvh.prim_ids.len());

@@ -402,7 +402,7 @@ impl Place<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::SplitStrategy;
+    use crate::bvh::Strategy;
 
     /// Every primitive in exactly one leaf of at most the leaf size, each box its subtree's union,
     /// and merging only ever joins neighbours in Morton order, so a row of boxes is paired in order.
@@ -411,7 +411,7 @@ mod tests {
         let mesh = crate::mesh::generate::torus(2.0, 0.5, 64, 40);
         let control = crate::work::WorkControl::new();
         let progress = Progress::new(&control, 1);
-        let params = BuildParams { strategy: SplitStrategy::Ploc, max_leaf_size: 4, ..BuildParams::default() };
+        let params = BuildParams { strategy: Strategy::Ploc, max_leaf_size: 4, ..BuildParams::default() };
         let mut prims: Vec<BuildPrim> = (0..mesh.triangle_count())
             .map(|i| BuildPrim::new(Aabb::from_points(&mesh.triangle(i as u32)), i as u32))
             .collect();

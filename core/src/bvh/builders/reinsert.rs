@@ -389,14 +389,14 @@ fn collapse(t: &Tree, params: &BuildParams) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{Accelerator, BuildParams, Layout, LinearScan, NoStats, SplitStrategy, TraceOptions};
+    use crate::bvh::{Accelerator, BuildParams, Layout, LinearScan, NoStats, Strategy, TraceOptions};
 
     /// Reinsertion lowers an LBVH tree's SAH cost (blocky Morton splits leave much to move),
     /// keeps every triangle once, keeps boxes tight, and every ray still finds the linear scan's hit.
     #[test]
     fn reinsertion_lowers_the_cost_and_keeps_the_hits() {
         let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 96, 8);
-        let params = BuildParams { strategy: SplitStrategy::Lbvh, layout: Layout::Binary, ..BuildParams::default() };
+        let params = BuildParams { strategy: Strategy::Lbvh, layout: Layout::Binary, ..BuildParams::default() };
         let mut bvh = Bvh::build(&mesh, &params);
         let r = optimise(&mut bvh, 8);
         assert!(r.sah_after < 0.97 * r.sah_before, "{r:?}");

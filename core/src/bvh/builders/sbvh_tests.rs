@@ -1,10 +1,10 @@
 //! The SBVH's tests (`sbvh.rs`).
 
-use crate::bvh::{BuildParams, Bvh, Layout, SplitStrategy, TreeStats};
+use crate::bvh::{BuildParams, Bvh, Layout, Strategy, TreeStats};
 use crate::mesh::generate;
 
 fn sbvh(growth: u32) -> BuildParams {
-    BuildParams { strategy: SplitStrategy::Sbvh, layout: Layout::Binary, sbvh_growth: growth, ..Default::default() }
+    BuildParams { strategy: Strategy::Sbvh, layout: Layout::Binary, sbvh_growth: growth, ..Default::default() }
 }
 
 /// Long thin triangles whose boxes overlap: spatial splits cut them, within the growth bound,

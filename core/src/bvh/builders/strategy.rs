@@ -7,9 +7,10 @@
 use super::split::{EqualCount, Midpoint, SahBinned, SahSweep, Splitter};
 use crate::bvh::{BuildParams, Param};
 
-/// How the builder chooses splits.
+/// How a tree is built: top down by a splitter (midpoint, equal count, SAH binned or swept), or
+/// by a builder of its own (LBVH, PLOC, SBVH). Its row of `REGISTRY` says which.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-pub enum SplitStrategy {
+pub enum Strategy {
     /// Middle of the centroid bounds on the widest axis.
     Midpoint,
     /// Median centroid on the widest axis: equally many triangles on each side.
@@ -19,7 +20,7 @@ pub enum SplitStrategy {
     SahBinned,
     /// Surface area heuristic, evaluated between every pair of neighbouring centroids.
     SahSweep,
-    /// Not a split strategy but a builder of its own (`builders::lbvh`): the hierarchy of the
+    /// A builder of its own (`builders::lbvh`): the hierarchy of the
     /// centroids' sorted Morton codes.
     Lbvh,
     /// A bottom-up builder of its own (`builders::ploc`): clusters merged with their nearest
@@ -45,25 +46,25 @@ pub enum Builder {
 }
 
 struct Entry {
-    strategy: SplitStrategy,
+    strategy: Strategy,
     builder: Builder,
     /// The numbers it reads besides those every build reads (`Param::every_build`).
     params: &'static [Param],
 }
 
 const REGISTRY: [Entry; 7] = [
-    Entry { strategy: SplitStrategy::Midpoint, builder: Builder::TopDown(|_| Box::new(Midpoint)), params: &[] },
-    Entry { strategy: SplitStrategy::EqualCount, builder: Builder::TopDown(|_| Box::new(EqualCount)), params: &[] },
+    Entry { strategy: Strategy::Midpoint, builder: Builder::TopDown(|_| Box::new(Midpoint)), params: &[] },
+    Entry { strategy: Strategy::EqualCount, builder: Builder::TopDown(|_| Box::new(EqualCount)), params: &[] },
     Entry {
-        strategy: SplitStrategy::SahBinned,
+        strategy: Strategy::SahBinned,
         builder: Builder::TopDown(|p| Box::new(SahBinned::new(p))),
         params: &[Param::SahBins],
     },
-    Entry { strategy: SplitStrategy::SahSweep, builder: Builder::TopDown(|p| Box::new(SahSweep::new(p))), params: &[] },
-    Entry { strategy: SplitStrategy::Lbvh, builder: Builder::Morton, params: &[] },
-    Entry { strategy: SplitStrategy::Ploc, builder: Builder::Clustering, params: &[Param::PlocRadius] },
+    Entry { strategy: Strategy::SahSweep, builder: Builder::TopDown(|p| Box::new(SahSweep::new(p))), params: &[] },
+    Entry { strategy: Strategy::Lbvh, builder: Builder::Morton, params: &[] },
+    Entry { strategy: Strategy::Ploc, builder: Builder::Clustering, params: &[Param::PlocRadius] },
     Entry {
-        strategy: SplitStrategy::Sbvh,
+        strategy: Strategy::Sbvh,
         builder: Builder::SpatialSplits,
         params: &[Param::SahBins, Param::SbvhAlpha, Param::SbvhGrowth],
     },
@@ -77,7 +78,7 @@ impl Param {
     }
 }
 
-impl SplitStrategy {
+impl Strategy {
     fn entry(self) -> &'static Entry {
         REGISTRY.iter().find(|e| e.strategy == self).expect("every strategy has its row")
     }
@@ -137,9 +138,9 @@ mod tests {
             assert!(REGISTRY[..i].iter().all(|f| f.strategy != e.strategy), "{:?} twice", e.strategy);
             assert!(e.params.iter().all(|p| !p.every_build()), "{:?}: a number every build reads", e.strategy);
         }
-        assert_eq!(REGISTRY.len(), SplitStrategy::ALL.len());
-        assert!(SplitStrategy::Sbvh.splits_references() && !SplitStrategy::SahBinned.splits_references());
-        assert!(SplitStrategy::Sbvh.uses_bins() && !SplitStrategy::Ploc.uses_bins());
-        assert!(SplitStrategy::Ploc.reads(Param::PlocRadius) && !SplitStrategy::Lbvh.reads(Param::PlocRadius));
+        assert_eq!(REGISTRY.len(), Strategy::ALL.len());
+        assert!(Strategy::Sbvh.splits_references() && !Strategy::SahBinned.splits_references());
+        assert!(Strategy::Sbvh.uses_bins() && !Strategy::Ploc.uses_bins());
+        assert!(Strategy::Ploc.reads(Param::PlocRadius) && !Strategy::Lbvh.reads(Param::PlocRadius));
     }
 }

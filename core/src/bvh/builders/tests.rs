@@ -2,7 +2,7 @@
 //! can be cancelled while it runs.
 
 use super::*;
-use crate::bvh::SplitStrategy;
+use crate::bvh::Strategy;
 use crate::mesh::generate::torus;
 
 #[test]
@@ -11,7 +11,7 @@ fn the_parallel_build_lays_out_the_same_tree_as_the_sequential_one() {
     let mesh = torus(2.0, 0.5, 256, 160);
     assert!(mesh.triangle_count() > 16 * PARALLEL_MIN_PRIMS);
     // (LBVH's own parallel build is compared with its one-thread build in `bvh::lbvh`.)
-    for strategy in SplitStrategy::ALL.into_iter().filter(|&s| s != SplitStrategy::SahSweep && s.splits_top_down()) {
+    for strategy in Strategy::ALL.into_iter().filter(|&s| s != Strategy::SahSweep && s.splits_top_down()) {
         let params = BuildParams::with_strategy(strategy).clamped();
         let bvh = Bvh::build(&mesh, &params);
         let mut prims: Vec<BuildPrim> = (0..mesh.triangle_count())
@@ -28,7 +28,7 @@ fn the_parallel_build_lays_out_the_same_tree_as_the_sequential_one() {
 #[test]
 fn build_reports_progress_and_can_be_cancelled() {
     let mesh = torus(2.0, 0.5, 64, 32);
-    for strategy in SplitStrategy::ALL {
+    for strategy in Strategy::ALL {
         for max_leaf_size in [1, 4, 16] {
             let control = WorkControl::new();
             let params = BuildParams { max_leaf_size, ..BuildParams::with_strategy(strategy) };
@@ -53,8 +53,7 @@ fn progress_moves_at_the_first_split_not_only_at_the_first_leaf() {
     let n = mesh.triangle_count() as u64;
     let control = WorkControl::new();
     let first_seen = std::thread::scope(|s| {
-        let build =
-            s.spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(SplitStrategy::SahSweep), &control));
+        let build = s.spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(Strategy::SahSweep), &control));
         let mut seen = 0;
         while seen == 0 && !build.is_finished() {
             seen = control.done();
@@ -73,8 +72,7 @@ fn a_build_cancelled_while_running_stops() {
     let mesh = torus(2.0, 0.5, 1024, 512);
     let control = WorkControl::new();
     let result = std::thread::scope(|s| {
-        let build =
-            s.spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(SplitStrategy::SahSweep), &control));
+        let build = s.spawn(|| Bvh::build_controlled(&mesh, &BuildParams::with_strategy(Strategy::SahSweep), &control));
         while control.done() == 0 && !build.is_finished() {
             std::thread::yield_now();
         }
@@ -105,8 +103,8 @@ fn every_strategy_builds_the_same_tree_on_one_and_four_threads() {
             })
             .collect()
     };
-    for strategy in SplitStrategy::ALL {
-        let meshes = if strategy == SplitStrategy::Sbvh { vec![&big, &needles] } else { vec![&big] };
+    for strategy in Strategy::ALL {
+        let meshes = if strategy == Strategy::Sbvh { vec![&big, &needles] } else { vec![&big] };
         for mesh in meshes {
             let params = BuildParams { strategy, layout: crate::bvh::Layout::Binary, ..Default::default() };
             let build = |threads| {

@@ -1,5 +1,5 @@
 use super::*;
-use crate::bvh::{BuildParams, BvhNode, Layout, SplitStrategy};
+use crate::bvh::{BuildParams, BvhNode, Layout, Strategy};
 use crate::geometry::Aabb;
 use crate::mesh::{generate, Mesh};
 use crate::random::Rng;
@@ -23,7 +23,7 @@ fn brute_terms(bvh: &Bvh, h: &Hierarchy) -> Vec<f64> {
         .collect()
 }
 
-fn build(mesh: &Mesh, strategy: SplitStrategy, max_leaf_size: u32) -> Bvh {
+fn build(mesh: &Mesh, strategy: Strategy, max_leaf_size: u32) -> Bvh {
     Bvh::build(mesh, &BuildParams { strategy, max_leaf_size, layout: Layout::Binary, ..BuildParams::default() })
 }
 
@@ -129,13 +129,7 @@ fn clipping_keeps_what_is_inside() {
 #[test]
 fn measure_equals_the_definition_on_small_meshes() {
     for (name, mesh) in meshes() {
-        for strategy in [
-            SplitStrategy::SahBinned,
-            SplitStrategy::Midpoint,
-            SplitStrategy::Lbvh,
-            SplitStrategy::Ploc,
-            SplitStrategy::Sbvh,
-        ] {
+        for strategy in [Strategy::SahBinned, Strategy::Midpoint, Strategy::Lbvh, Strategy::Ploc, Strategy::Sbvh] {
             for leaf in [1, 4] {
                 let bvh = build(&mesh, strategy, leaf);
                 let h = Hierarchy::of(&bvh);
@@ -166,7 +160,7 @@ fn measure_equals_the_definition_on_small_meshes() {
 #[test]
 fn an_estimate_within_its_stated_error() {
     for (name, mesh) in meshes() {
-        for strategy in [SplitStrategy::SahBinned, SplitStrategy::Sbvh] {
+        for strategy in [Strategy::SahBinned, Strategy::Sbvh] {
             let bvh = build(&mesh, strategy, 4);
             let h = Hierarchy::of(&bvh);
             let brute = brute_terms(&bvh, &h);
@@ -211,7 +205,7 @@ fn an_estimate_within_its_stated_error() {
 fn the_stated_error_is_honest() {
     let cases = [(generate::needles(400, 9), 400_000), (generate::torus_knot(2, 3, 0.3, 96, 6), 60_000)];
     for (mesh, budget) in cases {
-        let bvh = build(&mesh, SplitStrategy::SahBinned, 4);
+        let bvh = build(&mesh, Strategy::SahBinned, 4);
         let h = Hierarchy::of(&bvh);
         let want: f64 = brute_terms(&bvh, &h).iter().sum();
         for by in [Estimator::Walks, Estimator::Pairs, Estimator::Best] {
@@ -235,7 +229,7 @@ fn the_stated_error_is_honest() {
 /// gets a figure, not a walk for ever: the estimate's walks follow links forward only.
 #[test]
 fn a_tree_whose_links_loop_is_measured_in_bounded_time() {
-    let mut bvh = build(&generate::torus_knot(2, 3, 0.3, 48, 6), SplitStrategy::SahBinned, 4);
+    let mut bvh = build(&generate::torus_knot(2, 3, 0.3, 48, 6), Strategy::SahBinned, 4);
     let h = Hierarchy::of(&bvh);
     // The deepest interior node's children become the root's pair: a loop back to the top.
     let i = (0..bvh.nodes.len()).rev().find(|&i| !bvh.nodes[i].is_leaf()).expect("an interior node");

@@ -1,7 +1,7 @@
 //! Tests of `packet.rs`: packets against single rays, and the frustum test against the slab test.
 
 use super::*;
-use crate::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, SplitStrategy};
+use crate::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, Strategy};
 use crate::mesh::generate::{builtin_scene, torus_knot};
 use crate::mesh::Mesh;
 use crate::render::Camera;
@@ -93,7 +93,7 @@ fn axis_aligned(mesh: &Mesh) -> Vec<Ray> {
 fn packets_find_what_single_rays_find() {
     for mesh in [builtin_scene(), torus_knot(2, 3, 0.3, 256, 16)] {
         for layout in Layout::ALL {
-            for strategy in SplitStrategy::ALL {
+            for strategy in Strategy::ALL {
                 let bvh = AnyBvh::build(&mesh, &BuildParams { layout, ..BuildParams::with_strategy(strategy) });
                 let what = format!("{} {strategy:?} {layout:?}", mesh.name);
                 let hits = agree(&bvh, &primary_blocks(&mesh, 64), PACKET, &what);

@@ -3,9 +3,11 @@
 //! reached twice, never reached). Each kind of defect is one finding listing its nodes.
 
 use super::{count, defect, max_references, warning, Finding, Group, Tally};
+use crate::bvh::reach::{reach, Fault, Reach};
 use crate::dump::BvhDump;
 use crate::mesh::Mesh;
 use glam::Vec3;
+use std::ops::ControlFlow;
 
 /// The tree as reached from the root: which nodes, and the parent each was first reached from.
 pub(super) struct Walk {
@@ -126,40 +128,20 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, out: &mut Vec<Finding>) -> Opti
     Some(walk(dump, out))
 }
 
-/// The walk from the root, depth first: nodes reached twice (a cycle when the node is on the
-/// path from the root to the one reaching it again, else two parents), never reached. Without
-/// recursion and in time linear in the nodes and their children, however deep or tangled.
+/// The walk from the root (`bvh::reach`): nodes reached twice (a cycle when the node is on the
+/// path from the root to the one reaching it again, else two parents), never reached. A child
+/// past the last node is a finding of the nodes on their own, above.
 fn walk(dump: &BvhDump, out: &mut Vec<Finding>) -> Walk {
     let nodes = &dump.nodes;
-    let mut parent = vec![u32::MAX; nodes.len()];
-    let mut reached = vec![false; nodes.len()];
-    let mut on_path = vec![false; nodes.len()];
     let mut twice = Tally::new(Group::Structure, true, "node is reached twice", "nodes are reached twice");
-    // (node, its next child to follow)
-    let mut stack = vec![(0usize, 0usize)];
-    (reached[0], on_path[0]) = (true, true);
-    while let Some(top) = stack.last_mut() {
-        let (i, next) = *top;
-        let kids = nodes[i].children.as_deref().unwrap_or(&[]);
-        let Some(&k) = kids.get(next) else {
-            on_path[i] = false;
-            stack.pop();
-            continue;
-        };
-        top.1 += 1;
-        let k = k as usize;
-        if k >= nodes.len() {
-            continue;
+    let children = |i: usize, k: usize| nodes[i].children.as_deref().and_then(|c| c.get(k)).copied();
+    let Reach { reached, parent, .. } = reach(nodes.len(), children, |fault| {
+        if let Fault::Again { from, node, cycle } = fault {
+            let why = if cycle { "a cycle" } else { "two parents" };
+            twice.add(Some(node as u32), None, format!("node {node} (from node {from}: {why})"));
         }
-        if reached[k] {
-            let why = if on_path[k] { "a cycle" } else { "two parents" };
-            twice.add(Some(k as u32), None, format!("node {k} (from node {i}: {why})"));
-            continue;
-        }
-        (reached[k], on_path[k]) = (true, true);
-        parent[k] = i as u32;
-        stack.push((k, 0));
-    }
+        ControlFlow::Continue(())
+    });
     twice.finish(out);
     // Reached leaves of no triangle: harmless, but a binary node cannot hold nothing.
     let mut empty = Tally::new(

@@ -270,7 +270,7 @@ fn unreadable_dumps_say_why() {
 fn an_sbvh_tree_checks_clean_and_an_uncovered_part_of_a_cut_triangle_is_named() {
     let mesh = generate::diagonal_rods(2, 6, 4.0, 0.05, 0.3);
     let params = BuildParams {
-        strategy: crate::bvh::SplitStrategy::Sbvh,
+        strategy: crate::bvh::Strategy::Sbvh,
         layout: crate::bvh::Layout::Binary,
         sbvh_growth: 100,
         ..BuildParams::default()

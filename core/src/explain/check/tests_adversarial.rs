@@ -228,7 +228,7 @@ fn degenerate_faces_keep_their_numbers_first_middle_and_last() {
 #[test]
 fn every_built_tree_checks_clean_with_the_exact_bounds() {
     for mesh in [generate::torus_knot(2, 3, 0.3, 64, 8), generate::diagonal_rods(2, 6, 4.0, 0.05, 0.3)] {
-        for strategy in crate::bvh::SplitStrategy::ALL {
+        for strategy in crate::bvh::Strategy::ALL {
             for layout in crate::bvh::Layout::ALL {
                 let b =
                     AnyBvh::build(&mesh, &BuildParams { strategy, layout, sbvh_growth: 100, ..BuildParams::default() });

@@ -14,7 +14,6 @@ use crate::render::diff::{difference, difference_image};
 use crate::render::{draw_legend, view_image, ColorMap, HeatRange, View};
 use crate::work::{Cancelled, WorkControl};
 use std::panic::AssertUnwindSafe;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Grade one submission: never fails, never panics out (a panic becomes the row's reason).
@@ -60,28 +59,18 @@ pub fn evaluate(sub: &Submission, setup: &Setup, refs: &mut References, out: &Re
 /// Run `work` with a control that is cancelled once `limit` has passed.
 fn with_deadline<T>(limit: Duration, work: impl FnOnce(&WorkControl) -> T) -> T {
     let control = WorkControl::new();
-    let finished = AtomicBool::new(false);
-    // Set when `work` returns or panics, so the watcher never outlives it.
-    struct Finish<'a>(&'a AtomicBool);
-    impl Drop for Finish<'_> {
-        fn drop(&mut self) {
-            self.0.store(true, Ordering::Release);
-        }
-    }
-    std::thread::scope(|s| {
-        s.spawn(|| {
+    crate::work::watched(
+        |ended| {
             let start = Instant::now();
-            while !finished.load(Ordering::Acquire) {
+            while !ended.after(Duration::from_millis(20)) {
                 if start.elapsed() >= limit {
                     control.cancel();
                     return;
                 }
-                std::thread::sleep(Duration::from_millis(20));
             }
-        });
-        let _finish = Finish(&finished);
-        work(&control)
-    })
+        },
+        || work(&control),
+    )
 }
 
 /// What the check left: a finished row, or a row and the tree to measure.

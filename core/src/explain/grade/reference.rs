@@ -6,7 +6,7 @@
 
 use super::measure::{measure, time_linear, time_together, timed, tracer, Quality, Timing, Tracer, RUNS};
 use super::Setup;
-use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SplitStrategy};
+use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, Strategy};
 use crate::dump::{import, BvhDump};
 use crate::explain::check::Reference;
 use crate::mesh::Mesh;
@@ -53,9 +53,9 @@ pub struct References {
 impl References {
     /// The strategies built: SAH binned (the ratios and differences are against it), then the
     /// rubric's others in its order.
-    pub fn strategies(setup: &Setup) -> Vec<SplitStrategy> {
-        let mut s = vec![SplitStrategy::SahBinned];
-        s.extend(setup.rubric.references.iter().copied().filter(|&r| r != SplitStrategy::SahBinned));
+    pub fn strategies(setup: &Setup) -> Vec<Strategy> {
+        let mut s = vec![Strategy::SahBinned];
+        s.extend(setup.rubric.references.iter().copied().filter(|&r| r != Strategy::SahBinned));
         s
     }
 
@@ -93,7 +93,7 @@ impl References {
                 unreachable!("nobody else holds this control")
             };
             visits_max = visits_max.max(frame.ray_summary().max_nodes_visited as f32);
-            if strategy == SplitStrategy::SahBinned {
+            if strategy == Strategy::SahBinned {
                 sah_frame = Some(frame);
             }
             built.push((strategy, tree, q));

@@ -21,8 +21,9 @@
 //! bvhscope's SAH tree in the same layout (0.10: at most 10 % above it).
 
 use super::{GradeError, Quality, RankBy, VersusSah};
-use crate::bvh::SplitStrategy;
+use crate::bvh::Strategy;
 use crate::explain::check::Group;
+use crate::json::Fields;
 use glam::Vec3;
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
@@ -87,7 +88,7 @@ pub struct Rubric {
     /// The checks whose defects fail a submission (structure always: a tree with structure
     /// defects cannot be traced).
     pub required: Vec<Group>,
-    pub references: Vec<SplitStrategy>,
+    pub references: Vec<Strategy>,
     pub rank_by: RankBy,
     pub good: Good,
 }
@@ -105,7 +106,7 @@ impl Default for Rubric {
             rays: None,
             time_rays: None,
             required: Group::ALL.to_vec(),
-            references: vec![SplitStrategy::SahBinned, SplitStrategy::Midpoint],
+            references: vec![Strategy::SahBinned, Strategy::Midpoint],
             rank_by: RankBy::SahCost,
             good: Good { sah_cost_within: Some(0.10), ..Good::default() },
         }
@@ -136,14 +137,15 @@ impl Rubric {
 
     /// A rubric from its text (`path` names it in errors and anchors `mesh`).
     pub fn parse(path: &Path, text: &str) -> Result<Rubric, GradeError> {
-        let f = Fields { path };
+        let f = Fields::new(path, |path, field, message| GradeError::Rubric {
+            path: path.into(),
+            field: field.into(),
+            message,
+        });
         // A key given twice is refused: a rubric whose first "good" were silently lost would
         // grade as if nothing were wrong.
-        let json: Value =
-            crate::scene::strict_json::parse(text).map_err(|e| f.err(&format!("line {}", e.line()), e.to_string()))?;
-        let root = json
-            .as_object()
-            .ok_or_else(|| f.err("(top level)", format!("expected an object, found {}", kind(&json))))?;
+        let json: Value = crate::json::parse(text).map_err(|e| f.err(&format!("line {}", e.line()), e.to_string()))?;
+        let root = f.object(&json, "(top level)")?;
         f.known(root, "", &KEYS)?;
         let mut r = Rubric { file: Some(path.to_path_buf()), ..Rubric::default() };
         r.note = root.get("note").map(|v| f.text(v, "note")).transpose()?;
@@ -152,7 +154,7 @@ impl Rubric {
             r.mesh = Some(path.parent().unwrap_or(Path::new(".")).join(m));
         }
         if let Some(c) = root.get("camera") {
-            let o = c.as_object().ok_or_else(|| f.err("camera", format!("expected an object, found {}", kind(c))))?;
+            let o = f.object(c, "camera")?;
             f.known(o, "camera", &CAMERA_KEYS)?;
             let need = |k: &str| o.get(k).ok_or_else(|| f.err(&format!("camera.{k}"), "missing"));
             r.camera = Some(RubricCamera {
@@ -160,7 +162,7 @@ impl Rubric {
                 look_at: f.vec3(need("look_at")?, "camera.look_at")?,
                 up: o.get("up").map(|u| f.vec3(u, "camera.up")).transpose()?.unwrap_or(Vec3::Y),
                 vertical_fov: match o.get("vertical_fov") {
-                    Some(v) => f.number(v, "camera.vertical_fov", 0.01, 179.9)? as f32,
+                    Some(v) => f.number_in(v, "camera.vertical_fov", 0.01, 179.9)? as f32,
                     None => crate::render::Camera::DEFAULT_VFOV_DEG,
                 },
             });
@@ -186,8 +188,7 @@ impl Rubric {
             }
         }
         if let Some(v) = root.get("references") {
-            r.references =
-                f.list(v, "references", SplitStrategy::from_name, &SplitStrategy::ALL.map(|s| s.name()).join(", "))?;
+            r.references = f.list(v, "references", Strategy::from_name, &Strategy::ALL.map(|s| s.name()).join(", "))?;
         }
         if let Some(v) = root.get("rank_by") {
             let names = RankBy::ALL.map(|r| r.name()).join(", ");
@@ -197,9 +198,9 @@ impl Rubric {
                 .ok_or_else(|| f.err("rank_by", format!("expected one of {names}")))?;
         }
         if let Some(g) = root.get("good") {
-            let o = g.as_object().ok_or_else(|| f.err("good", format!("expected an object, found {}", kind(g))))?;
+            let o = f.object(g, "good")?;
             f.known(o, "good", &GOOD_KEYS)?;
-            let fraction = |k: &str| o.get(k).map(|v| f.number(v, &format!("good.{k}"), 0.0, 1e6)).transpose();
+            let fraction = |k: &str| o.get(k).map(|v| f.number_in(v, &format!("good.{k}"), 0.0, 1e6)).transpose();
             r.good = Good {
                 sah_cost_within: fraction("sah_cost_within")?,
                 nodes_per_ray_within: fraction("nodes_per_ray_within")?,
@@ -270,104 +271,5 @@ impl Rubric {
         }
         o.insert("good".into(), Value::Object(good));
         Value::Object(o)
-    }
-}
-
-/// Typed reading of the rubric's values; errors name the file and the field.
-struct Fields<'a> {
-    path: &'a Path,
-}
-
-impl Fields<'_> {
-    fn err(&self, field: &str, message: impl Into<String>) -> GradeError {
-        GradeError::Rubric { path: self.path.into(), field: field.into(), message: message.into() }
-    }
-
-    fn known(&self, o: &Map<String, Value>, parent: &str, keys: &[&str]) -> Result<(), GradeError> {
-        match o.keys().find(|k| !keys.contains(&k.as_str())) {
-            None => Ok(()),
-            Some(k) => {
-                let field = if parent.is_empty() { k.clone() } else { format!("{parent}.{k}") };
-                Err(self.err(&field, format!("unknown field (expected {})", keys.join(", "))))
-            }
-        }
-    }
-
-    fn text(&self, v: &Value, field: &str) -> Result<String, GradeError> {
-        v.as_str().map(str::to_string).ok_or_else(|| self.err(field, format!("expected a string, found {}", kind(v))))
-    }
-
-    fn number(&self, v: &Value, field: &str, lo: f64, hi: f64) -> Result<f64, GradeError> {
-        match v.as_f64() {
-            Some(x) if (lo..=hi).contains(&x) => Ok(x),
-            _ => Err(self.err(field, format!("expected a number from {lo} to {hi}, found {}", shown(v)))),
-        }
-    }
-
-    fn whole(&self, v: &Value, field: &str, lo: u64, hi: u64) -> Result<u64, GradeError> {
-        match v.as_u64() {
-            Some(x) if (lo..=hi).contains(&x) => Ok(x),
-            _ => Err(self.err(field, format!("expected a whole number from {lo} to {hi}, found {}", shown(v)))),
-        }
-    }
-
-    fn vec3(&self, v: &Value, field: &str) -> Result<Vec3, GradeError> {
-        let c: Option<Vec<f32>> = v
-            .as_array()
-            .filter(|a| a.len() == 3)
-            .and_then(|a| a.iter().map(|x| x.as_f64().map(|x| x as f32)).collect());
-        match c {
-            Some(c) if c.iter().all(|x| x.is_finite()) => Ok(Vec3::new(c[0], c[1], c[2])),
-            _ => Err(self.err(field, format!("expected [x, y, z], found {}", shown(v)))),
-        }
-    }
-
-    fn size(&self, v: &Value, field: &str) -> Result<(u32, u32), GradeError> {
-        let dims: Option<Vec<u64>> = v.as_array().and_then(|a| a.iter().map(|x| x.as_u64()).collect());
-        match dims.as_deref() {
-            Some(&[w, h]) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w as u32, h as u32)),
-            _ => Err(self.err(field, "expected [width, height], whole numbers 1..=16384")),
-        }
-    }
-
-    /// A list of names, each read by `from`; an unknown one is named with what is accepted.
-    fn list<T: PartialEq>(
-        &self,
-        v: &Value,
-        field: &str,
-        from: impl Fn(&str) -> Option<T>,
-        accepted: &str,
-    ) -> Result<Vec<T>, GradeError> {
-        let items = v.as_array().ok_or_else(|| self.err(field, format!("expected a list, found {}", kind(v))))?;
-        let mut out = Vec::new();
-        for (i, item) in items.iter().enumerate() {
-            let at = format!("{field}[{i}]");
-            let name = item.as_str().ok_or_else(|| self.err(&at, format!("expected a name, found {}", kind(item))))?;
-            let value = from(name).ok_or_else(|| self.err(&at, format!("\"{name}\" is not one of {accepted}")))?;
-            if out.contains(&value) {
-                return Err(self.err(&at, format!("\"{name}\" is given twice")));
-            }
-            out.push(value);
-        }
-        Ok(out)
-    }
-}
-
-fn kind(v: &Value) -> &'static str {
-    match v {
-        Value::Null => "null",
-        Value::Bool(_) => "a boolean",
-        Value::Number(_) => "a number",
-        Value::String(_) => "a string",
-        Value::Array(_) => "an array",
-        Value::Object(_) => "an object",
-    }
-}
-
-/// A value in an error: a number as written, anything else by its kind.
-fn shown(v: &Value) -> String {
-    match v {
-        Value::Number(n) => n.to_string(),
-        other => kind(other).to_string(),
     }
 }

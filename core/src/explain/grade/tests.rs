@@ -5,7 +5,7 @@
 use super::html::{base64, esc};
 use super::measure::epo_bounded;
 use super::*;
-use crate::bvh::{AnyBvh, Layout, SplitStrategy};
+use crate::bvh::{AnyBvh, Layout, Strategy};
 use crate::dump::{import, BvhDump, DumpNode};
 use crate::mesh::generate;
 use std::path::Path;
@@ -41,7 +41,7 @@ fn a_rubric_is_read_field_by_field_and_a_mistake_names_the_file_and_the_field() 
     assert_eq!(r.size, Some((64, 48)));
     assert_eq!((r.rays, r.time_rays, r.rank_by), (Some(500), Some(100), RankBy::NodesPerRay));
     assert_eq!(r.required, vec![Group::Structure, Group::Rays]);
-    assert_eq!(r.references, vec![SplitStrategy::Midpoint, SplitStrategy::Lbvh]);
+    assert_eq!(r.references, vec![Strategy::Midpoint, Strategy::Lbvh]);
     assert_eq!(r.good, Good { sah_cost_within: Some(0.2), max_depth_at_most: Some(30), ..Good::default() });
     // What the report states parses back to the same rubric.
     let again = Rubric::parse(p, &r.to_json().to_string()).unwrap();
@@ -203,9 +203,9 @@ fn a_small_class_is_graded_ranked_and_drawn() {
     let build = |s| {
         AnyBvh::build(&mesh, &crate::bvh::BuildParams { strategy: s, layout: Layout::Binary, ..Default::default() })
     };
-    let mid = BvhDump::of_any(&build(SplitStrategy::Midpoint), &mesh, None);
+    let mid = BvhDump::of_any(&build(Strategy::Midpoint), &mesh, None);
     mid.write(&d.join("mia.txt")).unwrap();
-    BvhDump::of_any(&build(SplitStrategy::SahBinned), &mesh, None).write(&d.join("sam.json")).unwrap();
+    BvhDump::of_any(&build(Strategy::SahBinned), &mesh, None).write(&d.join("sam.json")).unwrap();
     let mut bad = mid.clone();
     let leaf = bad.nodes.iter().position(|n| n.count.is_some_and(|c| c >= 2)).unwrap();
     bad.nodes[leaf].max[0] = (bad.nodes[leaf].min[0] + bad.nodes[leaf].max[0]) / 2.0;
@@ -246,8 +246,7 @@ fn a_grade_report_is_read_back_with_its_paths_found_again() {
     let mesh = generate::torus_knot(2, 3, 0.3, 64, 6);
     let mesh_path = d.join("knot.obj");
     std::fs::write(&mesh_path, "# the class's mesh; only its name is read back\n").unwrap();
-    let params =
-        crate::bvh::BuildParams { strategy: SplitStrategy::Midpoint, layout: Layout::Binary, ..Default::default() };
+    let params = crate::bvh::BuildParams { strategy: Strategy::Midpoint, layout: Layout::Binary, ..Default::default() };
     let mid = BvhDump::of_any(&AnyBvh::build(&mesh, &params), &mesh, None);
     std::fs::create_dir_all(d.join("class/empty")).unwrap();
     mid.write(&d.join("class/mia.txt")).unwrap();

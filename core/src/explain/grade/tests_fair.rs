@@ -4,7 +4,7 @@
 //! alone. (tests/cli_grade.rs: the same through the command line, with the report's files.)
 
 use super::*;
-use crate::bvh::{AnyBvh, BuildParams, Layout, SplitStrategy};
+use crate::bvh::{AnyBvh, BuildParams, Layout, Strategy};
 use crate::dump::BvhDump;
 use crate::mesh::{generate, parse_obj, write_obj, Mesh};
 use crate::work::WorkControl;
@@ -32,7 +32,7 @@ fn knot_and_far_degenerate(dir: &Path) -> (Mesh, PathBuf) {
     (mesh, path)
 }
 
-fn dump_of(mesh: &Mesh, strategy: SplitStrategy) -> BvhDump {
+fn dump_of(mesh: &Mesh, strategy: Strategy) -> BvhDump {
     let params = BuildParams { strategy, layout: Layout::Binary, ..Default::default() };
     BvhDump::of_any(&AnyBvh::build(mesh, &params), mesh, None)
 }
@@ -94,10 +94,10 @@ fn a_tree_keeping_a_far_degenerate_triangle_is_measured_on_the_mesh_box_and_rank
     let d = tmp("yardstick");
     let (mesh, mesh_path) = knot_and_far_degenerate(&d);
     let far = mesh.file_triangle_count() as u32 - 1;
-    let mid = dump_of(&mesh, SplitStrategy::Midpoint);
+    let mid = dump_of(&mesh, Strategy::Midpoint);
     mid.write(&d.join("mid.json")).unwrap();
     keeping(&mid, far, [0.0, 40.0, 0.0], [2.0, 40.0, 0.0]).write(&d.join("deg.json")).unwrap();
-    dump_of(&mesh, SplitStrategy::SahBinned).write(&d.join("sam.json")).unwrap();
+    dump_of(&mesh, Strategy::SahBinned).write(&d.join("sam.json")).unwrap();
     let rows = grade(&setup(&mesh, &mesh_path), &d, &["deg.json", "mid.json", "sam.json"]);
     let [deg, mid, sam] = [&rows[0], &rows[1], &rows[2]];
     assert!(
@@ -130,7 +130,7 @@ fn the_first_cause_is_the_most_serious_finding() {
     let d = tmp("severity");
     let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);
     let mesh_path = d.join("knot.obj");
-    let mut dump = dump_of(&mesh, SplitStrategy::Midpoint);
+    let mut dump = dump_of(&mesh, Strategy::Midpoint);
     let leaves: Vec<usize> = (0..dump.nodes.len()).filter(|&i| dump.nodes[i].count.is_some_and(|c| c >= 2)).collect();
     // The first node of all: a box a hair too small (beyond the checker's few ulps).
     dump.nodes[1].max[0] -= 2e-6;
@@ -166,7 +166,7 @@ fn wrong_mesh_only_when_the_dump_is_of_another_mesh() {
     let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);
     let mesh_path = d.join("knot.obj");
     let tris = mesh.file_triangle_count() as u32;
-    let mut one = dump_of(&mesh, SplitStrategy::SahBinned);
+    let mut one = dump_of(&mesh, Strategy::SahBinned);
     let at = one.primitives.len() / 2;
     one.primitives[at] = tris + 5;
     one.write(&d.join("one.json")).unwrap();
@@ -175,7 +175,7 @@ fn wrong_mesh_only_when_the_dump_is_of_another_mesh() {
         *p += tris;
     }
     most.write(&d.join("most.json")).unwrap();
-    let mut named = dump_of(&mesh, SplitStrategy::SahBinned);
+    let mut named = dump_of(&mesh, Strategy::SahBinned);
     named.mesh = Some("bunny.obj".into());
     named.primitives[0] = tris;
     named.write(&d.join("named.json")).unwrap();
@@ -241,12 +241,12 @@ fn links_out_of_a_submission_are_refused_never_followed() {
     std::fs::create_dir_all(d.join("secret")).unwrap();
     std::fs::create_dir_all(d.join("class/zoe/versions")).unwrap();
     std::fs::create_dir_all(d.join("class/yan")).unwrap();
-    dump_of(&mesh, SplitStrategy::SahBinned).write(&d.join("secret/solution.json")).unwrap();
+    dump_of(&mesh, Strategy::SahBinned).write(&d.join("secret/solution.json")).unwrap();
     std::fs::write(d.join("secret/notes.txt"), "SECRET-ANSWER 42\n").unwrap();
     symlink("../secret/solution.json", d.join("class/mallory.json")).unwrap();
     symlink("../secret/notes.txt", d.join("class/eve.txt")).unwrap();
     symlink("../../secret/solution.json", d.join("class/yan/bvh.json")).unwrap();
-    dump_of(&mesh, SplitStrategy::Midpoint).write(&d.join("class/zoe/versions/v3.json")).unwrap();
+    dump_of(&mesh, Strategy::Midpoint).write(&d.join("class/zoe/versions/v3.json")).unwrap();
     symlink("versions/v3.json", d.join("class/zoe/bvh.json")).unwrap();
     let subs = discover(&[d.join("class")]);
     let names: Vec<&str> = subs.iter().map(|s| s.name.as_str()).collect();
@@ -303,7 +303,7 @@ fn identical_trees_rank_alike_and_time_alike_on_a_busy_machine() {
     let d = tmp("busy");
     let mesh = generate::torus_knot(2, 3, 0.3, 300, 20);
     let mesh_path = d.join("knot.obj");
-    let dump = dump_of(&mesh, SplitStrategy::Midpoint);
+    let dump = dump_of(&mesh, Strategy::Midpoint);
     dump.write(&d.join("ann.json")).unwrap();
     dump.write(&d.join("bea.txt")).unwrap();
     let mut set = setup(&mesh, &mesh_path);

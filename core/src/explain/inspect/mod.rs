@@ -15,7 +15,7 @@
 use crate::bvh::builders::common::node_info;
 use crate::bvh::sbvh;
 use crate::bvh::split::{binned_planes, sweep_planes, BuildPrim, NodeInfo, PlaneSink, Proposal};
-use crate::bvh::{BuildParams, Bvh, Hierarchy, SahCost, SplitStrategy};
+use crate::bvh::{BuildParams, Bvh, Hierarchy, SahCost, Strategy};
 use crate::geometry::Aabb;
 use serde::Serialize;
 
@@ -94,7 +94,7 @@ impl CurvePoint {
 /// Where a strategy puts its plane at this node, and what that split costs.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Marker {
-    pub strategy: SplitStrategy,
+    pub strategy: Strategy,
     pub axis: u8,
     pub position: f32,
     pub left: u32,
@@ -149,7 +149,7 @@ pub struct Inspection {
     pub sbvh: Option<sbvh::NodeDecision>,
     /// Each strategy's plane, or none when it finds no split (all centroids on one side or
     /// coinciding: the builder then falls back to equal count).
-    pub markers: Vec<(SplitStrategy, Option<Marker>)>,
+    pub markers: Vec<(Strategy, Option<Marker>)>,
     /// The cost of the split this tree made, by the curves' formula over its children's boxes as
     /// stored and their triangle counts: where an imported tree's split stands against the curves
     /// (a built tree's children's boxes are tight, so this is its strategy's marker cost).
@@ -249,7 +249,7 @@ pub fn subtree_sah(bvh: &Bvh, node: usize) -> f64 {
 
 /// Where `strategy`'s own splitter cuts `prims` (a copy is partitioned), and at what cost; none
 /// when it finds no split.
-fn marker(strategy: SplitStrategy, prims: &[BuildPrim], info: &NodeInfo, params: &BuildParams) -> Option<Marker> {
+fn marker(strategy: Strategy, prims: &[BuildPrim], info: &NodeInfo, params: &BuildParams) -> Option<Marker> {
     let area = info.bounds.area();
     if prims.len() < 2 || area <= 0.0 {
         return None;
@@ -306,7 +306,7 @@ pub fn own_split(bvh: &Bvh, h: &Hierarchy, node: u32) -> (Option<Marker>, [Vec<C
 
 /// The SBVH's split as a marker (its left and right counts are references: a cut triangle is on
 /// both sides).
-fn sbvh_marker(e: &sbvh::NodeDecision, strategy: SplitStrategy, params: &BuildParams, area: f32) -> Option<Marker> {
+fn sbvh_marker(e: &sbvh::NodeDecision, strategy: Strategy, params: &BuildParams, area: f32) -> Option<Marker> {
     let s = e.split.filter(|_| area > 0.0)?;
     Some(Marker {
         strategy,
@@ -346,7 +346,7 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
         let sink = &mut Curves { out: &mut spatial, cost: params.cost, area: area.max(f32::MIN_POSITIVE) };
         sbvh::explain(work, &tri, &params, &bvh.root_bounds(), sink)
     });
-    let markers = SplitStrategy::ALL
+    let markers = Strategy::ALL
         .into_iter()
         .map(|strategy| {
             let m = match (strategy, &sbvh) {

@@ -5,7 +5,7 @@ use super::*;
 use crate::bvh::{BuildParams, Layout};
 use crate::mesh::generate;
 
-fn built(strategy: SplitStrategy, leaf: u32) -> (Bvh, Hierarchy) {
+fn built(strategy: Strategy, leaf: u32) -> (Bvh, Hierarchy) {
     let mesh = generate::torus_knot(2, 3, 0.3, 64, 8);
     let bvh = Bvh::build(
         &mesh,
@@ -29,7 +29,7 @@ fn a_wide_trees_binary_tree_is_the_binary_build() {
 
 #[test]
 fn the_hierarchy_knows_parents_depths_and_ranges() {
-    let (bvh, h) = built(SplitStrategy::SahBinned, 4);
+    let (bvh, h) = built(Strategy::SahBinned, 4);
     assert_eq!((h.first[0], h.count[0]), (0, bvh.prim_ids.len() as u32));
     for (i, n) in bvh.nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
         let (l, r) = (n.index as usize, n.index as usize + 1);
@@ -53,7 +53,7 @@ fn the_hierarchy_knows_parents_depths_and_ranges() {
 /// centroids. The inspector runs the builder's code, not a copy of it.
 #[test]
 fn each_trees_own_strategy_marks_the_split_it_made() {
-    for strategy in SplitStrategy::ALL.into_iter().filter(|s| s.splits_top_down()) {
+    for strategy in Strategy::ALL.into_iter().filter(|s| s.splits_top_down()) {
         let (bvh, h) = built(strategy, 2);
         let mut checked = 0;
         for (i, n) in bvh.nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
@@ -66,7 +66,7 @@ fn each_trees_own_strategy_marks_the_split_it_made() {
                 range.map(|s| Aabb::from_points(&bvh.tris[s]).center()[m.axis as usize]).collect::<Vec<_>>()
             };
             let (left, right) = (centroids(l), centroids(r));
-            if strategy == SplitStrategy::EqualCount {
+            if strategy == Strategy::EqualCount {
                 assert!(left.iter().all(|&c| c <= m.position) && right.iter().all(|&c| c >= m.position));
             } else {
                 assert!(left.iter().all(|&c| c < m.position), "{strategy:?} node {i}");
@@ -83,13 +83,13 @@ fn each_trees_own_strategy_marks_the_split_it_made() {
 /// SAH's bins) is what the inspector shows.
 #[test]
 fn own_split_is_the_inspectors_marker_of_the_trees_strategy() {
-    for strategy in SplitStrategy::ALL {
+    for strategy in Strategy::ALL {
         let (bvh, h) = built(strategy, 4);
         for node in [0u32, 1, 2, 3] {
             let ins = inspect(&bvh, &h, node).unwrap();
             let (m, binned) = own_split(&bvh, &h, node);
             assert_eq!(m, ins.markers.iter().find(|(s, _)| *s == strategy).unwrap().1, "{strategy:?} {node}");
-            let binning = matches!(strategy, SplitStrategy::SahBinned | SplitStrategy::Sbvh);
+            let binning = matches!(strategy, Strategy::SahBinned | Strategy::Sbvh);
             let want = if binning { ins.binned.clone() } else { Default::default() };
             assert_eq!(binned, want);
         }
@@ -104,13 +104,13 @@ fn own_split_is_the_inspectors_marker_of_the_trees_strategy() {
 fn an_sbvh_trees_inspector_replays_its_build() {
     let mesh = generate::diagonal_rods(3, 6, 6.0, 0.03, 0.2);
     let params =
-        BuildParams { strategy: SplitStrategy::Sbvh, layout: Layout::Binary, sbvh_growth: 100, ..Default::default() };
+        BuildParams { strategy: Strategy::Sbvh, layout: Layout::Binary, sbvh_growth: 100, ..Default::default() };
     let bvh = Bvh::build(&mesh, &params);
     let h = Hierarchy::of(&bvh);
     let (mut spatial, mut curves) = (0, 0);
     for (i, n) in bvh.nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
         let ins = inspect(&bvh, &h, i as u32).unwrap();
-        let m = ins.markers.iter().find(|(s, _)| *s == SplitStrategy::Sbvh).unwrap().1.unwrap();
+        let m = ins.markers.iter().find(|(s, _)| *s == Strategy::Sbvh).unwrap().1.unwrap();
         let count = |c: u32| inspect(&bvh, &h, c).unwrap().triangles;
         assert_eq!((m.axis, m.left, m.right), (n.axis, count(n.index), count(n.index + 1)), "node {i}");
         let e = ins.sbvh.unwrap();
@@ -154,7 +154,7 @@ fn an_sbvh_trees_inspector_replays_its_build() {
 /// strategy's marker gives on the curve (both SAH strategies; the boxes are tight).
 #[test]
 fn own_cost_is_the_strategys_marker_cost_for_a_built_tree() {
-    for strategy in [SplitStrategy::SahSweep, SplitStrategy::SahBinned] {
+    for strategy in [Strategy::SahSweep, Strategy::SahBinned] {
         let (bvh, h) = built(strategy, 4);
         for node in [0u32, 1, 2, 3, 4] {
             let ins = inspect(&bvh, &h, node).unwrap();
@@ -170,7 +170,7 @@ fn own_cost_is_the_strategys_marker_cost_for_a_built_tree() {
 /// middle of the centroid bounds on their widest axis; binned points lie at bin boundaries.
 #[test]
 fn curves_and_markers_match_a_brute_force_sah() {
-    let (bvh, h) = built(SplitStrategy::Midpoint, 4);
+    let (bvh, h) = built(Strategy::Midpoint, 4);
     let c = bvh.params.cost;
     for node in [0u32, 1, 2, 5, 9] {
         let ins = inspect(&bvh, &h, node).unwrap();
@@ -200,14 +200,14 @@ fn curves_and_markers_match_a_brute_force_sah() {
             }
         }
         let marker = |s| ins.markers.iter().find(|(m, _)| *m == s).unwrap().1.unwrap();
-        let sweep = marker(SplitStrategy::SahSweep);
+        let sweep = marker(Strategy::SahSweep);
         let min = ins.sweep.iter().flatten().map(|p| p.cost).fold(f32::INFINITY, f32::min);
         assert_eq!(sweep.cost, min, "node {node}: the sweep takes the curve's minimum");
-        let mid = marker(SplitStrategy::Midpoint);
+        let mid = marker(Strategy::Midpoint);
         let w = info.centroid_bounds.widest_axis();
         assert_eq!(mid.axis as usize, w);
         assert_eq!(mid.position, info.centroid_bounds.center()[w]);
-        let binned = marker(SplitStrategy::SahBinned);
+        let binned = marker(Strategy::SahBinned);
         let bmin = ins.binned.iter().flatten().map(|p| p.cost).fold(f32::INFINITY, f32::min);
         assert_eq!(binned.cost, bmin, "node {node}: the binned SAH takes its bins' minimum");
         assert!(sweep.cost <= binned.cost && sweep.cost <= mid.cost);

@@ -4,7 +4,7 @@
 use super::Inspection;
 use crate::bvh::sbvh::SplitKind;
 use crate::bvh::wide::WideGroup;
-use crate::bvh::{Builder, SplitStrategy};
+use crate::bvh::{Builder, Strategy};
 
 /// What the SBVH does at the node, in a line (the app's Node window shows the same line).
 pub fn sbvh_text(ins: &Inspection) -> Option<String> {
@@ -54,7 +54,7 @@ pub fn dump_text(d: Option<u32>) -> String {
 }
 
 /// Why `strategy` marks no plane at a node.
-pub fn no_split_text(strategy: SplitStrategy) -> &'static str {
+pub fn no_split_text(strategy: Strategy) -> &'static str {
     match strategy.builder() {
         Builder::SpatialSplits => "makes a leaf here",
         Builder::Morton | Builder::Clustering => "no plane priced here: it builds from the Morton order",

@@ -9,7 +9,7 @@ mod sah_binned;
 mod sah_sweep;
 mod spatial;
 
-pub use super::strategy::SplitStrategy;
+pub use super::strategy::Strategy;
 use crate::geometry::Aabb;
 use glam::{Vec3A, Vec4};
 

@@ -252,7 +252,7 @@ fn split_two(prims: &mut [BuildPrim], extent: Vec3A) -> Proposal {
 #[cfg(test)]
 mod tests {
     use super::{bin_indices, goes_left};
-    use crate::bvh::{BuildParams, Bvh, Layout, SplitStrategy, TreeStats};
+    use crate::bvh::{BuildParams, Bvh, Layout, Strategy, TreeStats};
     use crate::mesh::generate;
 
     #[test]
@@ -285,13 +285,13 @@ mod tests {
             let cost = |strategy| {
                 let bvh = Bvh::build(&mesh, &BuildParams { strategy, layout: Layout::Binary, ..Default::default() });
                 let stats = TreeStats::of(&bvh);
-                if strategy == SplitStrategy::SahBinned {
+                if strategy == Strategy::SahBinned {
                     assert_eq!(stats.fallback_splits, 0, "every node had a plane with triangles on both sides");
                 }
                 stats.sah_cost
             };
-            let (binned, sweep) = (cost(SplitStrategy::SahBinned), cost(SplitStrategy::SahSweep));
-            let midpoint = cost(SplitStrategy::Midpoint);
+            let (binned, sweep) = (cost(Strategy::SahBinned), cost(Strategy::SahSweep));
+            let midpoint = cost(Strategy::Midpoint);
             eprintln!("{}: binned {binned:.3}, sweep {sweep:.3}, midpoint {midpoint:.3}", mesh.triangle_count());
             assert!(binned <= sweep * 1.03, "binned {binned} against the sweep's {sweep}");
             assert!(binned < midpoint, "binned {binned} against midpoint's {midpoint}");

@@ -1,14 +1,22 @@
 //! Images derived from the frame on screen for the overlays, each cached while its inputs stay
 //! the same: the side-by-side pair and their difference, the selected node's mask, the legend's
-//! histogram and its threshold's mask.
+//! histogram and its threshold's mask, the imported tree's wrong pixels; and the figures of the
+//! current build and of B, as the statistics panel and its exports read them.
 
-use super::{compare_view, node_view, viewport, BvhscopeApp, MaskCache, Shown};
+use super::app::{BvhscopeApp, MaskCache};
+use super::figures::{MeasuredRays, Shown, StrategyFigures};
+use crate::app::jobs::Timed;
+use crate::app::views::{compare, node};
+use crate::bvh::TreeStats;
 use std::sync::Arc;
+
+/// Bins of the legend's histogram.
+pub const HISTOGRAM_BINS: usize = 32;
 
 impl BvhscopeApp {
     /// The side-by-side images (A's and B's on one scale, and their difference), once both frames
     /// of one camera are there (cached for the pair and the view).
-    pub fn compare_images(&self, ctx: &egui::Context) -> Option<Arc<compare_view::CompareImages>> {
+    pub fn compare_images(&self, ctx: &egui::Context) -> Option<Arc<compare::CompareImages>> {
         use crate::render::diff;
         let (shown, b) = self.shown_pair()?;
         let (view, colormap, cost) = (shown.style.view, shown.style.colormap, shown.style.cost);
@@ -35,7 +43,7 @@ impl BvhscopeApp {
             let (img, legend) = diff::difference_image(shown.frame.width(), &d, view, style.diff_range);
             (texture("compare-diff", img), d, legend)
         });
-        let images = Arc::new(compare_view::CompareImages {
+        let images = Arc::new(compare::CompareImages {
             a_frame: shown.frame.clone(),
             b_frame: b.frame.clone(),
             view,
@@ -53,7 +61,7 @@ impl BvhscopeApp {
 
     /// Compare's pair as it is on screen: A's frame (complete) and B's of the same camera; `None`
     /// outside Compare or while B is not there yet (the images and the exports both ask).
-    pub(super) fn shown_pair(&self) -> Option<(&Shown, &compare_view::CompareB)> {
+    pub(in crate::app) fn shown_pair(&self) -> Option<(&Shown, &compare::CompareB)> {
         if !self.compare.on {
             return None;
         }
@@ -75,7 +83,7 @@ impl BvhscopeApp {
         &self,
         ctx: &egui::Context,
         shown: &Shown,
-        e: &Arc<node_view::Explained>,
+        e: &Arc<node::Explained>,
         node: u32,
     ) -> Option<egui::TextureHandle> {
         let f = &shown.frame;
@@ -106,7 +114,7 @@ impl BvhscopeApp {
     }
 
     /// The legend's histogram of the heatmap on screen (`render::histogram` over the legend's
-    /// range, `viewport::HISTOGRAM_BINS` bins; cached for the frame and view).
+    /// range, `HISTOGRAM_BINS` bins; cached for the frame and view).
     pub fn legend_histogram(&self) -> Option<Vec<u32>> {
         let shown = self.shown.as_ref()?;
         let legend = shown.legend.as_ref()?;
@@ -123,7 +131,7 @@ impl BvhscopeApp {
             shown.style.cost,
             legend.range_min,
             legend.range_max,
-            viewport::HISTOGRAM_BINS,
+            HISTOGRAM_BINS,
         );
         *cache = Some((shown.frame.clone(), view, h.clone()));
         Some(h)
@@ -156,5 +164,70 @@ impl BvhscopeApp {
         );
         *cache = Some((f.clone(), view, t, tex.clone()));
         Some(tex)
+    }
+}
+
+impl BvhscopeApp {
+    /// Figures of the current strategy for the statistics panel.
+    pub fn current_figures(&self) -> Option<StrategyFigures> {
+        self.current_bvh().map(|b| StrategyFigures {
+            label: b.bvh.label(),
+            // The end-point overlap comes with the prepared tree, a moment after the image.
+            stats: {
+                let e = self.nodes.current(Some(&b.bvh));
+                TreeStats { epo: e.map(|e| e.epo), epo_error: e.and_then(|e| e.epo_error), ..b.stats.clone() }
+            },
+            build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
+            rays: self.rays,
+            frame_ms: self
+                .last_full_frame
+                .filter(|_| self.shown.as_ref().is_some_and(|s| Arc::ptr_eq(&s.bvh, &b.bvh)))
+                .map(|d| d.as_secs_f64() * 1e3),
+            speedup: self.fresh_speedup().map(|t| t.speedup),
+        })
+    }
+
+    /// The timing against the linear scan of the tree, camera and traversal on screen, if there
+    /// is one (an older tree's or camera's is stale).
+    pub fn fresh_speedup(&self) -> Option<&Timed> {
+        let shown = self.shown.as_ref()?;
+        self.speedup
+            .as_ref()
+            .filter(|t| Arc::ptr_eq(&t.bvh, &shown.bvh) && t.camera == shown.camera && t.trace == shown.trace)
+    }
+
+    /// B's figures for the statistics panel's second column, while comparing side by side.
+    pub fn compare_figures(&self) -> Option<StrategyFigures> {
+        let b = self.compare.b.as_ref().filter(|b| self.compare.on && b.scene_id == self.scene_id)?;
+        Some(StrategyFigures {
+            label: format!("B: {}", b.bvh.label()),
+            stats: b.stats.clone(),
+            build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
+            rays: Some(MeasuredRays { summary: b.summary, camera: b.camera, trace: b.trace }),
+            frame_ms: None,
+            speedup: None,
+        })
+    }
+}
+
+impl BvhscopeApp {
+    /// The red mask over the frame on screen: its pixels whose hit is wrong (cached per result).
+    pub fn wrong_mask(&self, ctx: &egui::Context) -> Option<(egui::TextureHandle, usize)> {
+        let s = self.shown.as_ref().filter(|s| self.import.mask && s.frame.is_complete())?;
+        let w = self.import.wrong_for(&s.bvh, &s.camera, &s.trace)?;
+        let mut cache = self.wrong_cache.borrow_mut();
+        if let Some((bvh, camera, trace, tex)) = cache.as_ref() {
+            if self.import.wrong_for(bvh, camera, trace).is_some_and(|c| std::ptr::eq(c, w)) {
+                return Some((tex.clone(), w.pixels.len()));
+            }
+        }
+        let (width, height) = (s.camera.width as usize, s.camera.height as usize);
+        let mut image = egui::ColorImage::new([width, height], vec![egui::Color32::TRANSPARENT; width * height]);
+        for &(x, y) in &w.pixels {
+            image.pixels[y as usize * width + x as usize] = egui::Color32::from_rgba_unmultiplied(255, 0, 0, 200);
+        }
+        let tex = ctx.load_texture("wrong-pixels", image, egui::TextureOptions::NEAREST);
+        *cache = Some((w.bvh.clone(), w.camera, w.trace, tex.clone()));
+        Some((tex, w.pixels.len()))
     }
 }

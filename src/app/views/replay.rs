@@ -2,7 +2,7 @@
 //! binary tree (`explain::replay`, prepared with the tree view's `Explained`), the step shown and
 //! whether it plays. While the window is open the viewport shows the tree after `k` splits.
 
-use super::node_view::Explained;
+use super::node::Explained;
 use crate::bvh::morton::MortonOrder;
 use crate::explain::inspect::{CurvePoint, Marker};
 use crate::explain::replay::{PartialBvh, Replay};

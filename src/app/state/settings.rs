@@ -51,7 +51,7 @@ pub struct Settings {
     /// What the image is rendered at: the viewport's size, or a scene file's film (its camera's
     /// size and aspect, letterboxed in the viewport), so the figures are the scene's frame's.
     pub film: Film,
-    /// Where frames are traced (and lbvh, ploc built): the CPU or the GPU (`app::gpu`).
+    /// Where frames are traced (and lbvh, ploc built): the CPU or the GPU (`app::state::gpu`).
     pub device: Device,
     /// The node format the GPU walks.
     pub gpu_nodes: GpuNodes,
@@ -211,7 +211,7 @@ mod tests {
     #[test]
     fn settings_and_recent_files_survive_a_restart() {
         let mut s = Settings::default();
-        s.build.strategy = crate::bvh::SplitStrategy::Midpoint;
+        s.build.strategy = crate::bvh::Strategy::Midpoint;
         s.view = View::TriTests;
         s.colormap = ColorMap::Turbo;
         s.up_axis = UpAxis::Z;
@@ -245,7 +245,7 @@ mod tests {
         assert!(!s.is_preset(Preset::Handout));
         s.apply_preset(Preset::Handout);
         assert!(s.is_preset(Preset::Handout));
-        assert_eq!(s.build.strategy, crate::bvh::SplitStrategy::Midpoint);
+        assert_eq!(s.build.strategy, crate::bvh::Strategy::Midpoint);
         assert_eq!(s.build.max_leaf_size, Preset::HANDOUT_MAX_LEAF_SIZE);
         assert!(!s.two_level);
         s.build.max_leaf_size = 8;

@@ -1,7 +1,15 @@
 //! What arrives from outside the panels: background jobs' results (a loaded scene, a build, a
 //! render pass, …), files picked in a dialog, dropped files and keys.
 
-use super::*;
+use super::export;
+use crate::app::jobs::{JobEvent, PassOutput, Pick, Probe};
+use crate::app::state::{shortcuts, Action, Actions, BvhscopeApp, MeasuredRays, MessageKind, PathWindow, Shown};
+use crate::dump::BvhDump;
+use crate::gpu_path::Device;
+use crate::scene::{SceneBuildError, SceneSource};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
 
 impl BvhscopeApp {
     pub(super) fn apply(&mut self, ctx: &egui::Context, event: JobEvent) {
@@ -196,7 +204,7 @@ impl BvhscopeApp {
     }
 
     /// Job results, and the actions of input outside the panels: dropped files and keys.
-    pub(super) fn handle_input(&mut self, ctx: &egui::Context, actions: &mut Actions) {
+    pub(in crate::app) fn handle_input(&mut self, ctx: &egui::Context, actions: &mut Actions) {
         for event in self.jobs.poll() {
             self.apply(ctx, event);
         }
@@ -218,5 +226,29 @@ impl BvhscopeApp {
         actions.extend(shortcuts::pressed(ctx));
         // Info messages fade out; errors stay until dismissed.
         self.messages.retain(|m| m.kind != MessageKind::Info || m.at.elapsed() < Duration::from_secs(6));
+    }
+}
+
+impl BvhscopeApp {
+    /// The GPU's answers: the adapter found or not, a GPU job that failed (back to the CPU).
+    fn gpu_event(&mut self, event: JobEvent) {
+        match event {
+            JobEvent::GpuProbed(Ok(gpu)) => self.jobs.gpu.probe = Probe::Found(gpu),
+            JobEvent::GpuProbed(Err(why)) => {
+                if self.settings.device == Device::Gpu {
+                    self.message(MessageKind::Warning, format!("No GPU: {why}. Tracing on the CPU."));
+                    self.settings.device = Device::Cpu;
+                }
+                self.jobs.gpu.probe = Probe::Missing(why);
+            }
+            JobEvent::GpuFailed(why) => {
+                self.message(MessageKind::Error, format!("{why}. Switched back to the CPU."));
+                self.settings.device = Device::Cpu;
+                // The last render and build asked for the GPU: ask again, on the CPU.
+                self.jobs.last_render = None;
+                self.jobs.last_build = None;
+            }
+            _ => {}
+        }
     }
 }

@@ -1,39 +1,13 @@
-//! A class's grade report in the app (`bvhscope grade`'s grade.json, read by the core's
-//! `explain::grade::GradeReport` in a job): the students in the report's order, and choosing one
-//! shows their tree as the grader saw it. Their dump is imported over the report's mesh as
-//! File ▸ Open BVH does (the mesh opened first when another scene is on screen; the import checks
-//! the dump again with the app's own rays), on the report's camera and traversal, side by side
-//! against SAH binned in the dump's layout (the Compare view: A the student's tree, B SAH). A
-//! student without a traceable tree (broken structure, another mesh, an unreadable file, no dump)
-//! shows the report's reason only, and nothing is imported.
+//! A class's grade report in the app: a report read, a student chosen and shown (their dump
+//! imported over the report's mesh, on its camera, side by side against SAH binned; the view's
+//! state is `views::GradeView`).
 
-use super::{orbit, Action, BvhscopeApp, MessageKind, OrbitCamera, SceneSource};
+use crate::app::state::{orbit, Action, BvhscopeApp, MessageKind, OrbitCamera};
+use crate::app::views::{GradeView, ImportView, Pending};
 use crate::explain::grade::GradeReport;
+use crate::scene::SceneSource;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-
-#[derive(Default)]
-pub struct GradeView {
-    pub report: Option<Arc<GradeReport>>,
-    /// The Grade report window is open.
-    pub window: bool,
-    /// The student chosen: their index in the report.
-    pub chosen: Option<usize>,
-    /// Why the chosen student's tree is not shown: the report's reason, a file not found, an
-    /// import that failed.
-    pub why_not: Option<String>,
-    /// Showing the chosen student, while it is on its way.
-    pub pending: Option<Pending>,
-}
-
-/// The steps of showing a student, each started when the one before has ended.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Pending {
-    /// The report's mesh is loading; then `dump` is imported over it.
-    Mesh { mesh: PathBuf, dump: PathBuf },
-    /// The dump is being read and checked.
-    Import { dump: PathBuf },
-}
 
 /// Whether two paths name the same file (the report's mesh may be named otherwise than the scene
 /// open, e.g. relative against absolute).
@@ -46,7 +20,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 
 impl BvhscopeApp {
     /// A report read (or why not): shown in the Grade report window, nothing chosen yet.
-    pub(super) fn report_read(&mut self, read: Result<Box<GradeReport>, String>) {
+    pub(in crate::app) fn report_read(&mut self, read: Result<Box<GradeReport>, String>) {
         match read {
             Ok(r) => {
                 let text = format!("Opened the grade report {}: {} students", r.file.display(), r.students.len());
@@ -61,7 +35,7 @@ impl BvhscopeApp {
     }
 
     /// Choose student `i` of the report: show their tree, or say why there is none to show.
-    pub(super) fn choose_student(&mut self, i: usize) {
+    pub(in crate::app) fn choose_student(&mut self, i: usize) {
         let Some(report) = self.grade.report.clone() else { return };
         let Some(student) = report.students.get(i) else { return };
         (self.grade.chosen, self.grade.why_not, self.grade.pending) = (Some(i), None, None);
@@ -88,7 +62,7 @@ impl BvhscopeApp {
         if let Some(job) = self.jobs.import.take() {
             job.control.cancel();
         }
-        self.import = super::ImportView { mask: self.import.mask, ..Default::default() };
+        self.import = ImportView { mask: self.import.mask, ..Default::default() };
         self.compare.on = false;
     }
 
@@ -106,7 +80,7 @@ impl BvhscopeApp {
     /// A scene loaded (`JobEvent::Loaded`): the chosen student's dump is imported when it is the
     /// report's mesh; another file opened meanwhile ends the wait (a dump being read is of the
     /// scene it replaced, and is dropped with it).
-    pub(super) fn grade_scene_loaded(&mut self) {
+    pub(in crate::app) fn grade_scene_loaded(&mut self) {
         let Some(pending) = self.grade.pending.clone() else { return };
         match pending {
             Pending::Mesh { mesh, dump } if self.scene_is(&mesh) => self.show_student(dump),
@@ -120,7 +94,7 @@ impl BvhscopeApp {
     }
 
     /// The report's mesh could not be loaded.
-    pub(super) fn grade_load_failed(&mut self, why: &str) {
+    pub(in crate::app) fn grade_load_failed(&mut self, why: &str) {
         if let Some(Pending::Mesh { .. }) = self.grade.pending.take() {
             self.grade.why_not = Some(why.to_string());
         }
@@ -128,7 +102,7 @@ impl BvhscopeApp {
 
     /// A dump imported (`JobEvent::Imported`; `Err` why it could not be read or traced): the
     /// chosen student's is set side by side against SAH binned in its layout.
-    pub(super) fn grade_imported(&mut self, path: Option<&Path>, traced: Result<(), String>) {
+    pub(in crate::app) fn grade_imported(&mut self, path: Option<&Path>, traced: Result<(), String>) {
         let Some(Pending::Import { dump }) = &self.grade.pending else { return };
         // The import job of another dump ended (an error carries no path: only the newest import
         // reports, and that is this one).

@@ -2,8 +2,11 @@
 //! legend and the per-pixel read-out on hover. It reports its size and the mouse's camera moves
 //! as actions; the app's reconciler renders what it would show.
 
-use super::{Action, Actions, BvhscopeApp, MessageKind};
+use super::explain_overlay;
+use crate::app::state::{overlay, Action, Actions, BvhscopeApp, MessageKind, Shown};
+use crate::app::views::compare::CompareImages;
 use crate::render::legend::fmt_value;
+use crate::render::PairView;
 use crate::render::{Frame, Legend};
 use egui::{Color32, PointerButton, Pos2, Rect, Sense, Stroke, Vec2};
 use std::sync::Arc;
@@ -132,9 +135,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     }
 
     if let Some(shown) = &app.shown {
-        super::explain_overlay::draw_replay(app, &painter, rect, shown);
-        super::explain_overlay::draw_selected_node(app, &painter, rect, shown);
-        super::explain_overlay::draw_pinned(app, &painter, rect, &shown.camera);
+        explain_overlay::draw_replay(app, &painter, rect, shown);
+        explain_overlay::draw_selected_node(app, &painter, rect, shown);
+        explain_overlay::draw_pinned(app, &painter, rect, &shown.camera);
     }
 
     // Files dragged over the window.
@@ -152,7 +155,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     messages(app, ui, full, out);
     if let Some(shown) = &app.shown {
         let compare_legend = compared.as_ref().and_then(|c| match app.compare.mode {
-            super::PairView::Difference => c.diff.as_ref().map(|d| d.2.clone()),
+            PairView::Difference => c.diff.as_ref().map(|d| d.2.clone()),
             _ => c.legend.clone(),
         });
         // The histogram is of the image's own values: not drawn for a side-by-side pair.
@@ -175,10 +178,9 @@ fn draw_compare(
     ui: &egui::Ui,
     painter: &egui::Painter,
     rect: Rect,
-    c: &super::compare_view::CompareImages,
+    c: &CompareImages,
     out: &mut Actions,
 ) {
-    use super::PairView;
     let label = |p: Pos2, align: egui::Align2, text: String| {
         let g = painter.layout_no_wrap(text, egui::FontId::proportional(14.0), Color32::WHITE);
         let r = align.anchor_size(p, g.size()).expand(4.0);
@@ -242,13 +244,13 @@ fn draw_compare(
 
 /// The node of the binary tree whose drawn box has an edge under `pos` (the overlay's boxes are
 /// the current layout's; a wide child's box is its binary node's, so it is found by its bounds).
-fn drawn_box_node(app: &BvhscopeApp, rect: Rect, shown: &super::Shown, pos: Pos2) -> Option<u32> {
+fn drawn_box_node(app: &BvhscopeApp, rect: Rect, shown: &Shown, pos: Pos2) -> Option<u32> {
     if !app.settings.show_boxes {
         return None;
     }
     let e = app.nodes.current(Some(&shown.bvh))?;
     let boxes = app.overlay_boxes()?;
-    let i = super::overlay::box_near(&boxes, &shown.camera, rect, pos, 5.0)?;
+    let i = overlay::box_near(&boxes, &shown.camera, rect, pos, 5.0)?;
     let corners = boxes[i].corners;
     e.tree.nodes.iter().position(|n| n.bounds().corners() == corners).map(|n| n as u32)
 }
@@ -314,9 +316,6 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
 
 /// The heatmap legend in the viewport's lower-left corner: title, colour bar with its ends, and
 /// the frame's min / mean / max. Real labels, so screen readers and UI tests see the numbers.
-/// Bins of the legend's histogram.
-pub const HISTOGRAM_BINS: usize = 32;
-
 fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, histogram: bool, out: &mut Actions) {
     // Anchored by its lower-left corner and kept inside the viewport: it grows upwards as its
     // note and histogram need, never over the status bar below.

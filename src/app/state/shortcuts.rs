@@ -1,6 +1,7 @@
 //! Keyboard shortcuts: one table, used both to handle keys and to list them in the Help window.
 
-use super::{Action, NodeStep};
+use super::action::Action;
+use crate::app::views::NodeStep;
 use egui::{Key, KeyboardShortcut, Modifiers};
 
 pub const SHORTCUTS: &[(KeyboardShortcut, Action, &str)] = &[

@@ -5,7 +5,7 @@
 //! and traced in the background; it is kept, so flipping modes is instant and changing A's
 //! strategy rebuilds only A.
 
-use crate::bvh::{Layout, SceneBuild, SceneBvh, SplitStrategy, TraceOptions, TreeStats};
+use crate::bvh::{Layout, SceneBuild, SceneBvh, Strategy, TraceOptions, TreeStats};
 use crate::render::{Camera, Frame, Legend, PairView, RaySummary};
 use std::sync::Arc;
 
@@ -44,7 +44,7 @@ pub struct CompareImages {
 pub struct CompareView {
     pub on: bool,
     /// B's own choices; the rest of B's build is A's.
-    pub strategy: SplitStrategy,
+    pub strategy: Strategy,
     pub max_leaf_size: u32,
     pub layout: crate::bvh::Layout,
     /// How B is traversed (order and triangle test).
@@ -60,7 +60,7 @@ impl Default for CompareView {
         let p = crate::bvh::BuildParams::default();
         Self {
             on: false,
-            strategy: SplitStrategy::SahBinned,
+            strategy: Strategy::SahBinned,
             max_leaf_size: p.max_leaf_size,
             layout: p.layout,
             trace: TraceOptions::default(),
@@ -86,10 +86,10 @@ impl CompareView {
     /// Start from A's build and traversal, with another strategy than A's; against an imported
     /// tree (`imported`: its layout), the reference: SAH binned in that layout.
     pub fn start_from(&mut self, a: &crate::bvh::BuildParams, trace: TraceOptions, imported: Option<Layout>) {
-        self.strategy = if a.strategy == SplitStrategy::SahBinned && imported.is_none() {
-            SplitStrategy::Midpoint
+        self.strategy = if a.strategy == Strategy::SahBinned && imported.is_none() {
+            Strategy::Midpoint
         } else {
-            SplitStrategy::SahBinned
+            Strategy::SahBinned
         };
         (self.max_leaf_size, self.layout, self.trace) = (a.max_leaf_size, imported.unwrap_or(a.layout), trace);
     }

@@ -1,8 +1,11 @@
-//! What the app says in its messages across the top of the viewport (`viewport::messages` draws
-//! them): one per topic, the old scene's cleared when a new one opens (`events`).
+//! What the app says in its messages across the top of the viewport (`panels::viewport` draws
+//! them): one per topic, the old scene's cleared when a new one opens (`events.rs`).
 
-use super::{BvhscopeApp, Message, MessageKind, MESSAGES_KEPT};
+use crate::app::state::{BvhscopeApp, Message, MessageKind};
 use std::time::Instant;
+
+/// Messages kept; the viewport shows the newest `panels::viewport::MESSAGES_SHOWN` of them.
+const MESSAGES_KEPT: usize = 8;
 
 impl BvhscopeApp {
     /// Show a message. One per topic: a message whose text is already shown, or of the same kind

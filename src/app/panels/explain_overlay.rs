@@ -3,7 +3,7 @@
 //! rays step by step. All in world space through `overlay`'s projection, so orbiting shows them
 //! from the side.
 
-use super::BvhscopeApp;
+use crate::app::state::{BvhscopeApp, Shown};
 use egui::{Color32, Pos2, Rect, Stroke};
 use std::sync::Arc;
 
@@ -15,8 +15,8 @@ const MAX_MORTON_SEGMENTS: usize = 20_000;
 
 /// A build replay's image: the frontier's boxes (its nodes acting as leaves) and the newest
 /// split's two children in the selected node's colours.
-pub(super) fn draw_replay(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &super::Shown) {
-    use super::overlay::{box_lines, lines_mesh};
+pub(super) fn draw_replay(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &Shown) {
+    use crate::app::state::overlay::{box_lines, lines_mesh};
     let (Some(p), Some(r)) = (&shown.partial, &app.replay.replay) else { return };
     if !Arc::ptr_eq(&p.tree, &r.tree) {
         return;
@@ -59,7 +59,7 @@ fn morton_lines(
     m: &crate::bvh::morton::MortonOrder,
     p: &crate::explain::replay::PartialBvh,
     h: &crate::bvh::Hierarchy,
-    out: &mut Vec<super::overlay::Line3>,
+    out: &mut Vec<crate::app::state::overlay::Line3>,
 ) {
     let mut pieces: Vec<(u32, u32)> =
         p.frontier().iter().map(|&n| (h.first[n as usize], h.count[n as usize])).collect();
@@ -70,15 +70,15 @@ fn morton_lines(
     for (k, w) in points.windows(2).enumerate() {
         let t = k as f32 / n;
         let color = Color32::from_rgb((40.0 + 210.0 * t) as u8, (120.0 + 100.0 * t) as u8, (250.0 - 200.0 * t) as u8);
-        out.push(super::overlay::Line3 { a: w[0], b: w[1], color, width: 3.0 });
+        out.push(crate::app::state::overlay::Line3 { a: w[0], b: w[1], color, width: 3.0 });
     }
 }
 
 /// The selected node of the Tree and Node windows: the rest of the image dimmed (a mask over the
 /// frame: pixels whose hit is not one of its triangles), its box, its children's boxes in their
 /// own colours, and the plane the builder split it at as a translucent quad.
-pub(super) fn draw_selected_node(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &super::Shown) {
-    use super::overlay::{box_lines, lines_mesh};
+pub(super) fn draw_selected_node(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, shown: &Shown) {
+    use crate::app::state::overlay::{box_lines, lines_mesh};
     let Some(node) = app.nodes.selected.filter(|_| app.nodes.window) else { return };
     let Some(e) = app.nodes.current(Some(&shown.bvh)) else { return };
     let Some(n) = e.tree.nodes.get(node as usize) else { return };
@@ -115,9 +115,9 @@ fn draw_plane(
     camera: &crate::render::Camera,
     b: &crate::geometry::Aabb,
     m: &crate::explain::inspect::Marker,
-    lines: &mut Vec<super::overlay::Line3>,
+    lines: &mut Vec<crate::app::state::overlay::Line3>,
 ) {
-    use super::overlay::{project, Line3};
+    use crate::app::state::overlay::{project, Line3};
     let (a, (u, v)) = (m.axis as usize, [(1, 2), (0, 2), (0, 1)][m.axis as usize]);
     let corner = |cu: f32, cv: f32| {
         let mut p = glam::Vec3::ZERO;
@@ -187,7 +187,7 @@ pub const RAY_COLORS: RayColors = RayColors {
 /// triangles outlined (green hit, red missed), and the closest hit so far marked. All in world
 /// space, so orbiting shows the ray from the side.
 pub(super) fn draw_pinned(app: &BvhscopeApp, painter: &egui::Painter, rect: Rect, camera: &crate::render::Camera) {
-    use super::overlay::{box_lines, lines_mesh, project, Line3};
+    use crate::app::state::overlay::{box_lines, lines_mesh, project, Line3};
     let rays = &app.pins;
     let Some(sel) = rays.current() else { return };
     let far = (camera.position - camera.look_at).length() * 2.0;

@@ -1,190 +1,16 @@
-//! Everything that changes the app's state, as values. Panels, windows, the viewport and the
-//! keyboard only read the state and emit actions; `BvhscopeApp::act` is the one place that
-//! changes it, and `BvhscopeApp::reconcile` the one place that decides, from the state alone,
-//! what to rebuild and what to re-render (the egui demo app's split of state and UI).
+//! `BvhscopeApp::act`: the one place the state changes in answer to the user (the actions are
+//! `state::Action`).
 
-use super::node_view::{Metric, Step as NodeStep};
-use super::settings::{PRESENT_SCALE, UI_SCALES};
-use super::{export, BvhscopeApp, MessageKind, PathWindow, Pick, PinnedRay, RayView, Settings};
-use crate::bvh::{Preset, SplitStrategy};
-use crate::render::{ColorMap, UpAxis, View};
+use super::export;
+use crate::app::jobs::Pick;
+use crate::app::state::dock;
+use crate::app::state::{Action, BvhscopeApp, MessageKind, PathWindow, Settings, PRESENT_SCALE, UI_SCALES};
+use crate::app::views::{PinnedRay, RayView, SecondaryOf};
+use crate::bvh::Strategy;
+use crate::render::{ColorMap, View};
 use crate::scene::Scene;
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum Action {
-    /// Ask for a mesh or scene with the file dialog.
-    Open,
-    /// Open the typed-path window to open a file.
-    OpenPath,
-    OpenFile(PathBuf),
-    ShowBuiltin,
-    /// Save the view as PNG through the file dialog.
-    SavePng,
-    /// Save the view as PNG to a typed path.
-    SavePngTyped,
-    /// Export the statistics as CSV through the file dialog.
-    ExportStats,
-    ExportStatsJson,
-    /// Export the counts behind the heatmap (one CSV row per pixel).
-    ExportCounts,
-    SaveScene,
-    /// A file was chosen (dialog or typed path) for `Pick`.
-    Picked(Pick, PathBuf),
-    /// File ▸ Open BVH…: a dump for the current mesh, by the dialog, a typed path, or a file.
-    OpenBvh,
-    OpenBvhPath,
-    ImportFile(PathBuf),
-    /// File ▸ Export BVH…: the current tree as a dump.
-    ExportBvh,
-    /// Show the imported tree (true) or the chosen strategy's build (false).
-    UseImported(bool),
-    /// The Imported BVH window (the checker's findings).
-    ShowImported(bool),
-    /// The red mask over the pixels whose hit through the imported tree is wrong.
-    WrongMask(bool),
-    /// File ▸ Open grade report…: a class's grade.json (`bvhscope grade`), by the dialog, a typed
-    /// path, or a file (or report folder) dropped; its students listed in the Grade report window.
-    OpenGradeReport,
-    OpenGradeReportPath,
-    OpenGradeReportFile(PathBuf),
-    /// The Grade report window.
-    ShowGrade(bool),
-    /// Student `i` of the report: their tree against SAH binned, or why there is none to show.
-    ChooseStudent(usize),
-    /// Select a node or a triangle as the dump names them (a finding's).
-    SelectDumpNode(u32),
-    SelectTriangle(u32),
-    /// The typed-path window's text changed.
-    PathText(String),
-    /// The typed-path window's field has taken the keyboard.
-    PathFocused,
-    ClosePathWindow,
-
-    /// Camera: orbit by a mouse drag in points, pan by a drag over a viewport of that height,
-    /// zoom by a scroll amount.
-    Orbit(f32, f32),
-    Pan {
-        dx: f32,
-        dy: f32,
-        height: f32,
-    },
-    Zoom(f32),
-    FrameMesh,
-    ResetView,
-    /// The viewport's rectangle this frame, the image's within it (the film letterboxed, or the
-    /// whole viewport) and the image size it renders at.
-    Viewport {
-        rect: egui::Rect,
-        image: egui::Rect,
-        pixels: (u32, u32),
-    },
-
-    /// Show view number `i` of `View::ALL` (shortcuts 1..5, the View menu).
-    View(usize),
-    ToggleBoxes,
-    DepthUp,
-    DepthDown,
-    NextStrategy,
-    NextColormap,
-    ApplyPreset(Preset),
-    /// Orbit about another axis (the camera goes back to that axis's default view).
-    SetUpAxis(UpAxis),
-    /// The build or view panel's form, edited: the settings as they now are.
-    Edit(Box<Settings>),
-
-    /// Pin the ray of pixel (x, y) of the image on screen (0-based, from the top left).
-    PinPixel(u32, u32),
-    /// Pin secondary ray `k` of pixel (x, y) (the View panel's ray kind, from its camera ray's
-    /// hit), to walk it.
-    PinSecondary(u32, u32, usize),
-    /// Pin the ray typed in the Ray window.
-    PinTyped,
-    /// The Ray window's typed origin and direction changed.
-    RayText {
-        origin: String,
-        dir: String,
-    },
-    Unpin(usize),
-    UnpinAll,
-    SelectPinned(usize),
-    /// Show step `k` (0-based) of the selected pinned ray.
-    RayStep(usize),
-    /// Step forwards (or back) by so many steps.
-    RayStepBy(i64),
-    RayPlay(bool),
-    /// Open the Ray window with nothing pinned (to type a ray).
-    ShowRayWindow,
-
-    /// Open (or close) the Tree and Node windows.
-    ShowTree(bool),
-    /// Select node `n` of the binary tree as built (tree view, icicle, breadcrumb).
-    SelectNode(u32),
-    /// Select the leaf that holds the hit of pixel (x, y) of the image on screen.
-    SelectPixelNode(u32, u32),
-    /// Move the selection to the parent, a child or the sibling.
-    NodeStep(NodeStep),
-    /// Open or close a row of the tree view.
-    ToggleOpen(u32),
-    /// What the icicle colours by.
-    SetMetric(Metric),
-
-    /// Side by side: show B (another strategy's build) next to A.
-    Compare(bool),
-    CompareStrategy(crate::bvh::SplitStrategy),
-    /// B's leaf size, layout and traversal.
-    CompareB {
-        max_leaf_size: u32,
-        layout: crate::bvh::Layout,
-        trace: crate::bvh::TraceOptions,
-    },
-    CompareMode(super::PairView),
-    /// Where the wipe line is, 0 (left) to 1 (right).
-    Wipe(f32),
-    /// Open (or close) the Replay window: the viewport shows the tree after some splits.
-    ShowReplay(bool),
-    /// Show the tree after `k` splits.
-    ReplayStep(usize),
-    ReplayPlay(bool),
-    /// Write the replay as an animation (.gif or .png), as `bvhscope replay -o` does.
-    ExportReplay,
-    /// Stop writing it.
-    CancelFilm,
-    /// Highlight the pixels whose heatmap value is above this (None: no highlight).
-    SetThreshold(Option<f32>),
-
-    /// Toggle the Help window.
-    Help,
-    SetHelp(bool),
-    /// Dismiss message `i` of the viewport's messages.
-    Dismiss(usize),
-    /// Dismiss the `n` oldest messages (those folded out of sight).
-    DismissEarlier(usize),
-    /// The Node window's cost curves on one scale for the three axes, or each on its own.
-    SharedCostScale(bool),
-    /// Time the current BVH against the linear scan on the frame on screen (or stop timing).
-    TimeLinear(bool),
-    /// Pin the ray of the pixel with the most work in the heatmap on screen (`false`), or of the
-    /// next one after the last pinned so (`true`), as `bvhscope trace --hottest K` traces it.
-    Hottest {
-        next: bool,
-    },
-    /// Put the selected pinned ray's `bvhscope trace` command on the clipboard.
-    CopyTraceCommand,
-    /// Presenting to a room: large text, large plots (View › Present), or the other way (F5).
-    Present(bool),
-    TogglePresent,
-    /// The screen's scale: set, or a step of 10 % up or down (Ctrl +/−).
-    UiScale(f32),
-    UiScaleBy(i32),
-    /// The docked layout as a fresh start has it.
-    ResetLayout,
-}
-
-/// Where panels put the actions they emit during one frame.
-pub type Actions = Vec<Action>;
 
 impl BvhscopeApp {
     /// Apply one action: the only place the state changes in answer to the user.
@@ -313,8 +139,8 @@ impl BvhscopeApp {
             }
             A::NextStrategy => {
                 self.import.on = false;
-                let i = SplitStrategy::ALL.iter().position(|s| *s == self.settings.build.strategy).unwrap_or(0);
-                self.settings.build.strategy = SplitStrategy::ALL[(i + 1) % SplitStrategy::ALL.len()];
+                let i = Strategy::ALL.iter().position(|s| *s == self.settings.build.strategy).unwrap_or(0);
+                self.settings.build.strategy = Strategy::ALL[(i + 1) % Strategy::ALL.len()];
             }
             A::NextColormap => {
                 let i = ColorMap::ALL.iter().position(|c| *c == self.settings.colormap).unwrap_or(0);
@@ -353,8 +179,7 @@ impl BvhscopeApp {
                 let Some(sec) = self.secondary_rays(&s.camera) else { return };
                 let rays = sec.pixel_rays(&*s.bvh, &*s.bvh, &s.camera, s.trace, (x, y)).unwrap_or_default();
                 if let Some(&ray) = rays.get(k) {
-                    let of =
-                        super::ray_view::SecondaryOf { spec: sec.spec, camera: s.camera, index: k, of: rays.len() };
+                    let of = SecondaryOf { spec: sec.spec, camera: s.camera, index: k, of: rays.len() };
                     let source = &self.scene.source;
                     self.pins.pin(PinnedRay::of(s.bvh.clone(), ray, s.trace, Some((x, y)), source, Some(of)));
                 }
@@ -483,7 +308,7 @@ impl BvhscopeApp {
                 self.settings.ui_scale = s.clamp(*UI_SCALES.start(), *UI_SCALES.end());
                 self.settings.present &= self.settings.ui_scale >= PRESENT_SCALE;
             }
-            A::ResetLayout => self.dock = Some(super::dock::default_layout()),
+            A::ResetLayout => self.dock = Some(dock::default_layout()),
             A::DismissEarlier(n) => {
                 self.messages.drain(..n.min(self.messages.len()));
             }

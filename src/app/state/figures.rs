@@ -1,9 +1,12 @@
 //! The plain data the app's state is made of: the image on screen and what produced it, the
 //! per-ray figures and what they depend on, a strategy's figures for the statistics panel, the
-//! messages, the path-typing window; and the figures of the current build and of B, as the
-//! statistics panel and its exports read them.
+//! messages, the path-typing window.
 
-use super::*;
+use crate::app::jobs::{GpuRender, Pick, ViewStyle};
+use crate::bvh::{SceneBvh, TraceOptions, TreeStats};
+use crate::render::{Camera, Frame, Legend, RaySummary};
+use std::sync::Arc;
+use std::time::Instant;
 
 /// The image on screen and what produced it.
 pub struct Shown {
@@ -21,8 +24,8 @@ pub struct Shown {
     /// The BVH and traversal that traced it: a pinned pixel is traced again through them.
     pub bvh: Arc<SceneBvh>,
     pub trace: TraceOptions,
-    /// The GPU that traced it, if one did (`app::gpu`).
-    pub gpu: Option<super::jobs::GpuRender>,
+    /// The GPU that traced it, if one did (`jobs::gpu`).
+    pub gpu: Option<GpuRender>,
     /// Rays of it whose GPU walk reached the step budget and were finished on the CPU.
     pub cpu_finished: usize,
 }
@@ -84,48 +87,5 @@ pub struct PathWindow {
 impl PathWindow {
     pub fn new(pick: Pick, text: String, note: Option<String>) -> Self {
         Self { pick, text, note, focus: true }
-    }
-}
-
-impl super::BvhscopeApp {
-    /// Figures of the current strategy for the statistics panel.
-    pub fn current_figures(&self) -> Option<StrategyFigures> {
-        self.current_bvh().map(|b| StrategyFigures {
-            label: b.bvh.label(),
-            // The end-point overlap comes with the prepared tree, a moment after the image.
-            stats: {
-                let e = self.nodes.current(Some(&b.bvh));
-                TreeStats { epo: e.map(|e| e.epo), epo_error: e.and_then(|e| e.epo_error), ..b.stats.clone() }
-            },
-            build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
-            rays: self.rays,
-            frame_ms: self
-                .last_full_frame
-                .filter(|_| self.shown.as_ref().is_some_and(|s| Arc::ptr_eq(&s.bvh, &b.bvh)))
-                .map(|d| d.as_secs_f64() * 1e3),
-            speedup: self.fresh_speedup().map(|t| t.speedup),
-        })
-    }
-
-    /// The timing against the linear scan of the tree, camera and traversal on screen, if there
-    /// is one (an older tree's or camera's is stale).
-    pub fn fresh_speedup(&self) -> Option<&jobs::Timed> {
-        let shown = self.shown.as_ref()?;
-        self.speedup
-            .as_ref()
-            .filter(|t| Arc::ptr_eq(&t.bvh, &shown.bvh) && t.camera == shown.camera && t.trace == shown.trace)
-    }
-
-    /// B's figures for the statistics panel's second column, while comparing side by side.
-    pub fn compare_figures(&self) -> Option<StrategyFigures> {
-        let b = self.compare.b.as_ref().filter(|b| self.compare.on && b.scene_id == self.scene_id)?;
-        Some(StrategyFigures {
-            label: format!("B: {}", b.bvh.label()),
-            stats: b.stats.clone(),
-            build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
-            rays: Some(MeasuredRays { summary: b.summary, camera: b.camera, trace: b.trace }),
-            frame_ms: None,
-            speedup: None,
-        })
     }
 }

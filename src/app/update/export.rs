@@ -1,8 +1,9 @@
 //! Saving what the app shows: the view as PNG (heatmaps with their legend), the statistics as CSV
 //! or JSON (current strategy and the one before).
 
-use super::jobs::Pick;
-use super::{BvhscopeApp, StrategyFigures};
+use crate::app::jobs::{FilmRequest, Pick, FILM_FRAMES};
+use crate::app::state::{BvhscopeApp, Shown, StrategyFigures};
+use crate::app::views::compare::CompareB;
 use crate::render::{draw_legend, full_size, view_image};
 use std::path::{Path, PathBuf};
 
@@ -62,7 +63,7 @@ pub fn check_output(app: &BvhscopeApp, pick: Pick, path: &Path) -> Result<(), St
 }
 
 /// Compare's pair, or why it cannot be written yet.
-fn pair_on_screen(app: &BvhscopeApp) -> Result<(&super::Shown, &super::compare_view::CompareB), String> {
+fn pair_on_screen(app: &BvhscopeApp) -> Result<(&Shown, &CompareB), String> {
     app.shown_pair().ok_or_else(|| "B is not traced yet: save once both builds are on screen".to_string())
 }
 
@@ -258,23 +259,10 @@ pub fn film_request(app: &BvhscopeApp) -> Result<FilmRequest, String> {
     Ok(FilmRequest { replay, mesh: mesh.clone(), camera, settings, subject })
 }
 
-/// Frames of the app's replay animation and how long each shows (`bvhscope replay`'s defaults).
-pub const FILM_FRAMES: u32 = 24;
-pub const FILM_DELAY_MS: u16 = 400;
-
-/// The replay's animation to write (`film_request`).
-pub struct FilmRequest {
-    pub replay: std::sync::Arc<crate::explain::replay::Replay>,
-    pub mesh: std::sync::Arc<crate::mesh::Mesh>,
-    pub camera: crate::render::Camera,
-    pub settings: crate::explain::replay_film::FilmSettings,
-    pub subject: String,
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::app::MeasuredRays;
+    use crate::app::state::MeasuredRays;
     use crate::bvh::TreeStats;
     use crate::render::{Camera, RaySummary};
 

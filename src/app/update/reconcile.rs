@@ -2,7 +2,11 @@
 //! state asks for, and starts the background work (build, render, explanations, the comparison,
 //! the imported tree's wrong pixels) that closes the gap.
 
-use super::*;
+use crate::app::jobs::RenderRequest;
+use crate::app::state::{BvhscopeApp, MessageKind};
+use crate::bvh::SceneBvh;
+use crate::render::View;
+use std::sync::Arc;
 
 impl BvhscopeApp {
     /// Bring the background work in line with the state: settings that depend on the BVH are
@@ -153,7 +157,10 @@ impl BvhscopeApp {
 
     /// The secondary rays the settings ask for, on `camera` over the scene's bounds (as the
     /// command line resolves `--ray-kind` over the loaded scene's): `None` for camera rays.
-    pub(super) fn secondary_rays(&self, camera: &crate::render::Camera) -> Option<crate::render::SecondaryRays> {
+    pub(in crate::app) fn secondary_rays(
+        &self,
+        camera: &crate::render::Camera,
+    ) -> Option<crate::render::SecondaryRays> {
         let spec = self.settings.rays;
         spec.kind.is_secondary().then(|| crate::render::SecondaryRays::new(spec, &self.scene.bounds(), camera))
     }
@@ -169,7 +176,7 @@ impl BvhscopeApp {
         }
         let Some(built) = self.current_bvh().filter(|_| w > 0 && h > 0) else { return };
         let camera = self.orbit.camera(w, h);
-        let req = jobs::RenderRequest {
+        let req = RenderRequest {
             bvh: built.bvh.clone(),
             camera,
             trace: self.settings.trace,

@@ -5,6 +5,9 @@
 
 use egui_tiles::{Container, Tile, TileId, Tiles, Tree};
 
+/// Where the docked layout is saved (beside the settings, under `eframe::APP_KEY`).
+pub const DOCK_KEY: &str = "bvhscope-dock";
+
 /// What a tile holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Pane {
