@@ -7,8 +7,9 @@ use crate::bvh::{AnyBvh, BuildParams, Bvh, RayCounters, SceneBuild, SceneBvh, St
 use crate::mesh::Mesh;
 use crate::render::Camera;
 use crate::scene::{Scene, SceneError};
-use bvhscope_gpu::{Cwbvh, Gpu, GpuBinaryBvh, GpuBuildTimings, GpuCwbvh, GpuError, GpuLbvh, GpuPloc, GpuTrace, Rays};
-use rayon::prelude::*;
+use bvhscope_gpu::{
+    BinaryFormat, CwbvhFormat, Gpu, GpuBuildTimings, GpuError, GpuFormat, GpuLbvh, GpuPloc, GpuTrace, Rays, Upload,
+};
 use std::sync::Arc;
 
 /// Where rays are traced: the CPU (the renderer of `core`) or the GPU (`bvhscope-gpu`).
@@ -28,13 +29,15 @@ pub enum GpuNodes {
     Cwbvh,
 }
 
-/// One node format's names: the value a flag and the saved settings take, the label messages,
-/// tables and the app show, the help the flag and the app's button give.
+/// One node format: the value a flag and the saved settings take, the label messages, tables and
+/// the app show, the help the flag and the app's button give, and how the format is made from the
+/// binary tree and uploaded (its `GpuFormat`, in its own file of `bvhscope-gpu`).
 pub struct GpuNodesRow {
     pub nodes: GpuNodes,
     pub value: &'static str,
     pub label: &'static str,
     pub help: &'static str,
+    upload: Upload,
 }
 
 /// Every node format the GPU walks, one row each: the command line, the app and `compare` read
@@ -45,6 +48,7 @@ pub const GPU_NODES: [GpuNodesRow; 2] = [
         value: "binary",
         label: "binary",
         help: "The binary tree as built: core's 32-byte nodes, byte for byte",
+        upload: BinaryFormat::upload,
     },
     GpuNodesRow {
         nodes: GpuNodes::Cwbvh,
@@ -52,6 +56,7 @@ pub const GPU_NODES: [GpuNodesRow; 2] = [
         label: "CWBVH",
         help: "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree; \
                its counts are those of its own walk",
+        upload: CwbvhFormat::upload,
     },
 ];
 
@@ -205,15 +210,16 @@ pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Opti
 }
 
 /// A tree on the GPU in the node format asked for, with its CPU form: the CPU walks of the same
-/// tree finish the rays a GPU walk leaves unfinished at its step budget (`GpuTree::walk`).
-pub enum GpuTree {
-    Binary(Box<Bvh>, GpuBinaryBvh),
-    /// The CWBVH's CPU walk is the reference for the GPU's counts.
-    Cwbvh(Box<Cwbvh>, GpuCwbvh),
+/// tree finish the rays a GPU walk leaves unfinished at its step budget (`GpuTree::walk`). What a
+/// format does is its `GpuFormat`; this holds one and finishes its walks.
+pub struct GpuTree {
+    nodes: GpuNodes,
+    format: Box<dyn GpuFormat>,
 }
 
 impl GpuTree {
-    /// Upload the binary tree of `bvh` (one level: as built, or an imported dump's) as `nodes`.
+    /// Upload the binary tree of `bvh` (one level: as built, or an imported dump's) as `nodes`,
+    /// by the upload of the format's row of `GPU_NODES`.
     pub fn new(gpu: &Gpu, bvh: &SceneBvh, nodes: GpuNodes) -> Result<(GpuTree, Arc<Mesh>), GpuError> {
         let SceneBvh::Single { mesh, .. } = bvh else {
             return Err(GpuError::Input("the GPU traces one BVH, not two levels".into()));
@@ -221,34 +227,18 @@ impl GpuTree {
         let tree = bvh.binary_tree().ok_or_else(|| {
             GpuError::Input("this imported wide tree has no binary form the GPU could walk; trace it on the CPU".into())
         })?;
-        let uploaded = match nodes {
-            GpuNodes::Binary => {
-                let on_gpu = GpuBinaryBvh::upload(gpu, &tree)?;
-                GpuTree::Binary(Box::new(tree.into_owned()), on_gpu)
-            }
-            GpuNodes::Cwbvh => {
-                let cw = Cwbvh::from_bvh(&tree)?;
-                let on_gpu = GpuCwbvh::upload(gpu, &cw)?;
-                GpuTree::Cwbvh(Box::new(cw), on_gpu)
-            }
-        };
-        Ok((uploaded, mesh.clone()))
+        let format = (nodes.row().upload)(gpu, &tree)?;
+        Ok((GpuTree { nodes, format }, mesh.clone()))
     }
 
     /// How many nodes of its own the format made from the binary tree (`None`: the binary tree's
     /// own nodes are walked).
     pub fn own_nodes(&self) -> Option<usize> {
-        match self {
-            GpuTree::Binary(..) => None,
-            GpuTree::Cwbvh(cw, _) => Some(cw.nodes.len()),
-        }
+        self.format.own_nodes()
     }
 
     pub fn nodes(&self) -> GpuNodes {
-        match self {
-            GpuTree::Binary(..) => GpuNodes::Binary,
-            GpuTree::Cwbvh(..) => GpuNodes::Cwbvh,
-        }
+        self.nodes
     }
 
     /// Trace `rays` (closest hits), counting when `counted`, in `trace`'s order (binary nodes;
@@ -257,10 +247,7 @@ impl GpuTree {
     /// miss: every hit and count is the CPU's, and `cpu_finished` says how many rays that was.
     pub fn walk(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, GpuError> {
         let opts = bvhscope_gpu::GpuTraceOptions { order: trace.order, counted, exact: true, test: trace.test };
-        let mut out = match self {
-            GpuTree::Binary(_, t) => t.trace(gpu, rays, opts)?,
-            GpuTree::Cwbvh(_, t) => t.trace(gpu, rays, opts)?,
-        };
+        let mut out = self.format.trace(gpu, rays, opts)?;
         if !out.unfinished.is_empty() {
             out.finish(|i| self.cpu_walk(&mut rays.ray(i), trace));
         }
@@ -274,34 +261,13 @@ impl GpuTree {
         ray: &mut crate::geometry::Ray,
         trace: TraceOptions,
     ) -> (Option<crate::bvh::Hit>, RayCounters) {
-        match self {
-            GpuTree::Binary(b, _) => {
-                let mut c = RayCounters::ZERO;
-                let hit = crate::bvh::Accelerator::closest_hit(&**b, ray, trace, &mut c);
-                (hit, c)
-            }
-            GpuTree::Cwbvh(cw, _) => cw.trace_cpu(ray, trace.test),
-        }
+        self.format.cpu_walk(ray, trace)
     }
 
     /// The per-pixel counts of the same walk on the CPU (row by row): core's renderer for binary
     /// nodes (`cpu` is the binary tree's `SceneBvh`), the CWBVH's own CPU walk for CWBVH nodes.
     pub fn cpu_counts(&self, cpu: &SceneBvh, camera: &Camera, trace: TraceOptions) -> Vec<RayCounters> {
-        match self {
-            GpuTree::Binary(..) => {
-                let settings =
-                    crate::render::RenderSettings { trace, count: true, progressive: false, secondary: None };
-                let frame = crate::render::render(cpu, cpu, camera, &settings);
-                frame.traced().map(|(_, c)| c).collect()
-            }
-            GpuTree::Cwbvh(cw, _) => {
-                let gen = camera.ray_gen();
-                (0..camera.width * camera.height)
-                    .into_par_iter()
-                    .map(|i| cw.trace_cpu(&mut gen.pixel_ray(i % camera.width, i / camera.width), trace.test).1)
-                    .collect()
-            }
-        }
+        self.format.cpu_counts(cpu, camera, trace)
     }
 }
 

@@ -108,3 +108,48 @@ impl GpuBinaryBvh {
         KERNELS.run(gpu, &[&self.nodes, &self.tris, &self.prim_ids], None, stack, rays, opts)
     }
 }
+
+/// The binary format: the tree as built, walked on the CPU by core's own walk and renderer.
+pub struct BinaryFormat {
+    cpu: Bvh,
+    gpu: GpuBinaryBvh,
+}
+
+impl BinaryFormat {
+    /// `bvh` uploaded as it is (`GPU_NODES`' upload for the binary format).
+    pub fn upload(gpu: &Gpu, bvh: &Bvh) -> Result<Box<dyn crate::format::GpuFormat>, GpuError> {
+        let on_gpu = GpuBinaryBvh::upload(gpu, bvh)?;
+        Ok(Box::new(BinaryFormat { cpu: bvh.clone(), gpu: on_gpu }))
+    }
+}
+
+impl crate::format::GpuFormat for BinaryFormat {
+    fn own_nodes(&self) -> Option<usize> {
+        None
+    }
+
+    fn trace(&self, gpu: &Gpu, rays: Rays, opts: GpuTraceOptions) -> Result<GpuTrace, GpuError> {
+        self.gpu.trace(gpu, rays, opts)
+    }
+
+    fn cpu_walk(
+        &self,
+        ray: &mut bvhscope_core::geometry::Ray,
+        trace: bvhscope_core::bvh::TraceOptions,
+    ) -> (Option<bvhscope_core::bvh::Hit>, bvhscope_core::bvh::RayCounters) {
+        let mut c = bvhscope_core::bvh::RayCounters::ZERO;
+        let hit = bvhscope_core::bvh::Accelerator::closest_hit(&self.cpu, ray, trace, &mut c);
+        (hit, c)
+    }
+
+    fn cpu_counts(
+        &self,
+        cpu: &bvhscope_core::bvh::SceneBvh,
+        camera: &bvhscope_core::render::Camera,
+        trace: bvhscope_core::bvh::TraceOptions,
+    ) -> Vec<bvhscope_core::bvh::RayCounters> {
+        use bvhscope_core::render::{render, RenderSettings};
+        let settings = RenderSettings { trace, count: true, progressive: false, secondary: None };
+        render(cpu, cpu, camera, &settings).traced().map(|(_, c)| c).collect()
+    }
+}

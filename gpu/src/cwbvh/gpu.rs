@@ -52,3 +52,51 @@ impl GpuCwbvh {
         )
     }
 }
+
+/// The CWBVH format: made from the binary tree, walked on the CPU by its own walk (`walk.rs`),
+/// whose counts are the reference for the GPU's.
+pub struct CwbvhFormat {
+    cpu: Cwbvh,
+    gpu: GpuCwbvh,
+}
+
+impl CwbvhFormat {
+    /// `bvh` encoded as a CWBVH and uploaded (`GPU_NODES`' upload for the CWBVH format).
+    pub fn upload(gpu: &Gpu, bvh: &bvhscope_core::bvh::Bvh) -> Result<Box<dyn crate::format::GpuFormat>, GpuError> {
+        let cpu = Cwbvh::from_bvh(bvh)?;
+        let on_gpu = GpuCwbvh::upload(gpu, &cpu)?;
+        Ok(Box::new(CwbvhFormat { cpu, gpu: on_gpu }))
+    }
+}
+
+impl crate::format::GpuFormat for CwbvhFormat {
+    fn own_nodes(&self) -> Option<usize> {
+        Some(self.cpu.nodes.len())
+    }
+
+    fn trace(&self, gpu: &Gpu, rays: Rays, opts: GpuTraceOptions) -> Result<GpuTrace, GpuError> {
+        self.gpu.trace(gpu, rays, opts)
+    }
+
+    fn cpu_walk(
+        &self,
+        ray: &mut bvhscope_core::geometry::Ray,
+        trace: bvhscope_core::bvh::TraceOptions,
+    ) -> (Option<bvhscope_core::bvh::Hit>, bvhscope_core::bvh::RayCounters) {
+        self.cpu.trace_cpu(ray, trace.test)
+    }
+
+    fn cpu_counts(
+        &self,
+        _cpu: &bvhscope_core::bvh::SceneBvh,
+        camera: &bvhscope_core::render::Camera,
+        trace: bvhscope_core::bvh::TraceOptions,
+    ) -> Vec<bvhscope_core::bvh::RayCounters> {
+        use rayon::prelude::*;
+        let gen = camera.ray_gen();
+        (0..camera.width * camera.height)
+            .into_par_iter()
+            .map(|i| self.cpu.trace_cpu(&mut gen.pixel_ray(i % camera.width, i / camera.width), trace.test).1)
+            .collect()
+    }
+}

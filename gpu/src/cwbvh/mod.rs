@@ -15,7 +15,7 @@
 pub(crate) mod gpu;
 mod walk;
 
-pub use gpu::GpuCwbvh;
+pub use gpu::{CwbvhFormat, GpuCwbvh};
 
 use crate::device::GpuError;
 use bvhscope_core::bvh::{Bvh, BvhNode};
