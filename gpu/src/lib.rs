@@ -20,9 +20,9 @@ mod trace;
 pub mod verify;
 
 pub use binary::{checked_depth, BinaryFormat, GpuBinaryBvh};
-pub use format::{GpuFormat, Upload};
 pub use cwbvh::{Cwbvh, CwbvhFormat, CwbvhNode, GpuCwbvh, META_INTERIOR, META_LEAF};
 pub use device::{gpu_for_tests, Gpu, GpuError, GpuOptions};
+pub use format::{GpuFormat, Upload};
 pub use lbvh::{GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
 pub use ploc::GpuPloc;
 pub use trace::{GpuTrace, GpuTraceOptions, Rays, STEP_BUDGET};

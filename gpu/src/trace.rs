@@ -213,33 +213,44 @@ impl Kernels {
         ])
     }
 
-    fn get(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Arc<Kernel>, GpuError> {
-        let key = format!("{} {stack:?} camera={camera} {opts:?}", self.format);
-        gpu.compiled(key, || self.compile(gpu, stack, camera, opts))
+    /// The kernel for these options, binding `tree_buffers` buffers of the tree after the rays'.
+    fn get(
+        &self,
+        gpu: &Gpu,
+        stack: Stack,
+        camera: bool,
+        opts: GpuTraceOptions,
+        tree_buffers: usize,
+    ) -> Result<Arc<Kernel>, GpuError> {
+        let key = format!("{} {stack:?} camera={camera} {opts:?} tree={tree_buffers}", self.format);
+        gpu.compiled(key, || self.compile(gpu, stack, camera, opts, tree_buffers))
     }
 
-    fn compile(&self, gpu: &Gpu, stack: Stack, camera: bool, opts: GpuTraceOptions) -> Result<Kernel, GpuError> {
+    /// What a format's kernel needs is read from the format, never from its name: the tree's
+    /// buffers are those its `trace` hands to `run`, and the traversal order is set where its
+    /// walk declares `override BY_DISTANCE` (a walk that orders its children otherwise, as the
+    /// CWBVH's by octant, does not).
+    fn compile(
+        &self,
+        gpu: &Gpu,
+        stack: Stack,
+        camera: bool,
+        opts: GpuTraceOptions,
+        tree_buffers: usize,
+    ) -> Result<Kernel, GpuError> {
         let source = self.source(gpu.has_f64(), stack);
         let binds = [Bind::Uniform, Bind::Read, Bind::ReadWrite, Bind::ReadWrite, Bind::ReadWrite];
         let mut binds = binds.to_vec();
-        binds.extend(std::iter::repeat_n(Bind::Read, self.tree_buffers()));
+        binds.extend(std::iter::repeat_n(Bind::Read, tree_buffers));
         let by_distance = (opts.order == TraversalOrder::EntryDistance) as u8 as f64;
         let moller = (opts.test == TriangleTest::MollerTrumbore) as u8 as f64;
         let mut constants =
             vec![("COUNTED", opts.counted as u8 as f64), ("EXACT", opts.exact as u8 as f64), ("MOLLER", moller)];
-        if self.format == "binary" {
+        if crate::shaders::source(self.walk_file).contains("override BY_DISTANCE") {
             constants.push(("BY_DISTANCE", by_distance));
         }
         let entry = if camera { "trace_camera" } else { "trace_list" };
         Kernel::new(gpu, &format!("{} {entry}", self.format), &source, entry, &binds, &constants)
-    }
-
-    fn tree_buffers(&self) -> usize {
-        if self.format == "binary" {
-            3
-        } else {
-            4
-        }
     }
 
     /// Trace `rays` against the tree in `tree` (bound from binding 5 on) with the stack `stack`;
@@ -261,7 +272,7 @@ impl Kernels {
             _ => ([f32::INFINITY, f32::INFINITY, f32::INFINITY, 0.0], [f32::NEG_INFINITY; 4]),
         };
         let camera = matches!(rays, Rays::Camera(_));
-        let kernel = self.get(gpu, stack, camera, opts)?;
+        let kernel = self.get(gpu, stack, camera, opts, tree.len())?;
         let n = rays.len();
         let mut out = GpuTrace {
             hits: Vec::with_capacity(n),
