@@ -28,7 +28,7 @@ fn main() {
     let fastest = std::env::var("PRESET").is_ok_and(|p| p == "fastest");
     let mut params =
         if fastest { bvhscope::bvh::Preset::Fastest.build() } else { BuildParams { layout, ..BuildParams::default() } };
-    let opts = if fastest { bvhscope::bvh::Preset::Fastest.trace() } else { TraceOptions::default() };
+    let opts = if fastest { bvhscope::bvh::Preset::Fastest.trace_options() } else { TraceOptions::default() };
     if let Ok(c) = std::env::var("COST") {
         params.cost.traversal = c.parse().expect("COST is a number");
     }

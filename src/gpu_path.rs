@@ -210,7 +210,7 @@ pub fn build_on_gpu(gpu: &Gpu, mesh: &Mesh, params: &BuildParams) -> Result<Opti
 }
 
 /// A tree on the GPU in the node format asked for, with its CPU form: the CPU walks of the same
-/// tree finish the rays a GPU walk leaves unfinished at its step budget (`GpuTree::walk`). What a
+/// tree finish the rays a GPU walk leaves unfinished at its step budget (`GpuTree::trace_rays`). What a
 /// format does is its `GpuFormat`; this holds one and finishes its walks.
 pub struct GpuTree {
     nodes: GpuNodes,
@@ -245,7 +245,7 @@ impl GpuTree {
     /// CWBVH orders its children by octant). A ray whose GPU walk reaches the step budget
     /// (`bvhscope_gpu::STEP_BUDGET`) is finished by the same walk on the CPU, never taken for a
     /// miss: every hit and count is the CPU's, and `cpu_finished` says how many rays that was.
-    pub fn walk(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, GpuError> {
+    pub fn trace_rays(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, GpuError> {
         let opts = bvhscope_gpu::GpuTraceOptions { order: trace.order, counted, exact: true, test: trace.test };
         let mut out = self.format.trace(gpu, rays, opts)?;
         if !out.unfinished.is_empty() {

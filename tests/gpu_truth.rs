@@ -99,7 +99,7 @@ fn agrees(gpu: &Gpu, what: &str, bvh: Bvh, mesh: Mesh, rays: Rays, nodes: GpuNod
     let (tree, _) = GpuTree::new(gpu, &scene, nodes).unwrap_or_else(|e| panic!("{what}: {e}"));
     let mut most = 0;
     for &trace in traces {
-        let t = tree.walk(gpu, rays, trace, true).unwrap_or_else(|e| panic!("{what}: {e}"));
+        let t = tree.trace_rays(gpu, rays, trace, true).unwrap_or_else(|e| panic!("{what}: {e}"));
         assert!(t.unfinished.is_empty(), "{what}: every unfinished ray is finished");
         most = most.max(t.cpu_finished);
         for i in 0..rays.len() {
@@ -145,7 +145,7 @@ fn walks_past_the_step_budget_are_finished_on_the_cpu_never_taken_for_misses() {
     let scene = SceneBvh::Single { bvh: AnyBvh::Binary(bvh), mesh: Arc::new(mesh.clone()), imported: None };
     let (tree, _) = GpuTree::new(&gpu, &scene, GpuNodes::Binary).unwrap();
     let last = [*rays.last().unwrap()];
-    let t = tree.walk(&gpu, Rays::List(&last), TraceOptions::default(), true).unwrap();
+    let t = tree.trace_rays(&gpu, Rays::List(&last), TraceOptions::default(), true).unwrap();
     assert!(t.hits[0].is_some() && t.cpu_finished == 1, "the issue's ray hits: {:?}", t.hits[0]);
 
     // 20,000 identical triangles.

@@ -71,7 +71,7 @@ fn check_ray(mesh: &Mesh, bvhs: &[AnyBvh], linear: &LinearScan, ray: Ray) {
             // "Rays in the root box" are the rays that visit a node: every layout tests the root
             // box first and visits nothing when it misses.
             let mut root = None;
-            bvh.walk(&mut |n| {
+            bvh.visit_nodes(&mut |n| {
                 root.get_or_insert(n.bounds);
                 false
             });

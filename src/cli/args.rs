@@ -130,8 +130,8 @@ impl BuildArgs {
         SceneBuild { bvh: params, top }
     }
 
-    pub fn trace(&self) -> TraceOptions {
-        let base = self.preset.map_or(TraceOptions::default(), Preset::trace);
+    pub fn trace_options(&self) -> TraceOptions {
+        let base = self.preset.map_or(TraceOptions::default(), Preset::trace_options);
         TraceOptions { order: self.order.unwrap_or(base.order), test: self.test.unwrap_or(base.test) }
     }
 }
@@ -312,15 +312,18 @@ mod tests {
         let plain = parse(&[]);
         assert_eq!(plain.params(None), BuildParams::default());
         assert_eq!(plain.params(Some(&scene)), scene, "a scene file's settings, as the app starts from them");
-        assert_eq!(plain.trace(), TraceOptions::default());
+        assert_eq!(plain.trace_options(), TraceOptions::default());
         let handout = parse(&["--preset", "handout"]);
         assert_eq!(handout.params(Some(&scene)), Preset::Handout.build());
-        assert_eq!(handout.trace(), Preset::Handout.trace());
+        assert_eq!(handout.trace_options(), Preset::Handout.trace_options());
         assert_eq!(handout.compare_layouts(), vec![Layout::Binary]);
         let mine = parse(&["--preset", "handout", "--max-leaf-size", "8", "--triangle-test", "watertight"]);
         let p = mine.params(None);
         assert_eq!((p.strategy, p.layout, p.max_leaf_size), (Strategy::Midpoint, Layout::Binary, 8));
-        assert_eq!(mine.trace(), TraceOptions { test: TriangleTest::Watertight, ..Preset::Handout.trace() });
+        assert_eq!(
+            mine.trace_options(),
+            TraceOptions { test: TriangleTest::Watertight, ..Preset::Handout.trace_options() }
+        );
         assert_eq!(parse(&["-s", "sah-sweep"]).params(Some(&scene)).strategy, Strategy::SahSweep);
         assert_eq!(parse(&[]).compare_layouts(), Layout::ALL.to_vec());
     }

@@ -117,7 +117,7 @@ pub fn output(a: &CheckArgs) -> Result<(String, usize), CliError> {
     let size = a.view_args.size.unwrap_or_else(|| scene.camera.map_or(CHECK_SIZE, |c| fit((c.width, c.height))));
     let view = super::args::ViewArgs { size: Some(size), ..a.view_args.clone() };
     let camera = view.camera(&scene.bounds(), scene.camera.as_ref())?;
-    let trace = a.build.trace();
+    let trace = a.build.trace_options();
     let subject = Subject { dump: &dump, dump_path: &a.bvh, mesh: &mesh, mesh_path: &a.mesh };
     let control = crate::work::WorkControl::new();
     let checked =

@@ -3,7 +3,7 @@
 //! nothing falls back to the CPU unasked. The GPU walks the binary tree as built (core's nodes,
 //! byte for byte) or its CWBVH form, with either triangle test, over one level; its per-ray counts
 //! are the CPU's for the binary layout. A walk that reaches the GPU's step budget is finished on
-//! the CPU (`GpuTree::walk`), and every command says how many rays were (`finished_note`). The strategies lbvh and ploc are built on the GPU too
+//! the CPU (`GpuTree::trace_rays`), and every command says how many rays were (`finished_note`). The strategies lbvh and ploc are built on the GPU too
 //! (core's trees node for node), with the build's phases timed.
 
 use super::args::{BuildArgs, DeviceArgs};
@@ -120,7 +120,7 @@ impl GpuTree {
 
     /// `walk`, with the command line's error.
     pub fn trace(&self, gpu: &Gpu, rays: Rays, trace: TraceOptions, counted: bool) -> Result<GpuTrace, CliError> {
-        self.walk(gpu, rays, trace, counted).map_err(gpu_error)
+        self.trace_rays(gpu, rays, trace, counted).map_err(gpu_error)
     }
 
     /// `camera`'s frame traced on the GPU, as a frame the views, legends and CSVs read.

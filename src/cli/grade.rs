@@ -131,7 +131,7 @@ pub fn run(a: &GradeArgs) -> Result<(), CliError> {
         camera,
         rays: a.rays.or(rubric.rays).unwrap_or(DEFAULT_RAYS),
         time_rays: a.time_rays.or(rubric.time_rays).unwrap_or(DEFAULT_TIME_RAYS) as usize,
-        trace: b.trace(),
+        trace: b.trace_options(),
         params: b.params(scene.build.as_ref()),
         dump_limit: a.dump_limit.bytes(&mesh),
         max_seconds: a.max_seconds,

@@ -266,7 +266,7 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
     // The visits of the frame's primary rays, through the binary tree (as the Tree window counts).
     let camera = a.view_args.camera(&scene.bounds(), scene.camera.as_ref())?;
     let visits =
-        crate::explain::visits::frame_visits(&tree, &camera, a.build.trace(), &crate::work::WorkControl::new())
+        crate::explain::visits::frame_visits(&tree, &camera, a.build.trace_options(), &crate::work::WorkControl::new())
             .map_err(|_| CliError::Usage("cancelled".into()))?
             .counts[node as usize];
     // A built wide tree is collapsed from the binary one; an imported one is not.

@@ -231,7 +231,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let mut params = a.build.params(loaded.build.as_ref());
     if gpu.is_some() {
         params = device::gpu_params(&a.build, loaded.build.as_ref(), params)?;
-        device::check_traceable(&a.build.scene_build(params), a.build.trace())?;
+        device::check_traceable(&a.build.scene_build(params), a.build.trace_options())?;
     }
     let bvh = match &a.bvh {
         Some(path) => a.dump_limit.import(&loaded, path)?,
@@ -243,7 +243,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     let count = a.view.is_heatmap() || a.counts.is_some();
     let secondary = a.rays.secondary(kind, &loaded.bounds(), &camera);
-    let settings = RenderSettings { trace: a.build.trace(), count, progressive: false, secondary };
+    let settings = RenderSettings { trace: a.build.trace_options(), count, progressive: false, secondary };
     let total = camera.width as u64 * camera.height as u64;
     let frame = frame_of(a, gpu.as_ref(), &bvh, &camera, &settings, "rendering")?;
     // What A is called in captions: the build, or the imported file.

@@ -77,7 +77,7 @@ pub fn output(a: &ReplayArgs) -> Result<String, CliError> {
         view: a.view,
         colormap: a.colormap,
         frames: a.frames,
-        trace: a.build.trace(),
+        trace: a.build.trace_options(),
         cost: params.cost,
     };
     let subject = format!("{}, {}, log scale", file_name(&a.mesh), params.strategy.label());

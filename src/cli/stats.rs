@@ -130,7 +130,7 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
     let gpu = device::open(&a.device)?;
     let loaded = load_noted(&a.mesh, true)?;
     let mut params = a.build.params(loaded.build.as_ref());
-    let trace = a.build.trace();
+    let trace = a.build.trace_options();
     if gpu.is_some() {
         params = device::gpu_params(&a.build, loaded.build.as_ref(), params)?;
         device::check_traceable(&a.build.scene_build(params), trace)?;
@@ -226,7 +226,7 @@ fn trace_rays(
     camera: &Camera,
     secondary: Option<SecondaryRays>,
 ) -> Result<(Camera, RaySummary, Option<Warp>), CliError> {
-    let trace = a.build.trace();
+    let trace = a.build.trace_options();
     let counts = |f: &crate::render::Frame| f.traced().map(|(_, c)| c).collect::<Vec<_>>();
     Ok(match gpu {
         Some(gpu) => {

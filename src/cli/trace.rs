@@ -129,7 +129,7 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
     let mut params = a.build.params(scene.build.as_ref());
     if gpu.is_some() {
         params = device::gpu_params(&a.build, scene.build.as_ref(), params)?;
-        device::check_traceable(&a.build.scene_build(params), a.build.trace())?;
+        device::check_traceable(&a.build.scene_build(params), a.build.trace_options())?;
     }
     let bvh = match &a.bvh {
         Some(path) => a.dump_limit.import(&scene, path)?,
@@ -149,7 +149,7 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
                 ));
             }
             let settings = crate::render::RenderSettings {
-                trace: a.build.trace(),
+                trace: a.build.trace_options(),
                 count: true,
                 progressive: false,
                 secondary: a.rays.secondary(kind, &scene.bounds(), &camera),
@@ -185,7 +185,7 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
         }
         (None, None) => unreachable!("clap requires --pixel or --ray"),
     };
-    let opts = a.build.trace();
+    let opts = a.build.trace_options();
     let build_label = bvh.label();
     let head = Head { a, ray, source, hot, build_label, opts, two_levels: bvh.two_level().is_some() };
     // On the GPU: its hit and counts, and no steps.
@@ -237,7 +237,7 @@ fn secondary_ray(
     (x, y): (u32, u32),
     mut source: serde_json::Value,
 ) -> Result<(Ray, serde_json::Value), CliError> {
-    let opts = a.build.trace();
+    let opts = a.build.trace_options();
     let kind = sec.spec.kind;
     let rays = sec.pixel_rays(bvh, bvh, camera, opts, (x, y)).ok_or_else(|| {
         CliError::Usage(format!("pixel {x},{y}: its camera ray misses the mesh, so it has no {} rays", kind.name()))

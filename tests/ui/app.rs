@@ -450,7 +450,7 @@ fn handout_mode_is_one_click() {
     let s = &h.state().settings;
     assert!(s.is_preset(bvhscope::bvh::Preset::Handout));
     assert_eq!(s.build.layout, bvhscope::bvh::Layout::Binary);
-    assert_eq!(s.trace, bvhscope::bvh::Preset::Handout.trace());
+    assert_eq!(s.trace, bvhscope::bvh::Preset::Handout.trace_options());
     h.get_by_label("Handout mode (on)");
     h.get_by_label("Midpoint, binary");
 }

@@ -113,8 +113,8 @@ impl Accelerator for AnyBvh {
 }
 
 impl TreeView for AnyBvh {
-    fn walk(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
-        self.tree().walk(f)
+    fn visit_nodes(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
+        self.tree().visit_nodes(f)
     }
     fn triangle_count(&self) -> usize {
         self.tree().triangle_count()

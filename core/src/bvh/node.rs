@@ -106,7 +106,7 @@ pub(crate) fn walk_nodes(nodes: &[BvhNode], empty: bool, f: &mut dyn FnMut(&supe
 }
 
 impl super::tree::TreeView for Bvh {
-    fn walk(&self, f: &mut dyn FnMut(&super::tree::TreeNode) -> bool) {
+    fn visit_nodes(&self, f: &mut dyn FnMut(&super::tree::TreeNode) -> bool) {
         walk_nodes(&self.nodes, self.prim_ids.is_empty(), f)
     }
 

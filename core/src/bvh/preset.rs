@@ -64,7 +64,7 @@ impl Preset {
         }
     }
 
-    pub fn trace(self) -> TraceOptions {
+    pub fn trace_options(self) -> TraceOptions {
         match self {
             Preset::Handout => {
                 TraceOptions { order: TraversalOrder::SplitAxisSign, test: TriangleTest::MollerTrumbore }
@@ -89,7 +89,7 @@ impl Preset {
             && build.layout == p.layout
             && build.max_leaf_size == p.max_leaf_size
             && build.cost == p.cost
-            && *trace == self.trace()
+            && *trace == self.trace_options()
             && two_level == self.two_level()
     }
 }

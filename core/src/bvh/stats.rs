@@ -107,7 +107,7 @@ impl TreeStats {
         };
         let mut depth_sum = 0u64;
         let mut cost = 0f64;
-        tree.walk(&mut |n| {
+        tree.visit_nodes(&mut |n| {
             if n.depth == 0 {
                 root_area = area.unwrap_or(n.bounds.area() as f64);
             }

@@ -22,7 +22,7 @@ pub struct TreeNode {
 
 pub trait TreeView {
     /// Visit every node, parents before children; `f` returns whether to visit the node's children.
-    fn walk(&self, f: &mut dyn FnMut(&TreeNode) -> bool);
+    fn visit_nodes(&self, f: &mut dyn FnMut(&TreeNode) -> bool);
     /// Triangle references in leaves: the triangles, plus the duplicates of any cut by spatial
     /// splits (SBVH).
     fn triangle_count(&self) -> usize;
@@ -43,7 +43,7 @@ pub trait TreeView {
     /// box overlay draws. Subtrees below `depth` are not visited.
     fn boxes_at_depth(&self, depth: u32, include_shallower_leaves: bool) -> Vec<(usize, Aabb)> {
         let mut out = Vec::new();
-        self.walk(&mut |n| {
+        self.visit_nodes(&mut |n| {
             let leaf = matches!(n.kind, NodeKind::Leaf { .. });
             if n.depth == depth || (include_shallower_leaves && leaf && n.depth < depth) {
                 out.push((n.id, n.bounds));

@@ -47,7 +47,7 @@ pub struct TopLevel {
 }
 
 impl TreeView for TopLevel {
-    fn walk(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
+    fn visit_nodes(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
         walk_nodes(&self.nodes, self.order.is_empty(), f)
     }
     /// The top level's primitives are instances.
@@ -232,7 +232,7 @@ pub fn placed_corners(b: &Aabb, to_world: &Affine3A) -> [Vec3; 8] {
 /// The top level's leaves, as the statistics see them: how many instances each holds.
 pub fn top_leaf_sizes(top: &TopLevel) -> Vec<u32> {
     let mut sizes = Vec::new();
-    top.walk(&mut |n| {
+    top.visit_nodes(&mut |n| {
         if let NodeKind::Leaf { count } = n.kind {
             sizes.push(count);
         }

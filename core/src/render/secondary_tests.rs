@@ -78,7 +78,7 @@ fn a_shadow_ray_ends_at_the_light() {
 fn adversarial(mesh: &Mesh, tree: &AnyBvh) -> Vec<Ray> {
     let mut rays = Vec::new();
     let far = mesh.bounds().center() + Vec3::new(3.0, 2.5, 4.0) * mesh.bounds().extent().length();
-    tree.walk(&mut |n: &TreeNode| {
+    tree.visit_nodes(&mut |n: &TreeNode| {
         let b = n.bounds;
         for c in 0..8 {
             let corner = Vec3::new(

@@ -1,7 +1,7 @@
 //! The GPU in the app's jobs: the look for an adapter (once, in the background, at start), the
 //! tree uploaded for the render job (one at a time), a frame traced there at full resolution in
 //! one pass, and lbvh and ploc built there by the build job. A ray whose GPU walk reaches the
-//! step budget is finished on the CPU (`GpuTree::walk`). When the app traces on the GPU is
+//! step budget is finished on the CPU (`GpuTree::trace_rays`). When the app traces on the GPU is
 //! `state::gpu`; its answers (`JobEvent::GpuProbed`, `GpuFailed`) are handled in `update`.
 use super::messages::{GpuRender, JobEvent, PassOutput, RenderRequest};
 use crate::bvh::{SceneBuild, SceneBvh};
@@ -89,7 +89,7 @@ impl GpuJobs {
         if control.is_cancelled() {
             return Ok(None);
         }
-        let t = tree.walk(&g.gpu, Rays::Camera(&r.camera), r.trace, true).map_err(|e| e.to_string())?;
+        let t = tree.trace_rays(&g.gpu, Rays::Camera(&r.camera), r.trace, true).map_err(|e| e.to_string())?;
         // While orbiting, a newer request has usually cancelled this one by now: skip its shading.
         if control.is_cancelled() {
             return Ok(None);

@@ -7,7 +7,7 @@
 //! render and build jobs, never on the UI thread. Where the GPU cannot trace (two levels, the
 //! build replay's partial trees) the CPU does, and the View panel's button and line say so; a
 //! GPU error (device lost, a command rejected) switches back to the CPU with a message. A ray
-//! whose GPU walk reaches the step budget is finished on the CPU (`GpuTree::walk`), and the
+//! whose GPU walk reaches the step budget is finished on the CPU (`GpuTree::trace_rays`), and the
 //! statistics say how many were.
 
 use super::app::BvhscopeApp;

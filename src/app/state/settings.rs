@@ -168,7 +168,7 @@ impl Settings {
             cost: p.cost,
             ..self.build
         };
-        self.trace = preset.trace();
+        self.trace = preset.trace_options();
         self.two_level = preset.two_level();
     }
 

@@ -53,7 +53,7 @@ pub fn gpu_rows(
     nodes: &[GpuNodes],
     linear_trace_ms: f64,
 ) -> Result<(Vec<GpuRow>, usize), CliError> {
-    let trace = build.trace();
+    let trace = build.trace_options();
     device::check_traceable(&build.scene_build(build.params(scene)), trace)?;
     let pixels = camera.width as usize * camera.height as usize;
     let incoherent = crate::render::incoherent_rays(mesh, pixels, 1);

@@ -74,14 +74,14 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
     let scene = loaded.build.as_ref();
     if gpu.is_some() {
         // Refused before the CPU rows are measured, not after.
-        crate::cli::device::check_traceable(&a.build.scene_build(a.build.params(scene)), a.build.trace())?;
+        crate::cli::device::check_traceable(&a.build.scene_build(a.build.params(scene)), a.build.trace_options())?;
     }
     let secondary = a.rays.kinds().iter().any(|k| k.is_secondary());
     if gpu.is_some() && secondary {
         let kind = a.rays.kinds().into_iter().find(|k| k.is_secondary()).expect("one is secondary");
         return Err(crate::cli::render::gpu_traces_primary_only(kind));
     }
-    let trace = a.build.trace();
+    let trace = a.build.trace_options();
     let mut kinds = secondary.then(|| {
         let cost = a.build.params(scene).cost;
         kinds::KindsTable::new(mesh, &camera, &a.rays, trace, cost)

@@ -116,7 +116,7 @@ pub fn compare_rows(
 ) -> (Vec<CompareRow>, CompareSetup) {
     let (frames, traces) = (pool(threads), pool(Some(threads.unwrap_or(1))));
     let rays = camera.width as f64 * camera.height as f64;
-    let trace = build.trace();
+    let trace = build.trace_options();
     let plain = RenderSettings { trace, count: false, progressive: false, secondary: None };
     let counting = RenderSettings { count: true, ..plain };
     let mut rows = Vec::new();

@@ -240,7 +240,7 @@ mod tests {
     /// The tree as (depth, bounds, kind) in walk order, which follows slots, not node indices.
     fn shape(w: &WideBvh) -> Vec<(u32, Aabb, NodeKind)> {
         let mut out = Vec::new();
-        w.walk(&mut |v| {
+        w.visit_nodes(&mut |v| {
             out.push((v.depth, v.bounds, v.kind));
             true
         });

@@ -62,7 +62,7 @@ fn every_kernel(mesh: &Mesh, params: &BuildParams) -> Vec<(Simd, AnyBvh)> {
 fn adversarial_rays(tree: &AnyBvh, from: &[Vec3]) -> Vec<Ray> {
     let mut rays = Vec::new();
     let mut boxes = Vec::new();
-    tree.walk(&mut |n: &TreeNode| {
+    tree.visit_nodes(&mut |n: &TreeNode| {
         boxes.push(n.bounds);
         boxes.len() < 200
     });
@@ -94,8 +94,8 @@ fn adversarial_rays(tree: &AnyBvh, from: &[Vec3]) -> Vec<Ray> {
 /// distance (Möller–Trumbore may return a neighbour a few units in the last place farther, see
 /// `slab.rs`).
 fn check(trees: &[(Simd, AnyBvh)], linear: &LinearScan, ray: Ray) -> Result<(), TestCaseError> {
-    let mt = TraceOptions { test: crate::geometry::TriangleTest::MollerTrumbore, ..Preset::Fastest.trace() };
-    for opts in [Preset::Fastest.trace(), mt] {
+    let mt = TraceOptions { test: crate::geometry::TriangleTest::MollerTrumbore, ..Preset::Fastest.trace_options() };
+    for opts in [Preset::Fastest.trace_options(), mt] {
         let run = |bvh: &AnyBvh| {
             let (mut r, mut c, mut a) = (ray, RayCounters::default(), RayCounters::default());
             let hit =

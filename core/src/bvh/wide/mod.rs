@@ -216,7 +216,7 @@ impl<const W: usize> WideBvh<W> {
 impl<const W: usize> TreeView for WideBvh<W> {
     /// The root is node 0 with the whole box; each valid slot is a child: an interior wide node
     /// (id = its index) or a leaf (id = nodes.len() + W·parent + slot).
-    fn walk(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
+    fn visit_nodes(&self, f: &mut dyn FnMut(&TreeNode) -> bool) {
         let root_kind = if self.prim_ids.is_empty() { NodeKind::Leaf { count: 0 } } else { NodeKind::Interior };
         if !f(&TreeNode { id: 0, bounds: self.root_bounds, depth: 0, kind: root_kind }) || self.prim_ids.is_empty() {
             return;
