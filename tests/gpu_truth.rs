@@ -130,7 +130,7 @@ fn down(n: usize) -> Vec<Ray> {
 #[test]
 fn walks_past_the_step_budget_are_finished_on_the_cpu_never_taken_for_misses() {
     let Some(gpu) = bvhscope_gpu::gpu_for_tests() else { return };
-    let formats = [GpuNodes::Binary, GpuNodes::Cwbvh];
+    let formats = GpuNodes::ALL;
     let sah = BuildParams { layout: Layout::Binary, ..Default::default() };
     // The fan: 40,000 triangles of one box; the ray among the grid's.
     let mesh = fan(40_000);
@@ -189,7 +189,7 @@ fn moller_trumbore_and_the_split_axis_order_run_on_the_gpu_as_on_the_cpu() {
     let camera = Camera::framing(&mesh.bounds(), 32, 24);
     let incoherent = bvhscope::render::incoherent_rays(&mesh, 2000, 1);
     for strategy in [Strategy::SahBinned, Strategy::Midpoint] {
-        for nodes in [GpuNodes::Binary, GpuNodes::Cwbvh] {
+        for nodes in GpuNodes::ALL {
             let bvh = || Bvh::build(&mesh, &BuildParams { strategy, layout: Layout::Binary, ..Default::default() });
             agrees(&gpu, "knot", bvh(), mesh.clone(), Rays::Camera(&camera), nodes, &ALL_TRACES);
             agrees(&gpu, "knot, incoherent", bvh(), mesh.clone(), Rays::List(&incoherent), nodes, &ALL_TRACES);
