@@ -213,7 +213,11 @@ impl Kernels {
         ])
     }
 
-    /// The kernel for these options, binding `tree_buffers` buffers of the tree after the rays'.
+    /// The kernel for these options, binding `tree_buffers` buffers of the tree after the rays',
+    /// compiled once. What a format's kernel needs is read from the format, never from its name:
+    /// the tree's buffers are those its `trace` hands to `run`, and the traversal order is set
+    /// where its walk declares `override BY_DISTANCE` (a walk that orders its children otherwise,
+    /// as the CWBVH's by octant, does not).
     fn get(
         &self,
         gpu: &Gpu,
@@ -223,34 +227,21 @@ impl Kernels {
         tree_buffers: usize,
     ) -> Result<Arc<Kernel>, GpuError> {
         let key = format!("{} {stack:?} camera={camera} {opts:?} tree={tree_buffers}", self.format);
-        gpu.compiled(key, || self.compile(gpu, stack, camera, opts, tree_buffers))
-    }
-
-    /// What a format's kernel needs is read from the format, never from its name: the tree's
-    /// buffers are those its `trace` hands to `run`, and the traversal order is set where its
-    /// walk declares `override BY_DISTANCE` (a walk that orders its children otherwise, as the
-    /// CWBVH's by octant, does not).
-    fn compile(
-        &self,
-        gpu: &Gpu,
-        stack: Stack,
-        camera: bool,
-        opts: GpuTraceOptions,
-        tree_buffers: usize,
-    ) -> Result<Kernel, GpuError> {
-        let source = self.source(gpu.has_f64(), stack);
-        let binds = [Bind::Uniform, Bind::Read, Bind::ReadWrite, Bind::ReadWrite, Bind::ReadWrite];
-        let mut binds = binds.to_vec();
-        binds.extend(std::iter::repeat_n(Bind::Read, tree_buffers));
-        let by_distance = (opts.order == TraversalOrder::EntryDistance) as u8 as f64;
-        let moller = (opts.test == TriangleTest::MollerTrumbore) as u8 as f64;
-        let mut constants =
-            vec![("COUNTED", opts.counted as u8 as f64), ("EXACT", opts.exact as u8 as f64), ("MOLLER", moller)];
-        if crate::shaders::source(self.walk_file).contains("override BY_DISTANCE") {
-            constants.push(("BY_DISTANCE", by_distance));
-        }
-        let entry = if camera { "trace_camera" } else { "trace_list" };
-        Kernel::new(gpu, &format!("{} {entry}", self.format), &source, entry, &binds, &constants)
+        gpu.compiled(key, || {
+            let source = self.source(gpu.has_f64(), stack);
+            let binds = [Bind::Uniform, Bind::Read, Bind::ReadWrite, Bind::ReadWrite, Bind::ReadWrite];
+            let mut binds = binds.to_vec();
+            binds.extend(std::iter::repeat_n(Bind::Read, tree_buffers));
+            let by_distance = (opts.order == TraversalOrder::EntryDistance) as u8 as f64;
+            let moller = (opts.test == TriangleTest::MollerTrumbore) as u8 as f64;
+            let mut constants =
+                vec![("COUNTED", opts.counted as u8 as f64), ("EXACT", opts.exact as u8 as f64), ("MOLLER", moller)];
+            if crate::shaders::source(self.walk_file).contains("override BY_DISTANCE") {
+                constants.push(("BY_DISTANCE", by_distance));
+            }
+            let entry = if camera { "trace_camera" } else { "trace_list" };
+            Kernel::new(gpu, &format!("{} {entry}", self.format), &source, entry, &binds, &constants)
+        })
     }
 
     /// Trace `rays` against the tree in `tree` (bound from binding 5 on) with the stack `stack`;
