@@ -227,7 +227,7 @@ impl GpuTree {
         let tree = bvh.binary_tree().ok_or_else(|| {
             GpuError::Input("this imported wide tree has no binary form the GPU could walk; trace it on the CPU".into())
         })?;
-        let format = (nodes.row().upload)(gpu, &tree)?;
+        let format = (nodes.row().upload)(gpu, tree)?;
         Ok((GpuTree { nodes, format }, mesh.clone()))
     }
 

@@ -117,9 +117,9 @@ pub struct BinaryFormat {
 
 impl BinaryFormat {
     /// `bvh` uploaded as it is (`GPU_NODES`' upload for the binary format).
-    pub fn upload(gpu: &Gpu, bvh: &Bvh) -> Result<Box<dyn crate::format::GpuFormat>, GpuError> {
-        let on_gpu = GpuBinaryBvh::upload(gpu, bvh)?;
-        Ok(Box::new(BinaryFormat { cpu: bvh.clone(), gpu: on_gpu }))
+    pub fn upload(gpu: &Gpu, bvh: std::borrow::Cow<'_, Bvh>) -> Result<Box<dyn crate::format::GpuFormat>, GpuError> {
+        let on_gpu = GpuBinaryBvh::upload(gpu, &bvh)?;
+        Ok(Box::new(BinaryFormat { cpu: bvh.into_owned(), gpu: on_gpu }))
     }
 }
 

@@ -27,5 +27,6 @@ pub trait GpuFormat: Send + Sync {
     fn cpu_counts(&self, cpu: &SceneBvh, camera: &Camera, trace: TraceOptions) -> Vec<RayCounters>;
 }
 
-/// How a format is made from the binary tree: the row of the GPU path's table names it.
-pub type Upload = fn(&Gpu, &bvhscope_core::bvh::Bvh) -> Result<Box<dyn GpuFormat>, GpuError>;
+/// How a format is made from the binary tree: the row of the GPU path's table names it. The tree
+/// comes borrowed or owned as the scene has it, so a format that keeps it moves it, not copies it.
+pub type Upload = fn(&Gpu, std::borrow::Cow<'_, bvhscope_core::bvh::Bvh>) -> Result<Box<dyn GpuFormat>, GpuError>;

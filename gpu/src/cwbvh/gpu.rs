@@ -62,8 +62,11 @@ pub struct CwbvhFormat {
 
 impl CwbvhFormat {
     /// `bvh` encoded as a CWBVH and uploaded (`GPU_NODES`' upload for the CWBVH format).
-    pub fn upload(gpu: &Gpu, bvh: &bvhscope_core::bvh::Bvh) -> Result<Box<dyn crate::format::GpuFormat>, GpuError> {
-        let cpu = Cwbvh::from_bvh(bvh)?;
+    pub fn upload(
+        gpu: &Gpu,
+        bvh: std::borrow::Cow<'_, bvhscope_core::bvh::Bvh>,
+    ) -> Result<Box<dyn crate::format::GpuFormat>, GpuError> {
+        let cpu = Cwbvh::from_bvh(&bvh)?;
         let on_gpu = GpuCwbvh::upload(gpu, &cpu)?;
         Ok(Box::new(CwbvhFormat { cpu, gpu: on_gpu }))
     }
