@@ -93,3 +93,21 @@ impl Preset {
             && two_level == self.two_level()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fastest tree follows the kernel family this process traces with: leaves of sixteen only
+    /// where one AVX-512 pass tests them, four elsewhere; and the preset reads as applied to it.
+    #[test]
+    fn the_fastest_tree_is_chosen_by_kernel_family() {
+        assert_eq!(Preset::fastest_leaves(Simd::Avx512), (16, 10.0));
+        for simd in [Simd::Scalar, Simd::Simd4, Simd::Avx2] {
+            assert_eq!(Preset::fastest_leaves(simd), (4, 3.0), "{simd:?}");
+        }
+        let p = Preset::Fastest.build();
+        assert_eq!((p.max_leaf_size, p.cost.traversal), Preset::fastest_leaves(Simd::chosen()));
+        assert!(Preset::Fastest.is_applied(&p, &Preset::Fastest.trace_options(), false));
+    }
+}
