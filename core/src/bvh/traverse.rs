@@ -317,7 +317,13 @@ pub(crate) fn test_triangles_grouped<T: TriangleIntersector, const ANY: bool, S:
         if mask == 0 && !S::STEPS {
             continue;
         }
-        for k in 0..(count - L::N * g).min(L::N) {
+        // The lanes to take: every one of the group where each step is reported, else only those
+        // hit (a lane missed then changes nothing: a leaf of sixteen with one hit takes one turn).
+        let lanes = ((1u64 << (count - L::N * g).min(L::N)) - 1) as u32;
+        let mut todo = if S::STEPS { lanes } else { mask & lanes };
+        while todo != 0 {
+            let k = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
             let hit = (mask & (1 << k) != 0).then(|| L::lane(&hits, k)).filter(|h| h.t < ray.t_max);
             let i = first + L::N * g + k;
             if S::STEPS {
