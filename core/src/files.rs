@@ -8,10 +8,17 @@
 //!   (`write_atomically`): a full disk or an error leaves the old file as it was, never a
 //!   truncated one;
 //! - an output that is one of the inputs is refused before anything is written (`refuse_inputs`):
-//!   `export-bvh m.obj -o m.obj` must not replace the mesh.
+//!   `export-bvh m.obj -o m.obj` must not replace the mesh;
+//! - a file named by a user's file (a glTF's buffer) is read only from that file's folder or below
+//!   (`beside`), and no more of it than the naming file declares (`read_declared`);
+//! - one set of limits (`limits`) that every reader counts against.
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+
+mod beside;
+pub mod limits;
+pub use beside::{beside, Refused};
 
 /// Why a file the user named cannot be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -30,6 +37,8 @@ pub enum FileError {
     OutputIsInput { path: PathBuf, what: String },
     #[error("{}: {what} is written here, and its name must end in {}", .path.display(), extensions_text(.extensions))]
     WrongName { path: PathBuf, what: &'static str, extensions: &'static [&'static str] },
+    #[error("{}: holds {len} bytes, fewer than the {declared} declared for it", .path.display())]
+    Short { path: PathBuf, len: u64, declared: u64 },
     #[error("{}: is read-only: refusing to replace it (as a shell's > would; make it writable, or name another file)", .path.display())]
     ReadOnly { path: PathBuf },
 }
@@ -132,6 +141,21 @@ pub fn read_limited(reader: impl Read, limit: u64) -> std::io::Result<Option<Vec
     let mut out = Vec::new();
     reader.take(limit.saturating_add(1)).read_to_end(&mut out)?;
     Ok((out.len() as u64 <= limit).then_some(out))
+}
+
+/// The first `declared` bytes of the regular file `path`: a file shorter than that is an error,
+/// and nothing past `declared` is read, however large the file is.
+pub fn read_declared(path: &Path, declared: u64) -> Result<Vec<u8>, FileError> {
+    let (file, len) = open_regular(path)?;
+    if len < declared {
+        return Err(FileError::Short { path: path.into(), len, declared });
+    }
+    let mut out = Vec::with_capacity(declared as usize);
+    file.take(declared).read_to_end(&mut out).map_err(|source| FileError::Read { path: path.into(), source })?;
+    if (out.len() as u64) < declared {
+        return Err(FileError::Short { path: path.into(), len: out.len() as u64, declared });
+    }
+    Ok(out)
 }
 
 /// Write `path` through `write` into a temporary file in the same folder, renamed over `path`
@@ -308,5 +332,14 @@ mod tests {
             assert!(e.contains("character device"), "{e}");
         }
         assert!(open_regular(&dir()).unwrap_err().to_string().contains("directory"));
+    }
+
+    #[test]
+    fn a_declared_read_takes_no_more_than_declared_and_refuses_less() {
+        let p = dir().join("declared.bin");
+        std::fs::write(&p, b"0123456789").unwrap();
+        assert_eq!(read_declared(&p, 4).unwrap(), b"0123");
+        let e = read_declared(&p, 11).unwrap_err().to_string();
+        assert!(e.ends_with("holds 10 bytes, fewer than the 11 declared for it"), "{e}");
     }
 }
