@@ -5,10 +5,19 @@
 //! hierarchy from the scene's roots. Primitives of other modes (points, lines, strips, fans) are
 //! skipped with a warning. A mesh's triangles are numbered primitive by primitive, in the file's
 //! order; a mesh's index is its place among the file's meshes that hold triangles.
+//!
+//! The file is hostile until checked: buffers are read only from the file's folder or below and
+//! no further than their `byteLength` (`files::beside`, `files::read_declared`), accessors by our
+//! own checked reader (`gltf_access.rs`), the node graph must be a forest (§3.5.1: a node has at
+//! most one parent), and vertices, triangles, nodes and placements count against
+//! `files::limits`.
 
 use super::assemble::{bad, finish};
+use super::gltf_access::Access;
 use super::{read_user_file, LoadReport, Mesh, MeshError};
-use glam::{Affine3A, Mat4, Vec3};
+use crate::files::limits;
+use glam::{Affine3A, Mat4};
+use std::collections::HashMap;
 use std::path::Path;
 
 /// A glTF file's meshes and where its nodes place them.
@@ -27,49 +36,78 @@ pub fn is_gltf(path: &Path) -> bool {
 
 pub fn load_gltf(path: &Path) -> Result<GltfScene, MeshError> {
     let bytes = read_user_file(path)?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| bad(path, "the document", e))?;
-    let buffers = buffers(path, &gltf)?;
+    let (json, blob) = container(path, &bytes)?;
+    let gltf = document(path, json)?;
+    let root = gltf.as_json();
+    limits::NODES.check(root.nodes.len() as u64).map_err(|e| bad(path, "the nodes", e))?;
+    let buffers = buffers(path, &gltf, blob)?;
+    let mut access = Access::new(root, buffers, bytes.len() as u64);
     let mut warnings = Vec::new();
     // Each mesh with triangles, read once; `index[m]` its place among them.
     let mut meshes = Vec::new();
     let mut index = vec![None; gltf.meshes().len()];
+    let mut triangles_in_file = 0u64;
     for m in gltf.meshes() {
         let name = m.name().map_or_else(|| format!("mesh {}", m.index()), str::to_string);
         let (mut positions, mut normals, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
         let mut all_normals = true;
+        // Primitives that share their vertices (one POSITION and NORMAL accessor, several index
+        // lists, as exporters write a mesh of several materials) share them here too.
+        let mut read: HashMap<(usize, Option<usize>), u32> = HashMap::new();
         for p in m.primitives() {
             let at = format!("{name}, primitive {}", p.index());
             if p.mode() != gltf::mesh::Mode::Triangles {
                 warnings.push(format!("{at}: {:?} primitives are skipped (triangles only)", p.mode()));
                 continue;
             }
-            // An empty accessor is refused before the crate's reader computes `count - 1` of it.
-            let empty = p.attributes().map(|(_, a)| a).chain(p.indices()).any(|a| a.count() == 0);
-            if empty {
-                return Err(bad(path, at, "an accessor of no elements"));
-            }
-            let reader = p.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-            let Some(read) = reader.read_positions() else {
-                return Err(bad(path, at, "no POSITION attribute (or its data lies outside its buffer)"));
+            let Some(pos) = p.get(&gltf::Semantic::Positions) else {
+                return Err(bad(path, at, "no POSITION attribute"));
             };
-            let base = positions.len() as u32;
-            positions.extend(read.map(Vec3::from_array));
-            let n = positions.len() as u32 - base;
-            match reader.read_normals() {
-                Some(read) if all_normals => normals.extend(read.map(Vec3::from_array)),
-                _ => all_normals = false,
-            }
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(read) => read.into_u32().collect(),
-                None if p.indices().is_some() => return Err(bad(path, at, "its indices lie outside their buffer")),
-                None => (0..n).collect(),
+            let accessor = |i: usize, role: &str, why: String| bad(path, &at, format!("{role} (accessor {i}) {why}"));
+            let nor = p.get(&gltf::Semantic::Normals).map(|a| a.index());
+            let key = (pos.index(), nor.filter(|_| all_normals));
+            let base = match read.get(&key) {
+                Some(&base) => base,
+                None => {
+                    let base = positions.len() as u32;
+                    let read_positions = access.vec3s(pos.index()).map_err(|e| accessor(pos.index(), "POSITION", e))?;
+                    for (k, p) in read_positions.iter().enumerate() {
+                        super::assemble::point(p.to_array().map(f64::from))
+                            .map_err(|e| bad(path, &at, format!("POSITION element {k}: {e}")))?;
+                    }
+                    positions.extend(read_positions);
+                    match key.1 {
+                        Some(n) => {
+                            let read_normals = access.vec3s(n).map_err(|e| accessor(n, "NORMAL", e))?;
+                            if let Some(k) = read_normals.iter().position(|v| !v.is_finite()) {
+                                let v = read_normals[k];
+                                return Err(bad(path, &at, format!("NORMAL element {k} is ({v}): not finite")));
+                            }
+                            normals.extend(read_normals);
+                        }
+                        None => all_normals = false,
+                    }
+                    read.insert(key, base);
+                    base
+                }
+            };
+            // Checked within the vertex limit when it was read.
+            let n = access.root.accessors[pos.index()].count.0 as u32;
+            let indices: Vec<u32> = match p.indices() {
+                Some(a) => access.indices(a.index()).map_err(|e| accessor(a.index(), "the indices", e))?,
+                None => {
+                    access.make(4 * n as u64).map_err(|e| bad(path, &at, e))?;
+                    (0..n).collect()
+                }
             };
             if !indices.len().is_multiple_of(3) {
                 return Err(bad(path, at, format!("{} indices, not a whole number of triangles", indices.len())));
             }
-            if let Some(i) = indices.iter().find(|&&i| i >= n) {
-                return Err(bad(path, at, format!("refers to vertex {i}, but it has {n}")));
+            if let Some(k) = indices.iter().position(|&i| i >= n) {
+                return Err(bad(path, at, format!("index {k} refers to vertex {}, but it has {n}", indices[k])));
             }
+            triangles_in_file += indices.len() as u64 / 3;
+            limits::TRIANGLES.check(triangles_in_file).map_err(|e| bad(path, &at, e))?;
             triangles.extend(indices.chunks_exact(3).map(|t| [t[0] + base, t[1] + base, t[2] + base]));
         }
         if !all_normals || normals.len() != positions.len() {
@@ -92,27 +130,7 @@ pub fn load_gltf(path: &Path) -> Result<GltfScene, MeshError> {
     if meshes.is_empty() {
         return Err(MeshError::NoTriangles { path: path.into(), degenerate: 0 });
     }
-    // The nodes of the default scene (else the first), each mesh node a placement.
-    let mut placements = Vec::new();
-    let roots: Vec<gltf::Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
-        Some(s) => s.nodes().collect(),
-        None => Vec::new(),
-    };
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
-    while let Some((node, parent, depth)) = stack.pop() {
-        if depth > 256 {
-            return Err(bad(
-                path,
-                format!("node {}", node.index()),
-                "the hierarchy is deeper than 256 levels (a cycle?)",
-            ));
-        }
-        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-        if let Some(k) = node.mesh().and_then(|m| index[m.index()]) {
-            placements.push((k, Affine3A::from_mat4(world)));
-        }
-        stack.extend(node.children().map(|c| (c, world, depth + 1)));
-    }
+    let mut placements = placements(path, &gltf, &index)?;
     if placements.is_empty() {
         // No scene places anything: each mesh once, where it is.
         placements = (0..meshes.len() as u32).map(|k| (k, Affine3A::IDENTITY)).collect();
@@ -126,15 +144,91 @@ pub fn load_gltf(path: &Path) -> Result<GltfScene, MeshError> {
     Ok(GltfScene { meshes, placements, warnings, report })
 }
 
-/// Each buffer's bytes: the GLB's binary chunk, a data URI's, or a file beside the glTF's.
-fn buffers(path: &Path, gltf: &gltf::Gltf) -> Result<Vec<Vec<u8>>, MeshError> {
+/// The JSON and the binary chunk: a GLB's two chunks (§4.4), their lengths checked here (the
+/// crate's GLB reader subtracts before it checks), or the whole file as JSON.
+fn container<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<&'a [u8]>), MeshError> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok((bytes, None));
+    }
+    let word = |at: usize| bytes.get(at..at + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        return Err(bad(path, "the GLB header", "the file ends inside it"));
+    };
+    if version != 2 {
+        return Err(bad(path, "the GLB header", format!("version {version}; only glTF 2 is read")));
+    }
+    if length > bytes.len() {
+        return Err(bad(path, "the GLB header", format!("declares {length} bytes, the file holds {}", bytes.len())));
+    }
+    let mut chunks = Vec::new();
+    let mut at = 12;
+    while at + 8 <= length {
+        let (n, kind) = (word(at).unwrap_or(0), &bytes[at + 4..at + 8]);
+        let start = at + 8;
+        if n > length - start {
+            return Err(bad(
+                path,
+                format!("GLB chunk {}", chunks.len()),
+                format!("declares {n} bytes, past the file's end"),
+            ));
+        }
+        chunks.push((kind, &bytes[start..start + n]));
+        at = start + n.next_multiple_of(4).min(length - start);
+    }
+    match chunks.as_slice() {
+        [(b"JSON", json), rest @ ..] => Ok((json, rest.iter().find(|(k, _)| *k == b"BIN\0").map(|(_, b)| *b))),
+        _ => Err(bad(path, "GLB chunk 0", "is not the JSON chunk")),
+    }
+}
+
+/// The document, validated by the crate once what its validation indexes unchecked is checked
+/// here (a POSITION accessor that does not exist panicked inside it).
+fn document(path: &Path, json: &[u8]) -> Result<gltf::Document, MeshError> {
+    let root: gltf::json::Root = gltf::json::deserialize::from_slice(json)
+        .map_err(|e| bad(path, "the document", format!("not glTF JSON: {e}")))?;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive.attributes.get(&gltf::json::validation::Checked::Valid(gltf::Semantic::Positions));
+            if let Some(i) = position.map(|i| i.value()).filter(|&i| i >= root.accessors.len()) {
+                return Err(bad(
+                    path,
+                    format!("mesh {m}, primitive {p}"),
+                    format!("POSITION names accessor {i}, which does not exist"),
+                ));
+            }
+        }
+    }
+    gltf::Document::from_json(root).map_err(|e| bad(path, "the document", document_error(e)))
+}
+
+/// The crate's refusal of the document, its first few faults (a hostile file may have millions).
+fn document_error(e: gltf::Error) -> String {
+    match e {
+        gltf::Error::Validation(faults) => {
+            let first: Vec<String> = faults.iter().take(3).map(|(at, why)| format!("{at}: {why}")).collect();
+            let more = faults.len().saturating_sub(3);
+            let more = if more > 0 { format!(" (and {more} more)") } else { String::new() };
+            format!("invalid glTF: {}{more}", first.join("; "))
+        }
+        e => e.to_string(),
+    }
+}
+
+/// Each buffer's bytes, no more than its `byteLength`: the GLB's binary chunk, a data URI's, or
+/// a file at or below the glTF's folder.
+fn buffers(path: &Path, gltf: &gltf::Document, blob: Option<&[u8]>) -> Result<Vec<Vec<u8>>, MeshError> {
     use base64::Engine;
     let mut out = Vec::new();
+    let mut total = 0u64;
     for b in gltf.buffers() {
         let at = format!("buffer {}", b.index());
-        let data = match b.source() {
+        let declared = b.length() as u64;
+        total = total.saturating_add(declared);
+        limits::BUFFER_BYTES.check(total).map_err(|e| bad(path, &at, e))?;
+        let short = |len: usize| bad(path, &at, format!("holds {len} bytes, its declared length is {declared}"));
+        let mut data = match b.source() {
             gltf::buffer::Source::Bin => {
-                gltf.blob.clone().ok_or_else(|| bad(path, &at, "refers to the GLB's binary chunk, which is missing"))?
+                blob.ok_or_else(|| bad(path, &at, "refers to the GLB's binary chunk, which is missing"))?.to_vec()
             }
             gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 let (_, data) = uri.split_once(',').ok_or_else(|| bad(path, &at, "a data URI without data"))?;
@@ -143,14 +237,81 @@ fn buffers(path: &Path, gltf: &gltf::Gltf) -> Result<Vec<Vec<u8>>, MeshError> {
                     .map_err(|e| bad(path, &at, format!("its data URI is not base64: {e}")))?
             }
             gltf::buffer::Source::Uri(uri) => {
-                let file = path.parent().unwrap_or(Path::new(".")).join(uri.replace("%20", " "));
-                read_user_file(&file).map_err(|e| bad(path, &at, e))?
+                let file = crate::files::beside(path, uri).map_err(|e| bad(path, &at, format!("uri {e}")))?;
+                crate::files::read_declared(&file, declared).map_err(|e| match e {
+                    crate::files::FileError::Short { len, .. } => short(len as usize),
+                    e => bad(path, &at, e),
+                })?
             }
         };
-        if data.len() < b.length() {
-            return Err(bad(path, &at, format!("holds {} bytes, its declared length is {}", data.len(), b.length())));
+        if (data.len() as u64) < declared {
+            return Err(short(data.len()));
         }
+        data.truncate(declared as usize);
         out.push(data);
+    }
+    Ok(out)
+}
+
+/// Where the nodes of the default scene (else the first) place the meshes (`index`: a glTF mesh's
+/// place among those with triangles). The graph must be a forest, each node visited once: a node
+/// named twice as a child, or a root that is also a child, would place its subtree again at each
+/// level (a 1 KB file made a million placements).
+fn placements(path: &Path, gltf: &gltf::Document, index: &[Option<u32>]) -> Result<Vec<(u32, Affine3A)>, MeshError> {
+    let root = gltf.as_json();
+    let node = |i: usize| format!("node {i}");
+    let mut parent: Vec<Option<usize>> = vec![None; root.nodes.len()];
+    for (i, n) in root.nodes.iter().enumerate() {
+        for c in n.children.iter().flatten().map(|c| c.value()) {
+            match parent[c] {
+                Some(p) if p == i => {
+                    return Err(bad(path, node(i), format!("names node {c} twice among its children")))
+                }
+                Some(p) => {
+                    return Err(bad(
+                        path,
+                        node(c),
+                        format!("has two parents, node {p} and node {i}: a glTF node has at most one"),
+                    ))
+                }
+                None => parent[c] = Some(i),
+            }
+        }
+        if let Some(m) = n.matrix {
+            if [m[3], m[7], m[11], m[15]] != [0.0, 0.0, 0.0, 1.0] {
+                return Err(bad(
+                    path,
+                    node(i),
+                    "a projective matrix (its last row is not 0 0 0 1): only affine transforms place a mesh",
+                ));
+            }
+        }
+    }
+    let Some(scene) = gltf.default_scene().or_else(|| gltf.scenes().next()) else { return Ok(Vec::new()) };
+    let mut is_root = vec![false; root.nodes.len()];
+    let mut stack = Vec::new();
+    for r in scene.nodes().map(|n| n.index()) {
+        if let Some(p) = parent[r] {
+            return Err(bad(path, node(r), format!("is a root of scene {} and a child of node {p}", scene.index())));
+        }
+        if std::mem::replace(&mut is_root[r], true) {
+            return Err(bad(path, node(r), format!("is named twice among scene {}'s nodes", scene.index())));
+        }
+        stack.push((r, Mat4::IDENTITY));
+    }
+    let nodes: Vec<gltf::Node> = gltf.nodes().collect();
+    let mut out = Vec::new();
+    while let Some((i, parent)) = stack.pop() {
+        let n = &nodes[i];
+        let world = parent * Mat4::from_cols_array_2d(&n.transform().matrix());
+        if !world.is_finite() {
+            return Err(bad(path, node(i), "its transform, composed down the hierarchy, is not finite"));
+        }
+        if let Some(k) = n.mesh().and_then(|m| index[m.index()]) {
+            limits::PLACEMENTS.check(out.len() as u64 + 1).map_err(|e| bad(path, node(i), e))?;
+            out.push((k, Affine3A::from_mat4(world)));
+        }
+        stack.extend(n.children().map(|c| (c.index(), world)));
     }
     Ok(out)
 }

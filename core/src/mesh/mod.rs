@@ -5,6 +5,7 @@ mod error;
 mod formats;
 pub mod generate;
 mod gltf;
+mod gltf_access;
 #[allow(clippy::module_inception)]
 mod mesh;
 mod obj;
