@@ -222,7 +222,10 @@ fn a_scene_of_too_many_placements_is_refused_early() {
     let before = LIVE.load(Ordering::Relaxed);
     PEAK.store(before, Ordering::Relaxed);
     let e = bvhscope::scene::describe(&path).unwrap_err().to_string();
-    assert!(e.ends_with(&format!("meshes: {n} placements, more than the {} a scene file may hold", n - 1)), "{e}");
+    assert!(
+        e.ends_with(&format!("meshes: {n} placements, more than the {} bvhscope reads from one file", n - 1)),
+        "{e}"
+    );
     let grew = PEAK.load(Ordering::Relaxed) - before;
     assert!(grew < 64 << 20, "refused before the JSON was parsed: {} MB", grew >> 20);
 }

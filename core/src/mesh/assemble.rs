@@ -4,6 +4,7 @@
 //! header's count may reserve.
 
 use super::{LoadReport, Mesh, MeshError, MeshGroup, MAX_COORDINATE};
+use crate::files::limits;
 use crate::geometry::triangle::double_area;
 use glam::Vec3;
 use std::path::Path;
@@ -28,15 +29,16 @@ pub(crate) fn finish(
     {
         return Err(bad(path, format!("triangle {t}"), format!("refers to vertex {i}, but only {n} are declared")));
     }
-    if positions.iter().any(|p| !p.is_finite()) {
-        return Err(MeshError::NonFinite { path: path.into(), line: None, what: "a vertex position" });
+    // The readers check each coordinate where they read it (naming its line or element); this
+    // is the last guard, naming the vertex.
+    for (k, p) in positions.iter().enumerate() {
+        point(p.to_array().map(f64::from)).map_err(|e| bad(path, format!("vertex {k}"), e))?;
     }
-    if positions.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
-        return Err(MeshError::TooLarge { path: path.into(), line: None });
+    if let Some(k) = normals.iter().position(|v| !v.is_finite()) {
+        return Err(bad(path, format!("vertex {k}"), format!("its normal ({}) is not finite", normals[k])));
     }
-    if normals.iter().any(|v| !v.is_finite()) {
-        return Err(MeshError::NonFinite { path: path.into(), line: None, what: "a vertex normal" });
-    }
+    limits::VERTICES.check(n as u64).map_err(|e| bad(path, "the vertices", e))?;
+    limits::TRIANGLES.check(file_triangles.len() as u64).map_err(|e| bad(path, "the triangles", e))?;
     let (mut triangles, mut numbers) =
         (Vec::with_capacity(file_triangles.len()), Vec::with_capacity(file_triangles.len()));
     for (i, t) in file_triangles.iter().enumerate() {
@@ -72,6 +74,25 @@ pub(crate) fn finish(
         file_triangles: file_triangles.len(),
     };
     Ok((mesh, report))
+}
+
+/// A coordinate read as a number (in double precision, so 1e39 is seen as the finite number it
+/// is) as a vertex takes it, or why it cannot be one, with its value.
+pub(crate) fn coordinate(x: f64) -> Result<f32, String> {
+    if !x.is_finite() {
+        return Err(format!("coordinate {x} is not a finite number"));
+    }
+    if x.abs() > MAX_COORDINATE as f64 {
+        return Err(format!(
+            "coordinate {x:e} exceeds ±{MAX_COORDINATE:e}, too large to trace in single precision (scale the mesh down)"
+        ));
+    }
+    Ok(x as f32)
+}
+
+/// A vertex position from three numbers (`coordinate`).
+pub(crate) fn point(p: [f64; 3]) -> Result<Vec3, String> {
+    Ok(Vec3::new(coordinate(p[0])?, coordinate(p[1])?, coordinate(p[2])?))
 }
 
 /// Fan-triangulate a polygon (as the OBJ reader does: (0, i, i + 1)).

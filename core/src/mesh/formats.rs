@@ -68,3 +68,7 @@ pub fn load_mesh(path: impl AsRef<Path>) -> Result<(Mesh, LoadReport), MeshError
 #[cfg(test)]
 #[path = "formats_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "hostile_tests.rs"]
+mod hostile_tests;

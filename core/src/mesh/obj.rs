@@ -110,6 +110,7 @@ fn read_pieces(path: &Path, len: usize, pieces: usize) -> std::io::Result<Vec<u8
 pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
     let path = path.as_ref();
     let text = &*super::obj_lines::lone_cr_as_line_break(text.strip_prefix('\u{feff}').unwrap_or(text));
+    let text = &*super::obj_lines::cut_trailing_comments(text);
     let text = &*join_continued_lines(text);
     let (models, by_tobj) = match obj_parallel::models(text) {
         Some(models) => (Ok(models), false),
@@ -127,6 +128,11 @@ pub fn parse_obj(path: impl AsRef<Path>, text: &str) -> Result<(Mesh, LoadReport
 
     let (mesh, report) =
         models.and_then(|models| build_mesh(path, models)).map_err(|problem| explain(path, text, problem))?;
+    // Within the limits every reader counts against (the text bounds it already: this names it).
+    let limit =
+        |what: &str, e: String| MeshError::Parse { path: path.into(), line: None, message: format!("{what}: {e}") };
+    crate::files::limits::VERTICES.check(mesh.positions.len() as u64).map_err(|e| limit("the vertices", e))?;
+    crate::files::limits::TRIANGLES.check(mesh.triangles.len() as u64).map_err(|e| limit("the triangles", e))?;
     // tobj ignores texture and normal indices when the file declares none (the parallel reader
     // declines such files). They can only be there if the text has a '/'.
     if by_tobj && text.contains('/') {

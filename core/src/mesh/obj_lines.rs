@@ -2,6 +2,7 @@
 //! text say *where*, so the user can open the file at the right place.
 
 use super::error::MeshError;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// 1-based line number of byte offset `pos`.
@@ -175,4 +176,30 @@ pub(super) fn first_vertex_with_words(text: &str) -> Option<(usize, String)> {
         }
         (args.len() > 7).then(|| (n, format!("a vertex of {} numbers: a vertex is x y z, optionally followed by a weight w or a colour r g b", args.len())))
     })
+}
+
+/// The text with comments that follow a statement on its line cut off (`v 0 1 0 # apex`), as
+/// the OBJ format's `#` starts a comment wherever it is; tobj reads them as part of the
+/// statement ("color parse error"). Lines keep their numbers. Borrowed when no line has one.
+pub(super) fn cut_trailing_comments(text: &str) -> Cow<'_, str> {
+    let trailing = text.match_indices('#').any(|(at, _)| {
+        let start = text[..at].rfind('\n').map_or(0, |n| n + 1);
+        !text[start..at].trim().is_empty()
+    });
+    if !trailing {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len());
+    for line in text.split_inclusive('\n') {
+        match line.find('#') {
+            Some(at) => {
+                out.push_str(&line[..at]);
+                if line.ends_with('\n') {
+                    out.push('\n');
+                }
+            }
+            None => out.push_str(line),
+        }
+    }
+    Cow::Owned(out)
 }

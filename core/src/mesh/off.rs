@@ -3,9 +3,11 @@
 //! four coordinates; the counts may follow on the same line), then the vertex, face and edge
 //! counts, the vertices (x y z and what the prefixes add), and the faces (n i₀ … iₙ₋₁, colour
 //! values after them ignored). `#` starts a comment. Faces are fan-triangulated as OBJ's are.
+//! A `4OFF` vertex is homogeneous (x y z w): the point is (x/w, y/w, z/w).
 
-use super::assemble::{bad, capacity, fan, finish};
+use super::assemble::{bad, capacity, coordinate, fan, finish};
 use super::{LoadReport, Mesh, MeshError};
+use crate::files::limits;
 use glam::Vec3;
 use std::path::Path;
 
@@ -49,10 +51,14 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
         t.parse::<u64>().map_err(|_| bad(path, format!("line {}", counts.0), format!("{what} '{t}' is not a count")))
     };
     let (nv, nf) = (count(0, "the vertex count")?, count(1, "the face count")?);
+    let at_counts = format!("line {}", counts.0);
+    limits::VERTICES.check(nv).map_err(|e| bad(path, &at_counts, e))?;
+    // A face is at least one triangle (fewer corners give none, and take bytes of the file).
+    limits::TRIANGLES.check(nf).map_err(|e| bad(path, &at_counts, e))?;
     let mut positions = Vec::with_capacity(capacity(nv, bytes.len(), 6));
     let mut vertex_normals = Vec::new();
-    let number = |line: usize, what: &str, t: &str| -> Result<f32, MeshError> {
-        t.parse::<f32>().map_err(|_| bad(path, format!("line {line}"), format!("{what}: '{t}' is not a number")))
+    let number = |line: usize, what: &str, t: &str| -> Result<f64, MeshError> {
+        t.parse::<f64>().map_err(|_| bad(path, format!("line {line}"), format!("{what}: '{t}' is not a number")))
     };
     for v in 0..nv {
         let (line, w) = lines
@@ -62,11 +68,21 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
         if w.len() < need {
             return Err(bad(path, format!("line {line}"), format!("vertex {v} has {} numbers, not {need}", w.len())));
         }
-        let x = |k: usize| number(line, &format!("vertex {v}"), w[k]);
-        positions.push(Vec3::new(x(0)?, x(1)?, x(2)?));
+        let what = format!("vertex {v}");
+        let x = |k: usize| number(line, &what, w[k]);
+        let scale = if four { x(3)? } else { 1.0 };
+        if scale == 0.0 {
+            return Err(bad(path, format!("line {line}"), format!("{what}: w is 0, a point at infinity")));
+        }
+        let at = |e: String| bad(path, format!("line {line}"), format!("{what}: {e}"));
+        let mut p = [0f32; 3];
+        for (k, c) in p.iter_mut().enumerate() {
+            *c = coordinate(x(k)? / scale).map_err(at)?;
+        }
+        positions.push(Vec3::from_array(p));
         if normals {
             let o = 3 + usize::from(four);
-            vertex_normals.push(Vec3::new(x(o)?, x(o + 1)?, x(o + 2)?));
+            vertex_normals.push(Vec3::new(x(o)? as f32, x(o + 1)? as f32, x(o + 2)? as f32));
         }
     }
     let mut triangles = Vec::with_capacity(capacity(nf, bytes.len(), 8));
@@ -77,7 +93,7 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
             .ok_or_else(|| bad(path, format!("face {f}"), format!("the file ends before it ({nf} declared)")))?;
         let at = format!("line {line}: face {f}");
         let n: usize = w[0].parse().map_err(|_| bad(path, &at, format!("'{}' is not a vertex count", w[0])))?;
-        if w.len() < n + 1 {
+        if n >= w.len() {
             return Err(bad(path, &at, format!("declares {n} vertices but lists {}", w.len() - 1)));
         }
         polygon.clear();

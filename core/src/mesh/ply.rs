@@ -6,8 +6,9 @@
 //! restart, unrolled with alternating winding. Triangles are numbered in the file's order: the
 //! faces', then the strips', element by element as the header lists them.
 
-use super::assemble::{bad, capacity, fan, finish};
+use super::assemble::{bad, capacity, fan, finish, point};
 use super::{LoadReport, Mesh, MeshError};
+use crate::files::limits;
 use glam::Vec3;
 use std::path::Path;
 
@@ -81,32 +82,78 @@ enum Encoding {
     Big,
 }
 
-/// Where the data is read from: ASCII numbers, or binary of one byte order.
+/// Where the data is read from: ASCII numbers, one item (a vertex, a face) a line, or binary of
+/// one byte order.
 struct Data<'a> {
     encoding: Encoding,
     bytes: &'a [u8],
     at: usize,
+    /// ASCII: the line of the item being read (1 is the file's first) and where it ends.
+    line: usize,
+    line_end: usize,
 }
 
 impl Data<'_> {
-    fn value(&mut self, t: Type) -> Option<f64> {
-        if self.encoding == Encoding::Ascii {
+    /// Where the item being read is, for messages: its line in ASCII, its byte in binary.
+    fn place(&self) -> (&'static str, usize) {
+        match self.encoding {
+            Encoding::Ascii => ("line", self.line),
+            _ => ("byte", self.at),
+        }
+    }
+
+    /// ASCII: move to the next line that holds something, the item's.
+    fn begin_item(&mut self) {
+        if self.encoding != Encoding::Ascii {
+            return;
+        }
+        while self.at < self.bytes.len() {
             let rest = &self.bytes[self.at..];
-            let start = rest.iter().position(|b| !b.is_ascii_whitespace())?;
+            self.line_end = self.at + rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+            if self.bytes[self.at..self.line_end].iter().any(|b| !b.is_ascii_whitespace()) {
+                return;
+            }
+            self.at = self.line_end + 1;
+            self.line += 1;
+        }
+        self.line_end = self.bytes.len();
+    }
+
+    /// ASCII: the item's line must hold nothing more (a value too many would shift every item
+    /// after it); then on to the next line.
+    fn end_item(&mut self, declared: usize) -> Result<(), String> {
+        if self.encoding != Encoding::Ascii {
+            return Ok(());
+        }
+        let rest = &self.bytes[self.at.min(self.line_end)..self.line_end];
+        let extra = rest.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty()).count();
+        if extra > 0 {
+            return Err(format!("{extra} more value(s) on the line than the {declared} the header declares"));
+        }
+        self.at = self.line_end + 1;
+        self.line += 1;
+        Ok(())
+    }
+
+    fn value(&mut self, t: Type) -> Result<f64, String> {
+        if self.encoding == Encoding::Ascii {
+            let rest = &self.bytes[self.at.min(self.line_end)..self.line_end];
+            let start = rest.iter().position(|b| !b.is_ascii_whitespace()).ok_or("the line ends before it")?;
             let len = rest[start..].iter().position(|b| b.is_ascii_whitespace()).unwrap_or(rest.len() - start);
             self.at += start + len;
-            return std::str::from_utf8(&rest[start..start + len]).ok()?.parse::<f64>().ok();
+            let word = String::from_utf8_lossy(&rest[start..start + len]);
+            return word.parse::<f64>().map_err(|_| format!("'{word}' is not a number"));
         }
-        let b = self.bytes.get(self.at..self.at + t.size())?;
+        let b = self.bytes.get(self.at..self.at + t.size()).ok_or("the file ends before it")?;
         self.at += t.size();
         let little = self.encoding == Encoding::Little;
         macro_rules! read {
             ($ty:ty) => {{
-                let a = b.try_into().ok()?;
+                let a = b.try_into().expect("the type's size");
                 (if little { <$ty>::from_le_bytes(a) } else { <$ty>::from_be_bytes(a) }) as f64
             }};
         }
-        Some(match t {
+        Ok(match t {
             Type::I8 => b[0] as i8 as f64,
             Type::U8 => b[0] as f64,
             Type::I16 => read!(i16),
@@ -119,54 +166,59 @@ impl Data<'_> {
     }
 }
 
-/// The header: the encoding, the elements, and where the data starts.
-fn header(path: &Path, bytes: &[u8]) -> Result<(Encoding, Vec<Element>, usize), MeshError> {
-    let end = bytes
-        .windows(10)
-        .position(|w| w == b"end_header")
-        .ok_or_else(|| bad(path, "the header", "no end_header line"))?;
-    let data = end + 10 + bytes[end + 10..].iter().position(|&b| b == b'\n').map_or(0, |p| p + 1);
-    let text = String::from_utf8_lossy(&bytes[..end]);
+/// The header: the encoding, the elements, where the data starts and the data's first line. It
+/// ends at the line that is `end_header` (a comment that mentions it does not end it).
+fn header(path: &Path, bytes: &[u8]) -> Result<(Encoding, Vec<Element>, usize, usize), MeshError> {
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
-    for (i, line) in text.lines().enumerate().skip(1) {
+    let mut at = 0;
+    let mut number = 0;
+    let data = loop {
+        let Some(len) = bytes[at..].iter().position(|&b| b == b'\n') else {
+            return Err(bad(path, "the header", "no end_header line"));
+        };
+        let line = String::from_utf8_lossy(&bytes[at..at + len]);
+        at += len + 1;
+        number += 1;
         let w: Vec<&str> = line.split_whitespace().collect();
-        let at = || format!("header line {}", i + 1);
+        let here = || format!("header line {number}");
         match w.first().copied() {
+            _ if number == 1 => {}
+            Some("end_header") => break at,
             Some("format") => {
                 encoding = Some(match w.get(1).copied() {
                     Some("ascii") => Encoding::Ascii,
                     Some("binary_little_endian") => Encoding::Little,
                     Some("binary_big_endian") => Encoding::Big,
-                    other => return Err(bad(path, at(), format!("unknown format {other:?}"))),
+                    other => return Err(bad(path, here(), format!("unknown format {other:?}"))),
                 })
             }
             Some("element") => {
                 let (Some(name), Some(count)) = (w.get(1), w.get(2).and_then(|c| c.parse::<u64>().ok())) else {
-                    return Err(bad(path, at(), "an element needs a name and a count"));
+                    return Err(bad(path, here(), "an element needs a name and a count"));
                 };
                 elements.push(Element { name: name.to_string(), count, properties: Vec::new() });
             }
             Some("property") => {
-                let e = elements.last_mut().ok_or_else(|| bad(path, at(), "a property before any element"))?;
+                let e = elements.last_mut().ok_or_else(|| bad(path, here(), "a property before any element"))?;
                 let ty = |k: usize| {
                     w.get(k)
                         .and_then(|t| Type::parse(t))
-                        .ok_or_else(|| bad(path, at(), format!("unknown property type {:?}", w.get(k))))
+                        .ok_or_else(|| bad(path, here(), format!("unknown property type {:?}", w.get(k))))
                 };
                 let p = if w.get(1) == Some(&"list") {
-                    let name = w.get(4).ok_or_else(|| bad(path, at(), "a list property needs a name"))?;
+                    let name = w.get(4).ok_or_else(|| bad(path, here(), "a list property needs a name"))?;
                     Property::List(name.to_string(), ty(2)?, ty(3)?)
                 } else {
-                    let name = w.get(2).ok_or_else(|| bad(path, at(), "a property needs a name"))?;
+                    let name = w.get(2).ok_or_else(|| bad(path, here(), "a property needs a name"))?;
                     Property::Scalar(name.to_string(), ty(1)?)
                 };
                 e.properties.push(p);
             }
             Some("comment") | Some("obj_info") | None => {}
-            Some(other) => return Err(bad(path, at(), format!("unknown header keyword '{other}'"))),
+            Some(other) => return Err(bad(path, here(), format!("unknown header keyword '{other}'"))),
         }
-    }
+    };
     let encoding = encoding.ok_or_else(|| bad(path, "the header", "no format line"))?;
     // No count may claim more than the file could hold: each item takes at least its least bytes
     // in binary, two in ASCII (a digit and a space).
@@ -184,13 +236,21 @@ fn header(path: &Path, bytes: &[u8]) -> Result<(Encoding, Vec<Element>, usize), 
             ));
         }
         room -= e.count * least;
+        let limit = match e.name.as_str() {
+            "vertex" => Some(limits::VERTICES),
+            "face" | "tristrips" => Some(limits::TRIANGLES),
+            _ => None,
+        };
+        if let Some(limit) = limit {
+            limit.check(e.count).map_err(|m| bad(path, format!("element {}", e.name), m))?;
+        }
     }
-    Ok((encoding, elements, data))
+    Ok((encoding, elements, data, number + 1))
 }
 
 pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), MeshError> {
-    let (encoding, elements, start) = header(path, bytes)?;
-    let mut data = Data { encoding, bytes, at: start };
+    let (encoding, elements, start, line) = header(path, bytes)?;
+    let mut data = Data { encoding, bytes, at: start, line, line_end: start };
     let (mut positions, mut normals, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
     let mut list: Vec<i64> = Vec::new();
     let mut seen_vertices = false;
@@ -209,14 +269,17 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
         }
         let with_normals = is_vertex && nx.is_some() && ny.is_some() && nz.is_some();
         for item in 0..e.count {
+            data.begin_item();
+            let place = data.place();
+            let at = || format!("{} {item} ({} {})", e.name, place.0, place.1);
             let mut v = [0f64; 6];
+            let mut values = 0;
             for (k, p) in e.properties.iter().enumerate() {
-                let at = || format!("{} {item}", e.name);
-                let short =
-                    || bad(path, at(), format!("the file ends, or a value is not a number, in property {}", p.name()));
+                let fail = |why: String| bad(path, at(), format!("property {}: {why}", p.name()));
                 match p {
                     Property::Scalar(_, t) => {
-                        let value = data.value(*t).ok_or_else(short)?;
+                        let value = data.value(*t).map_err(fail)?;
+                        values += 1;
                         for (slot, idx) in [x, y, z, nx, ny, nz].iter().enumerate() {
                             if *idx == Some(k) {
                                 v[slot] = value;
@@ -224,23 +287,32 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
                         }
                     }
                     Property::List(_, ct, it) => {
-                        let n = data.value(*ct).ok_or_else(short)?;
+                        let n = data.value(*ct).map_err(fail)?;
                         if !(0.0..=1e9).contains(&n) || n.fract() != 0.0 {
-                            return Err(bad(path, at(), format!("list length {n} of {}", p.name())));
+                            return Err(fail(format!("list length {n}")));
                         }
+                        values += 1 + n as usize;
+                        // Only the index list is kept: a list after it (MeshLab's per-corner
+                        // texture coordinates) is read past, not over it.
                         let keep = Some(k) == indices;
-                        list.clear();
+                        if keep {
+                            list.clear();
+                        }
                         for _ in 0..n as u64 {
-                            let value = data.value(*it).ok_or_else(short)?;
+                            let value = data.value(*it).map_err(fail)?;
                             if keep {
+                                if !value.is_finite() || value.fract() != 0.0 {
+                                    return Err(fail(format!("vertex index {value} is not a whole number")));
+                                }
                                 list.push(value as i64);
                             }
                         }
                     }
                 }
             }
+            data.end_item(values).map_err(|why| bad(path, at(), why))?;
             if is_vertex {
-                positions.push(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32));
+                positions.push(point([v[0], v[1], v[2]]).map_err(|why| bad(path, at(), why))?);
                 if with_normals {
                     normals.push(Vec3::new(v[3] as f32, v[4] as f32, v[5] as f32));
                 }
@@ -251,11 +323,7 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
                 let n = positions.len() as i64;
                 let restart = e.name == "tristrips";
                 if let Some(&bad_index) = list.iter().find(|&&i| i >= n || (i < 0 && !(restart && i == -1))) {
-                    return Err(bad(
-                        path,
-                        format!("{} {item}", e.name),
-                        format!("refers to vertex {bad_index}, but only {n} are declared"),
-                    ));
+                    return Err(bad(path, at(), format!("refers to vertex {bad_index}, but only {n} are declared")));
                 }
                 if restart {
                     for strip in list.split(|&i| i == -1) {
@@ -268,6 +336,7 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
                     let polygon: Vec<u32> = list.iter().map(|&i| i as u32).collect();
                     fan(&polygon, &mut triangles);
                 }
+                limits::TRIANGLES.check(triangles.len() as u64).map_err(|why| bad(path, at(), why))?;
             }
         }
     }

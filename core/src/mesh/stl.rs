@@ -5,8 +5,9 @@
 //! first word (many binary files start with "solid" too). STL stores each triangle's corners
 //! apart: the mesh has three vertices a triangle, the file's triangles in its order.
 
-use super::assemble::{bad, capacity, finish};
+use super::assemble::{bad, capacity, coordinate, finish};
 use super::{LoadReport, Mesh, MeshError};
+use crate::files::limits;
 use glam::Vec3;
 use std::path::Path;
 
@@ -46,12 +47,19 @@ pub(crate) fn parse(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), Mes
 
 fn binary(path: &Path, bytes: &[u8]) -> Result<(Mesh, LoadReport), MeshError> {
     let records = &bytes[84..];
+    limits::TRIANGLES.check(records.len() as u64 / 50).map_err(|e| bad(path, "the header", e))?;
     let mut positions = Vec::with_capacity(records.len() / 50 * 3);
     let f = |b: &[u8], k: usize| f32::from_le_bytes(b[4 * k..4 * k + 4].try_into().expect("four bytes"));
-    for r in records.chunks_exact(50) {
+    for (t, r) in records.chunks_exact(50).enumerate() {
         for c in 0..3 {
             let k = 3 + 3 * c;
-            positions.push(Vec3::new(f(r, k), f(r, k + 1), f(r, k + 2)));
+            let mut p = [0f32; 3];
+            for (j, x) in p.iter_mut().enumerate() {
+                *x = coordinate(f(r, k + j) as f64).map_err(|e| {
+                    bad(path, format!("triangle {t} (at byte {})", 84 + 50 * t), format!("corner {c}: {e}"))
+                })?;
+            }
+            positions.push(Vec3::from_array(p));
         }
     }
     let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
@@ -68,12 +76,17 @@ fn ascii(path: &Path, text: &str) -> Result<(Mesh, LoadReport), MeshError> {
                 let mut xyz = [0f32; 3];
                 for (k, x) in xyz.iter_mut().enumerate() {
                     let t = w.next().unwrap_or("");
-                    *x = t.parse().map_err(|_| {
-                        bad(path, format!("line {}", i + 1), format!("vertex coordinate {k} '{t}' is not a number"))
-                    })?;
+                    let at = format!("line {}", i + 1);
+                    let value: f64 = t
+                        .parse()
+                        .map_err(|_| bad(path, &at, format!("vertex coordinate {k} '{t}' is not a number")))?;
+                    *x = coordinate(value).map_err(|e| bad(path, &at, e))?;
                 }
                 positions.push(Vec3::from_array(xyz));
                 in_facet += 1;
+                if in_facet > 3 {
+                    return Err(bad(path, format!("line {}", i + 1), "a facet of more than 3 vertices"));
+                }
             }
             Some("endfacet") => {
                 if in_facet != 3 {

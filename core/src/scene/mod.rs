@@ -70,11 +70,9 @@ pub fn trs(translate: Vec3, axis: Vec3, radians: f32, scale: Vec3) -> Affine3A {
     Affine3A::from_scale_rotation_translation(scale, rotation, translate)
 }
 
-/// The most placements a scene file may hold. Each costs some 900 bytes while the file is read
-/// (a JSON object, then a placement with its path and transform), so three million took 2.6 GB
-/// and 17 s; a quarter of a million stays near 200 MB. More instances than that are a program's
-/// to make (`TwoLevelBvh`), not a file's to list.
-pub const MAX_PLACEMENTS: usize = 250_000;
+/// The most placements a scene file may hold: the one limit every file counts against
+/// (`files::limits::PLACEMENTS`, which says why).
+pub const MAX_PLACEMENTS: usize = crate::files::limits::PLACEMENTS.max as usize;
 
 /// The largest scene file read (what `MAX_PLACEMENTS` written out takes, and room to spare): a
 /// bigger one is refused before it is read, so its JSON is never held in memory.
@@ -82,14 +80,11 @@ pub const MAX_SCENE_BYTES: u64 = 32 << 20;
 
 /// Refuse a scene of more than `MAX_PLACEMENTS` placements, naming the file.
 pub(crate) fn check_placements(path: &Path, n: usize) -> Result<(), SceneError> {
-    if n > MAX_PLACEMENTS {
-        return Err(SceneError::Field {
-            path: path.into(),
-            field: "meshes".into(),
-            message: format!("{n} placements, more than the {MAX_PLACEMENTS} a scene file may hold"),
-        });
-    }
-    Ok(())
+    crate::files::limits::PLACEMENTS.check(n as u64).map_err(|message| SceneError::Field {
+        path: path.into(),
+        field: "meshes".into(),
+        message,
+    })
 }
 
 /// Read a JSON file, with errors that name the file and the line.

@@ -20,7 +20,7 @@ use std::sync::{Arc, OnceLock};
 /// (its share of positions, normals and indices), and the build about 100 more while it runs: 20M
 /// triangles stay within a few gigabytes, where 100k placements of a 968-triangle mesh (97M) took
 /// 42 s and 18.7 GB and a few more were killed for lack of memory.
-pub const MAX_FLAT_TRIANGLES: u64 = 20_000_000;
+pub const MAX_FLAT_TRIANGLES: u64 = crate::files::limits::TRIANGLES.max;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum SceneSource {
