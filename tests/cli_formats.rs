@@ -59,11 +59,37 @@ fn a_malformed_mesh_is_one_line_naming_the_file_and_the_element() {
     std::fs::write(&ply, TENT_PLY.replace("3 1 4 2", "3 1 4 9")).unwrap();
     let stl = tmp("broken.stl");
     std::fs::write(&stl, [1u8; 120]).unwrap();
-    for (f, needle) in [(&ply, "face 3: refers to vertex 9"), (&stl, "neither ASCII STL")] {
+    for (f, needle) in [(&ply, "face 3 (line 18): refers to vertex 9"), (&stl, "neither ASCII STL")] {
         let out = bvhscope(&["render", f.to_str().unwrap()]);
         assert_eq!(out.status.code(), Some(2));
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
         assert!(err.contains(f.to_str().unwrap()) && err.contains(needle), "{err}");
+    }
+}
+
+/// A glTF whose buffer names a file outside its folder (`/etc/passwd`, `../`) is one line naming
+/// the buffer, exit code 2, and nothing is written: the bytes of another file never become
+/// triangles, boxes in a dump or numbers in a message.
+#[test]
+fn a_gltf_naming_a_file_outside_its_folder_is_refused_and_nothing_is_written() {
+    let inner = tmp("hostile-gltf").join("scene");
+    std::fs::create_dir_all(&inner).unwrap();
+    std::fs::write(inner.parent().unwrap().join("secret.bin"), [0u8; 64]).unwrap();
+    for (k, uri) in ["/etc/passwd", "../secret.bin", "/proc/self/environ"].into_iter().enumerate() {
+        let gltf = inner.join(format!("h{k}.gltf"));
+        let json = format!(
+            r#"{{"asset": {{"version": "2.0"}}, "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+            "buffers": [{{"uri": "{uri}", "byteLength": 36}}], "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+            "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}}]}}"#
+        );
+        std::fs::write(&gltf, json).unwrap();
+        let dump = inner.join(format!("h{k}.json"));
+        let out = bvhscope(&["export-bvh", gltf.to_str().unwrap(), "-o", dump.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{uri}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert!(err.contains("buffer 0: uri") && err.contains(uri), "{err}");
+        assert!(!dump.exists(), "{uri}: nothing written");
     }
 }
