@@ -281,3 +281,35 @@ fn obj_comments_after_a_statement_are_comments() {
     assert_eq!(m.triangles.len(), 1);
     assert_eq!(m.positions[2], glam::Vec3::Y);
 }
+
+/// What exporters write and the checks must not refuse: positions and normals interleaved in one
+/// view (a byteStride of 24, the normals' accessor at offset 12), unsigned-byte indices, and two
+/// primitives sharing one POSITION accessor (read once, numbered primitive by primitive).
+#[test]
+fn interleaved_attributes_byte_indices_and_shared_positions_load() {
+    let mut bin = Vec::new();
+    for p in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]] {
+        for c in p.into_iter().chain([0.0, 0.0, 1.0]) {
+            bin.extend(c.to_le_bytes());
+        }
+    }
+    bin.extend([0u8, 1, 2, 0, 2, 3]);
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+        "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1}}, "indices": 2}},
+                                    {{"attributes": {{"POSITION": 0, "NORMAL": 1}}, "indices": 3}}]}}],
+        "buffers": [{{"uri": "{}", "byteLength": {}}}],
+        "bufferViews": [{{"buffer": 0, "byteLength": 96, "byteStride": 24}}, {{"buffer": 0, "byteOffset": 96, "byteLength": 6}}],
+        "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+                      {{"bufferView": 0, "byteOffset": 12, "componentType": 5126, "count": 4, "type": "VEC3"}},
+                      {{"bufferView": 1, "componentType": 5121, "count": 3, "type": "SCALAR"}},
+                      {{"bufferView": 1, "byteOffset": 3, "componentType": 5121, "count": 3, "type": "SCALAR"}}]}}"#,
+        b64(&bin),
+        bin.len()
+    );
+    let g = crate::mesh::load_gltf(&write("interleaved.gltf", json.as_bytes())).unwrap();
+    let m = &g.meshes[0];
+    assert_eq!(m.positions.len(), 4, "the shared positions read once");
+    assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    assert_eq!(m.normals, vec![glam::Vec3::Z; 4]);
+}
