@@ -68,12 +68,6 @@ impl KindRays {
         Self { kind: RayKind::Primary, rays: rays.map(|(x, y)| gen.pixel_ray(x, y)).collect() }
     }
 
-    /// At most `max` of the rays, evenly spread over the list (all of them when there are fewer).
-    pub fn spread_to(&self, max: usize) -> Self {
-        let n = self.rays.len().min(max);
-        Self { kind: self.kind, rays: (0..n).map(|k| self.rays[self.spread(k, n)]).collect() }
-    }
-
     /// Trace ray `i` as its kind asks (any hit for shadow and ao rays), counting into `stats`.
     #[inline]
     fn trace<A: Accelerator + ?Sized, S: crate::bvh::TraversalStats>(
@@ -211,7 +205,7 @@ mod tests {
                 &camera,
                 &RenderSettings { count: true, secondary: Some(sec), ..Default::default() },
             );
-            let list = KindRays { kind, rays: sec.frame_rays(&primary, &camera) };
+            let list = KindRays { kind, rays: sec.frame_rays(&primary, &camera, usize::MAX).rays };
             assert_eq!(list.rays.len() as u64, frame.ray_summary().rays);
             let work = list.count(&tree, opts, list.rays.len());
             let (nodes, tris) =

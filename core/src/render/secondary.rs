@@ -150,47 +150,78 @@ impl SecondaryRays {
     /// `dir` hit at `point` with shading normal `normal`: the same rays for the same pixel, hit and
     /// seed whatever traces them. Empty for primary frames.
     pub fn rays(&self, pixel: u64, point: Vec3, normal: Vec3, dir: Vec3) -> impl Iterator<Item = Ray> + '_ {
-        // The side the camera sees: rays leave from there.
+        let (n, origin) = self.leave(point, normal, dir);
+        (0..self.spec.rays_per_hit()).map(move |j| self.ray(pixel, j, n, origin))
+    }
+
+    /// The side of the surface the camera sees at a hit (rays leave from there), and the point
+    /// the rays leave from, lifted off the surface on that side.
+    fn leave(&self, point: Vec3, normal: Vec3, dir: Vec3) -> (Vec3, Vec3) {
         let n = if normal.dot(dir) > 0.0 { -normal } else { normal };
         let n = n.try_normalize().unwrap_or(-dir);
-        let origin = point + n * self.offset;
-        let count = self.spec.rays_per_hit();
-        // Two numbers per ray, each pixel its own stretch of the seed's stream.
-        let mut rng = Rng::at(self.spec.seed, pixel.wrapping_mul(2 * count as u64));
-        (0..count).map(move |_| match self.spec.kind {
-            RayKind::Shadow => {
-                let to = self.light - origin;
-                let d = to.length();
-                // Up to the light: nothing beyond it shadows.
-                Ray::segment(origin, to / d.max(1e-30), 0.0, d)
-            }
+        (n, point + n * self.offset)
+    }
+
+    /// Ray `j` of pixel `pixel`'s rays, leaving `origin` on side `n` (`leave`): made on its own,
+    /// without the pixel's rays before it, so a sample of a frame's rays costs its own rays only.
+    fn ray(&self, pixel: u64, j: u32, n: Vec3, origin: Vec3) -> Ray {
+        match self.spec.kind {
+            RayKind::Shadow => shadow_ray(origin, self.light),
             RayKind::Ao | RayKind::Bounce => {
+                // Two numbers per ray, each pixel its own stretch of the seed's stream: ray j's
+                // are its 2j-th and (2j+1)-th (`Rng::at` enters a stream anywhere).
+                let count = self.spec.rays_per_hit() as u64;
+                let mut rng = Rng::at(self.spec.seed, pixel.wrapping_mul(2 * count).wrapping_add(2 * j as u64));
                 let (u1, u2) = (rng.unit(), rng.unit());
                 let length = if self.spec.kind == RayKind::Ao { self.ao_length } else { f32::INFINITY };
                 Ray::segment(origin, cosine_direction(n, u1, u2), 0.0, length)
             }
             RayKind::Primary => unreachable!("no rays are made for primary frames"),
-        })
+        }
     }
 
-    /// Every secondary ray of a complete frame of primary rays on `camera` (its pixels row by
-    /// row, each hit pixel's `rays`): the rays a heatmap of this kind traces, as a list, so a
-    /// table can count and time each tree on exactly them.
-    pub fn frame_rays(&self, frame: &super::Frame, camera: &Camera) -> Vec<Ray> {
+    /// At most `max` of the secondary rays of a complete frame of primary rays on `camera`, evenly
+    /// spread over them: of the list of every hit pixel's `rays` (pixels row by row), `total`
+    /// long, the rays at k·total/n for k in 0..n (n = min(total, max); all of them when
+    /// `max >= total`). The rays a heatmap of this kind traces, or a sample of them, so a table
+    /// can count and time each tree on exactly them.
+    ///
+    /// The kept rays are made directly, one pixel at a time, never the whole list: a 2048×1536
+    /// frame of the bunny with 256 ao rays per pixel has over a hundred million of them, 6.6 GB listed
+    /// (issue 58), where `compare` keeps a quarter million.
+    pub fn frame_rays(&self, frame: &super::Frame, camera: &Camera, max: usize) -> FrameRays {
         assert!(frame.is_complete() && frame.width() == camera.width, "a complete frame of this camera");
+        let (width, height) = (camera.width, camera.height);
+        let pixels = move || (0..height).flat_map(move |y| (0..width).map(move |x| (x, y)));
+        let per = self.spec.rays_per_hit() as u64;
+        let total = pixels().filter(|&(x, y)| frame.sample(x, y).is_hit()).count() as u64 * per;
+        let n = total.min(max as u64);
+        // In u128: k·total passes u64 once a frame has four billion rays and all are kept.
+        let pick = |k: u64| (k as u128 * total as u128 / n.max(1) as u128) as u64;
         let gen = camera.ray_gen();
-        let mut out = Vec::new();
-        for y in 0..camera.height {
-            for x in 0..camera.width {
-                let s = frame.sample(x, y);
-                if s.is_hit() {
-                    let ray = gen.pixel_ray(x, y);
-                    let pixel = y as u64 * camera.width as u64 + x as u64;
-                    out.extend(self.rays(pixel, ray.origin() + ray.dir() * s.t, s.normal, ray.dir()));
+        let mut rays = Vec::with_capacity(n as usize);
+        // The next ray to keep, and the index in the list of the current pixel's first ray.
+        let (mut next, mut first) = (pick(0), 0u64);
+        for (x, y) in pixels() {
+            if rays.len() as u64 == n {
+                break;
+            }
+            let s = frame.sample(x, y);
+            if !s.is_hit() {
+                continue;
+            }
+            if next < first + per {
+                let ray = gen.pixel_ray(x, y);
+                let pixel = y as u64 * width as u64 + x as u64;
+                let (normal, origin) = self.leave(ray.origin() + ray.dir() * s.t, s.normal, ray.dir());
+                while (rays.len() as u64) < n && next < first + per {
+                    rays.push(self.ray(pixel, (next - first) as u32, normal, origin));
+                    next = pick(rays.len() as u64);
                 }
             }
+            first += per;
         }
-        out
+        FrameRays { rays, of: total }
     }
 
     /// Pixel (x, y)'s secondary rays on `camera`, from its camera ray's hit as the renderer finds
@@ -231,6 +262,20 @@ impl SecondaryRays {
         }
         (sum, hits)
     }
+}
+
+/// Some of a frame's secondary rays (`SecondaryRays::frame_rays`): `rays`, of the `of` the frame has.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameRays {
+    pub rays: Vec<Ray>,
+    pub of: u64,
+}
+
+/// The shadow ray from `origin` up to the point light at `light` (nothing beyond it shadows).
+fn shadow_ray(origin: Vec3, light: Vec3) -> Ray {
+    let to = light - origin;
+    let d = to.length();
+    Ray::segment(origin, to / d.max(1e-30), 0.0, d)
 }
 
 /// A cosine-weighted direction about unit normal `n` from two uniform numbers in [0, 1).

@@ -153,7 +153,7 @@ fn any_hit_packets_of_every_layout_answer_as_the_linear_scan_does() {
             let frame = render(&tree, &mesh, &cam, &RenderSettings::default());
             for kind in [RayKind::Shadow, RayKind::Ao] {
                 let sec = SecondaryRays::new(spec(kind), &mesh.bounds(), &cam);
-                rays.extend(sec.frame_rays(&frame, &cam));
+                rays.extend(sec.frame_rays(&frame, &cam, usize::MAX).rays);
             }
             let (mut occluded, mut packets) = (0, 0);
             for size in [64, 37, 1] {
@@ -216,5 +216,68 @@ fn a_frame_of_secondary_rays_counts_its_rays_and_marks_missed_pixels() {
         let csv = frame.counts_csv().unwrap();
         assert!(csv.starts_with("x,y,rays,nodes_visited"));
         assert_eq!(csv.lines().count() as u32, 1 + cam.width * cam.height);
+    }
+}
+
+/// The listing `compare` made before issue 58, kept as the reference its sample must equal: every
+/// hit pixel's rays made from one stream per pixel (two numbers per ray, in order) and listed, then
+/// ray k·len/n kept for k in 0..n.
+fn listed_then_spread(sec: &SecondaryRays, frame: &crate::render::Frame, camera: &Camera, max: usize) -> Vec<Ray> {
+    let gen = camera.ray_gen();
+    let mut all = Vec::new();
+    for y in 0..camera.height {
+        for x in 0..camera.width {
+            let s = frame.sample(x, y);
+            if !s.is_hit() {
+                continue;
+            }
+            let ray = gen.pixel_ray(x, y);
+            let (point, dir) = (ray.origin() + ray.dir() * s.t, ray.dir());
+            let n = if s.normal.dot(dir) > 0.0 { -s.normal } else { s.normal };
+            let n = n.try_normalize().unwrap_or(-dir);
+            let origin = point + n * sec.offset;
+            let count = sec.spec.rays_per_hit();
+            let pixel = y as u64 * camera.width as u64 + x as u64;
+            let mut rng = crate::random::Rng::at(sec.spec.seed, pixel.wrapping_mul(2 * count as u64));
+            for _ in 0..count {
+                all.push(match sec.spec.kind {
+                    RayKind::Shadow => {
+                        let to = sec.light - origin;
+                        let d = to.length();
+                        Ray::segment(origin, to / d.max(1e-30), 0.0, d)
+                    }
+                    _ => {
+                        let (u1, u2) = (rng.unit(), rng.unit());
+                        let length = if sec.spec.kind == RayKind::Ao { sec.ao_length } else { f32::INFINITY };
+                        Ray::segment(origin, cosine_direction(n, u1, u2), 0.0, length)
+                    }
+                });
+            }
+        }
+    }
+    let n = all.len().min(max);
+    (0..n).map(|k| all[k * all.len() / n]).collect()
+}
+
+/// `compare`'s sample of a frame's secondary rays, made directly, is the sample of the full list
+/// it used to make: the same rays, bit for bit, for every kind and any cap (issue 58).
+#[test]
+fn the_kept_rays_are_those_of_the_listed_frame_evenly_spread() {
+    let mesh = knot();
+    let cam = camera(&mesh);
+    let tree = AnyBvh::build(&mesh, &BuildParams::default());
+    let frame = render(&tree, &mesh, &cam, &RenderSettings::default());
+    for kind in [RayKind::Shadow, RayKind::Ao, RayKind::Bounce] {
+        for samples in [1, 3, 7] {
+            let sec = SecondaryRays::new(SecondarySpec { samples, ..spec(kind) }, &mesh.bounds(), &cam);
+            let total = listed_then_spread(&sec, &frame, &cam, usize::MAX).len();
+            assert!(total > 100, "{kind:?}: {total}");
+            for max in [0, 1, 2, 7, 100, total / 3, total - 1, total, total + 5, usize::MAX] {
+                let got = sec.frame_rays(&frame, &cam, max);
+                assert_eq!(got.of, total as u64, "{kind:?} ×{samples}");
+                assert_eq!(got.rays.len(), total.min(max), "{kind:?} ×{samples} max {max}");
+                assert!(got.rays == listed_then_spread(&sec, &frame, &cam, max), "{kind:?} ×{samples} max {max}");
+            }
+        }
     }
 }

@@ -66,13 +66,13 @@ impl KindsTable {
             .map(|kind| match args.secondary(kind, &mesh.bounds(), camera) {
                 None => (KindRays::primary(camera), "the camera's rays, one per pixel (closest hit)".to_string()),
                 Some(sec) => {
-                    let all = KindRays { kind, rays: sec.frame_rays(&hits, camera) };
-                    let (list, of) = (all.spread_to(MAX_SECONDARY_RAYS), all.rays.len());
-                    let note = match list.rays.len() < of {
-                        true => format!(" (an evenly spread {} of the frame's {of})", list.rays.len()),
+                    // Only the kept rays are made (a frame's are hundreds of millions at 256 per pixel).
+                    let kept = sec.frame_rays(&hits, camera, MAX_SECONDARY_RAYS);
+                    let note = match (kept.rays.len() as u64) < kept.of {
+                        true => format!(" (an evenly spread {} of the frame's {})", kept.rays.len(), kept.of),
                         false => String::new(),
                     };
-                    (list, format!("{}{note}", sec.spec.describe()))
+                    (KindRays { kind, rays: kept.rays }, format!("{}{note}", sec.spec.describe()))
                 }
             })
             .unzip();
