@@ -172,3 +172,37 @@ fn grade_draws_its_heatmaps_of_the_kind_and_keeps_its_figures() {
     assert_eq!(image(&ao).get_pixel(0, 0).0, [96, 96, 96], "the camera ray missed: grey");
     assert_ne!(image(&plain).get_pixel(0, 0).0, [96, 96, 96]);
 }
+
+/// A light 1e20 away shadows as one 1e19 away on the same line: its squared distance passes f32,
+/// and every shadow ray had the direction 0, an empty ray shadowing nothing (issue 58).
+#[test]
+fn a_far_light_shadows_as_a_near_one_on_its_line() {
+    let mesh = knot();
+    let m = mesh.to_str().unwrap();
+    let counts = |light: &str, name: &str| {
+        let (csv, png) = (tmp(&format!("{name}.csv")), tmp(&format!("{name}.png")));
+        let (c, p) = (csv.to_str().unwrap(), png.to_str().unwrap());
+        ok(&[
+            "render",
+            m,
+            "--size",
+            "32x24",
+            "--layout",
+            "binary",
+            "--ray-kind",
+            "shadow",
+            "--light",
+            light,
+            "--counts",
+            c,
+            "-o",
+            p,
+        ]);
+        std::fs::read_to_string(&csv).unwrap()
+    };
+    let (near, far) = (counts("1e19,1e19,1e19", "light-near"), counts("1e20,1e20,1e20", "light-far"));
+    // Column 3: the pixel's shadow ray's nodes visited (an empty ray visits none).
+    let walked = far.lines().skip(1).filter(|l| l.split(',').nth(3).is_some_and(|v| v != "0")).count();
+    assert!(walked > 100, "the far light's shadow rays walk the tree: {walked} pixels");
+    assert_eq!(near, far, "the same rays, the same counts");
+}

@@ -138,11 +138,13 @@ pub struct SecondaryRays {
 }
 
 impl SecondaryRays {
-    /// The default light is half the scene's diagonal above the camera (along its up vector).
+    /// The default light is half the scene's diagonal above the camera (along its up vector). A
+    /// light that is not finite (the command line refuses one; the app's saved settings could
+    /// hold one) has no direction to it and would shadow nothing: the default light stands in.
     pub fn new(spec: SecondarySpec, bounds: &Aabb, camera: &Camera) -> Self {
         let diagonal = if bounds.is_empty() { 1.0 } else { bounds.extent().length().max(1e-30) };
         let up = camera.up.try_normalize().unwrap_or(Vec3::Y);
-        let light = spec.light.unwrap_or(camera.position + up * 0.5 * diagonal);
+        let light = spec.light.filter(|l| l.is_finite()).unwrap_or(camera.position + up * 0.5 * diagonal);
         Self { spec, light, ao_length: spec.ao_length * diagonal, offset: diagonal * 1e-4 }
     }
 
@@ -275,7 +277,20 @@ pub struct FrameRays {
 fn shadow_ray(origin: Vec3, light: Vec3) -> Ray {
     let to = light - origin;
     let d = to.length();
-    Ray::segment(origin, to / d.max(1e-30), 0.0, d)
+    if d.is_finite() && d > 1e-15 {
+        return Ray::segment(origin, to / d, 0.0, d);
+    }
+    // A far light (1e20 away: its squared distance passes f32, `d` is infinite and the direction
+    // was 0, an empty ray that shadowed nothing, issue 58) or one a hair off the surface (its
+    // squared distance underflows): in f64, where no f32 input overflows or underflows. Lights in
+    // between keep their f32 rays bit for bit.
+    let to = light.as_dvec3() - origin.as_dvec3();
+    let d = to.length();
+    if d == 0.0 {
+        // On the light itself: no direction to it, and nothing between.
+        return Ray::segment(origin, Vec3::ZERO, 0.0, 0.0);
+    }
+    Ray::segment(origin, (to / d).as_vec3(), 0.0, d as f32)
 }
 
 /// A cosine-weighted direction about unit normal `n` from two uniform numbers in [0, 1).

@@ -281,3 +281,44 @@ fn the_kept_rays_are_those_of_the_listed_frame_evenly_spread() {
         }
     }
 }
+
+/// A light 1e20 away: its squared distance passes f32, and each shadow ray had the direction 0
+/// (an empty ray, shadowing nothing, issue 58). Its rays are those of a light 1e19 away along the
+/// same line (whose distance f32 still holds), and lights at the ends of f32 give unit directions.
+#[test]
+fn a_far_light_casts_the_shadows_of_a_near_one_in_its_direction() {
+    let mesh = knot();
+    let cam = camera(&mesh);
+    let tree = AnyBvh::build(&mesh, &BuildParams::default());
+    let frame = render(&tree, &mesh, &cam, &RenderSettings::default());
+    let rays_to = |light: Option<Vec3>| {
+        let sec = SecondaryRays::new(SecondarySpec { light, ..spec(RayKind::Shadow) }, &mesh.bounds(), &cam);
+        sec.frame_rays(&frame, &cam, usize::MAX).rays
+    };
+    let rays = |light: Vec3| rays_to(Some(light));
+    let opts = crate::bvh::TraceOptions::default();
+    for line in [Vec3::ONE, Vec3::new(-1.0, 0.5, -0.25), Vec3::new(0.0, -1.0, 0.0)] {
+        let (near, far) = (rays(line * 1e19), rays(line * 1e20));
+        assert_eq!(near.len(), far.len());
+        let shadowed = |rays: &[Ray]| rays.iter().map(|r| tree.any_hit(r, opts, &mut NoStats)).collect::<Vec<_>>();
+        let (a, b) = (shadowed(&near), shadowed(&far));
+        assert_eq!(a, b, "{line}: the same pixels in shadow");
+        assert!(a.contains(&true) && a.contains(&false), "{line}: both answers are tested");
+        for (n, f) in near.iter().zip(&far) {
+            assert!(!f.is_empty(), "{line}: {f:?}");
+            assert!((n.dir() - f.dir()).length() < 1e-6, "{line}: {n:?} {f:?}");
+            assert!((f.t_max / (line.length() * 1e20) - 1.0).abs() < 1e-5, "{line}: up to the light, {f:?}");
+        }
+    }
+    for light in [Vec3::splat(f32::MAX), Vec3::new(-f32::MAX, f32::MAX, 0.0), Vec3::splat(f32::MIN_POSITIVE)] {
+        for r in rays(light) {
+            assert!(!r.is_empty() && (r.dir().length() - 1.0).abs() < 1e-5, "{light}: {r:?}");
+        }
+    }
+    // A light that is not finite (from the app's saved settings; the command line refuses one):
+    // the default light's rays, not empty ones.
+    let default = rays_to(None);
+    for light in [Vec3::splat(f32::INFINITY), Vec3::new(f32::NAN, 0.0, 1.0)] {
+        assert!(rays_to(Some(light)) == default, "{light}");
+    }
+}
