@@ -206,3 +206,32 @@ fn a_far_light_shadows_as_a_near_one_on_its_line() {
     assert!(walked > 100, "the far light's shadow rays walk the tree: {walked} pixels");
     assert_eq!(near, far, "the same rays, the same counts");
 }
+
+/// A camera that sees no surface: the secondary kinds have no rays, and `compare --ray-kind all`
+/// says so where it printed rates and speed-ups of nothing (issue 58), in the table and the JSON.
+#[test]
+fn compare_says_a_kind_without_rays_has_none() {
+    let mesh = knot();
+    let m = mesh.to_str().unwrap();
+    let args = ["compare", m, "--size", "16x12", "--runs", "1", "--layout", "binary", "--ray-kind", "all"];
+    let away = ["--camera", "0,0,10:0,0,20"];
+    let out = ok(&[&args[..], &away[..]].concat());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let table = &text[text.find("| strategy | primary | shadow | ao | bounce |").expect("the kinds' table")..];
+    let rows: Vec<&str> = table.lines().skip(2).take_while(|l| l.starts_with('|')).collect();
+    assert!(rows.len() > 5, "{table}");
+    for row in rows {
+        let cells: Vec<&str> = row.trim_matches('|').split(" | ").map(str::trim).collect();
+        assert!(cells[1].contains('×'), "camera rays are timed, hit or not: {row}");
+        assert_eq!(cells[2..], ["no rays: the camera sees no surface"; 3], "{row}");
+    }
+    assert!(table.contains("- ao: no rays: the camera sees no surface"), "no correlation either: {table}");
+
+    let v = json(&[&args[..], &away[..], &["--format", "json"]].concat());
+    for c in v["ray_kinds"]["cells"].as_array().unwrap() {
+        let rated = c["kind"] == "primary";
+        assert_eq!(c["rays"].as_u64().unwrap() > 0, rated, "{c}");
+        assert_eq!(c["mrays_per_s"].is_number(), rated, "{c}");
+        assert_eq!(c["speedup_over_linear"].is_number(), rated, "{c}");
+    }
+}

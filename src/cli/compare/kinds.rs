@@ -18,6 +18,10 @@ use std::time::Duration;
 /// the table says when it is a sample.
 const MAX_SECONDARY_RAYS: usize = 1 << 18;
 
+/// What a cell says in place of figures when a secondary kind has no rays: they leave the camera
+/// rays' hits, and there are none.
+const NO_RAYS: &str = "no rays: the camera sees no surface";
+
 /// One strategy × kind: the work per ray and the speed.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct KindCell {
@@ -30,9 +34,10 @@ pub struct KindCell {
     /// The SAH cost model's combined cost per ray (traversal × nodes + intersection × tests).
     pub cost_per_ray: f64,
     /// Single rays on the trace timing's threads (one unless `--threads`); for the linear scan,
-    /// over the rays it was timed on.
-    pub mrays_per_s: f64,
-    pub speedup_over_linear: f64,
+    /// over the rays it was timed on. `None` for a kind with no rays (no camera ray hit): a rate
+    /// of nothing timed would be the clock's noise.
+    pub mrays_per_s: Option<f64>,
+    pub speedup_over_linear: Option<f64>,
     /// The linear scan's rays timed and counted, when fewer than the list's.
     pub sampled_rays: Option<usize>,
 }
@@ -68,9 +73,10 @@ impl KindsTable {
                 Some(sec) => {
                     // Only the kept rays are made (a frame's are hundreds of millions at 256 per pixel).
                     let kept = sec.frame_rays(&hits, camera, MAX_SECONDARY_RAYS);
-                    let note = match (kept.rays.len() as u64) < kept.of {
-                        true => format!(" (an evenly spread {} of the frame's {})", kept.rays.len(), kept.of),
-                        false => String::new(),
+                    let note = match kept.rays.len() as u64 {
+                        0 => format!(" ({NO_RAYS})"),
+                        n if n < kept.of => format!(" (an evenly spread {n} of the frame's {})", kept.of),
+                        _ => String::new(),
                     };
                     (KindRays { kind, rays: kept.rays }, format!("{}{note}", sec.spec.describe()))
                 }
@@ -89,8 +95,8 @@ impl KindsTable {
             nodes_per_ray: nodes,
             tri_tests_per_ray: tris,
             cost_per_ray: cost,
-            mrays_per_s: 1e-6 / seconds_per_ray.max(1e-15),
-            speedup_over_linear: 0.0,
+            mrays_per_s: (!list.rays.is_empty()).then(|| 1e-6 / seconds_per_ray.max(1e-15)),
+            speedup_over_linear: None,
             sampled_rays: sampled,
         }
     }
@@ -111,7 +117,11 @@ impl KindsTable {
                         c.map_or(f64::NAN, |c| c.cost_per_ray)
                     })
                     .collect();
-                (list.kind.name(), spearman(&sah, &measured), spearman(&epo, &measured))
+                match list.rays.is_empty() {
+                    // Nothing measured: no ranking (each tree's zero cost would tie).
+                    true => (list.kind.name(), None, None),
+                    false => (list.kind.name(), spearman(&sah, &measured), spearman(&epo, &measured)),
+                }
             })
             .collect()
     }
@@ -134,13 +144,15 @@ impl KindsTable {
                 .iter()
                 .map(|k| {
                     let c = self.cells.iter().find(|c| c.row == row && c.kind == *k).expect("every row has every kind");
+                    let (Some(rate), Some(speedup)) = (c.mrays_per_s, c.speedup_over_linear) else {
+                        return NO_RAYS.to_string();
+                    };
                     let star = if c.sampled_rays.is_some() { "*" } else { "" };
                     format!(
-                        "{:.1} / {:.1} · {}{star} · {:.0}×",
+                        "{:.1} / {:.1} · {}{star} · {speedup:.0}×",
                         c.nodes_per_ray,
                         c.tri_tests_per_ray,
-                        three_figures(c.mrays_per_s),
-                        c.speedup_over_linear
+                        three_figures(rate),
                     )
                 })
                 .collect();
@@ -164,8 +176,11 @@ impl KindsTable {
             self.ranked.len(),
             self.ranked.first().map_or(String::new(), |(n, ..)| format!("laid out as {}", layout_of(n)))
         );
-        for (kind, sah, epo) in self.correlations() {
-            let _ = writeln!(o, "- {kind}: SAH cost {}, EPO {}", fmt(sah), fmt(epo));
+        for ((kind, sah, epo), list) in self.correlations().into_iter().zip(&self.lists) {
+            let _ = match list.rays.is_empty() {
+                true => writeln!(o, "- {kind}: {NO_RAYS}"),
+                false => writeln!(o, "- {kind}: SAH cost {}, EPO {}", fmt(sah), fmt(epo)),
+            };
         }
         o
     }
@@ -178,6 +193,12 @@ impl PerTree for KindsTable {
         let Tree { bvh, row, first_layout, runs, pools } = t;
         for list in &self.lists {
             let n = list.rays.len();
+            if n == 0 {
+                // Nothing to count or time (a kind without rays: no camera ray hit).
+                let cell = self.cell(&row.name, list, Work::default(), 0.0, None);
+                self.cells.push(cell);
+                continue;
+            }
             let work = pools.0.install(|| list.count(bvh, self.trace, n));
             let t = pools.1.install(|| budgeted_median(runs, || ms(list.time(bvh, self.trace, n))));
             let cell = self.cell(&row.name, list, work, t / 1e3 / n.max(1) as f64, None);
@@ -195,6 +216,10 @@ impl PerTree for KindsTable {
         let each = budget / self.lists.len().max(1) as u32;
         let mut linear_cells = Vec::new();
         for list in &self.lists {
+            if list.rays.is_empty() {
+                linear_cells.push(self.cell("Linear scan", list, Work::default(), 0.0, None));
+                continue;
+            }
             let (per_ray, n) =
                 progress::with_spinner(&format!("timing the linear scan on {} rays", list.kind.name()), || {
                     traces.install(|| list.time_per_ray_within(&linear, self.trace, each))
@@ -205,10 +230,10 @@ impl PerTree for KindsTable {
         }
         for c in &mut self.cells {
             let l = linear_cells.iter().find(|l| l.kind == c.kind).expect("every kind has its linear cell");
-            c.speedup_over_linear = c.mrays_per_s / l.mrays_per_s.max(1e-12);
+            c.speedup_over_linear = c.mrays_per_s.zip(l.mrays_per_s).map(|(tree, linear)| tree / linear.max(1e-12));
         }
         for l in &mut linear_cells {
-            l.speedup_over_linear = 1.0;
+            l.speedup_over_linear = l.mrays_per_s.map(|_| 1.0);
         }
         self.cells.extend(linear_cells);
     }
