@@ -30,7 +30,9 @@ pub struct GradeArgs {
     /// student named by the file or folder (`class/*` grades a whole class).
     #[arg(required = true, value_name = "SUBMISSIONS")]
     pub submissions: Vec<PathBuf>,
-    /// The report's folder (made if needed): grade.html, grade.csv, grade.json and images/.
+    /// The report's folder (made if needed): grade.html, grade.csv, grade.json, images/ and
+    /// grade-files.txt, their list. A folder that is not empty is replaced only when it holds
+    /// nothing but what an earlier report listed there.
     #[arg(long, short, default_value = "grade-report")]
     pub out: PathBuf,
     /// A rubric (JSON): the checks required, thresholds for "good", the ranking key, the mesh,

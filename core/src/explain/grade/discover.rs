@@ -98,15 +98,15 @@ fn candidate(path: &Path) -> bool {
 }
 
 /// Whether the folder `path` (the one path given) is a class rather than one student's folder:
-/// it holds a folder, or more than one file that may be a dump.
+/// it holds a folder, or more than one file that may be a dump (two names of one file are one).
 fn is_class(path: &Path) -> bool {
     if !path.is_dir() {
         return false;
     }
     let list = entries(path);
     let folders = list.iter().any(|p| p.is_dir());
-    let dumps = list.iter().filter(|p| p.is_file() && candidate(p)).count();
-    folders || dumps > 1
+    let dumps: Vec<PathBuf> = list.into_iter().filter(|p| p.is_file() && candidate(p)).collect();
+    folders || distinct(dumps).len() > 1
 }
 
 /// A class folder's submissions: each folder, link and file named as a dump in it.
@@ -161,12 +161,14 @@ fn safe(name: &str) -> String {
 
 /// The one dump in folder `dir`: its regular files that may be dumps (`candidate`; hidden files
 /// left out); of several, the ones that start like dumps (`BvhDump::sniff`), so a `notes.json`
-/// beside `bvh.json` is no second dump. A link is followed only when it stays inside `dir`. Else
-/// why there is no one dump.
+/// beside `bvh.json` is no second dump. A link is followed only when it stays inside `dir`; two
+/// names of one file (a link to the dump beside it, a hard link) are one dump. Else why there is
+/// no one dump.
 fn dump_in(dir: &Path) -> Result<PathBuf, String> {
     std::fs::read_dir(dir).map_err(|e| format!("the folder cannot be listed: {e}"))?;
     let inside = std::fs::canonicalize(dir).map_err(|e| format!("the folder cannot be listed: {e}"))?;
-    let mut named: Vec<PathBuf> = Vec::new();
+    // With whether each is reached through a link.
+    let mut named: Vec<(PathBuf, bool)> = Vec::new();
     let mut links_out: Vec<PathBuf> = Vec::new();
     let mut not_dumps: Vec<PathBuf> = Vec::new();
     for p in entries(dir) {
@@ -189,11 +191,15 @@ fn dump_in(dir: &Path) -> Result<PathBuf, String> {
             continue;
         }
         if candidate(&target) {
-            named.push(target);
+            named.push((target, link));
         } else {
             not_dumps.push(p);
         }
     }
+    // Two names of one file (a link to the dump beside it, a hard link) are one dump, by the
+    // file's own name rather than a link's.
+    named.sort_by_key(|(_, link)| *link);
+    let mut named = distinct(named.into_iter().map(|(p, _)| p).collect());
     let list = |v: &[PathBuf]| {
         let names: Vec<String> =
             v.iter().take(5).map(|p| p.file_name().unwrap_or_default().to_string_lossy().into_owned()).collect();
@@ -221,6 +227,17 @@ fn dump_in(dir: &Path) -> Result<PathBuf, String> {
             Err(format!("the folder holds {count} dumps ({shown}): a submission is one dump"))
         }
     }
+}
+
+/// `paths` less those that name a file named before them (`same_file`: links and hard links).
+fn distinct(paths: Vec<PathBuf>) -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = Vec::with_capacity(paths.len());
+    for p in paths {
+        if !out.iter().any(|q| same_file::is_same_file(q, &p).unwrap_or(false)) {
+            out.push(p);
+        }
+    }
+    out
 }
 
 /// "a.json is" / "a.json, b.json are".

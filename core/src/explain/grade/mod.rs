@@ -11,7 +11,8 @@
 //!   submission at a time besides the references, whatever the size of the class;
 //! - `rank`: the order within the class, by a key the rubric names (`rubric`);
 //! - `report`: the report folder (`ReportDir`) and what is written there: `table` (the CSV's
-//!   records), `json`, `html` (with `page`'s style and script);
+//!   records), `json`, `html` (with `page`'s style and script), `manifest` (the list of the
+//!   report's files: what a later run into the folder may replace);
 //! - `report_file`: `grade.json` read back (`GradeReport`), its paths found again, for the app.
 //!
 //! One broken file never stops the run: every failure of a submission becomes its row's verdict
@@ -21,6 +22,7 @@ mod discover;
 mod evaluate;
 mod html;
 mod json;
+mod manifest;
 mod measure;
 mod page;
 mod rank;
@@ -33,11 +35,14 @@ mod table;
 mod tests;
 #[cfg(test)]
 mod tests_fair;
+#[cfg(test)]
+mod tests_out;
 
 pub use discover::{discover, Submission};
 pub use evaluate::evaluate;
 pub use html::write_html;
 pub use json::document;
+pub use manifest::MANIFEST_FILE;
 pub use measure::{Quality, Timing};
 pub use rank::{rank, RankBy};
 pub use reference::{ReferenceTree, References};

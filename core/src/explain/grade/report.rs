@@ -6,15 +6,20 @@
 //! OUT/grade.json            everything: setup, rubric, references, rows (`json::document`)
 //! OUT/images/NNN-name-visits.png       a student's heatmap (nodes visited per pixel)
 //! OUT/images/NNN-name-difference.png   the student's tree minus the SAH tree, per pixel
+//! OUT/grade-files.txt       every file above with its size, written last (`manifest`)
 //! ```
 //!
 //! The report is written into a fresh folder beside `--out` and renamed into place when complete
 //! (`ReportDir::publish`): two runs into one `--out` never mix (each leaves a whole report, the
 //! last one wins), no image of an earlier run survives, and the app never reads a half-written
-//! report. So an existing `--out` is replaced as a whole, and is accepted only when it is empty
-//! or holds a report (nothing else of the user's is in it); no input may be inside it, and no
-//! report file may be an input.
+//! report. An existing `--out` is accepted only when it is empty or holds nothing but what an
+//! earlier report listed in its `grade-files.txt`, unchanged (`manifest::ours`): anything else
+//! (a file of the user's, a report file edited since, a link, an older report that wrote no
+//! list) is refused by name, before any work and again before the report is put in place, and
+//! only the listed files are ever removed. No input may be inside `--out`, and no report file
+//! may be an input.
 
+use super::manifest;
 use super::GradeError;
 use crate::files::{refuse_inputs, FileError};
 use std::path::{Path, PathBuf};
@@ -23,9 +28,6 @@ pub const CSV_FILE: &str = "grade.csv";
 pub const JSON_FILE: &str = "grade.json";
 pub const HTML_FILE: &str = "grade.html";
 pub const IMAGES_DIR: &str = "images";
-
-/// What a report folder holds: an `--out` holding anything else is not replaced.
-const REPORT_ENTRIES: [&str; 4] = [CSV_FILE, JSON_FILE, HTML_FILE, IMAGES_DIR];
 
 /// A report folder made ready for a class: written in `work` until `publish` renames it to `root`.
 pub struct ReportDir {
@@ -39,8 +41,9 @@ pub struct ReportDir {
 
 impl ReportDir {
     /// Make a fresh folder ready beside `root`, after refusing a `root` that is a file, a
-    /// submission's folder, a folder holding anything but a report, or one holding an input, and
-    /// report files that are inputs (`inputs`: path and what it is).
+    /// submission's folder, a folder holding anything but what an earlier report listed
+    /// (`manifest::ours`), or one holding an input, and report files that are inputs (`inputs`:
+    /// path and what it is).
     pub fn prepare(root: &Path, inputs: Vec<(PathBuf, String)>) -> Result<ReportDir, GradeError> {
         let fail = |message: String| GradeError::Output { path: root.to_path_buf(), message };
         if root.exists() && !root.is_dir() {
@@ -64,18 +67,10 @@ impl ReportDir {
                 dir.inputs.iter().find(|(p, _)| std::fs::canonicalize(p).is_ok_and(|p| p.starts_with(&inside)));
             if let Some((_, what)) = within {
                 return Err(fail(format!(
-                    "holds {what}: a report replaces its folder as a whole; write it to another folder (--out)"
+                    "holds {what}: a report replaces what it wrote there; write it to another folder (--out)"
                 )));
             }
-            let list = std::fs::read_dir(root).map_err(|source| FileError::Read { path: root.into(), source })?;
-            let other =
-                list.filter_map(|e| e.ok()).find(|e| !REPORT_ENTRIES.contains(&&*e.file_name().to_string_lossy()));
-            if let Some(e) = other {
-                return Err(fail(format!(
-                    "holds {}, which is not part of a grade report: a report replaces its folder as a whole; write it to a new or empty folder, or an earlier report's (--out)",
-                    e.file_name().to_string_lossy()
-                )));
-            }
+            manifest::ours(root).map_err(fail)?;
         }
         let parent = match root.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -136,37 +131,82 @@ impl ReportDir {
         Ok(self.work().join(HTML_FILE))
     }
 
-    /// Put the finished report in place: the folder written renamed to `root`, an earlier report
-    /// there moved aside first and removed after. Another run may publish meanwhile: each rename
-    /// is of a whole report, so `root` always holds one.
+    /// Put the finished report in place: its files listed (`manifest::write`), the folder written
+    /// renamed to `root`, an earlier report there moved aside first and, once this one is in
+    /// place, emptied of the files its list names and removed. `root` is checked again first:
+    /// grading a class takes minutes, and a file put there meanwhile is refused as in `prepare`
+    /// (the new report is then left beside it, named). Another run may publish meanwhile: each
+    /// rename is of a whole report, so `root` always holds one.
     pub fn publish(&mut self) -> Result<(), GradeError> {
         let Some(work) = self.work.take() else { return Ok(()) };
-        let fail = |e: std::io::Error| GradeError::Output {
-            path: self.root.clone(),
-            message: format!("cannot be put in place: {e}"),
-        };
+        manifest::write(work.path())?;
+        let fail = |message: String| GradeError::Output { path: self.root.clone(), message };
         let parent = work.path().parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
         let work = work.keep();
+        let mut asides = Vec::new();
         let mut last = None;
         for _ in 0..16 {
+            if self.root.is_dir() {
+                if let Err(why) = manifest::ours(&self.root) {
+                    let _ = Self::clear(&asides);
+                    return Err(fail(format!("{why} (the new report is left in {})", work.display())));
+                }
+            }
             match std::fs::rename(&work, &self.root) {
-                Ok(()) => return Ok(()),
+                Ok(()) => return Self::clear(&asides).map_err(fail),
                 Err(e) if self.root.is_dir() => {
-                    // An earlier report (checked in `prepare`, or another run's since): aside,
-                    // then removed once this one is in place.
-                    let aside =
-                        tempfile::Builder::new().prefix(".grade-report.old-").tempdir_in(&parent).map_err(fail)?;
-                    match std::fs::rename(&self.root, aside.path().join("report")) {
-                        Ok(()) | Err(_) => last = Some(e),
+                    // An earlier report (checked just above): aside, then removed by its list
+                    // once this one is in place.
+                    let aside = tempfile::Builder::new()
+                        .prefix(".grade-report.old-")
+                        .tempdir_in(&parent)
+                        .map_err(|e| fail(format!("cannot be put in place: {e}")))?
+                        .keep();
+                    if std::fs::rename(&self.root, aside.join("report")).is_err() {
+                        let _ = std::fs::remove_dir(&aside);
+                    } else {
+                        asides.push(aside);
                     }
+                    last = Some(e);
                 }
                 Err(e) => {
-                    let _ = std::fs::remove_dir_all(&work);
-                    return Err(fail(e));
+                    last = Some(e);
+                    break;
                 }
             }
         }
         let _ = std::fs::remove_dir_all(&work);
-        Err(fail(last.unwrap_or_else(|| std::io::Error::other("another run kept replacing it"))))
+        self.restore(&mut asides);
+        let _ = Self::clear(&asides);
+        let e = last.unwrap_or_else(|| std::io::Error::other("another run kept replacing it"));
+        Err(fail(format!("cannot be put in place: {e}")))
+    }
+
+    /// The report last moved aside put back where it was, when nothing took its place: a
+    /// report that cannot be published leaves the earlier one as it found it.
+    fn restore(&self, asides: &mut Vec<PathBuf>) {
+        if let Some(aside) = asides.pop() {
+            if std::fs::rename(aside.join("report"), &self.root).is_ok() {
+                let _ = std::fs::remove_dir(&aside);
+            } else {
+                asides.push(aside);
+            }
+        }
+    }
+
+    /// Remove the earlier reports moved aside, each by its own list (`manifest::remove`): what
+    /// it did not list (put there in the instant between the check and the move) is kept, and
+    /// named.
+    fn clear(asides: &[PathBuf]) -> Result<(), String> {
+        for aside in asides {
+            manifest::remove(&aside.join("report")).map_err(|why| {
+                format!(
+                    "the report is in place, but the earlier one moved aside to {} is kept ({why})",
+                    aside.display()
+                )
+            })?;
+            let _ = std::fs::remove_dir(aside);
+        }
+        Ok(())
     }
 }

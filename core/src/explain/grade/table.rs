@@ -1,6 +1,9 @@
 //! The CSV's header and records, one per student in the order given: what `grade.csv` holds.
 //! The fields are plain text (numbers with fixed decimals, empty where nothing was measured);
 //! the `csv` crate quotes them by RFC 4180 where the CLI writes them (the core has no CSV writer).
+//! A text cell that a spreadsheet would take for a formula (a student's file named `=1+2.json`,
+//! `@SUM(…)`) starts with a `'` (`text`, OWASP's "CSV injection"); the numbers are written as
+//! they are, a negative one included.
 
 use super::measure::leaf_sizes_text;
 use super::GradeRow;
@@ -38,6 +41,16 @@ fn opt<T: ToString>(v: Option<T>) -> String {
     v.map_or(String::new(), |v| v.to_string())
 }
 
+/// A text cell as a spreadsheet shows it: one starting with `=`, `+`, `-`, `@`, a tab or a
+/// carriage return (what starts a formula) gets a leading `'`, which makes it text.
+fn text(cell: &str) -> String {
+    if cell.starts_with(['=', '+', '-', '@', '\t', '\r']) {
+        format!("'{cell}")
+    } else {
+        cell.to_string()
+    }
+}
+
 /// The header, then one record per row.
 pub fn csv_records(rows: &[GradeRow]) -> Vec<Vec<String>> {
     let mut out = vec![HEADER.map(String::from).to_vec()];
@@ -48,10 +61,10 @@ pub fn csv_records(rows: &[GradeRow]) -> Vec<Vec<String>> {
         };
         out.push(vec![
             opt(r.rank),
-            r.name.clone(),
+            text(&r.name),
             r.verdict.label().to_string(),
             opt(r.good.map(|g| if g { "yes" } else { "no" })),
-            r.reason.clone(),
+            text(&r.reason),
             r.defects.to_string(),
             r.warnings.to_string(),
             opt(q.map(|q| q.layout)),
@@ -69,10 +82,10 @@ pub fn csv_records(rows: &[GradeRow]) -> Vec<Vec<String>> {
             f(1, q.map(|q| q.trace_ns_per_ray)),
             f(1, q.map(|q| q.speedup_over_linear)),
             opt(q.map(|q| q.memory_bytes)),
-            r.misses.join("; "),
+            text(&r.misses.join("; ")),
             r.rays_checked.to_string(),
-            r.dump.as_ref().map_or(String::new(), |p| p.display().to_string()),
-            r.submission.display().to_string(),
+            r.dump.as_ref().map_or(String::new(), |p| text(&p.display().to_string())),
+            text(&r.submission.display().to_string()),
         ]);
     }
     out

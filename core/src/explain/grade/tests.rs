@@ -10,7 +10,7 @@ use crate::dump::{import, BvhDump, DumpNode};
 use crate::mesh::generate;
 use std::path::Path;
 
-fn tmp(name: &str) -> PathBuf {
+pub(super) fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("bvhscope-grade-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
