@@ -160,7 +160,13 @@ fn a_class_is_graded_row_by_row_and_ranked_the_same_twice() {
     assert_eq!((field(&a, 1, "layout"), field(&a, 2, "layout")), ("binary", "wide4"));
     assert_eq!(field(&a, 1, "good"), "yes", "within 10 % of the SAH tree");
     assert_eq!(field(&a, 0, "good"), "no", "midpoint is more than 10 % above it on the torus");
-    assert!(field(&a, 0, "misses").starts_with("SAH cost +"));
+    assert!(field(&a, 0, "not_good_because").starts_with("SAH cost +"));
+    // The rays the checker found wrong are counted in a column of their own (issue 59: "misses"
+    // held the rubric's words and was empty for a student whose tree missed rays): none for a
+    // correct tree, some for erin's leaf box that leaves triangles out.
+    let wrong = |name: &str| field(&a, wants.iter().position(|w| w.name == name).unwrap(), "wrong_rays").to_string();
+    assert_eq!(wrong("bob"), "0");
+    assert!(wrong("erin").parse::<u64>().is_ok_and(|n| n > 0), "erin's wrong rays: {:?}", wrong("erin"));
     assert_eq!(field(&a, 3, "dump"), s(&dir.join("dave/bvh.json.gz")), "a folder's one dump");
     // The same class again: the same ranks and verdicts.
     let (b, _) = grade(&class, &dir.join("report-b"), &[]);

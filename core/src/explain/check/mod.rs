@@ -270,6 +270,8 @@ pub struct Checked {
     pub reference: Option<Reference>,
     /// Rays traced.
     pub rays: u64,
+    /// Of them, the rays whose hit through the tree differs from the reference's.
+    pub wrong_rays: u64,
 }
 
 /// Findings of every group for `s`: the tree's, then, when its structure is sound, the rays'
@@ -311,7 +313,14 @@ pub fn check_with(
 
 impl Checked {
     fn untraced(findings: TreeFindings) -> Checked {
-        Checked { findings: findings.ordered(), tree: None, wrong_pixels: Vec::new(), reference: None, rays: 0 }
+        Checked {
+            findings: findings.ordered(),
+            tree: None,
+            wrong_pixels: Vec::new(),
+            reference: None,
+            rays: 0,
+            wrong_rays: 0,
+        }
     }
 }
 
@@ -385,5 +394,6 @@ fn check_rays_of(
         wrong_pixels: wrong.pixels,
         reference: None,
         rays: set.len(),
+        wrong_rays: wrong.count,
     })
 }

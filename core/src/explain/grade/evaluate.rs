@@ -123,6 +123,7 @@ fn checked(
     row.defects = findings.iter().filter(|f| f.defect).count();
     row.warnings = findings.len() - row.defects;
     row.rays_checked = checked.rays;
+    row.wrong_rays = checked.wrong_rays;
     let first_required = findings.iter().find(|f| f.defect && f.required);
     if let (Some(w), true) = (wrong_mesh(&subject), row.defects > 0) {
         (row.verdict, row.reason) = (Verdict::WrongMesh, w.text);

@@ -199,13 +199,15 @@ pub struct GradeRow {
     pub findings_total: usize,
     /// Rays the checker traced.
     pub rays_checked: u64,
+    /// Of them, the rays the student's tree hit differently from the linear scan.
+    pub wrong_rays: u64,
     pub quality: Option<Quality>,
     pub versus_sah: Option<VersusSah>,
     /// Place in the class among the correct submissions (1 = best), by the rubric's key.
     pub rank: Option<usize>,
     /// Whether every "good" threshold of the rubric is met (correct submissions only).
     pub good: Option<bool>,
-    /// The thresholds missed, in words.
+    /// The rubric's "good" thresholds missed, in words (not rays: `wrong_rays` counts those).
     pub misses: Vec<String>,
     pub images: Option<Images>,
     /// What else went wrong that is not the student's (an image that could not be written).
@@ -230,6 +232,7 @@ impl GradeRow {
             findings: Vec::new(),
             findings_total: 0,
             rays_checked: 0,
+            wrong_rays: 0,
             quality: None,
             versus_sah: None,
             rank: None,

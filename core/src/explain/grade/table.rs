@@ -8,7 +8,7 @@
 use super::measure::leaf_sizes_text;
 use super::GradeRow;
 
-pub const HEADER: [&str; 26] = [
+pub const HEADER: [&str; 27] = [
     "rank",
     "student",
     "verdict",
@@ -31,8 +31,9 @@ pub const HEADER: [&str; 26] = [
     "trace_ns_per_ray",
     "speedup_over_linear",
     "memory_bytes",
-    "misses",
+    "not_good_because",
     "rays_checked",
+    "wrong_rays",
     "dump",
     "submission",
 ];
@@ -84,6 +85,7 @@ pub fn csv_records(rows: &[GradeRow]) -> Vec<Vec<String>> {
             opt(q.map(|q| q.memory_bytes)),
             text(&r.misses.join("; ")),
             r.rays_checked.to_string(),
+            r.wrong_rays.to_string(),
             r.dump.as_ref().map_or(String::new(), |p| text(&p.display().to_string())),
             text(&r.submission.display().to_string()),
         ]);

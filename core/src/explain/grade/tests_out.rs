@@ -143,7 +143,7 @@ fn csv_text_cells_never_start_a_formula_and_numbers_stay_numbers() {
         let text = |v: String| if escaped { format!("'{v}") } else { v };
         assert_eq!(r[col("reason")], text(format!("{n}: no dump")));
         assert_eq!(r[col("submission")], text(format!("{n}.json")));
-        assert_eq!(r[col("misses")], format!("'-{n}"));
+        assert_eq!(r[col("not_good_because")], format!("'-{n}"));
         assert_eq!(r[col("sah_cost_vs_sah_tree")], "-5.4000", "a number is not text");
     }
 }
