@@ -7,7 +7,10 @@ use crate::bvh::morton::MortonOrder;
 use crate::bvh::{SahCost, TraceOptions};
 use crate::explain::replay::Replay;
 use crate::mesh::Mesh;
-use crate::render::{draw_legend, grid_values, render_progressive, Camera, ColorMap, Legend, RenderSettings, View};
+use crate::render::{
+    draw_legend_wrapped, grid_values, legend_rows, render_progressive, Camera, ColorMap, Legend, LegendRows,
+    RenderSettings, View,
+};
 use crate::work::{Cancelled, WorkControl};
 use image::RgbImage;
 use std::fmt::Write;
@@ -99,7 +102,7 @@ pub fn film(
     }
     let max = values.iter().flatten().copied().fold(0f32, f32::max).max(1e-20);
     let morton = MortonOrder::of(&replay.tree);
-    let (mut images, mut out) = (Vec::new(), Vec::new());
+    let (mut frames, mut out) = (Vec::new(), Vec::new());
     let (w, h) = (camera.width, camera.height);
     for (&k, v) in ks.iter().zip(&values) {
         let mean = v.iter().map(|&x| x as f64).sum::<f64>() / v.len().max(1) as f64;
@@ -132,9 +135,15 @@ pub fn film(
             max: v.iter().copied().fold(0.0, f32::max),
             mean,
         };
-        images.push(draw_legend(&img, &legend));
+        frames.push((img, legend));
         out.push(FilmStep { splits: k, sah: replay.sah[k], mean, split });
     }
+    // One strip for the whole film: each text at the body's size on as many rows as its longest
+    // frame needs. Fitted frame by frame, a headline that grew a digit shrank to half size and
+    // jumped between frames, and a GIF's frames must share one size anyway.
+    let rows = frames.iter().fold(LegendRows::default(), |r, (img, l)| r.max(legend_rows(img.width(), l)));
+    // Each plain frame let go once its strip is drawn: a long film holds one set of images, not two.
+    let images = frames.into_iter().map(|(img, l)| draw_legend_wrapped(&img, &l, rows)).collect();
     Ok(ReplayFilm { images, steps: out })
 }
 
@@ -196,5 +205,54 @@ mod tests {
         let stop = WorkControl::new();
         stop.cancel();
         assert!(film(&replay, &mesh, &camera, &s, "knot", &stop).is_err());
+    }
+
+    /// Rows of `img` from `from` down that have a light pixel (text; the colour bar is darker in red
+    /// only at its start, so runs are taken from the top and the bottom of the strip).
+    fn inked_runs(img: &RgbImage, from: u32) -> Vec<(u32, u32)> {
+        let inked = |y: u32| (0..img.width()).any(|x| img.get_pixel(x, y).0.iter().all(|&c| c > 200));
+        let mut runs: Vec<(u32, u32)> = Vec::new();
+        for y in (from..img.height()).filter(|&y| inked(y)) {
+            match runs.last_mut() {
+                Some((_, end)) if *end == y => *end = y + 1,
+                _ => runs.push((y, y + 1)),
+            }
+        }
+        runs
+    }
+
+    /// A headline too long for the frame ("combined cost: 12/4095 splits, SAH 1078.7" in a frame
+    /// 480 pixels wide) keeps the body text's size on every frame, wrapped rather than shrunk to
+    /// half size (issue 59: 7-pixel headlines jumping between frames of a replay GIF), and every
+    /// frame has the same size.
+    #[test]
+    fn a_long_headline_wraps_at_the_body_size_on_every_frame() {
+        let mesh = generate::torus_knot(2, 3, 0.3, 64, 8);
+        let tree = Arc::new(Bvh::build(&mesh, &BuildParams { layout: Layout::Binary, ..BuildParams::default() }));
+        let replay = Replay::of(tree);
+        let camera = Camera::framing_up(&mesh.bounds(), 480, 24, crate::render::UpAxis::Y, 45.0);
+        let s = FilmSettings {
+            view: View::Cost,
+            colormap: ColorMap::Viridis,
+            frames: 8,
+            trace: TraceOptions::default(),
+            cost: SahCost::default(),
+        };
+        let f = film(&replay, &mesh, &camera, &s, "knot", &WorkControl::new()).unwrap();
+        let size = (f.images[0].width(), f.images[0].height());
+        assert!(f.images.iter().all(|i| (i.width(), i.height()) == size), "one size for every frame");
+        let mut headline = None;
+        for (i, img) in f.images.iter().enumerate() {
+            let runs = inked_runs(img, 24);
+            // The headline's first row of glyphs, and the min / mean / max line at the bottom.
+            let (title, summary) = (runs[0], *runs.last().unwrap());
+            let (title_h, body_h) = (title.1 - title.0, summary.1 - summary.0);
+            assert!(title_h >= body_h, "frame {i}: a headline {title_h} px high under body text {body_h} px high");
+            // Its top in one place (its ink's height varies with descenders: "splits," or not).
+            assert_eq!(*headline.get_or_insert(title.0), title.0, "frame {i}: the headline's place");
+            // Wrapped, not cut off: no ink at the strip's right edge.
+            let right = (title.0..title.1).any(|y| (size.0 - 4..size.0).any(|x| img.get_pixel(x, y).0[0] > 200));
+            assert!(!right, "frame {i}: the headline runs off the frame");
+        }
     }
 }

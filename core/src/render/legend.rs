@@ -64,30 +64,170 @@ pub fn fmt_value(v: f64) -> String {
 
 /// Height of the strip `draw_legend` appends for `legend`.
 pub fn legend_height(legend: &Legend) -> u32 {
-    let lines = 3 + u32::from(!legend.subject.is_empty()) + u32::from(!legend.note.is_empty());
-    PAD * (lines + 1) + LINE * lines
+    rows_height(one_row_each(legend))
+}
+
+/// Space between the rows of one wrapped text: less than between the strip's texts, so a headline
+/// broken in two still reads as one.
+const WRAP_GAP: u32 = PAD / 2;
+
+/// How many rows each text of a legend strip takes when it is wrapped rather than shrunk
+/// (`draw_legend_wrapped`). The frames of one film take the largest of each (`max`), so every
+/// frame has the same size (a GIF's frames share one) and its headline the same place.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LegendRows {
+    pub title: u32,
+    pub subject: u32,
+    pub note: u32,
+    pub summary: u32,
+}
+
+impl LegendRows {
+    /// Each text's larger count.
+    pub fn max(self, o: LegendRows) -> LegendRows {
+        LegendRows {
+            title: self.title.max(o.title),
+            subject: self.subject.max(o.subject),
+            note: self.note.max(o.note),
+            summary: self.summary.max(o.summary),
+        }
+    }
+}
+
+/// `draw_legend`'s rows: a line for each text it has (the title always).
+fn one_row_each(legend: &Legend) -> LegendRows {
+    LegendRows {
+        title: 1,
+        subject: u32::from(!legend.subject.is_empty()),
+        note: u32::from(!legend.note.is_empty()),
+        summary: 1,
+    }
+}
+
+/// The strip's height for `rows`: the texts and the colour bar, `PAD` around each, `WRAP_GAP`
+/// between the rows of one text.
+fn rows_height(r: LegendRows) -> u32 {
+    let blocks = [r.title, r.subject, r.note, 1, r.summary];
+    let texts = blocks.iter().filter(|&&n| n > 0).count() as u32;
+    let rows: u32 = blocks.iter().sum();
+    PAD * (texts + 1) + LINE * rows + WRAP_GAP * (rows - texts)
+}
+
+/// `s` broken at spaces into lines of at most `chars` characters; a word longer than a line is
+/// broken inside it (a path or a long number stays whole across lines rather than cut off).
+fn wrap(s: &str, chars: usize) -> Vec<String> {
+    let chars = chars.max(1);
+    // A text that fits is kept as it is (the summary's double spaces).
+    if !s.is_empty() && s.chars().count() <= chars {
+        return vec![s.to_string()];
+    }
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for word in s.split(' ').filter(|w| !w.is_empty()) {
+        let (len, n) = (line.chars().count(), word.chars().count());
+        if len > 0 && len + 1 + n <= chars {
+            line.push(' ');
+            line.push_str(word);
+            continue;
+        }
+        if len > 0 {
+            lines.push(std::mem::take(&mut line));
+        }
+        let letters: Vec<char> = word.chars().collect();
+        let mut pieces = letters.chunks(chars).map(|c| c.iter().collect::<String>()).peekable();
+        while let Some(piece) = pieces.next() {
+            if pieces.peek().is_some() {
+                lines.push(piece);
+            } else {
+                line = piece;
+            }
+        }
+    }
+    if !line.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
+/// Characters of the legend's text size that fit on a line of a strip `w` wide.
+fn chars_per_line(w: u32) -> usize {
+    (w.saturating_sub(2 * PAD) / text_width("x", TEXT_SCALE)).max(1) as usize
+}
+
+/// The rows `legend`'s texts take wrapped at the legend's text size, in the strip below an image
+/// `width` wide (the title keeps its row even when empty, as in `draw_legend`).
+pub fn legend_rows(width: u32, legend: &Legend) -> LegendRows {
+    let chars = chars_per_line(strip_width(width, legend));
+    let rows = |s: &str| wrap(s, chars).len() as u32;
+    LegendRows {
+        title: rows(&legend.title).max(1),
+        subject: rows(&legend.subject),
+        note: rows(&legend.note),
+        summary: rows(&summary(legend)).max(1),
+    }
+}
+
+/// The frame's min / mean / max, as the strip's last line says them.
+fn summary(legend: &Legend) -> String {
+    format!(
+        "min {}  mean {}  max {}",
+        fmt_value(legend.min as f64),
+        fmt_value(legend.mean),
+        fmt_value(legend.max as f64)
+    )
+}
+
+/// The strip's width below an image `width` wide: wide enough for both range labels and a bar
+/// between them, whatever the image's width.
+fn strip_width(width: u32, legend: &Legend) -> u32 {
+    let lo = fmt_value(legend.range_min as f64);
+    let hi = fmt_value(legend.range_max as f64);
+    let labels = PAD + text_width(&lo, TEXT_SCALE) + PAD + 4 * LINE + PAD + text_width(&hi, TEXT_SCALE) + PAD;
+    width.max(2 * PAD + 10 * LINE).max(labels)
 }
 
 /// The image with a legend strip appended below it: the title, what the image is of (mesh,
-/// strategy, layout), the colour bar with its range, and the frame's min / mean / max.
+/// strategy, layout), the colour bar with its range, and the frame's min / mean / max. A text
+/// too long for the strip is drawn at half size.
 pub fn draw_legend(img: &RgbImage, legend: &Legend) -> RgbImage {
-    let strip = legend_height(legend);
+    strip(img, legend, one_row_each(legend), false)
+}
+
+/// `draw_legend` with every text at the legend's size, wrapped onto more rows where it is too
+/// long (never shrunk), in at least `rows` rows each: a film's frames, given the `max` of their
+/// `legend_rows`, share one size and one headline size whatever each frame's numbers.
+pub fn draw_legend_wrapped(img: &RgbImage, legend: &Legend, rows: LegendRows) -> RgbImage {
+    strip(img, legend, rows.max(legend_rows(img.width(), legend)), true)
+}
+
+/// The strip below `img` with `rows` rows for each text; `wrapped` breaks a long text onto its
+/// rows, else it is drawn on one at the size that fits.
+fn strip(img: &RgbImage, legend: &Legend, rows: LegendRows, wrapped: bool) -> RgbImage {
     let lo = fmt_value(legend.range_min as f64);
     let hi = fmt_value(legend.range_max as f64);
-    // Wide enough for both range labels and a bar between them, whatever the image's width.
-    let labels = PAD + text_width(&lo, TEXT_SCALE) + PAD + 4 * LINE + PAD + text_width(&hi, TEXT_SCALE) + PAD;
-    let (w, h) = (img.width().max(2 * PAD + 10 * LINE).max(labels), img.height());
-    let mut out = below(img, w, h + strip, [24, 24, 24]);
+    let (w, h) = (strip_width(img.width(), legend), img.height());
+    let mut out = below(img, w, h + rows_height(rows), [24, 24, 24]);
     let white = Rgb([235, 235, 235]);
     let grey = Rgb([170, 170, 170]);
-    let mut y = h + PAD;
-    draw_line(&mut out, PAD, y, &legend.title, white, w - 2 * PAD);
-    for line in [&legend.subject, &legend.note].into_iter().filter(|l| !l.is_empty()) {
-        y += LINE + PAD;
-        draw_line(&mut out, PAD, y, line, grey, w - 2 * PAD);
-    }
+    let chars = chars_per_line(w);
+    // A text in its `n` rows from `y`; the `y` below them and their gap.
+    let text = |out: &mut RgbImage, y: u32, s: &str, color: Rgb<u8>, n: u32| -> u32 {
+        if n == 0 {
+            return y;
+        }
+        if wrapped {
+            for (i, line) in wrap(s, chars).iter().enumerate() {
+                draw_text(out, PAD, y + i as u32 * (LINE + WRAP_GAP), line, color, TEXT_SCALE);
+            }
+        } else {
+            draw_line(out, PAD, y, s, color, w - 2 * PAD);
+        }
+        y + n * LINE + (n - 1) * WRAP_GAP + PAD
+    };
+    let y = text(&mut out, h + PAD, &legend.title, white, rows.title);
+    let y = text(&mut out, y, &legend.subject, grey, rows.subject);
     // Colour bar between the two range labels.
-    let bar_y = y + LINE + PAD;
+    let bar_y = text(&mut out, y, &legend.note, grey, rows.note);
     let bar_x0 = PAD + text_width(&lo, TEXT_SCALE) + PAD;
     let bar_x1 = w.saturating_sub(PAD + text_width(&hi, TEXT_SCALE) + PAD).max(bar_x0 + 1);
     draw_text(&mut out, PAD, bar_y, &lo, white, TEXT_SCALE);
@@ -98,13 +238,7 @@ pub fn draw_legend(img: &RgbImage, legend: &Legend) -> RgbImage {
             out.put_pixel(x, y, Rgb(c));
         }
     }
-    let summary = format!(
-        "min {}  mean {}  max {}",
-        fmt_value(legend.min as f64),
-        fmt_value(legend.mean),
-        fmt_value(legend.max as f64)
-    );
-    draw_line(&mut out, PAD, bar_y + LINE + PAD, &summary, white, w - 2 * PAD);
+    text(&mut out, bar_y + LINE + PAD, &summary(legend), white, rows.summary);
     out
 }
 
@@ -202,5 +336,35 @@ mod tests {
             .rev()
             .find(|&x| (10 + PAD + LINE..10 + 2 * (PAD + LINE)).any(|y| small.get_pixel(x, y).0[0] > 100));
         assert!(last_col.is_some_and(|x| x < 600 - PAD), "the long subject ends inside the strip: {last_col:?}");
+    }
+
+    /// Words stay whole where they fit; a word longer than a line is broken, not cut off.
+    #[test]
+    fn wrap_breaks_at_spaces_and_inside_only_words_too_long() {
+        assert_eq!(
+            wrap("nodes visited: 183/21880 splits, SAH 1078.7", 24),
+            ["nodes visited: 183/21880", "splits, SAH 1078.7"]
+        );
+        assert_eq!(wrap("a bunny-from-the-lab.obj x", 8), ["a", "bunny-fr", "om-the-l", "ab.obj x"]);
+        assert_eq!(wrap("fits", 4), ["fits"]);
+        assert!(wrap("", 10).is_empty());
+    }
+
+    /// Wrapped strips for titles of different lengths, given the larger rows, have one size; with
+    /// one row each they are `draw_legend`'s strips, pixel for pixel.
+    #[test]
+    fn wrapped_strips_share_one_size() {
+        // 400 pixels: 24 characters a line, the summary's length.
+        let img = RgbImage::new(400, 40);
+        let short = Legend { title: "visits".into(), ..legend("x") };
+        let long = Legend { title: "nodes visited: 183/21880 splits, SAH 1078.7".into(), ..legend("x") };
+        let rows = legend_rows(400, &short).max(legend_rows(400, &long));
+        assert_eq!(legend_rows(400, &short), one_row_each(&short), "a short title fits on one row");
+        assert_eq!(rows, LegendRows { title: 2, subject: 1, note: 0, summary: 1 });
+        let (a, b) = (draw_legend_wrapped(&img, &short, rows), draw_legend_wrapped(&img, &long, rows));
+        assert_eq!((a.width(), a.height()), (b.width(), b.height()));
+        assert_eq!(a.height(), 40 + legend_height(&short) + LINE + WRAP_GAP);
+        let wide = RgbImage::new(800, 40);
+        assert!(draw_legend_wrapped(&wide, &long, legend_rows(800, &long)) == draw_legend(&wide, &long));
     }
 }

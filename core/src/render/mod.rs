@@ -22,7 +22,7 @@ pub use camera::{Camera, CameraError, RayGen, RayGenParts, UpAxis};
 pub use colormap::ColorMap;
 pub use frame::{Frame, FramePool, FromHitsError};
 pub use incoherent::incoherent_rays;
-pub use legend::{draw_legend, legend_height};
+pub use legend::{draw_legend, draw_legend_wrapped, legend_height, legend_rows, LegendRows};
 pub use pair::PairView;
 pub use ray_summary::RaySummary;
 pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
