@@ -263,3 +263,32 @@ fn replay_writes_an_animated_png_and_the_sah_cost_per_step() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("must end in .gif or .png"));
     assert!(!mp4.exists());
 }
+
+/// A replay GIF's headline ("nodes visited: 0/2296 splits, SAH 4096.0") too long for its frame is
+/// wrapped at the body text's size on every frame, never shrunk to half of it (issue 59: 7-pixel
+/// headlines in some frames, their size jumping between frames).
+#[test]
+fn a_replay_gif_keeps_its_headline_size_on_every_frame() {
+    let knot = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/knot.obj");
+    let gif = tmp("replay-headline.gif");
+    let args = ["replay", knot, "--view", "visits", "--size", "480x24", "--frames", "6", "-o", gif.to_str().unwrap()];
+    let out = bvhscope(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&gif).unwrap();
+    let mut opts = gif::DecodeOptions::new();
+    opts.set_color_output(gif::ColorOutput::RGBA);
+    let mut d = opts.read_info(&bytes[..]).unwrap();
+    let w = d.width() as usize;
+    let mut runs = Vec::new();
+    while let Some(f) = d.read_next_frame().unwrap() {
+        // Rows below the image with white text (the headline first, the min / mean / max last).
+        let white = |y: usize| (0..w).any(|x| f.buffer[(y * w + x) * 4..][..3].iter().all(|&c| c > 200));
+        let rows: Vec<usize> = (24..f.height as usize).filter(|&y| white(y)).collect();
+        let first_run = rows.windows(2).take_while(|p| p[1] == p[0] + 1).count() + 1;
+        runs.push((rows[0], first_run));
+    }
+    assert_eq!(runs.len(), 6);
+    // Glyphs 14 pixels high (16 with a descender) at the body's size, 8 at most at half of it.
+    assert!(runs.iter().all(|&r| r.0 == runs[0].0), "one place for the headline: {runs:?}");
+    assert!(runs.iter().all(|&r| r.1 >= 12), "the headline at the body's size, not half of it: {runs:?}");
+}
