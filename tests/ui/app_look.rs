@@ -208,3 +208,23 @@ fn look_main_views() {
     h.state_mut().act(Action::CompareMode(bvhscope::render::PairView::Difference));
     save(&mut h, "app-compare-difference");
 }
+
+/// The View menu presenting at 1280×720 (issue 59): taller than the window, it scrolls: as it
+/// opens, and scrolled to its end (Present, Size, Reset the layout).
+#[test]
+#[ignore]
+fn look_view_menu_presenting() {
+    use egui::accesskit::Role;
+    use egui_kittest::kittest::Queryable;
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 720.0))
+        .wgpu()
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+    h.state_mut().act(Action::Present(true));
+    run_until(&mut h, "the first frame", idle);
+    h.get_by_role_and_label(Role::Button, "View").click();
+    h.run_steps(3);
+    save(&mut h, "projector-view-menu-present");
+    h.get_by_role_and_label(Role::Button, "View").get_by_label("Reset the layout").scroll_to_me();
+    save(&mut h, "projector-view-menu-present-end");
+}

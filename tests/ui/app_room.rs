@@ -217,3 +217,60 @@ fn presenting_draws_everything_larger_and_the_node_view_writes_its_planes_out() 
         }
     }
 }
+
+/// Presenting at 1280×720 (480 points tall at 150 %) the View menu is taller than the window:
+/// it scrolls, so its last commands (Compare side by side, Present, Size, Reset the layout) can
+/// be brought inside the window and clicked with the pointer (issue 59).
+#[test]
+fn presenting_at_720_px_the_view_menu_reaches_every_command() {
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 720.0))
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+    h.state_mut().act(Action::Present(true));
+    run_until(&mut h, "the first frame", idle);
+    let open_view = |h: &mut Harness<'_, BvhscopeApp>| {
+        h.get_by_role_and_label(Role::Button, "View").click();
+        h.run_steps(3);
+    };
+    // The menu's items hang below its button in the accessibility tree (other panels have a
+    // "Size" or a "100 %" of their own).
+    fn item<'t>(h: &'t Harness<'_, BvhscopeApp>, part: &'t str) -> egui_kittest::Node<'t> {
+        h.get_by_role_and_label(Role::Button, "View").get_by_label_contains(part)
+    }
+    // Scroll `part`'s item into view as a screen reader does; its rectangle, inside the window.
+    let shown = |h: &mut Harness<'_, BvhscopeApp>, part: &str| {
+        item(h, part).scroll_to_me();
+        h.run_steps(3);
+        let screen = h.ctx.content_rect();
+        let r = item(h, part).rect();
+        assert!(screen.contains_rect(r), "{part:?} at {r:?}, outside the window {screen:?}");
+        r
+    };
+    open_view(&mut h);
+    let bar = h.get_by_role_and_label(Role::Button, "View").rect();
+    let first = bvhscope::render::View::ALL[0].label();
+    for part in ["Reset the layout", "Size ", "100 %", "Present (", "Compare side by side", first] {
+        let r = shown(&mut h, part);
+        assert!(r.min.y >= bar.max.y, "{part:?} at {r:?} over the menu bar's {bar:?}");
+    }
+    // The pointer reaches them: a click on Compare side by side opens B ...
+    shown(&mut h, "Compare side by side");
+    item(&h, "Compare side by side").click();
+    h.run_steps(3);
+    assert!(h.state().compare.on, "Compare side by side clicked");
+    // ... and one on Present, near the bottom, ends presenting.
+    open_view(&mut h);
+    shown(&mut h, "Present (");
+    item(&h, "Present (").click();
+    h.run_steps(3);
+    assert!(!h.state().settings.present, "Present clicked");
+    // At scale 1 the window holds the whole menu: nothing to scroll, its first and last items in
+    // view as it opens.
+    h.run_steps(3);
+    open_view(&mut h);
+    let screen = h.ctx.content_rect();
+    for part in [first, "Reset the layout"] {
+        let r = item(&h, part).rect();
+        assert!(screen.contains_rect(r) && r.min.y >= bar.max.y, "{part:?} at {r:?} with nothing scrolled");
+    }
+}

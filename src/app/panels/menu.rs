@@ -1,4 +1,5 @@
-//! The menu bar: File (open, recent, built-in scene, export), View, Help.
+//! The menu bar: File (open, recent, built-in scene, export), View, Help; each menu scrolls when
+//! taller than the window.
 
 use crate::app::state::shortcuts::{shortcut_text as format_shortcut, SHORTCUTS};
 use crate::app::state::{Action, Actions, BvhscopeApp};
@@ -16,12 +17,39 @@ fn item(ui: &mut egui::Ui, out: &mut Actions, text: &str, action: Action) {
     }
 }
 
+/// A menu (top-level or within one) whose body scrolls when it is taller than the room between
+/// its top and the window's bottom. A popup that does not fit is cut off at the window's edge:
+/// presenting at 720 px (480 points at 150 %), the View menu's last commands were out of reach.
+fn menu(ui: &mut egui::Ui, title: &str, content: impl FnOnce(&mut egui::Ui)) {
+    ui.menu_button(title, |ui| {
+        // Below the body come the popup frame's margin and stroke, and a little air so the last
+        // item does not touch the window's edge.
+        let below =
+            ui.spacing().menu_margin.bottomf() + ui.visuals().window_stroke().width + ui.spacing().item_spacing.y;
+        let room = ui.ctx().content_rect().bottom() - ui.cursor().top() - below;
+        // A solid bar, shown whenever the body scrolls: a floating one stays hidden until the
+        // pointer is over it, and a menu cut short with no sign of more looks complete.
+        ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+        // At least a few rows, even in a window too small to hold them.
+        let room = room.max(3.0 * ui.spacing().interact_size.y);
+        // The room as the least height too: the popup's first frame measures it at most 400
+        // points tall, every later frame offers no more than that, and a body scrolling in
+        // 400 points would scroll in a window with room for all of it.
+        egui::ScrollArea::vertical().max_height(room).min_scrolled_height(room).show(ui, |ui| {
+            // The bar takes its width from the items: without this their labels wrap ("SIMT
+            // efficiency (32 / lanes)") where the menu could grow by the bar's width instead.
+            ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Extend);
+            content(ui)
+        });
+    });
+}
+
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     egui::MenuBar::new().ui(ui, |ui| {
-        ui.menu_button("File", |ui| {
+        menu(ui, "File", |ui| {
             item(ui, out, "Open…", Action::Open);
             item(ui, out, "Open path…", Action::OpenPath);
-            ui.menu_button("Open recent", |ui| {
+            menu(ui, "Open recent", |ui| {
                 if app.settings.recent_files.is_empty() {
                     ui.weak("No recent files");
                 }
@@ -95,7 +123,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
             }
         });
-        ui.menu_button("View", |ui| {
+        menu(ui, "View", |ui| {
             for (i, v) in View::ALL.iter().enumerate() {
                 let shortcut = shortcut_text(ui.ctx(), &Action::View(i));
                 if ui
@@ -163,7 +191,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 out.push(Action::ResetLayout);
             }
         });
-        ui.menu_button("Help", |ui| {
+        menu(ui, "Help", |ui| {
             let shortcut = shortcut_text(ui.ctx(), &Action::Help);
             if ui.add(egui::Button::new("Keyboard and mouse").shortcut_text(shortcut)).clicked() {
                 out.push(Action::SetHelp(true));
