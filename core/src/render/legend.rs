@@ -113,8 +113,9 @@ fn rows_height(r: LegendRows) -> u32 {
     PAD * (texts + 1) + LINE * rows + WRAP_GAP * (rows - texts)
 }
 
-/// `s` broken at spaces into lines of at most `chars` characters; a word longer than a line is
-/// broken inside it (a path or a long number stays whole across lines rather than cut off).
+/// `s` broken into lines of at most `chars` characters: after a comma where the phrases fit
+/// ("nodes visited: 0/2296 splits," above "SAH 4096.0", not "SAH" above its number), else at
+/// spaces; a word longer than a line is broken inside it (a path stays whole, not cut off).
 fn wrap(s: &str, chars: usize) -> Vec<String> {
     let chars = chars.max(1);
     // A text that fits is kept as it is (the summary's double spaces).
@@ -123,30 +124,41 @@ fn wrap(s: &str, chars: usize) -> Vec<String> {
     }
     let mut lines: Vec<String> = Vec::new();
     let mut line = String::new();
-    for word in s.split(' ').filter(|w| !w.is_empty()) {
-        let (len, n) = (line.chars().count(), word.chars().count());
-        if len > 0 && len + 1 + n <= chars {
-            line.push(' ');
-            line.push_str(word);
-            continue;
-        }
-        if len > 0 {
+    for phrase in s.split_inclusive(", ").map(str::trim).filter(|p| !p.is_empty()) {
+        let (len, n) = (line.chars().count(), phrase.chars().count());
+        if len > 0 && n <= chars && len + 1 + n > chars {
             lines.push(std::mem::take(&mut line));
         }
-        let letters: Vec<char> = word.chars().collect();
-        let mut pieces = letters.chunks(chars).map(|c| c.iter().collect::<String>()).peekable();
-        while let Some(piece) = pieces.next() {
-            if pieces.peek().is_some() {
-                lines.push(piece);
-            } else {
-                line = piece;
-            }
+        for word in phrase.split(' ').filter(|w| !w.is_empty()) {
+            add_word(&mut lines, &mut line, word, chars);
         }
     }
     if !line.is_empty() {
         lines.push(line);
     }
     lines
+}
+
+/// `word` after `line` when it fits there, else on lines of its own (`chars` letters at a time).
+fn add_word(lines: &mut Vec<String>, line: &mut String, word: &str, chars: usize) {
+    let (len, n) = (line.chars().count(), word.chars().count());
+    if len > 0 && len + 1 + n <= chars {
+        line.push(' ');
+        line.push_str(word);
+        return;
+    }
+    if len > 0 {
+        lines.push(std::mem::take(line));
+    }
+    let letters: Vec<char> = word.chars().collect();
+    let mut pieces = letters.chunks(chars).map(|c| c.iter().collect::<String>()).peekable();
+    while let Some(piece) = pieces.next() {
+        if pieces.peek().is_some() {
+            lines.push(piece);
+        } else {
+            *line = piece;
+        }
+    }
 }
 
 /// Characters of the legend's text size that fit on a line of a strip `w` wide.
@@ -338,13 +350,18 @@ mod tests {
         assert!(last_col.is_some_and(|x| x < 600 - PAD), "the long subject ends inside the strip: {last_col:?}");
     }
 
-    /// Words stay whole where they fit; a word longer than a line is broken, not cut off.
+    /// Phrases, then words, stay whole where they fit; a word longer than a line is broken, not cut off.
     #[test]
-    fn wrap_breaks_at_spaces_and_inside_only_words_too_long() {
+    fn wrap_breaks_after_commas_then_at_spaces_and_inside_only_words_too_long() {
         assert_eq!(
             wrap("nodes visited: 183/21880 splits, SAH 1078.7", 24),
             ["nodes visited: 183/21880", "splits, SAH 1078.7"]
         );
+        assert_eq!(
+            wrap("nodes visited: 0/2296 splits, SAH 4096.0", 39),
+            ["nodes visited: 0/2296 splits,", "SAH 4096.0"]
+        );
+        assert_eq!(wrap("knot.obj, SAH binned, log scale", 20), ["knot.obj,", "SAH binned,", "log scale"]);
         assert_eq!(wrap("a bunny-from-the-lab.obj x", 8), ["a", "bunny-fr", "om-the-l", "ab.obj x"]);
         assert_eq!(wrap("fits", 4), ["fits"]);
         assert!(wrap("", 10).is_empty());
