@@ -258,8 +258,11 @@ fn presenting_at_720_px_the_view_menu_reaches_every_command() {
     item(&h, "Compare side by side").click();
     h.run_steps(3);
     assert!(h.state().compare.on, "Compare side by side clicked");
-    // ... and one on Present, near the bottom, ends presenting.
+    // ... and one on Present, near the bottom, ends presenting. Opened again, the menu starts at
+    // its top, not where it was scrolled to.
     open_view(&mut h);
+    let top = item(&h, first).rect();
+    assert!(top.min.y >= bar.max.y && top.max.y <= h.ctx.content_rect().max.y, "{first:?} at {top:?} on opening");
     shown(&mut h, "Present (");
     item(&h, "Present (").click();
     h.run_steps(3);

@@ -35,7 +35,17 @@ fn menu(ui: &mut egui::Ui, title: &str, content: impl FnOnce(&mut egui::Ui)) {
         // The room as the least height too: the popup's first frame measures it at most 400
         // points tall, every later frame offers no more than that, and a body scrolling in
         // 400 points would scroll in a window with room for all of it.
-        egui::ScrollArea::vertical().max_height(room).min_scrolled_height(room).show(ui, |ui| {
+        let mut body = egui::ScrollArea::vertical().max_height(room).min_scrolled_height(room);
+        // A menu opens at its top, not where it was scrolled to the last time it was open: the
+        // scroll offset is kept under the same id from one opening to the next.
+        let pass = ui.ctx().cumulative_pass_nr();
+        let seen = ui.scope_id().with("menu shown in pass");
+        let last: Option<u64> = ui.data(|d| d.get_temp(seen));
+        ui.data_mut(|d| d.insert_temp(seen, pass));
+        if last.is_none_or(|l| l + 1 != pass) {
+            body = body.vertical_scroll_offset(0.0);
+        }
+        body.show(ui, |ui| {
             // The bar takes its width from the items: without this their labels wrap ("SIMT
             // efficiency (32 / lanes)") where the menu could grow by the bar's width instead.
             ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Extend);
