@@ -17,6 +17,10 @@ mod app_replay;
 mod app_room;
 mod app_scenes;
 mod app_truth;
+mod app_tiles;
+mod app_figures;
+mod app_small;
+mod app_legend;
 
 use bvhscope::app::{Action, AppOptions, BvhscopeApp, MessageKind, SceneSource};
 use bvhscope::bvh::Strategy;
