@@ -178,6 +178,8 @@ pub enum Action {
     UiScaleBy(i32),
     /// The docked layout as a fresh start has it.
     ResetLayout,
+    /// The heatmap legend folded to its colour bar (`true`) or shown whole.
+    FoldLegend(bool),
 }
 
 /// Where panels put the actions they emit during one frame.

@@ -61,6 +61,8 @@ pub struct Settings {
     /// Presenting to a room (View › Present): everything at least `PRESENT_SCALE`, the Node
     /// view's plots half its tile tall.
     pub present: bool,
+    /// The heatmap legend folded to its colour bar beside or below the image (more room for it).
+    pub legend_folded: bool,
 }
 
 /// Presenting: text of at least 18 px (egui's body text is 12.5 px at scale 1).
@@ -106,6 +108,7 @@ impl Default for Settings {
             recent_files: Vec::new(),
             ui_scale: 1.0,
             present: false,
+            legend_folded: false,
         }
     }
 }

@@ -309,6 +309,7 @@ impl BvhscopeApp {
                 self.settings.present &= self.settings.ui_scale >= PRESENT_SCALE;
             }
             A::ResetLayout => self.dock = Some(dock::default_layout()),
+            A::FoldLegend(folded) => self.settings.legend_folded = folded,
             A::DismissEarlier(n) => {
                 self.messages.drain(..n.min(self.messages.len()));
             }
