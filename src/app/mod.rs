@@ -86,7 +86,8 @@ impl eframe::App for BvhscopeApp {
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         eframe::set_value(storage, eframe::APP_KEY, &self.settings);
-        if let Some(layout) = &self.dock {
+        // Presenting, the layout to come back to is saved, not the one fitted for the room.
+        if let Some(layout) = self.dock_presenting.as_ref().map(|p| p.before()).or(self.dock.as_ref()) {
             eframe::set_value(storage, DOCK_KEY, layout);
         }
     }

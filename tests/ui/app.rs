@@ -265,7 +265,9 @@ fn the_view_and_the_statistics_can_be_exported() {
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["strategies"][0]["tree"]["nodes"], h.state().current_bvh().unwrap().stats.nodes);
     h.run_steps(3);
-    assert_eq!(h.query_all_by_label_contains("Note: Saved").count(), 3, "each file saved is confirmed on screen, once");
+    let saved = h.state().messages.iter().filter(|m| m.text.starts_with("Saved")).count();
+    assert_eq!(saved, 3, "each file saved is confirmed, once");
+    assert_eq!(h.query_all_by_label_contains("Note: Saved").count(), 1, "the newest on the status bar");
 }
 
 #[test]

@@ -228,3 +228,26 @@ fn look_view_menu_presenting() {
     h.get_by_role_and_label(Role::Button, "View").get_by_label("Reset the layout").scroll_to_me();
     save(&mut h, "projector-view-menu-present-end");
 }
+
+/// The heatmap with its legend at 1280×720 (issue 59): beside the image at scale 1, below it
+/// presenting, and folded to its colour bar.
+#[test]
+#[ignore]
+fn look_legend() {
+    for present in [false, true] {
+        let suffix = if present { "-present" } else { "" };
+        let mut h = Harness::builder()
+            .with_size(egui::vec2(1280.0, 720.0))
+            .wgpu()
+            .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+        h.state_mut().act(Action::Present(present));
+        open(&mut h, &root().join("scenes/knot-on-floor.json"));
+        h.state_mut().act(Action::View(2));
+        run_until(&mut h, "the heatmap", |a| idle(a) && a.shown.as_ref().is_some_and(|s| s.legend.is_some()));
+        h.state_mut().message(bvhscope::app::MessageKind::Info, "Opened knot-on-floor.json: 20,480 triangles");
+        save(&mut h, &format!("projector-heatmap{suffix}"));
+        h.state_mut().act(Action::FoldLegend(true));
+        run_until(&mut h, "the image at its new size", idle);
+        save(&mut h, &format!("projector-heatmap-folded{suffix}"));
+    }
+}

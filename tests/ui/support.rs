@@ -30,6 +30,24 @@ pub fn run_until(h: &mut Harness<'_, BvhscopeApp>, what: &str, done: impl Fn(&Bv
     }
     h.step();
     h.step();
+    assert_legend_apart(h);
+}
+
+/// The heatmap legend (its title, its histogram) never over the image: checked each time a test
+/// has waited for something, so in every layout the tests open (issue 59: floating over the image
+/// it hid half of it when presenting).
+pub fn assert_legend_apart(h: &Harness<'_, BvhscopeApp>) {
+    use egui_kittest::kittest::Queryable;
+    let image = h.state().image_rect;
+    let legend = h.query_all_by_label_contains("Legend: ").chain(h.query_all_by_label("Histogram of the heatmap"));
+    for node in legend {
+        let r = node.rect();
+        let both = r.intersect(image);
+        assert!(
+            both.width() <= 0.5 || both.height() <= 0.5,
+            "the legend's part at {r:?} overlaps the image at {image:?}"
+        );
+    }
 }
 
 /// What a long wait is waiting on: the jobs running, the image's size, the frames' cameras.

@@ -7,6 +7,7 @@ mod explain_overlay;
 pub mod grade;
 pub mod imported;
 mod layout;
+mod legend;
 pub mod menu;
 pub mod node;
 pub mod ray;
@@ -25,7 +26,7 @@ use crate::app::state::{Actions, BvhscopeApp};
 pub fn show_all(app: &mut BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let ctx = ui.ctx().clone();
     egui::Panel::top("menu").show(ui, |ui| menu::show(app, ui, out));
-    egui::Panel::bottom("status").show(ui, |ui| status::show(app, ui));
+    egui::Panel::bottom("status").show(ui, |ui| status::show(app, ui, out));
     egui::CentralPanel::default().frame(egui::Frame::NONE).show(ui, |ui| tiles::show(app, ui, out));
     windows::show(app, &ctx, out);
 }

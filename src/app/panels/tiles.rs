@@ -33,6 +33,8 @@ fn view_of(pane: Pane) -> Option<&'static View> {
 /// Lay out the tiles in `ui` (all of it): the open views shown, the closed ones hidden.
 pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let mut layout = app.dock.take().unwrap_or_else(dock::default_layout);
+    let open: Vec<Pane> = VIEWS.iter().filter(|v| (v.is_open)(app)).map(|v| v.pane).collect();
+    app.dock_presenting = dock::present(&mut layout, app.dock_presenting.take(), app.settings.present, &open);
     dock::show_open(&mut layout, |pane| view_of(pane).is_some_and(|v| (v.is_open)(app)));
     let mut tiles = Tiles { app, out };
     layout.ui(&mut tiles, ui);

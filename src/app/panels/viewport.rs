@@ -1,13 +1,13 @@
 //! The central view: the ray-cast image, mouse camera control, the node-box overlay, the heatmap
-//! legend and the per-pixel read-out on hover. It reports its size and the mouse's camera moves
-//! as actions; the app's reconciler renders what it would show.
+//! legend beside or below the image (`legend.rs`) and the per-pixel read-out on hover. Nothing
+//! but what the image shows draws over it: messages are in the status bar. It reports its size
+//! and the mouse's camera moves as actions; the app's reconciler renders what it would show.
 
-use super::explain_overlay;
-use crate::app::state::{overlay, Action, Actions, BvhscopeApp, MessageKind, Shown};
+use super::{explain_overlay, legend};
+use crate::app::state::{overlay, Action, Actions, BvhscopeApp, Shown};
 use crate::app::views::compare::CompareImages;
-use crate::render::legend::fmt_value;
+use crate::render::Frame;
 use crate::render::PairView;
-use crate::render::{Frame, Legend};
 use egui::{Color32, PointerButton, Pos2, Rect, Sense, Stroke, Vec2};
 use std::sync::Arc;
 
@@ -38,7 +38,15 @@ fn image_area(app: &BvhscopeApp, full: Rect, ppp: f32) -> (Rect, (u32, u32)) {
 }
 
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
-    let full = ui.available_rect_before_wrap();
+    let tile = ui.available_rect_before_wrap();
+    // A heatmap's legend takes its part of the tile (chosen by the view, not by the frame on
+    // screen, so the image's size does not change when the frame arrives).
+    let (full, legend_at) = if app.settings.view.is_heatmap() {
+        let (image, legend, place) = legend::split(tile, app.settings.legend_folded);
+        (image, Some((legend, place)))
+    } else {
+        (tile, None)
+    };
     let response = ui.allocate_rect(full, Sense::click_and_drag());
     // The image's rectangle: the viewport, or the film letterboxed in it.
     let (rect, pixels) = image_area(app, full, ui.ctx().pixels_per_point());
@@ -152,18 +160,19 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         );
     }
 
-    messages(app, ui, full, out);
-    if let Some(shown) = &app.shown {
+    if let (Some(shown), Some((at, place))) = (&app.shown, legend_at) {
         let compare_legend = compared.as_ref().and_then(|c| match app.compare.mode {
             PairView::Difference => c.diff.as_ref().map(|d| d.2.clone()),
             _ => c.legend.clone(),
         });
         // The histogram is of the image's own values: not drawn for a side-by-side pair.
-        if let Some(legend) = compare_legend.as_ref() {
-            legend_area(app, ui, full, legend, false, out);
-        } else if let Some(legend) = shown.legend.as_ref() {
-            legend_area(app, ui, full, legend, true, out);
+        if let Some(l) = compare_legend.as_ref() {
+            legend::show(app, ui, at, place, l, false, out);
+        } else if let Some(l) = shown.legend.as_ref() {
+            legend::show(app, ui, at, place, l, true, out);
         }
+    }
+    if let Some(shown) = &app.shown {
         if let Some(pos) = response.hover_pos() {
             let frame = shown.frame.clone();
             response.on_hover_ui_at_pointer(|ui| pixel_readout(ui, &frame, rect, pos));
@@ -312,170 +321,4 @@ fn pixel_readout(ui: &mut egui::Ui, frame: &Arc<Frame>, rect: Rect, pos: Pos2) {
             ui.end_row();
         }
     });
-}
-
-/// The heatmap legend in the viewport's lower-left corner: title, colour bar with its ends, and
-/// the frame's min / mean / max. Real labels, so screen readers and UI tests see the numbers.
-fn legend_area(app: &BvhscopeApp, ui: &egui::Ui, rect: Rect, legend: &Legend, histogram: bool, out: &mut Actions) {
-    // Anchored by its lower-left corner and kept inside the viewport: it grows upwards as its
-    // note and histogram need, never over the status bar below.
-    egui::Area::new(ui.scope_id().with("heatmap-legend"))
-        .pivot(egui::Align2::LEFT_BOTTOM)
-        .fixed_pos(rect.left_bottom() + Vec2::new(12.0, -12.0))
-        .constrain_to(rect)
-        .order(egui::Order::Foreground)
-        .show(ui.ctx(), |ui| {
-            egui::Frame::popup(ui.style()).show(ui, |ui| {
-                ui.set_max_width(330.0);
-                ui.label(egui::RichText::new(format!("Legend: {}", legend.title)).strong());
-                if !legend.note.is_empty() {
-                    ui.weak(&legend.note);
-                }
-                let mut bar_x = 0.0..=0.0;
-                ui.horizontal(|ui| {
-                    ui.label(fmt_value(legend.range_min as f64));
-                    let (bar, _) = ui.allocate_exact_size(Vec2::new(220.0, 14.0), Sense::hover());
-                    bar_x = bar.x_range().min..=bar.x_range().max;
-                    let steps = 110;
-                    for i in 0..steps {
-                        let t = i as f32 / (steps - 1) as f32;
-                        let [r, g, b] = legend.colormap.map(t);
-                        let x0 = bar.min.x + bar.width() * i as f32 / steps as f32;
-                        let x1 = bar.min.x + bar.width() * (i + 1) as f32 / steps as f32;
-                        ui.painter().rect_filled(
-                            Rect::from_x_y_ranges(x0..=x1 + 0.5, bar.y_range()),
-                            0.0,
-                            Color32::from_rgb(r, g, b),
-                        );
-                    }
-                    ui.painter().rect_stroke(bar, 0.0, Stroke::new(1.0, Color32::GRAY), egui::StrokeKind::Outside);
-                    ui.label(fmt_value(legend.range_max as f64));
-                });
-                if histogram {
-                    histogram_bars(app, ui, legend, bar_x, out);
-                    ui.horizontal(|ui| {
-                        if ui.small_button("Hottest pixel").on_hover_text("Pin the ray with the most work in this heatmap in the Ray window (bvhscope trace --hottest 1)").clicked() {
-                            out.push(Action::Hottest { next: false });
-                        }
-                        let next = ui.add_enabled(app.hottest.is_some(), egui::Button::new("Next").small());
-                        if next.on_hover_text("The pixel with the next most work (bvhscope trace --hottest K)").clicked() {
-                            out.push(Action::Hottest { next: true });
-                        }
-                    });
-                }
-                ui.label(format!(
-                    "min {}   mean {:.2}   max {}   (all traced rays)",
-                    fmt_value(legend.min as f64),
-                    legend.mean,
-                    fmt_value(legend.max as f64)
-                ));
-            });
-        });
-}
-
-/// The distribution of the heatmap's per-pixel values under the colour bar, on its range; a click
-/// or drag sets a threshold above which the image's pixels are highlighted (the rest dimmed).
-fn histogram_bars(
-    app: &BvhscopeApp,
-    ui: &mut egui::Ui,
-    legend: &Legend,
-    x: std::ops::RangeInclusive<f32>,
-    out: &mut Actions,
-) {
-    let Some(counts) = app.legend_histogram() else { return };
-    // The bars sit under the colour bar, bin for bin.
-    let (row, response) = ui
-        .horizontal(|ui| {
-            ui.add_space((*x.start() - ui.cursor().min.x).max(0.0));
-            ui.allocate_exact_size(Vec2::new(x.end() - x.start(), 44.0), Sense::click_and_drag())
-        })
-        .inner;
-    let bars = row;
-    let painter = ui.painter_at(row);
-    let top = counts.iter().copied().max().unwrap_or(1).max(1) as f32;
-    let w = bars.width() / counts.len() as f32;
-    for (i, &c) in counts.iter().enumerate() {
-        // A square root keeps the rare high values visible beside the crowd at the low end.
-        let h = bars.height() * (c as f32 / top).sqrt();
-        let x0 = bars.min.x + w * i as f32;
-        let [r, g, b] = legend.colormap.map((i as f32 + 0.5) / counts.len() as f32);
-        painter.rect_filled(
-            Rect::from_min_max(Pos2::new(x0, bars.max.y - h), Pos2::new(x0 + w - 0.5, bars.max.y)),
-            0.0,
-            Color32::from_rgb(r, g, b),
-        );
-    }
-    let span = legend.range_max - legend.range_min;
-    if let Some(t) = app.threshold {
-        let px = bars.min.x + bars.width() * ((t - legend.range_min) / span.max(1e-20)).clamp(0.0, 1.0);
-        painter.line_segment([Pos2::new(px, row.min.y), Pos2::new(px, row.max.y)], Stroke::new(2.0, Color32::WHITE));
-    }
-    if let Some(pos) = response.interact_pointer_pos().filter(|_| response.clicked() || response.dragged()) {
-        let t = legend.range_min + span * ((pos.x - bars.min.x) / bars.width()).clamp(0.0, 1.0);
-        out.push(Action::SetThreshold(Some(t)));
-    }
-    if response.double_clicked() || response.secondary_clicked() {
-        out.push(Action::SetThreshold(None));
-    }
-    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Histogram of the heatmap"));
-    let above = app.threshold.map_or(String::new(), |t| format!(" Pixels above {}: highlighted.", fmt_value(t as f64)));
-    ui.weak(format!("Pixels per value (square root scale). Click or drag to highlight the pixels above a value; double-click to clear.{above}"))
-        .on_hover_text("The same bins as `bvhscope render --histogram 32`");
-}
-
-/// Messages shown at once; older ones fold into one line.
-pub const MESSAGES_SHOWN: usize = 3;
-
-/// Errors (until dismissed) and notes (for a few seconds) across the top of the viewport, the
-/// newest `MESSAGES_SHOWN`, one per topic (`BvhscopeApp::message`). Always on top, over windows
-/// too (one hidden behind a window was never read); each wraps inside the viewport with its
-/// Dismiss button below the text, and a click anywhere on one dismisses it.
-fn messages(app: &BvhscopeApp, ui: &mut egui::Ui, rect: Rect, out: &mut Actions) {
-    if app.messages.is_empty() {
-        return;
-    }
-    let margin = 8.0;
-    let width = (rect.width().min(560.0) - 24.0 - 2.0 * margin).max(60.0);
-    egui::Area::new(ui.scope_id().with("messages"))
-        .fixed_pos(rect.left_top() + Vec2::new(12.0, 12.0))
-        .constrain_to(rect)
-        .order(egui::Order::Foreground)
-        .show(ui.ctx(), |ui| message_list(app, ui, width, margin, out));
-}
-
-fn message_list(app: &BvhscopeApp, ui: &mut egui::Ui, width: f32, margin: f32, out: &mut Actions) {
-    let mut dismiss = None;
-    ui.set_max_width(width + 2.0 * margin);
-    let first = app.messages.len().saturating_sub(MESSAGES_SHOWN);
-    if first > 0 {
-        egui::Frame::new().fill(Color32::from_black_alpha(170)).inner_margin(4.0).corner_radius(4.0).show(ui, |ui| {
-            ui.horizontal(|ui| {
-                ui.label(egui::RichText::new(format!("{first} earlier")).color(Color32::LIGHT_GRAY));
-                if ui.small_button("Dismiss them").clicked() {
-                    out.push(Action::DismissEarlier(first));
-                }
-            });
-        });
-    }
-    for (i, m) in app.messages.iter().enumerate().skip(first) {
-        let (fill, title) = match m.kind {
-            MessageKind::Error => (Color32::from_rgb(110, 24, 24), "Error"),
-            MessageKind::Warning => (Color32::from_rgb(110, 80, 10), "Warning"),
-            MessageKind::Info => (Color32::from_rgb(24, 60, 100), "Note"),
-        };
-        let shown = egui::Frame::new().fill(fill).inner_margin(margin).corner_radius(4.0).show(ui, |ui| {
-            ui.set_max_width(width);
-            let text = egui::RichText::new(format!("{title}: {}", m.text)).color(Color32::WHITE);
-            ui.add(egui::Label::new(text).wrap());
-            if ui.small_button("Dismiss").clicked() {
-                dismiss = Some(i);
-            }
-        });
-        // A click anywhere on a message dismisses it (and pins no ray under it).
-        if ui.interact(shown.response.rect, ui.scope_id().with(("message", i)), egui::Sense::click()).clicked() {
-            dismiss = Some(i);
-        }
-        ui.add_space(4.0);
-    }
-    out.extend(dismiss.map(Action::Dismiss));
 }

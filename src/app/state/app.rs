@@ -70,6 +70,8 @@ pub struct BvhscopeApp {
     pub clipboard: Option<String>,
     /// The docked layout (saved with the settings); out of the app only while it is drawn.
     pub dock: Option<dock::Layout>,
+    /// Presenting: the layout before it, given back when presenting ends.
+    pub dock_presenting: Option<dock::Presenting>,
     /// Derived from the state, kept while it is unchanged (the viewport reads them).
     pub(super) box_cache: std::cell::RefCell<Option<BoxCache>>,
     pub(super) overlay_cache: std::cell::RefCell<Option<OverlayCache>>,
@@ -142,6 +144,7 @@ impl BvhscopeApp {
             last_full_frame: None,
             messages: Vec::new(),
             clipboard: None,
+            dock_presenting: None,
             dock: Some(
                 cc.storage
                     .and_then(|s| eframe::get_value::<dock::Layout>(s, dock::DOCK_KEY))

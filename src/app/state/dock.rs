@@ -3,7 +3,7 @@
 //! 1280×720). A view's tile shows while the view is open; the arrangement, which the user may
 //! change by dragging a tile's tab, is saved with the settings.
 
-use egui_tiles::{Container, Tile, TileId, Tiles, Tree};
+use egui_tiles::{Container, LinearDir, Tile, TileId, Tiles, Tree};
 
 /// Where the docked layout is saved (beside the settings, under `eframe::APP_KEY`).
 pub const DOCK_KEY: &str = "bvhscope-dock";
@@ -119,6 +119,89 @@ pub fn show_open(layout: &mut Layout, open: impl Fn(Pane) -> bool) {
     }
 }
 
+/// Presenting (F5): the layout as it was before, restored when presenting ends, and the open
+/// views it was last fitted for.
+pub struct Presenting {
+    before: Layout,
+    fitted_for: Vec<Pane>,
+}
+
+impl Presenting {
+    /// The layout presenting started from.
+    pub fn before(&self) -> &Layout {
+        &self.before
+    }
+}
+
+/// Of a row, the share of the width an open explain view gets presenting, and of a column the
+/// share of the height: at 150 % a 1280-px screen is 853 points wide, and the Node view's table
+/// and plots, the Ray view's steps, need about half of it to be read from the back row.
+const PRESENT_WIDTH: f32 = 0.45;
+const PRESENT_HEIGHT: f32 = 0.55;
+
+/// Presenting or not, with the explain views `open`: on starting to present, and whenever
+/// another view opens or closes while presenting, each open view's tile is given the side of the
+/// screen it needs (its row and column widened, its share raised in each container holding it);
+/// presenting ended, the layout before it comes back (what was dragged meanwhile is not kept).
+pub fn present(layout: &mut Layout, was: Option<Presenting>, on: bool, open: &[Pane]) -> Option<Presenting> {
+    match (was, on) {
+        (None, false) => None,
+        (Some(p), false) => {
+            *layout = p.before;
+            None
+        }
+        (None, true) => {
+            let before = layout.clone();
+            fit(layout, open);
+            Some(Presenting { before, fitted_for: open.to_vec() })
+        }
+        (Some(p), true) if p.fitted_for != open => {
+            fit(layout, open);
+            Some(Presenting { fitted_for: open.to_vec(), ..p })
+        }
+        (p, true) => p,
+    }
+}
+
+/// Raise each open view's share, and its ancestors', to `PRESENT_WIDTH` of its row and
+/// `PRESENT_HEIGHT` of its column (never lowered), counting only the siblings on screen.
+fn fit(layout: &mut Layout, open: &[Pane]) {
+    let tiles = &mut layout.tiles;
+    for &pane in open {
+        let Some(mut child) = tiles.find_pane(&pane) else { continue };
+        while let Some(parent) = tiles.parent_of(child) {
+            let others = match tiles.get(parent) {
+                Some(Tile::Container(Container::Linear(l))) => {
+                    let want = if l.dir == LinearDir::Horizontal { PRESENT_WIDTH } else { PRESENT_HEIGHT };
+                    let others: f32 = l
+                        .children
+                        .iter()
+                        .filter(|&&c| c != child && on_screen(tiles, c, open))
+                        .map(|&c| l.shares[c])
+                        .sum();
+                    Some(want * others / (1.0 - want))
+                }
+                _ => None,
+            };
+            if let (Some(share), Some(Tile::Container(Container::Linear(l)))) = (others, tiles.get_mut(parent)) {
+                if l.shares[child] < share {
+                    l.shares.set_share(child, share);
+                }
+            }
+            child = parent;
+        }
+    }
+}
+
+/// Whether a tile will be on screen: a pane always there or open, a container holding one.
+fn on_screen(tiles: &Tiles<Pane>, id: TileId, open: &[Pane]) -> bool {
+    match tiles.get(id) {
+        Some(Tile::Pane(p)) => p.always_open() || open.contains(p),
+        Some(Tile::Container(c)) => c.children().any(|&c| on_screen(tiles, c, open)),
+        None => false,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -140,5 +223,33 @@ mod tests {
         let visible = |l: &Layout, p: Pane| l.tiles.is_visible(l.tiles.find_pane(&p).unwrap());
         assert!(visible(&layout, Pane::Image) && visible(&layout, Pane::Ray) && visible(&layout, Pane::Statistics));
         assert!(!visible(&layout, Pane::Node) && !visible(&layout, Pane::Grade));
+    }
+
+    #[test]
+    fn presenting_gives_an_open_view_its_side_and_gives_the_layout_back() {
+        let mut layout = default_layout();
+        let share_of = |l: &Layout, p: Pane| {
+            let id = l.tiles.find_pane(&p).unwrap();
+            let mut child = id;
+            // The right column's share of the whole row.
+            while let Some(parent) = l.tiles.parent_of(child) {
+                if l.root == Some(parent) {
+                    if let Some(Tile::Container(Container::Linear(row))) = l.tiles.get(parent) {
+                        let total: f32 = row.children.iter().map(|&c| row.shares[c]).sum();
+                        return row.shares[child] / total;
+                    }
+                }
+                child = parent;
+            }
+            unreachable!()
+        };
+        let before = share_of(&layout, Pane::Ray);
+        assert!(before < 0.3, "{before}");
+        let p = present(&mut layout, None, true, &[Pane::Ray]);
+        let presenting = share_of(&layout, Pane::Ray);
+        assert!((presenting - PRESENT_WIDTH).abs() < 0.01, "{presenting}");
+        let p = present(&mut layout, p, false, &[Pane::Ray]);
+        assert!(p.is_none());
+        assert_eq!(share_of(&layout, Pane::Ray), before, "the layout as it was");
     }
 }

@@ -308,7 +308,10 @@ impl BvhscopeApp {
                 self.settings.ui_scale = s.clamp(*UI_SCALES.start(), *UI_SCALES.end());
                 self.settings.present &= self.settings.ui_scale >= PRESENT_SCALE;
             }
-            A::ResetLayout => self.dock = Some(dock::default_layout()),
+            A::ResetLayout => {
+                self.dock = Some(dock::default_layout());
+                self.dock_presenting = None;
+            }
             A::FoldLegend(folded) => self.settings.legend_folded = folded,
             A::DismissEarlier(n) => {
                 self.messages.drain(..n.min(self.messages.len()));

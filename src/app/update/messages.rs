@@ -1,10 +1,10 @@
-//! What the app says in its messages across the top of the viewport (`panels::viewport` draws
+//! What the app says in its messages on the status bar (`panels::status` draws
 //! them): one per topic, the old scene's cleared when a new one opens (`events.rs`).
 
 use crate::app::state::{BvhscopeApp, Message, MessageKind};
 use std::time::Instant;
 
-/// Messages kept; the viewport shows the newest `panels::viewport::MESSAGES_SHOWN` of them.
+/// Messages kept; the status bar shows the newest, the others behind its "N earlier" button.
 const MESSAGES_KEPT: usize = 8;
 
 impl BvhscopeApp {
