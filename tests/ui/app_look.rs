@@ -167,6 +167,15 @@ fn look_projector() {
         h.state_mut().act(Action::CompareMode(bvhscope::render::PairView::Difference));
         run_until(&mut h, "B", pair_shown);
         save(&mut h, &format!("projector-compare{suffix}"));
+        // The build's replay after 40 splits, midpoint's, nodes visited.
+        h.state_mut().act(Action::Compare(false));
+        h.state_mut().act(Action::ShowReplay(true));
+        run_until(&mut h, "the replay", |a| a.replay.replay.is_some());
+        h.state_mut().act(Action::ReplayStep(40));
+        run_until(&mut h, "the tree after 40 splits", |a| {
+            idle(a) && a.shown.as_ref().is_some_and(|s| s.partial.as_ref().is_some_and(|p| p.splits == 40))
+        });
+        save(&mut h, &format!("projector-replay{suffix}"));
     }
 }
 
