@@ -1,4 +1,129 @@
-//! (issue 59) — filled in by this session.
+//! Every figure the app shows is the image's or says it is not, and reads as its command-line
+//! twin prints it (issue 59, points 6 to 8): stale marks for figures of another image size, ray
+//! kind, seed or tree; the "before" column only for the same kind of rays; one rounding for a
+//! figure shown twice. A module of the `app_ui` test binary (`app.rs`).
 
-#[allow(unused_imports)]
 use super::*;
+use bvhscope::render::RayKind;
+
+/// A change of the settings, as the panels make one.
+fn edit(h: &mut Harness<'static, BvhscopeApp>, change: impl FnOnce(&mut bvhscope::app::Settings)) {
+    let mut s = h.state().settings.clone();
+    change(&mut s);
+    h.state_mut().act(Action::Edit(Box::new(s)));
+}
+
+/// The per-ray cells of the current column marked "(stale)".
+fn stale_now(h: &Harness<'static, BvhscopeApp>) -> usize {
+    h.query_all_by_label_contains(" (stale)").count()
+}
+
+/// Under Replay the image is the partial tree's, and shrinks (703×646 to 703×459 in the issue):
+/// the statistics' per-ray figures, of the whole tree and the larger image, are marked stale and
+/// say why, until the whole tree's frame at the image's size replaces them.
+#[test]
+fn figures_of_another_image_size_or_tree_are_marked_stale() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", |a| idle(a) && a.rays.is_some());
+    assert_eq!(stale_now(&h), 0, "the figures are the image's");
+    h.state_mut().act(Action::ShowReplay(true));
+    let replay_shown =
+        |a: &BvhscopeApp| idle(a) && a.shown.as_ref().is_some_and(|s| s.partial.is_some() && s.frame.is_complete());
+    run_until(&mut h, "the replay's frame", replay_shown);
+    h.run_steps(2);
+    assert_eq!(stale_now(&h), 7, "every per-ray row of the current column: the image is the replay's tree");
+    h.get_by_label_contains("the image shows the build replay's partial tree");
+    // The image shrinks under the replay (its tile, a smaller window): the figures are of the
+    // larger image, and say so.
+    let before = h.state().rays.unwrap().camera;
+    h.set_size(egui::vec2(1400.0, 700.0));
+    run_until(&mut h, "the replay's smaller frame", |a| {
+        replay_shown(a) && a.shown.as_ref().is_some_and(|s| s.camera.height < before.height)
+    });
+    h.run_steps(2);
+    let now = h.state().shown.as_ref().unwrap().camera;
+    assert_eq!(stale_now(&h), 7);
+    h.get_by_label_contains(&format!(
+        "of a {}×{} image; the image is {}×{}",
+        before.width, before.height, now.width, now.height
+    ));
+    // The tree rows are the tree's whatever the image: unmarked.
+    let nodes = h.state().current_bvh().unwrap().stats.nodes;
+    h.get_by_label(&nodes.to_string());
+    // Closed: the whole tree's frame at the new size, figures the image's again.
+    h.state_mut().act(Action::ShowReplay(false));
+    run_until(&mut h, "the tree's frame", |a| {
+        idle(a) && a.shown.as_ref().is_some_and(|s| s.partial.is_none()) && a.rays.is_some()
+    });
+    h.run_steps(2);
+    assert_eq!(stale_now(&h), 0, "{:?}", h.state().rays.map(|r| r.camera));
+}
+
+/// Midpoint on ambient-occlusion rays, then SAH on shadow rays: the "before" column does not set
+/// midpoint's AO figures beside SAH's shadow figures; then midpoint on shadow rays of another
+/// seed: SAH's shadow figures are of other rays, marked stale and saying the seed.
+#[test]
+fn the_before_column_is_of_the_same_ray_kind_and_seed_or_marked() {
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    let kind_shown = |k: RayKind| {
+        move |a: &BvhscopeApp| {
+            idle(a)
+                && a.previous.is_some()
+                && a.rays.is_some_and(|r| r.secondary.map(|s| s.kind) == Some(k))
+                && a.shown.as_ref().is_some_and(|s| s.frame.ray_kind().0 == k)
+        }
+    };
+    edit(&mut h, |s| {
+        s.build.strategy = Strategy::Midpoint;
+        s.rays.kind = RayKind::Ao;
+    });
+    run_until(&mut h, "midpoint on ao rays", kind_shown(RayKind::Ao));
+    edit(&mut h, |s| {
+        s.build.strategy = Strategy::SahBinned;
+        s.rays.kind = RayKind::Shadow;
+    });
+    run_until(&mut h, "SAH on shadow rays", |a| {
+        kind_shown(RayKind::Shadow)(a) && a.previous.as_ref().is_some_and(|p| p.label.starts_with("Midpoint"))
+    });
+    h.run_steps(2);
+    h.get_by_label_contains("(other rays)");
+    assert_eq!(h.query_all_by_label("other rays").count(), 7, "no per-ray figure of AO rays beside shadow rays");
+    assert!(h.query_by_label("stale").is_none());
+    assert_eq!(stale_now(&h), 0, "SAH's own figures are the image's");
+    // Another seed, another strategy: the same kind, other rays.
+    edit(&mut h, |s| {
+        s.build.strategy = Strategy::Midpoint;
+        s.rays.seed = 7;
+    });
+    run_until(&mut h, "midpoint on shadow rays of seed 7", |a| {
+        kind_shown(RayKind::Shadow)(a)
+            && a.rays.is_some_and(|r| r.secondary.is_some_and(|s| s.seed == 7))
+            && a.previous.as_ref().is_some_and(|p| p.label.starts_with("SAH"))
+    });
+    h.run_steps(2);
+    assert!(h.query_by_label("other rays").is_none());
+    assert_eq!(h.query_all_by_label("stale").count(), 7, "every per-ray row of the before column");
+}
+
+/// Side by side, a figure shown in both the statistics and the Compare window reads the same in
+/// both, its difference B − A too: rounded once, from the figures (the SAH difference was −5.43
+/// in one and −5.44 in the other), and "Nodes visited / ray" is the same mean in both (Compare's
+/// was over all rays, the statistics' over the rays that enter the root box).
+#[test]
+fn a_figure_shown_twice_reads_the_same_in_the_statistics_and_compare() {
+    let mut h = midpoint_against_sah();
+    run_until(&mut h, "B's figures", |a| idle(a) && a.rays.is_some() && a.compare_figures().is_some());
+    h.run_steps(2);
+    let (a, b) = (h.state().current_figures().unwrap(), h.state().compare_figures().unwrap());
+    let sah = format!("{:+.2}", b.stats.sah_cost - a.stats.sah_cost);
+    assert_eq!(h.query_all_by_label(&sah).count(), 2, "the SAH difference {sah} in the statistics and in Compare");
+    let (ra, rb) = (a.rays.unwrap().summary, b.rays.unwrap().summary);
+    for (what, text) in [
+        ("A's nodes / ray", format!("{:.2}", ra.root_mean_nodes_visited)),
+        ("B's nodes / ray", format!("{:.2}", rb.root_mean_nodes_visited)),
+        ("B − A", format!("{:+.2}", rb.root_mean_nodes_visited - ra.root_mean_nodes_visited)),
+    ] {
+        assert!(h.query_all_by_label(&text).count() >= 2, "{what} {text} in both");
+    }
+}

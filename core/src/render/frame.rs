@@ -41,6 +41,9 @@ pub struct Frame {
     per_hit: u32,
     /// In a counted frame of secondary rays, the primary rays' own counters; else empty.
     primary: Vec<RayCounters>,
+    /// The secondary rays' whole spec (seed, light, length), `None` in a primary frame: figures
+    /// of another seed are of other rays, which the kind alone does not tell (issue 59).
+    spec: Option<SecondarySpec>,
     /// Where the storage goes when the frame is dropped.
     pool: FramePool,
 }
@@ -75,6 +78,7 @@ impl Frame {
             kind: RayKind::Primary,
             per_hit: 0,
             primary: Vec::new(),
+            spec: None,
             pool: pool.clone(),
         }
     }
@@ -84,6 +88,7 @@ impl Frame {
     pub(super) fn set_secondary(&mut self, spec: &SecondarySpec) {
         self.kind = spec.kind;
         self.per_hit = spec.rays_per_hit();
+        self.spec = spec.kind.is_secondary().then_some(*spec);
         if self.counted() && spec.kind.is_secondary() {
             self.primary = vec![RayCounters::ZERO; self.counters.len()];
         }
@@ -92,6 +97,11 @@ impl Frame {
     /// What the counters are of, and the secondary rays per hit pixel (0 for primary rays).
     pub fn ray_kind(&self) -> (RayKind, u32) {
         (self.kind, self.per_hit)
+    }
+
+    /// The secondary rays the frame traced from its hits (`None`: the camera's rays).
+    pub fn secondary(&self) -> Option<&SecondarySpec> {
+        self.spec.as_ref()
     }
 
     /// A heatmap's value at a traced pixel: the metric of its ray, or in a frame of secondary
@@ -246,6 +256,7 @@ impl Frame {
             kind: self.kind,
             per_hit: self.per_hit,
             primary,
+            spec: self.spec,
             pool,
         }
     }

@@ -2,6 +2,7 @@
 //! and the figures of A, B and B − A: the trees' and the frame's per-ray work, as the statistics
 //! panel gives them for A.
 
+use super::stats::{difference, StatRow};
 use crate::app::state::{Action, Actions, BvhscopeApp};
 use crate::bvh::{Layout, Strategy, TraversalOrder};
 use crate::options::Choice;
@@ -67,30 +68,29 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         );
         return;
     };
-    let same_camera = app.rays.as_ref().is_some_and(|r| r.camera == b.camera);
+    let Some(bf) = app.compare_figures() else { return };
+    // B's per-ray figures beside A's only where both are of the same rays (camera, kind, seed).
+    let same_rays = a.rays.zip(bf.rays).is_some_and(|(ra, rb)| ra.camera == rb.camera && ra.secondary == rb.secondary);
+    // The statistics panel's own rows: each figure, and B − A, reads as it does there.
     egui::Grid::new("compare-figures").num_columns(4).striped(true).show(ui, |ui| {
         for h in ["", "A", "B", "B - A"] {
             ui.strong(h);
         }
         ui.end_row();
-        let mut row = |name: &str, va: f64, vb: f64, digits: usize| {
-            ui.label(name);
-            ui.label(format!("{va:.digits$}"));
-            ui.label(format!("{vb:.digits$}"));
-            ui.label(format!("{:+.digits$}", vb - va));
+        for name in ["Nodes", "SAH cost", "Nodes visited / ray", "Box tests / ray", "Triangle tests / ray"] {
+            let row = StatRow::named(name);
+            if row.per_ray && !same_rays {
+                continue;
+            }
+            ui.label(row.name).on_hover_text(row.tip);
+            ui.label(row.text(&a).unwrap_or_default());
+            ui.label(row.text(&bf).unwrap_or_default());
+            ui.label(difference(row, &a, &bf).unwrap_or_default());
             ui.end_row();
-        };
-        row("Nodes", a.stats.nodes as f64, b.stats.nodes as f64, 0);
-        row("SAH cost", a.stats.sah_cost, b.stats.sah_cost, 2);
-        if let (Some(ra), true) = (a.rays.as_ref(), same_camera) {
-            let (sa, sb) = (&ra.summary, &b.summary);
-            row("Nodes visited / ray", sa.mean_nodes_visited, sb.mean_nodes_visited, 2);
-            row("Box tests / ray", sa.mean_box_tests, sb.mean_box_tests, 2);
-            row("Triangle tests / ray", sa.mean_triangle_tests, sb.mean_triangle_tests, 2);
         }
     });
     ui.weak(format!(
-        "A: {}. B: {}. Per-ray figures over all the frame's primary rays, one camera.",
+        "A: {}. B: {}. Per-ray figures over the frame's rays that enter the root box, one camera, as in the statistics.",
         a.label,
         b.bvh.label()
     ));

@@ -1,123 +1,14 @@
 //! The statistics panel: the current strategy's tree and per-ray figures, next to the strategy
 //! shown before it, and the leaf-size histogram. Every row says what it counts in its tooltip.
 
-use crate::app::state::{Action, Actions, BuiltBvh, BvhscopeApp, StrategyFigures};
+use crate::app::state::{Action, Actions, BuiltBvh, BvhscopeApp, RaysKey, StrategyFigures};
 use crate::bvh::{fmt_ms, SahCost, TreeView};
 use crate::render::RaySummary;
 use egui_plot::{Bar, BarChart, Plot};
 
-/// A row: its name, what it means (tooltip), and its value for a strategy (`None`: not measured
-/// yet). Per-ray rows are marked, because they depend on the camera as well as on the tree.
-struct StatRow {
-    name: &'static str,
-    tip: &'static str,
-    per_ray: bool,
-    value: fn(&StrategyFigures) -> Option<String>,
-}
-
-fn rays(f: &StrategyFigures) -> Option<&RaySummary> {
-    f.rays.as_ref().map(|r| &r.summary)
-}
-
-const ROWS: &[StatRow] = &[
-    StatRow {
-        name: "Build ms",
-        tip: "Time to build the BVH: every level (for two levels, the meshes' BVHs and the top level), with the tree laid out for traversal",
-        per_ray: false,
-        value: |f| Some(fmt_ms(f.build_ms)),
-    },
-    StatRow {
-        name: "Nodes",
-        tip: "Interior nodes and leaves (for the 4-wide layout: wide nodes and leaf slots)",
-        per_ray: false,
-        value: |f| Some(f.stats.nodes.to_string()),
-    },
-    StatRow { name: "Leaves", tip: "Nodes that hold triangles", per_ray: false, value: |f| Some(f.stats.leaves.to_string()) },
-    StatRow {
-        name: "Depth max / mean",
-        tip: "Levels from the root (depth 0) to the deepest leaf, and the mean over leaves, in levels of this layout",
-        per_ray: false,
-        value: |f| Some(format!("{} / {:.1}", f.stats.max_depth, f.stats.mean_leaf_depth)),
-    },
-    StatRow {
-        name: "SAH cost",
-        tip: "Surface area heuristic of the whole tree: Σ interior C_trav·A(node)/A(root) + Σ leaves C_isect·N·A(leaf)/A(root). The expected traversal steps plus triangle tests of a random ray through the root box (constants below)",
-        per_ray: false,
-        value: |f| Some(format!("{:.2}", f.stats.sah_cost)),
-    },
-    StatRow {
-        name: "EPO",
-        tip: "End-point overlap (Aila, Karras & Laine 2013, \"On Quality Metrics of Bounding Volume Hierarchies\"): Σ over nodes of C(n) × the area of other subtrees' triangles inside the node's box, over the total triangle area, with C(n) = C_trav for interior nodes and C_isect × triangles for leaves. A ray that starts or ends on a surface must visit every box around that point; EPO counts the ones that are not its leaf's ancestors, which the SAH does not see. Of the binary tree as built (the 4-wide layout is collapsed from it). Where summing every node would cost more than about the build, the terms it could not afford are estimated from points on the surface: value ± two standard errors",
-        per_ray: false,
-        value: |f| f.stats.epo.map(|e| crate::bvh::epo::figure(e, f.stats.epo_error)),
-    },
-    StatRow {
-        name: "References / triangle",
-        tip: "Leaf entries per triangle: 1, unless SBVH's spatial splits cut triangles so several leaves reference the parts of one (its growth bound limits this). In parentheses: the spatial splits",
-        per_ray: false,
-        value: |f| Some(format!("{:.3} ({})", f.stats.references_per_triangle(), f.stats.spatial_splits)),
-    },
-    StatRow {
-        name: "Bytes / triangle",
-        tip: "Memory of the nodes, the triangle index array and the triangles the tree keeps in leaf order (36 bytes each), per triangle",
-        per_ray: false,
-        value: |f| Some(format!("{:.1}", f.stats.memory_bytes as f64 / f.stats.triangles.max(1) as f64)),
-    },
-    StatRow {
-        name: "SIMD kernels",
-        tip: "What the wide layout's walk runs on this CPU, chosen when the program starts: avx2 (eight boxes in one pass, leaves four triangles per pass), simd4 (four lanes: SSE2 or NEON), scalar. BVHSCOPE_SIMD=simd4 or scalar asks for a more portable one. Every choice finds the same hits with the same counts",
-        per_ray: false,
-        value: |f| Some(f.stats.simd.unwrap_or("— (binary)").to_string()),
-    },
-    StatRow {
-        name: "Fallback splits",
-        tip: "Nodes where the strategy found no useful split (midpoint with an empty side, SAH with coincident centroids) and an equal-count split was used",
-        per_ray: false,
-        value: |f| Some(f.stats.fallback_splits.to_string()),
-    },
-    StatRow {
-        name: "Rays in root box",
-        tip: "Share of the frame's primary rays that enter the root box; the others cost one box test and visit nothing. The per-ray rows below are means over these rays, unless they say all rays. An imported tree is measured on the mesh's box instead (its SAH cost too), as the tree beside it: a root box larger than the mesh's lets more rays in, and their work counts against it",
-        per_ray: true,
-        value: |f| rays(f).map(|r| format!("{:.1} %", 100.0 * r.root_fraction())),
-    },
-    StatRow {
-        name: "Nodes visited / ray",
-        tip: "Nodes taken from the stack and processed (interior and leaf), per ray that enters the root box",
-        per_ray: true,
-        value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_nodes_visited)),
-    },
-    StatRow {
-        name: "Box tests / ray",
-        tip: "Ray–box slab tests per ray that enters the root box (the root's own test included; a wide node tests each valid child)",
-        per_ray: true,
-        value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_box_tests)),
-    },
-    StatRow {
-        name: "Triangle tests / ray",
-        tip: "Ray–triangle tests per ray that enters the root box",
-        per_ray: true,
-        value: |f| rays(f).map(|r| format!("{:.2}", r.root_mean_triangle_tests)),
-    },
-    StatRow {
-        name: "Nodes / ray, all rays",
-        tip: "Nodes visited per ray over all primary rays of the frame, those that miss the root box (0 nodes) included",
-        per_ray: true,
-        value: |f| rays(f).map(|r| format!("{:.2}", r.mean_nodes_visited)),
-    },
-    StatRow {
-        name: "Tri tests / ray, all rays",
-        tip: "Triangle tests per ray over all primary rays of the frame",
-        per_ray: true,
-        value: |f| rays(f).map(|r| format!("{:.2}", r.mean_triangle_tests)),
-    },
-    StatRow {
-        name: "Most in one ray",
-        tip: "The most nodes visited, and the most triangle tests, of any one ray of the frame",
-        per_ray: true,
-        value: |f| rays(f).map(|r| format!("{} / {}", r.max_nodes_visited, r.max_triangle_tests)),
-    },
-];
+mod rows;
+use rows::rays;
+pub use rows::{difference, StatRow, ROWS};
 
 /// The two levels: each mesh's BVH, and the per-ray work split by level.
 fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<&RaySummary>) {
@@ -184,6 +75,14 @@ fn two_level(ui: &mut egui::Ui, built: &BuiltBvh, rays: Option<&RaySummary>) {
     });
 }
 
+/// Why a second column's per-ray figures are not set beside the current ones.
+enum Second {
+    /// Of another kind of ray: not shown.
+    OtherKind(String),
+    /// Of other rays of the same kind (camera, size, seed, traversal): marked stale.
+    Stale(String),
+}
+
 /// What "combined cost" means with the constants in use (tooltips of the statistics and the
 /// heatmap views).
 pub fn combined_cost_text(c: SahCost) -> String {
@@ -242,13 +141,20 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let b = app.compare_figures();
     let comparing = b.is_some();
     let previous = b.or_else(|| app.previous.clone());
-    let key = app.rays_key();
-    // The second column's per-ray figures count only when they come from the same rays as the
-    // current ones (B: the same camera; its traversal is its own).
-    let comparable = |f: &StrategyFigures| match (&f.rays, &key) {
-        (Some(r), Some((camera, _))) if comparing => r.camera == *camera,
-        (Some(r), Some((camera, trace))) => r.comparable(camera, trace),
-        _ => false,
+    let key = app.figures_key();
+    // The current figures' per-ray rows, when they are not of the image on screen (another size,
+    // camera, ray kind, seed or tree: Replay's smaller image, a new ray kind still rendering).
+    let stale_now = app.stale_figures(&current);
+    // The second column's per-ray figures: not shown at all for another ray kind (AO figures
+    // beside shadow figures read as a comparison), marked stale for other rays of the same kind
+    // (B: the same camera and rays; its traversal is its own).
+    let second = |f: &StrategyFigures| -> Option<Second> {
+        let (r, key) = (f.rays.as_ref()?, key.as_ref()?);
+        if r.key().kind() != key.kind() {
+            return r.key().stale_because(key).map(Second::OtherKind);
+        }
+        let k = if comparing { RaysKey { trace: r.trace, ..*key } } else { *key };
+        r.key().stale_because(&k).map(Second::Stale)
     };
     let columns = if comparing { 4 } else { 3 };
     // Four columns share the width (a long label such as an imported file's wraps within its own).
@@ -256,9 +162,13 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     egui::Grid::new("bvh-stats").num_columns(columns).striped(true).max_col_width(width).show(ui, |ui| {
         ui.label("");
         ui.strong(&current.label);
+        let other_kind = previous.as_ref().is_some_and(|p| matches!(second(p), Some(Second::OtherKind(_))));
+        let other = if other_kind { " (other rays)" } else { "" };
         match &previous {
-            Some(p) if comparing => ui.strong(&p.label).on_hover_text("B, the build compared side by side"),
-            Some(p) => ui.weak(format!("before: {}", p.label)).on_hover_text("The strategy shown before this one, for comparison"),
+            Some(p) if comparing => ui.strong(format!("{}{other}", p.label)).on_hover_text("B, the build compared side by side"),
+            Some(p) => ui
+                .weak(format!("before: {}{other}", p.label))
+                .on_hover_text("The strategy shown before this one, for comparison (its per-ray figures only where they are of the same kind of rays)"),
             None => ui.weak("before: —").on_hover_text("The strategy shown before this one, for comparison"),
         };
         if comparing {
@@ -267,42 +177,50 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         ui.end_row();
         for row in ROWS {
             ui.label(row.name).on_hover_text(row.tip);
-            let a = (row.value)(&current);
-            ui.label(a.clone().unwrap_or_else(|| "…".into()));
-            match &previous {
-                Some(p) if row.per_ray && !comparable(p) => {
-                    let was = (row.value)(p).unwrap_or_else(|| "not measured".into());
-                    ui.weak(egui::RichText::new("stale").italics()).on_hover_text(format!(
-                        "Measured with another camera, image size or traversal order (was {was}); not comparable with this frame"
+            let a = row.text(&current);
+            match (&a, &stale_now) {
+                (Some(v), Some(why)) if row.per_ray => {
+                    ui.weak(egui::RichText::new(format!("{v} (stale)")).italics())
+                        .on_hover_text(format!("Measured {why}: not this image's figure (measured again with the next full frame of the tree)"));
+                }
+                _ => {
+                    ui.label(a.clone().unwrap_or_else(|| "…".into()));
+                }
+            }
+            let stale = previous.as_ref().filter(|_| row.per_ray).and_then(second);
+            match (&previous, stale) {
+                (Some(p), Some(Second::OtherKind(why))) => {
+                    let was = row.text(p).unwrap_or_else(|| "not measured".into());
+                    ui.weak(egui::RichText::new("other rays").italics()).on_hover_text(format!(
+                        "Measured {why} (was {was}): figures of another kind of ray are not set beside these"
                     ));
                 }
-                Some(p) if comparing => {
-                    let b = (row.value)(p);
-                    ui.label(b.clone().unwrap_or_default());
-                    // The difference of the rows that are one number (a percentage's too).
-                    let num = |v: &Option<String>| v.as_deref().and_then(|t| t.trim_end_matches(" %").parse::<f64>().ok());
-                    match (num(&a), num(&b)) {
-                        // Counts (nodes, leaves) differ by whole numbers: no decimals for them.
-                        (Some(x), Some(y)) if [&a, &b].iter().all(|v| v.as_deref().is_some_and(|t| t.parse::<i64>().is_ok())) => {
-                            ui.label(format!("{:+}", (y - x) as i64))
-                        }
-                        (Some(x), Some(y)) => ui.label(format!("{:+.2}", y - x)),
-                        _ => ui.label(""),
-                    };
+                (Some(p), Some(Second::Stale(why))) => {
+                    let was = row.text(p).unwrap_or_else(|| "not measured".into());
+                    ui.weak(egui::RichText::new("stale").italics()).on_hover_text(format!(
+                        "Measured {why} (was {was}); not comparable with this frame"
+                    ));
                 }
-                Some(p) => {
-                    ui.weak((row.value)(p).unwrap_or_default());
+                (Some(p), None) if comparing => {
+                    ui.label(row.text(p).unwrap_or_default());
+                    ui.label(difference(row, &current, p).unwrap_or_default());
                 }
-                None => {
+                (Some(p), None) => {
+                    ui.weak(row.text(p).unwrap_or_default());
+                }
+                (None, _) => {
                     ui.label("");
                 }
             }
-            if comparing && previous.as_ref().is_some_and(|p| row.per_ray && !comparable(p)) {
+            if comparing && previous.as_ref().is_some_and(|p| row.per_ray && second(p).is_some()) {
                 ui.label("");
             }
             ui.end_row();
         }
     });
+    if let Some(why) = &stale_now {
+        ui.weak(egui::RichText::new(format!("(stale): the per-ray figures are {why}.")).italics());
+    }
     let c = current.stats.sah_constants;
     let spec = app.settings.rays;
     let which = match spec.kind.is_secondary() {

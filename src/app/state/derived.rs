@@ -4,7 +4,7 @@
 //! current build and of B, as the statistics panel and its exports read them.
 
 use super::app::{BvhscopeApp, MaskCache};
-use super::figures::{MeasuredRays, Shown, StrategyFigures};
+use super::figures::{MeasuredRays, RaysKey, Shown, StrategyFigures};
 use crate::app::jobs::Timed;
 use crate::app::views::{compare, node};
 use crate::bvh::TreeStats;
@@ -196,6 +196,27 @@ impl BvhscopeApp {
             .filter(|t| Arc::ptr_eq(&t.bvh, &shown.bvh) && t.camera == shown.camera && t.trace == shown.trace)
     }
 
+    /// Why `f`'s per-ray figures are not of the image on screen (a phrase for their tooltips:
+    /// "of a 703×646 image; the image is 703×459"), or `None` when they are: measured on another
+    /// image size, camera, ray kind, seed or traversal, or the image is of another tree (the build
+    /// replay's partial one). Figures shown unmarked must be the image's (issue 59).
+    pub fn stale_figures(&self, f: &StrategyFigures) -> Option<String> {
+        let (r, shown) = (f.rays.as_ref()?, self.shown.as_ref()?);
+        let rays = r.key().stale_because(&shown.rays_key());
+        let tree =
+            shown.partial.is_some().then_some("of the whole tree; the image shows the build replay's partial tree");
+        match (rays, tree) {
+            (Some(r), Some(t)) => Some(format!("{r}, and {t}")),
+            (r, t) => r.or(t.map(str::to_string)),
+        }
+    }
+
+    /// The rays the statistics' second column is set against: the current figures' own, or
+    /// before there are any, the image's.
+    pub fn figures_key(&self) -> Option<RaysKey> {
+        self.rays.map(|r| r.key()).or_else(|| self.shown.as_ref().map(Shown::rays_key))
+    }
+
     /// B's figures for the statistics panel's second column, while comparing side by side.
     pub fn compare_figures(&self) -> Option<StrategyFigures> {
         let b = self.compare.b.as_ref().filter(|b| self.compare.on && b.scene_id == self.scene_id)?;
@@ -203,7 +224,12 @@ impl BvhscopeApp {
             label: format!("B: {}", b.bvh.label()),
             stats: b.stats.clone(),
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
-            rays: Some(MeasuredRays { summary: b.summary, camera: b.camera, trace: b.trace }),
+            rays: Some(MeasuredRays {
+                summary: b.summary,
+                camera: b.camera,
+                trace: b.trace,
+                secondary: b.frame.secondary().copied(),
+            }),
             frame_ms: None,
             speedup: None,
         })

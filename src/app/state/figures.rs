@@ -4,7 +4,7 @@
 
 use crate::app::jobs::{GpuRender, Pick, ViewStyle};
 use crate::bvh::{SceneBvh, TraceOptions, TreeStats};
-use crate::render::{Camera, Frame, Legend, RaySummary};
+use crate::render::{Camera, Frame, Legend, RayKind, RaySummary, SecondarySpec};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -30,19 +30,73 @@ pub struct Shown {
     pub cpu_finished: usize,
 }
 
+impl Shown {
+    /// The rays the image on screen traced.
+    pub fn rays_key(&self) -> RaysKey {
+        RaysKey { camera: self.camera, trace: self.trace, secondary: self.frame.secondary().copied() }
+    }
+}
+
 /// Per-ray figures of a full frame, with what they depend on besides the BVH: the camera (and
-/// image size) and the traversal options. Figures measured under other ones are not comparable.
+/// image size), the traversal options and the secondary rays. Figures measured under other ones
+/// are not comparable.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeasuredRays {
     pub summary: RaySummary,
     pub camera: Camera,
     pub trace: TraceOptions,
+    /// The secondary rays counted (kind, seed, light, length; `None`: the camera's rays).
+    pub secondary: Option<SecondarySpec>,
 }
 
 impl MeasuredRays {
-    /// Whether these figures and `other` come from the same rays (camera, image size, traversal).
-    pub fn comparable(&self, camera: &Camera, trace: &TraceOptions) -> bool {
-        self.camera == *camera && self.trace == *trace
+    /// What these figures were measured on.
+    pub fn key(&self) -> RaysKey {
+        RaysKey { camera: self.camera, trace: self.trace, secondary: self.secondary }
+    }
+
+    /// Whether these figures and `other` come from the same rays (camera, image size, traversal,
+    /// ray kind and seed).
+    pub fn comparable(&self, other: &RaysKey) -> bool {
+        self.key().stale_because(other).is_none()
+    }
+}
+
+/// What per-ray figures depend on besides the tree: the rays (camera, image size, kind, seed) and
+/// the traversal. The figures on screen are stale when theirs is not the image's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RaysKey {
+    pub camera: Camera,
+    pub trace: TraceOptions,
+    pub secondary: Option<SecondarySpec>,
+}
+
+impl RaysKey {
+    /// The rays' kind (camera rays when no secondary rays).
+    pub fn kind(&self) -> RayKind {
+        self.secondary.map_or(RayKind::Primary, |s| s.kind)
+    }
+
+    /// Why figures measured on `self` are not figures of `now` (a phrase for a tooltip: "of a
+    /// 703×646 image; the image is 703×459"), or `None` when they are of the same rays.
+    pub fn stale_because(&self, now: &RaysKey) -> Option<String> {
+        let describe = |k: &RaysKey| k.secondary.map_or("primary rays".to_string(), |s| s.describe());
+        let (a, b) = (&self.camera, &now.camera);
+        if self.kind() != now.kind() {
+            Some(format!("of {}; the image shows {}", describe(self), describe(now)))
+        } else if (a.width, a.height) != (b.width, b.height) {
+            Some(format!("of a {}×{} image; the image is {}×{}", a.width, a.height, b.width, b.height))
+        } else if a != b {
+            Some("of another camera (the view moved since)".to_string())
+        } else if let Some((x, y)) = self.secondary.zip(now.secondary).filter(|(x, y)| x.seed != y.seed) {
+            Some(format!("of seed {}; the image's rays are of seed {}", x.seed, y.seed))
+        } else if self.secondary != now.secondary {
+            Some(format!("of {}; the image shows {}", describe(self), describe(now)))
+        } else if self.trace != now.trace {
+            Some("of another traversal order or triangle test".to_string())
+        } else {
+            None
+        }
     }
 }
 

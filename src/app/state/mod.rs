@@ -20,7 +20,7 @@ pub use action::{Action, Actions};
 pub use app::{AppOptions, BvhscopeApp};
 pub use built::BuiltBvh;
 pub use dock::{Pane, DOCK_KEY};
-pub use figures::{MeasuredRays, Message, MessageKind, PathWindow, Shown, StrategyFigures};
+pub use figures::{MeasuredRays, Message, MessageKind, PathWindow, RaysKey, Shown, StrategyFigures};
 pub use orbit::OrbitCamera;
 pub use overlay::OverlayBox;
 pub use settings::{BoxLevel, Film, Settings, PRESENT_SCALE, UI_SCALES};

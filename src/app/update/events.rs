@@ -169,7 +169,8 @@ impl BvhscopeApp {
                     Some(y) => p.frame.ray_summary_in(&p.camera, &y),
                     None => p.frame.ray_summary(),
                 };
-                self.rays = Some(MeasuredRays { summary, camera: p.camera, trace: p.trace });
+                let secondary = p.frame.secondary().copied();
+                self.rays = Some(MeasuredRays { summary, camera: p.camera, trace: p.trace, secondary });
             }
         }
         let texture = match self.shown.take() {

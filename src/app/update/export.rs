@@ -277,7 +277,7 @@ mod tests {
             root_mean_nodes_visited: 4.5,
             ..Default::default()
         };
-        let measured = MeasuredRays { summary, camera, trace: Default::default() };
+        let measured = MeasuredRays { summary, camera, trace: Default::default(), secondary: None };
         let rows = [
             (
                 "current",
