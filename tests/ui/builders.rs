@@ -73,7 +73,8 @@ fn ploc_with_reinsertion_shows_what_stats_prints() {
     });
     h.state_mut().act(Action::SelectNode(0));
     run_until(&mut h, "the root's inspection", |a| a.nodes.inspection.is_some() && idle(a));
-    assert!(h.query_all_by_label_contains("no plane priced here").count() >= 2, "LBVH and PLOC rows");
+    // (One footnote under the table for both rows: issue 59.)
+    h.get_by_label_contains("LBVH (Morton), PLOC: no plane priced here");
 }
 
 /// The SBVH chosen in the list, its growth bound set in the build panel: the references per

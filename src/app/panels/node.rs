@@ -10,6 +10,8 @@ use crate::explain::inspect::{CurvePoint, Inspection};
 use egui::Color32;
 use egui_plot::{HLine, Line, LineStyle, Plot, PlotPoints, VLine};
 
+mod table;
+
 const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// Each strategy's marker colour: the strategies' table order picks it, so a strategy added to
@@ -38,6 +40,9 @@ pub fn is_open(app: &BvhscopeApp) -> bool {
 pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let nodes = &app.nodes;
     let (Some(node), true) = (nodes.selected, nodes.window) else { return };
+    // The tile's width, before a wide line widens the scrolled contents: the table and the plots
+    // fit in it (they were laid out in the widened width and ran off the tile).
+    let width = ui.available_width();
     let bvh = app.current_bvh().map(|b| b.bvh.clone());
     let Some(e) = nodes.current(bvh.as_ref()) else {
         ui.weak("Preparing the tree…");
@@ -97,7 +102,7 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     // An imported tree has no strategy of bvhscope's: its own split is drawn as its cost.
     let own = imported.is_none().then_some(e.tree.params.strategy);
     if ins.triangles >= 2 {
-        planes(ui, ins, own);
+        table::planes(ui, ins, own, width);
         ui.separator();
     }
     // Presenting, each plot is half the tile tall (a back row reads its curves).
@@ -130,7 +135,7 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
         let range = shared.then(|| cost_range(ins));
         for axis in 0..3 {
-            curve_plot(ui, ins, axis, own, range, Size { height, present });
+            curve_plot(ui, ins, axis, own, range, Size { height, width, present });
         }
     }
 }
@@ -144,7 +149,7 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<(u32, u
     egui::Grid::new("node-figures").num_columns(2).striped(true).show(ui, |ui| {
         let mut row = |k: &str, v: String, tip: &str| {
             ui.label(k).on_hover_text(tip);
-            ui.label(v);
+            ui.add(egui::Label::new(v).wrap());
             ui.end_row();
         };
         let kind = match (ins.children, ins.split_axis) {
@@ -164,36 +169,6 @@ fn figures(ui: &mut egui::Ui, ins: &Inspection, epo: f64, visits: Option<(u32, u
         row("As a leaf", format!("{:.3}", ins.leaf_cost), "What making it a leaf would cost: C_isect × triangles");
         let visits = visits.map_or("…".into(), |(v, w, h)| format!("{v} of the {w}×{h} frame's primary rays"));
         row("Visits", visits, "Primary rays of the frame on screen that entered it (a binary traversal of the same rays; `bvhscope inspect --size WxH` counts the same frame)");
-    });
-}
-
-/// Where each strategy puts its plane here, and every term of its cost, written out (as
-/// `bvhscope inspect` prints them; nothing only on hover, for a room to read).
-fn planes(ui: &mut egui::Ui, ins: &Inspection, own: Option<Strategy>) {
-    ui.label("Where each strategy splits these triangles: C_trav + C_isect (A_L/A n_L + A_R/A n_R)");
-    egui::Grid::new("node-planes").num_columns(7).striped(true).show(ui, |ui| {
-        for head in ["Strategy", "Plane", "n_L", "n_R", "A_L/A", "A_R/A", "Cost"] {
-            ui.strong(head);
-        }
-        ui.end_row();
-        for (s, m) in &ins.markers {
-            let name = if Some(*s) == own { format!("{} (this tree)", s.label()) } else { s.label().to_string() };
-            ui.label(egui::RichText::new(name).color(strategy_color(*s)));
-            match m {
-                Some(m) => {
-                    ui.label(format!("{} = {}", AXES[m.axis as usize], m.position));
-                    ui.label(m.left.to_string());
-                    ui.label(m.right.to_string());
-                    ui.label(format!("{:.3}", m.area_left));
-                    ui.label(format!("{:.3}", m.area_right));
-                    ui.label(format!("{:.3}", m.cost));
-                }
-                None => {
-                    ui.label(crate::explain::inspect::text::no_split_text(*s));
-                }
-            }
-            ui.end_row();
-        }
     });
 }
 
@@ -245,6 +220,7 @@ const LEGEND_WIDTH: f32 = 150.0;
 #[derive(Clone, Copy)]
 struct Size {
     height: f32,
+    width: f32,
     present: bool,
 }
 
@@ -310,11 +286,11 @@ fn curve_plot(
     let mut hovered = None;
     // The legend beside the plot where the tile is wide enough, else below it (a narrow tile,
     // or a presenter's large text).
-    let beside = ui.available_width() > 3.0 * LEGEND_WIDTH;
+    let beside = size.width > 3.0 * LEGEND_WIDTH;
     let layout =
         if beside { egui::Layout::left_to_right(egui::Align::Min) } else { egui::Layout::top_down(egui::Align::Min) };
     ui.with_layout(layout, |ui| {
-        let width = if beside { (ui.available_width() - LEGEND_WIDTH - 8.0).max(160.0) } else { ui.available_width() };
+        let width = if beside { (size.width - LEGEND_WIDTH - 8.0).max(160.0) } else { size.width };
         let mut plot = Plot::new(("node-curve", axis))
             .height(size.height)
             .width(width)
@@ -364,7 +340,8 @@ fn curve_plot(
                 ui.horizontal(|ui| {
                     let (r, _) = ui.allocate_exact_size(egui::vec2(14.0, 10.0), egui::Sense::hover());
                     ui.painter().rect_filled(r, 2.0, color);
-                    ui.label(size.note(text));
+                    // Wrapped at the tile's edge: a narrow tile (presenting) cuts no name.
+                    ui.add(egui::Label::new(size.note(text)).wrap());
                 });
             };
             swatch(ui, strategy_color(Strategy::SahSweep), format!("{sweep_name}: every plane"));

@@ -30,25 +30,69 @@ pub fn is_open(app: &BvhscopeApp) -> bool {
     !app.pins.pinned.is_empty() || app.ray_window
 }
 
-/// The view's contents, in its tile (`panels::tiles`).
+/// Rows of steps the list keeps in view however short the tile: what the rest gives way to.
+pub const MIN_STEP_ROWS: f32 = 8.0;
+
+/// The view's contents, in its tile (`panels::tiles`): the step controls and the step shown on
+/// top, always in view; the stack, the legend, the pinned rays and the typed ray below them in a
+/// scroll area of their own, as tall as leaves the step list `MIN_STEP_ROWS` rows; the step list
+/// in the rest (a short tile showed two rows of steps and cut the controls off: issue 59).
 pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let rays = &app.pins;
     if rays.pinned.is_empty() && !app.ray_window {
         return;
     }
-    pinned_list(app, ui, out);
-    ui.separator();
-    typed_ray(app, ui, out);
     let Some(r) = rays.current() else {
-        ui.weak(
-            "Click a pixel of the image to pin its ray (Ctrl-click while this window is closed), or type one above.",
+        pinned_list(app, ui, out);
+        ui.separator();
+        typed_ray(app, ui, out);
+        ui.add(
+            egui::Label::new(
+                "Click a pixel of the image to pin its ray (Ctrl-click while this window is closed), or type one above.",
+            )
+            .wrap(),
         );
         return;
     };
-    ui.separator();
     let n = r.len();
     let k = rays.step.min(n.saturating_sub(1));
-    ui.horizontal(|ui| {
+    controls(app, ui, out, n, k);
+    // The step shown, whole and wrapped (the list below keeps one line a step).
+    if let Some(s) = r.named.get(k) {
+        ui.add(egui::Label::new(egui::RichText::new(format!("Step {}: {}", k + 1, s.brief())).strong()).wrap());
+    }
+    let stack = r.trace.steps[..=k.min(n.saturating_sub(1))].iter().rev().find_map(|s| s.stack());
+    let stack_text = match stack {
+        Some(([], _)) | None => "empty".to_string(),
+        Some((st, below)) => {
+            let under = if below > 0 { format!("… {below} more, ") } else { String::new() };
+            under + &st.iter().map(|(n, t)| format!("{n} @ {t:.3}")).collect::<Vec<_>>().join(", ")
+        }
+    };
+    let row = step_row_height(ui);
+    let separator = ui.spacing().item_spacing.y * 2.0 + 1.0;
+    // At least a row's height, so that the details can still be scrolled to in a short tile.
+    let room = (ui.available_height() - (MIN_STEP_ROWS + 0.5) * row - separator).max(row);
+    egui::ScrollArea::both().id_salt("ray-details").max_height(room).min_scrolled_height(room).auto_shrink([false, true]).show(ui, |ui| {
+        ui.add(egui::Label::new(format!("Stack (bottom first): {stack_text}")).wrap()).on_hover_text(
+            "What the traversal stack holds after this step: each node with the distance at which the ray enters its box",
+        );
+        legend(ui);
+        command_line(r, ui, out);
+        ui.separator();
+        pinned_list(app, ui, out);
+        ui.separator();
+        typed_ray(app, ui, out);
+    });
+    ui.separator();
+    steps_list(app, ui, out, k);
+}
+
+/// First, Back, Play, Step, Last and the step slider, wrapped onto a second line in a narrow
+/// tile (the slider and Last were off its right edge when presenting).
+fn controls(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions, n: usize, k: usize) {
+    let rays = &app.pins;
+    ui.horizontal_wrapped(|ui| {
         if ui.button("First").on_hover_text("The first step").clicked() {
             out.push(Action::RayStep(0));
         }
@@ -67,7 +111,15 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             out.push(Action::RayStep(n.saturating_sub(1)));
         }
         let mut step = k + 1;
-        let slider = egui::Slider::new(&mut step, 1..=n.max(1)).text(format!("of {n}"));
+        // The slider takes the rest of the line, or a line of its own when under 80 points are
+        // left for its rail (a slider does not wrap by itself: it ran off the tile).
+        let text = format!("of {n}");
+        let text_width = 8.0 * text.len() as f32 + 60.0;
+        if ui.available_size_before_wrap().x < text_width + 80.0 {
+            ui.end_row();
+        }
+        ui.spacing_mut().slider_width = (ui.available_size_before_wrap().x - text_width).clamp(60.0, 220.0);
+        let slider = egui::Slider::new(&mut step, 1..=n.max(1)).text(text);
         if ui.add(slider).on_hover_text("The step the viewport shows").changed() {
             out.push(Action::RayStep(step - 1));
         }
@@ -79,24 +131,13 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
         ui.ctx().request_repaint_after(PLAY_STEP);
     }
-    let stack = r.trace.steps[..=k.min(n.saturating_sub(1))].iter().rev().find_map(|s| s.stack());
-    let stack_text = match stack {
-        Some(([], _)) | None => "empty".to_string(),
-        Some((st, below)) => {
-            let under = if below > 0 { format!("… {below} more, ") } else { String::new() };
-            under + &st.iter().map(|(n, t)| format!("{n} @ {t:.3}")).collect::<Vec<_>>().join(", ")
-        }
-    };
-    command_line(r, ui, out);
-    // The step shown, whole and wrapped (the list below keeps one line a step).
-    if let Some(s) = r.named.get(k) {
-        ui.add(egui::Label::new(egui::RichText::new(format!("Step {}: {}", k + 1, s.brief())).strong()).wrap());
-    }
-    ui.add(egui::Label::new(format!("Stack (bottom first): {stack_text}")).wrap()).on_hover_text(
-        "What the traversal stack holds after this step: each node with the distance at which the ray enters its box",
-    );
-    legend(ui);
-    steps_list(app, ui, out, k);
+}
+
+/// A step row's height: a selectable label's text and the button padding, at least the interact
+/// size.
+fn step_row_height(ui: &egui::Ui) -> f32 {
+    let text_height = ui.text_style_height(&egui::TextStyle::Monospace);
+    (text_height + 2.0 * ui.spacing().button_padding.y).max(ui.spacing().interact_size.y)
 }
 
 /// What closing the view's tile asks for.
@@ -227,9 +268,7 @@ fn typed_ray(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
 fn steps_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions, k: usize) {
     let Some(r) = app.pins.current() else { return };
     let steps = &r.named;
-    // A selectable label's height: its text and the button padding, at least the interact size.
-    let text_height = ui.text_style_height(&egui::TextStyle::Monospace);
-    let row_height = (text_height + 2.0 * ui.spacing().button_padding.y).max(ui.spacing().interact_size.y);
+    let row_height = step_row_height(ui);
     let levels = steps.iter().any(|s| s.level != TraceLevel::Mesh);
     // One line per step (show_rows needs equal rows): long stacks scroll sideways.
     let area = egui::ScrollArea::both().auto_shrink([false, false]).id_salt("ray-steps");
@@ -247,6 +286,8 @@ fn steps_list(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions, k: usize)
             s.depth().unwrap_or(entered + 1)
         })
         .collect();
+    // Rows touch (their highlight marks them apart): more of them in a short tile.
+    ui.spacing_mut().item_spacing.y = 0.0;
     area.show_rows(ui, row_height, steps.len(), |ui, range| {
         ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Extend);
         if moved {

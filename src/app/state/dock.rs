@@ -76,7 +76,8 @@ pub fn default_layout() -> Layout {
     share(&mut tiles, center, &[(image, 2.6), (below, 1.0)]);
     let right = [Pane::Statistics, Pane::Ray, Pane::Node].map(|p| tiles.insert_pane(p));
     let right_column = tiles.insert_vertical_tile(right.into());
-    share(&mut tiles, right_column, &[(right[0], 1.0), (right[1], 1.3), (right[2], 1.6)]);
+    // The Ray view's step list shows eight rows under its controls at 1280×720 (issue 59).
+    share(&mut tiles, right_column, &[(right[0], 1.0), (right[1], 2.0), (right[2], 1.6)]);
     let root = tiles.insert_horizontal_tile(vec![controls, center, right_column]);
     share(&mut tiles, root, &[(controls, 290.0), (center, 770.0), (right_column, 340.0)]);
     Tree::new(egui::Id::unique("bvhscope-dock"), root, tiles)
