@@ -118,7 +118,9 @@ fn moving_the_depth_slider_changes_the_number_of_boxes_drawn() {
     let mut h = harness();
     run_until(&mut h, "the first build", idle);
     assert_eq!(h.state().settings.box_depth, 3, "the default depth survives the first frames, built or not");
-    h.get_by_label("Show node boxes").click();
+    // By its accessibility action: the View panel's rows that do not apply stay, greyed (issue
+    // 59), and the node boxes lie below the fold of this window.
+    click_label(&mut h, "Show node boxes");
     h.get_by_role_and_label(Role::Slider, "Box depth").set_value_accesskit(0.0);
     h.step();
     h.step();
