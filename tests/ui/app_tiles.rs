@@ -2,6 +2,7 @@
 //! pinned ray across the Ray view, the tree and the icicle.
 
 use super::*;
+use egui_kittest::kittest::NodeT;
 
 /// The app at 1280×720 (a projector's size).
 fn at_720() -> Harness<'static, BvhscopeApp> {
@@ -36,6 +37,9 @@ fn look_tiles_at_720() {
     let mut h = at_720_drawn();
     explaining(&mut h);
     let dir = std::env::var("BVHSCOPE_LOOK").unwrap_or("/tmp".into());
+    // A step deep in the walk: the tree shows where the ray is.
+    let n = h.state().pins.current().unwrap().len();
+    h.state_mut().act(Action::RayStep(n * 2 / 3));
     for present in [false, true] {
         h.state_mut().act(Action::Present(present));
         for _ in 0..6 {
@@ -81,6 +85,9 @@ fn the_ray_tile_shows_eight_steps_and_its_controls_at_720() {
     explaining(&mut h);
     let n = h.state().pins.current().unwrap().len();
     assert!(n > 8, "{n} steps");
+    // A step deep in the walk: the tree shows where the ray is.
+    let n = h.state().pins.current().unwrap().len();
+    h.state_mut().act(Action::RayStep(n * 2 / 3));
     for present in [false, true] {
         h.state_mut().act(Action::Present(present));
         h.run_steps(4);
@@ -155,4 +162,103 @@ fn presenting_each_cost_plot_has_its_legend_inside_the_tile() {
             assert!(r.min.x >= left && r.max.x <= right + 0.5, "{entry} {r:?} inside the tile from x {left}");
         }
     }
+}
+
+/// A click of the pointer at `pos`.
+fn click_at(h: &mut Harness<'_, BvhscopeApp>, pos: egui::Pos2) {
+    h.input_mut().events.push(egui::Event::PointerMoved(pos));
+    h.step();
+    for pressed in [true, false] {
+        h.input_mut().events.push(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.step();
+    }
+    h.run_steps(2);
+}
+
+/// The tree row of `node` ("leaf 17 · d5 · …" or "node 17 · …").
+fn row_of(h: &Harness<'_, BvhscopeApp>, node: u32) -> String {
+    let (a, b) = (format!("leaf {node} · "), format!("node {node} · "));
+    let by = egui_kittest::kittest::by()
+        .predicate(move |n| n.label().is_some_and(|l| l.starts_with(&a) || l.starts_with(&b)));
+    h.query_all(by).next().and_then(|n| n.accesskit_node().label()).unwrap_or_else(|| panic!("no row of node {node}"))
+}
+
+/// One ray across the views (Madan & Nobre's synchronised query view): the pinned ray's entered
+/// nodes are marked in the tree's rows with the step that entered them; stepping in the Ray view
+/// moves the tree to the node the walk is at (its row shown, the ancestors opened), the leaf of
+/// the closest hit at the step that finds it; a click on a marked row or on the icicle's root
+/// takes the Ray view to the step that entered that node (issue 59).
+#[test]
+fn one_pinned_ray_across_the_ray_view_the_tree_and_the_icicle() {
+    use bvhscope::bvh::StepKind;
+    let mut h = harness();
+    explaining(&mut h);
+    h.get_by_label_contains("at step 1: the root's box test");
+    // Step 2 enters the root.
+    h.state_mut().act(Action::RayStep(1));
+    h.run_steps(3);
+    h.get_by_label_contains("at step 2: node 0");
+    assert!(row_of(&h, 0).ends_with(" · ray @ step 2"), "{}", row_of(&h, 0));
+    // The step that finds the closest hit: the walk is at the leaf holding that triangle.
+    let (k, leaf) = {
+        let a = h.state();
+        let r = a.pins.current().unwrap();
+        let hit = r.hit.expect("the pixel's ray hits");
+        let k = r.trace.steps.iter().rposition(|s| matches!(s.kind, StepKind::ClosestHit { .. })).unwrap();
+        (k, a.nodes.explained.as_ref().unwrap().hierarchy.leaf_of_prim(hit.prim).unwrap())
+    };
+    h.state_mut().act(Action::RayStep(k));
+    h.run_steps(3);
+    h.get_by_label_contains(&format!("at step {}: node {leaf}", k + 1));
+    let row = row_of(&h, leaf);
+    assert!(row.starts_with("leaf ") && row.contains(" · ray @ step "), "{row}");
+    // Back to the start, the leaf selected (its row stays open): a click on it goes to its step.
+    h.state_mut().act(Action::SelectNode(leaf));
+    h.state_mut().act(Action::RayStep(0));
+    h.run_steps(3);
+    let entered: usize = row_of(&h, leaf).rsplit("ray @ step ").next().unwrap().parse().unwrap();
+    click_label_containing(&mut h, &format!("leaf {leaf} · "));
+    h.run_steps(2);
+    let step = h.state().pins.step;
+    assert_eq!(step + 1, entered, "the Ray view at the step that entered leaf {leaf}");
+    let kind = &h.state().pins.current().unwrap().trace.steps[step].kind;
+    assert!(matches!(kind, StepKind::Leaf { .. } | StepKind::Enter { .. }), "{kind:?}");
+    assert!(step <= k, "the hit's leaf is entered before its hit is found");
+    h.get_by_label_contains(&format!("at step {}: node {leaf}", step + 1));
+    // The icicle's top row is the root: a click there goes to the step entering it.
+    let icicle = h.get_by_label("Icicle of the tree").rect();
+    click_at(&mut h, egui::pos2(icicle.center().x, icicle.top() + 6.0));
+    assert_eq!(h.state().nodes.selected, Some(0));
+    assert_eq!(h.state().pins.step, 1, "the root is entered at step 2");
+}
+
+/// The icicle coloured by EPO share names its colour scale and its two ends (the scale was
+/// nowhere, and a square root to the largest share left most nodes dark) (issue 59, point 8).
+#[test]
+fn the_icicle_shows_its_colour_scale() {
+    let mut h = harness();
+    explaining(&mut h);
+    h.get_by_label_contains("Colour scale: visits, log, ");
+    h.state_mut().act(Action::SetMetric(bvhscope::app::Metric::Epo));
+    h.run_steps(3);
+    let label = {
+        let n = h.get_by_label_contains("Colour scale: EPO share, log, ").accesskit_node();
+        n.label().or_else(|| n.value()).unwrap()
+    };
+    let hi = {
+        let e = h.state().nodes.explained.clone().unwrap();
+        e.epo_terms.iter().copied().fold(0.0, f64::max)
+    };
+    assert!(
+        label.ends_with(&format!(" to {hi:.4}")) || label.ends_with(&format!(" to {hi:.2e}")),
+        "{label} (largest {hi})"
+    );
+    h.state_mut().act(Action::SetMetric(bvhscope::app::Metric::Depth));
+    h.run_steps(3);
+    h.get_by_label_contains("Colour scale: depth, linear, 0 to ");
 }

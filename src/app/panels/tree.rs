@@ -4,10 +4,13 @@
 //! the viewport (shift-click: the pixel's leaf) or in the Node window's breadcrumb selects the
 //! same node everywhere.
 
+mod scale;
+
 use crate::app::state::{Action, Actions, BvhscopeApp};
 use crate::app::views::node::{Explained, Metric, NodeView};
-use crate::render::ColorMap;
+use crate::app::views::ray::nodes::RayOnTree;
 use egui::{Color32, Pos2, Rect, RichText, Sense, Stroke};
+use scale::Scale;
 
 /// Depths the icicle shows.
 const ICICLE_ROWS: u32 = 14;
@@ -66,10 +69,44 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             ui.weak("counting…");
         }
     });
-    icicle(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), out);
+    // The pinned ray the Ray view steps through, on this tree (the same trace, not walked again).
+    let walk = app.pins.current().and_then(|r| RayOnTree::of(r, e));
+    let ray = walk.as_ref().map(|w| Ray { walk: w, at: w.at.get(app.pins.step).copied().flatten() });
+    if let Some(r) = &ray {
+        ui.horizontal_wrapped(|ui| {
+            ui.label(RichText::new("Pinned ray:").color(ENTERED));
+            ui.label(format!("{} nodes entered (outlined, \"ray @ step\" in the rows);", r.walk.entered.len()));
+            let at = r.at.map_or("the root's box test".to_string(), |n| format!("node {n}"));
+            ui.label(RichText::new(format!("at step {}: {at}", app.pins.step + 1)).color(AT));
+            ui.weak("(click a marked node to go to its step)");
+        });
+    }
+    icicle(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), ray.as_ref(), out);
     ui.separator();
-    rows(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), out);
+    rows(ui, e, &app.nodes, visits.map(|v| v.counts.as_slice()), ray.as_ref(), out);
 }
+
+/// The pinned ray's walk on the tree, and the node it is at in the Ray view's step.
+struct Ray<'a> {
+    walk: &'a RayOnTree,
+    at: Option<u32>,
+}
+
+impl Ray<'_> {
+    /// What a click on `node` asks for: the node selected, and the Ray view at the step that
+    /// entered it when the ray entered it.
+    fn click(ray: Option<&Ray<'_>>, node: u32, out: &mut Actions) {
+        out.push(Action::SelectNode(node));
+        if let Some(k) = ray.and_then(|r| r.walk.step_of(node)) {
+            out.push(Action::RayStep(k));
+        }
+    }
+}
+
+/// The nodes the pinned ray entered (the viewport's tested-box cyan) and the one it is at (the
+/// viewport's current-node yellow).
+const ENTERED: Color32 = super::explain_overlay::RAY_COLORS.tested_hit;
+const AT: Color32 = super::explain_overlay::RAY_COLORS.current;
 
 /// What closing the view's tile asks for.
 pub fn close() -> Action {
@@ -110,7 +147,14 @@ fn icicle_cells(e: &Explained, rect: Rect) -> Vec<(u32, Rect)> {
     out
 }
 
-fn icicle(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u32]>, out: &mut Actions) {
+fn icicle(
+    ui: &mut egui::Ui,
+    e: &Explained,
+    view: &NodeView,
+    visits: Option<&[u32]>,
+    ray: Option<&Ray<'_>>,
+    out: &mut Actions,
+) {
     let depth = e.hierarchy.depth.iter().copied().max().unwrap_or(0).min(ICICLE_ROWS - 1) + 1;
     let size = egui::vec2(ui.available_width(), depth as f32 * ICICLE_ROW_HEIGHT);
     let (rect, response) = ui.allocate_exact_size(size, Sense::click());
@@ -118,23 +162,26 @@ fn icicle(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u3
     let cells = icicle_cells(e, rect);
     let values: Vec<Option<f64>> =
         cells.iter().map(|&(n, _)| metric_value(e, view.metric, visits, n as usize)).collect();
-    let max = values.iter().flatten().copied().fold(0.0, f64::max);
+    let scale = Scale::of(view.metric, &values);
     let painter = ui.painter_at(rect);
     let selected_path = view.selected.map(|s| e.hierarchy.path(s)).unwrap_or_default();
     for (&(n, r), v) in cells.iter().zip(&values) {
-        let fill = match v {
-            Some(v) if max > 0.0 => {
-                // Visits and shares span orders of magnitude: a square root keeps the small visible.
-                let [r8, g8, b8] = ColorMap::Viridis.map((v / max).sqrt() as f32);
-                Color32::from_rgb(r8, g8, b8)
-            }
+        let fill = match (v, &scale) {
+            (Some(v), Some(s)) => s.color(*v),
             _ => Color32::from_gray(60),
         };
         painter.rect_filled(r.shrink(0.25), 0.0, fill);
+        if ray.is_some_and(|ray| ray.walk.entered.contains_key(&n)) {
+            painter.rect_stroke(r, 0.0, Stroke::new(1.0, ENTERED), egui::StrokeKind::Inside);
+        }
         if selected_path.contains(&n) {
             let color = if Some(n) == view.selected { Color32::WHITE } else { Color32::from_gray(200) };
             painter.rect_stroke(r, 0.0, Stroke::new(1.5, color), egui::StrokeKind::Inside);
         }
+    }
+    // The ray's node last, over the selection's outline.
+    if let Some((_, r)) = ray.and_then(|ray| ray.at).and_then(|a| cells.iter().find(|(n, _)| *n == a)) {
+        painter.rect_stroke(*r, 0.0, Stroke::new(2.5, AT), egui::StrokeKind::Inside);
     }
     if response.clicked() {
         if let Some(pos) = response.interact_pointer_pos() {
@@ -142,26 +189,44 @@ fn icicle(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u3
             if let Some(&(n, _)) =
                 cells.iter().filter(|(_, r)| r.contains(pos)).max_by_key(|(n, _)| e.hierarchy.depth[*n as usize])
             {
-                out.push(Action::SelectNode(n));
+                Ray::click(ray, n, out);
             }
         }
     }
     response.on_hover_text(format!(
-        "One row per depth (the first {ICICLE_ROWS}), each node as wide as its triangles; colour: {} (square root of the share of the largest). Click to select.",
+        "One row per depth (the first {ICICLE_ROWS}), each node as wide as its triangles; colour: {}. Click to select (a node the pinned ray entered: the Ray view goes to that step).",
         view.metric.label()
     ));
+    if let Some(s) = &scale {
+        scale::bar(ui, s, view.metric);
+    }
 }
 
-fn rows(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u32]>, out: &mut Actions) {
-    let rows = view.rows();
+fn rows(
+    ui: &mut egui::Ui,
+    e: &Explained,
+    view: &NodeView,
+    visits: Option<&[u32]>,
+    ray: Option<&Ray<'_>>,
+    out: &mut Actions,
+) {
+    // The ray's node's row is shown (its ancestors open) as the Ray view steps.
+    let ray_at = ray.and_then(|r| r.at);
+    let rows = view.rows_showing(ray_at);
     let row_height = ui.spacing().interact_size.y;
     let mut area = egui::ScrollArea::vertical().auto_shrink([false, false]).id_salt("tree-rows");
     // Bring a newly selected node's row into view once (from the icicle, the viewport, a key).
+    // So is the ray's node's when the Ray view steps.
     let scrolled_id = ui.scope_id().with("tree-scrolled-to");
-    let moved = ui.data(|d| d.get_temp::<Option<u32>>(scrolled_id)) != Some(view.selected);
-    ui.data_mut(|d| d.insert_temp(scrolled_id, view.selected));
-    if moved {
-        if let Some(k) = view.selected.and_then(|s| rows.iter().position(|&r| r == s)) {
+    let before = ui.data(|d| d.get_temp::<(Option<u32>, Option<u32>)>(scrolled_id));
+    ui.data_mut(|d| d.insert_temp(scrolled_id, (view.selected, ray_at)));
+    let target = match before {
+        Some((_, r)) if r != ray_at && ray_at.is_some() => ray_at,
+        Some((s, _)) if s == view.selected => None,
+        _ => view.selected,
+    };
+    if target.is_some() {
+        if let Some(k) = target.and_then(|s| rows.iter().position(|&r| r == s)) {
             // The row in the middle of what the list shows.
             let step = row_height + ui.spacing().item_spacing.y;
             let visible = (ui.available_height() / step).max(1.0);
@@ -199,12 +264,22 @@ fn rows(ui: &mut egui::Ui, e: &Explained, view: &NodeView, visits: Option<&[u32]
                 };
                 let kind = if node.is_leaf() { "leaf" } else { "node" };
                 let v = visits.map_or("…".to_string(), |v| v[i].to_string());
-                let text = format!(
+                let mut text = format!(
                     "{kind} {n} · d{} · {} tris · {ratio} · {:.3} · {v}",
                     e.hierarchy.depth[i], e.hierarchy.count[i], e.sah_terms[i]
                 );
-                if ui.selectable_label(view.selected == Some(n), RichText::new(text).monospace()).clicked() {
-                    out.push(Action::SelectNode(n));
+                let entered = ray.and_then(|r| r.walk.step_of(n));
+                if let Some(k) = entered {
+                    text += &format!(" · ray @ step {}", k + 1);
+                }
+                let mut rich = RichText::new(text).monospace();
+                if ray_at == Some(n) {
+                    rich = rich.color(Color32::BLACK).background_color(AT);
+                } else if entered.is_some() {
+                    rich = rich.color(ENTERED);
+                }
+                if ui.selectable_label(view.selected == Some(n), rich).clicked() {
+                    Ray::click(ray, n, out);
                 }
             });
         }

@@ -180,13 +180,20 @@ impl NodeView {
 
     /// The rows the tree view shows: every node under an open one, depth first.
     pub fn rows(&self) -> Vec<u32> {
+        self.rows_showing(None)
+    }
+
+    /// The rows, with `also`'s ancestors open too (the pinned ray's node as the Ray view steps).
+    pub fn rows_showing(&self, also: Option<u32>) -> Vec<u32> {
         let Some(e) = &self.explained else { return Vec::new() };
+        let path = also.filter(|&n| (n as usize) < e.tree.nodes.len()).map(|n| e.hierarchy.path(n)).unwrap_or_default();
         let mut out = Vec::new();
         let mut stack = vec![0u32];
         while let Some(n) = stack.pop() {
             out.push(n);
             let node = &e.tree.nodes[n as usize];
-            if !node.is_leaf() && self.open.contains(&n) {
+            let open = self.open.contains(&n) || (path.contains(&n) && Some(n) != also);
+            if !node.is_leaf() && open {
                 stack.extend([node.index + 1, node.index]);
             }
         }

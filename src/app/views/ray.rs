@@ -3,6 +3,8 @@
 //! stand in its steps. Each pinned ray keeps the BVH it was traced through, so the same pixel can
 //! be pinned under two strategies and compared.
 
+pub mod nodes;
+
 use crate::bvh::{trace_query_into, Hit, NodeId, RayCounters, SceneBvh, StepKind, Trace, TraceLevel, TraceOptions};
 use crate::geometry::Ray;
 use crate::scene::SceneSource;
