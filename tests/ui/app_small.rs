@@ -133,3 +133,46 @@ fn look_view_panel_at_720() {
         eprintln!("wrote {}", path.display());
     }
 }
+
+/// With no file dialog, a save's typed-path window starts with the file the dialog would have
+/// suggested (the name `export` gives it), in the folder a relative path is written to, the field
+/// holding the keyboard with the cursor at its end; File › Save to a typed path… starts the same
+/// way, and an open's field starts empty. They started empty (issue 59).
+#[test]
+fn a_save_box_starts_with_the_suggested_file() {
+    use bvhscope::app::{default_name, Pick};
+    let mut h = harness();
+    run_until(&mut h, "the first frame", idle);
+    let here = std::env::current_dir().unwrap();
+    let saves = [
+        (Pick::SavePng, "png"),
+        (Pick::SaveStatsCsv, "csv"),
+        (Pick::SaveStatsJson, "json"),
+        (Pick::SaveCounts, "counts"),
+        (Pick::SaveBvh, "bvh"),
+        (Pick::SaveAnimation, "gif"),
+    ];
+    for (pick, ext) in saves {
+        h.state_mut().act(Action::NoFileDialog(pick));
+        h.run_steps(3);
+        let want = here.join(default_name(h.state(), ext)).display().to_string();
+        h.get_by_label_contains("No file dialog is available");
+        let field = h.get_by_label("Path");
+        assert_eq!(field.accesskit_node().value().as_deref(), Some(want.as_str()), "{pick:?}");
+        assert!(field.is_focused(), "{pick:?}: the field takes the keyboard");
+        // What is typed goes at the end (the cursor is there), not before the name.
+        type_keys(&mut h, "x");
+        assert_eq!(h.state().path_window.as_ref().map(|w| w.text.clone()), Some(format!("{want}x")), "{pick:?}");
+        h.key_press(egui::Key::Escape);
+        h.run_steps(2);
+        assert!(h.state().path_window.is_none());
+    }
+    h.state_mut().act(Action::SavePngTyped);
+    h.run_steps(3);
+    let png = here.join(default_name(h.state(), "png")).display().to_string();
+    assert_eq!(h.get_by_label("Path").accesskit_node().value().as_deref(), Some(png.as_str()));
+    h.state_mut().act(Action::ClosePathWindow);
+    h.state_mut().act(Action::NoFileDialog(Pick::Open));
+    h.run_steps(3);
+    assert_eq!(h.get_by_label("Path").accesskit_node().value().as_deref(), Some(""), "an open starts empty");
+}

@@ -30,6 +30,9 @@ pub enum Action {
     SaveScene,
     /// A file was chosen (dialog or typed path) for `Pick`.
     Picked(Pick, PathBuf),
+    /// The file dialog for `Pick` is not available: the typed-path window instead, its field
+    /// holding the suggested file.
+    NoFileDialog(Pick),
     /// File ▸ Open BVH…: a dump for the current mesh, by the dialog, a typed path, or a file.
     OpenBvh,
     OpenBvhPath,

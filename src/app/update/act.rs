@@ -27,16 +27,17 @@ impl BvhscopeApp {
             }
             A::SavePng => self.jobs.pick_file(Pick::SavePng, &export::default_name(self, "png")),
             A::SavePngTyped => {
-                let name = export::default_name(self, "png");
-                self.path_window = Some(PathWindow::new(Pick::SavePng, name, None));
+                self.path_window = Some(PathWindow::new(Pick::SavePng, export::typed_path(self, Pick::SavePng), None))
+            }
+            A::NoFileDialog(pick) => {
+                let note =
+                    "No file dialog is available on this system (no desktop portal or zenity). Type the path instead.";
+                self.path_window = Some(PathWindow::new(pick, export::typed_path(self, pick), Some(note.into())));
             }
             A::ExportStats => self.jobs.pick_file(Pick::SaveStatsCsv, &export::default_name(self, "csv")),
             A::ExportStatsJson => self.jobs.pick_file(Pick::SaveStatsJson, &export::default_name(self, "json")),
             A::ExportCounts => self.jobs.pick_file(Pick::SaveCounts, &export::default_name(self, "counts")),
-            A::SaveScene => {
-                let name = format!("{}.json", self.scene.title().trim_end_matches(".obj").trim_end_matches(".json"));
-                self.jobs.pick_file(Pick::SaveScene, &name);
-            }
+            A::SaveScene => self.jobs.pick_file(Pick::SaveScene, &export::suggested_name(self, Pick::SaveScene)),
             A::OpenBvh => self.jobs.pick_file(Pick::OpenBvh, ""),
             A::OpenBvhPath => self.path_window = Some(PathWindow::new(Pick::OpenBvh, String::new(), None)),
             A::ImportFile(path) => self.import_file(path),

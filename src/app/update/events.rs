@@ -3,7 +3,7 @@
 
 use super::export;
 use crate::app::jobs::{JobEvent, PassOutput, Pick, Probe};
-use crate::app::state::{shortcuts, Action, Actions, BvhscopeApp, MeasuredRays, MessageKind, PathWindow, Shown};
+use crate::app::state::{shortcuts, Action, Actions, BvhscopeApp, MeasuredRays, MessageKind, Shown};
 use crate::dump::BvhDump;
 use crate::gpu_path::Device;
 use crate::scene::{SceneBuildError, SceneSource};
@@ -104,8 +104,7 @@ impl BvhscopeApp {
                 // rfd answers None at once when it has no portal or zenity to ask; a person who
                 // cancels a real dialog takes longer than that.
                 if took < Duration::from_millis(300) {
-                    let note = "No file dialog is available on this system (no desktop portal or zenity). Type the path instead.";
-                    self.path_window = Some(PathWindow::new(pick, String::new(), Some(note.into())));
+                    self.act(Action::NoFileDialog(pick));
                 }
             }
         }

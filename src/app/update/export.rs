@@ -35,6 +35,36 @@ pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
     }
 }
 
+/// The name a save suggests for `pick` (the file dialog's), none for an open.
+pub fn suggested_name(app: &BvhscopeApp, pick: Pick) -> String {
+    match pick {
+        Pick::Open | Pick::OpenBvh | Pick::OpenGradeReport => String::new(),
+        Pick::SavePng => default_name(app, "png"),
+        Pick::SaveStatsCsv => default_name(app, "csv"),
+        Pick::SaveStatsJson => default_name(app, "json"),
+        Pick::SaveCounts => default_name(app, "counts"),
+        Pick::SaveBvh => default_name(app, "bvh"),
+        Pick::SaveAnimation => default_name(app, "gif"),
+        Pick::SaveScene => {
+            format!("{}.json", app.scene.title().trim_end_matches(".obj").trim_end_matches(".json"))
+        }
+    }
+}
+
+/// What the typed-path window starts with for `pick`: a save's suggested name in the folder a
+/// relative path is written to (so the field says where the file goes, and Enter saves it there);
+/// an open's field starts empty.
+pub fn typed_path(app: &BvhscopeApp, pick: Pick) -> String {
+    let name = suggested_name(app, pick);
+    if name.is_empty() {
+        return name;
+    }
+    match std::env::current_dir() {
+        Ok(dir) => dir.join(name).display().to_string(),
+        Err(_) => name,
+    }
+}
+
 /// Before anything is written: the file named for what it will hold, and none of the files the
 /// app has open (the scene, its meshes, the imported dump).
 pub fn check_output(app: &BvhscopeApp, pick: Pick, path: &Path) -> Result<(), String> {
@@ -290,6 +320,7 @@ mod tests {
                     speedup: Some(crate::explain::timing::Speedup {
                         rays: 3072,
                         tree_ms: 2.0,
+                        tree_runs: 5,
                         linear_ms: 90.0,
                         linear_sampled: None,
                         speedup: 45.0,
