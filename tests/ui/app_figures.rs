@@ -127,3 +127,47 @@ fn a_figure_shown_twice_reads_the_same_in_the_statistics_and_compare() {
         assert!(h.query_all_by_label(&text).count() >= 2, "{what} {text} in both");
     }
 }
+
+/// The app's speed-up over linear search and `bvhscope compare`'s trace column are one method
+/// (`explain::timing`): the same rays (the image's camera and size), the tree's median of the
+/// same runs, the linear scan on the same sample, the same tree; the speed-ups then agree up to
+/// timing noise. (The app timed its tree once, compare took a median of five: 73× against 105×.)
+#[test]
+fn the_speedup_is_measured_as_compare_measures_it() {
+    use bvhscope::bvh::SceneBvh;
+    let torus = root().join("assets/torus.obj");
+    let mut h = harness();
+    // A small image: the linear scan of its whole frame fits the 10 s budget, not sampled.
+    h.set_size(egui::vec2(900.0, 560.0));
+    open(&mut h, &torus);
+    // (The button, below the fold of this small window, asks for this.)
+    h.get_by_label("Time against the linear scan");
+    h.state_mut().act(Action::TimeLinear(true));
+    run_until(&mut h, "the timing", |a| idle(a) && a.fresh_speedup().is_some());
+    h.run_steps(2);
+    let t = h.state().fresh_speedup().unwrap();
+    let (s, camera, bvh, trace) = (t.speedup, t.camera, t.bvh.clone(), t.trace);
+    assert_eq!(s.tree_runs, bvhscope::explain::timing::RUNS as usize, "a fast tree's five runs: {s:?}");
+    h.get_by_label_contains(&format!("{:.0}× faster", s.speedup));
+    h.get_by_label_contains(&format!("(median of {} runs)", s.tree_runs));
+    // Under "The same rays on the command line": compare on the image's camera and this build.
+    h.get_by_label("The same rays on the command line");
+    let cmd = bvhscope::explain::words::compare_command(&torus, &bvh.build_params(), trace, &camera);
+    // Its words are compare's, on the app's camera: the CLI's rows of them.
+    let args: Vec<String> = cmd.split_whitespace().skip(1).map(str::to_string).collect();
+    let bvhscope::cli::Command::Compare(a) = words(&args) else { panic!("compare: {cmd}") };
+    let SceneBvh::Single { mesh, .. } = &*bvh else { panic!("one BVH") };
+    let (rows, setup) =
+        bvhscope::cli::compare_rows(mesh, &camera, &a.build, None, a.runs, a.threads, Duration::from_secs(10), None);
+    let p = bvh.build_params().bvh;
+    let name = format!("{} ({})", p.strategy.label(), p.layout.name());
+    let row = rows.iter().find(|r| r.name == name).unwrap_or_else(|| panic!("{name} in compare's rows"));
+    let linear = rows.last().unwrap();
+    assert_eq!(setup.rays, s.rays as u64, "the same rays");
+    assert_eq!(row.nodes, h.state().current_bvh().unwrap().stats.nodes, "the same tree");
+    assert_eq!(row.trace_runs, s.tree_runs, "the tree's median of as many runs");
+    assert_eq!(linear.sampled_rays, s.linear_sampled, "the scan on the same rays");
+    assert_eq!(trace, a.build.trace_options());
+    let ratio = row.speedup_over_linear / s.speedup;
+    assert!((0.4..2.5).contains(&ratio), "compare {:.0}×, the app {:.0}×", row.speedup_over_linear, s.speedup);
+}

@@ -112,3 +112,15 @@ mod tests {
         assert_eq!(o, ["1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "101st", "111th"]);
     }
 }
+
+/// The `bvhscope compare` command that times `build`'s tree on the same rays as the app's
+/// speed-up over the linear scan: the same camera and image size, the same traversal, the same
+/// runs (`explain::timing`); its row of the strategy is the app's figure, up to timing noise.
+pub fn compare_command(path: &Path, build: &SceneBuild, opts: TraceOptions, camera: &crate::render::Camera) -> String {
+    let v = |v: Vec3| format!("{},{},{}", v.x, v.y, v.z);
+    let mut words = vec!["bvhscope compare".to_string(), shell_word(&path.display().to_string())];
+    words.extend(build_flags(build, opts).into_iter().filter(|w| !w.starts_with("--strategy")));
+    words.push(format!("--camera {}:{}:{}", v(camera.position), v(camera.look_at), v(camera.up)));
+    words.push(format!("--fov {} --size {}x{}", camera.vfov_deg, camera.width, camera.height));
+    words.join(" ")
+}

@@ -250,7 +250,10 @@ impl Jobs {
             let SceneBvh::Single { mesh, .. } = &*bvh else { return };
             let linear = crate::bvh::LinearScan::new(mesh);
             let budget = LINEAR_BUDGET;
-            if let Ok(s) = crate::explain::timing::speedup_one_thread(&*bvh, &linear, &camera, trace, budget, &control)
+            // Timed as `compare` times its rows: the tree's median of as many runs (issue 59).
+            let runs = crate::explain::timing::RUNS;
+            if let Ok(s) =
+                crate::explain::timing::speedup_one_thread(&*bvh, &linear, &camera, trace, runs, budget, &control)
             {
                 send(JobEvent::Speedup(Box::new(Timed { bvh, camera, trace, speedup: s })));
             }

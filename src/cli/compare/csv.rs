@@ -109,6 +109,7 @@ mod tests {
             root_nodes_per_ray: 4.0,
             root_tri_tests_per_ray: 8.0,
             trace_ms: 1.0,
+            trace_runs: 5,
             frame_ms: 2.0,
             mrays_per_s: 3.0,
             speedup_over_linear: 4.0,

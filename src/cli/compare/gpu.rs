@@ -118,6 +118,7 @@ pub fn gpu_rows(
                         root_nodes_per_ray: summary.root_mean_nodes_visited,
                         root_tri_tests_per_ray: summary.root_mean_triangle_tests,
                         trace_ms: primary_ms,
+                        trace_runs: runs as usize,
                         frame_ms: primary_ms,
                         mrays_per_s: mrays(pixels, primary_ms),
                         speedup_over_linear: linear_trace_ms / primary_ms.max(1e-9),

@@ -4,7 +4,7 @@
 use crate::bvh::{epo, AnyBvh, BuildParams, Hierarchy, LinearScan, Strategy, TreeStats, TreeView};
 use crate::cli::args::BuildArgs;
 use crate::cli::progress;
-use crate::explain::timing::{ms, time_linear, trace_rays};
+use crate::explain::timing::{self, ms, time_linear, time_tree};
 use crate::render::{render, Camera, RenderSettings};
 use std::time::{Duration, Instant};
 
@@ -48,6 +48,8 @@ pub struct CompareRow {
     /// Single rays, closest hit, no shading, on `trace_threads` (median; projected from a sample
     /// for a sampled row).
     pub trace_ms: f64,
+    /// Runs of `trace_ms` timed (`timing::time_tree`; the linear scan's one).
+    pub trace_runs: usize,
     /// The renderer's full frame with shading (median of the timed frames; the linear scan's is
     /// its single-ray trace on the frame's threads, as it has no packets).
     pub frame_ms: f64,
@@ -70,24 +72,11 @@ pub struct CompareSetup {
     pub rays: u64,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
-/// Builds, frames and traces of one row stop once each kind has taken this long in all (at least one
-/// is made).
-const BUDGET_MS: f64 = 1000.0;
-
-/// The median of up to `runs` timings by `time` (ms), or of fewer once they pass `BUDGET_MS` in
-/// all, so that a slow mesh's table still comes in minutes. Past the budget, one more run when the
-/// count is even: the median of two would be the slower, often the first, cold one.
+/// `timing::budgeted_median` of a timing that cannot fail: the builds' and frames' medians, by
+/// the rule the trace column's runs follow too.
 pub(super) fn budgeted_median(runs: u32, mut time: impl FnMut() -> f64) -> f64 {
-    let mut times = vec![time()];
-    while times.len() < runs as usize && (times.iter().sum::<f64>() < BUDGET_MS || times.len().is_multiple_of(2)) {
-        times.push(time());
-    }
-    median(times)
+    let r: Result<_, std::convert::Infallible> = timing::budgeted_median(runs, || Ok(time()));
+    r.map_or_else(|e| match e {}, |(median, _)| median)
 }
 
 /// A thread pool of `n` threads (`None`: rayon's default, one per core).
@@ -143,7 +132,7 @@ pub fn compare_rows(
                 (bvh.expect("at least one build"), build_ms)
             })
         });
-        let (stats, summary, frame_ms, trace_ms) = progress::with_spinner(&step("tracing"), || {
+        let (stats, summary, frame_ms, (trace_ms, trace_runs)) = progress::with_spinner(&step("tracing"), || {
             let stats = TreeStats::of(&bvh);
             let (summary, frame_ms) = frames.install(|| {
                 let summary = render(&bvh, mesh, camera, &counting).ray_summary();
@@ -154,9 +143,11 @@ pub fn compare_rows(
                 });
                 (summary, frame_ms)
             });
-            let total = rays as usize;
-            let trace_ms = traces.install(|| budgeted_median(runs, || ms(trace_rays(&bvh, camera, trace, total))));
-            (stats, summary, frame_ms, trace_ms)
+            // The app's speed-up times its tree by the same `time_tree` (issue 59).
+            let control = crate::work::WorkControl::new();
+            let timed = traces.install(|| time_tree(&bvh, camera, trace, runs, &control));
+            let timed = timed.expect("nobody else holds this control");
+            (stats, summary, frame_ms, timed)
         });
         root_rays = summary.root_rays;
         // Within a budget of about the build's time (`bvh::epo`), so bounded on any mesh.
@@ -183,6 +174,7 @@ pub fn compare_rows(
             root_nodes_per_ray: summary.root_mean_nodes_visited,
             root_tri_tests_per_ray: summary.root_mean_triangle_tests,
             trace_ms,
+            trace_runs,
             frame_ms,
             mrays_per_s: rays / frame_ms / 1e3,
             speedup_over_linear: 0.0,
@@ -227,6 +219,7 @@ pub fn compare_rows(
         root_nodes_per_ray: 0.0,
         root_tri_tests_per_ray: n,
         trace_ms: linear_ms,
+        trace_runs: 1,
         frame_ms,
         mrays_per_s: rays / frame_ms / 1e3,
         speedup_over_linear: 1.0,
