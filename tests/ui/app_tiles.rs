@@ -139,27 +139,32 @@ fn the_node_table_keeps_its_names_in_view_and_its_notes_below() {
     }
 }
 
-/// Presenting at 1280×720, each axis's plot names its lines in a legend that lies inside the
-/// Node tile (its names wrap rather than run off the tile's edge) (issue 59, point 3).
+/// At 1280×720, and presenting, each axis's plot names its lines in a legend that lies inside
+/// the Node tile (its names wrap rather than run off the tile's edge) (issue 59, point 3).
 #[test]
-fn presenting_each_cost_plot_has_its_legend_inside_the_tile() {
+fn each_cost_plot_has_its_legend_inside_the_tile() {
     let mut h = at_720();
     explaining(&mut h);
     h.state_mut().act(Action::UnpinAll);
-    h.state_mut().act(Action::Present(true));
-    h.run_steps(4);
-    let left = topmost(&h, "Node").min.x - 8.0;
-    let right = h.ctx.content_rect().max.x;
-    let sweep = format!("{}: every plane", bvhscope::bvh::Strategy::SahSweep.label());
-    assert_eq!(h.query_all_by_label(&sweep).count(), 3, "one legend per axis");
-    for entry in [sweep.as_str(), "as a leaf", "| SAH binned (this tree)"] {
-        let n = h.query_all_by_label(entry).count();
-        assert!(n >= 1, "{entry}");
-        for k in 0..n {
-            h.query_all_by_label(entry).nth(k).unwrap().scroll_to_me();
-            h.run_steps(2);
-            let r = h.query_all_by_label(entry).nth(k).unwrap().rect();
-            assert!(r.min.x >= left && r.max.x <= right + 0.5, "{entry} {r:?} inside the tile from x {left}");
+    for present in [false, true] {
+        h.state_mut().act(Action::Present(present));
+        h.run_steps(4);
+        let left = topmost(&h, "Node").min.x - 8.0;
+        let right = h.ctx.content_rect().max.x;
+        let sweep = format!("{}: every plane", bvhscope::bvh::Strategy::SahSweep.label());
+        assert_eq!(h.query_all_by_label(&sweep).count(), 3, "one legend per axis");
+        for entry in [sweep.as_str(), "as a leaf", "| SAH binned (this tree)"] {
+            let n = h.query_all_by_label(entry).count();
+            assert!(n >= 1, "{entry}");
+            for k in 0..n {
+                h.query_all_by_label(entry).nth(k).unwrap().scroll_to_me();
+                h.run_steps(2);
+                let r = h.query_all_by_label(entry).nth(k).unwrap().rect();
+                assert!(
+                    r.min.x >= left && r.max.x <= right + 0.5,
+                    "presenting {present}: {entry} {r:?} inside the tile from x {left}"
+                );
+            }
         }
     }
 }
