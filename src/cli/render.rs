@@ -303,7 +303,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         total
     );
     if let Some(l) = legend {
-        eprint!("; {}: min {} mean {:.2} max {}", l.title, l.min, l.mean, l.max);
+        // The legend's own numbers, as the app's legend and the PNG's say them.
+        let v = |x: f32| crate::render::legend::fmt_value(x as f64);
+        eprint!("; {}: min {} mean {:.2} max {}", l.title, v(l.min), l.mean, v(l.max));
     }
     if let Some(gpu) = &gpu {
         eprint!("; traced on the GPU, {} nodes: {}", a.device.nodes().name(), gpu.name());

@@ -63,12 +63,7 @@ impl Warp {
             "warp            {} lanes: groups of {bw}×{bh} pixels; a group costs its rays' most steps (nodes visited + triangle tests)\n",
             self.size.lanes()
         );
-        let line = |who: &str, s: &WarpSummary| {
-            format!(
-                "  {who:<14}SIMT efficiency {:.4} (mean of groups {:.4}), group cost mean {:.2}, max {}, total {} steps\n",
-                s.simt_efficiency, s.mean_group_efficiency, s.mean_cost, s.max_cost, s.total_cost
-            )
-        };
+        let line = |who: &str, s: &WarpSummary| format!("  {who:<14}{}\n", s.text());
         if let Some(g) = &self.gpu {
             o += &line("GPU's counts", g);
         }

@@ -171,3 +171,39 @@ fn the_speedup_is_measured_as_compare_measures_it() {
     let ratio = row.speedup_over_linear / s.speedup;
     assert!((0.4..2.5).contains(&ratio), "compare {:.0}×, the app {:.0}×", row.speedup_over_linear, s.speedup);
 }
+
+/// The SIMT efficiency view: its legend's min is the CLI's (1/32, a warp with one busy lane, was
+/// "min 0.0"), and the statistics show the headline efficiency `stats --warp 32` prints, the
+/// same line of figures.
+#[test]
+fn the_simt_legend_and_headline_are_the_clis() {
+    use bvhscope::render::{legend::fmt_value, warp::WarpSize, View};
+    let torus = root().join("assets/torus.obj");
+    let mut h = harness();
+    open(&mut h, &torus);
+    edit(&mut h, |s| s.view = View::SimtEfficiency(WarpSize::W32));
+    run_until(&mut h, "the SIMT view", |a| {
+        idle(a)
+            && a.shown.as_ref().is_some_and(|s| {
+                s.style.view == View::SimtEfficiency(WarpSize::W32) && s.frame.is_complete() && s.legend.is_some()
+            })
+    });
+    h.run_steps(2);
+    let (legend, camera) = {
+        let s = h.state().shown.as_ref().unwrap();
+        (s.legend.clone().unwrap(), s.camera)
+    };
+    assert!(legend.min > 0.0 && legend.min < 1.0, "a warp with idle lanes: {}", legend.min);
+    // `render`'s line said the f32 as it is (0.03125); the app's legend now says it so too.
+    assert_eq!(fmt_value(legend.min as f64), legend.min.to_string());
+    h.get_by_label_contains(&format!("min {}", legend.min));
+    // The headline: `stats --warp 32`'s line of the CPU's counts, on the app's camera.
+    let mut args = vec![s("stats"), s(torus.display()), s("--warp"), s("32")];
+    args.extend(camera_words(&camera));
+    let bvhscope::cli::Command::Stats(a) = words(&args) else { panic!("stats") };
+    let out = bvhscope::cli::stats::output(&a).unwrap();
+    let line = out.lines().find(|l| l.contains("CPU's counts")).unwrap_or_else(|| panic!("{out}"));
+    let figures = line.trim().trim_start_matches("CPU's counts").trim();
+    assert!(figures.starts_with("SIMT efficiency 0."), "{figures}");
+    h.get_by_label_contains(figures);
+}

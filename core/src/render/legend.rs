@@ -44,9 +44,11 @@ fn draw_line(img: &mut RgbImage, x: u32, y: u32, s: &str, color: Rgb<u8>, width:
     draw_text(img, x, y + (LINE - 8 * scale) / 2, s, color, scale);
 }
 
-/// Format a legend number compactly: integers as integers, others with one decimal, and very
-/// large or very small ones in scientific notation (`-1e8`, `3.4e38`), so that any finite range
-/// has labels a few characters long.
+/// Format a legend number compactly: integers as integers, fractions below 1 to four significant
+/// digits (a SIMT efficiency of 1/32 is 0.03125, not 0.0: issue 59), others with one decimal, and
+/// very large or very small ones in scientific notation (`-1e8`, `3.4e38`), so that any finite
+/// range has labels a few characters long. The app's legend, the PNG's and `render`'s line say
+/// a figure by it alike.
 pub fn fmt_value(v: f64) -> String {
     if v != 0.0 && !(1e-2..1e6).contains(&v.abs()) {
         // Three significant digits, trailing zeros dropped: 1e20, 2.5e-3, -3.4e38.
@@ -57,6 +59,10 @@ pub fn fmt_value(v: f64) -> String {
     }
     if (v - v.round()).abs() < 1e-9 {
         format!("{}", v.round() as i64)
+    } else if v.abs() < 1.0 {
+        let digits = (3 - v.abs().log10().floor() as i32).max(1) as usize;
+        let s = format!("{v:.digits$}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
         format!("{v:.1}")
     }
@@ -315,6 +321,9 @@ mod tests {
         assert_eq!(fmt_value(12.0), "12");
         assert_eq!(fmt_value(2.5), "2.5");
         assert_eq!(fmt_value(0.0025), "2.5e-3");
+        assert_eq!(fmt_value(0.03125), "0.03125");
+        assert_eq!(fmt_value(0.69334), "0.6933");
+        assert_eq!(fmt_value(-0.5), "-0.5");
     }
 
     /// The parallel copy makes what `from_pixel` and `replace` made.

@@ -114,6 +114,17 @@ pub struct WarpSummary {
     pub max_cost: u32,
 }
 
+impl WarpSummary {
+    /// The figures as `stats --warp` prints them and the app's statistics show them, one text
+    /// for both (issue 59: the app never showed the headline efficiency).
+    pub fn text(&self) -> String {
+        format!(
+            "SIMT efficiency {:.4} (mean of groups {:.4}), group cost mean {:.2}, max {}, total {} steps",
+            self.simt_efficiency, self.mean_group_efficiency, self.mean_cost, self.max_cost, self.total_cost
+        )
+    }
+}
+
 impl WarpView {
     /// The groups of a `width`×`height` frame's per-pixel counts (row by row from the top).
     pub fn frame(width: u32, height: u32, counters: &[RayCounters], size: WarpSize, work: WarpWork) -> WarpView {

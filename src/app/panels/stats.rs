@@ -235,6 +235,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     if let Some(built) = app.current_bvh().filter(|b| b.bvh.two_level().is_some()) {
         two_level(ui, built, rays(&current));
     }
+    warp_line(app, ui);
     speedup(app, ui, out);
 
     ui.add_space(6.0);
@@ -250,6 +251,38 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     Plot::new("leaf-histogram").height(140.0).allow_drag(false).allow_zoom(false).allow_scroll(false).show(ui, |p| {
         p.bar_chart(BarChart::new("leaves", bars));
     });
+}
+
+/// The warp figures of the image's camera rays, as `bvhscope stats --warp N` prints them (its
+/// headline SIMT efficiency the app did not show, issue 59): of the warp view's lanes, else 32.
+/// Made once per frame (a pass over its counts), kept in egui's memory.
+fn warp_line(app: &BvhscopeApp, ui: &mut egui::Ui) {
+    use crate::render::warp::{WarpSize, WarpSummary, WarpView, WarpWork};
+    let Some(shown) = app
+        .shown
+        .as_ref()
+        .filter(|s| s.frame.is_complete() && s.frame.counted() && s.partial.is_none() && s.frame.secondary().is_none())
+    else {
+        return;
+    };
+    let size = shown.style.view.warp().unwrap_or(WarpSize::W32);
+    let key = (std::sync::Arc::as_ptr(&shown.frame) as usize, size.lanes());
+    let id = egui::Id::unique("warp-summary");
+    let cached = ui.ctx().data(|d| d.get_temp::<((usize, u32), WarpSummary)>(id)).filter(|(k, _)| *k == key);
+    let summary = cached.map(|(_, s)| s).unwrap_or_else(|| {
+        let f = &shown.frame;
+        let counts: Vec<_> = f.traced().map(|(_, c)| c).collect();
+        let s = WarpView::frame(f.width(), f.height(), &counts, size, WarpWork::Steps).summary();
+        ui.ctx().data_mut(|d| d.insert_temp(id, (key, s)));
+        s
+    });
+    let (bw, bh) = size.block();
+    ui.add_space(4.0);
+    ui.label(format!("Warps of {} lanes ({bw}×{bh} pixels): {}", size.lanes(), summary.text())).on_hover_text(format!(
+        "The image's camera rays in groups of {} side by side, as a GPU runs them: a group takes as long as its ray with the most steps (nodes visited + triangle tests) while finished lanes idle. SIMT efficiency: the share of lane-steps that do work. As bvhscope stats --warp {} prints it",
+        size.lanes(),
+        size.lanes()
+    ));
 }
 
 /// How the speed-up is measured, the same words wherever it is said: one method, in
