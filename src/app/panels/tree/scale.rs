@@ -90,7 +90,7 @@ pub fn bar(ui: &mut egui::Ui, scale: &Scale, metric: Metric) {
         ui.weak(format!("{} ({kind})", metric.label()));
     })
     .response
-    .widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Label, true, scale.text(metric)));
+    .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Label, true, scale.text(metric)));
 }
 
 #[cfg(test)]
