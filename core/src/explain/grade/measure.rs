@@ -49,7 +49,10 @@ pub struct Quality {
 /// unevenly (two identical trees timed one after the other differed by 2×): so a tree is timed
 /// in the same rounds as bvhscope's SAH tree of its layout, piece by piece (`PIECE` rays, the
 /// two trees alternately first), each piece's fastest of `RUNS` runs kept; the figure compared
-/// is the ratio of the two sums, which a load on the machine leaves alone. The linear scan is
+/// is the ratio of the two sums, which a load on the machine leaves alone, and a tree's time per
+/// ray is that ratio times the SAH tree's time, timed once per layout: bvhscope's own trees are
+/// timed so too, each beside the SAH tree, so a reference and a student's copy of it read alike
+/// (issue 59). The linear scan is
 /// timed once for the class, on as many of the rays as fit in a fifth of a second per run, and
 /// the SAH tree's speed-up over it carries each tree's ratio into a speed-up of its own.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
