@@ -6,7 +6,9 @@
 use super::*;
 
 fn at_720() -> Harness<'static, BvhscopeApp> {
-    Harness::builder().with_size(egui::vec2(1280.0, 720.0)).build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()))
+    Harness::builder()
+        .with_size(egui::vec2(1280.0, 720.0))
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()))
 }
 
 fn heatmap(h: &mut Harness<'_, BvhscopeApp>) {
@@ -52,7 +54,8 @@ fn the_legend_is_beside_or_below_the_image_and_folds_to_a_bar() {
     assert!(h.query_by_label("Histogram of the heatmap").is_none(), "folded");
     run_until(&mut h, "the image at its new size", idle);
     assert!(h.state().image_rect.area() > image.area(), "{:?} larger than {image:?}", h.state().image_rect);
-    let unfold = h.query_by_label("Show").or_else(|| h.query_by_label("Show the legend")).expect("the unfold button").rect();
+    let unfold =
+        h.query_by_label("Show").or_else(|| h.query_by_label("Show the legend")).expect("the unfold button").rect();
     let both = unfold.intersect(h.state().image_rect);
     assert!(both.width() <= 0.5 || both.height() <= 0.5, "the folded bar beside the image");
     h.query_by_label("Show").or_else(|| h.query_by_label("Show the legend")).unwrap().click();

@@ -13,7 +13,7 @@ use egui::{Color32, Pos2, Rect, Sense, Stroke, UiBuilder, Vec2};
 const SIDE_WIDTH: f32 = 240.0;
 /// Its height below the image: at most this, and at most `BELOW_SHARE` of the tile.
 const BELOW_HEIGHT: f32 = 112.0;
-const BELOW_SHARE: f32 = 0.4;
+const BELOW_SHARE: f32 = 0.35;
 /// Folded: the strip holding the colour bar, beside (its width) or below (its height).
 const FOLDED_SIDE: f32 = 52.0;
 const FOLDED_BELOW: f32 = 24.0;
@@ -25,23 +25,45 @@ pub enum Place {
     Below,
 }
 
-/// The image tile `tile` split into the image's part and the legend's: beside when the image,
-/// the whole legend taken off, is still at least as wide as it is tall; else below. Folded, the
-/// legend keeps that place (it does not jump from below to beside).
-pub fn split(tile: Rect, folded: bool) -> (Rect, Rect, Place) {
-    let side = if folded { FOLDED_SIDE } else { SIDE_WIDTH };
-    if tile.width() - SIDE_WIDTH >= tile.height() {
-        let x = tile.max.x - side;
-        (Rect::from_min_max(tile.min, Pos2::new(x, tile.max.y)), Rect::from_min_max(Pos2::new(x, tile.min.y), tile.max), Place::Beside)
+/// The image tile `tile` split into the image's part and the legend's: beside or below the
+/// image, whichever leaves the larger image (of `aspect`, a scene's film letterboxed, or the
+/// whole part when `None`). Folded, the legend keeps the place it has unfolded (it does not jump
+/// from below to beside).
+pub fn split(tile: Rect, folded: bool, aspect: Option<f32>) -> (Rect, Rect, Place) {
+    let below_height = |folded: bool| if folded { FOLDED_BELOW } else { BELOW_HEIGHT.min(tile.height() * BELOW_SHARE) };
+    let shown = |w: f32, h: f32| match aspect {
+        Some(a) => (w.min(h * a)) * (w.min(h * a) / a),
+        None => w * h,
+    };
+    let beside =
+        shown(tile.width() - SIDE_WIDTH, tile.height()) > shown(tile.width(), tile.height() - below_height(false));
+    if beside {
+        let x = tile.max.x - if folded { FOLDED_SIDE } else { SIDE_WIDTH };
+        (
+            Rect::from_min_max(tile.min, Pos2::new(x, tile.max.y)),
+            Rect::from_min_max(Pos2::new(x, tile.min.y), tile.max),
+            Place::Beside,
+        )
     } else {
-        let h = if folded { FOLDED_BELOW } else { BELOW_HEIGHT.min(tile.height() * BELOW_SHARE) };
-        let y = tile.max.y - h;
-        (Rect::from_min_max(tile.min, Pos2::new(tile.max.x, y)), Rect::from_min_max(Pos2::new(tile.min.x, y), tile.max), Place::Below)
+        let y = tile.max.y - below_height(folded);
+        (
+            Rect::from_min_max(tile.min, Pos2::new(tile.max.x, y)),
+            Rect::from_min_max(Pos2::new(tile.min.x, y), tile.max),
+            Place::Below,
+        )
     }
 }
 
 /// The legend in `rect` (from `split`); `histogram`: the image's own values (not a pair's).
-pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, rect: Rect, place: Place, legend: &Legend, histogram: bool, out: &mut Actions) {
+pub fn show(
+    app: &BvhscopeApp,
+    ui: &mut egui::Ui,
+    rect: Rect,
+    place: Place,
+    legend: &Legend,
+    histogram: bool,
+    out: &mut Actions,
+) {
     ui.painter().rect_filled(rect, 0.0, ui.visuals().panel_fill);
     let inner = rect.shrink2(Vec2::new(6.0, 4.0));
     let mut child = ui.new_child(UiBuilder::new().id_salt("heatmap-legend").max_rect(inner));
@@ -57,24 +79,18 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, rect: Rect, place: Place, lege
                 if histogram {
                     histogram_area(app, ui, legend, out);
                 }
-                ui.label(format!("min {}", fmt_value(legend.min as f64)));
-                ui.label(format!("mean {:.2}", legend.mean));
-                ui.label(format!("max {}", fmt_value(legend.max as f64)));
-                ui.weak("(all traced rays)");
+                summary(ui, legend);
             });
         }
         (false, Place::Below) => {
             egui::ScrollArea::vertical().id_salt("legend-below").auto_shrink([false, false]).show(ui, |ui| {
-                ui.columns(2, |cols| {
+                // Two columns when there is a histogram to show beside the bar; else one.
+                let columns = if histogram { 2 } else { 1 };
+                ui.columns(columns, |cols| {
                     header(&mut cols[0], legend, out);
                     let w = cols[0].available_width();
                     bar(&mut cols[0], legend, w);
-                    cols[0].label(format!(
-                        "min {}   mean {:.2}   max {}   (all traced rays)",
-                        fmt_value(legend.min as f64),
-                        legend.mean,
-                        fmt_value(legend.max as f64)
-                    ));
+                    summary(&mut cols[0], legend);
                     if histogram {
                         histogram_area(app, &mut cols[1], legend, out);
                     }
@@ -82,6 +98,17 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, rect: Rect, place: Place, lege
             });
         }
     }
+}
+
+/// The frame's min, mean and max on one line.
+fn summary(ui: &mut egui::Ui, legend: &Legend) {
+    let text = format!(
+        "min {}   mean {:.2}   max {}",
+        fmt_value(legend.min as f64),
+        legend.mean,
+        fmt_value(legend.max as f64)
+    );
+    ui.label(text).on_hover_text("Over all traced rays (the range above may be fixed)");
 }
 
 /// The title with the fold button, and the note.
@@ -149,7 +176,11 @@ fn folded_beside(ui: &mut egui::Ui, inner: Rect, legend: &Legend, out: &mut Acti
 /// Folded below the image: the unfold button and the bar between its ends, on one line.
 fn folded_below(ui: &mut egui::Ui, legend: &Legend, out: &mut Actions) {
     ui.horizontal(|ui| {
-        if ui.small_button("Show the legend").on_hover_text("Show the legend: title, histogram, hottest pixel, min / mean / max").clicked() {
+        if ui
+            .small_button("Show the legend")
+            .on_hover_text("Show the legend: title, histogram, hottest pixel, min / mean / max")
+            .clicked()
+        {
             out.push(Action::FoldLegend(false));
         }
         ui.label(&legend.title);

@@ -9,9 +9,10 @@ use egui::Color32;
 
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-        for job in [&app.jobs.render, &app.jobs.build, &app.jobs.load, &app.jobs.import, &app.jobs.film, &app.jobs.grade]
-            .into_iter()
-            .flatten()
+        for job in
+            [&app.jobs.render, &app.jobs.build, &app.jobs.load, &app.jobs.import, &app.jobs.film, &app.jobs.grade]
+                .into_iter()
+                .flatten()
         {
             let fraction = job.control.fraction();
             if job.control.total() > 0 {

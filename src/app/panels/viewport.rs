@@ -42,7 +42,8 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     // A heatmap's legend takes its part of the tile (chosen by the view, not by the frame on
     // screen, so the image's size does not change when the frame arrives).
     let (full, legend_at) = if app.settings.view.is_heatmap() {
-        let (image, legend, place) = legend::split(tile, app.settings.legend_folded);
+        let aspect = app.film().map(|(w, h)| w as f32 / h as f32);
+        let (image, legend, place) = legend::split(tile, app.settings.legend_folded, aspect);
         (image, Some((legend, place)))
     } else {
         (tile, None)

@@ -138,7 +138,7 @@ impl Presenting {
 /// share of the height: at 150 % a 1280-px screen is 853 points wide, and the Node view's table
 /// and plots, the Ray view's steps, need about half of it to be read from the back row.
 const PRESENT_WIDTH: f32 = 0.45;
-const PRESENT_HEIGHT: f32 = 0.55;
+const PRESENT_HEIGHT: f32 = 0.45;
 
 /// Presenting or not, with the explain views `open`: on starting to present, and whenever
 /// another view opens or closes while presenting, each open view's tile is given the side of the
