@@ -188,3 +188,31 @@ fn a_link_to_a_dump_beside_it_is_the_same_dump() {
         assert_eq!(row["dump"].as_str(), Some(s(&zoe.join("bvh.json")).as_str()));
     }
 }
+
+/// The time after "graded in" in `text`.
+fn graded_in(text: &str) -> &str {
+    let at = text.find("graded in ").unwrap_or_else(|| panic!("no grading time in {text}")) + "graded in ".len();
+    let end = text[at..].find(" s").unwrap();
+    &text[at..at + end]
+}
+
+/// The terminal and the page give one grading time: the references built and timed, then the
+/// students (the terminal's was its own, the report's writing included, the page's the students'
+/// alone: they differed, issue 59). Enough rays timed that the references take a visible time.
+#[test]
+fn grade_prints_the_grading_time_the_page_gives() {
+    let d = fresh("grade-out-time");
+    export(&d.join("ana.json"));
+    let out = d.join("report");
+    let args =
+        ["grade", TORUS, &s(&d.join("ana.json")), "--out", &s(&out), "--size", "160x120", "--time-rays", "19200"];
+    let r = bvhscope(&args);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    let page = std::fs::read_to_string(out.join("grade.html")).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("grade.json")).unwrap()).unwrap();
+    let seconds = json["seconds"].as_f64().unwrap();
+    assert_eq!(graded_in(&err), graded_in(&page), "the terminal's time and the page's");
+    assert_eq!(graded_in(&page), format!("{seconds:.1}"), "grade.json's");
+}

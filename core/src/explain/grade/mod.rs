@@ -262,7 +262,8 @@ fn lossy_opt<S: serde::Serializer>(p: &Option<PathBuf>, s: S) -> Result<S::Ok, S
 pub struct Graded {
     pub rows: Vec<GradeRow>,
     pub references: References,
-    /// Seconds spent on the submissions (the references are built before).
+    /// Seconds the grading took: the references built and timed (`References::seconds`), then
+    /// the submissions. The one time the terminal, the page and grade.json give.
     pub seconds: f64,
 }
 
@@ -279,6 +280,7 @@ pub fn grade_class(
     mut on_row: impl FnMut(&GradeRow),
 ) -> Graded {
     let start = std::time::Instant::now();
+    let before = references.seconds;
     control.set_total(submissions.len() as u64);
     let mut rows = Vec::with_capacity(submissions.len());
     for sub in submissions {
@@ -288,5 +290,5 @@ pub fn grade_class(
         control.add_done(1);
     }
     rank(&mut rows, setup.rubric.rank_by);
-    Graded { rows, references, seconds: start.elapsed().as_secs_f64() }
+    Graded { rows, references, seconds: before + start.elapsed().as_secs_f64() }
 }
