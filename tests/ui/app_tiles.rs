@@ -41,12 +41,28 @@ fn look_tiles_at_720() {
     let n = h.state().pins.current().unwrap().len();
     h.state_mut().act(Action::RayStep(n * 2 / 3));
     for present in [false, true] {
+        if h.state().pins.pinned.is_empty() {
+            pin_first_hit(&mut h);
+        }
         h.state_mut().act(Action::Present(present));
         for _ in 0..6 {
             h.step();
         }
         let img = h.render().expect("a wgpu adapter");
         img.save(format!("{dir}/tiles-720-{present}.png")).unwrap();
+        // The Node view's table (the Ray view closed for the room) and its first plot's legend.
+        h.state_mut().act(Action::UnpinAll);
+        h.run_steps(2);
+        h.get_by_label("Cost").scroll_to_me();
+        for _ in 0..4 {
+            h.step();
+        }
+        h.render().unwrap().save(format!("{dir}/tiles-720-{present}-table.png")).unwrap();
+        h.get_all_by_label("as a leaf").next().unwrap().scroll_to_me();
+        for _ in 0..4 {
+            h.step();
+        }
+        h.render().unwrap().save(format!("{dir}/tiles-720-{present}-legend.png")).unwrap();
     }
 }
 
@@ -266,4 +282,27 @@ fn the_icicle_shows_its_colour_scale() {
     h.state_mut().act(Action::SetMetric(bvhscope::app::Metric::Depth));
     h.run_steps(3);
     h.get_by_label_contains("Colour scale: depth, linear, 0 to ");
+}
+
+/// The Node view's table on LBVH's root in a tall window (to look at its footnote).
+#[test]
+#[ignore]
+fn look_node_table_tall() {
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 1700.0))
+        .wgpu()
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+    run_until(&mut h, "the first frame", idle);
+    with_strategy(&mut h, bvhscope::bvh::Strategy::Lbvh);
+    h.state_mut().act(Action::ShowTree(true));
+    run_until(&mut h, "LBVH", |a| {
+        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.strategy == bvhscope::bvh::Strategy::Lbvh)
+    });
+    h.state_mut().act(Action::SelectNode(0));
+    run_until(&mut h, "the root's inspection", |a| a.nodes.inspection.as_ref().is_some_and(|i| i.node == 0));
+    for _ in 0..6 {
+        h.step();
+    }
+    let dir = std::env::var("BVHSCOPE_LOOK").unwrap_or("/tmp".into());
+    h.render().unwrap().save(format!("{dir}/node-table-tall.png")).unwrap();
 }
