@@ -73,6 +73,9 @@ fn the_rays_choice_is_never_cut_at_720_px() {
     }
 }
 
+/// A change of the settings, named.
+type Change = (&'static str, fn(&mut bvhscope::app::Settings));
+
 /// The rows below a choice stay where they are when it changes: the GPU chosen (its node format's
 /// row), a warp view (64 lanes), ambient occlusion (rays per pixel), a fixed range (its row) and
 /// the node boxes shown each used to add a row and move everything below it; now a row that does
@@ -101,7 +104,7 @@ fn the_view_panels_rows_stay_put_when_a_choice_changes() {
         for l in ["64-lane warps", "Fixed difference range (±)", "no boxes drawn"] {
             assert!(h.get_by_label(l).accesskit_node().is_disabled(), "{l} greyed");
         }
-        let changes: [(&str, fn(&mut bvhscope::app::Settings)); 5] = [
+        let changes: [Change; 5] = [
             ("the GPU", |s| s.device = bvhscope::gpu_path::Device::Gpu),
             ("a warp view", |s| s.view = View::WarpCost(bvhscope::render::warp::WarpSize::W32)),
             ("ambient occlusion", |s| s.rays.kind = RayKind::Ao),

@@ -88,7 +88,7 @@ fn contents(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 "Groups of 64 rays (8×8 pixels, AMD's wave64) instead of 32 (8×4, NVIDIA's warp and most GPUs')",
             )
             .on_disabled_hover_text("For the Warp cost and SIMT efficiency views: choose one of them first");
-        if count % columns == 0 {
+        if count.is_multiple_of(columns) {
             ui.end_row();
         }
     });
