@@ -19,7 +19,9 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     if !c.on {
         return;
     }
-    ui.horizontal(|ui| {
+    // Every row wraps within the tile: a row wider than it made a sideways scroll bar, which
+    // floated over the mode buttons when presenting (issue 59).
+    ui.horizontal_wrapped(|ui| {
         ui.label("B: split by");
         egui::ComboBox::from_id_salt("compare-strategy").selected_text(c.strategy.label()).show_ui(ui, |ui| {
             for s in Strategy::ALL {
@@ -35,7 +37,7 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let (n, l) = (crate::bvh::Param::MaxLeafSize.option(), crate::bvh::params::MAX_LEAF_SIZE);
     let mut changed =
         ui.add(egui::Slider::new(&mut leaf, l.min..=l.max).text("B's max leaf size")).on_hover_text(n.help).changed();
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         for l in Layout::ALL {
             changed |= ui.radio_value(&mut layout, l, l.label()).changed();
         }
@@ -50,7 +52,7 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     if changed {
         out.push(Action::CompareB { max_leaf_size: leaf, layout, trace });
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         for m in PairView::ALL {
             if ui.radio(c.mode == m, m.label()).clicked() {
                 out.push(Action::CompareMode(m));

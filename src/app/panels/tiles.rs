@@ -76,6 +76,11 @@ impl egui_tiles::Behavior<Pane> for Tiles<'_> {
             pane => {
                 if let Some(v) = view_of(pane) {
                     margin(ui, |ui| {
+                        // Compare's bars take room of their own: floating, one covered its mode
+                        // buttons on hover when presenting (issue 59).
+                        if pane == Pane::Compare {
+                            ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+                        }
                         egui::ScrollArea::both()
                             .id_salt(pane.title())
                             .auto_shrink([false, false])
