@@ -104,15 +104,6 @@ pub fn secondary_trace_command(
     words.join(" ")
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn ordinals() {
-        let o: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22, 101, 111].into_iter().map(super::ordinal).collect();
-        assert_eq!(o, ["1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "101st", "111th"]);
-    }
-}
-
 /// The `bvhscope compare` command that times `build`'s tree on the same rays as the app's
 /// speed-up over the linear scan: the same camera and image size, the same traversal, the same
 /// runs (`explain::timing`); its row of the strategy is the app's figure, up to timing noise.
@@ -123,4 +114,13 @@ pub fn compare_command(path: &Path, build: &SceneBuild, opts: TraceOptions, came
     words.push(format!("--camera {}:{}:{}", v(camera.position), v(camera.look_at), v(camera.up)));
     words.push(format!("--fov {} --size {}x{}", camera.vfov_deg, camera.width, camera.height));
     words.join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn ordinals() {
+        let o: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22, 101, 111].into_iter().map(super::ordinal).collect();
+        assert_eq!(o, ["1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "101st", "111th"]);
+    }
 }
