@@ -13,6 +13,7 @@ pub mod explain;
 pub mod files;
 pub mod geometry;
 pub mod json;
+pub mod lesson;
 pub mod mesh;
 pub mod options;
 pub mod parallel;
