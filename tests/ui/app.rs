@@ -467,7 +467,7 @@ fn handout_mode_is_one_click() {
 fn a_z_up_mesh_is_seen_from_the_front() {
     let mut h = harness();
     run_until(&mut h, "the first build", idle);
-    h.get_by_label("Z up").click();
+    click_label(&mut h, "Z up");
     h.run_steps(2);
     let cam = h.state().orbit.camera(800, 600);
     assert_eq!(cam.up, glam::Vec3::Z);
