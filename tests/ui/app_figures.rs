@@ -264,5 +264,6 @@ fn look_compare_presenting() {
     h.hover_at(h.get_by_label("Difference B - A").rect().center());
     h.run_steps(6);
     let dir = std::env::var("BVHSCOPE_LOOK").unwrap_or("/tmp".into());
+    std::fs::create_dir_all(&dir).unwrap();
     h.render().expect("a wgpu adapter").save(format!("{dir}/compare-present.png")).unwrap();
 }
