@@ -296,7 +296,7 @@ fn an_unreadable_file_is_reported_without_its_content() {
 }
 
 /// Two students who hand in the same tree get the same figures and the same rank, and their
-/// trace times, timed in the same rounds as the SAH tree, are within 10 % of each other while
+/// trace times, timed in the same rounds as the SAH tree, are within 15 % of each other while
 /// four threads keep this machine's cores busy.
 #[test]
 fn identical_trees_rank_alike_and_time_alike_on_a_busy_machine() {
@@ -326,10 +326,14 @@ fn identical_trees_rank_alike_and_time_alike_on_a_busy_machine() {
     assert_eq!(a.rank, b.rank);
     let (qa, qb) = (a.quality.clone().unwrap(), b.quality.clone().unwrap());
     assert_eq!((qa.sah_cost, qa.nodes_per_ray, qa.epo), (qb.sah_cost, qb.nodes_per_ray, qb.epo));
+    // Within 15 % either way (the larger over the smaller): two timings on two cores shared with
+    // four busy threads and a parallel test run came 10.1 % apart; the unfairness this guards
+    // against was 2× (and a reference's 194 ns per ray against its copy's 127).
+    let apart = |x: f64, y: f64| x.max(y) / x.min(y) - 1.0;
     let (ta, tb) = (a.versus_sah.unwrap().trace_time, b.versus_sah.unwrap().trace_time);
-    assert!((ta / tb - 1.0).abs() < 0.10, "the same tree timed {ta:.3} and {tb:.3} of the SAH tree's time");
+    assert!(apart(ta, tb) < 0.15, "the same tree timed {ta:.3} and {tb:.3} of the SAH tree's time");
     let (sa, sb) = (qa.speedup_over_linear, qb.speedup_over_linear);
-    assert!((sa / sb - 1.0).abs() < 0.10, "speed-ups {sa:.0}× and {sb:.0}×");
+    assert!(apart(sa, sb) < 0.15, "speed-ups {sa:.0}× and {sb:.0}×");
 }
 
 /// A student who hands in bvhscope's own midpoint tree, and one who hands in its SAH tree, get
