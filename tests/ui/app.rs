@@ -9,18 +9,18 @@ use support::*;
 // The explaining views (pinned rays, the tree and the node inspector, the histogram, the replay,
 // two strategies side by side): the same binary, another file.
 mod app_explain;
+mod app_figures;
 mod app_gpu;
 mod app_grade;
+mod app_legend;
 mod app_look;
 mod app_rays;
 mod app_replay;
 mod app_room;
 mod app_scenes;
-mod app_truth;
-mod app_tiles;
-mod app_figures;
 mod app_small;
-mod app_legend;
+mod app_tiles;
+mod app_truth;
 
 use bvhscope::app::{Action, AppOptions, BvhscopeApp, MessageKind, SceneSource};
 use bvhscope::bvh::Strategy;
