@@ -64,6 +64,20 @@ impl BuildEdit {
         self.strategy.is_none() && self.layout.is_none() && self.params.is_empty()
     }
 
+    /// This edit with what `later` names changed (a parameter named again keeps its first place).
+    pub fn then(&self, later: &BuildEdit) -> BuildEdit {
+        let mut out = self.clone();
+        out.strategy = later.strategy.or(out.strategy);
+        out.layout = later.layout.or(out.layout);
+        for &(param, v) in &later.params {
+            match out.params.iter_mut().find(|(p, _)| *p == param) {
+                Some(slot) => slot.1 = v,
+                None => out.params.push((param, v)),
+            }
+        }
+        out
+    }
+
     /// `p` with what this names changed.
     pub fn apply(&self, p: &BuildParams) -> BuildParams {
         let mut out = *p;
@@ -131,7 +145,9 @@ pub enum Show {
 #[derive(Clone, Debug, PartialEq)]
 pub struct StepState {
     pub scene: PathBuf,
-    pub build: BuildParams,
+    /// The build options named since the lesson began; the rest are the scene's own (its file's
+    /// `bvh`), as `render` takes them when its flags leave them out (`StepState::build_params`).
+    pub build: BuildEdit,
     pub trace: TraceOptions,
     pub rays: SecondarySpec,
     pub view: View,
@@ -143,6 +159,13 @@ pub struct StepState {
     pub show: Show,
 }
 
+impl StepState {
+    /// The build this step shows, over the scene's own settings (`None`: a mesh, the defaults).
+    pub fn build_params(&self, scene: Option<&BuildParams>) -> BuildParams {
+        self.build.apply(&scene.copied().unwrap_or_default())
+    }
+}
+
 impl Lesson {
     /// The state at each step. The reader makes sure the first step names a scene.
     pub fn states(&self) -> Vec<StepState> {
@@ -152,7 +175,7 @@ impl Lesson {
                 Some(prev) => prev.clone(),
                 None => StepState {
                     scene: PathBuf::new(),
-                    build: BuildParams::default(),
+                    build: BuildEdit::default(),
                     trace: TraceOptions::default(),
                     rays: SecondarySpec::default(),
                     view: View::Normals,
@@ -171,7 +194,7 @@ impl Lesson {
                 }
                 s.scene = scene.clone();
             }
-            s.build = step.bvh.apply(&s.build);
+            s.build = s.build.then(&step.bvh);
             s.trace.order = step.order.unwrap_or(s.trace.order);
             s.trace.test = step.test.unwrap_or(s.trace.test);
             s.rays = step.rays.apply(&s.rays);

@@ -15,6 +15,7 @@
 use super::{BuildEdit, Lesson, RaysEdit, Show, Step};
 use crate::json::{join, kind, Fields};
 use crate::options::{Choice, BUILD_PARAMS};
+use crate::render::secondary::MAX_SAMPLES;
 use crate::render::{Camera, HeatRange};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -200,14 +201,25 @@ fn rays(f: &F, v: &Value, at: &str) -> Result<RaysEdit, LessonError> {
     let field = |k: &str| join(at, k);
     Ok(RaysEdit {
         kind: o.get("kind").map(|v| choice(f, v, &field("kind"))).transpose()?,
-        samples: o.get("samples").map(|v| f.whole(v, &field("samples"), 1, 256).map(|x| x as u32)).transpose()?,
-        seed: o.get("seed").map(|v| f.whole(v, &field("seed"), 0, u64::MAX)).transpose()?,
-        ao_length: o
-            .get("ao_length")
-            .map(|v| f.number_in(v, &field("ao_length"), 1e-6, 10.0).map(|x| x as f32))
+        samples: o
+            .get("samples")
+            .map(|v| f.whole(v, &field("samples"), 1, MAX_SAMPLES as u64).map(|x| x as u32))
             .transpose()?,
+        seed: o.get("seed").map(|v| f.whole(v, &field("seed"), 0, u64::MAX)).transpose()?,
+        ao_length: o.get("ao_length").map(|v| share(f, v, &field("ao_length"))).transpose()?,
         light: o.get("light").map(|v| f.vec3(v, &field("light"))).transpose()?,
     })
+}
+
+/// A share of the scene's diagonal, as `--ao-length` takes it: above 0, at most 100.
+fn share(f: &F, v: &Value, field: &str) -> Result<f32, LessonError> {
+    match v.as_f64() {
+        Some(x) if x > 0.0 && x <= 100.0 => Ok(x as f32),
+        _ => Err(f.err(
+            field,
+            format!("expected a share of the diagonal above 0 (at most 100), found {}", crate::json::shown(v)),
+        )),
+    }
 }
 
 /// A camera as a scene file writes it, and its image size.

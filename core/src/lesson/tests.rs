@@ -28,7 +28,8 @@ fn a_step_changes_only_what_it_names_and_the_rest_carries_over() {
     assert_eq!(states.len(), 5);
     let s = &states[1];
     assert_eq!(s.scene, Path::new("lessons/../scenes/knot-on-floor.json"));
-    assert_eq!((s.build.strategy, s.build.max_leaf_size), (Strategy::Midpoint, 2), "from step 0");
+    let build = s.build_params(None);
+    assert_eq!((build.strategy, build.max_leaf_size), (Strategy::Midpoint, 2), "from step 0");
     assert_eq!(s.view, View::Visits);
     assert_eq!(s.range, HeatRange::Fixed { min: 0.0, max: 30.0 });
     assert_eq!(s.boxes, None);
@@ -40,10 +41,15 @@ fn a_step_changes_only_what_it_names_and_the_rest_carries_over() {
     assert_eq!(s.range, HeatRange::Fixed { min: 0.0, max: 30.0 }, "kept");
     let Show::Compare { b, mode } = &s.show else { panic!("{:?}", s.show) };
     assert_eq!(*mode, PairView::Difference);
-    assert_eq!(b.apply(&s.build).strategy, Strategy::SahBinned);
-    assert_eq!(b.apply(&s.build).max_leaf_size, 2, "B is A with its strategy changed");
+    assert_eq!(b.apply(&s.build_params(None)).strategy, Strategy::SahBinned);
+    assert_eq!(b.apply(&s.build_params(None)).max_leaf_size, 2, "B is A with its strategy changed");
     let s = &states[3];
-    assert_eq!((s.build.strategy, s.build.layout), (Strategy::Midpoint, Layout::Wide4));
+    let build = s.build_params(None);
+    assert_eq!((build.strategy, build.layout), (Strategy::Midpoint, Layout::Wide4));
+    // Options a step leaves unnamed are the scene's own, as `render` takes them.
+    let scene = BuildParams { strategy: Strategy::EqualCount, max_leaf_size: 8, sah_bins: 7, ..Default::default() };
+    let over = s.build_params(Some(&scene));
+    assert_eq!((over.strategy, over.max_leaf_size, over.sah_bins), (Strategy::Midpoint, 2, 7));
     assert_eq!((s.trace.order, s.trace.test), (TraversalOrder::SplitAxisSign, TriangleTest::MollerTrumbore));
     assert_eq!(s.camera.map(|c| (c.width, c.height)), Some((800, 600)));
     assert_eq!(s.rays.kind, RayKind::Ao, "kept");
