@@ -1,8 +1,10 @@
 //! The ray-cast renderer shared by the CLI and the app: a pinhole camera, one ray per pixel in
 //! progressive passes over tiles (rayon), per-pixel counters, and conversion of the result into
 //! images: normals, depth, and heatmaps of traversal work with a legend.
+//! Node boxes as line segments over an image, and drawn into it: `boxes` (the app's overlay, `render --boxes`).
 
 pub mod animation;
+pub mod boxes;
 mod camera;
 mod colormap;
 pub mod diff;
