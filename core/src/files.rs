@@ -11,14 +11,20 @@
 //!   `export-bvh m.obj -o m.obj` must not replace the mesh;
 //! - a file named by a user's file (a glTF's buffer) is read only from that file's folder or below
 //!   (`beside`), and no more of it than the naming file declares (`read_declared`);
-//! - one set of limits (`limits`) that every reader counts against.
+//! - one set of limits (`limits`) that every reader counts against;
+//! - a folder a command writes whole (`ReportDir`, of a `FolderKind`: grade's report, a lesson's
+//!   handout) is written beside it and renamed into place, replacing only the files its list says
+//!   an earlier run wrote (`manifest`).
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 mod beside;
 pub mod limits;
+mod manifest;
+mod report_dir;
 pub use beside::{beside, Refused};
+pub use report_dir::{FolderError, FolderKind, ReportDir};
 
 /// Why a file the user named cannot be read or written.
 #[derive(Debug, thiserror::Error)]

@@ -9,7 +9,7 @@
 
 use super::measure::Quality;
 use super::page::{SCRIPT, STYLE};
-use super::{GradeRow, Graded, ReportDir, Setup, Verdict};
+use super::{GradeRow, Graded, ReportDir, Setup, Verdict, HTML_FILE};
 use crate::files::FileError;
 use crate::render::legend::fmt_value;
 use std::fmt::Write as _;
@@ -20,7 +20,7 @@ const MAX_IMAGE: u64 = 64 << 20;
 
 /// Write the page into the report folder.
 pub fn write_html(setup: &Setup, graded: &Graded, out: &ReportDir) -> Result<(), FileError> {
-    let path = out.html_path()?;
+    let path = out.path_while_written(HTML_FILE);
     let werr = |source| FileError::Write { path: path.clone(), source };
     crate::files::write_atomically(&path, |w| {
         w.write_all(head(setup, graded).as_bytes()).map_err(werr)?;

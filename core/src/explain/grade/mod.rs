@@ -10,9 +10,10 @@
 //! - `evaluate`: one submission read, checked, measured and drawn, then dropped: memory holds one
 //!   submission at a time besides the references, whatever the size of the class;
 //! - `rank`: the order within the class, by a key the rubric names (`rubric`);
-//! - `report`: the report folder (`ReportDir`) and what is written there: `table` (the CSV's
-//!   records), `json`, `html` (with `page`'s style and script), `manifest` (the list of the
-//!   report's files: what a later run into the folder may replace);
+//! - `report`: the report folder (`ReportDir`: the files service's `files::ReportDir` of the kind
+//!   `GRADE`, whose list of the report's files says what a later run into the folder may
+//!   replace) and what is written there: `table` (the CSV's records), `json`, `html` (with
+//!   `page`'s style and script);
 //! - `report_file`: `grade.json` read back (`GradeReport`), its paths found again, for the app.
 //!
 //! One broken file never stops the run: every failure of a submission becomes its row's verdict
@@ -20,9 +21,8 @@
 
 mod discover;
 mod evaluate;
-mod html;
+pub(crate) mod html;
 mod json;
-mod manifest;
 mod measure;
 mod page;
 mod rank;
@@ -42,11 +42,10 @@ pub use discover::{discover, Submission};
 pub use evaluate::evaluate;
 pub use html::write_html;
 pub use json::document;
-pub use manifest::MANIFEST_FILE;
 pub use measure::{Quality, Timing};
 pub use rank::{rank, RankBy};
 pub use reference::{ReferenceTree, References};
-pub use report::{ReportDir, CSV_FILE, HTML_FILE, IMAGES_DIR, JSON_FILE};
+pub use report::{ReportDir, CSV_FILE, GRADE, HTML_FILE, IMAGES_DIR, JSON_FILE, MANIFEST_FILE};
 pub use report_file::{is_report, GradeReport, GradedStudent};
 pub use rubric::{Good, Rubric};
 pub use table::csv_records;

@@ -280,7 +280,7 @@ fn a_grade_report_is_read_back_with_its_paths_found_again() {
     std::fs::remove_file(d.join("class/gone.txt")).unwrap();
     std::fs::write(out.file(JSON_FILE), serde_json::to_string_pretty(&doc).unwrap()).unwrap();
 
-    let r = GradeReport::read(&out.root).unwrap();
+    let r = GradeReport::read(out.root()).unwrap();
     assert_eq!(r.file, out.file(JSON_FILE), "a report folder is read through its grade.json");
     assert_eq!(r.mesh, Ok(d.join("knot.obj")), "found from the report folder's parent");
     assert_eq!((r.camera, r.trace), (setup.camera, setup.trace));
@@ -300,7 +300,7 @@ fn a_grade_report_is_read_back_with_its_paths_found_again() {
     let gone = s[5].openable().unwrap_err();
     assert!(gone.starts_with("gone's dump class/gone.txt is not found (looked for class/gone.txt, "), "{gone}");
     assert!(gone.contains(&d.join("class/gone.txt").display().to_string()), "{gone}");
-    assert!(is_report(&out.root) && is_report(&out.file(JSON_FILE)) && !is_report(&d.join("class/mia.txt")));
+    assert!(is_report(out.root()) && is_report(&out.file(JSON_FILE)) && !is_report(&d.join("class/mia.txt")));
 
     let refused = |change: &dyn Fn(&mut serde_json::Value)| {
         let mut v = doc.clone();

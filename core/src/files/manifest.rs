@@ -1,8 +1,9 @@
-//! The list of a report's files (`grade-files.txt`): every file and folder `grade` wrote, each
-//! file with its size, written last into the report before it is put in place. A later `grade
-//! --out` into the same folder replaces only what the list names, unchanged: a folder holding
-//! anything else (a file of the user's, a file edited since, a symbolic link, a report of a
-//! bvhscope that wrote no list) is refused, named, and left as it is.
+//! The list of a report folder's files (`grade-files.txt`, `handout-files.txt`: the kind's
+//! `FolderKind::list`): every file and folder the command wrote, each file with its size, written
+//! last into the folder before it is put in place. A later run into the same folder replaces only
+//! what the list names, unchanged: a folder holding anything else (a file of the user's, a file
+//! edited since, a symbolic link, a report of a bvhscope that wrote no list) is refused, named,
+//! and left as it is.
 //!
 //! ```text
 //! bvhscope-grade-files 1
@@ -15,18 +16,12 @@
 //! report's names hold no tab nor newline). Nothing is removed by the list's word alone: what is
 //! removed is what a walk of the folder finds, each entry checked against the list.
 
+use super::FolderKind;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-/// The list's name in the report folder.
-pub const MANIFEST_FILE: &str = "grade-files.txt";
-/// Its first line: what it is, and the version of its layout.
-const FIRST_LINE: &str = "bvhscope-grade-files 1";
 /// The largest list read: a class of a thousand lists about 100 kB.
 const MAX_BYTES: u64 = 16 << 20;
-/// The report's own names (`report.rs`'s, which imports this file): a folder holding one of
-/// them but no list is an older report, or someone's own files named alike.
-const REPORT_NAMES: [&str; 4] = ["grade.csv", "grade.json", "grade.html", "images"];
 
 /// An entry found in a folder, links not followed.
 struct Entry {
@@ -78,10 +73,10 @@ fn walk_into(dir: &Path, prefix: &str, out: &mut Vec<Entry>) -> std::io::Result<
     Ok(())
 }
 
-/// Write the list of everything in `work` (the report just written, all of it ours) into it.
-pub fn write(work: &Path) -> Result<(), crate::files::FileError> {
-    let read = |source| crate::files::FileError::Read { path: work.into(), source };
-    let mut text = format!("{FIRST_LINE}\n");
+/// Write the list of everything in `work` (the folder just written, all of it ours) into it.
+pub(super) fn write(work: &Path, kind: &FolderKind) -> Result<(), super::FileError> {
+    let read = |source| super::FileError::Read { path: work.into(), source };
+    let mut text = format!("{}\n", kind.first_line);
     for e in walk(work).map_err(read)? {
         match e.kind {
             Kind::File(bytes) => text += &format!("file\t{bytes}\t{}\n", e.rel),
@@ -90,68 +85,78 @@ pub fn write(work: &Path) -> Result<(), crate::files::FileError> {
             Kind::Link | Kind::Other => {}
         }
     }
-    crate::files::write_bytes(&work.join(MANIFEST_FILE), text.as_bytes())
+    super::write_bytes(&work.join(kind.list), text.as_bytes())
 }
 
 /// What a list says: each file's size (`None` for a folder), by relative path.
-fn read_list(root: &Path) -> Result<Option<HashMap<String, Option<u64>>>, String> {
-    let path = root.join(MANIFEST_FILE);
+fn read_list(root: &Path, kind: &FolderKind) -> Result<Option<HashMap<String, Option<u64>>>, String> {
+    let list = kind.list;
+    let path = root.join(list);
     match std::fs::symlink_metadata(&path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(format!("holds {MANIFEST_FILE}, which cannot be read: {e}")),
-        Ok(m) if !m.is_file() => return Err(not_list()),
+        Err(e) => return Err(format!("holds {list}, which cannot be read: {e}")),
+        Ok(m) if !m.is_file() => return Err(not_list(kind)),
         Ok(_) => {}
     }
-    let (file, _) = crate::files::open_regular(&path).map_err(|e| format!("holds {MANIFEST_FILE}: {e}"))?;
-    let bytes = crate::files::read_limited(file, MAX_BYTES)
-        .map_err(|e| format!("holds {MANIFEST_FILE}, which cannot be read: {e}"))?
-        .ok_or_else(not_list)?;
-    let text = String::from_utf8(bytes).map_err(|_| not_list())?;
+    let (file, _) = super::open_regular(&path).map_err(|e| format!("holds {list}: {e}"))?;
+    let bytes = super::read_limited(file, MAX_BYTES)
+        .map_err(|e| format!("holds {list}, which cannot be read: {e}"))?
+        .ok_or_else(|| not_list(kind))?;
+    let text = String::from_utf8(bytes).map_err(|_| not_list(kind))?;
     let mut lines = text.lines();
-    if lines.next() != Some(FIRST_LINE) {
-        return Err(not_list());
+    if lines.next() != Some(kind.first_line) {
+        return Err(not_list(kind));
     }
     let mut listed = HashMap::new();
     for line in lines {
         let mut f = line.splitn(3, '\t');
         match (f.next(), f.next(), f.next()) {
             (Some("file"), Some(bytes), Some(rel)) => {
-                listed.insert(rel.to_string(), Some(bytes.parse::<u64>().map_err(|_| not_list())?));
+                listed.insert(rel.to_string(), Some(bytes.parse::<u64>().map_err(|_| not_list(kind))?));
             }
             (Some("folder"), Some(rel), None) => {
                 listed.insert(rel.to_string(), None);
             }
-            _ => return Err(not_list()),
+            _ => return Err(not_list(kind)),
         }
     }
     Ok(Some(listed))
 }
 
-fn not_list() -> String {
-    format!("holds {MANIFEST_FILE}, which is not a list of a grade report's files: {REFUSED}")
+fn not_list(kind: &FolderKind) -> String {
+    format!("holds {}, which is not a list of a {}'s files: {}", kind.list, kind.what, refused(kind))
 }
 
 /// What a refusal tells the user to do.
-const REFUSED: &str =
-    "a report replaces only the files it wrote; move what is yours, or write the report to another folder (--out)";
+fn refused(kind: &FolderKind) -> String {
+    let noun = kind.noun();
+    format!(
+        "a {noun} replaces only the files it wrote; move what is yours, or write the {noun} to another folder ({})",
+        kind.flag
+    )
+}
 
 /// Whether the folder `root` holds only what a report listed (or nothing): every entry below it
 /// the list itself or a listed file of the listed size, or a listed folder. `Ok`: what to remove
 /// to empty it, deepest first, each with whether it is a folder; `Err`: the first entry that is
 /// not the report's, in words.
-pub fn ours(root: &Path) -> Result<Vec<(PathBuf, bool)>, String> {
+pub(super) fn ours(root: &Path, kind: &FolderKind) -> Result<Vec<(PathBuf, bool)>, String> {
     let entries = walk(root).map_err(|e| format!("cannot be read: {e}"))?;
     if entries.is_empty() {
         return Ok(Vec::new());
     }
-    let Some(listed) = read_list(root)? else {
-        let older = entries.iter().find(|e| REPORT_NAMES.contains(&e.rel.as_str()));
+    let (what, list, noun) = (kind.what, kind.list, kind.noun());
+    let Some(listed) = read_list(root, kind)? else {
+        // A folder holding one of the kind's own names but no list is an older report, or
+        // someone's own files named alike.
+        let older = entries.iter().find(|e| kind.names.contains(&e.rel.as_str()));
         return Err(match older {
             Some(e) => format!(
-                "holds {} but no {MANIFEST_FILE}: it is not a report this bvhscope wrote (an older bvhscope's report did not list its files: remove that one by hand); {REFUSED}",
-                e.rel
+                "holds {} but no {list}: it is not a {noun} this bvhscope wrote (an older bvhscope's {noun} did not list its files: remove that one by hand); {}",
+                e.rel,
+                refused(kind)
             ),
-            None => format!("holds {}, which is not part of a grade report: {REFUSED}", entries[0].rel),
+            None => format!("holds {}, which is not part of a {what}: {}", entries[0].rel, refused(kind)),
         });
     };
     // A folder not listed is named only when nothing in it is: "images/thesis/chapter1.tex"
@@ -159,19 +164,20 @@ pub fn ours(root: &Path) -> Result<Vec<(PathBuf, bool)>, String> {
     let mut folder = None;
     for e in &entries {
         let why = match (&e.kind, listed.get(&e.rel)) {
-            (Kind::File(_), _) if e.rel == MANIFEST_FILE => continue,
+            (Kind::File(_), _) if e.rel == list => continue,
             (Kind::Link, _) => ", a symbolic link,",
             (Kind::File(now), Some(Some(then))) if now == then => continue,
             (Kind::File(now), Some(Some(then))) => {
                 return Err(format!(
-                    "holds {}, changed since the grade report there wrote it ({then} bytes then, {now} now): {REFUSED}",
-                    e.rel
+                    "holds {}, changed since the {what} there wrote it ({then} bytes then, {now} now): {}",
+                    e.rel,
+                    refused(kind)
                 ))
             }
             (Kind::Folder, Some(None)) => continue,
             _ => "",
         };
-        let message = format!("holds {}{why}, which the grade report written there did not write: {REFUSED}", e.rel);
+        let message = format!("holds {}{why}, which the {what} written there did not write: {}", e.rel, refused(kind));
         if e.kind != Kind::Folder {
             return Err(message);
         }
@@ -186,8 +192,8 @@ pub fn ours(root: &Path) -> Result<Vec<(PathBuf, bool)>, String> {
 /// Remove the report in `root` and `root` itself, only when it holds nothing but what its list
 /// names (`ours`): each file by name, each folder only once empty, so nothing else is removed
 /// even if it appears meanwhile. `Err`: what was left, in words.
-pub fn remove(root: &Path) -> Result<(), String> {
-    for (path, folder) in ours(root)? {
+pub(super) fn remove(root: &Path, kind: &FolderKind) -> Result<(), String> {
+    for (path, folder) in ours(root, kind)? {
         let gone = if folder { std::fs::remove_dir(&path) } else { std::fs::remove_file(&path) };
         gone.map_err(|e| format!("{}: cannot be removed: {e}", path.display()))?;
     }
