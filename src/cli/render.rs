@@ -5,6 +5,7 @@ use super::device::{self, GpuTree};
 use super::{load_mesh, progress, CliError};
 use crate::bvh::SceneBvh;
 use crate::files::file_name;
+use crate::render::boxes::{draw_segments, Segment};
 use crate::render::{
     draw_legend, render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, PairView, RenderSettings, View,
 };
@@ -73,6 +74,32 @@ pub struct RenderArgs {
     /// With --pair-view wipe: where the line is, from 0 (the left edge) to 1 (the right).
     #[arg(long, value_parser = parse_wipe, default_value = "0.5", requires = "against")]
     pub wipe: f32,
+    /// Draw the boxes of the BVH's nodes at DEPTH (0: the root, up to the tree's deepest level)
+    /// over the image, as the app's node boxes at that depth: each in its node's colour; over a
+    /// two-level scene, each mesh's BVH at DEPTH placed by every instance and the top level's boxes
+    /// at depth 1, white. On the view's image (not the legend); with --against, A's boxes left of
+    /// the split and B's right of it, A's over a difference.
+    #[arg(long, value_name = "DEPTH")]
+    pub boxes: Option<u32>,
+}
+
+/// Width of the lines of `--boxes` in pixels (top-level boxes twice it).
+const BOX_WIDTH: f32 = 1.5;
+
+/// The lines of `--boxes` over the camera's image of `bvh` (`which`: A or B, for the error); a
+/// depth the tree does not have is refused, as the app's depth slider ends at its deepest level.
+fn box_lines(a: &RenderArgs, bvh: &SceneBvh, camera: &Camera, which: &str) -> Result<Vec<Segment>, CliError> {
+    use crate::render::boxes::{box_segments, boxes_at, max_depths, BoxPick};
+    let Some(depth) = a.boxes else { return Ok(Vec::new()) };
+    let (max, _) = max_depths(bvh);
+    if depth > max {
+        return Err(CliError::Usage(format!(
+            "--boxes {depth}: {which}'s deepest level is {max} (--boxes takes 0, the root, to {max})"
+        )));
+    }
+    let boxes = boxes_at(bvh, &BoxPick::at(bvh, depth));
+    let size = glam::Vec2::new(camera.width as f32, camera.height as f32);
+    Ok(box_segments(&boxes, camera, size, BOX_WIDTH, None))
 }
 
 fn parse_wipe(s: &str) -> Result<f32, String> {
@@ -169,6 +196,7 @@ fn run_against(
     params_a: &crate::bvh::SceneBuild,
     label_a: &str,
     against: crate::bvh::Strategy,
+    boxes_a: &[Segment],
 ) -> Result<(), CliError> {
     use crate::render::diff::{difference, tally, DiffRange};
     use crate::render::pair::{difference_csv, pair_picture, PairStyle};
@@ -181,6 +209,10 @@ fn run_against(
     let params_b =
         crate::bvh::SceneBuild { bvh: crate::bvh::BuildParams { strategy: against, ..params_a.bvh }, ..params_a };
     let (bvh_b, _) = super::build_scene(gpu, loaded, &params_b)?;
+    let boxes_b = match a.pair_view {
+        PairView::Difference => Vec::new(),
+        _ => box_lines(a, &bvh_b, camera, "B (--against)")?,
+    };
     let frame_b = frame_of(a, gpu, &bvh_b, camera, settings, "rendering the second build")?;
     let cost = params_a.bvh.cost;
     if let Some(path) = &a.difference {
@@ -198,8 +230,20 @@ fn run_against(
         },
     };
     let subject = format!("{}: A {label_a}, B {}", file_name(&a.mesh), bvh_b.label());
-    let img = pair_picture(frame_a, &frame_b, a.pair_view, a.wipe, &style, &subject)
+    let mut img = pair_picture(frame_a, &frame_b, a.pair_view, a.wipe, &style, &subject)
         .expect("two complete frames of one camera, counted for a heatmap");
+    // A's boxes over a difference; else each build's on its side of the split's white line (two
+    // pixels: x0 - 1 and x0).
+    let w = camera.width;
+    let (a_columns, b_columns) = match a.pair_view {
+        PairView::Difference => (0..w, 0..0),
+        show => {
+            let x0 = crate::render::pair::split_column(w, if show == PairView::Wipe { a.wipe } else { 0.5 });
+            (0..x0.saturating_sub(1), x0 + 1..w)
+        }
+    };
+    draw_segments(&mut img, boxes_a, a_columns, 0..camera.height);
+    draw_segments(&mut img, &boxes_b, b_columns, 0..camera.height);
     crate::files::write_png(&a.output, &img)?;
     let (w, h, b_label) = (camera.width, camera.height, bvh_b.label());
     match difference(frame_a, &frame_b, a.view, cost) {
@@ -237,6 +281,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         Some(path) => a.dump_limit.import(&loaded, path)?,
         None => super::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
     };
+    let boxes = box_lines(a, &bvh, &camera, "the BVH")?;
     let kind = a.rays.one("render")?;
     if gpu.is_some() && kind.is_secondary() {
         return Err(gpu_traces_primary_only(kind));
@@ -263,10 +308,12 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             &bvh.build_params(),
             &label_a,
             against,
+            &boxes,
         );
     }
     let range = a.range.map_or(HeatRange::Auto, |(min, max)| HeatRange::Fixed { min, max });
-    let (img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
+    let (mut img, mut legend) = view_image(&frame, a.view, a.colormap, range, params.cost);
+    draw_segments(&mut img, &boxes, 0..camera.width, 0..camera.height);
     if let Some(l) = &mut legend {
         l.subject = format!("{}, {label_a}", file_name(&a.mesh));
         if let Some(sec) = &secondary {
@@ -306,6 +353,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         // The legend's own numbers, as the app's legend and the PNG's say them.
         let v = |x: f32| crate::render::legend::fmt_value(x as f64);
         eprint!("; {}: min {} mean {:.2} max {}", l.title, v(l.min), l.mean, v(l.max));
+    }
+    if let Some(depth) = a.boxes {
+        eprint!("; node boxes at depth {depth}");
     }
     if let Some(gpu) = &gpu {
         eprint!("; traced on the GPU, {} nodes: {}", a.device.nodes().name(), gpu.name());

@@ -360,8 +360,7 @@ impl BvhscopeApp {
                 return c.mesh.clone();
             }
         }
-        let test = depth.as_deref().map(|frame| overlay::DepthTest { frame, rect });
-        let mesh = Arc::new(overlay::boxes_mesh(&boxes, &camera, rect, 1.2, test));
+        let mesh = Arc::new(overlay::boxes_mesh(&boxes, &camera, rect, 1.2, depth.as_deref()));
         *cache = Some(OverlayCache { boxes, camera, rect, depth, mesh: mesh.clone() });
         mesh
     }
