@@ -8,6 +8,7 @@ pub mod device;
 mod export_bvh;
 mod grade;
 pub mod inspect;
+pub mod lesson;
 mod progress;
 pub(crate) mod rays;
 pub(crate) mod render;
@@ -107,6 +108,9 @@ pub enum Command {
     /// Grade a class: check every student's BVH dump, measure it next to bvhscope's trees, rank
     /// them, and write a report folder (HTML, CSV, JSON).
     Grade(grade::GradeArgs),
+    /// Render a lesson (a teacher's steps through a BVH) to a handout folder: each step's picture
+    /// as `render` draws it, and one HTML page with the captions and commands; or check it.
+    Lesson(lesson::LessonArgs),
 }
 
 /// An error the CLI reports in one line before exiting with code 2.
@@ -207,6 +211,7 @@ pub fn run(command: Command) -> Result<(), CliError> {
         Command::Check(a) => check::run(&a),
         Command::ExportBvh(a) => export_bvh::run(&a),
         Command::Grade(a) => grade::run(&a),
+        Command::Lesson(a) => lesson::run(&a),
         Command::Stats(a) => stats::run(&a),
         Command::Compare(a) => compare::run(&a),
     }

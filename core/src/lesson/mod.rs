@@ -5,13 +5,23 @@
 //! keys and records one; the CLI renders it to a handout. The file is JSON, read as strictly as a
 //! scene file (`read.rs`), written back by `write.rs` (a recorded lesson reopens as the same steps).
 
+mod check;
+mod command;
+mod handout;
 mod read;
+mod record;
+mod text;
 mod write;
 
 #[cfg(test)]
 mod tests;
 
-pub use read::{parse_lesson, read_lesson};
+pub use check::{check, step_camera, Problem};
+pub use command::{explain_words, folded, render_words, shown};
+pub use handout::{caption_html, handout_html, HandoutStep};
+pub use read::{is_lesson, parse_lesson, read_lesson, LessonError, MAX_LESSON_BYTES};
+pub use record::{record, start_state};
+pub use text::{spans, Span};
 pub use write::write_lesson;
 
 use crate::bvh::{BuildParams, Layout, Param, ParamValue, Strategy, TraceOptions, TraversalOrder};

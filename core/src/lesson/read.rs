@@ -41,6 +41,18 @@ pub enum LessonError {
 
 type F<'a> = Fields<'a, LessonError>;
 
+/// Whether `path` is a lesson file (not a scene, a mesh or a dump): JSON of at most
+/// `MAX_LESSON_BYTES` whose top level is an object with a "steps" key. A scene file has no
+/// "steps"; a lesson with mistakes still counts, so that opening it says what is wrong.
+pub fn is_lesson(path: &Path) -> bool {
+    let Ok((file, len)) = crate::files::open_regular(path) else { return false };
+    if len > MAX_LESSON_BYTES {
+        return false;
+    }
+    let Ok(Some(bytes)) = crate::files::read_limited(file, MAX_LESSON_BYTES) else { return false };
+    matches!(serde_json::from_slice::<Value>(&bytes), Ok(Value::Object(o)) if o.contains_key("steps"))
+}
+
 /// Read the lesson file `path` (paths in it are relative to its folder).
 pub fn read_lesson(path: &Path) -> Result<Lesson, LessonError> {
     let (file, _) = crate::files::open_regular(path)?;
