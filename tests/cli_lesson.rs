@@ -169,5 +169,14 @@ fn a_handout_replaces_only_what_a_handout_wrote() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(String::from_utf8_lossy(&o.stderr).contains("steps/notes.txt"), "{}", text(&o));
     assert_eq!(std::fs::read_to_string(&mine).unwrap(), "mine", "kept");
+    // A folder of someone's own, holding an index.html and no list: refused, kept.
+    let site = dir.join("site");
+    std::fs::create_dir_all(&site).unwrap();
+    std::fs::write(site.join("index.html"), "<p>my page</p>").unwrap();
+    let o = bvhscope(&["lesson", l.to_str().unwrap(), "-o", site.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("holds index.html but no handout-files.txt") && err.contains("named alike"), "{err}");
+    assert_eq!(std::fs::read_to_string(site.join("index.html")).unwrap(), "<p>my page</p>");
     let _ = std::fs::remove_dir_all(&dir);
 }

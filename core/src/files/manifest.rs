@@ -152,7 +152,7 @@ pub(super) fn ours(root: &Path, kind: &FolderKind) -> Result<Vec<(PathBuf, bool)
         let older = entries.iter().find(|e| kind.names.contains(&e.rel.as_str()));
         return Err(match older {
             Some(e) => format!(
-                "holds {} but no {list}: it is not a {noun} this bvhscope wrote (an older bvhscope's {noun} did not list its files: remove that one by hand); {}",
+                "holds {} but no {list}: it is not a {noun} this bvhscope wrote (someone's own file named alike, or an older bvhscope's {noun}, which listed none: move it or remove it by hand); {}",
                 e.rel,
                 refused(kind)
             ),
