@@ -22,9 +22,10 @@ mod views;
 pub use crate::render::PairView;
 pub use crate::scene::{Scene, SceneSource};
 pub use jobs::{Pick, Probe, Timed};
+pub use panels::lesson::plain as caption_text;
 pub use state::{
-    Action, Actions, AppOptions, BoxLevel, BuiltBvh, BvhscopeApp, Film, MeasuredRays, Message, MessageKind,
-    OrbitCamera, OverlayBox, Pane, PathWindow, Settings, Shown, StrategyFigures,
+    Action, Actions, AppOptions, BoxLevel, BuildCache, BuiltBvh, BvhscopeApp, Film, LessonState, MeasuredRays, Message,
+    MessageKind, OrbitCamera, OverlayBox, Pane, PathWindow, Settings, Shown, StrategyFigures,
 };
 pub use update::{default_name, StatsFormat};
 pub use views::{

@@ -99,6 +99,9 @@ pub enum Pick {
     SaveAnimation,
     /// A class's grade report (`bvhscope grade`'s grade.json) to list.
     OpenGradeReport,
+    /// A lesson file to open, and where to save the lesson.
+    OpenLesson,
+    SaveLesson,
 }
 
 pub enum JobEvent {

@@ -364,6 +364,8 @@ impl Jobs {
                     Pick::SaveCounts => dialog.add_filter("CSV", &["csv"]).set_file_name(&name).save_file().await,
                     Pick::OpenBvh => dialog.add_filter("bvhscope-bvh dumps", &["json", "gz", "txt"]).pick_file().await,
                     Pick::OpenGradeReport => dialog.add_filter("grade report", &["json"]).pick_file().await,
+                    Pick::OpenLesson => dialog.add_filter("lesson", &["json"]).pick_file().await,
+                    Pick::SaveLesson => dialog.add_filter("lesson", &["json"]).set_file_name(&name).save_file().await,
                     Pick::SaveAnimation => {
                         let filters = dialog.add_filter("GIF", &["gif"]).add_filter("animated PNG", &["png"]);
                         filters.set_file_name(&name).save_file().await

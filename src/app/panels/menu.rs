@@ -73,6 +73,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 out.push(Action::ShowBuiltin);
             }
             ui.separator();
+            if ui.button("Open lesson…").on_hover_text("A teacher's steps (a lesson file): PageDown or Right for the next").clicked() {
+                out.push(Action::OpenLesson);
+            }
             if ui
                 .button("Open BVH…")
                 .on_hover_text("A BVH written by your own renderer (bvhscope-bvh: JSON, .json.gz or the text form; see the README) for this mesh: checked, then shown as \"imported\" in the strategy list")
@@ -201,6 +204,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 out.push(Action::ResetLayout);
             }
         });
+        menu(ui, "Lesson", |ui| lesson_menu(app, ui, out));
         menu(ui, "Help", |ui| {
             let shortcut = shortcut_text(ui.ctx(), &Action::Help);
             if ui.add(egui::Button::new("Keyboard and mouse").shortcut_text(shortcut)).clicked() {
@@ -210,4 +214,48 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         ui.separator();
         ui.label(egui::RichText::new(app.scene.title()).strong());
     });
+}
+
+/// The Lesson menu: open, step, record (each step only what changed), save, close.
+fn lesson_menu(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
+    let open = app.lesson.is_some();
+    let steps = app.lesson.as_ref().map_or(0, |l| l.len());
+    if ui.button("New lesson").on_hover_text("No steps yet: set up a view, then add it as a step").clicked() {
+        out.push(Action::NewLesson);
+    }
+    if ui.button("Open lesson…").clicked() {
+        out.push(Action::OpenLesson);
+    }
+    if ui.button("Open lesson path…").on_hover_text("Type the lesson file's path").clicked() {
+        out.push(Action::OpenLessonPath);
+    }
+    ui.separator();
+    let add = ui.add_enabled(open, egui::Button::new("Add this view as a step"));
+    if add.on_hover_text("What the app shows now, after the step on screen (only what changed is kept)").clicked() {
+        out.push(Action::AddStep);
+    }
+    let replace = ui.add_enabled(steps > 0, egui::Button::new("Replace this step"));
+    if replace.on_hover_text("The step on screen shows what the app shows now (its text kept)").clicked() {
+        out.push(Action::ReplaceStep);
+    }
+    if let Some(l) = &app.lesson {
+        let mut editing = l.editing;
+        if ui.checkbox(&mut editing, "Edit the text").changed() {
+            out.push(Action::LessonEditing(editing));
+        }
+    }
+    ui.separator();
+    if ui.add_enabled(steps > 0, egui::Button::new("Previous step").shortcut_text("PageUp")).clicked() {
+        out.push(Action::LessonPrevious);
+    }
+    if ui.add_enabled(steps > 0, egui::Button::new("Next step").shortcut_text("PageDown")).clicked() {
+        out.push(Action::LessonNext);
+    }
+    ui.separator();
+    if ui.add_enabled(steps > 0, egui::Button::new("Save lesson…")).clicked() {
+        out.push(Action::SaveLesson);
+    }
+    if ui.add_enabled(open, egui::Button::new("Close lesson")).clicked() {
+        out.push(Action::CloseLesson);
+    }
 }

@@ -1,7 +1,7 @@
 //! Floating windows: Help (shortcuts), and the path field used when no file dialog is available.
 
 use crate::app::jobs::Pick;
-use crate::app::state::shortcuts::{shortcut_text, MOUSE, SHORTCUTS};
+use crate::app::state::shortcuts::{shortcut_text, LESSON_HELP, MOUSE, SHORTCUTS};
 use crate::app::state::{Action, Actions, BvhscopeApp};
 use std::path::PathBuf;
 
@@ -12,6 +12,11 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         egui::Grid::new("keys").num_columns(2).striped(true).show(ui, |ui| {
             for (shortcut, _, what) in SHORTCUTS {
                 ui.monospace(shortcut_text(ctx, shortcut));
+                ui.label(*what);
+                ui.end_row();
+            }
+            for (keys, what) in LESSON_HELP {
+                ui.monospace(*keys);
                 ui.label(*what);
                 ui.end_row();
             }
@@ -44,6 +49,8 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         Pick::SaveBvh => ("Export the BVH", "As a bvhscope-bvh dump (.json, .json.gz or .txt)"),
         Pick::SaveAnimation => ("Export the replay", "As an animation (.gif or .png)"),
         Pick::OpenGradeReport => ("Open a grade report", "Its grade.json, or its folder"),
+        Pick::OpenLesson => ("Open a lesson", "A lesson file (.json): a teacher's steps"),
+        Pick::SaveLesson => ("Save the lesson", "As a lesson file (.json)"),
     };
     let mut keep = true;
     let mut chosen = None;
@@ -66,7 +73,7 @@ pub fn show(app: &BvhscopeApp, ctx: &egui::Context, out: &mut Actions) {
         }
         ui.horizontal(|ui| {
             let verb = match window.pick {
-                Pick::Open | Pick::OpenGradeReport => "Open",
+                Pick::Open | Pick::OpenGradeReport | Pick::OpenLesson => "Open",
                 Pick::OpenBvh => "Import",
                 _ => "Save",
             };

@@ -183,6 +183,37 @@ pub enum Action {
     ResetLayout,
     /// The heatmap legend folded to its colour bar (`true`) or shown whole.
     FoldLegend(bool),
+    /// The camera: a lesson step's, or (`None`) the scene's own (the mesh's default view).
+    SetCamera(Option<crate::render::Camera>),
+
+    /// Lessons (`state::lesson`): File ▸ Open lesson… by the dialog, by a typed path, or a file
+    /// (opened at its first step).
+    OpenLesson,
+    OpenLessonPath,
+    OpenLessonFile(PathBuf),
+    /// Go to step `k` (0-based) of the open lesson.
+    LessonGo(usize),
+    /// The clicker's keys: the step's answer if it has one not shown yet, else the next step; the
+    /// previous step (its answer shown), or the answer hidden again.
+    LessonNext,
+    LessonPrevious,
+    /// Lesson ▸ New lesson: no steps yet, the band ready to type in.
+    NewLesson,
+    /// What the app shows, as a step after the one on screen (or in place of it).
+    AddStep,
+    ReplaceStep,
+    /// The band's fields: the lesson's title and the step's caption, question and answer.
+    LessonText {
+        title: String,
+        caption: String,
+        question: String,
+        answer: String,
+    },
+    /// The band's fields shown (to type the captions) or the captions as the room sees them.
+    LessonEditing(bool),
+    /// Save the lesson through the file dialog.
+    SaveLesson,
+    CloseLesson,
 }
 
 /// Where panels put the actions they emit during one frame.

@@ -3,9 +3,10 @@
 //! `update` applies.
 
 use super::action::Action;
-use super::built::BuiltBvh;
+use super::built::{BuildCache, BuiltBvh};
 use super::dock;
 use super::figures::{MeasuredRays, Message, MessageKind, PathWindow, Shown, StrategyFigures};
+use super::lesson::LessonState;
 use super::orbit::{self, OrbitCamera};
 use super::overlay::{self, OverlayBox};
 use super::settings::{BoxLevel, Film, Settings};
@@ -21,7 +22,8 @@ use std::time::Duration;
 /// How the app starts.
 #[derive(Clone, Debug, Default)]
 pub struct AppOptions {
-    /// A mesh to open at start (the built-in scene shows until it is loaded).
+    /// A mesh or scene to open at start (the built-in scene shows until it is loaded), or a lesson
+    /// (`lesson::is_lesson`), opened at its first step.
     pub file: Option<PathBuf>,
     /// A BVH dump to import for it once it is loaded.
     pub bvh: Option<PathBuf>,
@@ -33,6 +35,11 @@ pub struct BvhscopeApp {
     /// Increases with every scene loaded; a BVH belongs to the scene it was built for.
     pub scene_id: u64,
     pub built: Option<BuiltBvh>,
+    /// The last few trees built for this scene, by their options (a lesson's step back shows
+    /// its tree at once).
+    pub built_cache: BuildCache,
+    /// The lesson open: its steps, the one on screen, the one being applied.
+    pub lesson: Option<LessonState>,
     /// Work per ray in the latest full frame of the current BVH.
     pub rays: Option<MeasuredRays>,
     /// The figures of the strategy shown before the current one.
@@ -137,6 +144,8 @@ impl BvhscopeApp {
             scene,
             scene_id: 1,
             built: None,
+            built_cache: BuildCache::default(),
+            lesson: None,
             rays: None,
             previous: None,
             jobs: Jobs::new(cc.egui_ctx.clone()),
@@ -255,6 +264,7 @@ impl BvhscopeApp {
         if self.current_bvh().is_none_or(|b| binary(&b.bvh) != binary(&bvh)) {
             self.nodes.deselect();
         }
+        self.built_cache.keep(self.scene_id, &bvh);
         self.built = Some(BuiltBvh::new(bvh, &names, self.scene_id));
         self.rays = None;
     }

@@ -1,7 +1,8 @@
 //! The BVH built over the scene on screen (the scene itself is the core's `scene::Scene`), with the
 //! statistics the panels show.
 
-use crate::bvh::{SceneBvh, TreeStats};
+use crate::bvh::{SceneBuild, SceneBvh, TreeStats};
+use std::collections::VecDeque;
 use std::sync::Arc;
 
 /// The BVH of the current scene.
@@ -56,5 +57,40 @@ impl BuiltBvh {
             Some(_) => self.bottom.iter().map(|(_, s)| s.max_depth).max().unwrap_or(0),
             None => self.stats.max_depth,
         }
+    }
+}
+
+/// The last few trees built for the scene on screen, by their options: a lesson stepping back
+/// and forth between two builds (or a user between two strategies) gets each again at once
+/// instead of rebuilding it. Imported trees are not kept (they are the import's).
+#[derive(Default)]
+pub struct BuildCache(VecDeque<(u64, SceneBuild, Arc<SceneBvh>)>);
+
+impl BuildCache {
+    /// How many trees are kept: a lesson's few builds, without holding many big trees in memory.
+    pub const KEEP: usize = 4;
+
+    /// The tree built for scene `scene_id` with `build`, if kept.
+    pub fn get(&self, scene_id: u64, build: &SceneBuild) -> Option<Arc<SceneBvh>> {
+        self.0.iter().find(|(id, b, _)| *id == scene_id && b == build).map(|(_, _, t)| t.clone())
+    }
+
+    /// Keep `bvh`, built for scene `scene_id` (trees of other scenes go: their scene is gone).
+    pub fn keep(&mut self, scene_id: u64, bvh: &Arc<SceneBvh>) {
+        if bvh.import().is_some() {
+            return;
+        }
+        let build = bvh.build_params();
+        self.0.retain(|(id, b, _)| *id == scene_id && *b != build);
+        self.0.push_front((scene_id, build, bvh.clone()));
+        self.0.truncate(Self::KEEP);
+    }
+
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
     }
 }

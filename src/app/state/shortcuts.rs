@@ -102,3 +102,37 @@ pub fn pressed(ctx: &egui::Context) -> Vec<Action> {
             .collect()
     })
 }
+
+/// A lesson's keys: what a presentation clicker sends (PageDown / PageUp; some send the arrows).
+/// With a lesson open and no text field taking the keyboard they step the lesson before anything
+/// else sees them: plain arrows and the page keys are bound to nothing else (the Node view's
+/// steps are Alt+arrows, which stay its own), and a slider or scroll area with the keyboard does
+/// not take them from the lesson. Only the key with no modifier counts.
+pub const LESSON_KEYS: &[(Key, bool)] =
+    &[(Key::PageDown, true), (Key::ArrowRight, true), (Key::PageUp, false), (Key::ArrowLeft, false)];
+
+/// The lesson's keys as the Help window lists them.
+pub const LESSON_HELP: &[(&str, &str)] = &[
+    ("PageDown, Right", "Lesson: the step's answer, then the next step"),
+    ("PageUp, Left", "Lesson: the previous step (or hide the answer)"),
+];
+
+/// The lesson's steps asked for this frame (`LESSON_KEYS`); the keys are taken from the input so
+/// that nothing else acts on them. Call only while a lesson is open.
+pub fn lesson_keys(ctx: &egui::Context) -> Vec<Action> {
+    if ctx.egui_wants_keyboard_input() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    ctx.input_mut(|i| {
+        i.events.retain(|e| {
+            let egui::Event::Key { key, pressed: true, repeat: false, modifiers, .. } = e else { return true };
+            let Some((_, next)) = LESSON_KEYS.iter().find(|(k, _)| k == key).filter(|_| modifiers.is_none()) else {
+                return true;
+            };
+            out.push(if *next { Action::LessonNext } else { Action::LessonPrevious });
+            false
+        });
+    });
+    out
+}

@@ -20,6 +20,7 @@ impl BvhscopeApp {
             A::Open => self.jobs.pick_file(Pick::Open, ""),
             A::OpenPath => self.path_window = Some(PathWindow::new(Pick::Open, String::new(), None)),
             // Loads in the background; the current scene stays until it has loaded.
+            A::OpenFile(path) if crate::lesson::is_lesson(&path) => self.open_lesson(path),
             A::OpenFile(path) => self.jobs.load(path),
             A::ShowBuiltin => {
                 self.messages.clear();
@@ -314,6 +315,20 @@ impl BvhscopeApp {
                 self.dock_presenting = None;
             }
             A::FoldLegend(folded) => self.settings.legend_folded = folded,
+            A::SetCamera(camera) => self.set_camera(camera),
+            a @ (A::OpenLesson
+            | A::OpenLessonPath
+            | A::OpenLessonFile(_)
+            | A::LessonGo(_)
+            | A::LessonNext
+            | A::LessonPrevious
+            | A::NewLesson
+            | A::AddStep
+            | A::ReplaceStep
+            | A::LessonText { .. }
+            | A::LessonEditing(_)
+            | A::SaveLesson
+            | A::CloseLesson) => self.act_lesson(a),
             A::DismissEarlier(n) => {
                 self.messages.drain(..n.min(self.messages.len()));
             }

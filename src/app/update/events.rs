@@ -117,9 +117,15 @@ impl BvhscopeApp {
         }
         let result = match pick {
             Pick::Open => {
-                self.jobs.load(path);
+                // A lesson chosen in File ▸ Open opens as a lesson.
+                self.act(Action::OpenFile(path));
                 return;
             }
+            Pick::OpenLesson => {
+                self.open_lesson(path);
+                return;
+            }
+            Pick::SaveLesson => self.save_lesson(&path),
             Pick::SavePng => export::save_png(self, &path),
             Pick::SaveStatsCsv => export::save_stats(self, &path, export::StatsFormat::Csv),
             Pick::SaveStatsJson => export::save_stats(self, &path, export::StatsFormat::Json),
@@ -223,7 +229,13 @@ impl BvhscopeApp {
             }
         };
         actions.extend(dropped.into_iter().take(1).map(open));
+        // A lesson's keys first: with a lesson open, the clicker's keys are its own.
+        if self.lesson.is_some() {
+            actions.extend(shortcuts::lesson_keys(ctx));
+        }
         actions.extend(shortcuts::pressed(ctx));
+        // The step being applied moves on (its scene loaded, its tree built, its frame there).
+        actions.extend(self.lesson_actions());
         // Info messages fade out; errors stay until dismissed.
         self.messages.retain(|m| m.kind != MessageKind::Info || m.at.elapsed() < Duration::from_secs(6));
     }

@@ -38,7 +38,7 @@ pub fn default_name(app: &BvhscopeApp, ext: &str) -> String {
 /// The name a save suggests for `pick` (the file dialog's), none for an open.
 pub fn suggested_name(app: &BvhscopeApp, pick: Pick) -> String {
     match pick {
-        Pick::Open | Pick::OpenBvh | Pick::OpenGradeReport => String::new(),
+        Pick::Open | Pick::OpenBvh | Pick::OpenGradeReport | Pick::OpenLesson => String::new(),
         Pick::SavePng => default_name(app, "png"),
         Pick::SaveStatsCsv => default_name(app, "csv"),
         Pick::SaveStatsJson => default_name(app, "json"),
@@ -48,6 +48,22 @@ pub fn suggested_name(app: &BvhscopeApp, pick: Pick) -> String {
         Pick::SaveScene => {
             format!("{}.json", app.scene.title().trim_end_matches(".obj").trim_end_matches(".json"))
         }
+        Pick::SaveLesson => lesson_name(app),
+    }
+}
+
+/// The lesson's file name: the one it was read from, else its title's words joined by dashes.
+fn lesson_name(app: &BvhscopeApp) -> String {
+    let Some(l) = &app.lesson else { return "lesson.json".into() };
+    if let Some(name) = l.path.as_ref().and_then(|p| p.file_name()) {
+        return name.to_string_lossy().into_owned();
+    }
+    let words: Vec<String> =
+        l.lesson.title.split(|c: char| !c.is_alphanumeric()).filter(|w| !w.is_empty()).map(str::to_lowercase).collect();
+    if words.is_empty() {
+        "lesson.json".into()
+    } else {
+        format!("{}.json", words.join("-"))
     }
 }
 
@@ -70,10 +86,10 @@ pub fn typed_path(app: &BvhscopeApp, pick: Pick) -> String {
 pub fn check_output(app: &BvhscopeApp, pick: Pick, path: &Path) -> Result<(), String> {
     use crate::files::{CSV, JSON, PNG};
     let kind = match pick {
-        Pick::Open | Pick::OpenBvh | Pick::OpenGradeReport => return Ok(()),
+        Pick::Open | Pick::OpenBvh | Pick::OpenGradeReport | Pick::OpenLesson => return Ok(()),
         Pick::SavePng => PNG,
         Pick::SaveStatsCsv | Pick::SaveCounts => CSV,
-        Pick::SaveStatsJson | Pick::SaveScene => JSON,
+        Pick::SaveStatsJson | Pick::SaveScene | Pick::SaveLesson => JSON,
         Pick::SaveBvh => return crate::dump::BvhDump::written_as(path).map(|_| ()),
         Pick::SaveAnimation => crate::render::animation::ANIMATION,
     };

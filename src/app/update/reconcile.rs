@@ -147,9 +147,14 @@ impl BvhscopeApp {
         let have = self.current_bvh().is_some_and(|b| {
             b.bvh.import().is_none() && b.bvh.build_params() == build && self.built_where_wanted(&b.bvh, &build)
         });
+        let kept = self.built_cache.get(self.scene_id, &build).filter(|b| self.built_where_wanted(b, &build));
         if have {
             // Switched back to what is built while another build ran: that build is not wanted.
             self.jobs.cancel_build();
+        } else if let Some(bvh) = kept {
+            // Built before for this scene (a lesson's step back): shown at once.
+            self.jobs.cancel_build();
+            self.set_built(bvh);
         } else if self.jobs.last_build != Some(wanted) || self.jobs.gpu.last_build_on_gpu != gpu.is_some() {
             self.jobs.build(self.scene.clone(), build, self.scene_id, gpu);
         }
