@@ -13,6 +13,7 @@ mod app_figures;
 mod app_gpu;
 mod app_grade;
 mod app_legend;
+mod app_lesson;
 mod app_look;
 mod app_rays;
 mod app_replay;
