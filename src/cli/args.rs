@@ -240,6 +240,11 @@ impl ViewArgs {
     }
 }
 
+/// The help of every command's mesh argument, written once: each format `mesh::load` reads
+/// (`MeshFormat::EXTENSIONS`, a test holds them together) and the scene files.
+pub const MESH_HELP: &str =
+    "The mesh (.obj, .ply, .off, .stl; .gltf or .glb, opened as a scene) or a scene file (.json: bvhscope's or Moer-lite's)";
+
 /// A vertical field of view within the camera's limits.
 pub fn parse_fov(s: &str) -> Result<f32, String> {
     let (lo, hi) = (Camera::MIN_VFOV_DEG, Camera::MAX_VFOV_DEG);
@@ -285,6 +290,24 @@ pub fn parse_camera(s: &str) -> Result<(Vec3, Vec3, Option<Vec3>), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every command's mesh argument says the same, and names every format the readers take.
+    #[test]
+    fn the_mesh_argument_has_one_help_naming_every_format() {
+        use clap::CommandFactory;
+        let cli = crate::cli::Cli::command();
+        let mut seen = 0;
+        for sub in cli.get_subcommands() {
+            if let Some(arg) = sub.get_arguments().find(|a| a.get_id() == "mesh") {
+                assert_eq!(arg.get_help().map(|h| h.to_string()).as_deref(), Some(MESH_HELP), "{}", sub.get_name());
+                seen += 1;
+            }
+        }
+        assert!(seen >= 9, "{seen} commands take a mesh");
+        for ext in crate::mesh::MeshFormat::EXTENSIONS {
+            assert!(MESH_HELP.contains(&format!(".{ext}")), "{ext}");
+        }
+    }
 
     #[test]
     fn sizes_and_cameras_parse() {

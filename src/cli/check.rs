@@ -21,9 +21,10 @@ pub enum CheckFormat {
 
 #[derive(Args, Debug)]
 pub struct CheckArgs {
-    /// The mesh the BVH was built over (.obj; faces in file order).
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
-    /// The BVH: bvhscope-bvh JSON, .json.gz, or the text form (see the README).
+    /// The BVH: bvhscope-bvh JSON, .json.gz, or the text form (see the README), built over the
+    /// mesh's triangles numbered as its file lists them (faces in file order).
     #[arg(long)]
     pub bvh: PathBuf,
     /// Random rays traced against the linear scan, besides the frame's primary rays and the rays

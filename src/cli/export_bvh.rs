@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ExportBvhArgs {
-    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene). The tree written is the binary one unless --layout wide4 or wide8 is given.
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,

@@ -24,7 +24,7 @@ const DEFAULT_TIME_RAYS: u32 = 16_384;
 
 #[derive(Args, Debug)]
 pub struct GradeArgs {
-    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene) or scene (.json) the class built their BVHs over.
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
     /// The submissions: each a dump (.json, .json.gz, .txt) or a folder holding one dump, the
     /// student named by the file or folder (`class/*` grades a whole class).

@@ -24,7 +24,7 @@ pub enum InspectFormat {
 
 #[derive(Args, Debug)]
 pub struct InspectArgs {
-    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene) or scene (.json, one level).
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
     /// The node: its id in the binary tree as built (0 is the root; the app's tree view shows
     /// the same ids); with --bvh, the dump's own id of the node.

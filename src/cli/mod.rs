@@ -103,7 +103,8 @@ pub enum Command {
     /// Check a BVH written by another program against the mesh and the linear scan (exit 0: correct,
     /// 1: defects, 2: unreadable).
     Check(check::CheckArgs),
-    /// Write a built-in strategy's binary tree in the bvhscope-bvh format.
+    /// Write a built-in strategy's tree in the bvhscope-bvh format (the binary tree unless --layout
+    /// wide4 or wide8 is given).
     ExportBvh(export_bvh::ExportBvhArgs),
     /// Grade a class: check every student's BVH dump, measure it next to bvhscope's trees, rank
     /// them, and write a report folder (HTML, CSV, JSON).

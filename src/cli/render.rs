@@ -15,7 +15,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene) or scene (.json: bvhscope's or Moer-lite's).
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,

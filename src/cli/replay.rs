@@ -16,7 +16,7 @@ use std::sync::Arc;
 
 #[derive(Args, Debug)]
 pub struct ReplayArgs {
-    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene) or scene (.json, one level).
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,

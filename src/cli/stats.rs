@@ -20,7 +20,7 @@ pub enum StatsOutput {
 
 #[derive(Args, Debug)]
 pub struct StatsArgs {
-    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene) or scene (.json: bvhscope's or Moer-lite's).
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,

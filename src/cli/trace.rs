@@ -21,7 +21,7 @@ pub enum TraceFormat {
 
 #[derive(Args, Debug)]
 pub struct TraceArgs {
-    /// The mesh (.obj, .ply, .off, .stl; .gltf/.glb as a scene) or scene (.json: bvhscope's or Moer-lite's).
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
     /// The pixel X,Y of the camera's image (0-based, x from the left, y from the top).
     #[arg(long, value_parser = parse_pixel, conflicts_with_all = ["ray", "hottest"], required_unless_present_any = ["ray", "hottest"])]

@@ -39,7 +39,7 @@ pub enum CompareFormat {
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// The mesh (.obj) or scene (.json: bvhscope's or Moer-lite's).
+    #[arg(help = crate::cli::args::MESH_HELP)]
     pub mesh: PathBuf,
     #[command(flatten)]
     pub build: BuildArgs,
