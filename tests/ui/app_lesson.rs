@@ -95,12 +95,27 @@ fn assert_band(h: &Harness<'_, BvhscopeApp>, lesson: &Lesson, k: usize, revealed
 /// target, and its caption; a question's answer on the extra key press.
 #[test]
 fn a_shipped_lesson_steps_through_with_the_clicker() {
-    let path = shipped("why-sah-wins.json");
-    let lesson = read_lesson(&path).unwrap();
+    step_through(&shipped("why-sah-wins.json"));
+}
+
+/// The course's lab lesson too, where the lab's models are checked out beside the repository.
+#[test]
+fn the_course_lab_lesson_steps_through_with_the_clicker() {
+    if !root().join("../shared/models/moer-lite-lab1-bvh").is_dir() {
+        eprintln!("skipped: the lab's models (../shared/models/moer-lite-lab1-bvh) are not here");
+        return;
+    }
+    step_through(&shipped("course-lab.json"));
+}
+
+/// Open `path` as File ▸ Open lesson… does and press PageDown through it, checking each step
+/// against the file's own states (so the test follows the lesson's content).
+fn step_through(path: &std::path::Path) {
+    let lesson = read_lesson(path).unwrap();
     let states = lesson.states();
     let mut h = harness();
     run_until(&mut h, "the first frame", idle);
-    h.state_mut().act(Action::Picked(Pick::OpenLesson, path));
+    h.state_mut().act(Action::Picked(Pick::OpenLesson, path.to_path_buf()));
     for (k, state) in states.iter().enumerate() {
         if k > 0 {
             h.key_press(Key::PageDown);
