@@ -264,7 +264,7 @@ impl BvhscopeApp {
         if self.current_bvh().is_none_or(|b| binary(&b.bvh) != binary(&bvh)) {
             self.nodes.deselect();
         }
-        self.built_cache.keep(self.scene_id, &bvh);
+        self.built_cache.keep(self.scene_id, self.scene.report.triangles, &bvh);
         self.built = Some(BuiltBvh::new(bvh, &names, self.scene_id));
         self.rays = None;
     }

@@ -69,21 +69,25 @@ pub struct BuildCache(VecDeque<(u64, SceneBuild, Arc<SceneBvh>)>);
 impl BuildCache {
     /// How many trees are kept: a lesson's few builds, without holding many big trees in memory.
     pub const KEEP: usize = 4;
+    /// Over this many triangles only the tree on screen is kept (four trees of a scan of tens of
+    /// millions of triangles would take gigabytes).
+    pub const KEEP_ONE_OVER: usize = 2_000_000;
 
     /// The tree built for scene `scene_id` with `build`, if kept.
     pub fn get(&self, scene_id: u64, build: &SceneBuild) -> Option<Arc<SceneBvh>> {
         self.0.iter().find(|(id, b, _)| *id == scene_id && b == build).map(|(_, _, t)| t.clone())
     }
 
-    /// Keep `bvh`, built for scene `scene_id` (trees of other scenes go: their scene is gone).
-    pub fn keep(&mut self, scene_id: u64, bvh: &Arc<SceneBvh>) {
+    /// Keep `bvh`, built for scene `scene_id` of `triangles` triangles (trees of other scenes
+    /// go: their scene is gone).
+    pub fn keep(&mut self, scene_id: u64, triangles: usize, bvh: &Arc<SceneBvh>) {
         if bvh.import().is_some() {
             return;
         }
         let build = bvh.build_params();
         self.0.retain(|(id, b, _)| *id == scene_id && *b != build);
         self.0.push_front((scene_id, build, bvh.clone()));
-        self.0.truncate(Self::KEEP);
+        self.0.truncate(if triangles > Self::KEEP_ONE_OVER { 1 } else { Self::KEEP });
     }
 
     pub fn len(&self) -> usize {
