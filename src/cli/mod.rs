@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// A mesh (.obj, .ply, .off, .stl, .gltf, .glb) or scene (.json) to open in the desktop app.
+    /// A mesh (.obj, .ply, .off, .stl, .gltf, .glb), scene (.json) or lesson (.json with "steps") to open in the desktop app.
     pub file: Option<PathBuf>,
     /// A BVH dump (bvhscope-bvh) to import for it in the app, as File ▸ Open BVH does.
     #[arg(long, value_name = "DUMP")]
