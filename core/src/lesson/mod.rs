@@ -181,21 +181,7 @@ impl Lesson {
     pub fn states(&self) -> Vec<StepState> {
         let mut out: Vec<StepState> = Vec::with_capacity(self.steps.len());
         for step in &self.steps {
-            let mut s = match out.last() {
-                Some(prev) => prev.clone(),
-                None => StepState {
-                    scene: PathBuf::new(),
-                    build: BuildEdit::default(),
-                    trace: TraceOptions::default(),
-                    rays: SecondarySpec::default(),
-                    view: View::Normals,
-                    colormap: ColorMap::Viridis,
-                    range: HeatRange::Auto,
-                    camera: None,
-                    boxes: None,
-                    show: Show::Image,
-                },
-            };
+            let mut s = out.last().cloned().unwrap_or_else(start_state);
             if let Some(scene) = &step.scene {
                 if *scene != s.scene {
                     // Another scene: its own camera, and a view's target no longer means anything.
