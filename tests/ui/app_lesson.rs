@@ -362,6 +362,9 @@ fn the_caption_band_is_below_the_image_at_1280_by_720() {
             band = band.union(r);
         }
         eprintln!("presenting {presenting}: image {image:?}, the band's words {band:?}, window {window:?}");
+        // A lesson presented is slides: the Build and view panel is the teacher's, hidden while
+        // presenting (the image takes its room) and back afterwards.
+        assert_eq!(h.query_by_label("Handout mode").is_some(), !presenting, "presenting {presenting}: the Build panel");
         assert!(
             band.height() < window.height() / 3.0,
             "presenting {presenting}: the band's words {band:?} take over a third"

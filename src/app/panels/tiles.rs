@@ -35,7 +35,8 @@ pub fn show(app: &mut BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let mut layout = app.dock.take().unwrap_or_else(dock::default_layout);
     let open: Vec<Pane> = VIEWS.iter().filter(|v| (v.is_open)(app)).map(|v| v.pane).collect();
     app.dock_presenting = dock::present(&mut layout, app.dock_presenting.take(), app.settings.present, &open);
-    dock::show_open(&mut layout, |pane| view_of(pane).is_some_and(|v| (v.is_open)(app)));
+    let slides = app.settings.present && app.lesson.is_some();
+    dock::show_open(&mut layout, slides, |pane| view_of(pane).is_some_and(|v| (v.is_open)(app)));
     let mut tiles = Tiles { app, out };
     layout.ui(&mut tiles, ui);
     app.dock = Some(layout);

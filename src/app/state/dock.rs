@@ -100,11 +100,13 @@ pub fn valid(layout: &Layout) -> bool {
 }
 
 /// Show the open views' tiles and hide the closed ones'. A view opened just now is brought to
-/// the front of its tabs, unless the image shares those tabs (it would hide the image).
-pub fn show_open(layout: &mut Layout, open: impl Fn(Pane) -> bool) {
+/// the front of its tabs, unless the image shares those tabs (it would hide the image). `slides`:
+/// a lesson presented, where the Build and view panel's sliders are for the teacher, not the
+/// room: its tile is hidden and the image takes its room (it comes back when presenting ends).
+pub fn show_open(layout: &mut Layout, slides: bool, open: impl Fn(Pane) -> bool) {
     for pane in Pane::ALL {
         let Some(id) = layout.tiles.find_pane(&pane) else { continue };
-        let now = pane.always_open() || open(pane);
+        let now = (pane.always_open() && !(slides && pane == Pane::Controls)) || open(pane);
         let was = layout.tiles.is_visible(id);
         layout.tiles.set_visible(id, now);
         if now && !was {
@@ -220,7 +222,7 @@ mod tests {
     #[test]
     fn closed_views_are_hidden_and_the_image_never() {
         let mut layout = default_layout();
-        show_open(&mut layout, |p| p == Pane::Ray);
+        show_open(&mut layout, false, |p| p == Pane::Ray);
         let visible = |l: &Layout, p: Pane| l.tiles.is_visible(l.tiles.find_pane(&p).unwrap());
         assert!(visible(&layout, Pane::Image) && visible(&layout, Pane::Ray) && visible(&layout, Pane::Statistics));
         assert!(!visible(&layout, Pane::Node) && !visible(&layout, Pane::Grade));
