@@ -360,13 +360,11 @@ fn a_reference_and_a_students_identical_tree_time_alike() {
         let (theirs, ours) = (row.quality.clone().unwrap(), reference(strategy));
         assert_eq!(theirs.nodes_per_ray, ours.nodes_per_ray, "{strategy}: the same tree");
         let (a, b) = (theirs.trace_ns_per_ray, ours.trace_ns_per_ray);
-        assert!((a / b - 1.0).abs() < 0.15, "{strategy}: {a:.1} ns per ray as a student's, {b:.1} as the reference");
+        // Within 30 %: the unfairness this guards against was half again (194 against 127 ns per
+        // ray); two timings of one tree on a machine busy with CI's other tests came 16 % apart.
+        assert!((a / b - 1.0).abs() < 0.3, "{strategy}: {a:.1} ns per ray as a student's, {b:.1} as the reference");
         let (a, b) = (theirs.speedup_over_linear, ours.speedup_over_linear);
-        // A ratio of two timings in the same rounds: within 15 % on a machine busy with other
-        // tests (the references' times were up to half again a student's copy's).
-        assert!(
-            (a / b - 1.0).abs() < 0.15,
-            "{strategy}: speed-ups {a:.0}× as a student's and {b:.0}× as the reference"
-        );
+        // A ratio of two timings in the same rounds, held to the same 30 %.
+        assert!((a / b - 1.0).abs() < 0.3, "{strategy}: speed-ups {a:.0}× as a student's and {b:.0}× as the reference");
     }
 }
