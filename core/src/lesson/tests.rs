@@ -161,3 +161,71 @@ fn a_huge_or_binary_lesson_file_is_refused_before_it_is_parsed() {
     assert!(read_lesson(&dir).unwrap_err().to_string().contains("directory"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The lesson reader's fuzzer: the shipped lessons mutated (bytes flipped, cut short, spans
+/// doubled or dropped, hostile values put in) never panic; a lesson read back has states and
+/// writes back to text that reads again; a refusal is one line naming the file.
+#[test]
+fn mutated_lessons_never_panic_and_refusals_are_one_line() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../lessons");
+    let seeds: Vec<String> = ["why-sah-wins.json", "course-lab.json"]
+        .iter()
+        .map(|n| std::fs::read_to_string(root.join(n)).unwrap())
+        .chain([LAB.to_string()])
+        .collect();
+    let hostile: [&[u8]; 10] = [
+        b"1e400",
+        b"-1",
+        b"18446744073709551616",
+        b"\"\\u0000\"",
+        b"[[[[[[[[",
+        b"null",
+        b"\"../../../../etc/passwd\"",
+        b"{\"ray\":{\"pixel\":[4294967295,0],\"step\":4294967295}}",
+        b"\"\\u202e\"",
+        b"NaN",
+    ];
+    let path = Path::new("fuzz/l.json");
+    let mut rng = crate::random::Rng::new(0x001E_550F);
+    let (mut read, mut refused) = (0, 0);
+    for case in 0..3000u32 {
+        let mut b = seeds[case as usize % seeds.len()].clone().into_bytes();
+        for _ in 0..1 + rng.next_u64() % 4 {
+            let at = (rng.next_u64() as usize) % b.len().max(1);
+            match rng.next_u64() % 5 {
+                0 => b[at] = rng.next_u64() as u8,
+                1 => b.truncate(at),
+                2 => {
+                    let end = (at + 1 + (rng.next_u64() as usize % 64)).min(b.len());
+                    let span = b[at..end].to_vec();
+                    b.splice(at..at, span);
+                }
+                3 => {
+                    let end = (at + 1 + (rng.next_u64() as usize % 64)).min(b.len());
+                    b.drain(at..end);
+                }
+                _ => {
+                    let h = hostile[rng.next_u64() as usize % hostile.len()];
+                    let end = (at + (rng.next_u64() as usize % 12)).min(b.len());
+                    b.splice(at..end, h.iter().copied());
+                }
+            }
+        }
+        let Ok(text) = String::from_utf8(b) else { continue };
+        match parse_lesson(path, &text) {
+            Ok(l) => {
+                read += 1;
+                assert_eq!(l.states().len(), l.steps.len());
+                let again = write_lesson(&l, path);
+                let back = parse_lesson(path, &again).unwrap_or_else(|e| panic!("case {case}: {e}\n{again}"));
+                assert_eq!(back.steps.len(), l.steps.len(), "case {case}");
+            }
+            Err(e) => {
+                refused += 1;
+                let e = e.to_string();
+                assert!(e.starts_with("fuzz/l.json: ") && !e.contains('\n'), "case {case}: {e}");
+            }
+        }
+    }
+    assert!(read > 100 && refused > 1000, "{read} read, {refused} refused: the mutations reach both sides");
+}
