@@ -202,7 +202,7 @@ pub(crate) fn test_triangles<T: TriangleIntersector, const ANY: bool, S: Travers
 }
 
 /// How a leaf stored coordinate by coordinate (`wide::leaves`) is tested: `N` triangles per SIMD
-/// pass, four with every kernel (`Groups4`), sixteen with AVX-512 (`Groups16`).
+/// pass: four with every kernel (`Groups4`), eight with AVX2 (`Groups8`), sixteen with AVX-512 (`Groups16`).
 pub(crate) trait LeafGroups: Copy {
     const N: usize;
     /// One pass's hits (`Hits4`, `Hits16`).
@@ -286,6 +286,36 @@ impl LeafGroups for Groups16 {
     }
     #[inline(always)]
     fn lane(h: &crate::geometry::avx512::Hits16, k: usize) -> TriangleHit {
+        TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] }
+    }
+}
+
+/// Eight triangles per pass with AVX2 (`TriangleIntersector::intersect_group8_coords`).
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Groups8(pub crate::geometry::slab8::Avx2);
+
+#[cfg(target_arch = "x86_64")]
+impl LeafGroups for Groups8 {
+    const N: usize = 8;
+    type Hits = crate::geometry::triangle8::Hits8;
+    #[inline(always)]
+    fn test<T: TriangleIntersector>(
+        self,
+        p: &T::Prepared,
+        ray: &Ray,
+        coords: &[f32],
+        count: usize,
+        g: usize,
+    ) -> crate::geometry::triangle8::Hits8 {
+        T::intersect_group8_coords(self.0, p, ray, coords, count, g)
+    }
+    #[inline(always)]
+    fn mask(h: &crate::geometry::triangle8::Hits8) -> u32 {
+        h.mask
+    }
+    #[inline(always)]
+    fn lane(h: &crate::geometry::triangle8::Hits8, k: usize) -> TriangleHit {
         TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] }
     }
 }

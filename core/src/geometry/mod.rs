@@ -10,6 +10,8 @@ pub mod slab8;
 pub mod slab_packet;
 pub(crate) mod triangle;
 mod triangle4;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod triangle8;
 
 pub(crate) use triangle4::leaf_triangle;
 

@@ -10,6 +10,8 @@
 use super::avx512::{packet::WatertightRay16, Avx512, Hits16};
 pub use super::shear::{Hits4, WatertightRay};
 use super::Ray;
+#[cfg(target_arch = "x86_64")]
+use super::{slab8::Avx2, triangle8::Hits8};
 use glam::{DVec3, Vec3};
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::__m512;
@@ -118,6 +120,31 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
         }
         hits
     }
+
+    /// `intersect_group_coords` of triangles `8g..8g + 8` (those below `count`) at once: lane k of
+    /// the result is triangle `8g + k`'s `intersect`, bit for bit. The watertight test does them in
+    /// one AVX2 pass (`triangle8`); this default runs two groups of four.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect_group8_coords(
+        _: Avx2,
+        p: &Self::Prepared,
+        ray: &Ray,
+        coords: &[f32],
+        count: usize,
+        g: usize,
+    ) -> Hits8 {
+        let mut hits = Hits8::NONE;
+        for q in (2 * g..2 * g + 2).take_while(|&q| 4 * q < count) {
+            let h = Self::intersect_group_coords(p, ray, coords, count, q);
+            let at = 4 * (q - 2 * g);
+            hits.mask |= h.mask << at;
+            hits.t[at..at + 4].copy_from_slice(&h.t);
+            hits.u[at..at + 4].copy_from_slice(&h.u);
+            hits.v[at..at + 4].copy_from_slice(&h.v);
+        }
+        hits
+    }
 }
 
 /// Watertight ray–triangle intersection. Woop, Benthin & Wald, "Watertight Ray/Triangle
@@ -207,6 +234,13 @@ impl TriangleIntersector for Watertight {
     ) -> Hits16 {
         // SAFETY: `k` proves the CPU has AVX-512F/VL.
         unsafe { super::avx512::watertight_leaf16(k, p, ray, coords, count, g) }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect_group8_coords(k: Avx2, p: &WatertightRay, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits8 {
+        // SAFETY: `k` proves the CPU has AVX2.
+        unsafe { super::triangle8::watertight_leaf8(k, p, ray, coords, count, g) }
     }
 
     type Prepared4 = WatertightRay4;
@@ -320,6 +354,15 @@ impl TriangleIntersector for MollerTrumbore {
             return None;
         }
         Some(TriangleHit { t, u, v })
+    }
+
+    /// A leaf's triangles in one AVX2 pass of eight, as the watertight test's (`triangle8`), so
+    /// the two tests can be raced on one tree with the same loads.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect_group8_coords(k: Avx2, _: &(), ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits8 {
+        // SAFETY: `k` proves the CPU has AVX2.
+        unsafe { super::triangle8::moller_trumbore_leaf8(k, ray, coords, count, g) }
     }
 
     /// The four rays themselves: this test is not vectorised (it is the one students write first,

@@ -2,7 +2,9 @@
 //! the linear scan: single rays' hits and counts bit for bit the scalar kernel's, any-hit answers
 //! the same, packets the same hits, on adversarial rays (aimed at the corners of the tree's own
 //! boxes, axis-parallel along shared edges with origins on box planes, both zeros), with leaves of
-//! up to 20 triangles so the AVX-512 leaf test runs in 256-bit, 512-bit and two passes.
+//! up to 20 triangles so the AVX2 leaf test runs in its four- and eight-lane passes and more than
+//! one (`geometry::triangle8`, Möller–Trumbore too), and the AVX-512 one in 256-bit, 512-bit and
+//! two passes.
 
 use crate::bvh::{Accelerator, AnyBvh, BuildParams, Hit, Layout, LinearScan, NoStats, Preset, RayCounters};
 use crate::bvh::{TraceOptions, TreeNode, TreeView};

@@ -255,28 +255,37 @@ impl<const W: usize> WideBvh<W> {
         stats: &mut S,
     ) -> Option<Hit> {
         let (mut prepared, mut best) = (None, None);
-        self.walk_ray::<S, K, N>(kernel, ray, stats, |first, count, ray, stats| {
-            let ids = |i: usize| self.prim_ids[i];
-            if GROUPED {
-                // The 8-wide layout's leaves, coordinate by coordinate (`leaves.rs`).
-                let coords = &super::leaves::floats(&self.tris)[9 * first..];
-                test_triangles_grouped::<T, ANY, S, _>(
-                    groups,
-                    coords,
-                    count,
-                    first,
-                    ray,
-                    stats,
-                    &mut prepared,
-                    &mut best,
-                    ids,
-                )
-            } else {
-                self.with_leaf(first, count, |tris| {
-                    test_triangles::<T, ANY, S>(tris, first, ray, stats, &mut prepared, &mut best, ids)
-                })
-            }
-        });
+        // Inlined always: this closure is compiled without the AVX2 walk's features (it is defined
+        // here, not in `trace_avx2`), and as a call it could not inline the AVX2 leaf test either,
+        // which then cost a second call per leaf (seen in a profile).
+        self.walk_ray::<S, K, N>(
+            kernel,
+            ray,
+            stats,
+            #[inline(always)]
+            |first, count, ray, stats| {
+                let ids = |i: usize| self.prim_ids[i];
+                if GROUPED {
+                    // The 8-wide layout's leaves, coordinate by coordinate (`leaves.rs`).
+                    let coords = &super::leaves::floats(&self.tris)[9 * first..];
+                    test_triangles_grouped::<T, ANY, S, _>(
+                        groups,
+                        coords,
+                        count,
+                        first,
+                        ray,
+                        stats,
+                        &mut prepared,
+                        &mut best,
+                        ids,
+                    )
+                } else {
+                    self.with_leaf(first, count, |tris| {
+                        test_triangles::<T, ANY, S>(tris, first, ray, stats, &mut prepared, &mut best, ids)
+                    })
+                }
+            },
+        );
         best.map(|(i, h)| Hit { t: h.t, u: h.u, v: h.v, prim: self.prim_ids[i] })
     }
 }
@@ -310,7 +319,8 @@ impl Accelerator for WideBvh {
 impl WideBvh<8> {
     /// The walk compiled for AVX2 (and the bit instructions that come with it: a loop over a
     /// mask's bits becomes POPCNT, not a multiply trick), so the eight-lane kernel's intrinsics and
-    /// everything else in the walk are inlined as AVX code. FMA is enabled but never contracted
+    /// everything else in the walk are inlined as AVX code; leaves are tested eight triangles a
+    /// pass (`triangle8`; up to four take the four-lane pass). FMA is enabled but never contracted
     /// into (Rust does not fuse `a * b + c`), so results stay those of the other kernels.
     ///
     /// # Safety
@@ -323,7 +333,8 @@ impl WideBvh<8> {
         ray: &mut Ray,
         stats: &mut S,
     ) -> Option<Hit> {
-        self.trace_with::<T, ANY, S, _, STACK8, true>(kernel, Groups4, ray, stats)
+        let groups = crate::bvh::traverse::Groups8(kernel);
+        self.trace_with::<T, ANY, S, _, STACK8, true>(kernel, groups, ray, stats)
     }
 
     /// The walk compiled for AVX-512F/VL on top of the AVX2 set: the eight boxes tested with mask
