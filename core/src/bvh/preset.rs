@@ -9,12 +9,14 @@
 //!
 //! `Fastest` is the tree bvhscope traces fastest on a CPU: binned SAH collapsed into 8-wide nodes
 //! (eight boxes per AVX2 pass), its leaves as large as one SIMD pass of the CPU's kernel family
-//! tests (`Preset::fastest_leaves`): up to sixteen triangles where the CPU has AVX-512, four
-//! elsewhere. The SAH is told that a traversal step costs as much as that many triangle tests
-//! would (10 or 3), so leaves grow towards that size and the tree has fewer nodes. On AVX-512 the
-//! sixteen-triangle leaves were as fast or faster on every mesh of `versus` (primary single rays
-//! 0.98–1.14×, incoherent 1.02–1.15×, at 46–49 bytes per triangle instead of 60–68: BENCHMARKS.md,
-//! "The fastest preset by kernel family"); with AVX2 only, a leaf of sixteen takes four passes.
+//! tests (`Preset::fastest_leaves`): up to sixteen triangles where the CPU has AVX-512, eight with
+//! AVX2, four elsewhere. The SAH is told that a traversal step costs as much as that many triangle
+//! tests would (10, 5 or 3), so leaves grow towards that size and the tree has fewer nodes. On
+//! AVX-512 the sixteen-triangle leaves were as fast or faster on every mesh of `versus` (primary
+//! single rays 0.98–1.14×, incoherent 1.02–1.15×, at 46–49 bytes per triangle instead of 60–68:
+//! BENCHMARKS.md, "The fastest preset by kernel family"); with AVX2 the leaves of eight, one pass
+//! of `geometry::triangle8`, against leaves of four: bunny primary 1.01×, incoherent 1.15×, 55
+//! bytes per triangle instead of 62 (BENCHMARKS.md, "AVX2 a family of its own").
 
 use super::{BuildParams, Layout, SahCost, Strategy, TraceOptions, TraversalOrder};
 use crate::cpu::Simd;
@@ -31,12 +33,15 @@ impl Preset {
     pub const HANDOUT_MAX_LEAF_SIZE: u32 = 4;
     /// The fastest preset's largest leaf and SAH traversal cost (relative to one triangle test)
     /// for a kernel family: sixteen triangles, one AVX-512 pass (cost 10: BENCH_KERNEL_LEAVES's
-    /// best of 8, 10 and 12), or four, one pass of four lanes (cost 3: bunny, 8-wide, incoherent
-    /// rays, 1 → 2.54, 2 → 2.82, 3 → 2.91, 4 → 2.82 MRays/s on one thread).
+    /// best of 8, 10 and 12); eight, one AVX2 pass (cost 5: bunny, one thread, 8:4, 8:5, 8:7 and
+    /// 6:4 within 2 % of each other on primary rays, 8:5 kept); or four, one pass of four lanes (cost 3:
+    /// bunny, 8-wide, incoherent rays, 1 → 2.54, 2 → 2.82, 3 → 2.91, 4 → 2.82 MRays/s on one
+    /// thread).
     pub fn fastest_leaves(simd: Simd) -> (u32, f32) {
         match simd {
             Simd::Avx512 => (16, 10.0),
-            Simd::Scalar | Simd::Simd4 | Simd::Avx2 => (4, 3.0),
+            Simd::Avx2 => (8, 5.0),
+            Simd::Scalar | Simd::Simd4 => (4, 3.0),
         }
     }
 
@@ -98,12 +103,14 @@ impl Preset {
 mod tests {
     use super::*;
 
-    /// The fastest tree follows the kernel family this process traces with: leaves of sixteen only
-    /// where one AVX-512 pass tests them, four elsewhere; and the preset reads as applied to it.
+    /// The fastest tree follows the kernel family this process traces with: leaves of sixteen
+    /// where one AVX-512 pass tests them, eight for one AVX2 pass, four elsewhere; and the preset
+    /// reads as applied to it.
     #[test]
     fn the_fastest_tree_is_chosen_by_kernel_family() {
         assert_eq!(Preset::fastest_leaves(Simd::Avx512), (16, 10.0));
-        for simd in [Simd::Scalar, Simd::Simd4, Simd::Avx2] {
+        assert_eq!(Preset::fastest_leaves(Simd::Avx2), (8, 5.0));
+        for simd in [Simd::Scalar, Simd::Simd4] {
             assert_eq!(Preset::fastest_leaves(simd), (4, 3.0), "{simd:?}");
         }
         let p = Preset::Fastest.build();
