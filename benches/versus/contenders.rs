@@ -104,8 +104,10 @@ impl Tracer for OursPackets {
     }
 }
 
-fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(bvh: AnyBvh) -> Box<dyn Tracer> {
-    let opts = TraceOptions::default();
+fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(
+    bvh: AnyBvh,
+    opts: TraceOptions,
+) -> Box<dyn Tracer> {
     match bvh {
         AnyBvh::Binary(accel) => Box::new(Ours::<_, S> { accel, opts, _stats: Default::default() }),
         AnyBvh::Wide(accel) => Box::new(Ours::<_, S> { accel, opts, _stats: Default::default() }),
@@ -117,7 +119,8 @@ fn tracer<S: bvhscope::bvh::TraversalStats + Default + Sync + Send + 'static>(bv
 /// for the alternated overhead measurement in `main.rs`.
 pub fn plain_and_counting(mesh: &Mesh, layout: Layout) -> [Box<dyn Tracer>; 2] {
     let params = BuildParams { layout, ..BuildParams::with_strategy(Strategy::SahBinned) };
-    [tracer::<NoStats>(AnyBvh::build(mesh, &params)), tracer::<RayCounters>(AnyBvh::build(mesh, &params))]
+    let opts = TraceOptions::default();
+    [tracer::<NoStats>(AnyBvh::build(mesh, &params), opts), tracer::<RayCounters>(AnyBvh::build(mesh, &params), opts)]
 }
 
 /// How our rows trace: plain single rays, single rays with the heatmap counters on, or packets of 64.
@@ -136,16 +139,23 @@ pub fn ours(strategy: Strategy, layout: Layout, tracing: Tracing) -> Contender {
 
 /// Our BVH built with `params` (named `label` in the table), traced as `tracing` says.
 pub fn ours_with(label: &str, params: BuildParams, tracing: Tracing) -> Contender {
-    ours_with_kernels(label, params, tracing, None)
+    ours_with_kernels(label, params, tracing, None, TriangleTest::Watertight)
 }
 
 /// `ours_with`, walked with the kernels of `simd` instead of the best this CPU has (`with_simd`):
 /// the same tree raced with AVX2 and with AVX-512 in one run (named "…, avx2").
-pub fn ours_with_kernels(label: &str, params: BuildParams, tracing: Tracing, simd: Option<Simd>) -> Contender {
+pub fn ours_with_kernels(
+    label: &str,
+    params: BuildParams,
+    tracing: Tracing,
+    simd: Option<Simd>,
+    test: TriangleTest,
+) -> Contender {
     let label = match simd {
         Some(s) => format!("{label}, {}", s.name()),
         None => label.to_string(),
     };
+    let label = if test == TriangleTest::MollerTrumbore { format!("{label}, Möller–Trumbore") } else { label };
     let layout_name = match params.layout {
         Layout::Binary => "BVH2",
         Layout::Wide4 => "BVH4",
@@ -176,13 +186,14 @@ pub fn ours_with_kernels(label: &str, params: BuildParams, tracing: Tracing, sim
                 (bvh, _) => bvh,
             };
             let took = t.elapsed();
+            let opts = TraceOptions { test, ..TraceOptions::default() };
             let stats = TreeStats::of(&bvh);
             let built = Built {
                 sah_cost: Some(stats.sah_cost),
                 bytes_per_tri: Some(stats.memory_bytes as f64 / mesh.triangle_count() as f64),
                 tracer: match tracing {
-                    Tracing::Plain => tracer::<NoStats>(bvh),
-                    Tracing::Counting => tracer::<RayCounters>(bvh),
+                    Tracing::Plain => tracer::<NoStats>(bvh, opts),
+                    Tracing::Counting => tracer::<RayCounters>(bvh, opts),
                     Tracing::Packets => Box::new(OursPackets { bvh }),
                 },
             };

@@ -1,7 +1,7 @@
 //! `BENCH_KERNELS=1`: the fastest preset's tree walked with each SIMD kernel this CPU has from four
 //! lanes up (`cpu::Simd`, forced with `with_simd`), and with `BENCH_KERNEL_LEAVES=8:5,16:8` trees of
 //! larger leaves (leaf size : SAH traversal cost) with AVX2 and AVX-512; single rays and 8×8
-//! packets, primary and incoherent, on one thread; Embree beside them where it was found. The kernels
+//! packets, primary and incoherent, on one thread; Embree (where found) and tinybvh (in an AVX2 build) beside them. The kernels
 //! take turns on every slice of 16384 rays (the order rotating from slice to slice), their times
 //! summed over the ray set; the median of several such passes is kept. Rows of the main table are
 //! timed minutes apart, and this shared machine drifts by ±15% over minutes: two turns on a slice
@@ -13,14 +13,17 @@
 use crate::contenders::{ours_with_kernels, Built, Tracer, Tracing};
 use crate::embree;
 use crate::rays::{self, RaySpec};
+use crate::tinybvh;
 use crate::{median, Settings};
 use bvhscope::bvh::Preset;
 use bvhscope::cpu::Simd;
+use bvhscope::geometry::TriangleTest;
 use bvhscope::mesh::Mesh;
 use rayon::ThreadPool;
 use std::fmt::Write;
 
 const SLICE: usize = 16384;
+const WATERTIGHT: TriangleTest = TriangleTest::Watertight;
 
 /// One column: a kernel and the tree's leaf size and SAH traversal cost.
 #[derive(Clone, Copy)]
@@ -28,6 +31,7 @@ struct Setup {
     simd: Simd,
     leaf: u32,
     cost: f32,
+    test: TriangleTest,
 }
 
 /// The columns: every kernel on the fastest preset's tree, then AVX2 and AVX-512 on the trees of
@@ -37,14 +41,25 @@ fn setups() -> Vec<Setup> {
     let mut v: Vec<Setup> = Simd::ALL
         .into_iter()
         .filter(|&k| k >= Simd::Simd4 && k <= Simd::detected())
-        .map(|simd| Setup { simd, leaf: fastest.max_leaf_size, cost: fastest.cost.traversal })
+        .map(|simd| Setup { simd, leaf: fastest.max_leaf_size, cost: fastest.cost.traversal, test: WATERTIGHT })
         .collect();
+    // Möller–Trumbore on the same tree, its leaves in the same AVX2 pass of eight (`triangle8`):
+    // what the watertight test costs.
+    if Simd::detected() >= Simd::Avx2 {
+        let simd = Simd::Avx2;
+        v.push(Setup {
+            simd,
+            leaf: fastest.max_leaf_size,
+            cost: fastest.cost.traversal,
+            test: TriangleTest::MollerTrumbore,
+        });
+    }
     let extra = std::env::var("BENCH_KERNEL_LEAVES").unwrap_or_default();
     for pair in extra.split(',').filter(|p| !p.trim().is_empty()) {
         let (leaf, cost) = pair.split_once(':').expect("BENCH_KERNEL_LEAVES=leaf:cost,…");
         let (leaf, cost) = (leaf.trim().parse().expect("a leaf size"), cost.trim().parse().expect("a cost"));
         for simd in [Simd::Avx2, Simd::Avx512].into_iter().filter(|&k| k <= Simd::detected()) {
-            v.push(Setup { simd, leaf, cost });
+            v.push(Setup { simd, leaf, cost, test: WATERTIGHT });
         }
     }
     v
@@ -53,7 +68,8 @@ fn setups() -> Vec<Setup> {
 /// The tables for `mesh`, single rays then 8×8 packets: per column, median MRays/s and the ratio
 /// to the fastest preset's AVX2 column. Where Embree was found, its medium build races in the same
 /// alternation: `rtcIntersect1` (and the high-quality build) beside single rays, `rtcIntersect8`
-/// and the coherent stream of 64 beside packets.
+/// and the coherent stream of 64 beside packets; tinybvh's BVH8_CPU (both builds) beside single rays
+/// where the bench was built with AVX2 (`tinybvh::notice`).
 pub fn table(mesh: &Mesh, s: &Settings, one: &ThreadPool) -> String {
     let setups = setups();
     let passes = if s.quick { 3 } else { 7 };
@@ -64,12 +80,15 @@ pub fn table(mesh: &Mesh, s: &Settings, one: &ThreadPool) -> String {
     for tracing in [Tracing::Plain, Tracing::Packets] {
         let mut columns: Vec<(String, Built)> = setups
             .iter()
+            // Packets trace with the watertight test only.
+            .filter(|c| tracing == Tracing::Plain || c.test == WATERTIGHT)
             .map(|c| {
                 let mut params = Preset::Fastest.build();
                 (params.max_leaf_size, params.cost.traversal) = (c.leaf, c.cost);
-                let b = (ours_with_kernels("fastest", params, tracing, Some(c.simd)).build)(mesh).0;
+                let b = (ours_with_kernels("fastest", params, tracing, Some(c.simd), c.test).build)(mesh).0;
+                let mt = if c.test == WATERTIGHT { "" } else { " Möller–Trumbore" };
                 let name = format!(
-                    "{} leaf {} cost {} ({:.1} B/tri)",
+                    "{}{mt} leaf {} cost {} ({:.1} B/tri)",
                     c.simd.name(),
                     c.leaf,
                     c.cost,
@@ -82,7 +101,9 @@ pub fn table(mesh: &Mesh, s: &Settings, one: &ThreadPool) -> String {
             Tracing::Plain => &["embree medium (rtcIntersect1)", "embree high (rtcIntersect1)"],
             _ => &["embree medium (rtcIntersect8)", "embree medium (stream of 64)"],
         };
-        for c in embree::all().into_iter().filter(|c| theirs.contains(&c.name.as_str())) {
+        let tiny = if tracing == Tracing::Plain { tinybvh::all() } else { Vec::new() };
+        let anchors = embree::all().into_iter().filter(|c| theirs.contains(&c.name.as_str())).chain(tiny);
+        for c in anchors {
             let b = (c.build)(mesh).0;
             columns.push((format!("{} ({:.1} B/tri)", c.name, b.bytes_per_tri.unwrap_or(0.0)), b));
         }

@@ -31,6 +31,7 @@ mod scenes;
 mod tinybvh;
 
 use bvhscope::bvh::Layout;
+use bvhscope::geometry::TriangleTest;
 use bvhscope::mesh::Mesh;
 use contenders::{Contender, Family, Tracer, Tracing};
 use rayon::prelude::*;
@@ -381,14 +382,19 @@ fn main() {
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Plain));
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Packets));
     contenders.push(contenders::ours_with("fastest", fastest, Tracing::Counting));
-    // Where the CPU has AVX-512, the same tree with the AVX2 kernels forced, in the same run, and
-    // trees of other leaf sizes: the preset's tree on AVX2 machines (leaves ≤ 4), and ≤ 32
+    // Where the CPU has AVX-512, the AVX2 family in the same run: the preset's tree on an AVX2
+    // machine (leaves of eight) walked with the AVX2 kernels forced; and the tree of leaves ≤ 32
     // (BENCHMARKS.md, "The fastest preset by kernel family").
     if bvhscope::cpu::Simd::detected() > bvhscope::cpu::Simd::Avx2 {
         let avx2 = Some(bvhscope::cpu::Simd::Avx2);
-        contenders.push(contenders::ours_with_kernels("fastest", fastest, Tracing::Plain, avx2));
-        contenders.push(contenders::ours_with_kernels("fastest", fastest, Tracing::Packets, avx2));
-        let others = [bvhscope::bvh::Preset::fastest_leaves(bvhscope::cpu::Simd::Avx2), (32, 12.0)];
+        let (leaf, cost) = bvhscope::bvh::Preset::fastest_leaves(bvhscope::cpu::Simd::Avx2);
+        let cost = bvhscope::bvh::SahCost { traversal: cost, ..fastest.cost };
+        let tree = bvhscope::bvh::BuildParams { max_leaf_size: leaf, cost, ..fastest };
+        for tracing in [Tracing::Plain, Tracing::Packets] {
+            let wt = TriangleTest::Watertight;
+            contenders.push(contenders::ours_with_kernels("fastest for AVX2", tree, tracing, avx2, wt));
+        }
+        let others = [(32, 12.0)];
         for (leaf, cost) in others {
             let cost = bvhscope::bvh::SahCost { traversal: cost, ..fastest.cost };
             let p = bvhscope::bvh::BuildParams { max_leaf_size: leaf, cost, ..fastest };
