@@ -366,7 +366,7 @@ impl Accelerator for WideBvh<8> {
     ) -> Option<Hit> {
         match self.simd {
             #[cfg(target_arch = "x86_64")]
-            // Leaves of up to four triangles (the fastest preset's) take the AVX2 walk: there the
+            // Leaves of up to four triangles take the AVX2 walk (its four-lane pass): there the
             // AVX-512 one measured 1–8% slower (BENCHMARKS.md, "AVX-512"); it pays from leaves of
             // eight on, which it tests in one pass.
             Simd::Avx512 if self.params.max_leaf_size > 4 => match crate::geometry::avx512::Avx512::detect() {
