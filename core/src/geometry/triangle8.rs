@@ -52,22 +52,8 @@ pub(crate) fn watertight_leaf8(_: Avx2, p: &WatertightRay, ray: &Ray, coords: &[
         return hits;
     }
     let lanes = (1u32 << n) - 1;
-    let base = coords.as_ptr();
-    let len = coords.len();
-    // SAFETY: the CPU has AVX2 (this function's features, proved by the `Avx2` argument). A full
-    // load of coordinate j reads coords[j·count + 8g ..][..8], inside the slice when checked so;
-    // otherwise the masked load reads lanes k < n only, coords[j·count + 8g + k] with
-    // 8g + k < count, inside the slice (asserted above).
-    unsafe {
-        let keep = _mm256_cmpgt_epi32(_mm256_set1_epi32(n as i32), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-        let load = |j: usize| {
-            let at = j * count + 8 * g;
-            if at + 8 <= len {
-                _mm256_loadu_ps(base.add(at))
-            } else {
-                _mm256_maskload_ps(base.add(at), keep)
-            }
-        };
+    let load = loads(coords, count, g, n);
+    {
         let o = ray.origin();
         let vertex = |v: usize| {
             [
@@ -100,18 +86,8 @@ pub(crate) fn moller_trumbore_leaf8(_: Avx2, ray: &Ray, coords: &[f32], count: u
         return Hits8::NONE;
     }
     let lanes = (1u32 << n) - 1;
-    let (base, len) = (coords.as_ptr(), coords.len());
-    // SAFETY: as in `watertight_leaf8`: full loads inside the slice, masked ones below `count`.
-    unsafe {
-        let keep = _mm256_cmpgt_epi32(_mm256_set1_epi32(n as i32), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-        let load = |j: usize| {
-            let at = j * count + 8 * g;
-            if at + 8 <= len {
-                _mm256_loadu_ps(base.add(at))
-            } else {
-                _mm256_maskload_ps(base.add(at), keep)
-            }
-        };
+    let load = loads(coords, count, g, n);
+    {
         let (add, sub, mul) = (|a, b| _mm256_add_ps(a, b), |a, b| _mm256_sub_ps(a, b), |a, b| _mm256_mul_ps(a, b));
         let dot = |a: [__m256; 3], b: [__m256; 3]| add(add(mul(a[0], b[0]), mul(a[1], b[1])), mul(a[2], b[2]));
         let cross = |a: [__m256; 3], b: [__m256; 3]| {
@@ -149,11 +125,36 @@ pub(crate) fn moller_trumbore_leaf8(_: Avx2, ray: &Ray, coords: &[f32], count: u
         let mask = _mm256_movemask_ps(ok) as u32 & lanes;
         let mut hits = Hits8 { mask, ..Hits8::NONE };
         if mask != 0 {
-            _mm256_storeu_ps(hits.t.as_mut_ptr(), t);
-            _mm256_storeu_ps(hits.u.as_mut_ptr(), u);
-            _mm256_storeu_ps(hits.v.as_mut_ptr(), v);
+            // SAFETY: each array holds eight floats, the width of the stores.
+            unsafe {
+                _mm256_storeu_ps(hits.t.as_mut_ptr(), t);
+                _mm256_storeu_ps(hits.u.as_mut_ptr(), u);
+                _mm256_storeu_ps(hits.v.as_mut_ptr(), v);
+            }
         }
         hits
+    }
+}
+
+/// Coordinate j (0..9) of triangles `8g..8g + n` of a leaf of `count` stored coordinate by
+/// coordinate, as eight lanes: a plain load where eight floats lie inside `coords`, else a masked
+/// one of the `n` lanes only (lanes past them are zero). `coords` holds at least `9·count` floats.
+#[inline]
+#[target_feature(enable = "avx2,fma")]
+fn loads(coords: &[f32], count: usize, g: usize, n: usize) -> impl Fn(usize) -> __m256 + '_ {
+    let keep = _mm256_cmpgt_epi32(_mm256_set1_epi32(n as i32), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    move |j: usize| {
+        let at = j * count + 8 * g;
+        // SAFETY: the CPU has AVX2 (the callers' features, proved by their `Avx2` argument). A full
+        // load reads coords[at..at + 8], inside the slice when checked so; the masked load reads
+        // lanes k < n only, coords[j·count + 8g + k] with 8g + k < count, inside the slice.
+        unsafe {
+            if at + 8 <= coords.len() {
+                _mm256_loadu_ps(coords.as_ptr().add(at))
+            } else {
+                _mm256_maskload_ps(coords.as_ptr().add(at), keep)
+            }
+        }
     }
 }
 
