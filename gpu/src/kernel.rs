@@ -1,8 +1,10 @@
 //! One compute kernel: a WGSL module compiled for one entry point with its pipeline-overridable
 //! constants, an explicit bind group layout (so a binding a variant leaves unused still binds),
-//! and its dispatch. Compilation errors come back as `GpuError::Rejected` with naga's message.
+//! and its dispatch; a builder's kernels as one set (`KernelSet`). Compilation errors come back as
+//! `GpuError::Rejected` with naga's message.
 
 use crate::device::{Gpu, GpuError};
+use std::sync::Arc;
 
 /// A module's source: the prelude every module starts with (`shaders/prelude.wgsl`: `Tri`), then
 /// `parts` in order.
@@ -120,5 +122,59 @@ impl Kernel {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind, &[]);
         pass.dispatch_workgroups(groups.0, groups.1, 1);
+    }
+}
+
+/// A builder's kernels: one module's entry points, each with the bindings it uses (binding 0 the
+/// uniform parameters, 1..=`read_only` read-only storage, the rest read-write), compiled once per
+/// device, and recorded into an encoder by name.
+pub(crate) struct KernelSet {
+    table: &'static [(&'static str, &'static [u32])],
+    kernels: Vec<Arc<Kernel>>,
+}
+
+impl KernelSet {
+    /// Compile every entry of `table` from `source`; `name` keys the device's cache.
+    pub(crate) fn new(
+        gpu: &Gpu,
+        name: &str,
+        source: &str,
+        table: &'static [(&'static str, &'static [u32])],
+        read_only: u32,
+    ) -> Result<KernelSet, GpuError> {
+        let mut kernels = Vec::with_capacity(table.len());
+        for &(entry, binds) in table {
+            let binds: Vec<(u32, Bind)> = binds
+                .iter()
+                .map(|&b| {
+                    let kind = match b {
+                        0 => Bind::Uniform,
+                        b if b <= read_only => Bind::Read,
+                        _ => Bind::ReadWrite,
+                    };
+                    (b, kind)
+                })
+                .collect();
+            kernels.push(gpu.compiled(format!("{name} {entry}"), || {
+                Kernel::with_bindings(gpu, entry, source, entry, &binds, &[])
+            })?);
+        }
+        Ok(KernelSet { table, kernels })
+    }
+
+    /// Record `entry` over `threads` invocations (64 a group), binding each of its bindings `b`
+    /// to `buffer(b)`.
+    pub(crate) fn record<'a>(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        entry: &str,
+        buffer: impl Fn(u32) -> &'a wgpu::Buffer,
+        threads: u32,
+    ) {
+        let k = self.table.iter().position(|(e, _)| *e == entry).expect("an entry of the set's table");
+        let entries: Vec<(u32, &wgpu::Buffer)> = self.table[k].1.iter().map(|&b| (b, buffer(b))).collect();
+        let kernel = &self.kernels[k];
+        kernel.dispatch(encoder, &kernel.bind_numbered(gpu, &entries), gpu.grid(threads, 64));
     }
 }

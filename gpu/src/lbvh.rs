@@ -11,14 +11,13 @@
 //! triangle count and checked against the adapter's limit before anything is uploaded.
 
 use crate::device::{Gpu, GpuError};
-use crate::kernel::{Bind, Kernel};
+use crate::kernel::KernelSet;
 use crate::scan::Scan;
 use crate::sort::RadixSort;
 use bvhscope_core::bvh::params::MAX_LEAF_SIZE;
 use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, Strategy};
 use bvhscope_core::geometry::Aabb;
 use bvhscope_core::mesh::Mesh;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// How long each phase of a GPU build took (wall time on the host, each phase waited for).
@@ -46,17 +45,17 @@ impl GpuBuildTimings {
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct LParams {
-    lo: [f32; 4],
-    scale: [f32; 4],
-    n: u32,
-    max_leaf: u32,
-    pad: [u32; 2],
+pub(crate) struct LParams {
+    pub(crate) lo: [f32; 4],
+    pub(crate) scale: [f32; 4],
+    pub(crate) n: u32,
+    pub(crate) max_leaf: u32,
+    pub(crate) pad: [u32; 2],
 }
 
 /// The LBVH builder's kernels on one device.
 pub struct GpuLbvh {
-    kernels: Vec<(&'static str, Arc<Kernel>)>,
+    kernels: KernelSet,
     sort: RadixSort,
     scan: Scan,
 }
@@ -135,28 +134,7 @@ fn unordered(u: u32) -> f32 {
 
 impl GpuLbvh {
     pub fn new(gpu: &Gpu) -> Result<GpuLbvh, GpuError> {
-        let src = &source();
-        let mut kernels = Vec::new();
-        for (entry, binds) in KERNELS {
-            let binds: Vec<(u32, Bind)> = binds
-                .iter()
-                .map(|&b| {
-                    (
-                        b,
-                        if b == 0 {
-                            Bind::Uniform
-                        } else if b == 1 {
-                            Bind::Read
-                        } else {
-                            Bind::ReadWrite
-                        },
-                    )
-                })
-                .collect();
-            let k =
-                gpu.compiled(format!("lbvh {entry}"), || Kernel::with_bindings(gpu, entry, src, entry, &binds, &[]))?;
-            kernels.push((entry, k));
-        }
+        let kernels = KernelSet::new(gpu, "lbvh", &source(), &KERNELS, 1)?;
         Ok(GpuLbvh { kernels, sort: RadixSort::new(gpu)?, scan: Scan::new(gpu)? })
     }
 
@@ -178,12 +156,8 @@ impl GpuLbvh {
         bufs: &[Option<wgpu::Buffer>],
         threads: u32,
     ) {
-        let (_, k) = self.kernels.iter().find(|(e, _)| *e == entry).expect("a kernel of KERNELS");
-        let binds = KERNELS.iter().find(|(e, _)| *e == entry).expect("listed").1;
-        let entries: Vec<(u32, &wgpu::Buffer)> =
-            binds.iter().map(|&b| (b, bufs[b as usize].as_ref().expect("every bound buffer is made"))).collect();
-        let bind = k.bind_numbered(gpu, &entries);
-        k.dispatch(enc, &bind, gpu.grid(threads, 64));
+        let buffer = |b: u32| bufs[b as usize].as_ref().expect("every bound buffer is made");
+        self.kernels.record(gpu, enc, entry, buffer, threads);
     }
 
     /// Upload `mesh`'s triangles and sort them by Morton code as core's LBVH does (phases upload,

@@ -10,6 +10,8 @@ mod cwbvh;
 mod device;
 mod format;
 mod kernel;
+#[cfg(test)]
+mod layout_tests;
 mod lbvh;
 mod ploc;
 mod scan;

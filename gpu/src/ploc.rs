@@ -6,24 +6,23 @@
 //! under the SAH and its layout (O(n), after the clustered tree is read back).
 
 use crate::device::{Gpu, GpuError};
-use crate::kernel::{Bind, Kernel};
+use crate::kernel::KernelSet;
 use crate::lbvh::{morton_sizes, GpuBuildTimings, GpuLbvh, MAX_TRIANGLES};
 use crate::scan::Scan;
 use bvhscope_core::bvh::params::{MAX_LEAF_SIZE, PLOC_RADIUS, TRAVERSAL_COST};
-use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, SahCost, Strategy};
+use bvhscope_core::bvh::{BuildParams, BuildReport, Bvh, BvhNode, Strategy};
 use bvhscope_core::geometry::Aabb;
 use bvhscope_core::mesh::Mesh;
 use glam::Vec3;
-use std::sync::Arc;
 use std::time::Instant;
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct PParams {
-    count: u32,
-    radius: u32,
-    n: u32,
-    never: u32,
+pub(crate) struct PParams {
+    pub(crate) count: u32,
+    pub(crate) radius: u32,
+    pub(crate) n: u32,
+    pub(crate) never: u32,
 }
 
 const LEAF: u32 = u32::MAX;
@@ -59,19 +58,8 @@ fn buffer_sizes(n: u64) -> Vec<(&'static str, u64)> {
 /// The PLOC builder's kernels on one device (and the LBVH's, for the Morton order).
 pub struct GpuPloc {
     lbvh: GpuLbvh,
-    kernels: Vec<(&'static str, Arc<Kernel>)>,
+    kernels: KernelSet,
     scan: Scan,
-}
-
-/// core's `SahCost::leaf_or_split` (`pub(super)` there), the same arithmetic in f64.
-fn leaf_or_split(c: &SahCost, area: f64, count: u32, children: f64, max_leaf: u32) -> (f64, bool) {
-    let split = c.traversal as f64 * area + children;
-    let as_leaf = c.intersection as f64 * count as f64 * area;
-    if count <= max_leaf && as_leaf <= split {
-        (as_leaf, true)
-    } else {
-        (split, false)
-    }
 }
 
 /// A node of the clustered tree as read back: its box and children (LEAF: a primitive's slot).
@@ -97,7 +85,7 @@ fn layout(nodes: &[ClusterNode], root: u32, params: &BuildParams) -> (Vec<BvhNod
         }
         let (l, r) = (c.left as usize, c.right as usize);
         count[k] = count[l] + count[r];
-        (cost[k], leaf[k]) = leaf_or_split(&params.cost, area, count[k], cost[l] + cost[r], params.max_leaf_size);
+        (cost[k], leaf[k]) = params.cost.leaf_or_split(area, count[k], cost[l] + cost[r], params.max_leaf_size);
     }
     let mut out = vec![BvhNode::leaf(Aabb::EMPTY, 0, 0)];
     let mut order: Vec<u32> = Vec::with_capacity(count[root as usize] as usize);
@@ -122,15 +110,8 @@ fn layout(nodes: &[ClusterNode], root: u32, params: &BuildParams) -> (Vec<BvhNod
         }
         let left = out.len();
         out.extend([BvhNode::leaf(Aabb::EMPTY, 0, 0); 2]);
-        let e = c.bounds.max - c.bounds.min;
-        let axis = if e.x >= e.y && e.x >= e.z {
-            0
-        } else if e.y >= e.z {
-            1
-        } else {
-            2
-        };
-        out[slot] = BvhNode::interior(c.bounds, left as u32, axis);
+        // The widest axis: clusters are not split on a plane (core's PLOC names the same).
+        out[slot] = BvhNode::interior(c.bounds, left as u32, c.bounds.widest_axis() as u8);
         stack.push((c.right, left + 1));
         stack.push((c.left, left));
     }
@@ -139,28 +120,7 @@ fn layout(nodes: &[ClusterNode], root: u32, params: &BuildParams) -> (Vec<BvhNod
 
 impl GpuPloc {
     pub fn new(gpu: &Gpu) -> Result<GpuPloc, GpuError> {
-        let src = &source();
-        let mut kernels = Vec::new();
-        for (entry, binds) in KERNELS {
-            let binds: Vec<(u32, Bind)> = binds
-                .iter()
-                .map(|&b| {
-                    (
-                        b,
-                        if b == 0 {
-                            Bind::Uniform
-                        } else if b <= 2 {
-                            Bind::Read
-                        } else {
-                            Bind::ReadWrite
-                        },
-                    )
-                })
-                .collect();
-            let k =
-                gpu.compiled(format!("ploc {entry}"), || Kernel::with_bindings(gpu, entry, src, entry, &binds, &[]))?;
-            kernels.push((entry, k));
-        }
+        let kernels = KernelSet::new(gpu, "ploc", &source(), &KERNELS, 2)?;
         Ok(GpuPloc { lbvh: GpuLbvh::new(gpu)?, kernels, scan: Scan::new(gpu)? })
     }
 
@@ -180,10 +140,7 @@ impl GpuPloc {
     }
 
     fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, entry: &str, bufs: &[&wgpu::Buffer], threads: u32) {
-        let (_, k) = self.kernels.iter().find(|(e, _)| *e == entry).expect("a kernel of KERNELS");
-        let binds = KERNELS.iter().find(|(e, _)| *e == entry).expect("listed").1;
-        let entries: Vec<(u32, &wgpu::Buffer)> = binds.iter().map(|&b| (b, bufs[b as usize])).collect();
-        k.dispatch(enc, &k.bind_numbered(gpu, &entries), gpu.grid(threads, 64));
+        self.kernels.record(gpu, enc, entry, |b| bufs[b as usize], threads);
     }
 
     /// Build core's PLOC tree of `mesh` with `params` (its leaf size, SAH costs and radius).

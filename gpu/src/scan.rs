@@ -10,10 +10,10 @@ pub(crate) const BLOCK: u32 = 4096;
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ScanParams {
-    len: u32,
-    blocks: u32,
-    pad: [u32; 2],
+pub(crate) struct ScanParams {
+    pub(crate) len: u32,
+    pub(crate) blocks: u32,
+    pub(crate) pad: [u32; 2],
 }
 
 pub(crate) struct Scan {

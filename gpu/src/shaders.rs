@@ -34,12 +34,13 @@ macro_rules! shader {
 }
 
 /// Every file of `shaders/`.
-pub(crate) const SHADERS: [Shader; 15] = [
+pub(crate) const SHADERS: [Shader; 16] = [
     shader!("prelude.wgsl", Shared),
     shader!("common.wgsl", Shared),
     shader!("triangle.wgsl", Shared),
     shader!("edge_f32.wgsl", Shared),
     shader!("edge_f64.wgsl", Shared),
+    shader!("leaf.wgsl", Shared),
     shader!("stack_private.wgsl", Shared),
     shader!("stack_global.wgsl", Shared),
     shader!("entry.wgsl", Shared),

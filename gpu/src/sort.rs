@@ -12,11 +12,11 @@ const TILE: u32 = 4096;
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct SortParams {
-    n: u32,
-    shift: u32,
-    tiles: u32,
-    pad: u32,
+pub(crate) struct SortParams {
+    pub(crate) n: u32,
+    pub(crate) shift: u32,
+    pub(crate) tiles: u32,
+    pub(crate) pad: u32,
 }
 
 pub(crate) struct RadixSort {

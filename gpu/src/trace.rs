@@ -106,20 +106,20 @@ impl GpuTrace {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct Params {
-    origin: [f32; 4],
-    forward: [f32; 4],
-    right: [f32; 4],
-    up: [f32; 4],
+    pub(crate) origin: [f32; 4],
+    pub(crate) forward: [f32; 4],
+    pub(crate) right: [f32; 4],
+    pub(crate) up: [f32; 4],
     pub(crate) root_lo: [f32; 4],
     pub(crate) root_hi: [f32; 4],
-    inv_w: f32,
-    inv_h: f32,
-    width: u32,
-    height: u32,
-    count: u32,
-    offset: u32,
-    stack_stride: u32,
-    never: u32,
+    pub(crate) inv_w: f32,
+    pub(crate) inv_h: f32,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) count: u32,
+    pub(crate) offset: u32,
+    pub(crate) stack_stride: u32,
+    pub(crate) never: u32,
 }
 
 /// The camera's ray generator as core's `Camera::ray_gen` makes it (`RayGen::parts`), for the GPU
@@ -144,11 +144,11 @@ fn camera_params(cam: &Camera) -> Result<Params, GpuError> {
 /// The GPU form of a ray (shaders/common.wgsl's `RayIn`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct RayIn {
-    o: [f32; 3],
-    t_min: f32,
-    d: [f32; 3],
-    t_max: f32,
+pub(crate) struct RayIn {
+    pub(crate) o: [f32; 3],
+    pub(crate) t_min: f32,
+    pub(crate) d: [f32; 3],
+    pub(crate) t_max: f32,
 }
 
 /// Where a walk keeps its stack: in private memory of a fixed size, or `stride` entries per
@@ -207,6 +207,7 @@ impl Kernels {
             source("common.wgsl"),
             source("triangle.wgsl"),
             edge,
+            source("leaf.wgsl"),
             &stack_src,
             source(self.walk_file),
             source("entry.wgsl"),

@@ -18,7 +18,8 @@ mod walk;
 pub use gpu::{CwbvhFormat, GpuCwbvh};
 
 use crate::device::GpuError;
-use bvhscope_core::bvh::{Bvh, BvhNode};
+use bvhscope_core::bvh::wide::wide_children;
+use bvhscope_core::bvh::Bvh;
 use bvhscope_core::geometry::Aabb;
 use glam::Vec3;
 
@@ -161,21 +162,6 @@ fn assign_slots(node: &Aabb, children: &[Aabb]) -> [Option<usize>; 8] {
     slots
 }
 
-/// The binary nodes a wide node over binary node `i` takes as children (core's greedy collapse).
-fn collapse(b: &[BvhNode], i: usize) -> Vec<usize> {
-    let mut kids = vec![b[i].index as usize, b[i].index as usize + 1];
-    while kids.len() < 8 {
-        let widest = kids
-            .iter()
-            .enumerate()
-            .filter(|(_, &k)| !b[k].is_leaf())
-            .max_by(|x, y| b[*x.1].bounds().area().total_cmp(&b[*y.1].bounds().area()).then(y.0.cmp(&x.0)));
-        let Some((pos, &k)) = widest else { break };
-        kids.splice(pos..=pos, [b[k].index as usize, b[k].index as usize + 1]);
-    }
-    kids
-}
-
 impl Cwbvh {
     /// Collapse, place and quantise `bvh` (checked as the binary upload checks it).
     pub fn from_bvh(bvh: &Bvh) -> Result<Cwbvh, GpuError> {
@@ -204,7 +190,12 @@ impl Cwbvh {
         out.nodes.push(CwbvhNode::zeroed());
         while let Some((w, i, level)) = queue.pop_front() {
             out.depth = out.depth.max(level);
-            let kids = if b[i].is_leaf() { vec![i] } else { collapse(b, i) };
+            let kids = if b[i].is_leaf() {
+                vec![i]
+            } else {
+                let (kids, n) = wide_children::<8>(b, i);
+                kids[..n].to_vec()
+            };
             let boxes: Vec<Aabb> = kids.iter().map(|&k| b[k].bounds()).collect();
             let node_box = Aabb::of(boxes.iter().copied());
             let slots = assign_slots(&node_box, &boxes);

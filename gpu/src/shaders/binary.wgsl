@@ -15,47 +15,19 @@ struct Node {
     info: u32,
 }
 
-// `Tri`, a triangle's three vertices in leaf order: prelude.wgsl.
+// `Tri`, a triangle's three vertices in leaf order: prelude.wgsl; `test_leaf` and `prim_of`: leaf.wgsl.
 
 @group(0) @binding(5) var<storage, read> nodes: array<Node>;
 @group(0) @binding(6) var<storage, read> tris: array<Tri>;
 @group(0) @binding(7) var<storage, read> prim_ids: array<u32>;
-
-// The mesh's number of the triangle in leaf slot i.
-fn prim_of(i: u32) -> u32 {
-    return prim_ids[i];
-}
 
 fn node_slab(i: u32, t_min: f32, limit: f32) -> vec2<f32> {
     let n = nodes[i];
     return slab(vec3<f32>(n.lo_x, n.lo_y, n.lo_z), vec3<f32>(n.hi_x, n.hi_y, n.hi_z), t_min, limit);
 }
 
-// core's test_triangles: every triangle of the leaf in order, each nearer hit shrinking t_max.
-fn test_leaf(first: u32, count: u32) {
-    if !spend(count) {
-        return;
-    }
-    for (var k = 0u; k < count; k++) {
-        let i = first + k;
-        let t = tris[i].v;
-        let h = intersect(vec3<f32>(t[0], t[1], t[2]), vec3<f32>(t[3], t[4], t[5]), vec3<f32>(t[6], t[7], t[8]));
-        if h.w != 0.0 {
-            R_t_max = h.x;
-            best = i;
-            best_u = h.y;
-            best_v = h.z;
-        }
-    }
-    count_tris(count);
-}
-
 fn walk() {
-    best = MISS;
-    C = vec4<u32>(0u);
-    overflow = false;
-    steps = 0u;
-    unfinished = false;
+    start_walk();
     // The closest hit so far, widened: what boxes and stack entries are compared with.
     var limit = widen(R_t_max);
     count_boxes(1u);

@@ -6,7 +6,7 @@
 
 // An 80-byte node as 20 words (gpu/src/cwbvh/mod.rs documents the bytes).
 struct CNode { w: array<u32, 20> }
-// `Tri`: prelude.wgsl.
+// `Tri`: prelude.wgsl; `test_leaf` and `prim_of`: leaf.wgsl.
 
 @group(0) @binding(5) var<storage, read> cnodes: array<CNode>;
 // (first triangle, count) per leaf.
@@ -14,39 +14,13 @@ struct CNode { w: array<u32, 20> }
 @group(0) @binding(7) var<storage, read> tris: array<Tri>;
 @group(0) @binding(8) var<storage, read> prim_ids: array<u32>;
 
-fn prim_of(i: u32) -> u32 {
-    return prim_ids[i];
-}
-
 // Byte k (0 = lowest) of the 8-byte field that starts at word w, for slot s.
 fn slot_byte(n: ptr<function, CNode>, w: u32, s: u32) -> u32 {
     return ((*n).w[w + (s >> 2u)] >> (8u * (s & 3u))) & 0xffu;
 }
 
-fn test_leaf(first: u32, count: u32) {
-    if !spend(count) {
-        return;
-    }
-    for (var k = 0u; k < count; k++) {
-        let i = first + k;
-        let t = tris[i].v;
-        let h = intersect(vec3<f32>(t[0], t[1], t[2]), vec3<f32>(t[3], t[4], t[5]), vec3<f32>(t[6], t[7], t[8]));
-        if h.w != 0.0 {
-            R_t_max = h.x;
-            best = i;
-            best_u = h.y;
-            best_v = h.z;
-        }
-    }
-    count_tris(count);
-}
-
 fn walk() {
-    best = MISS;
-    C = vec4<u32>(0u);
-    overflow = false;
-    steps = 0u;
-    unfinished = false;
+    start_walk();
     var limit = widen(R_t_max);
     count_boxes(1u);
     let root = slab(P.root_lo.xyz, P.root_hi.xyz, R_t_min, limit);
