@@ -5,6 +5,7 @@
 
 use crate::bvh::{AnyBvh, BuildParams, Bvh, RayCounters, SceneBuild, SceneBvh, Strategy, TraceOptions};
 use crate::mesh::Mesh;
+use crate::options::Named;
 use crate::render::Camera;
 use crate::scene::{Scene, SceneError};
 use bvhscope_gpu::{
@@ -21,7 +22,8 @@ pub enum Device {
     Gpu,
 }
 
-/// The node format the GPU walks (its names and help: its row of `GPU_NODES`).
+/// The node format the GPU walks (its names and help: `GPU_NODE_NAMES`; how it is made and
+/// uploaded: its row of `GPU_NODES`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GpuNodes {
     #[default]
@@ -29,78 +31,75 @@ pub enum GpuNodes {
     Cwbvh,
 }
 
-/// One node format: the value a flag and the saved settings take, the label messages, tables and
-/// the app show, the help the flag and the app's button give, and how the format is made from the
-/// binary tree and uploaded (its `GpuFormat`, in its own file of `bvhscope-gpu`).
-pub struct GpuNodesRow {
-    pub nodes: GpuNodes,
-    pub value: &'static str,
-    pub label: &'static str,
-    pub help: &'static str,
-    upload: Upload,
-}
+/// The devices by name: `--device`, the saved settings and the app's buttons.
+const DEVICES: [Named<Device>; 2] = [
+    Named {
+        value: Device::Cpu,
+        name: "cpu",
+        label: "CPU",
+        help: "the renderer of the core, with the CPU's SIMD kernels",
+    },
+    Named {
+        value: Device::Gpu,
+        name: "gpu",
+        label: "GPU",
+        help: "wgpu compute shaders (Vulkan, Metal, DX12, lavapipe)",
+    },
+];
+bvhscope_core::choice!(Device, DEVICES, 2);
 
-/// Every node format the GPU walks, one row each: the command line, the app and `compare` read
-/// them here.
-pub const GPU_NODES: [GpuNodesRow; 2] = [
-    GpuNodesRow {
-        nodes: GpuNodes::Binary,
-        value: "binary",
+/// The node formats by name: `--gpu-nodes`, the saved settings, the app's buttons, messages and
+/// tables.
+const GPU_NODE_NAMES: [Named<GpuNodes>; 2] = [
+    Named {
+        value: GpuNodes::Binary,
+        name: "binary",
         label: "binary",
         help: "The binary tree as built: core's 32-byte nodes, byte for byte",
-        upload: BinaryFormat::upload,
     },
-    GpuNodesRow {
-        nodes: GpuNodes::Cwbvh,
-        value: "cwbvh",
+    Named {
+        value: GpuNodes::Cwbvh,
+        name: "cwbvh",
         label: "CWBVH",
         help: "Compressed 8-wide nodes of 80 bytes (Ylitie, Karras & Laine 2017), made from the binary tree; \
                its counts are those of its own walk",
-        upload: CwbvhFormat::upload,
     },
+];
+bvhscope_core::choice!(GpuNodes, GPU_NODE_NAMES, 2);
+
+/// How a node format is made from the binary tree and uploaded (its `GpuFormat`, in its own file
+/// of `bvhscope-gpu`).
+pub struct GpuNodesRow {
+    pub nodes: GpuNodes,
+    upload: Upload,
+}
+
+/// Every node format the GPU walks, one row each.
+pub const GPU_NODES: [GpuNodesRow; 2] = [
+    GpuNodesRow { nodes: GpuNodes::Binary, upload: BinaryFormat::upload },
+    GpuNodesRow { nodes: GpuNodes::Cwbvh, upload: CwbvhFormat::upload },
 ];
 
 impl GpuNodes {
-    /// Every format, in the table's order.
-    pub const ALL: [GpuNodes; GPU_NODES.len()] = {
-        let mut all = [GpuNodes::Binary; GPU_NODES.len()];
-        let mut i = 0;
-        while i < all.len() {
-            all[i] = GPU_NODES[i].nodes;
-            i += 1;
-        }
-        all
-    };
-
     /// This format's row of `GPU_NODES`.
     pub fn row(self) -> &'static GpuNodesRow {
         GPU_NODES.iter().find(|r| r.nodes == self).expect("every node format has a row (a test checks)")
     }
-
-    /// How messages and tables name the format.
-    pub fn name(self) -> &'static str {
-        self.row().label
-    }
-
-    /// The format a flag's or the settings' value names.
-    pub fn from_value(value: &str) -> Option<GpuNodes> {
-        GPU_NODES.iter().find(|r| r.value == value).map(|r| r.nodes)
-    }
 }
 
-/// Saved by its row's value.
+/// Saved by its name.
 impl serde::Serialize for GpuNodes {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.row().value)
+        s.serialize_str(self.name())
     }
 }
 
 impl<'de> serde::Deserialize<'de> for GpuNodes {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let value = String::deserialize(d)?;
-        GpuNodes::from_value(&value).ok_or_else(|| {
-            let values: Vec<&str> = GPU_NODES.iter().map(|r| r.value).collect();
-            serde::de::Error::custom(format!("unknown GPU node format \"{value}\" (expected {})", values.join(", ")))
+        GpuNodes::from_name(&value).ok_or_else(|| {
+            let names = <GpuNodes as crate::options::Choice>::names();
+            serde::de::Error::custom(format!("unknown GPU node format \"{value}\" (expected {names})"))
         })
     }
 }

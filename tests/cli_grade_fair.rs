@@ -2,7 +2,7 @@
 //! line: a class folder given as one path, links out of a submission refused with nothing of
 //! their targets in any report file, a file name with escape sequences printed harmlessly, the
 //! time limit kept on a tree whose boxes all overlap, and two runs into one `--out` that never
-//! mix. (core/src/explain/grade/tests_fair.rs: the yardstick, the order of findings, the times
+//! mix. (core/src/explain/grade/fair_tests.rs: the yardstick, the order of findings, the times
 //! under load.)
 
 mod cli_support;

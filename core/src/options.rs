@@ -37,7 +37,8 @@ pub trait Choice: Copy + PartialEq + Send + Sync + 'static {
 }
 
 /// The values of a table in its order (the choices' `ALL` constants).
-const fn values<T: Copy, const N: usize>(table: &[Named<T>; N]) -> [T; N] {
+/// A table's values in its order (the `ALL` of `choice!`).
+pub const fn values<T: Copy, const N: usize>(table: &[Named<T>; N]) -> [T; N] {
     let mut out = [table[0].value; N];
     let mut i = 0;
     while i < N {
@@ -48,25 +49,26 @@ const fn values<T: Copy, const N: usize>(table: &[Named<T>; N]) -> [T; N] {
 }
 
 /// `ALL`, `name`, `label`, `help` and `from_name` of a choice, read from its table.
+#[macro_export]
 macro_rules! choice {
     ($ty:ty, $table:ident, $n:literal) => {
-        impl Choice for $ty {
-            const TABLE: &'static [Named<Self>] = &$table;
+        impl $crate::options::Choice for $ty {
+            const TABLE: &'static [$crate::options::Named<Self>] = &$table;
         }
         impl $ty {
-            pub const ALL: [$ty; $n] = values(&$table);
+            pub const ALL: [$ty; $n] = $crate::options::values(&$table);
 
             pub fn name(self) -> &'static str {
-                Choice::named(self).name
+                $crate::options::Choice::named(self).name
             }
             pub fn label(self) -> &'static str {
-                Choice::named(self).label
+                $crate::options::Choice::named(self).label
             }
             pub fn help(self) -> &'static str {
-                Choice::named(self).help
+                $crate::options::Choice::named(self).help
             }
             pub fn from_name(name: &str) -> Option<Self> {
-                <Self as Choice>::from_name(name)
+                <Self as $crate::options::Choice>::from_name(name)
             }
         }
     };

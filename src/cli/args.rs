@@ -141,11 +141,11 @@ impl BuildArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct DeviceArgs {
     /// Trace the rays on the CPU or on the GPU (its help: `device_help`).
-    #[arg(long, value_enum, default_value = "cpu", help = device_help())]
+    #[arg(long, value_parser = choice::<Device>(), default_value = "cpu", help = device_help())]
     pub device: Device,
     /// With --device gpu: the node format walked, the binary tree as built or its compressed
     /// 8-wide form (CWBVH) [default: binary].
-    #[arg(long, value_enum, value_name = "FORMAT")]
+    #[arg(long, value_parser = choice::<GpuNodes>(), value_name = "FORMAT")]
     pub gpu_nodes: Option<GpuNodes>,
 }
 
@@ -192,8 +192,8 @@ impl DumpLimit {
         &self,
         scene: &crate::scene::Scene,
         path: &std::path::Path,
-    ) -> Result<crate::bvh::SceneBvh, super::CliError> {
-        use super::CliError;
+    ) -> Result<crate::bvh::SceneBvh, crate::cli::error::CliError> {
+        use crate::cli::error::CliError;
         let mesh = scene.flat_mesh().map_err(|e| CliError::Usage(e.to_string()))?;
         let dump = crate::dump::BvhDump::read(path, self.bytes(&mesh)).map_err(|e| CliError::Usage(e.to_string()))?;
         let structure = crate::explain::check::check_tree(&dump, &mesh);
@@ -225,7 +225,7 @@ pub struct ViewArgs {
 impl ViewArgs {
     /// The camera: `--camera` if given, else the scene's, else one framing the mesh; the size is
     /// `--size`, else the scene's, else 1280x720.
-    pub fn camera(&self, bounds: &Aabb, scene: Option<&Camera>) -> Result<Camera, super::CliError> {
+    pub fn camera(&self, bounds: &Aabb, scene: Option<&Camera>) -> Result<Camera, crate::cli::error::CliError> {
         let (w, h) = self.size.or(scene.map(|c| (c.width, c.height))).unwrap_or((1280, 720));
         let cam = match (self.camera, scene) {
             (Some((position, look_at, up)), _) => {
@@ -235,7 +235,7 @@ impl ViewArgs {
             (None, Some(c)) => Camera { width: w, height: h, ..*c },
             (None, None) => Camera::framing_up(bounds, w, h, self.up, self.fov),
         };
-        cam.validate().map_err(|e| super::CliError::Usage(format!("--camera: {e}")))?;
+        cam.validate().map_err(|e| crate::cli::error::CliError::Usage(format!("--camera: {e}")))?;
         Ok(cam)
     }
 }

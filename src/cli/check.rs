@@ -4,20 +4,29 @@
 //! which writes a built-in strategy's tree in that format, is `export_bvh.rs`.)
 
 use super::args::{BuildArgs, DumpLimit, ViewArgs};
-use super::{load_mesh, progress, CliError};
+use super::progress;
 use crate::bvh::{epo, AnyBvh, BuildParams, Strategy, TreeStats, TreeView};
+use crate::cli::error::CliError;
+use crate::cli::load::load_mesh;
 use crate::dump::BvhDump;
 use crate::explain::check::{check, Finding, Group, Subject, FINDINGS_LISTED, LISTED, MAX_RAYS};
+use crate::options::Named;
 use crate::render::{render, RenderSettings};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::fmt::Write;
 use std::path::PathBuf;
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CheckFormat {
     Text,
     Json,
 }
+
+const CHECK_FORMATS: [Named<CheckFormat>; 2] = [
+    Named { value: CheckFormat::Text, name: "text", label: "Text", help: "plain text, to read" },
+    Named { value: CheckFormat::Json, name: "json", label: "JSON", help: "one JSON document, for scripts" },
+];
+bvhscope_core::choice!(CheckFormat, CHECK_FORMATS, 2);
 
 #[derive(Args, Debug)]
 pub struct CheckArgs {
@@ -39,7 +48,7 @@ pub struct CheckArgs {
     pub view_args: ViewArgs,
     #[command(flatten)]
     pub build: BuildArgs,
-    #[arg(long, value_enum, default_value = "text")]
+    #[arg(long, value_parser = crate::cli::args::choice::<CheckFormat>(), default_value = "text")]
     pub format: CheckFormat,
     /// Leave out the quality table (it builds every strategy and measures each tree's EPO: most
     /// of the time on a big mesh).

@@ -7,8 +7,9 @@
 //! (core's trees node for node), with the build's phases timed.
 
 use super::args::{BuildArgs, DeviceArgs};
-use super::{progress, CliError};
+use super::progress;
 use crate::bvh::{AnyBvh, BuildParams, Layout, SceneBuild, SceneBvh, TraceOptions};
+use crate::cli::error::CliError;
 pub use crate::gpu_path::{
     build_on_gpu, build_scene_on_gpu, builds_on_gpu, GpuBuild, GpuBuildError, GpuNodes, GpuTree,
 };
@@ -140,28 +141,5 @@ impl GpuTree {
         let frame = Frame::from_hits(mesh, camera, &t.hits, &t.counters)
             .map_err(|e| CliError::Usage(format!("--device gpu: {e}")))?;
         Ok((frame, t))
-    }
-}
-
-/// The flags' names of the GPU path's choices: `gpu_path` knows nothing of flags.
-impl clap::ValueEnum for crate::gpu_path::Device {
-    fn value_variants<'a>() -> &'a [Self] {
-        &[crate::gpu_path::Device::Cpu, crate::gpu_path::Device::Gpu]
-    }
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(match self {
-            crate::gpu_path::Device::Cpu => "cpu",
-            crate::gpu_path::Device::Gpu => "gpu",
-        }))
-    }
-}
-
-impl clap::ValueEnum for GpuNodes {
-    fn value_variants<'a>() -> &'a [Self] {
-        &GpuNodes::ALL
-    }
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        let row = self.row();
-        Some(clap::builder::PossibleValue::new(row.value).help(row.help))
     }
 }

@@ -2,8 +2,9 @@
 //! (the format `check` reads).
 
 use super::args::{BuildArgs, DeviceArgs};
-use super::{load_mesh, CliError};
 use crate::bvh::{AnyBvh, BuildParams, Layout};
+use crate::cli::error::CliError;
+use crate::cli::load::load_mesh;
 use crate::dump::BvhDump;
 use clap::Args;
 use std::path::PathBuf;

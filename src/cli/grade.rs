@@ -4,7 +4,10 @@
 //! Exit 0 once the report is written, whatever the students' verdicts; 2 when it cannot be.
 
 use super::args::{BuildArgs, DumpLimit, ViewArgs};
-use super::{load_mesh, printable, progress, CliError};
+use super::progress;
+use crate::cli::error::CliError;
+use crate::cli::load::load_mesh;
+use crate::cli::print::printable;
 use crate::explain::check::MAX_RAYS;
 use crate::explain::grade::{
     csv_records, discover, document, grade_class, write_html, GradeError, GradeRow, Graded, References, ReportDir,

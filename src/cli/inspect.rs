@@ -3,24 +3,38 @@
 //! triangles at every candidate plane with each strategy's choice marked (`explain::inspect`).
 
 use super::args::{BuildArgs, ViewArgs};
-use super::{build_scene, load_mesh, CliError};
 use crate::bvh::wide::wide_group_in;
 use crate::bvh::Hierarchy;
 use crate::bvh::{SceneBvh, TreeView};
+use crate::cli::error::CliError;
+use crate::cli::load::{build_scene, load_mesh};
 use crate::explain::inspect::text::{dump_text, no_split_text, sbvh_text, wide_group_text};
 use crate::explain::inspect::{inspect, CurvePoint, Inspection};
 use crate::options::Choice;
-use clap::{Args, ValueEnum};
+use crate::options::Named;
+use clap::Args;
 use std::fmt::Write;
 use std::path::PathBuf;
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum InspectFormat {
     Text,
     Json,
     /// The exact sweep's curves: `axis,position,left_count,right_count,cost`.
     Csv,
 }
+
+const INSPECT_FORMATS: [Named<InspectFormat>; 3] = [
+    Named { value: InspectFormat::Text, name: "text", label: "Text", help: "plain text, to read" },
+    Named { value: InspectFormat::Json, name: "json", label: "JSON", help: "one JSON document, for scripts" },
+    Named {
+        value: InspectFormat::Csv,
+        name: "csv",
+        label: "CSV",
+        help: "the exact sweep's curves: axis,position,left_count,right_count,cost",
+    },
+];
+bvhscope_core::choice!(InspectFormat, INSPECT_FORMATS, 3);
 
 #[derive(Args, Debug)]
 pub struct InspectArgs {
@@ -42,7 +56,7 @@ pub struct InspectArgs {
     /// size as `render` takes them).
     #[command(flatten)]
     pub view_args: ViewArgs,
-    #[arg(long, value_enum, default_value = "text")]
+    #[arg(long, value_parser = crate::cli::args::choice::<InspectFormat>(), default_value = "text")]
     pub format: InspectFormat,
 }
 

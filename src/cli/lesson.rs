@@ -4,7 +4,8 @@
 //! the commands. `--check` opens every scene, builds every step's tree and looks up every target
 //! (`lesson::check`), naming the step and field of each problem.
 
-use super::{printable, Cli, CliError, Command};
+use crate::cli::error::CliError;
+use crate::cli::print::printable;
 use crate::files::{FolderKind, ReportDir};
 use crate::lesson::{self, HandoutStep, Lesson};
 use clap::Args;
@@ -105,12 +106,21 @@ fn write_handout(l: &Lesson, path: &Path, dir: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `bvhscope render` run on `words` (those after `bvhscope`), as the command line would.
+/// `bvhscope render` run on `words` (those after `bvhscope`), as the command line would: parsed by
+/// `render`'s own arguments, so a step's command is read with the very flags `render` takes.
 fn render(words: &[String]) -> Result<(), CliError> {
-    let cli = Cli::from_words(std::iter::once("bvhscope".to_string()).chain(words.iter().cloned()))
-        .map_err(|e| CliError::Usage(format!("the step's render command does not parse: {e}")))?;
-    match cli.command {
-        Some(Command::Render(r)) => super::render::run(&r),
-        _ => Err(CliError::Usage("the step's command is not a render".into())),
+    /// The command line with `render` as its only subcommand.
+    #[derive(clap::Parser)]
+    #[command(name = "bvhscope")]
+    enum OnlyRender {
+        Render(super::render::RenderArgs),
     }
+    if words.first().map(String::as_str) != Some("render") {
+        return Err(CliError::Usage("the step's command is not a render".into()));
+    }
+    let OnlyRender::Render(r) = <OnlyRender as clap::Parser>::try_parse_from(
+        std::iter::once("bvhscope".to_string()).chain(words.iter().cloned()),
+    )
+    .map_err(|e| CliError::Usage(format!("the step's render command does not parse: {e}")))?;
+    super::render::run(&r)
 }

@@ -2,7 +2,7 @@
 //! the secondary rays' parameters, declared once for every command that traces a frame.
 
 use super::args::parse_vec3;
-use super::CliError;
+use crate::cli::error::CliError;
 use crate::render::secondary::{DEFAULT_AO_LENGTH, DEFAULT_SAMPLES, DEFAULT_SEED, MAX_SAMPLES};
 use crate::render::{Camera, RayKind, SecondaryRays, SecondarySpec};
 use crate::{geometry::Aabb, options::Choice};

@@ -1,10 +1,13 @@
 //! `bvhscope render`: ray-cast a mesh to a PNG.
 
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
-use super::device::{self, GpuTree};
-use super::{load_mesh, progress, CliError};
+use super::device;
+use super::progress;
 use crate::bvh::SceneBvh;
+use crate::cli::error::CliError;
+use crate::cli::load::load_mesh;
 use crate::files::file_name;
+use crate::gpu_path::GpuTree;
 use crate::render::boxes::{draw_segments, Segment};
 use crate::render::{
     draw_legend, render_progressive, view_image, Camera, ColorMap, Frame, HeatRange, PairView, RenderSettings, View,
@@ -208,7 +211,7 @@ fn run_against(
     let params_a = *params_a;
     let params_b =
         crate::bvh::SceneBuild { bvh: crate::bvh::BuildParams { strategy: against, ..params_a.bvh }, ..params_a };
-    let (bvh_b, _) = super::build_scene(gpu, loaded, &params_b)?;
+    let (bvh_b, _) = crate::cli::load::build_scene(gpu, loaded, &params_b)?;
     let boxes_b = match a.pair_view {
         PairView::Difference => Vec::new(),
         _ => box_lines(a, &bvh_b, camera, "B (--against)")?,
@@ -279,7 +282,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     let bvh = match &a.bvh {
         Some(path) => a.dump_limit.import(&loaded, path)?,
-        None => super::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
+        None => crate::cli::load::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?.0,
     };
     let boxes = box_lines(a, &bvh, &camera, "the BVH")?;
     let kind = a.rays.one("render")?;
@@ -358,7 +361,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         eprint!("; node boxes at depth {depth}");
     }
     if let Some(gpu) = &gpu {
-        eprint!("; traced on the GPU, {} nodes: {}", a.device.nodes().name(), gpu.name());
+        eprint!("; traced on the GPU, {} nodes: {}", a.device.nodes().label(), gpu.name());
     }
     eprintln!(")");
     Ok(())

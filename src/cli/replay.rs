@@ -4,8 +4,10 @@
 //! of the heatmap's metric, for a lab report (`explain::replay`).
 
 use super::args::{BuildArgs, ViewArgs};
-use super::{build_scene, load_mesh, progress, CliError};
+use super::progress;
 use crate::bvh::{Layout, SceneBvh};
+use crate::cli::error::CliError;
+use crate::cli::load::{build_scene, load_mesh};
 use crate::explain::replay::Replay;
 use crate::explain::replay_film::{film, steps, FilmSettings};
 use crate::files::file_name;

@@ -2,21 +2,31 @@
 //! figures of the app's statistics panel, from the same camera and size when given the same).
 
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
-use super::device::{self, GpuBuild, GpuTree};
-use super::{load_noted, progress, CliError};
+use super::device;
+use super::progress;
 use crate::bvh::{epo, Hierarchy, RayCounters, SceneBvh, TreeStats, TreeView};
+use crate::cli::error::CliError;
+use crate::cli::load::load_noted;
+use crate::gpu_path::{GpuBuild, GpuTree};
+use crate::options::Named;
 use crate::render::warp::{WarpSize, WarpSummary, WarpView, WarpWork};
 use crate::render::{render, Camera, RaySummary, RenderSettings, SecondaryRays, SecondarySpec};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::fmt::Write;
 use std::path::PathBuf;
 
 /// How `stats` prints (`--format`); the app's stats files are `app::StatsFormat`.
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum StatsOutput {
     Text,
     Json,
 }
+
+const STATS_OUTPUTS: [Named<StatsOutput>; 2] = [
+    Named { value: StatsOutput::Text, name: "text", label: "Text", help: "plain text, to read" },
+    Named { value: StatsOutput::Json, name: "json", label: "JSON", help: "one JSON document, for scripts" },
+];
+bvhscope_core::choice!(StatsOutput, STATS_OUTPUTS, 2);
 
 #[derive(Args, Debug)]
 pub struct StatsArgs {
@@ -37,7 +47,7 @@ pub struct StatsArgs {
     /// Only the tree's statistics: trace no rays.
     #[arg(long)]
     pub no_rays: bool,
-    #[arg(long, value_enum, default_value = "text")]
+    #[arg(long, value_parser = crate::cli::args::choice::<StatsOutput>(), default_value = "text")]
     pub format: StatsOutput,
 }
 
@@ -130,7 +140,7 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
         params = device::gpu_params(&a.build, loaded.build.as_ref(), params)?;
         device::check_traceable(&a.build.scene_build(params), trace)?;
     }
-    let (bvh, gpu_build) = super::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?;
+    let (bvh, gpu_build) = crate::cli::load::build_scene(gpu.as_ref(), &loaded, &a.build.scene_build(params))?;
     let report = &loaded.report;
     let kind = a.rays.one("stats")?;
     if gpu.is_some() && kind.is_secondary() && !a.no_rays {
@@ -153,7 +163,7 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
     });
     let mut rays_text = rays.as_ref().map_or(String::new(), |(camera, r, warp)| {
         let on = gpu.as_ref().map_or(String::new(), |g| {
-            format!("device          GPU, {} nodes: {}\n", a.device.nodes().name(), g.name())
+            format!("device          GPU, {} nodes: {}\n", a.device.nodes().label(), g.name())
         });
         let warp = warp.as_ref().map_or(String::new(), Warp::text);
         format!("{on}{}{warp}", format_rays(camera, &trace, &spec, r))

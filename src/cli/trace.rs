@@ -3,21 +3,30 @@
 //! the left, y from the top, as everywhere) or typed as an origin and a direction.
 
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
-use super::device::{self, GpuTree};
-use super::{load_mesh, CliError};
+use super::device;
 use crate::bvh::{trace_query_into, RayCounters, SceneBvh, StepKind, StepOut, Trace, TraceLevel, TraceStep};
+use crate::cli::error::CliError;
+use crate::cli::load::load_mesh;
 use crate::geometry::Ray;
-use clap::{Args, ValueEnum};
+use crate::gpu_path::GpuTree;
+use crate::options::Named;
+use clap::Args;
 use glam::Vec3;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TraceFormat {
     Text,
     Json,
 }
+
+const TRACE_FORMATS: [Named<TraceFormat>; 2] = [
+    Named { value: TraceFormat::Text, name: "text", label: "Text", help: "plain text, to read" },
+    Named { value: TraceFormat::Json, name: "json", label: "JSON", help: "one JSON document, for scripts" },
+];
+bvhscope_core::choice!(TraceFormat, TRACE_FORMATS, 2);
 
 #[derive(Args, Debug)]
 pub struct TraceArgs {
@@ -52,7 +61,7 @@ pub struct TraceArgs {
     /// Which of the pixel's secondary rays to walk (0-based; the listing names them all).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub secondary: u32,
-    #[arg(long, value_enum, default_value = "text")]
+    #[arg(long, value_parser = crate::cli::args::choice::<TraceFormat>(), default_value = "text")]
     pub format: TraceFormat,
     /// Trace through a BVH written by another program (bvhscope-bvh, as `check` reads it) instead
     /// of building one.
@@ -133,7 +142,7 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
     }
     let bvh = match &a.bvh {
         Some(path) => a.dump_limit.import(&scene, path)?,
-        None => super::build_scene(gpu.as_ref(), &scene, &a.build.scene_build(params))?.0,
+        None => crate::cli::load::build_scene(gpu.as_ref(), &scene, &a.build.scene_build(params))?.0,
     };
     let on_gpu = match &gpu {
         Some(g) => Some((g, GpuTree::upload(g, &bvh, a.device.nodes())?)),
@@ -202,7 +211,7 @@ pub fn write(a: &TraceArgs, out: &mut dyn std::io::Write) -> Result<(), CliError
         };
         let note = format!(
             "traced on the GPU ({} nodes, {}){finished}: the GPU walk records no steps (its kernels keep each ray's hit and counts only); for the walk step by step, run this with --device cpu",
-            tree.nodes().name(),
+            tree.nodes().label(),
             g.name()
         );
         let hit = t.hits.first().copied().flatten();

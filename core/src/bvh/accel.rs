@@ -1,7 +1,7 @@
 //! The interface shared by every acceleration structure (BVH, linear scan), so the renderer, the
 //! tests and the CLI can swap one for another.
 
-use super::TraversalStats;
+use crate::bvh::counters::TraversalStats;
 use crate::geometry::{Ray, TriangleIntersector, TriangleTest};
 
 /// Most rays in one packet (`Accelerator::closest_hits`): an 8×8 pixel tile.

@@ -1,8 +1,11 @@
 //! A built BVH in any layout behind one type: what the app, the CLI and the tests hold.
 
 use super::tree::{TreeNode, TreeView};
-use super::wide::WideBvh;
-use super::{Accelerator, BuildParams, BuildReport, Bvh, Hit, Layout, TraceOptions, TraversalStats};
+use crate::bvh::accel::{Accelerator, Hit, TraceOptions};
+use crate::bvh::counters::TraversalStats;
+use crate::bvh::node::Bvh;
+use crate::bvh::params::{BuildParams, BuildReport, Layout};
+use crate::bvh::wide::wide_bvh::WideBvh;
 use crate::geometry::TriangleIntersector;
 use crate::mesh::Mesh;
 use crate::work::{Cancelled, WorkControl};

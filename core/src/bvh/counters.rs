@@ -4,8 +4,26 @@
 //! sets `STEPS` (`bvh::trace::Trace`) is also told every step of the walk, in order; for every
 //! other sink `STEPS` is a constant false and the step reports compile away.
 
-use super::trace::NodeId;
 use crate::geometry::TriangleHit;
+
+/// A node of the walk. In the binary layout every node, leaves included, is a `Node` (its index in
+/// the node array); in the 4-wide layout a `Node` is a wide node and a leaf lives in a slot of its
+/// parent (`Leaf`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NodeId {
+    Node(u32),
+    Leaf { node: u32, slot: u8 },
+}
+
+impl std::fmt::Display for NodeId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NodeId::Node(n) => write!(f, "node {n}"),
+            NodeId::Leaf { node, slot } => write!(f, "leaf {node}.{slot}"),
+        }
+    }
+}
 
 /// How many of the stack's top entries a walk reports with each change (`step_stack`): more than
 /// one step changes (an 8-wide node pushes at most seven, then sorts them).

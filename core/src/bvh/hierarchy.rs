@@ -2,7 +2,7 @@
 //! leaf of each triangle. The nodes do not store these; the tree view, the inspector, the replay,
 //! EPO and the checker's tests all need them.
 
-use super::Bvh;
+use crate::bvh::node::Bvh;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
@@ -326,7 +326,8 @@ impl Out<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{BuildParams, Layout, Strategy};
+    use crate::bvh::params::Strategy;
+    use crate::bvh::params::{BuildParams, Layout};
     use crate::mesh::generate::{grid_of, torus_knot};
 
     /// The parallel reading of a big tree is `serial_of`'s, on 1 and 4 threads, with cut

@@ -2,7 +2,8 @@
 //! the dump's id of each node, so that traces and the tree view name nodes as the student's
 //! program does.
 
-use super::{Bvh, NodeId};
+use crate::bvh::counters::NodeId;
+use crate::bvh::node::Bvh;
 use crate::mesh::Mesh;
 
 /// What tells an imported tree from a built one: its file, and the dump's id of each node.

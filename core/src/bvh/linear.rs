@@ -1,7 +1,8 @@
 //! The brute-force reference: test every triangle. Slow, obviously right, and the yardstick for
 //! the BVH's correctness tests and the CLI's speedup column.
 
-use super::{Accelerator, Hit, TraversalStats};
+use crate::bvh::accel::{Accelerator, Hit};
+use crate::bvh::counters::TraversalStats;
 use crate::geometry::{Ray, TriangleIntersector};
 use crate::mesh::Mesh;
 use glam::Vec3;

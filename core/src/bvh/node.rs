@@ -1,7 +1,7 @@
 //! The flat BVH: 32-byte nodes in one array, children of a node stored next to each other, and
 //! the triangles reordered so each leaf is a contiguous range (the handout's `orderedShapes`).
 
-use super::{BuildParams, BuildReport};
+use crate::bvh::params::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use glam::Vec3;
 

@@ -2,7 +2,6 @@
 //! constants, the layout, and the report of the phases. The builder owns each number's limits and
 //! default (`Param`); `crate::options` gives them their names, labels and help for users.
 
-use super::Strategy;
 use std::time::Duration;
 
 /// A number's limits (inclusive) and default, as the builder accepts it.
@@ -205,7 +204,7 @@ impl SahCost {
     /// triangles in a box of `area`, whose two children cost `children` (their SAH costs summed,
     /// in area units), costs the cheaper of a leaf (C_isect·n·A, only when `count` fits a leaf of
     /// `max_leaf`) and a split (C_trav·A + children). Returns the cost and whether it is a leaf.
-    pub(super) fn leaf_or_split(&self, area: f64, count: u32, children: f64, max_leaf: u32) -> (f64, bool) {
+    pub fn leaf_or_split(&self, area: f64, count: u32, children: f64, max_leaf: u32) -> (f64, bool) {
         let split = self.traversal as f64 * area + children;
         let as_leaf = self.intersection as f64 * count as f64 * area;
         if count <= max_leaf && as_leaf <= split {
@@ -233,6 +232,30 @@ pub enum Layout {
     /// Collapsed into 8-wide nodes: eight child boxes in one AVX2 pass where the CPU has it
     /// (`crate::cpu`), two passes of four elsewhere.
     Wide8,
+}
+
+/// How a tree is built: top down by a splitter (midpoint, equal count, SAH binned or swept), or
+/// by a builder of its own (LBVH, PLOC, SBVH). Its row of `REGISTRY` says which.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Strategy {
+    /// Middle of the centroid bounds on the widest axis.
+    Midpoint,
+    /// Median centroid on the widest axis: equally many triangles on each side.
+    EqualCount,
+    /// Surface area heuristic, evaluated at bin boundaries on all three axes.
+    #[default]
+    SahBinned,
+    /// Surface area heuristic, evaluated between every pair of neighbouring centroids.
+    SahSweep,
+    /// A builder of its own (`builders::lbvh`): the hierarchy of the
+    /// centroids' sorted Morton codes.
+    Lbvh,
+    /// A bottom-up builder of its own (`builders::ploc`): clusters merged with their nearest
+    /// neighbours in Morton order.
+    Ploc,
+    /// The binned SAH with spatial splits (`builders::sbvh`): triangles cut where that beats
+    /// sorting them to one side, so a triangle may be referenced by several leaves.
+    Sbvh,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

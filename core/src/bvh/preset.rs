@@ -18,7 +18,9 @@
 //! of `geometry::triangle8`, against leaves of four: bunny primary 1.01×, incoherent 1.15×, 55
 //! bytes per triangle instead of 62 (BENCHMARKS.md, "AVX2 a family of its own").
 
-use super::{BuildParams, Layout, SahCost, Strategy, TraceOptions, TraversalOrder};
+use crate::bvh::accel::{TraceOptions, TraversalOrder};
+use crate::bvh::params::Strategy;
+use crate::bvh::params::{BuildParams, Layout, SahCost};
 use crate::cpu::Simd;
 use crate::geometry::TriangleTest;
 

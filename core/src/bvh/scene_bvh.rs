@@ -5,7 +5,11 @@
 
 use super::imported::Imported;
 use super::tree::TreeView;
-use super::{Accelerator, AnyBvh, BuildParams, Hit, TraceOptions, TraversalStats, TwoLevelBvh};
+use crate::bvh::accel::{Accelerator, Hit, TraceOptions};
+use crate::bvh::any::AnyBvh;
+use crate::bvh::counters::TraversalStats;
+use crate::bvh::params::BuildParams;
+use crate::bvh::two_level::TwoLevelBvh;
 use crate::geometry::{Ray, TriangleHit, TriangleIntersector};
 use crate::mesh::{Mesh, Surface};
 use crate::work::{Cancelled, WorkControl};
@@ -194,7 +198,8 @@ impl SceneBvh {
     /// The world-space corners (`Aabb::corners` order) of the box of `node` at `level`, as a
     /// trace names them: a placement's mesh BVH's boxes are placed by its transform.
     pub fn node_corners(&self, level: super::TraceLevel, node: super::NodeId) -> Option<[Vec3; 8]> {
-        use super::{NodeId, TraceLevel};
+        use crate::bvh::counters::NodeId;
+        use crate::bvh::trace::TraceLevel;
         let in_tree = |bvh: &AnyBvh| match (bvh, node) {
             (AnyBvh::Binary(b), NodeId::Node(i)) => b.nodes.get(i as usize).map(|n| n.bounds()),
             (AnyBvh::Wide(w), id) => w.node_box(id),

@@ -6,7 +6,7 @@
 //! traversal steps plus triangle tests (with unit constants), ignoring early termination.
 
 use super::tree::{NodeKind, TreeView};
-use super::SahCost;
+use crate::bvh::params::SahCost;
 use std::time::Duration;
 
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]

@@ -8,28 +8,10 @@
 //! The totals of a trace (entered nodes, box tests, leaves, triangle tests) are the counting sink's
 //! counts for the same ray, step for step (`tests/ray_trace.rs`).
 
-use super::{Accelerator, Hit, RayCounters, TraceOptions, TraversalStats};
+use crate::bvh::accel::{Accelerator, Hit, TraceOptions};
+use crate::bvh::counters::{NodeId, RayCounters, TraversalStats};
 use crate::geometry::{Ray, TriangleHit};
 use std::collections::HashMap;
-
-/// A node of the walk. In the binary layout every node, leaves included, is a `Node` (its index in
-/// the node array); in the 4-wide layout a `Node` is a wide node and a leaf lives in a slot of its
-/// parent (`Leaf`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum NodeId {
-    Node(u32),
-    Leaf { node: u32, slot: u8 },
-}
-
-impl std::fmt::Display for NodeId {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            NodeId::Node(n) => write!(f, "node {n}"),
-            NodeId::Leaf { node, slot } => write!(f, "leaf {node}.{slot}"),
-        }
-    }
-}
 
 /// Which tree a step is in: the one BVH, or for two levels the top level or the mesh BVH of a
 /// placement.

@@ -11,8 +11,9 @@
 
 use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;
-use super::trace::NodeId;
-use super::{Accelerator, Hit, TraceOptions, TraversalStats};
+use crate::bvh::accel::{Accelerator, Hit, TraceOptions};
+use crate::bvh::counters::NodeId;
+use crate::bvh::counters::TraversalStats;
 use crate::geometry::slab::{widen, OneRay};
 use crate::geometry::{Ray, TriangleHit, TriangleIntersector};
 use std::ops::Range;
@@ -393,10 +394,10 @@ impl Accelerator for Bvh {
     }
 
     fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
-        crate::bvh::packet::closest_hits_packet(self, rays, hits, opts)
+        crate::bvh::packet::walk::closest_hits_packet(self, rays, hits, opts)
     }
 
     fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
-        crate::bvh::packet::any_hits_packet(self, rays, occluded, opts)
+        crate::bvh::packet::walk::any_hits_packet(self, rays, occluded, opts)
     }
 }

@@ -1,7 +1,7 @@
 //! A layout-independent view of a built hierarchy: what the statistics and the box overlay need,
 //! the same for the binary BVH and the wide one.
 
-use super::{BuildParams, BuildReport};
+use crate::bvh::params::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

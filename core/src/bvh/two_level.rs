@@ -12,11 +12,15 @@
 //! The top level is always a binary tree (a scene has few instances next to its triangles); its
 //! strategy and leaf size are chosen separately from the bottom level's, which may be wide.
 
-use super::builders::{build_over_boxes, build_work};
+use super::builders::build_over_boxes;
 use super::node::{walk_nodes, BvhNode};
 use super::traverse::{walk, TopLevelWalk};
 use super::tree::{NodeKind, TreeNode, TreeView};
-use super::{Accelerator, AnyBvh, BuildParams, BuildReport, Hit, TraversalStats};
+use crate::bvh::accel::{Accelerator, Hit};
+use crate::bvh::any::AnyBvh;
+use crate::bvh::builders::common::build_work;
+use crate::bvh::counters::TraversalStats;
+use crate::bvh::params::{BuildParams, BuildReport};
 use crate::geometry::{Aabb, Ray, TriangleIntersector};
 use crate::mesh::Mesh;
 use crate::work::{Cancelled, WorkControl};
@@ -244,7 +248,10 @@ pub fn top_leaf_sizes(top: &TopLevel) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{LinearScan, NoStats, RayCounters, Strategy, TraceOptions};
+    use crate::bvh::accel::TraceOptions;
+    use crate::bvh::counters::{NoStats, RayCounters};
+    use crate::bvh::linear::LinearScan;
+    use crate::bvh::params::Strategy;
     use crate::mesh::generate::torus;
 
     /// A torus placed four times (one of them rotated and scaled), and the same scene flattened.

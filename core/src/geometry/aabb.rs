@@ -3,7 +3,7 @@
 //! SAH's bins) are one instruction each; nodes store their boxes as plain floats (`BvhNode`,
 //! `WideNode`) and hand them to the slab tests of `slab.rs`.
 
-use super::Ray;
+use crate::geometry::ray::Ray;
 use glam::{Vec3, Vec3A};
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -33,7 +33,8 @@
 //! place farther: the same point, the other triangle (`core/tests/watertight_traversal.rs`). Both widenings stay off the per-node dependency chain: a widening
 //! of each exit there cost a fifth of the wide traversal's speed.
 
-use super::{Aabb, Ray};
+use crate::geometry::aabb::Aabb;
+use crate::geometry::ray::Ray;
 use glam::Vec3;
 use wide::f32x4;
 

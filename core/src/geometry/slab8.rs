@@ -6,7 +6,7 @@
 //! an FMA would round `(plane − origin)·inv` once instead of twice and break that equality.
 
 use super::slab::{Boxes, RayX4, Simd4, SlabKernel};
-use super::Ray;
+use crate::geometry::ray::Ray;
 
 /// Eight boxes: an 8-wide node's children.
 pub type Boxes8 = Boxes<8>;
@@ -35,7 +35,8 @@ pub use avx2::{Avx2, RayX8};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::{Boxes8, Ray, SlabKernel};
+    use super::{Boxes8, Ray};
+    use crate::geometry::slab::SlabKernel;
     use std::arch::x86_64::*;
 
     /// Proof that this CPU has AVX2 and FMA, and the bit instructions every such CPU has (POPCNT,

@@ -3,7 +3,8 @@
 //! (`RayInterval`, the packet's frustum test).
 
 use super::slab::{max_keep, min_keep, widen, widen4, Boxes4, SLACK};
-use super::{Aabb, Ray};
+use crate::geometry::aabb::Aabb;
+use crate::geometry::ray::Ray;
 use wide::f32x4;
 
 /// Four rays of a packet in SIMD form (lane k = ray k), for one slab test of a box against all

@@ -7,11 +7,13 @@
 //! surface at its far end.
 
 #[cfg(target_arch = "x86_64")]
-use super::avx512::{packet::WatertightRay16, Avx512, Hits16};
+use super::avx512::packet::WatertightRay16;
 pub use super::shear::{Hits4, WatertightRay};
-use super::Ray;
 #[cfg(target_arch = "x86_64")]
 use super::{slab8::Avx2, triangle8::Hits8};
+use crate::geometry::avx512::lanes::Avx512;
+use crate::geometry::avx512::leaf::Hits16;
+use crate::geometry::ray::Ray;
 use glam::{DVec3, Vec3};
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::__m512;

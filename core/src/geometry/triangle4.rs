@@ -7,7 +7,7 @@
 //! and turned into lanes here: nine loads of four lanes.
 
 use super::shear::{Hits4, WatertightRay};
-use super::Ray;
+use crate::geometry::ray::Ray;
 use glam::Vec3;
 use wide::f32x4;
 

@@ -10,7 +10,7 @@
 
 use super::shear::WatertightRay;
 use super::slab8::Avx2;
-use super::Ray;
+use crate::geometry::ray::Ray;
 use std::arch::x86_64::*;
 
 /// The hits of one pass: lane k (triangle k of the group) hit when bit k of `mask` is set, with

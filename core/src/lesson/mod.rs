@@ -14,7 +14,7 @@ mod text;
 mod write;
 
 #[cfg(test)]
-mod tests;
+mod lesson_tests;
 
 pub use check::{check, step_camera, Problem};
 pub use command::{explain_words, folded, render_words, shown};

@@ -3,9 +3,11 @@
 //! triangles with the checks the OBJ reader makes, fan triangulation, and the bound on what a
 //! header's count may reserve.
 
-use super::{LoadReport, Mesh, MeshError, MeshGroup, MAX_COORDINATE};
 use crate::files::limits;
 use crate::geometry::triangle::double_area;
+use crate::mesh::error::{MeshError, MAX_COORDINATE};
+use crate::mesh::mesh::{Mesh, MeshGroup};
+use crate::mesh::obj::LoadReport;
 use glam::Vec3;
 use std::path::Path;
 

@@ -6,7 +6,9 @@
 //! bounds what it allocates by the file's size, whatever its header claims.
 
 use super::assemble::bad;
-use super::{load_obj, read_user_file, LoadReport, Mesh, MeshError};
+use crate::mesh::error::MeshError;
+use crate::mesh::mesh::Mesh;
+use crate::mesh::obj::{load_obj, read_user_file, LoadReport};
 use std::path::Path;
 use std::time::Instant;
 

@@ -3,7 +3,9 @@
 //! each format has; malformed files give one message naming the file and the element.
 
 use super::*;
-use crate::mesh::{generate, write_obj, MeshError};
+use crate::mesh::error::MeshError;
+use crate::mesh::generate;
+use crate::mesh::obj::write_obj;
 use glam::Vec3;
 use std::path::PathBuf;
 

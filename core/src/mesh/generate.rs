@@ -1,6 +1,6 @@
 //! Meshes made by code: the app's built-in scene and the small assets in `assets/`.
 
-use super::{Mesh, MeshGroup};
+use crate::mesh::mesh::{Mesh, MeshGroup};
 use glam::{Vec2, Vec3};
 use std::f32::consts::TAU;
 

@@ -14,8 +14,10 @@
 
 use super::assemble::{bad, finish};
 use super::gltf_access::Access;
-use super::{read_user_file, LoadReport, Mesh, MeshError};
 use crate::files::limits;
+use crate::mesh::error::MeshError;
+use crate::mesh::mesh::Mesh;
+use crate::mesh::obj::{read_user_file, LoadReport};
 use glam::{Affine3A, Mat4};
 use std::collections::HashMap;
 use std::path::Path;

@@ -8,8 +8,8 @@
 use super::error::{MeshError, MAX_COORDINATE};
 use super::obj_lines::{diagnose, first_bad_face, first_bad_line, line_at, statements, Corner};
 use super::obj_parallel::{self, extend_with};
-use super::{Mesh, MeshGroup};
 use crate::geometry::triangle::double_area;
+use crate::mesh::mesh::{Mesh, MeshGroup};
 use crate::parallel::region;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;

@@ -317,4 +317,4 @@ fn export(all: Stitched) -> Vec<tobj::Model> {
 }
 
 #[cfg(test)]
-mod tests;
+mod obj_parallel_tests;

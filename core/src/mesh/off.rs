@@ -6,8 +6,10 @@
 //! A `4OFF` vertex is homogeneous (x y z w): the point is (x/w, y/w, z/w).
 
 use super::assemble::{bad, capacity, coordinate, fan, finish};
-use super::{LoadReport, Mesh, MeshError};
 use crate::files::limits;
+use crate::mesh::error::MeshError;
+use crate::mesh::mesh::Mesh;
+use crate::mesh::obj::LoadReport;
 use glam::Vec3;
 use std::path::Path;
 

@@ -7,8 +7,10 @@
 //! faces', then the strips', element by element as the header lists them.
 
 use super::assemble::{bad, capacity, fan, finish, point};
-use super::{LoadReport, Mesh, MeshError};
 use crate::files::limits;
+use crate::mesh::error::MeshError;
+use crate::mesh::mesh::Mesh;
+use crate::mesh::obj::LoadReport;
 use glam::Vec3;
 use std::path::Path;
 

@@ -6,8 +6,10 @@
 //! apart: the mesh has three vertices a triangle, the file's triangles in its order.
 
 use super::assemble::{bad, capacity, coordinate, finish};
-use super::{LoadReport, Mesh, MeshError};
 use crate::files::limits;
+use crate::mesh::error::MeshError;
+use crate::mesh::mesh::Mesh;
+use crate::mesh::obj::LoadReport;
 use glam::Vec3;
 use std::path::Path;
 

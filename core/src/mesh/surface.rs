@@ -3,8 +3,8 @@
 //! ids of its placed meshes, through each placement's transform, so two levels shade without a
 //! flattened copy of the scene.
 
-use super::Mesh;
 use crate::geometry::{Ray, TriangleHit};
+use crate::mesh::mesh::Mesh;
 use glam::Vec3;
 
 pub trait Surface: Sync {

@@ -9,16 +9,17 @@
 //! the ray of the pixel under it travelled to its hit (the depth test of a rasteriser, against
 //! the ray-cast frame).
 
-mod raster;
 #[cfg(test)]
-mod tests;
+mod boxes_tests;
+mod raster;
 
-pub use raster::draw_segments;
+pub use raster::{draw_segments, Segment};
 
-use super::{Camera, Frame};
 use crate::bvh::two_level::placed_corners;
 use crate::bvh::{SceneBvh, TreeStats, TreeView};
 use crate::geometry::Aabb;
+use crate::render::camera::Camera;
+use crate::render::frame::Frame;
 use glam::{Vec2, Vec3};
 
 /// Corner pairs of the 12 box edges; corner k has x from bit 0, y from bit 1, z from bit 2
@@ -211,15 +212,6 @@ fn srgb_u8(l: f32) -> u8 {
 
 /// The colour of top-level boxes.
 pub const TOP_RGB: [u8; 3] = [255, 255, 255];
-
-/// A line to draw over the image, in its units.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Segment {
-    pub a: Vec2,
-    pub b: Vec2,
-    pub rgb: [u8; 3],
-    pub width: f32,
-}
 
 /// Screen length of the pieces an edge is cut into for the depth test.
 const PIECE: f32 = 3.0;

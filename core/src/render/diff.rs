@@ -2,8 +2,10 @@
 //! camera, shown through a diverging colour map centred on zero (blue where B does less work than
 //! A, red where it does more, white where they agree) on a range symmetric about zero.
 
-use super::{ColorMap, Frame, Legend, View};
 use crate::bvh::SahCost;
+use crate::render::colormap::ColorMap;
+use crate::render::frame::Frame;
+use crate::render::views::{Legend, View};
 use image::RgbImage;
 
 /// B − A of `view`'s metric at every pixel, row by row; `None` unless both frames are complete,
@@ -105,7 +107,8 @@ mod tests {
     use super::*;
     use crate::bvh::{AnyBvh, BuildParams, Strategy};
     use crate::mesh::generate;
-    use crate::render::{render, Camera, RenderSettings, UpAxis};
+    use crate::render::camera::{Camera, UpAxis};
+    use crate::render::raycast::{render, RenderSettings};
 
     fn frame(strategy: Strategy) -> Frame {
         let mesh = generate::torus_knot(2, 3, 0.3, 96, 8);

@@ -131,7 +131,8 @@ fn an_untraced_frame_has_no_samples_to_show() {
 #[test]
 fn a_frame_from_hits_and_counts_is_the_rendered_frame() {
     use crate::bvh::{Accelerator, BuildParams, Bvh, TraceOptions};
-    use crate::render::{render, Camera, RenderSettings};
+    use crate::render::camera::Camera;
+    use crate::render::raycast::{render, RenderSettings};
     let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 64, 8);
     let bvh = Bvh::build(&mesh, &BuildParams::default());
     let camera = Camera::framing_from(&mesh.bounds(), 29, 17, Vec3::new(0.3, 0.5, 1.0), 45.0);

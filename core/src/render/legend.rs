@@ -1,7 +1,7 @@
 //! Drawing a heatmap's legend into an image (for PNG export): a colour bar with its end values and
 //! the frame's min / mean / max, in the 8×8 bitmap font of the `font8x8` crate.
 
-use super::Legend;
+use crate::render::views::Legend;
 use font8x8::UnicodeFonts;
 use image::{Rgb, RgbImage};
 use rayon::prelude::*;

@@ -5,8 +5,11 @@
 //! app's exports and the command line's files are the same bytes.
 
 use super::diff::{difference, difference_image, DiffRange};
-use super::{draw_legend, grid_values, metric_stats, view_image, ColorMap, Frame, HeatRange, Legend, View};
 use crate::bvh::SahCost;
+use crate::render::colormap::ColorMap;
+use crate::render::frame::Frame;
+use crate::render::legend::draw_legend;
+use crate::render::views::{grid_values, metric_stats, view_image, HeatRange, Legend, View};
 use image::RgbImage;
 
 /// How the pair is shown.

@@ -1,7 +1,7 @@
 //! A frame's per-ray work summed up (`RaySummary`): means over all its rays and over those that
 //! entered the tree, on the tree's own root box or on one yardstick for a comparison.
 
-use super::Frame;
+use crate::render::frame::Frame;
 use rayon::prelude::*;
 
 /// Per-ray work over the traced rays of a frame: means over all rays (hit and missed), and over

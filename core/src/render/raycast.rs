@@ -8,10 +8,12 @@
 //! hover read-out) every ray is traced alone.
 
 use super::secondary::SecondaryRays;
-use super::{Camera, Frame, FramePool, PixelSample};
 use crate::bvh::packet::{packet_position, PACKET, PACKET_SIDE};
 use crate::bvh::{Accelerator, NoStats, RayCounters, TraceOptions, TraversalStats};
 use crate::mesh::Surface;
+use crate::render::camera::Camera;
+use crate::render::frame::{Frame, FramePool};
+use crate::render::sample::PixelSample;
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -405,7 +407,9 @@ mod tests {
     /// the heatmap's legend are the same on one thread and on three, counted and in packets.
     #[test]
     fn a_frame_is_the_same_on_one_thread_and_on_three() {
-        use crate::render::{draw_legend, view_image, ColorMap, HeatRange, View};
+        use crate::render::colormap::ColorMap;
+        use crate::render::legend::draw_legend;
+        use crate::render::views::{view_image, HeatRange, View};
         let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 128, 12);
         // Wider than a piece, with partial pieces and bands at the right and bottom edges.
         let cam = Camera::framing_from(&mesh.bounds(), 301, 45, Vec3::new(0.3, 0.5, 1.0), 45.0);

@@ -9,10 +9,10 @@
 //! around an orthonormal basis built from the normal alone (Duff et al., "Building an Orthonormal
 //! Basis, Revisited", JCGT 2017).
 
-use super::Camera;
 use crate::bvh::{Accelerator, RayCounters, TraceOptions, TraversalStats};
 use crate::geometry::{Aabb, Ray};
 use crate::random::Rng;
+use crate::render::camera::Camera;
 use glam::Vec3;
 
 /// Which rays a frame's heatmap is of.

@@ -6,7 +6,9 @@ use super::*;
 use crate::bvh::{AnyBvh, BuildParams, Layout, LinearScan, NoStats, Strategy, TreeNode, TreeView};
 use crate::geometry::TriangleTest;
 use crate::mesh::{generate, Mesh};
-use crate::render::{render, view_image, ColorMap, HeatRange, RenderSettings, View};
+use crate::render::colormap::ColorMap;
+use crate::render::raycast::{render, RenderSettings};
+use crate::render::views::{view_image, HeatRange, View};
 
 fn knot() -> Mesh {
     generate::torus_knot(2, 3, 0.25, 96, 12)

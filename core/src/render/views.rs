@@ -3,8 +3,9 @@
 
 use super::exact_stats::exact_stats;
 use super::warp::{WarpSize, WarpView, WarpWork};
-use super::{ColorMap, Frame};
 use crate::bvh::{RayCounters, SahCost};
+use crate::render::colormap::ColorMap;
+use crate::render::frame::Frame;
 use image::RgbImage;
 use rayon::prelude::*;
 
@@ -337,7 +338,8 @@ fn grid_image(frame: &Frame, pixel: impl Fn(&super::PixelSample, RayCounters) ->
 mod histogram_tests {
     use super::*;
     use crate::bvh::{AnyBvh, BuildParams};
-    use crate::render::{render, Camera, RenderSettings, UpAxis};
+    use crate::render::camera::{Camera, UpAxis};
+    use crate::render::raycast::{render, RenderSettings};
 
     /// Every traced pixel is counted once, in the bin its value falls in.
     #[test]
@@ -365,7 +367,8 @@ mod histogram_tests {
 mod tests {
     use super::*;
     use crate::bvh::{AnyBvh, BuildParams};
-    use crate::render::{render, render_passes, Camera, RenderSettings};
+    use crate::render::camera::Camera;
+    use crate::render::raycast::{render, render_passes, RenderSettings};
     use crate::work::WorkControl;
 
     #[test]
@@ -406,7 +409,8 @@ mod tests {
 mod warp_tests {
     use super::*;
     use crate::bvh::{AnyBvh, BuildParams};
-    use crate::render::{render, render_passes, Camera, RenderSettings};
+    use crate::render::camera::Camera;
+    use crate::render::raycast::{render, render_passes, RenderSettings};
     use crate::work::WorkControl;
 
     /// The warp views show each pixel's group: its cost (most steps) or efficiency (mean/max), the

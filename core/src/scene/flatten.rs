@@ -2,9 +2,9 @@
 //! the scene flattened into one mesh for the single-level BVH: every placement applied (positions
 //! by the transform, normals by its inverse transpose).
 
-use super::{SceneDesc, SceneError};
 use crate::geometry::Aabb;
 use crate::mesh::{load_mesh, LoadReport, Mesh, MeshGroup};
+use crate::scene::desc::{SceneDesc, SceneError};
 use glam::Affine3A;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

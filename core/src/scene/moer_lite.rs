@@ -6,9 +6,9 @@
 //! so its camera carries over unchanged. Analytic shapes are not tessellated yet: they are named
 //! in a warning and the rest of the scene loads.
 
-use super::{resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
 use crate::json::{join, kind};
 use crate::render::Camera;
+use crate::scene::desc::{resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
 use glam::Vec3;
 use std::path::Path;
 

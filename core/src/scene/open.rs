@@ -7,11 +7,13 @@
 //! not per placed triangle; one level flattens it, on demand, once, and only within a budget
 //! (`MAX_FLAT_TRIANGLES`) that is checked before a byte is allocated.
 
-use super::{describe, flatten, load_instances, SceneDesc, SceneError, SceneInstances};
+use super::flatten;
 use crate::bvh::{BuildParams, SceneBuild, SceneBvh};
 use crate::geometry::Aabb;
 use crate::mesh::{generate, load_mesh, LoadReport, Mesh};
 use crate::render::Camera;
+use crate::scene::desc::{describe, SceneDesc, SceneError};
+use crate::scene::flatten::{load_instances, SceneInstances};
 use crate::work::{Cancelled, WorkControl};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};

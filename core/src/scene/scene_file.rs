@@ -2,10 +2,10 @@
 //! settings to start with. The README documents the format; every field is checked and an error
 //! names it (`meshes[1].transform.rotate.degrees: expected a number, found a string`).
 
-use super::{fields, resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
 use crate::bvh::BuildParams;
 use crate::json::{join, kind};
 use crate::render::Camera;
+use crate::scene::desc::{fields, resolve, trs, Fields, SceneDesc, SceneError, SceneMesh};
 use glam::{Affine3A, Mat4, Vec3};
 use std::path::Path;
 

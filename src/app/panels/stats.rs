@@ -365,7 +365,7 @@ fn gpu_lines(app: &BvhscopeApp, ui: &mut egui::Ui) {
     }
     egui::Grid::new("gpu-stats").num_columns(2).striped(true).show(ui, |ui| {
         if let Some(s) = traced {
-            let nodes = s.gpu.as_ref().map_or("", |g| g.nodes.name());
+            let nodes = s.gpu.as_ref().map_or("", |g| g.nodes.label());
             ui.label("Traced on").on_hover_text("The frame on screen was traced on this GPU, in one pass at full resolution; its counts are those of bvhscope render --device gpu");
             ui.label(format!("GPU, {nodes} nodes"))
                 .on_hover_text(s.gpu.as_ref().map_or(String::new(), |g| g.gpu.name()));

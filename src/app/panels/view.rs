@@ -3,7 +3,7 @@
 
 use crate::app::jobs::Probe;
 use crate::app::state::{Action, Actions, BoxLevel, BvhscopeApp, Film, Settings};
-use crate::gpu_path::{Device, GPU_NODES};
+use crate::gpu_path::{Device, GpuNodes};
 use crate::render::secondary::MAX_SAMPLES;
 use crate::render::warp::WarpSize;
 use crate::render::{RayKind, UpAxis, View};
@@ -324,7 +324,7 @@ fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
     ui.label("Trace on").on_hover_text(
         format!("Where the frames are traced: the CPU, or the GPU (wgpu compute shaders) at full resolution in one pass, with the same per-pixel counts as the CPU's binary layout (bvhscope render --device gpu). With the GPU, the tree is built in the binary layout and {} are built on the GPU too.", crate::gpu_path::gpu_built()),
     );
-    ui.radio_value(&mut s.device, Device::Cpu, "CPU");
+    ui.radio_value(&mut s.device, Device::Cpu, Device::Cpu.label());
     let why = match probe {
         Probe::Looking => "Looking for a GPU adapter…".to_string(),
         Probe::Missing(why) => format!("No GPU: {why}"),
@@ -333,7 +333,6 @@ fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
         }
         Probe::Found(g) => g.name(),
     };
-    // The GPU chosen but not tracing now (two levels, the replay): the button says so.
     // The GPU chosen but not tracing now (two levels, the replay, secondary rays): why, on hover
     // here and on the greyed GPU nodes row. Its label stays "GPU": a longer one wrapped this row
     // and moved every row below it.
@@ -343,7 +342,7 @@ fn trace_on(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
         _ => why,
     };
     // One widget, so that the heading's row wraps it whole where the tile is narrow.
-    let gpu = egui::RadioButton::new(s.device == Device::Gpu, "GPU");
+    let gpu = egui::RadioButton::new(s.device == Device::Gpu, Device::Gpu.label());
     if ui.add_enabled(matches!(probe, Probe::Found(_)), gpu).on_hover_text(&why).on_disabled_hover_text(&why).clicked()
     {
         s.device = Device::Gpu;
@@ -364,10 +363,10 @@ fn gpu_choices(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
             if let Some(why) = &why {
                 label.on_disabled_hover_text(why);
             }
-            for row in &GPU_NODES {
-                let r = ui.radio_value(&mut s.gpu_nodes, row.nodes, row.label).on_hover_text(row.help);
+            for nodes in GpuNodes::ALL {
+                let r = ui.radio_value(&mut s.gpu_nodes, nodes, nodes.label()).on_hover_text(nodes.help());
                 if let Some(why) = &why {
-                    r.on_disabled_hover_text(format!("{}. {why}", row.help));
+                    r.on_disabled_hover_text(format!("{}. {why}", nodes.help()));
                 }
             }
         });

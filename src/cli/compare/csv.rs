@@ -80,7 +80,7 @@ pub fn rows_csv_with_gpu(rows: &[CompareRow], gpu: &[GpuRow]) -> String {
     for g in gpu {
         let more = vec![
             "gpu".into(),
-            g.gpu_nodes.name().to_lowercase(),
+            g.gpu_nodes.name().to_string(),
             g.counted.to_string(),
             format!("{:.3}", g.incoherent_ms),
             format!("{:.3}", g.incoherent_mrays_per_s),

@@ -7,9 +7,11 @@
 use super::rows::CompareRow;
 use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SceneBvh, Strategy, TraceOptions, TreeStats, TreeView};
 use crate::cli::args::BuildArgs;
-use crate::cli::device::{self, GpuTree};
-use crate::cli::{progress, CliError};
+use crate::cli::device;
+use crate::cli::error::CliError;
+use crate::cli::progress;
 use crate::gpu_path::GpuNodes;
+use crate::gpu_path::GpuTree;
 use crate::mesh::Mesh;
 use crate::render::warp::{WarpSize, WarpView, WarpWork};
 use crate::render::Camera;
@@ -73,7 +75,7 @@ pub fn gpu_rows(
         for &format in nodes {
             let (tree, _) = GpuTree::upload(gpu, &scene_bvh, format)?;
             let cw_nodes = tree.own_nodes();
-            let label = format!("timing {} ({} nodes) on the GPU", strategy.label(), format.name());
+            let label = format!("timing {} ({} nodes) on the GPU", strategy.label(), format.label());
             let measured = progress::with_spinner(&label, || -> Result<_, CliError> {
                 let mut out = Vec::new();
                 for counted in [true, false] {
@@ -105,7 +107,7 @@ pub fn gpu_rows(
                 let kind = if counted { "counted" } else { "plain" };
                 rows.push(GpuRow {
                     row: CompareRow {
-                        name: format!("{} (GPU {}, {kind})", strategy.label(), format.name()),
+                        name: format!("{} (GPU {}, {kind})", strategy.label(), format.label()),
                         build_ms: Some(build_ms),
                         nodes: cw_nodes.unwrap_or(stats.nodes),
                         max_depth: stats.max_depth,

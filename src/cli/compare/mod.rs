@@ -23,19 +23,38 @@ pub use csv::{rows_csv, rows_csv_with_gpu};
 pub use rows::{compare_rows, CompareRow};
 
 use crate::cli::args::{BuildArgs, DeviceArgs, ViewArgs};
-use crate::cli::{load_mesh, CliError};
+use crate::cli::error::CliError;
+use crate::cli::load::load_mesh;
 use crate::gpu_path::GpuNodes;
-use clap::{Args, ValueEnum};
+use crate::options::Named;
+use clap::Args;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::Duration;
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CompareFormat {
     Markdown,
     Csv,
     Json,
 }
+
+const COMPARE_FORMATS: [Named<CompareFormat>; 3] = [
+    Named {
+        value: CompareFormat::Markdown,
+        name: "markdown",
+        label: "Markdown",
+        help: "a Markdown table, for a lab report",
+    },
+    Named {
+        value: CompareFormat::Csv,
+        name: "csv",
+        label: "CSV",
+        help: "one row per strategy and figure, for a spreadsheet",
+    },
+    Named { value: CompareFormat::Json, name: "json", label: "JSON", help: "one JSON document, for scripts" },
+];
+bvhscope_core::choice!(CompareFormat, COMPARE_FORMATS, 3);
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
@@ -53,7 +72,7 @@ pub struct CompareArgs {
     /// camera's always first), and how well the SAH cost and EPO rank the trees for each.
     #[command(flatten)]
     pub rays: crate::cli::rays::RayArgs,
-    #[arg(long, value_enum, default_value = "markdown")]
+    #[arg(long, value_parser = crate::cli::args::choice::<CompareFormat>(), default_value = "markdown")]
     pub format: CompareFormat,
     /// Frames timed per strategy, and builds (the medians are reported; builds stop early once
     /// they have taken a second).

@@ -2,7 +2,7 @@
 //! can be cancelled while it runs.
 
 use super::*;
-use crate::bvh::Strategy;
+use crate::bvh::params::Strategy;
 use crate::mesh::generate::torus;
 
 #[test]

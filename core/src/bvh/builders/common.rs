@@ -2,9 +2,9 @@
 //! comparison, the count of nodes where the driver overrode a strategy, and the depth past which
 //! every builder splits by equal count.
 
-use super::split::{BuildPrim, NodeInfo};
+use crate::bvh::builders::split::splitter::{BuildPrim, NodeInfo};
 use crate::bvh::node::TRAVERSAL_STACK_SIZE;
-use crate::bvh::BuildParams;
+use crate::bvh::params::BuildParams;
 use crate::geometry::Aabb;
 use crate::work::{Cancelled, WorkControl};
 use rayon::prelude::*;

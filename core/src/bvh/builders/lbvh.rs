@@ -12,10 +12,10 @@
 
 use super::common::Progress;
 use super::morton::{grid, in_triangle_order, morton, sort, split_of, tie_split, Keyed};
-use super::split::BuildPrim;
 use super::subtree::Subtree;
+use crate::bvh::builders::split::splitter::BuildPrim;
 use crate::bvh::node::{Bvh, BvhNode};
-use crate::bvh::{BuildParams, BuildReport};
+use crate::bvh::params::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use crate::parallel::region;
 use crate::work::Cancelled;

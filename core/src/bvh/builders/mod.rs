@@ -14,8 +14,10 @@ pub mod split;
 pub mod strategy;
 mod subtree;
 
+use crate::bvh::builders::split::equal_count::EqualCount;
+use crate::bvh::builders::split::splitter::{BuildPrim, NodeInfo, Proposal, Splitter};
 use crate::bvh::node::{Bvh, BvhNode};
-use crate::bvh::{BuildParams, BuildReport};
+use crate::bvh::params::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
 use crate::parallel::{region, region_if, PARTITION_MIN};
@@ -23,7 +25,6 @@ use crate::work::{Cancelled, WorkControl};
 pub use common::{build_work, HEURISTIC_DEPTH_LIMIT};
 use common::{leaf_is_cheaper, node_info, progress_levels, Overrides, Progress, PARALLEL_MIN_PRIMS};
 use rayon::prelude::*;
-use split::{BuildPrim, EqualCount, NodeInfo, Proposal, Splitter};
 use std::time::Instant;
 use strategy::Builder;
 use subtree::Subtree;
@@ -337,4 +338,4 @@ fn build_sequential(
 }
 
 #[cfg(test)]
-mod tests;
+mod builders_tests;

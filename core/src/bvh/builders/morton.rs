@@ -5,7 +5,7 @@
 //! differing bit flips (an axis-aligned plane of the grid). The LBVH is built from the sort alone,
 //! PLOC starts from it, and the build replay draws the curve (`MortonOrder`).
 
-use super::split::BuildPrim;
+use crate::bvh::builders::split::splitter::BuildPrim;
 use crate::bvh::node::Bvh;
 use crate::geometry::Aabb;
 use glam::Vec3A;
@@ -196,8 +196,10 @@ impl MortonOrder {
 #[cfg(test)]
 mod morton_order_tests {
     use super::MortonOrder;
-    use crate::bvh::Hierarchy;
-    use crate::bvh::{BuildParams, Bvh, Layout, Strategy};
+    use crate::bvh::hierarchy::Hierarchy;
+    use crate::bvh::node::Bvh;
+    use crate::bvh::params::Strategy;
+    use crate::bvh::params::{BuildParams, Layout};
     use crate::mesh::generate;
 
     /// The leaf order of an LBVH tree is its Morton order, and every split of the tree (not a

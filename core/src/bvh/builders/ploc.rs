@@ -14,10 +14,10 @@
 //! when they meet. The layout then places big subtrees in parallel: each merge knows its size.
 
 use super::common::Progress;
-use super::split::BuildPrim;
 use super::subtree::Subtree;
+use crate::bvh::builders::split::splitter::BuildPrim;
 use crate::bvh::node::BvhNode;
-use crate::bvh::BuildParams;
+use crate::bvh::params::BuildParams;
 use crate::geometry::Aabb;
 use crate::parallel::region;
 use crate::work::Cancelled;
@@ -282,18 +282,6 @@ struct Place<'a> {
     progress: &'a Progress<'a>,
 }
 
-/// The widest axis of a box: an interior node's `axis` (clusters are not split on a plane).
-fn widest(b: &Aabb) -> u8 {
-    let e = b.max - b.min;
-    if e.x >= e.y && e.x >= e.z {
-        0
-    } else if e.y >= e.z {
-        1
-    } else {
-        2
-    }
-}
-
 impl Place<'_> {
     /// Lay out node `k` into `slot`, its other nodes into `rest` (the first of which has global
     /// index `rest_base`), its primitives into `order` (the first of which is leaf slot `first`).
@@ -317,7 +305,7 @@ impl Place<'_> {
             return self.sequential(k, slot, rest, rest_base, order, first, depth);
         }
         self.progress.check()?;
-        *slot = BvhNode::interior(c.bounds, rest_base, widest(&c.bounds));
+        *slot = BvhNode::interior(c.bounds, rest_base, c.bounds.widest_axis() as u8);
         self.progress.add(self.progress.split_units(c.count as usize, depth));
         let (l, r) = (&self.nodes[c.left as usize], &self.nodes[c.right as usize]);
         let (pair, rests) = rest.split_at_mut(2);
@@ -386,7 +374,7 @@ impl Place<'_> {
                 done += self.progress.split_units(c.count as usize, depth);
                 stack.push((c.right, left + 1, depth + 1));
                 stack.push((c.left, left, depth + 1));
-                BvhNode::interior(c.bounds, rest_base + left as u32 - 1, widest(&c.bounds))
+                BvhNode::interior(c.bounds, rest_base + left as u32 - 1, c.bounds.widest_axis() as u8)
             };
             if place == 0 {
                 *slot = node;
@@ -402,7 +390,7 @@ impl Place<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::Strategy;
+    use crate::bvh::params::Strategy;
 
     /// Every primitive in exactly one leaf of at most the leaf size, each box its subtree's union,
     /// and merging only ever joins neighbours in Morton order, so a row of boxes is paired in order.

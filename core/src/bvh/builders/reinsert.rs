@@ -18,7 +18,8 @@
 //! the root's area, which never changes.
 
 use crate::bvh::node::{Bvh, BvhNode};
-use crate::bvh::{BuildParams, TreeStats};
+use crate::bvh::params::BuildParams;
+use crate::bvh::stats::TreeStats;
 use crate::geometry::Aabb;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -389,7 +390,11 @@ fn collapse(t: &Tree, params: &BuildParams) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{Accelerator, BuildParams, Layout, LinearScan, NoStats, Strategy, TraceOptions};
+    use crate::bvh::accel::{Accelerator, TraceOptions};
+    use crate::bvh::counters::NoStats;
+    use crate::bvh::linear::LinearScan;
+    use crate::bvh::params::Strategy;
+    use crate::bvh::params::{BuildParams, Layout};
 
     /// Reinsertion lowers an LBVH tree's SAH cost (blocky Morton splits leave much to move),
     /// keeps every triangle once, keeps boxes tight, and every ray still finds the linear scan's hit.

@@ -18,12 +18,13 @@
 //! the curves the inspector draws are the ones the builder priced.
 
 use super::common::{leaf_is_cheaper, node_info, Overrides, Progress, HEURISTIC_DEPTH_LIMIT};
-use super::split::{
-    binned_planes, spatial_partition, spatial_planes, BuildPrim, EqualCount, NodeInfo, PlaneSink, Proposal,
-};
 use super::subtree::Subtree;
+use crate::bvh::builders::split::equal_count::EqualCount;
+use crate::bvh::builders::split::sah_binned::binned_planes;
+use crate::bvh::builders::split::spatial::{spatial_partition, spatial_planes};
+use crate::bvh::builders::split::splitter::{BuildPrim, NodeInfo, PlaneSink, Proposal};
 use crate::bvh::node::BvhNode;
-use crate::bvh::BuildParams;
+use crate::bvh::params::BuildParams;
 use crate::geometry::Aabb;
 use crate::parallel::region;
 use crate::work::Cancelled;

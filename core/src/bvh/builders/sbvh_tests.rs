@@ -1,6 +1,9 @@
 //! The SBVH's tests (`sbvh.rs`).
 
-use crate::bvh::{BuildParams, Bvh, Layout, Strategy, TreeStats};
+use crate::bvh::node::Bvh;
+use crate::bvh::params::Strategy;
+use crate::bvh::params::{BuildParams, Layout};
+use crate::bvh::stats::TreeStats;
 use crate::mesh::generate;
 
 fn sbvh(growth: u32) -> BuildParams {

@@ -4,32 +4,12 @@
 //! here, its row in `REGISTRY`, its names in `crate::options`, and its splitter's file
 //! (ARCHITECTURE.md, "Adding a strategy").
 
-use super::split::{EqualCount, Midpoint, SahBinned, SahSweep, Splitter};
-use crate::bvh::{BuildParams, Param};
-
-/// How a tree is built: top down by a splitter (midpoint, equal count, SAH binned or swept), or
-/// by a builder of its own (LBVH, PLOC, SBVH). Its row of `REGISTRY` says which.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-pub enum Strategy {
-    /// Middle of the centroid bounds on the widest axis.
-    Midpoint,
-    /// Median centroid on the widest axis: equally many triangles on each side.
-    EqualCount,
-    /// Surface area heuristic, evaluated at bin boundaries on all three axes.
-    #[default]
-    SahBinned,
-    /// Surface area heuristic, evaluated between every pair of neighbouring centroids.
-    SahSweep,
-    /// A builder of its own (`builders::lbvh`): the hierarchy of the
-    /// centroids' sorted Morton codes.
-    Lbvh,
-    /// A bottom-up builder of its own (`builders::ploc`): clusters merged with their nearest
-    /// neighbours in Morton order.
-    Ploc,
-    /// The binned SAH with spatial splits (`builders::sbvh`): triangles cut where that beats
-    /// sorting them to one side, so a triangle may be referenced by several leaves.
-    Sbvh,
-}
+use crate::bvh::builders::split::equal_count::EqualCount;
+use crate::bvh::builders::split::midpoint::Midpoint;
+use crate::bvh::builders::split::sah_binned::SahBinned;
+use crate::bvh::builders::split::sah_sweep::SahSweep;
+use crate::bvh::builders::split::splitter::Splitter;
+use crate::bvh::params::{BuildParams, Param, Strategy};
 
 /// How a strategy builds.
 #[derive(Clone, Copy)]

@@ -1,5 +1,11 @@
+use super::measure::*;
 use super::*;
-use crate::bvh::{BuildParams, BvhNode, Layout, Strategy};
+use crate::bvh::epo::sample::Estimator;
+use crate::bvh::hierarchy::Hierarchy;
+use crate::bvh::node::Bvh;
+use crate::bvh::node::BvhNode;
+use crate::bvh::params::Strategy;
+use crate::bvh::params::{BuildParams, Layout};
 use crate::geometry::Aabb;
 use crate::mesh::{generate, Mesh};
 use crate::random::Rng;

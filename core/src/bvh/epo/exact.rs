@@ -6,9 +6,16 @@
 //! has done `cap` units of work.
 
 use super::clip::{clipped_area, inside, meets_only_in_a_plane, overlaps, tri_box, triangle_area};
-use crate::bvh::{Bvh, Hierarchy};
+use crate::bvh::hierarchy::Hierarchy;
+use crate::bvh::node::Bvh;
 use crate::geometry::Aabb;
 use rayon::prelude::*;
+
+/// Whether a pass over `items` nodes, triangles or points gives 16 threads work: then it is
+/// marked a parallel region (issue 37's serial fraction), else it counts as serial.
+pub(super) fn wide(items: usize) -> bool {
+    items >= 1 << 12
+}
 
 /// Work units: a node visited or a triangle's box tested is one; a clip costs this many more.
 pub(super) const CLIP_WORK: u64 = 8;
@@ -37,7 +44,7 @@ fn running_areas(tris: &[[glam::Vec3; 3]]) -> Vec<f64> {
 impl<'a> Prepared<'a> {
     pub fn new(bvh: &'a Bvh, h: &'a Hierarchy) -> Prepared<'a> {
         // Passes over every triangle and node: parallel regions where they give 16 threads work.
-        let wide = super::wide(bvh.tris.len());
+        let wide = wide(bvh.tris.len());
         let prefix = crate::parallel::region_if(wide, || running_areas(&bvh.tris));
         let nodes = &bvh.nodes;
         let sound = crate::parallel::region_if(wide, || {

@@ -22,8 +22,7 @@
 //! Carlo theory, methods and examples", ch. 17).
 
 use super::clip::holds_point;
-use super::exact::Prepared;
-use super::wide;
+use super::exact::{wide, Prepared};
 use crate::random::Rng;
 use glam::{DVec3, Vec3A};
 use rayon::prelude::*;

@@ -1,11 +1,21 @@
 //! Tests of `packet.rs`: packets against single rays, and the frustum test against the slab test.
 
-use super::*;
-use crate::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, Strategy};
+use super::walk::*;
+use crate::bvh::accel::Accelerator;
+use crate::bvh::accel::PACKET;
+use crate::bvh::accel::{Hit, TraceOptions};
+use crate::bvh::any::AnyBvh;
+use crate::bvh::counters::NoStats;
+use crate::bvh::packet::lanes::Four;
+use crate::bvh::packet::state::Packet;
+use crate::bvh::params::Strategy;
+use crate::bvh::params::{BuildParams, Layout};
+use crate::geometry::{Aabb, Ray};
 use crate::mesh::generate::{builtin_scene, torus_knot};
 use crate::mesh::Mesh;
 use crate::render::Camera;
 use glam::Vec3;
+use std::mem::MaybeUninit;
 
 /// `rays` traced in packets of `size` against single rays: the same hit or miss at the same
 /// distance, and the same `t_max` left on each ray. Returns the hits.

@@ -3,7 +3,8 @@
 //! triangle test, and each ray's hit so far.
 
 use super::lanes::PacketLanes;
-use super::{Hit, PACKET};
+use crate::bvh::accel::Hit;
+use crate::bvh::accel::PACKET;
 use crate::geometry::slab_packet::RayInterval;
 use crate::geometry::{Ray, TriangleHit, TriangleIntersector};
 use std::mem::MaybeUninit;

@@ -3,8 +3,8 @@
 //! explicit stack, or for big trees its top levels one by one and the subtrees below on rayon. The
 //! node inspector walks the same rule to say which wide node a binary node is collapsed into.
 
-use super::WideNode;
 use crate::bvh::node::BvhNode;
+use crate::bvh::wide::node::WideNode;
 use rayon::prelude::*;
 
 /// How the collapse groups binary nodes into one wide node: the binary node at its top, the
@@ -68,7 +68,7 @@ pub fn wide_group_in(layout: crate::bvh::Layout, b: &[BvhNode], parent: &[u32], 
 /// The binary nodes a wide node over interior binary node `bin` takes as its children: its two
 /// children, then, while fewer than `W`, the interior one of largest surface area replaced by
 /// its own two.
-pub(super) fn wide_children<const W: usize>(b: &[BvhNode], bin: usize) -> ([usize; W], usize) {
+pub fn wide_children<const W: usize>(b: &[BvhNode], bin: usize) -> ([usize; W], usize) {
     let mut kids = [0usize; W];
     kids[0] = b[bin].index as usize;
     kids[1] = kids[0] + 1;
@@ -231,10 +231,12 @@ mod tests {
         assert_eq!(tops.len(), wide.nodes.len());
     }
 
-    use super::super::{WideBvh, WIDTH};
     use super::*;
+    use crate::bvh::node::Bvh;
+    use crate::bvh::params::BuildParams;
     use crate::bvh::tree::{NodeKind, TreeView};
-    use crate::bvh::{BuildParams, Bvh};
+    use crate::bvh::wide::node::WIDTH;
+    use crate::bvh::wide::wide_bvh::WideBvh;
     use crate::geometry::Aabb;
 
     /// The tree as (depth, bounds, kind) in walk order, which follows slots, not node indices.

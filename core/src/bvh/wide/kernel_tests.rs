@@ -6,8 +6,14 @@
 //! one (`geometry::triangle8`, Möller–Trumbore too), and the AVX-512 one in 256-bit, 512-bit and
 //! two passes.
 
-use crate::bvh::{Accelerator, AnyBvh, BuildParams, Hit, Layout, LinearScan, NoStats, Preset, RayCounters};
-use crate::bvh::{TraceOptions, TreeNode, TreeView};
+use crate::bvh::accel::TraceOptions;
+use crate::bvh::accel::{Accelerator, Hit};
+use crate::bvh::any::AnyBvh;
+use crate::bvh::counters::{NoStats, RayCounters};
+use crate::bvh::linear::LinearScan;
+use crate::bvh::params::{BuildParams, Layout};
+use crate::bvh::preset::Preset;
+use crate::bvh::tree::{TreeNode, TreeView};
 use crate::cpu::Simd;
 use crate::geometry::Ray;
 use crate::mesh::Mesh;

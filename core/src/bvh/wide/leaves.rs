@@ -5,7 +5,7 @@
 //! Everything else that reads a leaf's triangles (the one-at-a-time test, packets, checks) goes
 //! through `with_leaf`, which hands it the triangles in leaf order, as the other layouts store them.
 
-use super::WideBvh;
+use crate::bvh::wide::wide_bvh::WideBvh;
 use crate::geometry::leaf_triangle;
 use glam::Vec3;
 use rayon::prelude::*;

@@ -3,8 +3,8 @@
 //! wide tree has half the levels, so a packet pops, pushes and sorts half as often, and the
 //! frustum tests four children in one SIMD pass.
 
-use super::{ChildRef, WideBvh};
-use crate::bvh::packet::PacketTree;
+use crate::bvh::packet::walk::PacketTree;
+use crate::bvh::wide::wide_bvh::{ChildRef, WideBvh};
 use crate::geometry::Aabb;
 use crate::geometry::{slab::Boxes4, slab_packet::RayInterval};
 use glam::Vec3;

@@ -10,11 +10,13 @@
 //! into the cache: incoherent rays wait on memory, and by the time it is popped its node has
 //! arrived (BENCHMARKS.md, sixth round).
 
-use super::{ChildRef, WideBvh, WideNode};
+use crate::bvh::accel::{Accelerator, Hit, TraceOptions};
+use crate::bvh::counters::NodeId;
+use crate::bvh::counters::TraversalStats;
 use crate::bvh::stack::TraversalStack;
-use crate::bvh::trace::NodeId;
 use crate::bvh::traverse::{test_triangles, test_triangles_grouped, Groups4, LeafGroups};
-use crate::bvh::{Accelerator, Hit, TraceOptions, TraversalStats};
+use crate::bvh::wide::node::WideNode;
+use crate::bvh::wide::wide_bvh::{ChildRef, WideBvh};
 use crate::cpu::Simd;
 use crate::geometry::slab::{widen, Scalar, Simd4, SlabKernel};
 use crate::geometry::{Ray, TriangleIntersector};
@@ -308,11 +310,11 @@ impl Accelerator for WideBvh {
     }
 
     fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
-        crate::bvh::packet::closest_hits_packet(self, rays, hits, opts)
+        crate::bvh::packet::walk::closest_hits_packet(self, rays, hits, opts)
     }
 
     fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
-        crate::bvh::packet::any_hits_packet(self, rays, occluded, opts)
+        crate::bvh::packet::walk::any_hits_packet(self, rays, occluded, opts)
     }
 }
 
@@ -396,10 +398,10 @@ impl Accelerator for WideBvh<8> {
     }
 
     fn closest_hits(&self, rays: &mut [Ray], hits: &mut [Option<Hit>], opts: TraceOptions) {
-        crate::bvh::packet::closest_hits_packet(self, rays, hits, opts)
+        crate::bvh::packet::walk::closest_hits_packet(self, rays, hits, opts)
     }
 
     fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
-        crate::bvh::packet::any_hits_packet(self, rays, occluded, opts)
+        crate::bvh::packet::walk::any_hits_packet(self, rays, occluded, opts)
     }
 }

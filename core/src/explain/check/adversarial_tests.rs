@@ -1,7 +1,7 @@
 //! The checker against adversarial trees: correct trees deeper than any built one, tolerances
 //! that must not grow with the scene, gaps between the leaves of a cut triangle.
 
-use super::tests::*;
+use super::check_tests::*;
 use super::*;
 use crate::bvh::{Accelerator, BuildParams, Bvh};
 use crate::mesh::generate;

@@ -12,14 +12,14 @@
 //! checker is bounded: references are counted before any is followed (`max_references`), rays
 //! are traced in batches (`rays`), deep trees are walked without recursion.
 
+#[cfg(test)]
+mod adversarial_tests;
 mod bounds;
+#[cfg(test)]
+mod check_tests;
 mod cover;
 mod rays;
 mod structure;
-#[cfg(test)]
-mod tests;
-#[cfg(test)]
-mod tests_adversarial;
 
 pub use rays::{check_rays, wrong_rays, RaySet, Reference, WrongRay, WrongRays, LINEAR_REFERENCE_MAX, MAX_RAYS};
 

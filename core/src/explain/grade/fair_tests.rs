@@ -75,7 +75,7 @@ fn keeping(dump: &BvhDump, t: u32, lo: [f32; 3], hi: [f32; 3]) -> BvhDump {
 }
 
 fn setup<'a>(mesh: &'a Mesh, mesh_path: &'a Path) -> Setup<'a> {
-    super::tests::small_setup(mesh, mesh_path)
+    super::grade_tests::small_setup(mesh, mesh_path)
 }
 
 fn grade(setup: &Setup, dir: &Path, names: &[&str]) -> Vec<GradeRow> {
@@ -198,8 +198,8 @@ fn wrong_mesh_only_when_the_dump_is_of_another_mesh() {
 #[test]
 fn a_folder_of_notes_is_no_dump_and_a_class_folder_is_its_entries() {
     let d = tmp("folders");
-    let dump = super::tests::TINY_DUMP;
-    let write = |rel: &str, text: &str| super::tests::put(&d, rel, text);
+    let dump = super::grade_tests::TINY_DUMP;
+    let write = |rel: &str, text: &str| super::grade_tests::put(&d, rel, text);
     write("class/ana/bvh.txt", dump);
     write("class/ben/README.txt", "my tree is in the attic\n");
     write("class/cy.json", "{}");

@@ -21,9 +21,15 @@
 
 mod discover;
 mod evaluate;
+#[cfg(test)]
+mod fair_tests;
+#[cfg(test)]
+mod grade_tests;
 pub(crate) mod html;
 mod json;
 mod measure;
+#[cfg(test)]
+mod out_tests;
 mod page;
 mod rank;
 mod reference;
@@ -31,12 +37,6 @@ mod report;
 mod report_file;
 mod rubric;
 mod table;
-#[cfg(test)]
-mod tests;
-#[cfg(test)]
-mod tests_fair;
-#[cfg(test)]
-mod tests_out;
 
 pub use discover::{discover, Submission};
 pub use evaluate::evaluate;

@@ -3,7 +3,7 @@
 //! names of one file in a student's folder are one dump. (tests/cli_grade_out.rs: the same
 //! through the command line.)
 
-use super::tests::{put, tmp, TINY_DUMP};
+use super::grade_tests::{put, tmp, TINY_DUMP};
 use super::*;
 
 /// A report of `images` written into `root` and published.

@@ -399,4 +399,4 @@ pub fn inspect(bvh: &Bvh, h: &Hierarchy, node: u32) -> Option<Inspection> {
 pub mod text;
 
 #[cfg(test)]
-mod tests;
+mod inspect_tests;

@@ -8,9 +8,9 @@
 //! four-lane kernel's copy at the array's end is not needed. Up to eight triangles take 256-bit
 //! registers (AVX-512VL), more take 512-bit ones.
 
-use super::{Avx512, Lanes};
+use crate::geometry::avx512::lanes::{Avx512, Lanes};
+use crate::geometry::ray::Ray;
 use crate::geometry::shear::WatertightRay;
-use crate::geometry::Ray;
 use std::arch::x86_64::*;
 
 /// The hits of one pass: lane k (triangle k of the group) hit when bit k of `mask` is set, with
@@ -253,7 +253,7 @@ mod tests {
                 Watertight::intersect16(k, p, t0, t1, l, tri)
             }
         }
-        use crate::geometry::triangle::Hits4;
+        use crate::geometry::shear::Hits4;
         use wide::f32x4;
         Four::intersect_group16_coords(k, p, ray, coords, count, g)
     }

@@ -11,10 +11,10 @@
 //! call them in `unsafe`, the proof in hand.
 
 use super::leaf::{edge_test, Hits16};
-use super::Avx512;
+use crate::geometry::avx512::lanes::Avx512;
+use crate::geometry::ray::Ray;
 use crate::geometry::slab::SLACK;
 use crate::geometry::slab_packet::RayInterval;
-use crate::geometry::Ray;
 use glam::Vec3;
 use std::arch::x86_64::*;
 

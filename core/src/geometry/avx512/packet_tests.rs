@@ -2,10 +2,10 @@
 //! adversarial rays (box corners, axis-parallel directions with origins on box planes, both zeros).
 
 use super::*;
+use crate::geometry::aabb::Aabb;
 use crate::geometry::slab::{widen, OneRay};
 use crate::geometry::slab_packet::RayGroup;
 use crate::geometry::triangle::{TriangleIntersector, Watertight};
-use crate::geometry::Aabb;
 use proptest::prelude::*;
 
 // The kernels are compiled for AVX-512 (`#[target_feature]`): called through these wrappers.

@@ -7,10 +7,10 @@
 //! too, Wald et al., "Embree: A Kernel Framework for Efficient CPU Ray Tracing", SIGGRAPH 2014):
 //! for rays in random directions those three branches mispredict at every ray's first nodes.
 
-use super::Avx512;
+use crate::geometry::avx512::lanes::Avx512;
+use crate::geometry::ray::Ray;
 use crate::geometry::slab::{SlabKernel, SLACK};
 use crate::geometry::slab8::Boxes8;
-use crate::geometry::Ray;
 use std::arch::x86_64::*;
 
 /// One ray splat over eight lanes, with the float offsets in a `Boxes8` of its near and far plane

@@ -1,7 +1,7 @@
 use super::*;
 use crate::bvh::{AnyBvh, BuildParams};
 use crate::mesh::Mesh;
-use crate::render::{render, RenderSettings};
+use crate::render::raycast::{render, RenderSettings};
 use image::{Rgb, RgbImage};
 use std::sync::Arc;
 

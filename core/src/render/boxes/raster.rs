@@ -3,10 +3,18 @@
 //! plus half a pixel of falloff), blended over what is there in the order given. Plain arithmetic
 //! in one thread: the same segments give the same bytes every run.
 
-use super::Segment;
-use glam::DVec2;
+use glam::{DVec2, Vec2};
 use image::RgbImage;
 use std::ops::Range;
+
+/// A line to draw over the image, in its units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Segment {
+    pub a: Vec2,
+    pub b: Vec2,
+    pub rgb: [u8; 3],
+    pub width: f32,
+}
 
 /// Draw `segments` into `img`, touching only the pixels in `columns` × `rows` (the part of a
 /// larger picture the segments' coordinates are of, from its top left corner).

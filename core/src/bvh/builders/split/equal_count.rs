@@ -3,7 +3,7 @@
 //! driver's fallback when another strategy cannot. Big nodes select in parallel: a radix select on
 //! the sort key's bytes (histograms per chunk), then a parallel partition at the key found.
 
-use super::{partition, BuildPrim, NodeInfo, Proposal, Splitter};
+use crate::bvh::builders::split::splitter::{partition, BuildPrim, NodeInfo, Proposal, Splitter};
 use crate::parallel::PARTITION_MIN;
 use rayon::prelude::*;
 

@@ -2,7 +2,7 @@
 //! "SplitMethod::Middle"; the handout's first BVH). When all centroids fall on one side the cut is
 //! useless, and the driver falls back to an equal-count split.
 
-use super::{partition, BuildPrim, NodeInfo, Proposal, Splitter};
+use crate::bvh::builders::split::splitter::{partition, BuildPrim, NodeInfo, Proposal, Splitter};
 
 pub struct Midpoint;
 

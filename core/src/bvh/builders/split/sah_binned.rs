@@ -5,8 +5,8 @@
 //! binned in one pass over the triangles, so a node costs O(n + bins), with no per-node allocation
 //! below the top levels; big nodes are binned in parallel chunks.
 
-use super::{is_active, partition, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
-use crate::bvh::BuildParams;
+use crate::bvh::builders::split::splitter::{is_active, partition, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
+use crate::bvh::params::BuildParams;
 use crate::geometry::Aabb;
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
@@ -252,7 +252,10 @@ fn split_two(prims: &mut [BuildPrim], extent: Vec3A) -> Proposal {
 #[cfg(test)]
 mod tests {
     use super::{bin_indices, goes_left};
-    use crate::bvh::{BuildParams, Bvh, Layout, Strategy, TreeStats};
+    use crate::bvh::node::Bvh;
+    use crate::bvh::params::Strategy;
+    use crate::bvh::params::{BuildParams, Layout};
+    use crate::bvh::stats::TreeStats;
     use crate::mesh::generate;
 
     #[test]

@@ -4,8 +4,8 @@
 //! O(n log n) per node; use the binned version for big meshes in interactive work. Big nodes (the
 //! top of the tree) are sorted and swept in parallel (`sweep_parallel`), to the same split.
 
-use super::{is_active, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
-use crate::bvh::BuildParams;
+use crate::bvh::builders::split::splitter::{is_active, BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
+use crate::bvh::params::BuildParams;
 use crate::geometry::Aabb;
 use crate::parallel::{region, PARTITION_MIN};
 use rayon::prelude::*;

@@ -19,7 +19,7 @@
 //! whose bins and lists are merged in order (counts add, boxes unite exactly), so the split does
 //! not depend on the thread count.
 
-use super::{is_active, BuildPrim, PlaneSink};
+use crate::bvh::builders::split::splitter::{is_active, BuildPrim, PlaneSink};
 use crate::geometry::Aabb;
 use crate::parallel::{concat, region};
 use glam::{Vec3, Vec3A};
