@@ -424,7 +424,12 @@ fn the_checker_finds_a_loop_and_an_import_up() {
     let found = loops(&graph, &a);
     assert_eq!(found, vec![vec![a.join("x.rs"), a.join("y.rs")]]);
     assert!(graph[&a.join("x.rs")].contains(&a.join("mod.rs")));
-    assert_eq!(graph[&a.join("x.rs")].len(), 2, "an inline module's `super` is its own file: {:?}", graph[&a.join("x.rs")]);
+    assert_eq!(
+        graph[&a.join("x.rs")].len(),
+        2,
+        "an inline module's `super` is its own file: {:?}",
+        graph[&a.join("x.rs")]
+    );
     assert!(!graph[&a.join("y.rs")].contains(&a.join("mod.rs")), "a test module's import is exempt");
     assert!(!graph.contains_key(&a.join("t.rs")) || graph[&a.join("t.rs")].is_empty(), "a test file is exempt");
     std::fs::remove_dir_all(&dir).unwrap();

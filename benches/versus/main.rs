@@ -344,30 +344,12 @@ fn machine() -> String {
     format!("{cpu}, {} threads available", std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
-fn main() {
-    // `cargo bench` passes `--bench`; nothing else is accepted.
-    let quick = std::env::var("BENCH_QUICK").is_ok_and(|v| v == "1");
-    let s = if quick {
-        Settings { quick, primary_size: 512, incoherent: 200_000, reps: 1, build_reps: 3 }
-    } else {
-        Settings { quick, primary_size: 1024, incoherent: 1_000_000, reps: 3, build_reps: 11 }
-    };
-    let one = ThreadPoolBuilder::new().num_threads(1).build().expect("a one-thread pool");
-    let all = ThreadPoolBuilder::new().build().expect("a pool");
-    let threads = all.current_num_threads();
-    // Wake both pools' threads once, so the first contender's figures do not include their start.
-    for pool in [&one, &all] {
-        pool.install(|| (0..1 << 20).into_par_iter().map(|i: u64| i * i).sum::<u64>());
-    }
-
-    // BENCH_THREADS=1,2,…: only the scaling tables (`scaling.rs`), on pools of their own.
-    if let Ok(list) = std::env::var("BENCH_THREADS") {
-        print!("{}", scaling::table(&scaling::thread_counts(&list)));
-        return;
-    }
-
+/// Every contender: each of our strategies in each layout, packets and counting walks, the
+/// `fastest` preset (and on an AVX-512 CPU the AVX2 family's), obvhs, the bvh crate, Embree and
+/// tinybvh where found.
+fn contenders() -> Vec<Contender> {
     let mut contenders = vec![];
-    use bvhscope::bvh::{Layout, Strategy};
+    use bvhscope::bvh::Strategy;
     for layout in Layout::ALL {
         for strategy in Strategy::ALL {
             contenders.push(contenders::ours(strategy, layout, Tracing::Plain));
@@ -413,14 +395,12 @@ fn main() {
     for n in [embree::notice(), tinybvh::notice()].into_iter().flatten() {
         eprintln!("notice: {n}");
     }
-    // BENCH_ONLY=a,b keeps contenders whose name contains one of the words (for quick iteration).
-    if let Ok(only) = std::env::var("BENCH_ONLY") {
-        let words: Vec<String> = only.split(',').map(|w| w.trim().to_lowercase()).collect();
-        contenders.retain(|c| words.iter().any(|w| c.name.to_lowercase().contains(w.as_str())));
-    }
+    contenders
+}
 
-    // BENCH_APP=1: only the app figures (frame time, 2M load + build, strategy switch).
-    let app_only = std::env::var("BENCH_APP").is_ok_and(|v| v == "1");
+/// The meshes raced: the shared ones found, the generated scenes, the 2M-triangle knot (not in a
+/// quick run unless for the app figures) and the needle soup (full run, or asked for by name).
+fn meshes(quick: bool, app_only: bool) -> Vec<Mesh> {
     let mut meshes: Vec<Mesh> = Vec::new();
     meshes.extend(scenes::shared("stanford-bunny.obj"));
     meshes.extend(scenes::shared("beast.obj"));
@@ -436,6 +416,41 @@ fn main() {
     if !quick || std::env::var("BENCH_MESH").is_ok_and(|m| m.contains("needles")) {
         meshes.push(scenes::needles());
     }
+    meshes
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; nothing else is accepted.
+    let quick = std::env::var("BENCH_QUICK").is_ok_and(|v| v == "1");
+    let s = if quick {
+        Settings { quick, primary_size: 512, incoherent: 200_000, reps: 1, build_reps: 3 }
+    } else {
+        Settings { quick, primary_size: 1024, incoherent: 1_000_000, reps: 3, build_reps: 11 }
+    };
+    let one = ThreadPoolBuilder::new().num_threads(1).build().expect("a one-thread pool");
+    let all = ThreadPoolBuilder::new().build().expect("a pool");
+    let threads = all.current_num_threads();
+    // Wake both pools' threads once, so the first contender's figures do not include their start.
+    for pool in [&one, &all] {
+        pool.install(|| (0..1 << 20).into_par_iter().map(|i: u64| i * i).sum::<u64>());
+    }
+
+    // BENCH_THREADS=1,2,…: only the scaling tables (`scaling.rs`), on pools of their own.
+    if let Ok(list) = std::env::var("BENCH_THREADS") {
+        print!("{}", scaling::table(&scaling::thread_counts(&list)));
+        return;
+    }
+
+    let mut contenders = contenders();
+    // BENCH_ONLY=a,b keeps contenders whose name contains one of the words (for quick iteration).
+    if let Ok(only) = std::env::var("BENCH_ONLY") {
+        let words: Vec<String> = only.split(',').map(|w| w.trim().to_lowercase()).collect();
+        contenders.retain(|c| words.iter().any(|w| c.name.to_lowercase().contains(w.as_str())));
+    }
+
+    // BENCH_APP=1: only the app figures (frame time, 2M load + build, strategy switch).
+    let app_only = std::env::var("BENCH_APP").is_ok_and(|v| v == "1");
+    let mut meshes = meshes(quick, app_only);
     if app_only {
         println!("{}", app_figures(&meshes, &all));
         return;

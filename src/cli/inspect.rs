@@ -4,14 +4,12 @@
 
 use super::args::{BuildArgs, ViewArgs};
 use crate::bvh::wide::wide_group_in;
-use crate::bvh::Hierarchy;
-use crate::bvh::{SceneBvh, TreeView};
+use crate::bvh::{Hierarchy, SceneBvh, TreeView};
 use crate::cli::error::CliError;
 use crate::cli::load::{build_scene, load_mesh};
 use crate::explain::inspect::text::{dump_text, no_split_text, sbvh_text, wide_group_text};
 use crate::explain::inspect::{inspect, CurvePoint, Inspection};
-use crate::options::Choice;
-use crate::options::Named;
+use crate::options::{Choice, Named};
 use clap::Args;
 use std::fmt::Write;
 use std::path::PathBuf;

@@ -1,8 +1,7 @@
 //! `bvhscope render`: ray-cast a mesh to a PNG.
 
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
-use super::device;
-use super::progress;
+use super::{device, progress};
 use crate::bvh::SceneBvh;
 use crate::cli::error::CliError;
 use crate::cli::load::load_mesh;

@@ -2,8 +2,7 @@
 //! figures of the app's statistics panel, from the same camera and size when given the same).
 
 use super::args::{BuildArgs, DeviceArgs, ViewArgs};
-use super::device;
-use super::progress;
+use super::{device, progress};
 use crate::bvh::{epo, Hierarchy, RayCounters, SceneBvh, TreeStats, TreeView};
 use crate::cli::error::CliError;
 use crate::cli::load::load_noted;

@@ -19,8 +19,7 @@
 //! bytes per triangle instead of 62 (BENCHMARKS.md, "AVX2 a family of its own").
 
 use crate::bvh::accel::{TraceOptions, TraversalOrder};
-use crate::bvh::params::Strategy;
-use crate::bvh::params::{BuildParams, Layout, SahCost};
+use crate::bvh::params::{BuildParams, Layout, SahCost, Strategy};
 use crate::cpu::Simd;
 use crate::geometry::TriangleTest;
 

@@ -12,8 +12,7 @@
 use super::node::{Bvh, BvhNode, TRAVERSAL_STACK_SIZE};
 use super::stack::TraversalStack;
 use crate::bvh::accel::{Accelerator, Hit, TraceOptions};
-use crate::bvh::counters::NodeId;
-use crate::bvh::counters::TraversalStats;
+use crate::bvh::counters::{NodeId, TraversalStats};
 use crate::geometry::slab::{widen, OneRay};
 use crate::geometry::{Ray, TriangleHit, TriangleIntersector};
 use std::ops::Range;

@@ -118,7 +118,6 @@ impl BvhDump {
     }
 
     fn from_text(text: &str, name: &str) -> Result<BvhDump, DumpError> {
-        let err = |line: usize, why: String| DumpError::Text { path: name.into(), line, why, plain: None };
         // A message that quotes the line.
         let quotes = |line: usize, why: String, plain: &'static str| DumpError::Text {
             path: name.into(),
@@ -134,10 +133,6 @@ impl BvhDump {
             let mut words = line.split_whitespace();
             let Some(head) = words.next() else { continue };
             let rest: Vec<&str> = words.collect();
-            let num = |s: &str| {
-                s.parse::<f32>()
-                    .map_err(|_| quotes(n, format!("'{s}' is not a number"), "a word where a number must be"))
-            };
             let int = |s: &str| {
                 s.parse::<u32>().map_err(|_| {
                     quotes(n, format!("'{s}' is not a whole number"), "a word where a whole number must be")
@@ -171,70 +166,7 @@ impl BvhDump {
                         dump.primitives.push(int(w)?);
                     }
                 }
-                "node" => {
-                    if rest.len() < 8 {
-                        return Err(err(
-                            n,
-                            "a node is 'node MIN(3) MAX(3) children C..' or '... leaf FIRST COUNT'".into(),
-                        ));
-                    }
-                    let f: Vec<f32> = rest[..6].iter().map(|w| num(w)).collect::<Result<_, _>>()?;
-                    let mut node = DumpNode {
-                        min: [f[0], f[1], f[2]],
-                        max: [f[3], f[4], f[5]],
-                        children: None,
-                        first: None,
-                        count: None,
-                        axis: None,
-                    };
-                    match rest[6] {
-                        "leaf" if rest.len() == 9 => {
-                            node.first = Some(int(rest[7])?);
-                            node.count = Some(int(rest[8])?);
-                        }
-                        "leaf" => {
-                            return Err(err(
-                                n,
-                                format!("'leaf' takes FIRST COUNT: two numbers, not {}", rest.len() - 7),
-                            ))
-                        }
-                        "children" => {
-                            let mut kids = Vec::new();
-                            let mut k = 7;
-                            while k < rest.len() && rest[k] != "axis" {
-                                kids.push(int(rest[k])?);
-                                k += 1;
-                            }
-                            if k < rest.len() {
-                                let a = rest.get(k + 1).ok_or_else(|| err(n, "'axis' without a value".into()))?;
-                                let axis = a.parse::<u8>().ok().filter(|&a| a <= 2);
-                                node.axis = Some(axis.ok_or_else(|| {
-                                    quotes(
-                                        n,
-                                        format!("axis '{a}' is not 0, 1 or 2 (x, y, z)"),
-                                        "an axis that is not 0, 1 or 2 (x, y, z)",
-                                    )
-                                })?);
-                                if let Some(extra) = rest.get(k + 2) {
-                                    return Err(quotes(
-                                        n,
-                                        format!("'{extra}' after the axis: a node line ends with it"),
-                                        "words after the axis: a node line ends with it",
-                                    ));
-                                }
-                            }
-                            node.children = Some(kids);
-                        }
-                        other => {
-                            return Err(quotes(
-                                n,
-                                format!("'{other}': expected 'children' or 'leaf FIRST COUNT'"),
-                                "a word where 'children' or 'leaf FIRST COUNT' must be",
-                            ))
-                        }
-                    }
-                    dump.nodes.push(node);
-                }
+                "node" => dump.nodes.push(text_node(&rest, n, name)?),
                 other => {
                     return Err(quotes(
                         n,
@@ -249,6 +181,69 @@ impl BvhDump {
         }
         Ok(dump)
     }
+}
+
+/// One `node` line of the text form: its words after `node`, line `n` of the file `name`.
+fn text_node(rest: &[&str], n: usize, name: &str) -> Result<DumpNode, DumpError> {
+    let err = |why: String| DumpError::Text { path: name.into(), line: n, why, plain: None };
+    // A message that quotes the line.
+    let quotes =
+        |why: String, plain: &'static str| DumpError::Text { path: name.into(), line: n, why, plain: Some(plain) };
+    let num = |s: &str| {
+        s.parse::<f32>().map_err(|_| quotes(format!("'{s}' is not a number"), "a word where a number must be"))
+    };
+    let int = |s: &str| {
+        s.parse::<u32>()
+            .map_err(|_| quotes(format!("'{s}' is not a whole number"), "a word where a whole number must be"))
+    };
+    if rest.len() < 8 {
+        return Err(err("a node is 'node MIN(3) MAX(3) children C..' or '... leaf FIRST COUNT'".into()));
+    }
+    let f: Vec<f32> = rest[..6].iter().map(|w| num(w)).collect::<Result<_, _>>()?;
+    let mut node = DumpNode {
+        min: [f[0], f[1], f[2]],
+        max: [f[3], f[4], f[5]],
+        children: None,
+        first: None,
+        count: None,
+        axis: None,
+    };
+    match rest[6] {
+        "leaf" if rest.len() == 9 => {
+            node.first = Some(int(rest[7])?);
+            node.count = Some(int(rest[8])?);
+        }
+        "leaf" => return Err(err(format!("'leaf' takes FIRST COUNT: two numbers, not {}", rest.len() - 7))),
+        "children" => {
+            let mut kids = Vec::new();
+            let mut k = 7;
+            while k < rest.len() && rest[k] != "axis" {
+                kids.push(int(rest[k])?);
+                k += 1;
+            }
+            if k < rest.len() {
+                let a = rest.get(k + 1).ok_or_else(|| err("'axis' without a value".into()))?;
+                let axis = a.parse::<u8>().ok().filter(|&a| a <= 2);
+                node.axis = Some(axis.ok_or_else(|| {
+                    quotes(format!("axis '{a}' is not 0, 1 or 2 (x, y, z)"), "an axis that is not 0, 1 or 2 (x, y, z)")
+                })?);
+                if let Some(extra) = rest.get(k + 2) {
+                    return Err(quotes(
+                        format!("'{extra}' after the axis: a node line ends with it"),
+                        "words after the axis: a node line ends with it",
+                    ));
+                }
+            }
+            node.children = Some(kids);
+        }
+        other => {
+            return Err(quotes(
+                format!("'{other}': expected 'children' or 'leaf FIRST COUNT'"),
+                "a word where 'children' or 'leaf FIRST COUNT' must be",
+            ))
+        }
+    }
+    Ok(node)
 }
 
 /// A dump's bytes as text: a UTF-8 byte-order mark dropped, bytes that are not UTF-8 decoded as

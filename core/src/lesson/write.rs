@@ -3,8 +3,7 @@
 //! lie under it or beside it, so a lesson folder moves as a whole.
 
 use super::{BuildEdit, Lesson, Show, Step};
-use crate::options::ParamOption;
-use crate::options::BUILD_PARAMS;
+use crate::options::{ParamOption, BUILD_PARAMS};
 use crate::render::HeatRange;
 use serde_json::{json, Map, Value};
 use std::path::{Component, Path, PathBuf};

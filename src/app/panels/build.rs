@@ -1,7 +1,7 @@
 //! The build panel: strategy and its parameters, traversal order and triangle test. Any change
 //! rebuilds (or re-renders) in the background.
 
-use crate::app::state::{Action, Actions, BvhscopeApp};
+use crate::app::state::{Action, Actions, BvhscopeApp, Settings};
 use crate::bvh::{BuildParams, Param, ParamLimits, ParamValue, Preset, Strategy};
 use crate::options::{Choice, ParamOption, BUILD_PARAMS, TOP_MAX_LEAF_SIZE};
 
@@ -43,86 +43,13 @@ fn radios<T: Choice>(ui: &mut egui::Ui, value: &mut T) {
 
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.heading("Build");
-    for preset in Preset::ALL {
-        let on = app.settings.is_preset(preset);
-        let text = if on { format!("{} (on)", preset.label()) } else { preset.label().to_string() };
-        if ui
-            .add_enabled(!on, egui::Button::new(text))
-            .on_hover_text(format!("One click to {}", preset.help()))
-            .on_disabled_hover_text(format!("These are the settings of {}", preset.help()))
-            .clicked()
-        {
-            out.push(Action::ApplyPreset(preset));
-        }
-    }
-    let has_instances = app.has_instances();
-    let placements = app.scene.instances().map_or(0, |i| i.placements.len());
-    let meshes = app.scene.instances().map_or(0, |i| i.meshes.len());
+    presets(app, ui, out);
     let mut edited = app.settings.clone();
     let s = &mut edited;
-    if has_instances {
-        ui.checkbox(&mut s.two_level, format!("Two levels: {placements} placements of {meshes} meshes"))
-            .on_hover_text("A top-level BVH over the scene's mesh placements, and one BVH per mesh built once however often it is placed. Off: one BVH over the whole scene flattened.");
-        if s.two_level {
-            ui.horizontal(|ui| {
-                let label = ui.label("Top-level strategy");
-                egui::ComboBox::from_id_salt("top-strategy")
-                    .selected_text(s.top_build.strategy.label())
-                    .show_ui(ui, |ui| {
-                        for k in Strategy::ALL {
-                            ui.selectable_value(&mut s.top_build.strategy, k, k.label()).on_hover_text(k.help());
-                        }
-                    })
-                    .response
-                    .labelled_by(label.id);
-            });
-            let n = &TOP_MAX_LEAF_SIZE;
-            ui.add(
-                egui::Slider::new(&mut s.top_build.max_leaf_size, n.limits.min..=n.limits.max)
-                    .logarithmic(true)
-                    .text(n.label),
-            )
-            .on_hover_text(n.help);
-            ui.label("Bottom level (each mesh's BVH)");
-        }
+    if app.has_instances() {
+        two_levels(app, ui, s);
     }
-    // The strategies, and an imported tree (File ▸ Open BVH) as one more entry.
-    let imported = app.import.tree.as_ref().filter(|t| t.scene_id == app.scene_id);
-    let on = app.import.on && imported.is_some();
-    let label = ui.label("Split strategy");
-    let selected = match imported.filter(|_| on) {
-        Some(t) => format!("imported: {}", t.name()),
-        None => s.build.strategy.label().to_string(),
-    };
-    egui::ComboBox::from_id_salt("strategy")
-        .selected_text(selected)
-        .width(200.0)
-        .show_ui(ui, |ui| {
-            for k in Strategy::ALL {
-                if ui.selectable_label(!on && s.build.strategy == k, k.label()).on_hover_text(k.help()).clicked() {
-                    s.build.strategy = k;
-                    out.push(Action::UseImported(false));
-                }
-            }
-            if let Some(t) = imported {
-                let text = format!("imported: {}", t.name());
-                let tip = format!(
-                    "The BVH read from {}, traced as written. {} defects, {} warnings (View › Imported BVH…)",
-                    t.path.display(),
-                    t.defects(),
-                    t.findings.len() - t.defects()
-                );
-                let item = ui.add_enabled(t.bvh.is_ok(), egui::Button::selectable(on, text));
-                let why = t.bvh.as_ref().err().cloned().unwrap_or_default();
-                if item.on_hover_text(tip).on_disabled_hover_text(format!("Cannot be traced: {why}")).clicked() {
-                    out.push(Action::UseImported(true));
-                }
-            }
-        })
-        .response
-        .labelled_by(label.id)
-        .on_hover_text(if on { "The imported BVH, as its program wrote it" } else { s.build.strategy.help() });
-
+    let on = strategy_choice(app, ui, s, out);
     // An imported tree is traced as written: the build's parameters do not apply to it.
     ui.add_enabled_ui(!on, |ui| {
         // Each parameter of the table, greyed out where the strategy does not read it.
@@ -161,4 +88,92 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             ui.label(format!("{} {:.0}%", job.label, job.control.fraction() * 100.0));
         });
     }
+}
+
+/// The presets, one button each (greyed where its settings are the current ones).
+fn presets(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
+    for preset in Preset::ALL {
+        let on = app.settings.is_preset(preset);
+        let text = if on { format!("{} (on)", preset.label()) } else { preset.label().to_string() };
+        if ui
+            .add_enabled(!on, egui::Button::new(text))
+            .on_hover_text(format!("One click to {}", preset.help()))
+            .on_disabled_hover_text(format!("These are the settings of {}", preset.help()))
+            .clicked()
+        {
+            out.push(Action::ApplyPreset(preset));
+        }
+    }
+}
+
+/// Two levels over a scene of placed meshes: on or off, the top level's strategy and leaves.
+fn two_levels(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
+    let placements = app.scene.instances().map_or(0, |i| i.placements.len());
+    let meshes = app.scene.instances().map_or(0, |i| i.meshes.len());
+    ui.checkbox(&mut s.two_level, format!("Two levels: {placements} placements of {meshes} meshes"))
+        .on_hover_text("A top-level BVH over the scene's mesh placements, and one BVH per mesh built once however often it is placed. Off: one BVH over the whole scene flattened.");
+    if s.two_level {
+        ui.horizontal(|ui| {
+            let label = ui.label("Top-level strategy");
+            egui::ComboBox::from_id_salt("top-strategy")
+                .selected_text(s.top_build.strategy.label())
+                .show_ui(ui, |ui| {
+                    for k in Strategy::ALL {
+                        ui.selectable_value(&mut s.top_build.strategy, k, k.label()).on_hover_text(k.help());
+                    }
+                })
+                .response
+                .labelled_by(label.id);
+        });
+        let n = &TOP_MAX_LEAF_SIZE;
+        ui.add(
+            egui::Slider::new(&mut s.top_build.max_leaf_size, n.limits.min..=n.limits.max)
+                .logarithmic(true)
+                .text(n.label),
+        )
+        .on_hover_text(n.help);
+        ui.label("Bottom level (each mesh's BVH)");
+    }
+}
+
+/// The split strategy, with an imported tree (File ▸ Open BVH) as one more entry; whether the
+/// imported tree is the one traced.
+fn strategy_choice(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings, out: &mut Actions) -> bool {
+    // The strategies, and an imported tree (File ▸ Open BVH) as one more entry.
+    let imported = app.import.tree.as_ref().filter(|t| t.scene_id == app.scene_id);
+    let on = app.import.on && imported.is_some();
+    let label = ui.label("Split strategy");
+    let selected = match imported.filter(|_| on) {
+        Some(t) => format!("imported: {}", t.name()),
+        None => s.build.strategy.label().to_string(),
+    };
+    egui::ComboBox::from_id_salt("strategy")
+        .selected_text(selected)
+        .width(200.0)
+        .show_ui(ui, |ui| {
+            for k in Strategy::ALL {
+                if ui.selectable_label(!on && s.build.strategy == k, k.label()).on_hover_text(k.help()).clicked() {
+                    s.build.strategy = k;
+                    out.push(Action::UseImported(false));
+                }
+            }
+            if let Some(t) = imported {
+                let text = format!("imported: {}", t.name());
+                let tip = format!(
+                    "The BVH read from {}, traced as written. {} defects, {} warnings (View › Imported BVH…)",
+                    t.path.display(),
+                    t.defects(),
+                    t.findings.len() - t.defects()
+                );
+                let item = ui.add_enabled(t.bvh.is_ok(), egui::Button::selectable(on, text));
+                let why = t.bvh.as_ref().err().cloned().unwrap_or_default();
+                if item.on_hover_text(tip).on_disabled_hover_text(format!("Cannot be traced: {why}")).clicked() {
+                    out.push(Action::UseImported(true));
+                }
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text(if on { "The imported BVH, as its program wrote it" } else { s.build.strategy.help() });
+    on
 }

@@ -56,154 +56,8 @@ fn menu(ui: &mut egui::Ui, title: &str, content: impl FnOnce(&mut egui::Ui)) {
 
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     egui::MenuBar::new().ui(ui, |ui| {
-        menu(ui, "File", |ui| {
-            item(ui, out, "Open…", Action::Open);
-            item(ui, out, "Open path…", Action::OpenPath);
-            menu(ui, "Open recent", |ui| {
-                if app.settings.recent_files.is_empty() {
-                    ui.weak("No recent files");
-                }
-                for path in app.settings.recent_files.clone() {
-                    if ui.button(path.display().to_string()).clicked() {
-                        out.push(Action::OpenFile(path));
-                    }
-                }
-            });
-            if ui.button("Built-in scene").clicked() {
-                out.push(Action::ShowBuiltin);
-            }
-            ui.separator();
-            if ui.button("Open lesson…").on_hover_text("A teacher's steps (a lesson file): PageDown or Right for the next").clicked() {
-                out.push(Action::OpenLesson);
-            }
-            if ui
-                .button("Open BVH…")
-                .on_hover_text("A BVH written by your own renderer (bvhscope-bvh: JSON, .json.gz or the text form; see the README) for this mesh: checked, then shown as \"imported\" in the strategy list")
-                .clicked()
-            {
-                out.push(Action::OpenBvh);
-            }
-            if ui.button("Open BVH path…").on_hover_text("Type the dump's path").clicked() {
-                out.push(Action::OpenBvhPath);
-            }
-            if ui
-                .button("Open grade report…")
-                .on_hover_text("A class's report from bvhscope grade (its grade.json): the students listed; choosing one shows their BVH against SAH binned")
-                .clicked()
-            {
-                out.push(Action::OpenGradeReport);
-            }
-            if ui.button("Open grade report path…").on_hover_text("Type the path of grade.json or its folder").clicked() {
-                out.push(Action::OpenGradeReportPath);
-            }
-            if ui
-                .button("Export BVH…")
-                .on_hover_text("The current tree in the bvhscope-bvh format (JSON; the text form when the name ends in .txt), as bvhscope export-bvh writes it")
-                .clicked()
-            {
-                out.push(Action::ExportBvh);
-            }
-            ui.separator();
-            item(ui, out, "Save view as PNG…", Action::SavePng);
-            item(ui, out, "Export statistics as CSV…", Action::ExportStats);
-            if ui.button("Export statistics as JSON…").clicked() {
-                out.push(Action::ExportStatsJson);
-            }
-            let counts = if app.compare.on {
-                ui.button("Export the pair's counts as CSV…").on_hover_text(
-                    "One row per pixel: x, y, A's value, B's value, B - A of the heatmap's metric (render --against … --difference)",
-                )
-            } else {
-                ui.button("Export counts as CSV…").on_hover_text(
-                    "One row per pixel: x, y, nodes visited, box tests, leaves, triangle tests, hit triangle (-1: miss); the numbers the heatmaps colour",
-                )
-            };
-            if counts.clicked() {
-                out.push(Action::ExportCounts);
-            }
-            if ui
-                .button("Save scene as…")
-                .on_hover_text("The camera, the meshes and the BVH settings, as a scene file")
-                .clicked()
-            {
-                out.push(Action::SaveScene);
-            }
-            if ui.button("Save to a typed path…").clicked() {
-                out.push(Action::SavePngTyped);
-            }
-            ui.separator();
-            if ui.button("Quit").clicked() {
-                ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
-            }
-        });
-        menu(ui, "View", |ui| {
-            for (i, v) in View::ALL.iter().enumerate() {
-                let shortcut = shortcut_text(ui.ctx(), &Action::View(i));
-                if ui
-                    .add(egui::Button::selectable(app.settings.view == *v, v.label()).shortcut_text(shortcut))
-                    .clicked()
-                {
-                    out.push(Action::View(i));
-                }
-            }
-            ui.separator();
-            item(ui, out, "Frame the mesh", Action::FrameMesh);
-            item(ui, out, "Reset camera", Action::ResetView);
-            item(ui, out, "Node boxes", Action::ToggleBoxes);
-            if ui.button("Trace a ray…").on_hover_text("The Ray window: click a pixel to pin its ray, or type a ray").clicked() {
-                out.push(Action::ShowRayWindow);
-            }
-            if ui.button("Tree and node…").on_hover_text("The Tree and Node windows: the hierarchy, and why a node was split where it was").clicked() {
-                out.push(Action::ShowTree(true));
-            }
-            if ui.button("Replay the build…").on_hover_text("The Replay window: the tree after each split, traced").clicked() {
-                out.push(Action::ShowReplay(true));
-            }
-            if ui
-                .add_enabled(app.import.tree.is_some(), egui::Button::new("Imported BVH…"))
-                .on_hover_text("The checker's findings of the imported BVH")
-                .on_disabled_hover_text("No BVH is imported: File › Open BVH…")
-                .clicked()
-            {
-                out.push(Action::ShowImported(true));
-            }
-            if ui
-                .add_enabled(app.grade.report.is_some(), egui::Button::new("Grade report…"))
-                .on_hover_text("The class of the grade report opened")
-                .on_disabled_hover_text("No grade report is open: File › Open grade report…")
-                .clicked()
-            {
-                out.push(Action::ShowGrade(true));
-            }
-            if ui.button("Compare side by side…").on_hover_text("B, another strategy's build, next to A on the same camera and scale").clicked() {
-                out.push(Action::Compare(true));
-            }
-            ui.separator();
-            let mut present = app.settings.present;
-            let f5 = shortcut_text(ui.ctx(), &Action::TogglePresent);
-            if ui
-                .checkbox(&mut present, format!("Present ({f5})"))
-                .on_hover_text("For a room: everything at 150 % or more (text of 18 px and up), the Node view's plots half its tile tall, every figure written out")
-                .changed()
-            {
-                out.push(Action::Present(present));
-            }
-            ui.horizontal(|ui| {
-                ui.label(format!("Size {:.0} %", 100.0 * app.settings.zoom()));
-                if ui.small_button("−").on_hover_text(shortcut_text(ui.ctx(), &Action::UiScaleBy(-1))).clicked() {
-                    out.push(Action::UiScaleBy(-1));
-                }
-                if ui.small_button("+").on_hover_text(shortcut_text(ui.ctx(), &Action::UiScaleBy(1))).clicked() {
-                    out.push(Action::UiScaleBy(1));
-                }
-                if ui.small_button("100 %").clicked() {
-                    out.push(Action::UiScale(1.0));
-                }
-            });
-            if ui.button("Reset the layout").on_hover_text("The image, the panels and the views where a fresh start puts them").clicked() {
-                out.push(Action::ResetLayout);
-            }
-        });
+        menu(ui, "File", |ui| file_menu(app, ui, out));
+        menu(ui, "View", |ui| view_menu(app, ui, out));
         menu(ui, "Lesson", |ui| lesson_menu(app, ui, out));
         menu(ui, "Help", |ui| {
             let shortcut = shortcut_text(ui.ctx(), &Action::Help);
@@ -214,6 +68,173 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         ui.separator();
         ui.label(egui::RichText::new(app.scene.title()).strong());
     });
+}
+
+/// The File menu: open (a mesh, a lesson, a BVH, a grade report), export, save, quit.
+fn file_menu(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
+    item(ui, out, "Open…", Action::Open);
+    item(ui, out, "Open path…", Action::OpenPath);
+    menu(ui, "Open recent", |ui| {
+        if app.settings.recent_files.is_empty() {
+            ui.weak("No recent files");
+        }
+        for path in app.settings.recent_files.clone() {
+            if ui.button(path.display().to_string()).clicked() {
+                out.push(Action::OpenFile(path));
+            }
+        }
+    });
+    if ui.button("Built-in scene").clicked() {
+        out.push(Action::ShowBuiltin);
+    }
+    ui.separator();
+    if ui
+        .button("Open lesson…")
+        .on_hover_text("A teacher's steps (a lesson file): PageDown or Right for the next")
+        .clicked()
+    {
+        out.push(Action::OpenLesson);
+    }
+    if ui
+        .button("Open BVH…")
+        .on_hover_text("A BVH written by your own renderer (bvhscope-bvh: JSON, .json.gz or the text form; see the README) for this mesh: checked, then shown as \"imported\" in the strategy list")
+        .clicked()
+    {
+        out.push(Action::OpenBvh);
+    }
+    if ui.button("Open BVH path…").on_hover_text("Type the dump's path").clicked() {
+        out.push(Action::OpenBvhPath);
+    }
+    if ui
+        .button("Open grade report…")
+        .on_hover_text("A class's report from bvhscope grade (its grade.json): the students listed; choosing one shows their BVH against SAH binned")
+        .clicked()
+    {
+        out.push(Action::OpenGradeReport);
+    }
+    if ui.button("Open grade report path…").on_hover_text("Type the path of grade.json or its folder").clicked() {
+        out.push(Action::OpenGradeReportPath);
+    }
+    if ui
+        .button("Export BVH…")
+        .on_hover_text("The current tree in the bvhscope-bvh format (JSON; the text form when the name ends in .txt), as bvhscope export-bvh writes it")
+        .clicked()
+    {
+        out.push(Action::ExportBvh);
+    }
+    ui.separator();
+    item(ui, out, "Save view as PNG…", Action::SavePng);
+    item(ui, out, "Export statistics as CSV…", Action::ExportStats);
+    if ui.button("Export statistics as JSON…").clicked() {
+        out.push(Action::ExportStatsJson);
+    }
+    let counts = if app.compare.on {
+        ui.button("Export the pair's counts as CSV…").on_hover_text(
+            "One row per pixel: x, y, A's value, B's value, B - A of the heatmap's metric (render --against … --difference)",
+        )
+    } else {
+        ui.button("Export counts as CSV…").on_hover_text(
+            "One row per pixel: x, y, nodes visited, box tests, leaves, triangle tests, hit triangle (-1: miss); the numbers the heatmaps colour",
+        )
+    };
+    if counts.clicked() {
+        out.push(Action::ExportCounts);
+    }
+    if ui
+        .button("Save scene as…")
+        .on_hover_text("The camera, the meshes and the BVH settings, as a scene file")
+        .clicked()
+    {
+        out.push(Action::SaveScene);
+    }
+    if ui.button("Save to a typed path…").clicked() {
+        out.push(Action::SavePngTyped);
+    }
+    ui.separator();
+    if ui.button("Quit").clicked() {
+        ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+    }
+}
+
+/// The View menu: the views, the camera, the explain windows, presenting and the layout.
+fn view_menu(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
+    for (i, v) in View::ALL.iter().enumerate() {
+        let shortcut = shortcut_text(ui.ctx(), &Action::View(i));
+        if ui.add(egui::Button::selectable(app.settings.view == *v, v.label()).shortcut_text(shortcut)).clicked() {
+            out.push(Action::View(i));
+        }
+    }
+    ui.separator();
+    item(ui, out, "Frame the mesh", Action::FrameMesh);
+    item(ui, out, "Reset camera", Action::ResetView);
+    item(ui, out, "Node boxes", Action::ToggleBoxes);
+    if ui.button("Trace a ray…").on_hover_text("The Ray window: click a pixel to pin its ray, or type a ray").clicked()
+    {
+        out.push(Action::ShowRayWindow);
+    }
+    if ui
+        .button("Tree and node…")
+        .on_hover_text("The Tree and Node windows: the hierarchy, and why a node was split where it was")
+        .clicked()
+    {
+        out.push(Action::ShowTree(true));
+    }
+    if ui.button("Replay the build…").on_hover_text("The Replay window: the tree after each split, traced").clicked()
+    {
+        out.push(Action::ShowReplay(true));
+    }
+    if ui
+        .add_enabled(app.import.tree.is_some(), egui::Button::new("Imported BVH…"))
+        .on_hover_text("The checker's findings of the imported BVH")
+        .on_disabled_hover_text("No BVH is imported: File › Open BVH…")
+        .clicked()
+    {
+        out.push(Action::ShowImported(true));
+    }
+    if ui
+        .add_enabled(app.grade.report.is_some(), egui::Button::new("Grade report…"))
+        .on_hover_text("The class of the grade report opened")
+        .on_disabled_hover_text("No grade report is open: File › Open grade report…")
+        .clicked()
+    {
+        out.push(Action::ShowGrade(true));
+    }
+    if ui
+        .button("Compare side by side…")
+        .on_hover_text("B, another strategy's build, next to A on the same camera and scale")
+        .clicked()
+    {
+        out.push(Action::Compare(true));
+    }
+    ui.separator();
+    let mut present = app.settings.present;
+    let f5 = shortcut_text(ui.ctx(), &Action::TogglePresent);
+    if ui
+        .checkbox(&mut present, format!("Present ({f5})"))
+        .on_hover_text("For a room: everything at 150 % or more (text of 18 px and up), the Node view's plots half its tile tall, every figure written out")
+        .changed()
+    {
+        out.push(Action::Present(present));
+    }
+    ui.horizontal(|ui| {
+        ui.label(format!("Size {:.0} %", 100.0 * app.settings.zoom()));
+        if ui.small_button("−").on_hover_text(shortcut_text(ui.ctx(), &Action::UiScaleBy(-1))).clicked() {
+            out.push(Action::UiScaleBy(-1));
+        }
+        if ui.small_button("+").on_hover_text(shortcut_text(ui.ctx(), &Action::UiScaleBy(1))).clicked() {
+            out.push(Action::UiScaleBy(1));
+        }
+        if ui.small_button("100 %").clicked() {
+            out.push(Action::UiScale(1.0));
+        }
+    });
+    if ui
+        .button("Reset the layout")
+        .on_hover_text("The image, the panels and the views where a fresh start puts them")
+        .clicked()
+    {
+        out.push(Action::ResetLayout);
+    }
 }
 
 /// The Lesson menu: open, step, record (each step only what changed), save, close.

@@ -94,8 +94,40 @@ pub fn combined_cost_text(c: SahCost) -> String {
 
 pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     ui.heading("Statistics");
-    // The scene's note: its first sentence, the rest on asking (a paragraph pushed the figures
-    // out of a projector's view).
+    scene_note(app, ui);
+    scene_counts(app, ui);
+    ui.add_space(6.0);
+    let Some(current) = app.current_figures() else {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label("Building…");
+        });
+        return;
+    };
+    gpu_lines(app, ui);
+    figures_table(app, ui, &current);
+    let c = current.stats.sah_constants;
+    let spec = app.settings.rays;
+    let which = match spec.kind.is_secondary() {
+        true => format!("the {} from the hits of the last full frame", spec.describe()),
+        false => "the primary rays of the last full frame".to_string(),
+    };
+    ui.weak(format!(
+        "Per-ray figures: {which} that enter the root box, unless a row says all rays. SAH cost with C_trav = {}, C_isect = {}.",
+        c.traversal, c.intersection
+    ))
+    .on_hover_text(combined_cost_text(c));
+    if let Some(built) = app.current_bvh().filter(|b| b.bvh.two_level().is_some()) {
+        two_level(ui, built, rays(&current));
+    }
+    warp_line(app, ui);
+    speedup(app, ui, out);
+    leaf_histogram(ui, &current);
+}
+
+/// The scene's note: its first sentence, the rest on asking (a paragraph pushed the figures out
+/// of a projector's view).
+fn scene_note(app: &BvhscopeApp, ui: &mut egui::Ui) {
     if let Some(note) = app.scene.desc.as_ref().and_then(|d| d.note.as_ref()) {
         match crate::explain::words::first_sentence(note) {
             Some(first) => {
@@ -110,6 +142,10 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         }
         ui.add_space(4.0);
     }
+}
+
+/// What the scene holds: triangles, the degenerate ones skipped, vertices, groups.
+fn scene_counts(app: &BvhscopeApp, ui: &mut egui::Ui) {
     let r = &app.scene.report;
     egui::Grid::new("scene-stats").num_columns(2).striped(true).show(ui, |ui| {
         ui.label("Triangles").on_hover_text("Triangles in the scene as the rays see it (polygons fan-triangulated, placements counted), zero-area ones left out");
@@ -127,15 +163,11 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         ui.label(r.groups.to_string());
         ui.end_row();
     });
-    ui.add_space(6.0);
-    let Some(current) = app.current_figures() else {
-        ui.horizontal(|ui| {
-            ui.spinner();
-            ui.label("Building…");
-        });
-        return;
-    };
-    gpu_lines(app, ui);
+}
+
+/// The tree's figures beside the strategy shown before (or, side by side, beside B with B − A),
+/// each per-ray figure marked where it is not of the image on screen.
+fn figures_table(app: &BvhscopeApp, ui: &mut egui::Ui, current: &StrategyFigures) {
     // Side by side, the second column is B and a third gives B − A; otherwise it is the strategy
     // shown before this one.
     let b = app.compare_figures();
@@ -144,7 +176,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let key = app.figures_key();
     // The current figures' per-ray rows, when they are not of the image on screen (another size,
     // camera, ray kind, seed or tree: Replay's smaller image, a new ray kind still rendering).
-    let stale_now = app.stale_figures(&current);
+    let stale_now = app.stale_figures(current);
     // The second column's per-ray figures: not shown at all for another ray kind (AO figures
     // beside shadow figures read as a comparison), marked stale for other rays of the same kind
     // (B: the same camera and rays; its traversal is its own).
@@ -177,7 +209,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         ui.end_row();
         for row in ROWS {
             ui.label(row.name).on_hover_text(row.tip);
-            let a = row.text(&current);
+            let a = row.text(current);
             match (&a, &stale_now) {
                 (Some(v), Some(why)) if row.per_ray => {
                     ui.weak(egui::RichText::new(format!("{v} (stale)")).italics())
@@ -203,7 +235,7 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
                 }
                 (Some(p), None) if comparing => {
                     ui.label(row.text(p).unwrap_or_default());
-                    ui.label(difference(row, &current, p).unwrap_or_default());
+                    ui.label(difference(row, current, p).unwrap_or_default());
                 }
                 (Some(p), None) => {
                     ui.weak(row.text(p).unwrap_or_default());
@@ -221,23 +253,10 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     if let Some(why) = &stale_now {
         ui.weak(egui::RichText::new(format!("(stale): the per-ray figures are {why}.")).italics());
     }
-    let c = current.stats.sah_constants;
-    let spec = app.settings.rays;
-    let which = match spec.kind.is_secondary() {
-        true => format!("the {} from the hits of the last full frame", spec.describe()),
-        false => "the primary rays of the last full frame".to_string(),
-    };
-    ui.weak(format!(
-        "Per-ray figures: {which} that enter the root box, unless a row says all rays. SAH cost with C_trav = {}, C_isect = {}.",
-        c.traversal, c.intersection
-    ))
-    .on_hover_text(combined_cost_text(c));
-    if let Some(built) = app.current_bvh().filter(|b| b.bvh.two_level().is_some()) {
-        two_level(ui, built, rays(&current));
-    }
-    warp_line(app, ui);
-    speedup(app, ui, out);
+}
 
+/// How many leaves hold each number of triangles, as bars.
+fn leaf_histogram(ui: &mut egui::Ui, current: &StrategyFigures) {
     ui.add_space(6.0);
     ui.label("Leaf sizes (triangles per leaf)").on_hover_text("How many leaves hold each number of triangles");
     let bars: Vec<Bar> = current

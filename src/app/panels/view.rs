@@ -36,9 +36,6 @@ fn contents(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         ui.add_space(12.0);
         trace_on(app, ui, &mut edited);
     });
-    let max_depth = app.current_bvh().map_or(0, |b| b.bottom_max_depth());
-    // The top level's depth, when two levels are built.
-    let top_depth = app.current_bvh().and_then(|b| b.top_stats.as_ref()).map(|s| s.max_depth);
     // The range on screen: side by side, the pair's one scale (A's alone would clip B's hottest
     // pixels); the difference's is its own ±range (below).
     let compared = app.compare_images(ui.ctx());
@@ -47,9 +44,33 @@ fn contents(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let legend_range =
         pair_range.or(app.shown.as_ref().and_then(|s| s.legend.as_ref())).map(|l| (l.range_min, l.range_max));
     let diff_legend = compared.as_ref().filter(|_| difference).and_then(|c| c.diff.as_ref()).map(|d| d.2.range_max);
+    let ranges = Ranges { legend: legend_range, difference, diff_legend };
     let cost = super::stats::combined_cost_text(app.settings.build.cost);
+    // The top level's depth, when two levels are built.
+    let top_depth = app.current_bvh().and_then(|b| b.top_stats.as_ref()).map(|s| s.max_depth);
     let s = &mut edited;
     gpu_choices(app, ui, s);
+    view_choices(ui, s, top_depth.is_some(), &cost);
+    ui.add_enabled_ui(s.view.is_heatmap(), |ui| heatmap_controls(ui, s, &ranges));
+    film_and_axis(app, ui, s);
+    ui.separator();
+    node_boxes(app, ui, s, top_depth);
+    if edited != app.settings {
+        out.push(Action::Edit(Box::new(edited)));
+    }
+}
+
+/// The heatmap's range on screen: this frame's (or the pair's) legend, and for Compare's
+/// difference B − A its own ± range.
+struct Ranges {
+    legend: Option<(f32, f32)>,
+    difference: bool,
+    diff_legend: Option<f32>,
+}
+
+/// The views, in two columns where both fit; the 64-lane switch of the warp views; the two-level
+/// views when two levels are built.
+fn view_choices(ui: &mut egui::Ui, s: &mut Settings, two_levels: bool, cost: &str) {
     // The warp views are listed once, at 32 lanes; "64 lanes" below switches the one shown.
     let listed = |v: &View| !v.is_per_level() && v.warp() != Some(WarpSize::W64);
     let shown = match s.view {
@@ -76,7 +97,7 @@ fn contents(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let count = labels.len();
     egui::Grid::new("views").num_columns(columns).show(ui, |ui| {
         for (i, (v, label)) in labels.into_iter().enumerate() {
-            if ui.radio(shown == v, label).on_hover_text(view_tip(v, &cost)).clicked() {
+            if ui.radio(shown == v, label).on_hover_text(view_tip(v, cost)).clicked() {
                 s.view = v;
             }
             if i % columns == columns - 1 {
@@ -99,93 +120,100 @@ fn contents(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             _ => View::SimtEfficiency(size),
         };
     }
-    if top_depth.is_some() {
+    if two_levels {
         ui.label("Two-level work (Nodes visited counts both levels)");
         for v in View::ALL.into_iter().filter(|v| v.is_per_level()) {
-            ui.radio_value(&mut s.view, v, v.label()).on_hover_text(view_tip(v, &cost));
+            ui.radio_value(&mut s.view, v, v.label()).on_hover_text(view_tip(v, cost));
         }
     }
-    ui.add_enabled_ui(s.view.is_heatmap(), |ui| {
-        // A row each: side by side, a narrow tile cut the rays' name to "Pri" (issue 59).
-        combo(ui, "Colour map", &mut s.colormap)
-            .on_hover_text("Perceptual colour maps: equal steps in value look like equal steps in colour");
-        combo(ui, "Rays", &mut s.rays.kind).on_hover_text("Which rays the heatmaps count: the camera's, or rays from each of its hits (bvhscope render --ray-kind). A pixel's value is the mean over its rays; grey pixels: the camera ray missed.");
-        ray_numbers(ui, &mut s.rays);
-        let view = s.view;
-        // The range's values are always there, beside the checkbox (greyed, this frame's, while
-        // auto): rows that came and went moved the controls below them between two clicks
-        // (issue 59), as do the fix button and the difference's row below.
-        let mut auto = !s.fixed_ranges.contains_key(&view);
-        let auto_range = legend_range.filter(|_| !difference).unwrap_or((0.0, 100.0));
-        let mut shown_range = s.fixed_ranges.get(&view).copied().unwrap_or(auto_range);
-        ui.horizontal_wrapped(|ui| {
-            if ui
-                .checkbox(&mut auto, "Auto range")
-                .on_hover_text("On: this frame's min..max. Off: a fixed range for this view, kept when the strategy changes so two strategies show in the same colours. Each view has its own; opening a scene clears them.")
-                .changed()
-            {
-                if auto {
-                    s.fixed_ranges.remove(&view);
-                } else {
-                    let (lo, hi) = legend_range.unwrap_or((0.0, 100.0));
-                    s.fixed_ranges.insert(view, (lo, hi.max(lo + 1.0)));
-                    shown_range = (lo, hi.max(lo + 1.0));
-                }
-            }
-            let why = "Auto range is on (this frame's min..max): uncheck it to set the range";
-            let min = egui::DragValue::new(&mut shown_range.0).speed(0.5).prefix("min ");
-            ui.add_enabled(!auto, min).on_disabled_hover_text(why);
-            let max = egui::DragValue::new(&mut shown_range.1).speed(0.5).prefix("max ");
-            ui.add_enabled(!auto, max).on_disabled_hover_text(why);
-        });
-        if let Some(range) = s.fixed_ranges.get_mut(&view) {
-            *range = shown_range;
-            if range.1 <= range.0 {
-                range.1 = range.0 + 1.0;
-            }
-        }
-        let fixable = legend_range.filter(|_| !difference);
-        let why = if difference {
-            "The difference B − A has its own ± range: the rows below"
-        } else {
-            "No heatmap on screen yet"
-        };
+}
+
+/// The colour map, the rays counted, and the range: auto, fixed, or the difference's ±.
+fn heatmap_controls(ui: &mut egui::Ui, s: &mut Settings, ranges: &Ranges) {
+    let (legend_range, difference, diff_legend) = (ranges.legend, ranges.difference, ranges.diff_legend);
+    // A row each: side by side, a narrow tile cut the rays' name to "Pri" (issue 59).
+    combo(ui, "Colour map", &mut s.colormap)
+        .on_hover_text("Perceptual colour maps: equal steps in value look like equal steps in colour");
+    combo(ui, "Rays", &mut s.rays.kind).on_hover_text("Which rays the heatmaps count: the camera's, or rays from each of its hits (bvhscope render --ray-kind). A pixel's value is the mean over its rays; grey pixels: the camera ray missed.");
+    ray_numbers(ui, &mut s.rays);
+    let view = s.view;
+    // The range's values are always there, beside the checkbox (greyed, this frame's, while
+    // auto): rows that came and went moved the controls below them between two clicks
+    // (issue 59), as do the fix button and the difference's row below.
+    let mut auto = !s.fixed_ranges.contains_key(&view);
+    let auto_range = legend_range.filter(|_| !difference).unwrap_or((0.0, 100.0));
+    let mut shown_range = s.fixed_ranges.get(&view).copied().unwrap_or(auto_range);
+    ui.horizontal_wrapped(|ui| {
         if ui
-            .add_enabled(fixable.is_some(), egui::Button::new("Fix the current range"))
-            .on_hover_text("Keep this scale for this view, to compare strategies on the same colours (side by side: the pair's one scale)")
-            .on_disabled_hover_text(why)
-            .clicked()
+            .checkbox(&mut auto, "Auto range")
+            .on_hover_text("On: this frame's min..max. Off: a fixed range for this view, kept when the strategy changes so two strategies show in the same colours. Each view has its own; opening a scene clears them.")
+            .changed()
         {
-            if let Some((lo, hi)) = fixable {
+            if auto {
+                s.fixed_ranges.remove(&view);
+            } else {
+                let (lo, hi) = legend_range.unwrap_or((0.0, 100.0));
                 s.fixed_ranges.insert(view, (lo, hi.max(lo + 1.0)));
+                shown_range = (lo, hi.max(lo + 1.0));
             }
         }
-        // The difference B − A (Compare): its own ±range, fixable as `render --difference --range`.
-        ui.add_enabled_ui(difference, |ui| {
-            ui.horizontal_wrapped(|ui| {
-            let why = "For Compare's Difference B − A only";
-            let mut fixed = s.diff_ranges.contains_key(&view);
-            if ui
-                .checkbox(&mut fixed, "Fixed difference range (±)")
-                .on_hover_text("Off: ± the 99th percentile of this difference's values. On: this ±range for this view, as bvhscope render --difference … --range -R:R")
-                .on_disabled_hover_text(why)
-                .changed()
-            {
-                if fixed {
-                    s.diff_ranges.insert(view, diff_legend.unwrap_or(10.0).abs().max(1.0));
-                } else {
-                    s.diff_ranges.remove(&view);
-                }
+        let why = "Auto range is on (this frame's min..max): uncheck it to set the range";
+        let min = egui::DragValue::new(&mut shown_range.0).speed(0.5).prefix("min ");
+        ui.add_enabled(!auto, min).on_disabled_hover_text(why);
+        let max = egui::DragValue::new(&mut shown_range.1).speed(0.5).prefix("max ");
+        ui.add_enabled(!auto, max).on_disabled_hover_text(why);
+    });
+    if let Some(range) = s.fixed_ranges.get_mut(&view) {
+        *range = shown_range;
+        if range.1 <= range.0 {
+            range.1 = range.0 + 1.0;
+        }
+    }
+    let fixable = legend_range.filter(|_| !difference);
+    let why = if difference {
+        "The difference B − A has its own ± range: the rows below"
+    } else {
+        "No heatmap on screen yet"
+    };
+    if ui
+        .add_enabled(fixable.is_some(), egui::Button::new("Fix the current range"))
+        .on_hover_text("Keep this scale for this view, to compare strategies on the same colours (side by side: the pair's one scale)")
+        .on_disabled_hover_text(why)
+        .clicked()
+    {
+        if let Some((lo, hi)) = fixable {
+            s.fixed_ranges.insert(view, (lo, hi.max(lo + 1.0)));
+        }
+    }
+    // The difference B − A (Compare): its own ±range, fixable as `render --difference --range`.
+    ui.add_enabled_ui(difference, |ui| {
+        ui.horizontal_wrapped(|ui| {
+        let why = "For Compare's Difference B − A only";
+        let mut fixed = s.diff_ranges.contains_key(&view);
+        if ui
+            .checkbox(&mut fixed, "Fixed difference range (±)")
+            .on_hover_text("Off: ± the 99th percentile of this difference's values. On: this ±range for this view, as bvhscope render --difference … --range -R:R")
+            .on_disabled_hover_text(why)
+            .changed()
+        {
+            if fixed {
+                s.diff_ranges.insert(view, diff_legend.unwrap_or(10.0).abs().max(1.0));
+            } else {
+                s.diff_ranges.remove(&view);
             }
-            let mut r = s.diff_ranges.get(&view).copied().or(diff_legend.map(f32::abs)).unwrap_or(10.0);
-            ui.add_enabled(fixed, egui::DragValue::new(&mut r).speed(0.5).range(0.001..=f32::MAX).prefix("± "))
-                .on_disabled_hover_text(if difference { "Check Fixed difference range to set it" } else { why });
-            if let Some(fixed) = s.diff_ranges.get_mut(&view) {
-                *fixed = r;
-            }
-            });
+        }
+        let mut r = s.diff_ranges.get(&view).copied().or(diff_legend.map(f32::abs)).unwrap_or(10.0);
+        ui.add_enabled(fixed, egui::DragValue::new(&mut r).speed(0.5).range(0.001..=f32::MAX).prefix("± "))
+            .on_disabled_hover_text(if difference { "Check Fixed difference range to set it" } else { why });
+        if let Some(fixed) = s.diff_ranges.get_mut(&view) {
+            *fixed = r;
+        }
         });
     });
+}
+
+/// Progressive refinement, the film's size and the up axis.
+fn film_and_axis(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings) {
     ui.checkbox(&mut s.progressive, "Progressive refinement")
         .on_hover_text("Coarse passes first (1/8, 1/4, 1/2, full)");
     ui.horizontal_wrapped(|ui| {
@@ -210,8 +238,11 @@ fn contents(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             ui.radio_value(&mut s.up_axis, a, a.label()).on_hover_text(a.help());
         }
     });
+}
 
-    ui.separator();
+/// The node-box overlay: on or off, its depth (per level when two are built), which boxes.
+fn node_boxes(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings, top_depth: Option<u32>) {
+    let max_depth = app.current_bvh().map_or(0, |b| b.bottom_max_depth());
     ui.heading("Node boxes");
     ui.checkbox(&mut s.show_boxes, "Show node boxes")
         .on_hover_text("The boxes of every node at the chosen depth, as wireframes over the image (B)");
@@ -249,9 +280,6 @@ fn contents(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     // Always a row (greyed with none drawn), so nothing moves when the boxes are switched on.
     let drawn = if s.show_boxes { format!("{} boxes drawn", app.boxes_drawn()) } else { "no boxes drawn".to_string() };
     ui.add_enabled(s.show_boxes, egui::Label::new(drawn));
-    if edited != app.settings {
-        out.push(Action::Edit(Box::new(edited)));
-    }
 }
 
 /// A labelled combo box of a choice from the option tables (`options::Choice`): its labels, each

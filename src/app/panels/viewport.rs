@@ -6,8 +6,7 @@
 use super::{explain_overlay, legend};
 use crate::app::state::{overlay, Action, Actions, BvhscopeApp, Shown};
 use crate::app::views::compare::CompareImages;
-use crate::render::Frame;
-use crate::render::PairView;
+use crate::render::{Frame, PairView};
 use egui::{Color32, PointerButton, Pos2, Rect, Sense, Stroke, Vec2};
 use std::sync::Arc;
 
@@ -51,8 +50,56 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     let response = ui.allocate_rect(full, Sense::click_and_drag());
     // The image's rectangle: the viewport, or the film letterboxed in it.
     let (rect, pixels) = image_area(app, full, ui.ctx().pixels_per_point());
+    pointer_input(app, ui, &response, rect, out);
+    if full != app.viewport_rect || rect != app.image_rect || pixels != app.viewport_pixels() {
+        out.push(Action::Viewport { rect: full, image: rect, pixels });
+    }
+    // Drawing over the image is clipped to it.
+    let painter = ui.painter_at(rect);
+    let around = ui.painter_at(full);
+    draw_image(app, ui, &painter, &around, rect);
 
-    // Camera input.
+    // Side by side: A and B over the image, as halves, a wipe, or their difference.
+    let compared = app.compare_images(ui.ctx());
+    if let Some(c) = &compared {
+        draw_compare(app, ui, &painter, rect, c, out);
+    }
+    draw_overlays(app, ui, &painter, rect, compared.is_none());
+    // Files dragged over the window.
+    if ui.ctx().input(|i| !i.raw.hovered_files.is_empty()) {
+        around.rect_filled(full, 0.0, Color32::from_black_alpha(160));
+        around.text(
+            full.center(),
+            egui::Align2::CENTER_CENTER,
+            "Drop a mesh or scene to open it, or a BVH dump to import it",
+            egui::FontId::proportional(22.0),
+            Color32::WHITE,
+        );
+    }
+
+    if let (Some(shown), Some((at, place))) = (&app.shown, legend_at) {
+        let compare_legend = compared.as_ref().and_then(|c| match app.compare.mode {
+            PairView::Difference => c.diff.as_ref().map(|d| d.2.clone()),
+            _ => c.legend.clone(),
+        });
+        // The histogram is of the image's own values: not drawn for a side-by-side pair.
+        if let Some(l) = compare_legend.as_ref() {
+            legend::show(app, ui, at, place, l, false, out);
+        } else if let Some(l) = shown.legend.as_ref() {
+            legend::show(app, ui, at, place, l, true, out);
+        }
+    }
+    if let Some(shown) = &app.shown {
+        if let Some(pos) = response.hover_pos() {
+            let frame = shown.frame.clone();
+            response.on_hover_ui_at_pointer(|ui| pixel_readout(ui, &frame, rect, pos));
+        }
+    }
+}
+
+/// The pointer over the image: dragging orbits or pans, the wheel zooms, a click pins a ray or
+/// selects a node.
+fn pointer_input(app: &BvhscopeApp, ui: &egui::Ui, response: &egui::Response, rect: Rect, out: &mut Actions) {
     if response.dragged_by(PointerButton::Primary) {
         let d = response.drag_delta();
         out.push(Action::Orbit(d.x, d.y));
@@ -85,15 +132,11 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
             out.push(Action::Zoom(scroll));
         }
     }
+}
 
-    if full != app.viewport_rect || rect != app.image_rect || pixels != app.viewport_pixels() {
-        out.push(Action::Viewport { rect: full, image: rect, pixels });
-    }
-
-    // The image, stretched to the viewport while a new size is on its way.
-    // Drawing over the image is clipped to it; the film's outline and its size around it.
-    let painter = ui.painter_at(rect);
-    let around = ui.painter_at(full);
+/// The image, stretched to the viewport while a new size is on its way; the film's outline and
+/// its size around it.
+fn draw_image(app: &BvhscopeApp, ui: &mut egui::Ui, painter: &egui::Painter, around: &egui::Painter, rect: Rect) {
     if let Some((w, h)) = app.film() {
         around.rect_stroke(rect.expand(1.0), 0.0, Stroke::new(1.0, Color32::from_gray(110)), egui::StrokeKind::Outside);
         let text = egui::RichText::new(format!("film {w}×{h}")).small().color(Color32::from_gray(150));
@@ -116,21 +159,19 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
         let busy = app.jobs.build.as_ref().map_or("Preparing…".to_string(), |b| format!("{}…", b.label));
         painter.text(rect.center(), egui::Align2::CENTER_CENTER, busy, egui::FontId::proportional(18.0), Color32::GRAY);
     }
+}
 
-    // Side by side: A and B over the image, as halves, a wipe, or their difference.
-    let compared = app.compare_images(ui.ctx());
-    if let Some(c) = &compared {
-        draw_compare(app, ui, &painter, rect, c, out);
-    }
-
+/// Over the image: the threshold's dimming and the imported tree's wrong pixels (not over a
+/// side-by-side pair), the node boxes, and the explain views' marks.
+fn draw_overlays(app: &BvhscopeApp, ui: &egui::Ui, painter: &egui::Painter, rect: Rect, single: bool) {
     // The legend histogram's threshold: the pixels at or below it dimmed.
     if let Some(shown) = &app.shown {
-        if let Some(mask) = app.threshold_mask(ui.ctx(), shown).filter(|_| compared.is_none()) {
+        if let Some(mask) = app.threshold_mask(ui.ctx(), shown).filter(|_| single) {
             painter.image(mask.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
         }
     }
     // An imported tree's pixels whose hit differs from the linear scan's, in red.
-    if let Some((mask, _)) = app.wrong_mask(ui.ctx()).filter(|_| compared.is_none()) {
+    if let Some((mask, _)) = app.wrong_mask(ui.ctx()).filter(|_| single) {
         painter.image(mask.id(), rect, Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)), Color32::WHITE);
     }
 
@@ -144,40 +185,9 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     }
 
     if let Some(shown) = &app.shown {
-        explain_overlay::draw_replay(app, &painter, rect, shown);
-        explain_overlay::draw_selected_node(app, &painter, rect, shown);
-        explain_overlay::draw_pinned(app, &painter, rect, &shown.camera);
-    }
-
-    // Files dragged over the window.
-    if ui.ctx().input(|i| !i.raw.hovered_files.is_empty()) {
-        around.rect_filled(full, 0.0, Color32::from_black_alpha(160));
-        around.text(
-            full.center(),
-            egui::Align2::CENTER_CENTER,
-            "Drop a mesh or scene to open it, or a BVH dump to import it",
-            egui::FontId::proportional(22.0),
-            Color32::WHITE,
-        );
-    }
-
-    if let (Some(shown), Some((at, place))) = (&app.shown, legend_at) {
-        let compare_legend = compared.as_ref().and_then(|c| match app.compare.mode {
-            PairView::Difference => c.diff.as_ref().map(|d| d.2.clone()),
-            _ => c.legend.clone(),
-        });
-        // The histogram is of the image's own values: not drawn for a side-by-side pair.
-        if let Some(l) = compare_legend.as_ref() {
-            legend::show(app, ui, at, place, l, false, out);
-        } else if let Some(l) = shown.legend.as_ref() {
-            legend::show(app, ui, at, place, l, true, out);
-        }
-    }
-    if let Some(shown) = &app.shown {
-        if let Some(pos) = response.hover_pos() {
-            let frame = shown.frame.clone();
-            response.on_hover_ui_at_pointer(|ui| pixel_readout(ui, &frame, rect, pos));
-        }
+        explain_overlay::draw_replay(app, painter, rect, shown);
+        explain_overlay::draw_selected_node(app, painter, rect, shown);
+        explain_overlay::draw_pinned(app, painter, rect, &shown.camera);
     }
 }
 

@@ -3,8 +3,7 @@
 
 use super::export;
 use crate::app::jobs::Pick;
-use crate::app::state::dock;
-use crate::app::state::{Action, BvhscopeApp, MessageKind, PathWindow, Settings, PRESENT_SCALE, UI_SCALES};
+use crate::app::state::{dock, Action, BvhscopeApp, MessageKind, PathWindow, Settings, PRESENT_SCALE, UI_SCALES};
 use crate::app::views::{PinnedRay, RayView, SecondaryOf};
 use crate::bvh::Strategy;
 use crate::render::{ColorMap, View};
@@ -15,6 +14,112 @@ use std::time::Instant;
 impl BvhscopeApp {
     /// Apply one action: the only place the state changes in answer to the user.
     pub fn act(&mut self, action: Action) {
+        use Action as A;
+        match action {
+            a @ (A::Open
+            | A::OpenPath
+            | A::OpenFile(..)
+            | A::ShowBuiltin
+            | A::SavePng
+            | A::SavePngTyped
+            | A::NoFileDialog(..)
+            | A::ExportStats
+            | A::ExportStatsJson
+            | A::ExportCounts
+            | A::SaveScene
+            | A::OpenBvh
+            | A::OpenBvhPath
+            | A::ImportFile(..)
+            | A::ExportBvh
+            | A::UseImported(..)
+            | A::ShowImported(..)
+            | A::WrongMask(..)
+            | A::OpenGradeReport
+            | A::OpenGradeReportPath
+            | A::OpenGradeReportFile(..)
+            | A::ShowGrade(..)
+            | A::ChooseStudent(..)
+            | A::SelectDumpNode(..)
+            | A::SelectTriangle(..)
+            | A::Picked(..)
+            | A::PathText(..)
+            | A::PathFocused
+            | A::ClosePathWindow) => self.act_file(a),
+            a @ (A::Orbit(..)
+            | A::Pan { .. }
+            | A::Zoom(..)
+            | A::FrameMesh
+            | A::ResetView
+            | A::Viewport { .. }
+            | A::View(..)
+            | A::SetThreshold(..)
+            | A::ToggleBoxes
+            | A::DepthUp
+            | A::DepthDown
+            | A::NextStrategy
+            | A::NextColormap
+            | A::ApplyPreset(..)
+            | A::SetUpAxis(..)
+            | A::Edit(..)
+            | A::SetCamera(..)) => self.act_view(a),
+            a @ (A::Compare(..)
+            | A::CompareStrategy(..)
+            | A::CompareB { .. }
+            | A::CompareMode(..)
+            | A::Wipe(..)
+            | A::ShowReplay(..)
+            | A::ReplayStep(..)
+            | A::ReplayPlay(..)
+            | A::ExportReplay
+            | A::CancelFilm) => self.act_compare(a),
+            a @ (A::PinPixel(..)
+            | A::PinSecondary(..)
+            | A::PinTyped
+            | A::RayText { .. }
+            | A::Unpin(..)
+            | A::UnpinAll
+            | A::SelectPinned(..)
+            | A::RayStep(..)
+            | A::RayStepBy(..)
+            | A::RayPlay(..)
+            | A::ShowRayWindow
+            | A::Hottest { .. }
+            | A::TimeLinear(..)
+            | A::CopyTraceCommand) => self.act_ray(a),
+            a @ (A::ShowTree(..)
+            | A::SelectNode(..)
+            | A::SelectPixelNode(..)
+            | A::NodeStep(..)
+            | A::ToggleOpen(..)
+            | A::SetMetric(..)
+            | A::SharedCostScale(..)) => self.act_nodes(a),
+            a @ (A::Help
+            | A::SetHelp(..)
+            | A::Dismiss(..)
+            | A::DismissEarlier(..)
+            | A::Present(..)
+            | A::TogglePresent
+            | A::UiScale(..)
+            | A::UiScaleBy(..)
+            | A::ResetLayout
+            | A::FoldLegend(..)) => self.act_window(a),
+            a @ (A::OpenLesson
+            | A::OpenLessonPath
+            | A::OpenLessonFile(_)
+            | A::LessonGo(_)
+            | A::LessonNext
+            | A::LessonPrevious
+            | A::NewLesson
+            | A::AddStep
+            | A::ReplaceStep
+            | A::LessonText { .. }
+            | A::LessonEditing(_)
+            | A::SaveLesson
+            | A::CloseLesson) => self.act_lesson(a),
+        }
+    }
+    /// Opening, saving and exporting files, the path window, the import and the grade report.
+    fn act_file(&mut self, action: Action) {
         use Action as A;
         match action {
             A::Open => self.jobs.pick_file(Pick::Open, ""),
@@ -70,6 +175,14 @@ impl BvhscopeApp {
                 }
             }
             A::ClosePathWindow => self.path_window = None,
+            _ => unreachable!("act sends only its file actions here"),
+        }
+    }
+
+    /// The camera, the view and the boxes shown, and the build settings changed from the keyboard.
+    fn act_view(&mut self, action: Action) {
+        use Action as A;
+        match action {
             A::Orbit(dx, dy) => self.orbit.orbit(dx, dy),
             A::Pan { dx, dy, height } => self.orbit.pan(dx, dy, height),
             A::Zoom(amount) => self.orbit.zoom(amount),
@@ -86,6 +199,49 @@ impl BvhscopeApp {
                 self.threshold = None;
             }
             A::SetThreshold(t) => self.threshold = t,
+            A::ToggleBoxes => self.settings.show_boxes = !self.settings.show_boxes,
+            A::DepthUp => {
+                let max = self.current_bvh().map_or(0, |b| b.bottom_max_depth());
+                self.settings.box_depth = (self.settings.box_depth + 1).min(max);
+                self.settings.show_boxes = true;
+            }
+            A::DepthDown => {
+                self.settings.box_depth = self.settings.box_depth.saturating_sub(1);
+                self.settings.show_boxes = true;
+            }
+            A::NextStrategy => {
+                self.import.on = false;
+                let i = Strategy::ALL.iter().position(|s| *s == self.settings.build.strategy).unwrap_or(0);
+                self.settings.build.strategy = Strategy::ALL[(i + 1) % Strategy::ALL.len()];
+            }
+            A::NextColormap => {
+                let i = ColorMap::ALL.iter().position(|c| *c == self.settings.colormap).unwrap_or(0);
+                self.settings.colormap = ColorMap::ALL[(i + 1) % ColorMap::ALL.len()];
+            }
+            A::ApplyPreset(preset) => {
+                self.settings.apply_preset(preset);
+                self.message(MessageKind::Info, format!("{}: {}", preset.label(), preset.help()));
+            }
+            A::SetUpAxis(up) => {
+                if self.settings.up_axis != up {
+                    self.settings.up_axis = up;
+                    self.reset_view();
+                }
+            }
+            A::Edit(settings) => {
+                let up = settings.up_axis;
+                self.settings = Settings { up_axis: self.settings.up_axis, ..*settings };
+                self.act(A::SetUpAxis(up));
+            }
+            A::SetCamera(camera) => self.set_camera(camera),
+            _ => unreachable!("act sends only its view actions here"),
+        }
+    }
+
+    /// Side by side and the build replay.
+    fn act_compare(&mut self, action: Action) {
+        use Action as A;
+        match action {
             A::Compare(on) => {
                 if on && !self.compare.on {
                     let imported = self.import.shown(self.scene_id).map(|b| b.build_params().bvh.layout);
@@ -129,40 +285,14 @@ impl BvhscopeApp {
                     job.control.cancel();
                 }
             }
-            A::ToggleBoxes => self.settings.show_boxes = !self.settings.show_boxes,
-            A::DepthUp => {
-                let max = self.current_bvh().map_or(0, |b| b.bottom_max_depth());
-                self.settings.box_depth = (self.settings.box_depth + 1).min(max);
-                self.settings.show_boxes = true;
-            }
-            A::DepthDown => {
-                self.settings.box_depth = self.settings.box_depth.saturating_sub(1);
-                self.settings.show_boxes = true;
-            }
-            A::NextStrategy => {
-                self.import.on = false;
-                let i = Strategy::ALL.iter().position(|s| *s == self.settings.build.strategy).unwrap_or(0);
-                self.settings.build.strategy = Strategy::ALL[(i + 1) % Strategy::ALL.len()];
-            }
-            A::NextColormap => {
-                let i = ColorMap::ALL.iter().position(|c| *c == self.settings.colormap).unwrap_or(0);
-                self.settings.colormap = ColorMap::ALL[(i + 1) % ColorMap::ALL.len()];
-            }
-            A::ApplyPreset(preset) => {
-                self.settings.apply_preset(preset);
-                self.message(MessageKind::Info, format!("{}: {}", preset.label(), preset.help()));
-            }
-            A::SetUpAxis(up) => {
-                if self.settings.up_axis != up {
-                    self.settings.up_axis = up;
-                    self.reset_view();
-                }
-            }
-            A::Edit(settings) => {
-                let up = settings.up_axis;
-                self.settings = Settings { up_axis: self.settings.up_axis, ..*settings };
-                self.act(A::SetUpAxis(up));
-            }
+            _ => unreachable!("act sends only its compare actions here"),
+        }
+    }
+
+    /// Pinned rays: pinning, stepping, the hottest pixels, the linear-scan timing and the trace command.
+    fn act_ray(&mut self, action: Action) {
+        use Action as A;
+        match action {
             A::PinPixel(x, y) => {
                 let Some(s) = &self.shown else { return };
                 if s.partial.is_some() {
@@ -218,51 +348,6 @@ impl BvhscopeApp {
                 }
             }
             A::ShowRayWindow => self.ray_window = true,
-            A::ShowTree(open) => {
-                self.nodes.window = open;
-                if open && self.nodes.selected.is_none() {
-                    self.nodes.selected = Some(0);
-                    self.nodes.inspection = None;
-                }
-            }
-            A::SelectNode(n) => {
-                self.nodes.window = true;
-                self.nodes.select(n);
-            }
-            A::SelectPixelNode(x, y) => {
-                let Some(shown) = &self.shown else { return };
-                let explained = self.nodes.current(Some(&shown.bvh)).cloned();
-                match (explained, shown.frame.sample(x, y)) {
-                    (_, s) if !s.is_hit() => self.message(MessageKind::Info, "That pixel hits nothing: no leaf to select."),
-                    (Some(e), s) => match e.hierarchy.leaf_of_hit(&e.tree, s.prim, shown.camera.ray_gen().pixel_ray(x, y).at(s.t)) {
-                        Some(leaf) => self.act(A::SelectNode(leaf)),
-                        None => self.message(MessageKind::Warning, "The pixel's triangle is in no leaf of this tree."),
-                    },
-                    (None, _) => self.message(
-                        MessageKind::Info,
-                        "The tree view is still being prepared (or the scene is built as two levels, which it does not show).",
-                    ),
-                }
-            }
-            A::NodeStep(step) => {
-                if let Some(n) = self.nodes.step(step) {
-                    self.nodes.select(n);
-                }
-            }
-            A::ToggleOpen(n) => {
-                if !self.nodes.open.remove(&n) {
-                    self.nodes.open.insert(n);
-                }
-            }
-            A::SetMetric(m) => self.nodes.metric = m,
-            A::Help => self.show_help = !self.show_help,
-            A::SetHelp(on) => self.show_help = on,
-            A::Dismiss(i) => {
-                if i < self.messages.len() {
-                    self.messages.remove(i);
-                }
-            }
-            A::SharedCostScale(on) => self.nodes.shared_scale = on,
             A::Hottest { next } => {
                 let Some(s) = self.shown.as_ref() else { return };
                 let k = if next { self.hottest.map_or(0, |k| k + 1) } else { 0 };
@@ -301,6 +386,67 @@ impl BvhscopeApp {
                 ),
                 None => self.message(MessageKind::Info, "Pin a ray first (Ctrl+click on the image)"),
             },
+            _ => unreachable!("act sends only its ray actions here"),
+        }
+    }
+
+    /// The tree view and the node inspector.
+    fn act_nodes(&mut self, action: Action) {
+        use Action as A;
+        match action {
+            A::ShowTree(open) => {
+                self.nodes.window = open;
+                if open && self.nodes.selected.is_none() {
+                    self.nodes.selected = Some(0);
+                    self.nodes.inspection = None;
+                }
+            }
+            A::SelectNode(n) => {
+                self.nodes.window = true;
+                self.nodes.select(n);
+            }
+            A::SelectPixelNode(x, y) => {
+                let Some(shown) = &self.shown else { return };
+                let explained = self.nodes.current(Some(&shown.bvh)).cloned();
+                match (explained, shown.frame.sample(x, y)) {
+                    (_, s) if !s.is_hit() => self.message(MessageKind::Info, "That pixel hits nothing: no leaf to select."),
+                    (Some(e), s) => match e.hierarchy.leaf_of_hit(&e.tree, s.prim, shown.camera.ray_gen().pixel_ray(x, y).at(s.t)) {
+                        Some(leaf) => self.act(A::SelectNode(leaf)),
+                        None => self.message(MessageKind::Warning, "The pixel's triangle is in no leaf of this tree."),
+                    },
+                    (None, _) => self.message(
+                        MessageKind::Info,
+                        "The tree view is still being prepared (or the scene is built as two levels, which it does not show).",
+                    ),
+                }
+            }
+            A::NodeStep(step) => {
+                if let Some(n) = self.nodes.step(step) {
+                    self.nodes.select(n);
+                }
+            }
+            A::ToggleOpen(n) => {
+                if !self.nodes.open.remove(&n) {
+                    self.nodes.open.insert(n);
+                }
+            }
+            A::SetMetric(m) => self.nodes.metric = m,
+            A::SharedCostScale(on) => self.nodes.shared_scale = on,
+            _ => unreachable!("act sends only its nodes actions here"),
+        }
+    }
+
+    /// Help, messages, presenting, the UI scale and the dock.
+    fn act_window(&mut self, action: Action) {
+        use Action as A;
+        match action {
+            A::Help => self.show_help = !self.show_help,
+            A::SetHelp(on) => self.show_help = on,
+            A::Dismiss(i) => {
+                if i < self.messages.len() {
+                    self.messages.remove(i);
+                }
+            }
             A::Present(on) => self.settings.present = on,
             A::TogglePresent => self.settings.present = !self.settings.present,
             A::UiScale(s) => self.settings.ui_scale = s.clamp(*UI_SCALES.start(), *UI_SCALES.end()),
@@ -315,23 +461,10 @@ impl BvhscopeApp {
                 self.dock_presenting = None;
             }
             A::FoldLegend(folded) => self.settings.legend_folded = folded,
-            A::SetCamera(camera) => self.set_camera(camera),
-            a @ (A::OpenLesson
-            | A::OpenLessonPath
-            | A::OpenLessonFile(_)
-            | A::LessonGo(_)
-            | A::LessonNext
-            | A::LessonPrevious
-            | A::NewLesson
-            | A::AddStep
-            | A::ReplaceStep
-            | A::LessonText { .. }
-            | A::LessonEditing(_)
-            | A::SaveLesson
-            | A::CloseLesson) => self.act_lesson(a),
             A::DismissEarlier(n) => {
                 self.messages.drain(..n.min(self.messages.len()));
             }
+            _ => unreachable!("act sends only its window actions here"),
         }
     }
 }

@@ -5,8 +5,7 @@
 //! and the inspector show; its inspection (`explain::inspect`) is computed in the background too,
 //! since a node of millions of triangles takes a moment to sweep.
 
-use crate::bvh::Hierarchy;
-use crate::bvh::{Bvh, SceneBvh, TraceOptions};
+use crate::bvh::{Bvh, Hierarchy, SceneBvh, TraceOptions};
 use crate::explain::inspect::Inspection;
 use crate::render::Camera;
 use std::collections::HashSet;

@@ -7,11 +7,9 @@
 use super::rows::CompareRow;
 use crate::bvh::{AnyBvh, BuildParams, Bvh, Layout, SceneBvh, Strategy, TraceOptions, TreeStats, TreeView};
 use crate::cli::args::BuildArgs;
-use crate::cli::device;
 use crate::cli::error::CliError;
-use crate::cli::progress;
-use crate::gpu_path::GpuNodes;
-use crate::gpu_path::GpuTree;
+use crate::cli::{device, progress};
+use crate::gpu_path::{GpuNodes, GpuTree};
 use crate::mesh::Mesh;
 use crate::render::warp::{WarpSize, WarpView, WarpWork};
 use crate::render::Camera;

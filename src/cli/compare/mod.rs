@@ -22,11 +22,14 @@ mod rows;
 pub use csv::{rows_csv, rows_csv_with_gpu};
 pub use rows::{compare_rows, CompareRow};
 
+use crate::bvh::TraceOptions;
 use crate::cli::args::{BuildArgs, DeviceArgs, ViewArgs};
+use crate::cli::compare::rows::CompareSetup;
 use crate::cli::error::CliError;
 use crate::cli::load::load_mesh;
 use crate::gpu_path::GpuNodes;
 use crate::options::Named;
+use crate::render::Camera;
 use clap::Args;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -121,7 +124,6 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
         Some(g) => Some(gpu::gpu_rows(g, &mesh_arc, &camera, &a.build, scene, a.runs, &formats, linear_ms)?),
         None => None,
     };
-    let rays = setup.rays;
     let mut o = String::new();
     match a.format {
         CompareFormat::Json => {
@@ -147,61 +149,7 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
             }
         }
         CompareFormat::Markdown => {
-            let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | EPO | nodes / ray: all / in root box | tri tests / ray: all / in root box | trace ms | frame ms | speedup vs linear |");
-            let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
-            for r in &rows {
-                let depth =
-                    if r.nodes > 0 { format!("{} / {:.1}", r.max_depth, r.mean_leaf_depth) } else { "—".into() };
-                let sampled = if r.sampled_rays.is_some() { " *" } else { "" };
-                let dash = |v: Option<f64>, d: usize| v.map_or("—".to_string(), |v| format!("{v:.d$}"));
-                let _ = writeln!(
-                    o,
-                    "| {} | {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} / {:.1} | {}{sampled} | {}{sampled} | {:.0}× |",
-                    r.name,
-                    r.build_ms.map_or("—".to_string(), crate::bvh::fmt_ms),
-                    r.nodes,
-                    depth,
-                    dash(r.sah_cost, 2),
-                    r.epo.map_or("—".to_string(), |v| match r.epo_error {
-                        Some(e) => crate::bvh::epo::figure(v, Some(e)),
-                        None => format!("{v:.2}"),
-                    }),
-                    r.nodes_per_ray,
-                    r.root_nodes_per_ray,
-                    r.tri_tests_per_ray,
-                    r.root_tri_tests_per_ray,
-                    crate::bvh::fmt_ms(r.trace_ms),
-                    crate::bvh::fmt_ms(r.frame_ms),
-                    r.speedup_over_linear
-                );
-            }
-            let _ = writeln!(o);
-            let preset = a.build.preset.map_or(String::new(), |p| format!("preset {}; ", p.name()));
-            let _ = writeln!(
-                o,
-                "{}: {} triangles; {}x{} primary rays ({} rays, {} = {:.0}% enter the root box); {preset}traversal {}, {} test.",
-                a.mesh.display(), mesh.triangle_count(), camera.width, camera.height, rays, setup.root_rays,
-                100.0 * setup.root_rays as f64 / rays.max(1) as f64, trace.order.label(), trace.test.label()
-            );
-            let _ = writeln!(
-                o,
-                "trace ms: single rays, closest hit, no shading, {} thread(s); frame ms: the renderer (8×8 packets, shading) on {} thread(s); medians of up to {} frames; build ms: median of up to {} builds on {} thread(s) (fewer runs of each where they pass a second in all); speedup: the linear scan's trace ms over the row's.",
-                setup.trace_threads, setup.frame_threads, a.runs, a.runs, setup.frame_threads
-            );
-            if rows.iter().any(|r| r.epo_error.is_some()) {
-                let _ = writeln!(o, "EPO a ± b: estimated, where summing every node's overlap would cost more than about the build (± two standard errors).");
-            }
-            if let Some(n) = rows.last().and_then(|r| r.sampled_rays) {
-                let _ = writeln!(o, "* linear scan timed on {n} of {rays} rays (a full frame would take over 10 s) and scaled to the full frame.");
-            }
-            let fallbacks: Vec<String> = rows
-                .iter()
-                .filter(|r| r.fallback_splits > 0)
-                .map(|r| format!("{} {}", r.name, r.fallback_splits))
-                .collect();
-            if !fallbacks.is_empty() {
-                let _ = writeln!(o, "Equal-count fallback splits (no useful split found): {}.", fallbacks.join(", "));
-            }
+            o = markdown(a, &rows, &setup, mesh, &camera, trace);
             if let (Some(g), Some((r, n))) = (&gpu, &gpu_rows) {
                 o += &gpu::markdown(g, r, &camera, *n, a.runs, trace);
             }
@@ -213,4 +161,69 @@ pub fn run(a: &CompareArgs) -> Result<(), CliError> {
     }
     crate::cli::out(&o);
     Ok(())
+}
+
+/// The Markdown table of the rows, and the notes that say what its figures are.
+fn markdown(
+    a: &CompareArgs,
+    rows: &[CompareRow],
+    setup: &CompareSetup,
+    mesh: &crate::mesh::Mesh,
+    camera: &Camera,
+    trace: TraceOptions,
+) -> String {
+    let mut o = String::new();
+    let rays = setup.rays;
+    let _ = writeln!(o, "| strategy | build ms | nodes | depth max / mean | SAH cost | EPO | nodes / ray: all / in root box | tri tests / ray: all / in root box | trace ms | frame ms | speedup vs linear |");
+    let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in rows {
+        let depth = if r.nodes > 0 { format!("{} / {:.1}", r.max_depth, r.mean_leaf_depth) } else { "—".into() };
+        let sampled = if r.sampled_rays.is_some() { " *" } else { "" };
+        let dash = |v: Option<f64>, d: usize| v.map_or("—".to_string(), |v| format!("{v:.d$}"));
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} / {:.1} | {}{sampled} | {}{sampled} | {:.0}× |",
+            r.name,
+            r.build_ms.map_or("—".to_string(), crate::bvh::fmt_ms),
+            r.nodes,
+            depth,
+            dash(r.sah_cost, 2),
+            r.epo.map_or("—".to_string(), |v| match r.epo_error {
+                Some(e) => crate::bvh::epo::figure(v, Some(e)),
+                None => format!("{v:.2}"),
+            }),
+            r.nodes_per_ray,
+            r.root_nodes_per_ray,
+            r.tri_tests_per_ray,
+            r.root_tri_tests_per_ray,
+            crate::bvh::fmt_ms(r.trace_ms),
+            crate::bvh::fmt_ms(r.frame_ms),
+            r.speedup_over_linear
+        );
+    }
+    let _ = writeln!(o);
+    let preset = a.build.preset.map_or(String::new(), |p| format!("preset {}; ", p.name()));
+    let _ = writeln!(
+        o,
+        "{}: {} triangles; {}x{} primary rays ({} rays, {} = {:.0}% enter the root box); {preset}traversal {}, {} test.",
+        a.mesh.display(), mesh.triangle_count(), camera.width, camera.height, rays, setup.root_rays,
+        100.0 * setup.root_rays as f64 / rays.max(1) as f64, trace.order.label(), trace.test.label()
+    );
+    let _ = writeln!(
+        o,
+        "trace ms: single rays, closest hit, no shading, {} thread(s); frame ms: the renderer (8×8 packets, shading) on {} thread(s); medians of up to {} frames; build ms: median of up to {} builds on {} thread(s) (fewer runs of each where they pass a second in all); speedup: the linear scan's trace ms over the row's.",
+        setup.trace_threads, setup.frame_threads, a.runs, a.runs, setup.frame_threads
+    );
+    if rows.iter().any(|r| r.epo_error.is_some()) {
+        let _ = writeln!(o, "EPO a ± b: estimated, where summing every node's overlap would cost more than about the build (± two standard errors).");
+    }
+    if let Some(n) = rows.last().and_then(|r| r.sampled_rays) {
+        let _ = writeln!(o, "* linear scan timed on {n} of {rays} rays (a full frame would take over 10 s) and scaled to the full frame.");
+    }
+    let fallbacks: Vec<String> =
+        rows.iter().filter(|r| r.fallback_splits > 0).map(|r| format!("{} {}", r.name, r.fallback_splits)).collect();
+    if !fallbacks.is_empty() {
+        let _ = writeln!(o, "Equal-count fallback splits (no useful split found): {}.", fallbacks.join(", "));
+    }
+    o
 }

@@ -1,7 +1,7 @@
 //! The table's rows: every strategy built and measured on the same primary rays, next to a
 //! linear scan of all triangles (how, in `compare`'s module comment).
 
-use crate::bvh::{epo, AnyBvh, BuildParams, Hierarchy, LinearScan, Strategy, TreeStats, TreeView};
+use crate::bvh::{epo, AnyBvh, BuildParams, Hierarchy, LinearScan, Strategy, TraceOptions, TreeStats, TreeView};
 use crate::cli::args::BuildArgs;
 use crate::cli::progress;
 use crate::explain::timing::{self, ms, time_linear, time_tree};
@@ -194,18 +194,46 @@ pub fn compare_rows(
         }
         rows.push(row);
     }
+    let linear = linear_scan_row(mesh, camera, trace, linear_budget, (&frames, &traces));
+    let linear_ms = linear.trace_ms;
+    rows.push(linear);
+    for r in &mut rows {
+        r.speedup_over_linear = linear_ms / r.trace_ms;
+    }
+    if let Some(k) = kinds {
+        k.done(mesh, linear_budget, &traces);
+    }
+    let setup = CompareSetup {
+        trace_threads: traces.current_num_threads(),
+        frame_threads: frames.current_num_threads(),
+        root_rays,
+        rays: rays as u64,
+    };
+    (rows, setup)
+}
+
+/// The linear scan's row: its single-ray trace timed on the trace threads, its "frame" (the scan
+/// has no packets) on the frame threads, each within `budget` (sampled past it).
+fn linear_scan_row(
+    mesh: &crate::mesh::Mesh,
+    camera: &Camera,
+    trace: TraceOptions,
+    budget: Duration,
+    (frames, traces): (&rayon::ThreadPool, &rayon::ThreadPool),
+) -> CompareRow {
     let linear = LinearScan::new(mesh);
     let ((linear_ms, sampled), (frame_ms, _)) = progress::with_spinner("timing the linear scan", || {
         // The scan has no packets: its "frame" is its trace on the frame's threads.
         let control = crate::work::WorkControl::new();
         let timed = |pool: &rayon::ThreadPool| {
-            pool.install(|| time_linear(&linear, camera, trace, linear_budget, &control))
+            pool.install(|| time_linear(&linear, camera, trace, budget, &control))
                 .expect("nobody else holds this control")
         };
-        (timed(&traces), timed(&frames))
+        (timed(traces), timed(frames))
     });
     let n = mesh.triangle_count() as f64;
-    rows.push(CompareRow {
+    let rays = camera.width as f64 * camera.height as f64;
+    CompareRow {
         name: "Linear scan".to_string(),
         build_ms: None,
         nodes: 0,
@@ -225,18 +253,5 @@ pub fn compare_rows(
         speedup_over_linear: 1.0,
         sampled_rays: sampled,
         fallback_splits: 0,
-    });
-    for r in &mut rows {
-        r.speedup_over_linear = linear_ms / r.trace_ms;
     }
-    if let Some(k) = kinds {
-        k.done(mesh, linear_budget, &traces);
-    }
-    let setup = CompareSetup {
-        trace_threads: traces.current_num_threads(),
-        frame_threads: frames.current_num_threads(),
-        root_rays,
-        rays: rays as u64,
-    };
-    (rows, setup)
 }

@@ -1,8 +1,7 @@
 //! The SBVH's tests (`sbvh.rs`).
 
 use crate::bvh::node::Bvh;
-use crate::bvh::params::Strategy;
-use crate::bvh::params::{BuildParams, Layout};
+use crate::bvh::params::{BuildParams, Layout, Strategy};
 use crate::bvh::stats::TreeStats;
 use crate::mesh::generate;
 

@@ -1,15 +1,12 @@
 //! Tests of `packet.rs`: packets against single rays, and the frustum test against the slab test.
 
 use super::walk::*;
-use crate::bvh::accel::Accelerator;
-use crate::bvh::accel::PACKET;
-use crate::bvh::accel::{Hit, TraceOptions};
+use crate::bvh::accel::{Accelerator, Hit, TraceOptions, PACKET};
 use crate::bvh::any::AnyBvh;
 use crate::bvh::counters::NoStats;
 use crate::bvh::packet::lanes::Four;
 use crate::bvh::packet::state::Packet;
-use crate::bvh::params::Strategy;
-use crate::bvh::params::{BuildParams, Layout};
+use crate::bvh::params::{BuildParams, Layout, Strategy};
 use crate::geometry::{Aabb, Ray};
 use crate::mesh::generate::{builtin_scene, torus_knot};
 use crate::mesh::Mesh;

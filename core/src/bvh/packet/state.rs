@@ -3,8 +3,7 @@
 //! triangle test, and each ray's hit so far.
 
 use super::lanes::PacketLanes;
-use crate::bvh::accel::Hit;
-use crate::bvh::accel::PACKET;
+use crate::bvh::accel::{Hit, PACKET};
 use crate::geometry::slab_packet::RayInterval;
 use crate::geometry::{Ray, TriangleHit, TriangleIntersector};
 use std::mem::MaybeUninit;

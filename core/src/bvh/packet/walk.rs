@@ -1,7 +1,6 @@
 //! The packet walk: 8×8 rays through one tree, lanes masked as they leave.
 
-use crate::bvh::accel::PACKET;
-use crate::bvh::accel::{Hit, TraceOptions};
+use crate::bvh::accel::{Hit, TraceOptions, PACKET};
 use crate::bvh::node::{Bvh, TRAVERSAL_STACK_SIZE};
 use crate::bvh::packet::lanes::{Four, PacketLanes};
 use crate::bvh::packet::state::Packet;

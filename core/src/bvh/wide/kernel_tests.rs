@@ -6,8 +6,7 @@
 //! one (`geometry::triangle8`, Möller–Trumbore too), and the AVX-512 one in 256-bit, 512-bit and
 //! two passes.
 
-use crate::bvh::accel::TraceOptions;
-use crate::bvh::accel::{Accelerator, Hit};
+use crate::bvh::accel::{Accelerator, Hit, TraceOptions};
 use crate::bvh::any::AnyBvh;
 use crate::bvh::counters::{NoStats, RayCounters};
 use crate::bvh::linear::LinearScan;

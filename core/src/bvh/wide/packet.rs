@@ -5,8 +5,7 @@
 
 use crate::bvh::packet::walk::PacketTree;
 use crate::bvh::wide::wide_bvh::{ChildRef, WideBvh};
-use crate::geometry::Aabb;
-use crate::geometry::{slab::Boxes4, slab_packet::RayInterval};
+use crate::geometry::{slab::Boxes4, slab_packet::RayInterval, Aabb};
 use glam::Vec3;
 use wide::f32x4;
 

@@ -11,8 +11,7 @@
 //! arrived (BENCHMARKS.md, sixth round).
 
 use crate::bvh::accel::{Accelerator, Hit, TraceOptions};
-use crate::bvh::counters::NodeId;
-use crate::bvh::counters::TraversalStats;
+use crate::bvh::counters::{NodeId, TraversalStats};
 use crate::bvh::stack::TraversalStack;
 use crate::bvh::traverse::{test_triangles, test_triangles_grouped, Groups4, LeafGroups};
 use crate::bvh::wide::node::WideNode;

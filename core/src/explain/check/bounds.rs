@@ -67,15 +67,26 @@ struct Cause {
 }
 
 pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Finding>) {
-    let (nodes, prims) = (&dump.nodes, &dump.primitives);
     let by_file = mesh.triangles_by_file_number();
-    let tris = by_file.len();
-    let leaf_prims = |i: usize| -> Option<&[u32]> {
-        let n = &nodes[i];
-        let (Some(f), Some(c), None) = (n.first, n.count, &n.children) else { return None };
-        prims.get(f as usize..f as usize + c as usize)
-    };
-    // First pass: how many distinct leaves hold each triangle; a triangle twice in one leaf.
+    let (leaves_of, twice) = leaves_per_triangle(dump, walk, by_file.len());
+    let regions = walk_regions(dump, mesh, &by_file, walk, &leaves_of);
+    report_causes(dump, regions.causes, out);
+    report_cut(mesh, &by_file, &regions.shared, &regions.reach, out);
+    report_missing(mesh, &by_file, &regions.covered, out);
+    regions.degenerate_in.finish(out);
+    twice.finish(out);
+}
+
+/// Leaf `i`'s triangles (file numbers), when it is a leaf whose range lies in the dump.
+fn leaf_prims(dump: &BvhDump, i: usize) -> Option<&[u32]> {
+    let n = &dump.nodes[i];
+    let (Some(f), Some(c), None) = (n.first, n.count, &n.children) else { return None };
+    dump.primitives.get(f as usize..f as usize + c as usize)
+}
+
+/// The first pass: how many distinct reached leaves hold each triangle, and the triangles a leaf
+/// holds twice.
+fn leaves_per_triangle(dump: &BvhDump, walk: &Walk, tris: usize) -> (Vec<u32>, Tally) {
     let mut leaves_of = vec![0u32; tris];
     let mut last = vec![u32::MAX; tris];
     let mut twice = Tally::new(
@@ -84,8 +95,8 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
         "triangle is referenced twice in one leaf (tested twice by every ray that reaches it)",
         "triangles are referenced twice in one leaf (tested twice by every ray that reaches it)",
     );
-    for i in (0..nodes.len()).filter(|&i| walk.reached[i]) {
-        for &p in leaf_prims(i).into_iter().flatten() {
+    for i in (0..dump.nodes.len()).filter(|&i| walk.reached[i]) {
+        for &p in leaf_prims(dump, i).into_iter().flatten() {
             let Some(l) = last.get_mut(p as usize) else { continue };
             if *l == i as u32 {
                 twice.add(Some(i as u32), Some(p), format!("triangle {p} (leaf node {i})"));
@@ -95,49 +106,68 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
             }
         }
     }
-    // Second pass: the walk from the root with the path and each node's reachable region.
-    let mut reach = vec![Aabb::EMPTY; nodes.len()];
+    (leaves_of, twice)
+}
+
+/// What the walk from the root finds: each node's reachable region, the boxes that leave a
+/// triangle of one leaf out (by the highest node at fault and its child on the path), the
+/// triangles cut among several leaves (with their leaves), which triangles are in a leaf, and
+/// the degenerate ones that are.
+struct Regions {
+    reach: Vec<Aabb>,
+    causes: BTreeMap<(u32, Option<u32>), Cause>,
+    shared: BTreeMap<u32, Vec<usize>>,
+    covered: Vec<bool>,
+    degenerate_in: Tally,
+}
+
+/// The second pass: the walk from the root with the path and each node's reachable region.
+fn walk_regions(dump: &BvhDump, mesh: &Mesh, by_file: &[Option<u32>], walk: &Walk, leaves_of: &[u32]) -> Regions {
+    let nodes = &dump.nodes;
+    let mut r = Regions {
+        reach: vec![Aabb::EMPTY; nodes.len()],
+        causes: BTreeMap::new(),
+        shared: BTreeMap::new(),
+        covered: vec![false; by_file.len()],
+        degenerate_in: Tally::new(
+            Group::Coverage,
+            false,
+            "degenerate (zero-area) triangle is in a leaf: harmless, no ray can hit it",
+            "degenerate (zero-area) triangles are in leaves: harmless, no ray can hit them",
+        ),
+    };
+    let mut last = vec![u32::MAX; by_file.len()];
     let mut path: Vec<usize> = Vec::new();
     let mut stack = vec![(0usize, 0usize)];
-    let mut causes: BTreeMap<(u32, Option<u32>), Cause> = BTreeMap::new();
-    let mut shared: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
-    let mut degenerate_in = Tally::new(
-        Group::Coverage,
-        false,
-        "degenerate (zero-area) triangle is in a leaf: harmless, no ray can hit it",
-        "degenerate (zero-area) triangles are in leaves: harmless, no ray can hit them",
-    );
-    let mut covered = vec![false; tris];
-    last.fill(u32::MAX);
     while let Some((i, depth)) = stack.pop() {
         path.truncate(depth);
         path.push(i);
         let b = nodes[i].bounds();
-        reach[i] = if depth == 0 { b } else { reach[path[depth - 1]].intersection(b) };
+        r.reach[i] = if depth == 0 { b } else { r.reach[path[depth - 1]].intersection(b) };
         for &k in nodes[i].children.iter().flatten().rev() {
             let k = k as usize;
             if k < nodes.len() && k != 0 && walk.parent[k] == i as u32 {
                 stack.push((k, depth + 1));
             }
         }
-        let Some(leaf) = leaf_prims(i) else { continue };
+        let Some(leaf) = leaf_prims(dump, i) else { continue };
         for &p in leaf {
             let Some(l) = last.get_mut(p as usize) else { continue };
             if std::mem::replace(l, i as u32) == i as u32 {
                 continue; // the second reference in this leaf: already looked at
             }
-            covered[p as usize] = true;
+            r.covered[p as usize] = true;
             let Some(m) = by_file[p as usize] else {
-                degenerate_in.add(Some(i as u32), Some(p), format!("triangle {p} (leaf node {i})"));
+                r.degenerate_in.add(Some(i as u32), Some(p), format!("triangle {p} (leaf node {i})"));
                 continue;
             };
             let t = mesh.triangle(m);
             if leaves_of[p as usize] > 1 {
-                shared.entry(p).or_default().push(i);
+                r.shared.entry(p).or_default().push(i);
                 continue;
             }
             let tol = tolerance(&t);
-            if holds(&reach[i], &t, tol) {
+            if holds(&r.reach[i], &t, tol) {
                 continue;
             }
             // The highest node on the path whose region leaves the triangle out: each side of
@@ -146,8 +176,8 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
             let (lo, hi) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
             let mut k = depth;
             for a in 0..3 {
-                let low = path.partition_point(|&q| !(reach[q].min[a] - lo[a] > tol));
-                let high = path.partition_point(|&q| !(hi[a] - reach[q].max[a] > tol));
+                let low = path.partition_point(|&q| !(r.reach[q].min[a] - lo[a] > tol));
+                let high = path.partition_point(|&q| !(hi[a] - r.reach[q].max[a] > tol));
                 k = k.min(low).min(high);
             }
             // NaN in a box (a structure defect) breaks the order the search relies on.
@@ -155,7 +185,7 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
             let worst = path[k];
             let e = excess(&nodes[worst].bounds(), &t);
             let child = (k < depth).then(|| path[k + 1] as u32);
-            let cause = causes.entry((worst as u32, child)).or_default();
+            let cause = r.causes.entry((worst as u32, child)).or_default();
             cause.first.get_or_insert(p);
             // (NaN, a box that is no box, counts as farthest.)
             cause.excess = if e.0.is_nan() { f32::INFINITY } else { cause.excess.max(e.0) };
@@ -165,8 +195,13 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
             });
         }
     }
-    // Leaves whose own box is wrong: one finding, a leaf each; a wrong box above the leaves: one
-    // finding per box, the triangles it leaves out listed.
+    r
+}
+
+/// Leaves whose own box is wrong: one finding, a leaf each; a wrong box above the leaves: one
+/// finding per box, the triangles it leaves out listed.
+fn report_causes(dump: &BvhDump, causes: BTreeMap<(u32, Option<u32>), Cause>, out: &mut Vec<Finding>) {
+    let nodes = &dump.nodes;
     let mut leaves = Tally::new(
         Group::Bounds,
         true,
@@ -210,6 +245,16 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
         );
     }
     leaves.finish(out);
+}
+
+/// Triangles cut among several leaves: each must be covered by the union of its leaves' regions.
+fn report_cut(
+    mesh: &Mesh,
+    by_file: &[Option<u32>],
+    shared: &BTreeMap<u32, Vec<usize>>,
+    reach: &[Aabb],
+    out: &mut Vec<Finding>,
+) {
     let mut cut = Tally::new(
         Group::Bounds,
         true,
@@ -222,7 +267,7 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
         "triangle is cut among too many leaves to clip exactly (its rays are still checked)",
         "triangles are cut among too many leaves to clip exactly (their rays are still checked)",
     );
-    for (p, leaves) in shared {
+    for (&p, leaves) in shared {
         let Some(Some(m)) = by_file.get(p as usize) else { continue };
         let t = mesh.triangle(*m);
         let regions: Vec<Aabb> = leaves.iter().map(|&i| reach[i]).collect();
@@ -246,6 +291,10 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
     }
     cut.finish(out);
     complex.finish(out);
+}
+
+/// Triangles in no leaf: a defect, or a warning for a degenerate one no ray can hit.
+fn report_missing(mesh: &Mesh, by_file: &[Option<u32>], covered: &[bool], out: &mut Vec<Finding>) {
     let mut missing = Tally::new(Group::Coverage, true, "triangle is in no leaf", "triangles are in no leaf");
     let mut degenerate_out = Tally::new(
         Group::Coverage,
@@ -253,15 +302,13 @@ pub(super) fn check(dump: &BvhDump, mesh: &Mesh, walk: &Walk, out: &mut Vec<Find
         "degenerate (zero-area) triangle is in no leaf: harmless, no ray can hit it",
         "degenerate (zero-area) triangles are in no leaf: harmless, no ray can hit them",
     );
-    for t in (0..tris).filter(|&t| !covered[t]) {
+    for t in (0..by_file.len()).filter(|&t| !covered[t]) {
         let degenerate = by_file[t].is_none_or(|m| crate::geometry::triangle_double_area(&mesh.triangle(m)) <= 0.0);
         let tally = if degenerate { &mut degenerate_out } else { &mut missing };
         tally.add(None, Some(t as u32), format!("triangle {t}"));
     }
     missing.finish(out);
     degenerate_out.finish(out);
-    degenerate_in.finish(out);
-    twice.finish(out);
 }
 
 /// A root box larger than the mesh's box: no defect (every ray still finds its hit), but a

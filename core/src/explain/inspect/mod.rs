@@ -13,9 +13,8 @@
 
 // The node's bounds as the builders take them, so the inspector's curves start from the same box.
 use crate::bvh::builders::common::node_info;
-use crate::bvh::sbvh;
 use crate::bvh::split::{binned_planes, sweep_planes, BuildPrim, NodeInfo, PlaneSink, Proposal};
-use crate::bvh::{BuildParams, Bvh, Hierarchy, SahCost, Strategy};
+use crate::bvh::{sbvh, BuildParams, Bvh, Hierarchy, SahCost, Strategy};
 use crate::geometry::Aabb;
 use serde::Serialize;
 
