@@ -1,4 +1,4 @@
-//! `cargo bench --bench versus`: bvhscope against obvhs and the bvh crate on the same meshes and
+//! `cargo bench -p bvhscope-versus --bench versus`: bvhscope against obvhs and the bvh crate on the same meshes and
 //! the same rays. Prints one markdown table per mesh and closing ratio lines. Every time is the
 //! median of several runs; hit counts are printed so nobody wins by missing.
 //! `BENCH_QUICK=1` runs a reduced set (under two minutes on 2 cores). For iterating on one thing:
@@ -18,7 +18,7 @@
 //! `BENCH_EMBREE_ROBUST=1` for its robust mode.
 //! Embree 3 is raced when `build.rs` found it (Debian: libembree-dev); tinybvh's BVH8_CPU (the
 //! `tinybvh-rs` crate) when the bench is built with AVX2 enabled: `RUSTFLAGS="-C target-cpu=native"
-//! CARGO_TARGET_DIR=target/native cargo bench --bench versus`.
+//! CARGO_TARGET_DIR=target/native cargo bench -p bvhscope-versus --bench versus`.
 
 mod contenders;
 mod counts;

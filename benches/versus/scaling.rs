@@ -68,7 +68,7 @@ pub fn thread_counts(list: &str) -> Vec<usize> {
 fn mesh_path() -> PathBuf {
     match std::env::var("BENCH_SCALING_MESH") {
         Ok(p) => PathBuf::from(p),
-        Err(_) => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/models/stanford-bunny.obj"),
+        Err(_) => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/models/stanford-bunny.obj"),
     }
 }
 

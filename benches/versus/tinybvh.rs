@@ -25,7 +25,7 @@ pub fn notice() -> Option<&'static str> {
     } else {
         Some(
             "tinybvh's BVH8_CPU walk is compiled only with AVX2 enabled: raced without it \
-             (RUSTFLAGS=\"-C target-cpu=native\" CARGO_TARGET_DIR=target/native cargo bench --bench versus).",
+             (RUSTFLAGS=\"-C target-cpu=native\" CARGO_TARGET_DIR=target/native cargo bench -p bvhscope-versus --bench versus).",
         )
     }
 }

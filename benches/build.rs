@@ -2,7 +2,7 @@
 //! `libembree-dev`). Nothing else links it: `cargo test`, the app and the CLI never need it.
 //! Found: the cfg `embree` is set and the bench links `libembree3`; not found: the bench prints a
 //! notice and races the others. `EMBREE_DIR=/some/lib` names another folder; `BVHSCOPE_NO_EMBREE=1`
-//! leaves Embree out. Installed after a build? `touch build.rs` so this looks again.
+//! leaves Embree out. Installed after a build? `touch benches/build.rs` so this looks again.
 
 use std::path::PathBuf;
 
