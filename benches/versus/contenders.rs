@@ -442,3 +442,57 @@ pub fn bvh_crate() -> Contender {
         }),
     }
 }
+
+/// Every contender: each of our strategies in each layout, packets and counting walks, the
+/// `fastest` preset (and on an AVX-512 CPU the AVX2 family's), obvhs, the bvh crate, Embree and
+/// tinybvh where found.
+pub fn all() -> Vec<Contender> {
+    let mut contenders = vec![];
+    use bvhscope::bvh::Strategy;
+    for layout in Layout::ALL {
+        for strategy in Strategy::ALL {
+            contenders.push(ours(strategy, layout, Tracing::Plain));
+        }
+    }
+    contenders.push(ours(Strategy::SahBinned, Layout::Binary, Tracing::Packets));
+    contenders.push(ours(Strategy::SahBinned, Layout::Wide4, Tracing::Packets));
+    contenders.push(ours(Strategy::SahBinned, Layout::Wide8, Tracing::Packets));
+    // The fastest preset (8-wide; leaves of up to 16 with AVX-512, else 4), as the app's and CLI's
+    // `--preset fastest` on this CPU.
+    let fastest = bvhscope::bvh::Preset::Fastest.build();
+    contenders.push(ours_with("fastest", fastest, Tracing::Plain));
+    contenders.push(ours_with("fastest", fastest, Tracing::Packets));
+    contenders.push(ours_with("fastest", fastest, Tracing::Counting));
+    // Where the CPU has AVX-512, the AVX2 family in the same run: the preset's tree on an AVX2
+    // machine (leaves of eight) walked with the AVX2 kernels forced; and the tree of leaves ≤ 32
+    // (BENCHMARKS.md, "The fastest preset by kernel family").
+    if bvhscope::cpu::Simd::detected() > bvhscope::cpu::Simd::Avx2 {
+        let avx2 = Some(bvhscope::cpu::Simd::Avx2);
+        let (leaf, cost) = bvhscope::bvh::Preset::fastest_leaves(bvhscope::cpu::Simd::Avx2);
+        let cost = bvhscope::bvh::SahCost { traversal: cost, ..fastest.cost };
+        let tree = bvhscope::bvh::BuildParams { max_leaf_size: leaf, cost, ..fastest };
+        for tracing in [Tracing::Plain, Tracing::Packets] {
+            let wt = TriangleTest::Watertight;
+            contenders.push(ours_with_kernels("fastest for AVX2", tree, tracing, avx2, wt));
+        }
+        let others = [(32, 12.0)];
+        for (leaf, cost) in others {
+            let cost = bvhscope::bvh::SahCost { traversal: cost, ..fastest.cost };
+            let p = bvhscope::bvh::BuildParams { max_leaf_size: leaf, cost, ..fastest };
+            let label = format!("fastest, leaves {leaf}");
+            contenders.push(ours_with(&label, p, Tracing::Plain));
+            contenders.push(ours_with(&label, p, Tracing::Packets));
+        }
+    }
+    contenders.push(ours(Strategy::SahBinned, Layout::Binary, Tracing::Counting));
+    contenders.push(ours(Strategy::SahBinned, Layout::Wide4, Tracing::Counting));
+    contenders.push(ours(Strategy::SahBinned, Layout::Wide8, Tracing::Counting));
+    contenders.extend(obvhs_all());
+    contenders.push(bvh_crate());
+    contenders.extend(crate::embree::all());
+    contenders.extend(crate::tinybvh::all());
+    for n in [crate::embree::notice(), crate::tinybvh::notice()].into_iter().flatten() {
+        eprintln!("notice: {n}");
+    }
+    contenders
+}

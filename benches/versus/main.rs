@@ -31,9 +31,8 @@ mod scenes;
 mod tinybvh;
 
 use bvhscope::bvh::Layout;
-use bvhscope::geometry::TriangleTest;
 use bvhscope::mesh::Mesh;
-use contenders::{Contender, Family, Tracer, Tracing};
+use contenders::{Contender, Family, Tracer};
 use rayon::prelude::*;
 use rayon::{ThreadPool, ThreadPoolBuilder};
 use rays::RaySpec;
@@ -344,60 +343,6 @@ fn machine() -> String {
     format!("{cpu}, {} threads available", std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
-/// Every contender: each of our strategies in each layout, packets and counting walks, the
-/// `fastest` preset (and on an AVX-512 CPU the AVX2 family's), obvhs, the bvh crate, Embree and
-/// tinybvh where found.
-fn contenders() -> Vec<Contender> {
-    let mut contenders = vec![];
-    use bvhscope::bvh::Strategy;
-    for layout in Layout::ALL {
-        for strategy in Strategy::ALL {
-            contenders.push(contenders::ours(strategy, layout, Tracing::Plain));
-        }
-    }
-    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Binary, Tracing::Packets));
-    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Wide4, Tracing::Packets));
-    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Wide8, Tracing::Packets));
-    // The fastest preset (8-wide; leaves of up to 16 with AVX-512, else 4), as the app's and CLI's
-    // `--preset fastest` on this CPU.
-    let fastest = bvhscope::bvh::Preset::Fastest.build();
-    contenders.push(contenders::ours_with("fastest", fastest, Tracing::Plain));
-    contenders.push(contenders::ours_with("fastest", fastest, Tracing::Packets));
-    contenders.push(contenders::ours_with("fastest", fastest, Tracing::Counting));
-    // Where the CPU has AVX-512, the AVX2 family in the same run: the preset's tree on an AVX2
-    // machine (leaves of eight) walked with the AVX2 kernels forced; and the tree of leaves ≤ 32
-    // (BENCHMARKS.md, "The fastest preset by kernel family").
-    if bvhscope::cpu::Simd::detected() > bvhscope::cpu::Simd::Avx2 {
-        let avx2 = Some(bvhscope::cpu::Simd::Avx2);
-        let (leaf, cost) = bvhscope::bvh::Preset::fastest_leaves(bvhscope::cpu::Simd::Avx2);
-        let cost = bvhscope::bvh::SahCost { traversal: cost, ..fastest.cost };
-        let tree = bvhscope::bvh::BuildParams { max_leaf_size: leaf, cost, ..fastest };
-        for tracing in [Tracing::Plain, Tracing::Packets] {
-            let wt = TriangleTest::Watertight;
-            contenders.push(contenders::ours_with_kernels("fastest for AVX2", tree, tracing, avx2, wt));
-        }
-        let others = [(32, 12.0)];
-        for (leaf, cost) in others {
-            let cost = bvhscope::bvh::SahCost { traversal: cost, ..fastest.cost };
-            let p = bvhscope::bvh::BuildParams { max_leaf_size: leaf, cost, ..fastest };
-            let label = format!("fastest, leaves {leaf}");
-            contenders.push(contenders::ours_with(&label, p, Tracing::Plain));
-            contenders.push(contenders::ours_with(&label, p, Tracing::Packets));
-        }
-    }
-    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Binary, Tracing::Counting));
-    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Wide4, Tracing::Counting));
-    contenders.push(contenders::ours(Strategy::SahBinned, Layout::Wide8, Tracing::Counting));
-    contenders.extend(contenders::obvhs_all());
-    contenders.push(contenders::bvh_crate());
-    contenders.extend(embree::all());
-    contenders.extend(tinybvh::all());
-    for n in [embree::notice(), tinybvh::notice()].into_iter().flatten() {
-        eprintln!("notice: {n}");
-    }
-    contenders
-}
-
 /// The meshes raced: the shared ones found, the generated scenes, the 2M-triangle knot (not in a
 /// quick run unless for the app figures) and the needle soup (full run, or asked for by name).
 fn meshes(quick: bool, app_only: bool) -> Vec<Mesh> {
@@ -441,7 +386,7 @@ fn main() {
         return;
     }
 
-    let mut contenders = contenders();
+    let mut contenders = contenders::all();
     // BENCH_ONLY=a,b keeps contenders whose name contains one of the words (for quick iteration).
     if let Ok(only) = std::env::var("BENCH_ONLY") {
         let words: Vec<String> = only.split(',').map(|w| w.trim().to_lowercase()).collect();
