@@ -2,6 +2,7 @@
 //! can be cancelled while it runs.
 
 use super::*;
+use crate::bvh::builders::common::PARALLEL_MIN_PRIMS;
 use crate::bvh::params::Strategy;
 use crate::mesh::generate::torus;
 
@@ -18,10 +19,21 @@ fn the_parallel_build_lays_out_the_same_tree_as_the_sequential_one() {
             .map(|i| BuildPrim::new(Aabb::from_points(&mesh.triangle(i as u32)), i as u32))
             .collect();
         let progress = Progress { control: &WorkControl::new(), levels: 1 };
-        let (nodes, _) = build_sequential(&mut prims, 0, 0, &params, &progress).unwrap();
+        let tri = |i: u32| mesh.triangle(i);
+        let root = node_info(&prims).bounds;
+        let setup = Setup { params: &params, tri: Some(&tri), root };
+        let splitter = || strategy.splitter_for(&setup).unwrap();
+        let d = Driver { params: &params, progress: &progress, splitter: &splitter };
+        let (nodes, ids) = if strategy.splits_references() {
+            let (nodes, refs, _) = driver::build_sequential(sbvh::Work::root(prims, &params), &d).unwrap();
+            (nodes, refs.iter().map(|p| p.index()).collect::<Vec<_>>())
+        } else {
+            let (nodes, (), _) = driver::build_sequential(InPlace::root(&mut prims), &d).unwrap();
+            (nodes, prims.iter().map(|p| p.index()).collect())
+        };
         assert_eq!(bvh.nodes.len(), nodes.len(), "{strategy:?}");
         assert!(bvh.nodes == nodes, "{strategy:?}: the same nodes in the same places");
-        assert!(bvh.prim_ids.iter().copied().eq(prims.iter().map(|p| p.index())), "{strategy:?}");
+        assert!(bvh.prim_ids == ids, "{strategy:?}");
     }
 }
 

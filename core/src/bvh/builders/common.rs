@@ -15,7 +15,7 @@ use rayon::prelude::*;
 pub const HEURISTIC_DEPTH_LIMIT: u32 = (TRAVERSAL_STACK_SIZE as u32) - 33;
 
 /// Ranges at least this long are bounded in parallel.
-pub(super) const PARALLEL_MIN_PRIMS: usize = 4096;
+pub(crate) const PARALLEL_MIN_PRIMS: usize = 4096;
 
 /// The work units of building over `n` primitives, the total a build's progress reaches.
 ///
@@ -86,14 +86,16 @@ impl<'a> Progress<'a> {
 
 /// The node's bounds and centroid bounds (in parallel for big ranges).
 pub(crate) fn node_info(prims: &[BuildPrim]) -> NodeInfo {
-    const EMPTY: NodeInfo = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY };
+    const EMPTY: NodeInfo = NodeInfo { bounds: Aabb::EMPTY, centroid_bounds: Aabb::EMPTY, budget: 0 };
     let add = |i: NodeInfo, p: &BuildPrim| NodeInfo {
         bounds: i.bounds.union(p.bounds()),
         centroid_bounds: i.centroid_bounds.grow(p.centroid()),
+        budget: 0,
     };
     let merge = |a: NodeInfo, b: NodeInfo| NodeInfo {
         bounds: a.bounds.union(b.bounds),
         centroid_bounds: a.centroid_bounds.union(b.centroid_bounds),
+        budget: 0,
     };
     if prims.len() >= PARALLEL_MIN_PRIMS {
         crate::parallel::region(|| prims.par_chunks(4096).map(|c| c.iter().fold(EMPTY, add)).reduce(|| EMPTY, merge))
@@ -102,17 +104,20 @@ pub(crate) fn node_info(prims: &[BuildPrim]) -> NodeInfo {
     }
 }
 
-/// Nodes where the driver overrode or replaced the strategy's answer.
+/// Nodes where the driver overrode or replaced the strategy's answer, and the splits that cut
+/// primitives (the SBVH's spatial splits).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Overrides {
     pub fallback: u32,
     pub depth_limited: u32,
+    pub cut: u32,
 }
 
 impl std::ops::AddAssign for Overrides {
     fn add_assign(&mut self, o: Overrides) {
         self.fallback += o.fallback;
         self.depth_limited += o.depth_limited;
+        self.cut += o.cut;
     }
 }
 

@@ -1,10 +1,10 @@
-//! The top-down build driver shared by every split strategy (pbrt-v4 §7.3, "BVH construction").
-//!
-//! It keeps an explicit work stack instead of recursing, so a 10M-triangle mesh or a million
-//! identical triangles cannot overflow the call stack. Nodes are allocated in pairs when a node is
-//! split, so the two children of a node are adjacent and an interior node needs only one index.
+//! Building a binary BVH: the entry points (`Bvh::build`, `build_over_boxes`), which prepare the
+//! primitives and hand them to the strategy's builder: the top-down driver (`driver`) with a
+//! splitter (`split`), in place or over references (`sbvh`); the LBVH (`lbvh`); PLOC (`ploc`).
+//! Reinsertion (`reinsert`) may follow any of them.
 
 pub(crate) mod common;
+pub mod driver;
 pub mod lbvh;
 pub mod morton;
 pub(crate) mod ploc;
@@ -14,27 +14,20 @@ pub mod split;
 pub mod strategy;
 mod subtree;
 
-use crate::bvh::builders::split::equal_count::EqualCount;
-use crate::bvh::builders::split::splitter::{BuildPrim, NodeInfo, Proposal, Splitter};
+use crate::bvh::builders::split::spatial::Triangles;
+use crate::bvh::builders::split::splitter::BuildPrim;
 use crate::bvh::node::{Bvh, BvhNode};
 use crate::bvh::params::{BuildParams, BuildReport};
 use crate::geometry::Aabb;
 use crate::mesh::Mesh;
-use crate::parallel::{region, region_if, PARTITION_MIN};
+use crate::parallel::region;
 use crate::work::{Cancelled, WorkControl};
 pub use common::{build_work, HEURISTIC_DEPTH_LIMIT};
-use common::{leaf_is_cheaper, node_info, progress_levels, Overrides, Progress, PARALLEL_MIN_PRIMS};
+use common::{node_info, progress_levels, Overrides, Progress};
+use driver::{build_subtree, Driver, InPlace};
 use rayon::prelude::*;
 use std::time::Instant;
-use strategy::Builder;
-use subtree::Subtree;
-
-struct Task {
-    node: u32,
-    start: u32,
-    end: u32,
-    depth: u32,
-}
+use strategy::{Builder, Setup};
 
 impl Bvh {
     /// Build a BVH over the mesh's triangles.
@@ -121,220 +114,48 @@ pub fn build_over_boxes(
     Ok((nodes, prims.iter().map(|p| p.index()).collect(), report))
 }
 
-/// The top-down splitting over prepared primitives, which it leaves in leaf order (the SBVH's
-/// references replace them: more than one per triangle where spatial splits cut triangles of
-/// `tri`).
+/// The splitting over prepared primitives, which it leaves in leaf order (the SBVH's references
+/// replace them: more than one per triangle where spatial splits cut triangles of `tri`).
 fn build_nodes(
     prims: &mut Vec<BuildPrim>,
-    tri: Option<sbvh::Triangles>,
+    tri: Option<Triangles>,
     params: &BuildParams,
     control: &WorkControl,
 ) -> Result<(Vec<BvhNode>, BuildReport), Cancelled> {
     let t1 = Instant::now();
     let progress = Progress { control, levels: progress_levels(prims.len(), params) };
-    let (tree, over) = match params.strategy.builder() {
-        Builder::SpatialSplits => {
-            let (nodes, refs, kinds) = sbvh::build(std::mem::take(prims), tri, params, &progress)?;
-            *prims = refs;
-            let report = BuildReport {
-                split_time: t1.elapsed(),
-                fallback_splits: kinds.over.fallback,
-                depth_limited_splits: kinds.over.depth_limited,
-                spatial_splits: kinds.spatial,
-                ..Default::default()
-            };
-            return Ok((nodes, report));
+    let (nodes, over) = match params.strategy.builder() {
+        Builder::TopDown { make, references } => {
+            let root = if references { node_info(prims).bounds } else { Aabb::EMPTY };
+            let setup = Setup { params, tri, root };
+            let splitter = || make(&setup);
+            if references {
+                let (nodes, refs, over) = sbvh::build(std::mem::take(prims), params, &progress, &splitter)?;
+                *prims = refs;
+                (nodes, over)
+            } else {
+                let d = Driver { params, progress: &progress, splitter: &splitter };
+                let (tree, _, over) = build_subtree(InPlace::root(prims), &d)?;
+                (tree.into_nodes(), over)
+            }
         }
         Builder::Morton => {
             let (tree, fallback) = lbvh::build(prims, params, &progress)?;
-            (tree, Overrides { fallback, depth_limited: 0 })
+            (tree.into_nodes(), Overrides { fallback, ..Overrides::default() })
         }
         Builder::Clustering => {
             let (tree, _) = ploc::build(prims, params, params.ploc_radius as usize, &progress)?;
-            (tree, Overrides::default())
+            (tree.into_nodes(), Overrides::default())
         }
-        Builder::TopDown(_) => build_subtree(prims, 0, 0, params, &progress)?,
     };
-    let nodes = tree.into_nodes();
-    Ok((
-        nodes,
-        BuildReport {
-            split_time: t1.elapsed(),
-            fallback_splits: over.fallback,
-            depth_limited_splits: over.depth_limited,
-            ..Default::default()
-        },
-    ))
-}
-
-/// What becomes of a node.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Decision {
-    Leaf,
-    /// `prims[..mid]` go to the left child.
-    Split {
-        axis: u8,
-        mid: usize,
-    },
-}
-
-/// Leaf or split, for every strategy, decided here and nowhere else: a single triangle is a leaf;
-/// below the depth limit every node is split by equal count; a node that fits in a leaf is one,
-/// unless the strategy prices splits (the SAH) and its best split is cheaper; a node that does not
-/// fit is split as the strategy proposes, or by equal count when it finds no useful split.
-fn decide(
-    range: &mut [BuildPrim],
-    info: &NodeInfo,
-    depth: u32,
-    params: &BuildParams,
-    splitter: &mut dyn Splitter,
-    over: &mut Overrides,
-) -> Decision {
-    let n = range.len();
-    if n == 1 {
-        return Decision::Leaf;
-    }
-    let equal_count = |range: &mut [BuildPrim]| {
-        let (axis, mid) = EqualCount::median(range, info);
-        Decision::Split { axis, mid }
+    let report = BuildReport {
+        split_time: t1.elapsed(),
+        fallback_splits: over.fallback,
+        depth_limited_splits: over.depth_limited,
+        spatial_splits: over.cut,
+        ..Default::default()
     };
-    if depth >= HEURISTIC_DEPTH_LIMIT {
-        over.depth_limited += 1;
-        return equal_count(range);
-    }
-    let fits = n <= params.max_leaf_size as usize;
-    if fits && !splitter.prices_splits() {
-        return Decision::Leaf;
-    }
-    match splitter.split(range, info) {
-        // A split must leave both sides non-empty.
-        Proposal::Split { axis, mid, weighted, .. } if mid > 0 && mid < n => {
-            if fits && weighted.is_none_or(|w| leaf_is_cheaper(n, w, info, params)) {
-                Decision::Leaf
-            } else {
-                Decision::Split { axis, mid }
-            }
-        }
-        // No useful split, but the triangles fit in a leaf: that is the best we can do (e.g. the
-        // two halves of a quad whose diagonal spans its box share a centroid).
-        _ if fits => Decision::Leaf,
-        _ => {
-            over.fallback += 1;
-            equal_count(range)
-        }
-    }
-}
-
-/// Subtrees at least `PARALLEL_MIN_PRIMS` big are split in parallel (`rayon::join`) down to this
-/// depth, which bounds the recursion; deeper work uses the explicit stack.
-const PARALLEL_MAX_DEPTH: u32 = 16;
-
-/// The splitter of a top-down strategy (`build_nodes` sends the others to their own builders).
-fn top_down(params: &BuildParams) -> Box<dyn split::Splitter> {
-    params.strategy.splitter(params).expect("build_nodes builds only top-down strategies with the driver")
-}
-
-/// Build the subtree over `prims`, which start at `offset` in the full primitive array. Leaf
-/// indices are global, child indices local to the subtree.
-fn build_subtree(
-    prims: &mut [BuildPrim],
-    offset: u32,
-    depth: u32,
-    params: &BuildParams,
-    progress: &Progress,
-) -> Result<(Subtree, Overrides), Cancelled> {
-    if prims.len() < PARALLEL_MIN_PRIMS || depth >= PARALLEL_MAX_DEPTH {
-        return flat(prims, offset, depth, params, progress);
-    }
-    // Below PARTITION_MIN, one of many subtrees built side by side, each on one thread from here
-    // (issue 37's serial fraction counts the bigger nodes' own work, outside their parallel passes).
-    region_if(prims.len() < PARTITION_MIN, || build_parallel(prims, offset, depth, params, progress))
-}
-
-/// `build_sequential`'s nodes as a subtree.
-fn flat(
-    prims: &mut [BuildPrim],
-    offset: u32,
-    depth: u32,
-    params: &BuildParams,
-    progress: &Progress,
-) -> Result<(Subtree, Overrides), Cancelled> {
-    build_sequential(prims, offset, depth, params, progress).map(|(nodes, over)| (Subtree::Flat(nodes), over))
-}
-
-/// `build_subtree` for a node that is split here, its children in parallel.
-fn build_parallel(
-    prims: &mut [BuildPrim],
-    offset: u32,
-    depth: u32,
-    params: &BuildParams,
-    progress: &Progress,
-) -> Result<(Subtree, Overrides), Cancelled> {
-    progress.check()?;
-    let info = node_info(prims);
-    let mut over = Overrides::default();
-    let decision = decide(prims, &info, depth, params, &mut *top_down(params), &mut over);
-    let Decision::Split { axis, mid } = decision else {
-        return flat(prims, offset, depth, params, progress);
-    };
-    progress.split(prims.len(), depth);
-    let (l, r) = prims.split_at_mut(mid);
-    let (left, right) = rayon::join(
-        || build_subtree(l, offset, depth + 1, params, progress),
-        || build_subtree(r, offset + mid as u32, depth + 1, params, progress),
-    );
-    let ((left, lo), (right, ro)) = (left?, right?);
-    over += lo;
-    over += ro;
-    let len = 1 + left.len() + right.len();
-    Ok((Subtree::Split { bounds: info.bounds, axis, left: Box::new(left), right: Box::new(right), len }, over))
-}
-
-/// Build a subtree with an explicit work stack (no recursion, however deep the tree).
-fn build_sequential(
-    prims: &mut [BuildPrim],
-    offset: u32,
-    depth0: u32,
-    params: &BuildParams,
-    progress: &Progress,
-) -> Result<(Vec<BvhNode>, Overrides), Cancelled> {
-    let mut nodes = Vec::with_capacity((2 * prims.len() / params.max_leaf_size.max(1) as usize).max(1));
-    nodes.push(BvhNode::leaf(Aabb::EMPTY, offset, 0));
-    let mut over = Overrides::default();
-    if prims.is_empty() {
-        return Ok((nodes, over)); // one empty leaf: every ray misses its empty box
-    }
-    let mut splitter = top_down(params);
-    let mut stack = vec![Task { node: 0, start: 0, end: prims.len() as u32, depth: depth0 }];
-    let mut steps = 0u32;
-    while let Some(task) = stack.pop() {
-        steps += 1;
-        if steps.is_multiple_of(256) {
-            progress.check()?;
-        }
-        let range = &mut prims[task.start as usize..task.end as usize];
-        let info = node_info(range);
-        let n = range.len();
-        match decide(range, &info, task.depth, params, &mut *splitter, &mut over) {
-            Decision::Split { axis, mid } => {
-                let left = nodes.len() as u32;
-                nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
-                nodes.push(BvhNode::leaf(Aabb::EMPTY, 0, 0));
-                nodes[task.node as usize] = BvhNode::interior(info.bounds, left, axis);
-                progress.split(n, task.depth);
-                let mid = task.start + mid as u32;
-                let depth = task.depth + 1;
-                // Right pushed first so the left subtree is laid out right after its parent pair.
-                stack.push(Task { node: left + 1, start: mid, end: task.end, depth });
-                stack.push(Task { node: left, start: task.start, end: mid, depth });
-            }
-            Decision::Leaf => {
-                nodes[task.node as usize] = BvhNode::leaf(info.bounds, offset + task.start, n as u16);
-                progress.leaf(n, task.depth);
-            }
-        }
-    }
-    Ok((nodes, over))
+    Ok((nodes, report))
 }
 
 #[cfg(test)]

@@ -41,7 +41,7 @@ fn the_tree_does_not_depend_on_the_thread_count() {
     mesh.triangles.extend(rods.triangles.iter().map(|t| t.map(|i| i + base)));
     mesh.groups.clear();
     mesh.groups.push(crate::mesh::MeshGroup { name: "all".into(), triangles: 0..mesh.triangles.len() as u32 });
-    assert!(mesh.triangle_count() > 4 * super::PARALLEL_MIN);
+    assert!(mesh.triangle_count() > 4 * crate::bvh::builders::common::PARALLEL_MIN_PRIMS);
     let build = |threads| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| Bvh::build(&mesh, &sbvh(30)))

@@ -8,21 +8,40 @@ use crate::bvh::builders::split::equal_count::EqualCount;
 use crate::bvh::builders::split::midpoint::Midpoint;
 use crate::bvh::builders::split::sah_binned::SahBinned;
 use crate::bvh::builders::split::sah_sweep::SahSweep;
+use crate::bvh::builders::split::spatial::{SpatialSplits, Triangles};
 use crate::bvh::builders::split::splitter::Splitter;
 use crate::bvh::params::{BuildParams, Param, Strategy};
+use crate::geometry::Aabb;
+
+/// What a splitter is made from: the build's parameters and, for one that cuts triangles, the
+/// triangles and the root's box.
+pub struct Setup<'a> {
+    pub params: &'a BuildParams,
+    /// `None`: nothing to clip (the top level of two levels, the inspector's markers).
+    pub tri: Option<Triangles<'a>>,
+    /// The root's box (measured only for a build over references; else empty).
+    pub root: Aabb,
+}
+
+/// A strategy's splitter for a build.
+pub type MakeSplitter = for<'a> fn(&Setup<'a>) -> Box<dyn Splitter + 'a>;
 
 /// How a strategy builds.
 #[derive(Clone, Copy)]
 pub enum Builder {
-    /// Top-down by the driver (`builders::build_nodes`), node by node, with a splitter made for
-    /// the build's parameters.
-    TopDown(fn(&BuildParams) -> Box<dyn Splitter>),
+    /// Top-down by the driver (`builders::driver`), node by node, with a splitter made for the
+    /// build. `references`: over references of its own (`sbvh::Work`), which its splitter's cuts
+    /// duplicate, rather than in place in the build's array.
+    TopDown { make: MakeSplitter, references: bool },
     /// The hierarchy of the sorted Morton codes (`lbvh`): no plane is chosen at a node.
     Morton,
     /// Bottom-up clustering in Morton order (`ploc`).
     Clustering,
-    /// Top-down over references, with spatial splits that cut triangles (`sbvh`).
-    SpatialSplits,
+}
+
+/// A strategy split top-down in place.
+const fn in_place(make: MakeSplitter) -> Builder {
+    Builder::TopDown { make, references: false }
 }
 
 struct Entry {
@@ -33,19 +52,22 @@ struct Entry {
 }
 
 const REGISTRY: [Entry; 7] = [
-    Entry { strategy: Strategy::Midpoint, builder: Builder::TopDown(|_| Box::new(Midpoint)), params: &[] },
-    Entry { strategy: Strategy::EqualCount, builder: Builder::TopDown(|_| Box::new(EqualCount)), params: &[] },
+    Entry { strategy: Strategy::Midpoint, builder: in_place(|_| Box::new(Midpoint)), params: &[] },
+    Entry { strategy: Strategy::EqualCount, builder: in_place(|_| Box::new(EqualCount)), params: &[] },
     Entry {
         strategy: Strategy::SahBinned,
-        builder: Builder::TopDown(|p| Box::new(SahBinned::new(p))),
+        builder: in_place(|s| Box::new(SahBinned::new(s.params))),
         params: &[Param::SahBins],
     },
-    Entry { strategy: Strategy::SahSweep, builder: Builder::TopDown(|p| Box::new(SahSweep::new(p))), params: &[] },
+    Entry { strategy: Strategy::SahSweep, builder: in_place(|s| Box::new(SahSweep::new(s.params))), params: &[] },
     Entry { strategy: Strategy::Lbvh, builder: Builder::Morton, params: &[] },
     Entry { strategy: Strategy::Ploc, builder: Builder::Clustering, params: &[Param::PlocRadius] },
     Entry {
         strategy: Strategy::Sbvh,
-        builder: Builder::SpatialSplits,
+        builder: Builder::TopDown {
+            make: |s| Box::new(SpatialSplits::new(s.tri, s.params, &s.root)),
+            references: true,
+        },
         params: &[Param::SahBins, Param::SbvhAlpha, Param::SbvhGrowth],
     },
 ];
@@ -67,24 +89,29 @@ impl Strategy {
         self.entry().builder
     }
 
-    /// A splitter of this strategy for a build with `params`; `None` for a builder that does not
-    /// split node by node at a plane it chooses there.
-    pub fn splitter(self, params: &BuildParams) -> Option<Box<dyn Splitter>> {
+    /// A splitter of this strategy for `setup`; `None` for a builder that does not split node by
+    /// node at a plane it chooses there.
+    pub fn splitter_for<'a>(self, setup: &Setup<'a>) -> Option<Box<dyn Splitter + 'a>> {
         match self.builder() {
-            Builder::TopDown(make) => Some(make(params)),
+            Builder::TopDown { make, .. } => Some(make(setup)),
             _ => None,
         }
     }
 
+    /// `splitter_for` a build with `params` and no triangles to clip.
+    pub fn splitter(self, params: &BuildParams) -> Option<Box<dyn Splitter + '_>> {
+        self.splitter_for(&Setup { params, tri: None, root: Aabb::EMPTY })
+    }
+
     /// Whether the top-down driver builds with this strategy's splitter.
     pub fn splits_top_down(self) -> bool {
-        matches!(self.builder(), Builder::TopDown(_))
+        matches!(self.builder(), Builder::TopDown { .. })
     }
 
     /// Whether its leaves hold references (parts of triangles) rather than triangles: a triangle
     /// may be in several leaves, and a node's triangles are found by replaying the build.
     pub fn splits_references(self) -> bool {
-        matches!(self.builder(), Builder::SpatialSplits)
+        matches!(self.builder(), Builder::TopDown { references: true, .. })
     }
 
     /// Whether its tree's leaf order is its Morton order (an LBVH's, not reinserted).

@@ -114,7 +114,7 @@ fn an_sbvh_trees_inspector_replays_its_build() {
         let count = |c: u32| inspect(&bvh, &h, c).unwrap().triangles;
         assert_eq!((m.axis, m.left, m.right), (n.axis, count(n.index), count(n.index + 1)), "node {i}");
         let e = ins.sbvh.unwrap();
-        if e.split.unwrap().kind == crate::bvh::sbvh::SplitKind::Spatial {
+        if e.split.unwrap().kind == crate::bvh::builders::driver::SplitKind::Spatial {
             spatial += 1;
             let cheapest = ins.spatial.iter().flatten().map(|p| p.cost).fold(f32::INFINITY, f32::min);
             assert!(cheapest <= m.cost * 1.0001, "node {i}: the bins' best {cheapest}, the split {}", m.cost);

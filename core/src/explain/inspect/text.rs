@@ -2,7 +2,7 @@
 //! them both.
 
 use super::Inspection;
-use crate::bvh::sbvh::SplitKind;
+use crate::bvh::builders::driver::SplitKind;
 use crate::bvh::wide::WideGroup;
 use crate::bvh::{Builder, Strategy};
 
@@ -56,8 +56,8 @@ pub fn dump_text(d: Option<u32>) -> String {
 /// Why `strategy` marks no plane at a node.
 pub fn no_split_text(strategy: Strategy) -> &'static str {
     match strategy.builder() {
-        Builder::SpatialSplits => "makes a leaf here",
+        Builder::TopDown { references: true, .. } => "makes a leaf here",
         Builder::Morton | Builder::Clustering => "no plane priced here: it builds from the Morton order",
-        Builder::TopDown(_) => "no split (the builder falls back to equal count)",
+        Builder::TopDown { .. } => "no split (the builder falls back to equal count)",
     }
 }

@@ -20,6 +20,12 @@ pub trait Splitter: Send {
 
     /// Propose a split of `prims`, partitioned so the first `mid` go left.
     fn split(&mut self, prims: &mut [BuildPrim], node: &NodeInfo) -> Proposal;
+
+    /// The two sides' references of the `Proposal::Cut` this splitter has just proposed (the
+    /// driver's partition step takes them when it makes the cut).
+    fn take_cut(&mut self) -> (Vec<BuildPrim>, Vec<BuildPrim>) {
+        unreachable!("only a splitter that proposes cuts is asked for them")
+    }
 }
 
 /// A triangle as the builder sees it: its bounds in SIMD registers' layout (a box union is two
@@ -72,6 +78,9 @@ impl BuildPrim {
 pub struct NodeInfo {
     pub bounds: Aabb,
     pub centroid_bounds: Aabb,
+    /// The duplicates a split here may add (`Proposal::Cut`): the SBVH's budget; 0 in a build
+    /// whose primitives are partitioned in place.
+    pub budget: u64,
 }
 
 /// A strategy's answer.
@@ -82,6 +91,11 @@ pub enum Proposal {
     /// split with the SAH, the sum A_L·n_L + A_R·n_R of the two sides (the driver compares it
     /// with a leaf's cost).
     Split { axis: u8, mid: usize, weighted: Option<f32>, plane: f32 },
+    /// A spatial split at `plane` on `axis`: each primitive goes to the side it lies on, and one
+    /// that straddles the plane to both, each with the box of its part there (the SBVH's;
+    /// proposed only within `NodeInfo::budget`). The splitter made the two sides' references
+    /// already (`Splitter::take_cut`); `weighted` is A_L·n_L + A_R·n_R of those.
+    Cut { axis: u8, plane: f32, weighted: f32 },
     /// No useful split (midpoint with one side empty, coincident centroids). The driver makes a
     /// leaf if the triangles fit in one, else splits by equal count and counts it in the statistics.
     None,
