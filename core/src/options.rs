@@ -291,7 +291,7 @@ const PRESETS: [Named<Preset>; 2] = [
         value: Preset::Fastest,
         name: "fastest",
         label: "Fastest traversal",
-        help: "bvhscope's fastest tree: binned SAH, 8-wide layout, leaves as large as one SIMD pass tests (16 triangles and traversal cost 10 where the CPU has AVX-512, else 4 and cost 3), entry-distance order, watertight test, one level",
+        help: "bvhscope's fastest tree: binned SAH, 8-wide layout, leaves as large as one SIMD pass tests (16 triangles and traversal cost 10 where the CPU has AVX-512, 8 and cost 5 with AVX2, else 4 and cost 3), entry-distance order, watertight test, one level",
     },
 ];
 choice!(Preset, PRESETS, 2);
