@@ -1,7 +1,7 @@
 //! Split strategies: given the primitives of one node, propose where to split and partition the
 //! primitives accordingly. One file per strategy, each a `Splitter` that keeps the scratch memory it
 //! reuses from node to node; the driver that calls them, and decides leaf or split, is
-//! `bvh::builders`.
+//! `bvh::builders::driver`.
 
 pub(crate) mod equal_count;
 pub(crate) mod midpoint;

@@ -15,7 +15,7 @@
 //! side's count one lower. A reference kept whole is not duplicated.
 //!
 //! The bins report every plane to a `PlaneSink`, so the node inspector's spatial cost curve is
-//! what the builder (`bvh::sbvh`) priced. Big nodes are binned and partitioned in parallel chunks
+//! what the build (the driver with `SpatialSplits`, below) priced. Big nodes are binned and partitioned in parallel chunks
 //! whose bins and lists are merged in order (counts add, boxes unite exactly), so the split does
 //! not depend on the thread count.
 
