@@ -3,6 +3,8 @@
 mod aabb;
 #[cfg(target_arch = "x86_64")]
 pub mod avx512;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod packet8;
 mod ray;
 mod shear;
 pub mod slab;

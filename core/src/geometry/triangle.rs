@@ -8,6 +8,8 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::avx512::packet::WatertightRay16;
+#[cfg(target_arch = "x86_64")]
+use super::packet8::WatertightRay8;
 pub use super::shear::{Hits4, WatertightRay};
 #[cfg(target_arch = "x86_64")]
 use super::{slab8::Avx2, triangle8::Hits8};
@@ -16,7 +18,7 @@ use crate::geometry::avx512::leaf::Hits16;
 use crate::geometry::ray::Ray;
 use glam::{DVec3, Vec3};
 #[cfg(target_arch = "x86_64")]
-use std::arch::x86_64::__m512;
+use std::arch::x86_64::{__m256, __m512};
 use wide::f32x4;
 
 /// Distance and barycentrics of a ray–triangle hit.
@@ -70,6 +72,16 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
         lanes: u32,
         tri: &[Vec3; 3],
     ) -> Hits16;
+
+    /// `Prepared4` for a group of eight rays (AVX2 packets, `packet8`).
+    #[cfg(target_arch = "x86_64")]
+    type Prepared8: Copy;
+    /// The setup of rays `base..base + 8` of `rays` (lanes past the end repeat the last ray).
+    #[cfg(target_arch = "x86_64")]
+    fn prepare8(k: Avx2, rays: &[Ray], base: usize) -> Self::Prepared8;
+    /// `intersect4` for eight rays: lane by lane the same result as `intersect`.
+    #[cfg(target_arch = "x86_64")]
+    fn intersect8(k: Avx2, p: &Self::Prepared8, t_min: __m256, t_max: __m256, lanes: u32, tri: &[Vec3; 3]) -> Hits8;
 
     /// One ray against up to four triangles (`tris.len() <= 4`): lane k of the result is
     /// `intersect(p, ray, &tris[k])`, bit for bit. The watertight test does the four in one SIMD
@@ -283,6 +295,23 @@ impl TriangleIntersector for Watertight {
     }
 
     #[cfg(target_arch = "x86_64")]
+    type Prepared8 = WatertightRay8;
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn prepare8(k: Avx2, rays: &[Ray], base: usize) -> WatertightRay8 {
+        // SAFETY: `k` proves the CPU has AVX2 and FMA.
+        unsafe { WatertightRay8::new(k, rays, base) }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect8(k: Avx2, p: &WatertightRay8, t_min: __m256, t_max: __m256, lanes: u32, tri: &[Vec3; 3]) -> Hits8 {
+        // SAFETY: `k` proves the CPU has AVX2 and FMA.
+        unsafe { p.intersect(k, t_min, t_max, lanes, tri) }
+    }
+
+    #[cfg(target_arch = "x86_64")]
     type Prepared16 = WatertightRay16;
 
     #[cfg(target_arch = "x86_64")]
@@ -378,6 +407,35 @@ impl TriangleIntersector for MollerTrumbore {
     fn intersect4(rays: &[Ray; 4], t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
         let mut hits = Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
         let (t_min, t_max) = (t_min.to_array(), t_max.to_array());
+        let mut m = lanes;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let mut ray = rays[k];
+            (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
+            if let Some(h) = Self::intersect(&(), &ray, tri) {
+                hits.mask |= 1 << k;
+                (hits.t[k], hits.u[k], hits.v[k]) = (h.t, h.u, h.v);
+            }
+        }
+        hits
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    type Prepared8 = [Ray; 8];
+
+    #[cfg(target_arch = "x86_64")]
+    fn prepare8(_: Avx2, rays: &[Ray], base: usize) -> [Ray; 8] {
+        std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
+    }
+
+    /// Lane by lane, as `intersect4`.
+    #[cfg(target_arch = "x86_64")]
+    fn intersect8(_: Avx2, rays: &[Ray; 8], t_min: __m256, t_max: __m256, lanes: u32, tri: &[Vec3; 3]) -> Hits8 {
+        let mut hits = Hits8::NONE;
+        // SAFETY: `__m256` and `[f32; 8]` have the same size, and every bit pattern is a float.
+        let (t_min, t_max): ([f32; 8], [f32; 8]) =
+            unsafe { (std::mem::transmute::<__m256, [f32; 8]>(t_min), std::mem::transmute::<__m256, [f32; 8]>(t_max)) };
         let mut m = lanes;
         while m != 0 {
             let k = m.trailing_zeros() as usize;

@@ -69,7 +69,7 @@ pub(crate) fn watertight_leaf8(_: Avx2, p: &WatertightRay, ray: &Ray, coords: &[
         };
         let xy = [dot(&a, p.rx), dot(&a, p.ry), dot(&b, p.rx), dot(&b, p.ry), dot(&c, p.rx), dot(&c, p.ry)];
         let z = [dot(&a, p.rz), dot(&b, p.rz), dot(&c, p.rz)];
-        edge_test8(xy, z, ray.t_min, ray.t_max, lanes)
+        edge_test8(xy, z, _mm256_set1_ps(ray.t_min), _mm256_set1_ps(ray.t_max), lanes)
     }
 }
 
@@ -161,10 +161,11 @@ fn loads(coords: &[f32], count: usize, g: usize, n: usize) -> impl Fn(usize) -> 
 /// The watertight test's second half in eight lanes, `triangle4::edge_test4` lane for lane: from
 /// the sheared vertices `[ax, ay, bx, by, cx, cy]` and their distances `z`, the edge functions (in
 /// double precision in a lane where one is exactly zero), the inside test and the hit within
-/// `[t_min, t_max)`, for the lanes in `lanes`.
+/// `[t_min, t_max)` (per lane: one ray's interval in every lane for a leaf, each ray's own for a
+/// packet's group, `packet8`), for the lanes in `lanes`.
 #[inline]
 #[target_feature(enable = "avx2,fma")]
-fn edge_test8(xy: [__m256; 6], z: [__m256; 3], t_min: f32, t_max: f32, lanes: u32) -> Hits8 {
+pub(crate) fn edge_test8(xy: [__m256; 6], z: [__m256; 3], t_min: __m256, t_max: __m256, lanes: u32) -> Hits8 {
     let [ax, ay, bx, by, cx, cy] = xy;
     let diff = |p: __m256, q: __m256, r: __m256, s: __m256| _mm256_sub_ps(_mm256_mul_ps(p, q), _mm256_mul_ps(r, s));
     let mut u = diff(cx, by, cy, bx);
@@ -183,10 +184,7 @@ fn edge_test8(xy: [__m256; 6], z: [__m256; 3], t_min: f32, t_max: f32, lanes: u3
     // `det != 0` is true for NaN (unordered), as the scalar `det == 0.0` rejects only zero.
     let inside = _mm256_and_ps(
         _mm256_cmp_ps::<_CMP_NEQ_UQ>(det, zero_v),
-        _mm256_and_ps(
-            _mm256_cmp_ps::<_CMP_GE_OQ>(t, _mm256_set1_ps(t_min)),
-            _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(t_max)),
-        ),
+        _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(t, t_min), _mm256_cmp_ps::<_CMP_LT_OQ>(t, t_max)),
     );
     let mask = _mm256_movemask_ps(inside) as u32 & !outside & lanes;
     let mut hits = Hits8 { mask, ..Hits8::NONE };

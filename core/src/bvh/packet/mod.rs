@@ -4,13 +4,13 @@
 //! and at each node only the rays from the first one that hits the node's box onwards stay active.
 //!
 //! Why it is fast for primary rays: near the top of the tree the first active rays hit nearly every
-//! box the packet reaches, so a node costs one SIMD box test (four rays, or sixteen with AVX-512:
+//! box the packet reaches, so a node costs one SIMD box test (four rays, eight with AVX2, sixteen with AVX-512:
 //! `lanes.rs`) for all 64. When that first
 //! group misses, a conservative test of the whole packet (interval arithmetic over the rays'
 //! origins and inverse directions, the paper's §4.2) rejects most boxes no ray reaches before the
 //! other groups are tried one by one. At a leaf every group from the first active one is
 //! box-tested and its hitting rays test the leaf's triangles a group at a time
-//! (`TriangleIntersector::intersect4`/`intersect16`, bit for bit the single-ray test), so every ray gets the hit
+//! (`TriangleIntersector::intersect4`/`intersect8`/`intersect16`, bit for bit the single-ray test), so every ray gets the hit
 //! it would get alone (the same distance; between triangles hit at exactly the same distance either
 //! may be reported).
 //!

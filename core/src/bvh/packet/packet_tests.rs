@@ -117,7 +117,8 @@ fn packets_find_what_single_rays_find() {
 }
 
 /// The same with each kernel forced on the wide trees (`with_simd`): four-ray groups (`Simd4`,
-/// `Avx2`, `Scalar`) and sixteen-ray groups (`Avx512`, where the CPU has it), every packet size.
+/// `Scalar`), eight-ray groups (`Avx2`) and sixteen-ray groups (`Avx512`), each where the CPU has
+/// it, every packet size.
 #[test]
 fn packets_with_every_kernel_find_what_single_rays_find() {
     use crate::cpu::Simd;

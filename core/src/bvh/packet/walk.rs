@@ -266,8 +266,30 @@ pub(super) fn packet<B: PacketTree, const ANY: bool>(
                 return unsafe { walk_avx512::<B, T, ANY>(k, bvh, rays, hits) };
             }
         }
+        #[cfg(target_arch = "x86_64")]
+        if bvh.simd() == Simd::Avx2 {
+            if let Some(k) = crate::geometry::slab8::Avx2::detect() {
+                // SAFETY: `detect` found AVX2, FMA and the bit instructions.
+                return unsafe { walk_avx2::<B, T, ANY>(k, bvh, rays, hits) };
+            }
+        }
         walk::<B, T, _, GROUPS, ANY>(Four, bvh, rays, hits)
     })
+}
+
+/// The walk compiled for AVX2 with groups of eight rays (`geometry::packet8`): eight per packet.
+///
+/// # Safety
+/// The CPU must have these features: `k` proves it.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,lzcnt")]
+pub(super) unsafe fn walk_avx2<B: PacketTree, T: TriangleIntersector, const ANY: bool>(
+    k: crate::geometry::slab8::Avx2,
+    bvh: &B,
+    rays: &mut [Ray],
+    hits: &mut [Option<Hit>],
+) {
+    walk::<B, T, _, { PACKET / 8 }, ANY>(crate::bvh::packet::lanes::Eight(k), bvh, rays, hits)
 }
 
 /// The walk compiled for AVX-512 with groups of sixteen rays (`avx512::packet`): four per packet.

@@ -245,6 +245,13 @@ mod tests {
             fn intersect4(p: &Self::Prepared4, t0: f32x4, t1: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
                 Watertight::intersect4(p, t0, t1, lanes, tri)
             }
+            type Prepared8 = <Watertight as TriangleIntersector>::Prepared8;
+            fn prepare8(k: Avx2, rays: &[Ray], base: usize) -> Self::Prepared8 {
+                Watertight::prepare8(k, rays, base)
+            }
+            fn intersect8(k: Avx2, p: &Self::Prepared8, t0: __m256, t1: __m256, l: u32, tri: &[Vec3; 3]) -> Hits8 {
+                Watertight::intersect8(k, p, t0, t1, l, tri)
+            }
             type Prepared16 = <Watertight as TriangleIntersector>::Prepared16;
             fn prepare16(k: Avx512, rays: &[Ray], base: usize) -> Self::Prepared16 {
                 Watertight::prepare16(k, rays, base)
@@ -254,6 +261,8 @@ mod tests {
             }
         }
         use crate::geometry::shear::Hits4;
+        use crate::geometry::slab8::Avx2;
+        use crate::geometry::triangle8::Hits8;
         use wide::f32x4;
         Four::intersect_group16_coords(k, p, ray, coords, count, g)
     }
