@@ -3,6 +3,8 @@
 mod aabb;
 #[cfg(target_arch = "x86_64")]
 pub mod avx512;
+#[cfg(all(test, target_arch = "x86_64"))]
+mod group_tests;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod packet8;
 mod ray;

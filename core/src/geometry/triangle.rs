@@ -351,6 +351,34 @@ pub struct WatertightRay4 {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct MollerTrumbore;
 
+impl MollerTrumbore {
+    /// A group of `N` rays one lane at a time (this test is not vectorised): for the lanes in
+    /// `lanes`, ray k within `[t_min[k], t_max[k])` against `tri`; the mask of the hits and their
+    /// `t`, `u`, `v`.
+    #[allow(clippy::type_complexity)]
+    fn lane_by_lane<const N: usize>(
+        rays: &[Ray; N],
+        t_min: [f32; N],
+        t_max: [f32; N],
+        lanes: u32,
+        tri: &[Vec3; 3],
+    ) -> (u32, [f32; N], [f32; N], [f32; N]) {
+        let (mut mask, mut t, mut u, mut v) = (0, [0.0; N], [0.0; N], [0.0; N]);
+        let mut m = lanes;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let mut ray = rays[k];
+            (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
+            if let Some(h) = <Self as TriangleIntersector>::intersect(&(), &ray, tri) {
+                mask |= 1 << k;
+                (t[k], u[k], v[k]) = (h.t, h.u, h.v);
+            }
+        }
+        (mask, t, u, v)
+    }
+}
+
 impl TriangleIntersector for MollerTrumbore {
     type Prepared = ();
 
@@ -405,20 +433,8 @@ impl TriangleIntersector for MollerTrumbore {
     }
 
     fn intersect4(rays: &[Ray; 4], t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
-        let mut hits = Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
-        let (t_min, t_max) = (t_min.to_array(), t_max.to_array());
-        let mut m = lanes;
-        while m != 0 {
-            let k = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let mut ray = rays[k];
-            (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
-            if let Some(h) = Self::intersect(&(), &ray, tri) {
-                hits.mask |= 1 << k;
-                (hits.t[k], hits.u[k], hits.v[k]) = (h.t, h.u, h.v);
-            }
-        }
-        hits
+        let (mask, t, u, v) = Self::lane_by_lane(rays, t_min.to_array(), t_max.to_array(), lanes, tri);
+        Hits4 { mask, t, u, v }
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -432,22 +448,11 @@ impl TriangleIntersector for MollerTrumbore {
     /// Lane by lane, as `intersect4`.
     #[cfg(target_arch = "x86_64")]
     fn intersect8(_: Avx2, rays: &[Ray; 8], t_min: __m256, t_max: __m256, lanes: u32, tri: &[Vec3; 3]) -> Hits8 {
-        let mut hits = Hits8::NONE;
         // SAFETY: `__m256` and `[f32; 8]` have the same size, and every bit pattern is a float.
         let (t_min, t_max): ([f32; 8], [f32; 8]) =
             unsafe { (std::mem::transmute::<__m256, [f32; 8]>(t_min), std::mem::transmute::<__m256, [f32; 8]>(t_max)) };
-        let mut m = lanes;
-        while m != 0 {
-            let k = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let mut ray = rays[k];
-            (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
-            if let Some(h) = Self::intersect(&(), &ray, tri) {
-                hits.mask |= 1 << k;
-                (hits.t[k], hits.u[k], hits.v[k]) = (h.t, h.u, h.v);
-            }
-        }
-        hits
+        let (mask, t, u, v) = Self::lane_by_lane(rays, t_min, t_max, lanes, tri);
+        Hits8 { mask, t, u, v }
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -461,23 +466,12 @@ impl TriangleIntersector for MollerTrumbore {
     /// Lane by lane, as `intersect4`.
     #[cfg(target_arch = "x86_64")]
     fn intersect16(_: Avx512, rays: &[Ray; 16], t_min: __m512, t_max: __m512, lanes: u32, tri: &[Vec3; 3]) -> Hits16 {
-        let mut hits = Hits16::NONE;
         // SAFETY: `__m512` and `[f32; 16]` have the same size, and every bit pattern is a float.
         let (t_min, t_max): ([f32; 16], [f32; 16]) = unsafe {
             (std::mem::transmute::<__m512, [f32; 16]>(t_min), std::mem::transmute::<__m512, [f32; 16]>(t_max))
         };
-        let mut m = lanes;
-        while m != 0 {
-            let k = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let mut ray = rays[k];
-            (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
-            if let Some(h) = Self::intersect(&(), &ray, tri) {
-                hits.mask |= 1 << k;
-                (hits.t[k], hits.u[k], hits.v[k]) = (h.t, h.u, h.v);
-            }
-        }
-        hits
+        let (mask, t, u, v) = Self::lane_by_lane(rays, t_min, t_max, lanes, tri);
+        Hits16 { mask, t, u, v }
     }
 }
 
