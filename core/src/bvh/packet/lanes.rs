@@ -162,225 +162,144 @@ impl<T: TriangleIntersector> PacketLanes<T> for Four {
     }
 }
 
+/// The `PacketLanes` of a wide group (`Eight` with AVX2, `Sixteen` with AVX-512): the same calls
+/// on their kernels (`geometry::packet8`, `avx512::packet`), which are compiled for the family's
+/// features and take its proof, so every call below is `unsafe` with the proof in hand. The leaf
+/// loop is compiled for the features too, so the triangle test inlines into it (the packet walk
+/// calls it from a closure, which has no target features).
 #[cfg(target_arch = "x86_64")]
-pub(crate) use eight::Eight;
+macro_rules! wide_lanes {
+    (
+        $(#[$doc:meta])*
+        $name:ident($proof:ty, $features:literal): $n:literal lanes, $bits:ty, frustum first: $ff:literal,
+        $group:ty, $hits:ty, $interval:path,
+        $prepared:ident, $prepare:ident, $intersect:ident, $leaf:ident
+    ) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug)]
+        pub(crate) struct $name(pub $proof);
+
+        // SAFETY (every `unsafe` below): the kernels are compiled for the family's features
+        // (`#[target_feature]`), and `self.0` proves the CPU has them.
+        impl<T: TriangleIntersector> PacketLanes<T> for $name {
+            const N: usize = $n;
+            const FRUSTUM_FIRST: bool = $ff;
+            type Group = $group;
+            type Prepared = T::$prepared;
+            type Hits = $hits;
+
+            #[inline(always)]
+            fn group(self, rays: &[Ray], base: usize) -> $group {
+                unsafe { <$group>::new(self.0, rays, base) }
+            }
+            #[inline(always)]
+            fn hit(self, g: &$group, lo: [f32; 3], hi: [f32; 3]) -> u32 {
+                unsafe { g.hit(self.0, lo, hi) }
+            }
+            #[inline(always)]
+            fn hit_planes(self, g: &$group, near: [f32; 3], far: [f32; 3]) -> u32 {
+                unsafe { g.hit_planes(self.0, near, far) }
+            }
+            #[inline(always)]
+            fn refresh(self, g: &mut $group, rays: &[Ray], base: usize) {
+                unsafe { g.refresh(self.0, rays, base) };
+            }
+            #[inline(always)]
+            fn signs(self, groups: &[$group]) -> (bool, [bool; 3]) {
+                let (mut all_neg, mut any_neg) = ([<$bits>::MAX; 3], [0 as $bits; 3]);
+                for group in groups {
+                    for axis in 0..3 {
+                        (all_neg[axis], any_neg[axis]) =
+                            (all_neg[axis] & group.neg[axis], any_neg[axis] | group.neg[axis]);
+                    }
+                }
+                let one_sign = (0..3).all(|a| all_neg[a] == <$bits>::MAX || any_neg[a] == 0);
+                (one_sign, all_neg.map(|m| m == <$bits>::MAX))
+            }
+            #[inline(always)]
+            fn t_far(self, groups: &[$group]) -> f32 {
+                groups.iter().map(|g| unsafe { g.t_far(self.0) }).fold(f32::NEG_INFINITY, f32::max)
+            }
+            #[inline(always)]
+            fn frustum(self, groups: &[$group]) -> RayInterval {
+                unsafe { $interval(self.0, groups) }
+            }
+            #[inline(always)]
+            fn prepare(self, rays: &[Ray], base: usize) -> T::$prepared {
+                T::$prepare(self.0, rays, base)
+            }
+            #[inline(always)]
+            fn intersect(self, p: &T::$prepared, g: &$group, lanes: u32, tri: &[Vec3; 3]) -> $hits {
+                T::$intersect(self.0, p, g.t_min, g.t_max, lanes, tri)
+            }
+            #[inline(always)]
+            fn mask(h: &$hits) -> u32 {
+                h.mask
+            }
+            #[inline(always)]
+            fn lane(h: &$hits, k: usize) -> TriangleHit {
+                TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] }
+            }
+            #[inline(always)]
+            fn leaf(
+                self,
+                p: &T::$prepared,
+                g: &mut $group,
+                lanes: u32,
+                tris: &[[Vec3; 3]],
+                rays: &mut [Ray],
+                base: usize,
+                record: impl FnMut(usize, usize, TriangleHit),
+            ) -> bool {
+                unsafe { $leaf::<T, _>(self, p, g, lanes, tris, rays, base, record) }
+            }
+        }
+
+        /// `leaf_loop` compiled for the family's features.
+        ///
+        /// # Safety
+        /// The CPU has them (`k.0` proves it).
+        #[inline]
+        #[target_feature(enable = $features)]
+        #[allow(clippy::too_many_arguments)]
+        unsafe fn $leaf<T: TriangleIntersector, F: FnMut(usize, usize, TriangleHit)>(
+            k: $name,
+            p: &T::$prepared,
+            g: &mut $group,
+            lanes: u32,
+            tris: &[[Vec3; 3]],
+            rays: &mut [Ray],
+            base: usize,
+            record: F,
+        ) -> bool {
+            leaf_loop::<T, $name>(k, p, g, lanes, tris, rays, base, record)
+        }
+    };
+}
 
 #[cfg(target_arch = "x86_64")]
-mod eight {
+pub(crate) use groups::{Eight, Sixteen};
+
+#[cfg(target_arch = "x86_64")]
+mod groups {
     use super::*;
+    use crate::geometry::avx512::packet::{interval16, RayGroup16};
+    use crate::geometry::avx512::{Avx512, Hits16};
     use crate::geometry::packet8::{interval8, RayGroup8};
     use crate::geometry::slab8::Avx2;
     use crate::geometry::triangle8::Hits8;
 
-    /// Groups of eight rays in AVX2 registers (`geometry::packet8`), where the CPU has them.
-    #[derive(Clone, Copy, Debug)]
-    pub(crate) struct Eight(pub Avx2);
-
-    // SAFETY (every `unsafe` below): the kernels are compiled for AVX2 and FMA
-    // (`#[target_feature]`), and `self.0` proves the CPU has them.
-    impl<T: TriangleIntersector> PacketLanes<T> for Eight {
-        const N: usize = 8;
-        // Measured both ways (bunny and beast, leaves of 8, AVX2): the frustum first was 4 %
-        // faster on the bunny's primary packets and 15 % slower on the beast's.
-        const FRUSTUM_FIRST: bool = false;
-        type Group = RayGroup8;
-        type Prepared = T::Prepared8;
-        type Hits = Hits8;
-
-        #[inline(always)]
-        fn group(self, rays: &[Ray], base: usize) -> RayGroup8 {
-            unsafe { RayGroup8::new(self.0, rays, base) }
-        }
-        #[inline(always)]
-        fn hit(self, g: &RayGroup8, lo: [f32; 3], hi: [f32; 3]) -> u32 {
-            unsafe { g.hit(self.0, lo, hi) }
-        }
-        #[inline(always)]
-        fn hit_planes(self, g: &RayGroup8, near: [f32; 3], far: [f32; 3]) -> u32 {
-            unsafe { g.hit_planes(self.0, near, far) }
-        }
-        #[inline(always)]
-        fn refresh(self, g: &mut RayGroup8, rays: &[Ray], base: usize) {
-            unsafe { g.refresh(self.0, rays, base) };
-        }
-        #[inline(always)]
-        fn signs(self, groups: &[RayGroup8]) -> (bool, [bool; 3]) {
-            let (mut all_neg, mut any_neg) = ([u8::MAX; 3], [0u8; 3]);
-            for group in groups {
-                for axis in 0..3 {
-                    (all_neg[axis], any_neg[axis]) = (all_neg[axis] & group.neg[axis], any_neg[axis] | group.neg[axis]);
-                }
-            }
-            let one_sign = (0..3).all(|a| all_neg[a] == u8::MAX || any_neg[a] == 0);
-            (one_sign, all_neg.map(|m| m == u8::MAX))
-        }
-        #[inline(always)]
-        fn t_far(self, groups: &[RayGroup8]) -> f32 {
-            groups.iter().map(|g| unsafe { g.t_far(self.0) }).fold(f32::NEG_INFINITY, f32::max)
-        }
-        #[inline(always)]
-        fn frustum(self, groups: &[RayGroup8]) -> RayInterval {
-            unsafe { interval8(self.0, groups) }
-        }
-        #[inline(always)]
-        fn prepare(self, rays: &[Ray], base: usize) -> T::Prepared8 {
-            T::prepare8(self.0, rays, base)
-        }
-        #[inline(always)]
-        fn intersect(self, p: &T::Prepared8, g: &RayGroup8, lanes: u32, tri: &[Vec3; 3]) -> Hits8 {
-            T::intersect8(self.0, p, g.t_min, g.t_max, lanes, tri)
-        }
-        #[inline(always)]
-        fn mask(h: &Hits8) -> u32 {
-            h.mask
-        }
-        #[inline(always)]
-        fn lane(h: &Hits8, k: usize) -> TriangleHit {
-            TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] }
-        }
-        #[inline(always)]
-        fn leaf(
-            self,
-            p: &T::Prepared8,
-            g: &mut RayGroup8,
-            lanes: u32,
-            tris: &[[Vec3; 3]],
-            rays: &mut [Ray],
-            base: usize,
-            record: impl FnMut(usize, usize, TriangleHit),
-        ) -> bool {
-            unsafe { leaf8::<T, _>(self, p, g, lanes, tris, rays, base, record) }
-        }
+    // The frustum first was measured both ways on AVX2 (bunny and beast, leaves of 8): 4 % faster
+    // on the bunny's primary packets, 15 % slower on the beast's.
+    wide_lanes! {
+        /// Groups of eight rays in AVX2 registers (`geometry::packet8`), where the CPU has them.
+        Eight(Avx2, "avx2,fma"): 8 lanes, u8, frustum first: false,
+        RayGroup8, Hits8, interval8, Prepared8, prepare8, intersect8, leaf8
     }
 
-    /// `leaf_loop` compiled for AVX2, so that the triangle test inlines into the loop over the
-    /// leaf's triangles (the packet walk calls it from a closure, which has no target features).
-    ///
-    /// # Safety
-    /// The CPU has AVX2 and FMA (`k.0` proves it).
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn leaf8<T: TriangleIntersector, F: FnMut(usize, usize, TriangleHit)>(
-        k: Eight,
-        p: &T::Prepared8,
-        g: &mut RayGroup8,
-        lanes: u32,
-        tris: &[[Vec3; 3]],
-        rays: &mut [Ray],
-        base: usize,
-        record: F,
-    ) -> bool {
-        leaf_loop::<T, Eight>(k, p, g, lanes, tris, rays, base, record)
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-pub(crate) use sixteen::Sixteen;
-
-#[cfg(target_arch = "x86_64")]
-mod sixteen {
-    use super::*;
-    use crate::geometry::avx512::packet::{interval16, RayGroup16};
-    use crate::geometry::avx512::{Avx512, Hits16};
-
-    /// Groups of sixteen rays in AVX-512 registers (`avx512::packet`), where the CPU has them.
-    #[derive(Clone, Copy, Debug)]
-    pub(crate) struct Sixteen(pub Avx512);
-
-    // SAFETY (every `unsafe` below): the kernels are compiled for AVX-512 (`#[target_feature]`),
-    // and `self.0` proves the CPU has it.
-    impl<T: TriangleIntersector> PacketLanes<T> for Sixteen {
-        const N: usize = 16;
-        const FRUSTUM_FIRST: bool = true;
-        type Group = RayGroup16;
-        type Prepared = T::Prepared16;
-        type Hits = Hits16;
-
-        #[inline(always)]
-        fn group(self, rays: &[Ray], base: usize) -> RayGroup16 {
-            unsafe { RayGroup16::new(self.0, rays, base) }
-        }
-        #[inline(always)]
-        fn hit(self, g: &RayGroup16, lo: [f32; 3], hi: [f32; 3]) -> u32 {
-            unsafe { g.hit(self.0, lo, hi) }
-        }
-        #[inline(always)]
-        fn hit_planes(self, g: &RayGroup16, near: [f32; 3], far: [f32; 3]) -> u32 {
-            unsafe { g.hit_planes(self.0, near, far) }
-        }
-        #[inline(always)]
-        fn refresh(self, g: &mut RayGroup16, rays: &[Ray], base: usize) {
-            unsafe { g.refresh(self.0, rays, base) };
-        }
-        #[inline(always)]
-        fn signs(self, groups: &[RayGroup16]) -> (bool, [bool; 3]) {
-            let (mut all_neg, mut any_neg) = ([u16::MAX; 3], [0u16; 3]);
-            for group in groups {
-                for axis in 0..3 {
-                    (all_neg[axis], any_neg[axis]) = (all_neg[axis] & group.neg[axis], any_neg[axis] | group.neg[axis]);
-                }
-            }
-            let one_sign = (0..3).all(|a| all_neg[a] == u16::MAX || any_neg[a] == 0);
-            (one_sign, all_neg.map(|m| m == u16::MAX))
-        }
-        #[inline(always)]
-        fn t_far(self, groups: &[RayGroup16]) -> f32 {
-            groups.iter().map(|g| unsafe { g.t_far(self.0) }).fold(f32::NEG_INFINITY, f32::max)
-        }
-        #[inline(always)]
-        fn frustum(self, groups: &[RayGroup16]) -> RayInterval {
-            unsafe { interval16(self.0, groups) }
-        }
-        #[inline(always)]
-        fn prepare(self, rays: &[Ray], base: usize) -> T::Prepared16 {
-            T::prepare16(self.0, rays, base)
-        }
-        #[inline(always)]
-        fn intersect(self, p: &T::Prepared16, g: &RayGroup16, lanes: u32, tri: &[Vec3; 3]) -> Hits16 {
-            T::intersect16(self.0, p, g.t_min, g.t_max, lanes, tri)
-        }
-        #[inline(always)]
-        fn mask(h: &Hits16) -> u32 {
-            h.mask
-        }
-        #[inline(always)]
-        fn lane(h: &Hits16, k: usize) -> TriangleHit {
-            TriangleHit { t: h.t[k], u: h.u[k], v: h.v[k] }
-        }
-        #[inline(always)]
-        fn leaf(
-            self,
-            p: &T::Prepared16,
-            g: &mut RayGroup16,
-            lanes: u32,
-            tris: &[[Vec3; 3]],
-            rays: &mut [Ray],
-            base: usize,
-            record: impl FnMut(usize, usize, TriangleHit),
-        ) -> bool {
-            unsafe { leaf16::<T, _>(self, p, g, lanes, tris, rays, base, record) }
-        }
-    }
-
-    /// `leaf_loop` compiled for AVX-512, so that the triangle test inlines into the loop over the
-    /// leaf's triangles (the packet walk calls it from a closure, which has no target features).
-    ///
-    /// # Safety
-    /// The CPU has AVX-512F/VL (`k.0` proves it).
-    #[inline]
-    #[target_feature(enable = "avx512f,avx512vl")]
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn leaf16<T: TriangleIntersector, F: FnMut(usize, usize, TriangleHit)>(
-        k: Sixteen,
-        p: &T::Prepared16,
-        g: &mut RayGroup16,
-        lanes: u32,
-        tris: &[[Vec3; 3]],
-        rays: &mut [Ray],
-        base: usize,
-        record: F,
-    ) -> bool {
-        leaf_loop::<T, Sixteen>(k, p, g, lanes, tris, rays, base, record)
+    wide_lanes! {
+        /// Groups of sixteen rays in AVX-512 registers (`avx512::packet`), where the CPU has them.
+        Sixteen(Avx512, "avx512f,avx512vl"): 16 lanes, u16, frustum first: true,
+        RayGroup16, Hits16, interval16, Prepared16, prepare16, intersect16, leaf16
     }
 }
