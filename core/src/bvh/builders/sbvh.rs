@@ -21,7 +21,8 @@
 
 use crate::bvh::builders::common::{node_info, Overrides, Progress};
 use crate::bvh::builders::driver::{build_subtree, children, decide, Decision, Driver, MakeSplitter, Part, SplitKind};
-use crate::bvh::builders::split::spatial::{area_of, SpatialSplits, Triangles};
+use crate::bvh::builders::split::spatial::{area_of, Triangles};
+use crate::bvh::builders::split::spatial_splits::SpatialSplits;
 use crate::bvh::builders::split::splitter::{BuildPrim, NodeInfo, PlaneSink, Proposal, Splitter};
 use crate::bvh::node::BvhNode;
 use crate::bvh::params::BuildParams;

@@ -8,6 +8,7 @@ pub(crate) mod midpoint;
 pub(crate) mod sah_binned;
 pub(crate) mod sah_sweep;
 pub(crate) mod spatial;
+pub(crate) mod spatial_splits;
 pub(crate) mod splitter;
 
 pub use equal_count::EqualCount;
