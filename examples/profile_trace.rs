@@ -101,7 +101,7 @@ fn time_builds(mesh: &Mesh, params: &BuildParams) {
 /// 1280×720, all threads: the renderer's plain frame (shading included), and the app's (counted,
 /// progressive, each pass's image built as the render job builds it).
 fn time_frames(bvh: &AnyBvh, mesh: &Mesh, layout: Layout) {
-    use bvhscope::render::{render, render_passes, view_image, RenderSettings, View};
+    use bvhscope::render::{render, render_passes, render_passes_counts_after, view_image, RenderSettings, View};
     let cam = Camera::framing(&mesh.bounds(), 1280, 720);
     let median = |f: &dyn Fn()| {
         let mut t: Vec<f64> = (0..20)
@@ -126,7 +126,23 @@ fn time_frames(bvh: &AnyBvh, mesh: &Mesh, layout: Layout) {
             std::hint::black_box(view_image(&f, style.0, style.1, style.2, style.3));
         });
     });
-    println!("frame {layout:?}, as the app renders it: median {app_ms:.1} ms of 20");
+    println!("frame {layout:?}, as the app renders a heatmap: median {app_ms:.1} ms of 20");
+    // The app's normal and depth views: the image from uncounted packets, then the counts.
+    let image_ms = std::cell::Cell::new(0.0);
+    let counts_ms = median(&|| {
+        let (control, t) = (bvhscope::work::WorkControl::new(), Instant::now());
+        let _ = render_passes_counts_after(bvh, mesh, &cam, &app, &frames, &control, |f, p| {
+            if f.is_complete() && !p.counts_only {
+                image_ms.set(image_ms.get() + t.elapsed().as_secs_f64() * 1e3 / 20.0);
+            }
+            let style = (View::Normals, Default::default(), Default::default(), Default::default());
+            std::hint::black_box(view_image(&f, style.0, style.1, style.2, style.3));
+        });
+    });
+    println!(
+        "frame {layout:?}, as the app renders the normal view: image after {:.1} ms (mean of 20), counts after {counts_ms:.1} (median)",
+        image_ms.get()
+    );
     if std::env::var("PARTS").is_ok() {
         // Where the app's frame goes beyond the plain one: counting, passes, snapshots.
         let counted = RenderSettings { count: true, ..RenderSettings::default() };

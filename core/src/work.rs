@@ -40,6 +40,12 @@ impl WorkControl {
         }
     }
 
+    /// Progress back to none done, for a second stretch of work under the same control (the
+    /// counted pass after an image, `render::render_passes_counts_after`).
+    pub fn restart(&self) {
+        self.done.store(0, Ordering::Relaxed);
+    }
+
     pub fn set_total(&self, total: u64) {
         self.total.store(total, Ordering::Relaxed);
     }

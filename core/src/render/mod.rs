@@ -27,7 +27,9 @@ pub use incoherent::incoherent_rays;
 pub use legend::{draw_legend, draw_legend_wrapped, legend_height, legend_rows, LegendRows};
 pub use pair::PairView;
 pub use ray_summary::RaySummary;
-pub use raycast::{render, render_passes, render_progressive, PassInfo, RenderSettings, PASS_STRIDES};
+pub use raycast::{
+    render, render_passes, render_passes_counts_after, render_progressive, PassInfo, RenderSettings, PASS_STRIDES,
+};
 pub use sample::PixelSample;
 pub use secondary::{RayKind, SecondaryRays, SecondarySpec};
 pub use views::{

@@ -4,8 +4,9 @@
 //! (traced in 16-pixel-square tiles) run on rayon; the cancel flag is read before each piece, and
 //! the caller sees the frame after each pass. Without counters, an accelerator that traces packets
 //! (both BVH layouts, `bvh::packet`; not the linear scan) gets each pass in packets of up to 8×8
-//! pixels of the pass's grid; with counters on (the heatmaps, and the app, which counts for its
-//! hover read-out) every ray is traced alone.
+//! pixels of the pass's grid; with counters on (the heatmaps) every ray is traced alone. The app's
+//! normal and depth views take both: the image from packets, then its counts for the hover
+//! read-out and the Statistics panel (`render_passes_counts_after`).
 
 use super::secondary::SecondaryRays;
 use crate::bvh::packet::{packet_position, PACKET, PACKET_SIDE};
@@ -43,6 +44,11 @@ pub struct PassInfo {
     pub pass_time: Duration,
     /// Since the render started.
     pub elapsed: Duration,
+    /// The pass only adds counters to a frame already handed on whole and uncounted
+    /// (`render_passes_counts_after`): its samples, and so its image, are the previous pass's.
+    pub counts_only: bool,
+    /// The frame is whole but uncounted, and a `counts_only` pass follows.
+    pub counts_follow: bool,
 }
 
 /// Render a full frame in one pass (no cancellation, no progress).
@@ -94,7 +100,17 @@ pub fn render_progressive<A: Accelerator, M: Surface + ?Sized>(
         control.check()?;
         frame.stride = stride;
         previous = stride;
-        on_pass(&frame, &PassInfo { stride, rays, pass_time: t.elapsed(), elapsed: start.elapsed() });
+        on_pass(
+            &frame,
+            &PassInfo {
+                stride,
+                rays,
+                pass_time: t.elapsed(),
+                elapsed: start.elapsed(),
+                counts_only: false,
+                counts_follow: false,
+            },
+        );
     }
     Ok(frame)
 }
@@ -121,6 +137,39 @@ pub fn render_passes<A: Accelerator, M: Surface + ?Sized>(
     })?;
     on_pass(frame, last.expect("the last pass is complete"));
     Ok(())
+}
+
+/// `render_passes` for a view drawn without counters (the normal and depth views) in a program
+/// that still reads them (the app's hover read-out and Statistics panel): the passes uncounted, in
+/// 8×8 packets (the counted walk goes ray by ray, because a heatmap's count is that of the ray's own
+/// walk, and takes about twice as long: BENCHMARKS.md, "Packets in groups of eight on AVX2"), then
+/// the frame once more ray by ray with counters, handed on as one more full pass marked
+/// `counts_only`. Where packets would not be traced (a tree without them, secondary rays) or
+/// `settings.count` is off, this is `render_passes`.
+pub fn render_passes_counts_after<A: Accelerator, M: Surface + ?Sized>(
+    accel: &A,
+    mesh: &M,
+    camera: &Camera,
+    settings: &RenderSettings,
+    frames: &FramePool,
+    control: &WorkControl,
+    mut on_pass: impl FnMut(Frame, PassInfo),
+) -> Result<(), Cancelled> {
+    let secondary = settings.secondary.is_some_and(|s| s.spec.kind.is_secondary());
+    if !settings.count || secondary || !accel.traces_packets() {
+        return render_passes(accel, mesh, camera, settings, frames, control, on_pass);
+    }
+    let start = Instant::now();
+    let image = RenderSettings { count: false, ..*settings };
+    render_passes(accel, mesh, camera, &image, frames, control, |frame, info| {
+        let counts_follow = frame.is_complete();
+        on_pass(frame, PassInfo { counts_follow, ..info })
+    })?;
+    control.restart();
+    let counted = RenderSettings { progressive: false, ..*settings };
+    render_passes(accel, mesh, camera, &counted, frames, control, |frame, info| {
+        on_pass(frame, PassInfo { elapsed: start.elapsed(), counts_only: true, ..info })
+    })
 }
 
 /// One pass: the pixels on the `stride` grid that the `previous` grid (0: none) did not cover.
@@ -401,6 +450,53 @@ mod tests {
                 assert!(counted.counters(i as u32 % 45, i as u32 / 45).box_tests >= 1, "{layout:?}: pixel {i}");
             }
         }
+    }
+
+    /// The app's normal and depth views: the image from uncounted passes first, then the same
+    /// frame counted, as the counted render makes it; where packets are not traced (secondary
+    /// rays), counted passes straight away.
+    #[test]
+    fn counts_after_the_image_give_the_counted_frame_as_a_last_pass() {
+        let mesh = crate::mesh::generate::torus_knot(2, 3, 0.3, 128, 12);
+        let cam = Camera::framing_from(&mesh.bounds(), 45, 29, Vec3::new(0.3, 0.5, 1.0), 45.0);
+        let bvh =
+            crate::bvh::AnyBvh::build(&mesh, &BuildParams { layout: crate::bvh::Layout::Wide8, ..Default::default() });
+        let settings = RenderSettings { count: true, progressive: true, ..Default::default() };
+        let mut passes = Vec::new();
+        let control = WorkControl::new();
+        render_passes_counts_after(&bvh, &mesh, &cam, &settings, &FramePool::default(), &control, |f, p| {
+            passes.push((f, p))
+        })
+        .unwrap();
+        let shape: Vec<_> =
+            passes.iter().map(|(f, p)| (p.stride, f.counted(), p.counts_follow, p.counts_only)).collect();
+        let image = |stride| (stride, false, stride == 1, false);
+        assert_eq!(shape, [image(8), image(4), image(2), image(1), (1, true, false, true)]);
+        assert_eq!(control.done(), 45 * 29, "progress starts again for the counted pass");
+        let counted = render(&bvh, &mesh, &cam, &settings);
+        let (image, last) = (&passes[3].0, &passes[4].0);
+        assert_eq!(image.full_samples(), last.full_samples(), "the counted pass draws the same image");
+        assert_eq!(last.full_samples(), counted.full_samples());
+        assert!(last.traced().eq(counted.traced()), "and counts what the counted render counts");
+        assert_eq!(passes[4].1.rays, 45 * 29);
+
+        // Without counters asked for: the uncounted passes only.
+        let plain = RenderSettings { count: false, ..settings };
+        let mut n = 0;
+        render_passes_counts_after(&bvh, &mesh, &cam, &plain, &FramePool::default(), &control, |f, p| {
+            assert!(!f.counted() && !p.counts_only && !p.counts_follow);
+            n += 1;
+        })
+        .unwrap();
+        assert_eq!(n, PASS_STRIDES.len());
+        // The linear scan traces no packets: counted passes straight away.
+        let scan = crate::bvh::LinearScan::new(&mesh);
+        let mut counted_passes = Vec::new();
+        render_passes_counts_after(&scan, &mesh, &cam, &settings, &FramePool::default(), &control, |f, p| {
+            counted_passes.push((f.counted(), p.counts_only || p.counts_follow))
+        })
+        .unwrap();
+        assert_eq!(counted_passes, vec![(true, false); PASS_STRIDES.len()]);
     }
 
     /// The pieces are shared among however many threads there are: the frame, its images and

@@ -98,7 +98,14 @@ impl GpuJobs {
         let rays = t.hits.len() as u64;
         let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
         let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
-        let info = PassInfo { stride: 1, rays, pass_time: start.elapsed(), elapsed: start.elapsed() };
+        let info = PassInfo {
+            stride: 1,
+            rays,
+            pass_time: start.elapsed(),
+            elapsed: start.elapsed(),
+            counts_only: false,
+            counts_follow: false,
+        };
         Ok(Some(PassOutput {
             bvh: r.bvh.clone(),
             frame: Arc::new(frame),

@@ -6,7 +6,9 @@ use crate::app::views::compare::CompareB;
 use crate::app::views::import::{ImportedTree, WrongPixels, CHECK_RAYS};
 use crate::app::views::node::{Explained, FrameVisits};
 use crate::bvh::{SceneBuild, SceneBvh, TraceOptions};
-use crate::render::{render_passes, view_image, Camera, Frame, FramePool, PassInfo, RenderSettings};
+use crate::render::{
+    render_passes, render_passes_counts_after, view_image, Camera, Frame, FramePool, PassInfo, RenderSettings,
+};
 use crate::scene::Scene;
 use crate::work::WorkControl;
 use std::path::PathBuf;
@@ -209,7 +211,8 @@ impl Jobs {
                 JobEvent::Loaded(_) if current(&self.load) => self.load = None,
                 JobEvent::Built { .. } | JobEvent::NotBuilt if current(&self.build) => self.build = None,
                 JobEvent::Pass(p) if current(&self.render) => {
-                    if p.info.stride == 1 {
+                    // The normal and depth views' whole image is followed by its counts.
+                    if p.info.stride == 1 && !p.info.counts_follow {
                         self.render = None;
                     }
                 }

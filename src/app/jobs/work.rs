@@ -89,10 +89,12 @@ impl Jobs {
                 }
                 return;
             }
-            // Always count: the heatmaps and the hover read-out need the counters, and counting
-            // costs little next to shading.
+            // Always count: the heatmaps, the hover read-out and the Statistics panel need the
+            // counters. A heatmap is drawn from them; the normal and depth views are drawn from
+            // uncounted packets first, and their counts follow in one more pass.
             let settings =
                 RenderSettings { trace: r.trace, count: true, progressive: r.progressive, secondary: r.secondary };
+            let passes = if r.style.view.is_heatmap() { render_passes } else { render_passes_counts_after };
             let on_pass = |frame: Frame, info: PassInfo| {
                 let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
@@ -108,7 +110,7 @@ impl Jobs {
                 (Some(p), SceneBvh::Single { mesh, .. }) => {
                     render_passes(&**p, &**mesh, &r.camera, &settings, &frames, &control, on_pass)
                 }
-                _ => render_passes(&*r.bvh, &*r.bvh, &r.camera, &settings, &frames, &control, on_pass),
+                _ => passes(&*r.bvh, &*r.bvh, &r.camera, &settings, &frames, &control, on_pass),
             };
         });
         self.render = Some(job);

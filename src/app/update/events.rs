@@ -158,9 +158,17 @@ impl BvhscopeApp {
 
     pub(super) fn show_pass(&mut self, ctx: &egui::Context, p: PassOutput) {
         let options = egui::TextureOptions::NEAREST;
-        let rays_per_s = p.info.rays as f64 / p.info.pass_time.as_secs_f64().max(1e-9);
+        // A pass that only adds counts to the image on screen keeps the image's figures: its
+        // time and speed are those of the counted walk, not of what drew the image.
+        let image_pass = self.shown.as_ref().filter(|_| p.info.counts_only);
+        let rays_per_s = match image_pass {
+            Some(s) => s.rays_per_s,
+            None => p.info.rays as f64 / p.info.pass_time.as_secs_f64().max(1e-9),
+        };
         if p.info.stride == 1 {
-            self.last_full_frame = Some(p.info.elapsed);
+            if !p.info.counts_only {
+                self.last_full_frame = Some(p.info.elapsed);
+            }
             // An import's check waits for the scene's first full frame (`Jobs::import`).
             if p.partial.is_none() && self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
                 self.jobs.shown_scene.store(self.scene_id, std::sync::atomic::Ordering::SeqCst);
@@ -168,7 +176,11 @@ impl BvhscopeApp {
             // Per-ray figures belong to the BVH that traced them; a pass of an older BVH that
             // arrives after a rebuild must not be shown (or remembered) under the new strategy.
             // A replay's partial tree is not the strategy's tree: its figures are not recorded.
-            if p.partial.is_none() && self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh)) {
+            // An uncounted frame (the normal and depth views' image, its counts to follow) has none.
+            if p.partial.is_none()
+                && p.frame.counted()
+                && self.current_bvh().is_some_and(|b| Arc::ptr_eq(&b.bvh, &p.bvh))
+            {
                 // An imported tree's rays counted on the mesh's box, as the tree beside it.
                 let summary = match p.bvh.yardstick() {
                     Some(y) => p.frame.ray_summary_in(&p.camera, &y),
