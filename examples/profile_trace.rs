@@ -3,7 +3,8 @@
 //! `cargo run --release --example profile_trace -- [binary|wide4|wide8] [primary|incoherent|build|frame]`
 //! (`PRESET=fastest`: the `fastest` preset's tree and trace options instead)
 //! (`TIME=n`: also the plain closest-hit traversal of all rays, n times, with its median)
-//! (`frame` with `PARTS=1` also splits the app's frame into counting, passes and snapshots;
+//! (`frame` with `PARTS=1` also splits the app's frame into counting, passes and snapshots, with
+//! `ONLY=counted` times only the counted frame;
 //! `primary` with `PACKET=1` also times 8×8 packets, with `PACKET=only` nothing else).
 
 use bvhscope::bvh::{Accelerator, AnyBvh, BuildParams, Layout, NoStats, TraceOptions};
@@ -114,6 +115,12 @@ fn time_frames(bvh: &AnyBvh, mesh: &Mesh, layout: Layout) {
         t.sort_by(f64::total_cmp);
         t[10]
     };
+    if std::env::var("ONLY").is_ok_and(|o| o == "counted") {
+        // Only the counted single-pass frame, for a profile of it.
+        let counted = RenderSettings { count: true, ..RenderSettings::default() };
+        let ms = median(&|| drop(std::hint::black_box(render(bvh, mesh, &cam, &counted))));
+        return println!("counted frame {layout:?}: median {ms:.1} ms of 20");
+    }
     let plain = RenderSettings::default();
     let plain_ms = median(&|| drop(std::hint::black_box(render(bvh, mesh, &cam, &plain))));
     println!("frame {layout:?}, plain: median {plain_ms:.1} ms of 20");
