@@ -212,7 +212,11 @@ impl Jobs {
                 JobEvent::Built { .. } | JobEvent::NotBuilt if current(&self.build) => self.build = None,
                 JobEvent::Pass(p) if current(&self.render) => {
                     // The normal and depth views' whole image is followed by its counts.
-                    if p.info.stride == 1 && !p.info.counts_follow {
+                    if p.info.counts_follow {
+                        if let Some(r) = self.render.as_mut() {
+                            r.label = "Counting the rays' work".to_string();
+                        }
+                    } else if p.info.stride == 1 {
                         self.render = None;
                     }
                 }

@@ -94,7 +94,6 @@ impl Jobs {
             // uncounted packets first, and their counts follow in one more pass.
             let settings =
                 RenderSettings { trace: r.trace, count: true, progressive: r.progressive, secondary: r.secondary };
-            let passes = if r.style.view.is_heatmap() { render_passes } else { render_passes_counts_after };
             let on_pass = |frame: Frame, info: PassInfo| {
                 let (img, legend) = view_image(&frame, r.style.view, r.style.colormap, r.style.range, r.style.cost);
                 let image = egui::ColorImage::from_rgb([img.width() as usize, img.height() as usize], img.as_raw());
@@ -110,7 +109,10 @@ impl Jobs {
                 (Some(p), SceneBvh::Single { mesh, .. }) => {
                     render_passes(&**p, &**mesh, &r.camera, &settings, &frames, &control, on_pass)
                 }
-                _ => passes(&*r.bvh, &*r.bvh, &r.camera, &settings, &frames, &control, on_pass),
+                _ if r.style.view.is_heatmap() => {
+                    render_passes(&*r.bvh, &*r.bvh, &r.camera, &settings, &frames, &control, on_pass)
+                }
+                _ => render_passes_counts_after(&*r.bvh, &*r.bvh, &r.camera, &settings, &frames, &control, on_pass),
             };
         });
         self.render = Some(job);
