@@ -115,7 +115,38 @@ impl RayGen {
     pub fn pixel_ray(&self, px: u32, py: u32) -> Ray {
         self.ray(px as f32 + 0.5, py as f32 + 0.5)
     }
+
+    /// The rays through the centres of pixels `xs` of row `py` (at most `ROW_RAYS`), into `out`:
+    /// bit for bit `pixel_ray`'s (the same operations in the same order), the directions made
+    /// lane by lane in arrays the compiler turns into SIMD. Made one at a time between two walks,
+    /// each ray's square root and divisions waited on the previous ones (BENCHMARKS.md, "The
+    /// counted frame's camera rays").
+    pub fn row_rays(&self, py: u32, xs: &[u32], out: &mut [Ray]) {
+        const N: usize = ROW_RAYS;
+        assert!(xs.len() <= N && out.len() >= xs.len(), "at most {N} rays a call");
+        let sy = 1.0 - 2.0 * (py as f32 + 0.5) * self.inv_h;
+        let mut sx = [0.0f32; N];
+        for (s, &x) in sx.iter_mut().zip(xs) {
+            *s = 2.0 * (x as f32 + 0.5) * self.inv_w - 1.0;
+        }
+        let (f, r, u) = (self.forward, self.right, self.up);
+        let (mut dx, mut dy, mut dz, mut len) = ([0.0f32; N], [0.0f32; N], [0.0f32; N], [0.0f32; N]);
+        for i in 0..N {
+            // `forward + right * sx + up * sy`, component by component as glam adds them.
+            dx[i] = f.x + r.x * sx[i] + u.x * sy;
+            dy[i] = f.y + r.y * sx[i] + u.y * sy;
+            dz[i] = f.z + r.z * sx[i] + u.z * sy;
+            // `normalize`: times 1 / sqrt(dot), the dot product summed x, y, z.
+            len[i] = 1.0 / (dx[i] * dx[i] + dy[i] * dy[i] + dz[i] * dz[i]).sqrt();
+        }
+        for (i, ray) in out.iter_mut().enumerate().take(xs.len()) {
+            *ray = Ray::new(self.origin, Vec3::new(dx[i] * len[i], dy[i] * len[i], dz[i] * len[i]));
+        }
+    }
 }
+
+/// The most rays `RayGen::row_rays` makes in one call.
+pub const ROW_RAYS: usize = 16;
 
 impl Camera {
     /// The narrowest and widest vertical field of view (a narrower one would frame a mesh from
@@ -277,6 +308,34 @@ mod tests {
         assert!((top.angle_between(bottom).to_degrees() - 45.0).abs() < 1e-3);
         assert!(top.y > bottom.y, "row 0 is the top of the image");
         assert!(g.ray(1200.0, 400.0).dir().x > 0.0, "the last column is on the right");
+    }
+
+    /// A row's rays made together are `pixel_ray`'s, bit for bit, on cameras of every shape.
+    #[test]
+    fn row_rays_are_pixel_rays_bit_for_bit() {
+        let b = Aabb::new(Vec3::new(-1.0, 0.0, -2.0), Vec3::new(3.0, 1.0, 0.5));
+        let bits = |r: &Ray| {
+            let v = [r.origin(), r.dir(), r.inv_dir()];
+            (v.map(|v| v.to_array().map(f32::to_bits)), r.t_min.to_bits(), r.t_max.to_bits())
+        };
+        for (w, h, fov, from) in [
+            (640, 480, 45.0, Camera::DEFAULT_VIEW_FROM),
+            (301, 45, 10.0, Vec3::X),
+            (33, 900, 120.0, Vec3::new(0.0, 0.0, -1.0)),
+            (1280, 720, 0.01, Vec3::new(0.3, -0.8, 0.2)),
+        ] {
+            let g = Camera::framing_from(&b, w, h, from, fov).ray_gen();
+            let mut out = [g.pixel_ray(0, 0); ROW_RAYS];
+            for py in [0, 1, h / 2, h - 1] {
+                for start in (0..w).step_by(7) {
+                    let xs: Vec<u32> = (start..w).step_by(1 + start as usize % 3).take(ROW_RAYS).collect();
+                    g.row_rays(py, &xs, &mut out);
+                    for (k, &x) in xs.iter().enumerate() {
+                        assert_eq!(bits(&out[k]), bits(&g.pixel_ray(x, py)), "{w}×{h} {fov}°: pixel {x}, {py}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -22,6 +22,7 @@ use std::time::{Duration, Instant};
 /// Pixel strides of the passes, coarse to fine.
 pub const PASS_STRIDES: [u32; 4] = [8, 4, 2, 1];
 const TILE: u32 = 16;
+const _: () = assert!(TILE as usize <= crate::render::camera::ROW_RAYS, "a tile's row is made in one call");
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderSettings {
@@ -193,22 +194,23 @@ impl<A: Accelerator, M: Surface + ?Sized> Pass<'_, A, M> {
         for_each_piece(frame, control, |piece| {
             let mut traced = 0u64;
             let Piece { y0, x0, x1, mut samples, mut counters, mut primary } = piece;
-            let mut rays = [(0u32, gen.pixel_ray(0, 0)); TILE as usize];
+            let (mut xs, mut rays) = ([0u32; TILE as usize], [gen.pixel_ray(0, 0); TILE as usize]);
             // Tile by tile across the piece: neighbouring rays walk the same nodes.
             for t0 in (x0..x1).step_by(TILE as usize) {
                 for dy in (0..samples.len() as u32).filter(|dy| (y0 + dy).is_multiple_of(stride)) {
                     let y = y0 + dy;
-                    // The row's rays made first, then traced: made one by one between walks, each
-                    // ray's square root and divisions waited on the one before (10 % of a counted
-                    // frame on AVX2, BENCHMARKS.md); in a loop of their own they overlap.
+                    // The row's rays made first, together (`RayGen::row_rays`), then traced: made
+                    // one by one between walks, each ray's square root and divisions waited on the
+                    // one before (10 % of a counted frame on AVX2, BENCHMARKS.md).
                     let mut n = 0;
                     for x in (t0..(t0 + TILE).min(x1)).step_by(stride as usize) {
                         if previous == 0 || !x.is_multiple_of(previous) || !y.is_multiple_of(previous) {
-                            rays[n] = (x, gen.pixel_ray(x, y));
+                            xs[n] = x;
                             n += 1;
                         }
                     }
-                    for &(x, mut ray) in &rays[..n] {
+                    gen.row_rays(y, &xs[..n], &mut rays[..n]);
+                    for (&x, &(mut ray)) in xs.iter().zip(&rays[..n]) {
                         let mut stats = S::default();
                         let hit = accel.closest_hit(&mut ray, trace, &mut stats);
                         let i = (x - x0) as usize;
