@@ -160,8 +160,8 @@ impl BvhscopeApp {
         let options = egui::TextureOptions::NEAREST;
         // A pass that only adds counts to the image on screen keeps the image's figures: its
         // time and speed are those of the counted walk, not of what drew the image.
-        let image_pass = self.shown.as_ref().filter(|_| p.info.counts_only);
-        let rays_per_s = match image_pass {
+        let counted_image_on_screen = self.shown.as_ref().filter(|_| p.info.counts_only);
+        let rays_per_s = match counted_image_on_screen {
             Some(s) => s.rays_per_s,
             None => p.info.rays as f64 / p.info.pass_time.as_secs_f64().max(1e-9),
         };
