@@ -1,7 +1,8 @@
 //! A profiling driver: traces the bunny's primary and incoherent rays with the wide SAH BVH on
 //! one thread, many times over, for `perf record` / `valgrind --tool=callgrind`.
 //! `cargo run --release --example profile_trace -- [binary|wide4|wide8] [primary|incoherent|build|frame]`
-//! (`PRESET=fastest`: the `fastest` preset's tree and trace options instead)
+//! (`PRESET=fastest`: the `fastest` preset's tree and trace options instead; `TEST=name`: that
+//! triangle test, e.g. `moller-trumbore-stored`)
 //! (`TIME=n`: also the plain closest-hit traversal of all rays, n times, with its median)
 //! (`frame` with `PARTS=1` also splits the app's frame into counting, passes and snapshots, with
 //! `ONLY=counted` times only the counted frame;
@@ -63,7 +64,10 @@ fn params_from_env(layout: Layout) -> (BuildParams, TraceOptions) {
     let fastest = std::env::var("PRESET").is_ok_and(|p| p == "fastest");
     let mut params =
         if fastest { bvhscope::bvh::Preset::Fastest.build() } else { BuildParams { layout, ..BuildParams::default() } };
-    let opts = if fastest { bvhscope::bvh::Preset::Fastest.trace_options() } else { TraceOptions::default() };
+    let mut opts = if fastest { bvhscope::bvh::Preset::Fastest.trace_options() } else { TraceOptions::default() };
+    if let Ok(t) = std::env::var("TEST") {
+        opts.test = bvhscope::geometry::TriangleTest::from_name(&t).expect("TEST is a triangle test's name");
+    }
     if let Ok(c) = std::env::var("COST") {
         params.cost.traversal = c.parse().expect("COST is a number");
     }

@@ -1,7 +1,7 @@
 //! The GPU never answers silently wrong (issue 46), on lavapipe in CI: walks longer than the GPU's
 //! step budget (a fan of triangles sharing one box, thousands of identical triangles, a correct
 //! tree of fat boxes, a 100,000-deep chain) are finished on the CPU and said to be, so every hit
-//! and count equals the CPU's walk; the Möller–Trumbore test and the split-axis-sign order run on
+//! and count equals the CPU's walk; the Möller–Trumbore tests and the split-axis-sign order run on
 //! the GPU with the CPU's hits and counts; the GPU's LBVH and PLOC build the CPU's trees on
 //! thousands of identical centroids, and a broken tree is refused before anyone uses it.
 
@@ -17,11 +17,13 @@ use bvhscope_gpu::{Gpu, Rays, STEP_BUDGET};
 use glam::Vec3;
 use std::sync::Arc;
 
-const ALL_TRACES: [TraceOptions; 4] = [
+const ALL_TRACES: [TraceOptions; 6] = [
     TraceOptions { order: TraversalOrder::EntryDistance, test: TriangleTest::Watertight },
     TraceOptions { order: TraversalOrder::SplitAxisSign, test: TriangleTest::Watertight },
     TraceOptions { order: TraversalOrder::EntryDistance, test: TriangleTest::MollerTrumbore },
     TraceOptions { order: TraversalOrder::SplitAxisSign, test: TriangleTest::MollerTrumbore },
+    TraceOptions { order: TraversalOrder::EntryDistance, test: TriangleTest::MollerTrumboreStored },
+    TraceOptions { order: TraversalOrder::SplitAxisSign, test: TriangleTest::MollerTrumboreStored },
 ];
 
 /// `n` triangles of one box, the unit square: two corners shared, the third anywhere inside.
@@ -180,8 +182,9 @@ fn walks_past_the_step_budget_are_finished_on_the_cpu_never_taken_for_misses() {
     }
 }
 
-/// Both triangle tests and both child orders on the GPU: the CPU's hits and counts, on meshes
-/// whose rays meet edges and vertices (the handout's Möller–Trumbore test included).
+/// Every triangle test and both child orders on the GPU: the CPU's hits and counts, on meshes
+/// whose rays meet edges and vertices (the handout's Möller–Trumbore test and its stored form
+/// included).
 #[test]
 fn moller_trumbore_and_the_split_axis_order_run_on_the_gpu_as_on_the_cpu() {
     let Some(gpu) = bvhscope_gpu::gpu_for_tests() else { return };

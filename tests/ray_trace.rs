@@ -103,7 +103,7 @@ fn check_mesh(name: &str, mesh: &Mesh, n: usize) {
         for layout in Layout::ALL {
             let bvh = AnyBvh::build(mesh, &BuildParams { strategy, layout, ..BuildParams::default() });
             for order in [TraversalOrder::SplitAxisSign, TraversalOrder::EntryDistance] {
-                for test in [TriangleTest::Watertight, TriangleTest::MollerTrumbore] {
+                for test in TriangleTest::ALL {
                     let opts = TraceOptions { order, test };
                     for ray in &rays {
                         let what = format!("{name} {strategy:?} {layout:?} {opts:?} {ray:?}");

@@ -155,7 +155,7 @@ pub fn ours_with_kernels(
         Some(s) => format!("{label}, {}", s.name()),
         None => label.to_string(),
     };
-    let label = if test == TriangleTest::MollerTrumbore { format!("{label}, Möller–Trumbore") } else { label };
+    let label = if test == TriangleTest::Watertight { label } else { format!("{label}, {}", test.label()) };
     let layout_name = match params.layout {
         Layout::Binary => "BVH2",
         Layout::Wide4 => "BVH4",
@@ -187,6 +187,7 @@ pub fn ours_with_kernels(
             };
             let took = t.elapsed();
             let opts = TraceOptions { test, ..TraceOptions::default() };
+            bvh.ready_for(opts);
             let stats = TreeStats::of(&bvh);
             let built = Built {
                 sah_cost: Some(stats.sah_cost),

@@ -43,16 +43,13 @@ fn setups() -> Vec<Setup> {
         .filter(|&k| k >= Simd::Simd4 && k <= Simd::detected())
         .map(|simd| Setup { simd, leaf: fastest.max_leaf_size, cost: fastest.cost.traversal, test: WATERTIGHT })
         .collect();
-    // Möller–Trumbore on the same tree, its leaves in the same AVX2 pass of eight (`triangle8`):
-    // what the watertight test costs.
+    // The other triangle tests on the same tree, their leaves in AVX2 passes of eight:
+    // Möller–Trumbore from the same vertex loads (`triangle8`), and on the stored edges and normal
+    // (`stored_triangle`): what the watertight test costs, and what the stored form buys.
     if Simd::detected() >= Simd::Avx2 {
-        let simd = Simd::Avx2;
-        v.push(Setup {
-            simd,
-            leaf: fastest.max_leaf_size,
-            cost: fastest.cost.traversal,
-            test: TriangleTest::MollerTrumbore,
-        });
+        for test in TriangleTest::ALL.into_iter().filter(|&t| t != WATERTIGHT) {
+            v.push(Setup { simd: Simd::Avx2, leaf: fastest.max_leaf_size, cost: fastest.cost.traversal, test });
+        }
     }
     let extra = std::env::var("BENCH_KERNEL_LEAVES").unwrap_or_default();
     for pair in extra.split(',').filter(|p| !p.trim().is_empty()) {
@@ -86,9 +83,9 @@ pub fn table(mesh: &Mesh, s: &Settings, one: &ThreadPool) -> String {
                 let mut params = Preset::Fastest.build();
                 (params.max_leaf_size, params.cost.traversal) = (c.leaf, c.cost);
                 let b = (ours_with_kernels("fastest", params, tracing, Some(c.simd), c.test).build)(mesh).0;
-                let mt = if c.test == WATERTIGHT { "" } else { " Möller–Trumbore" };
+                let test = if c.test == WATERTIGHT { String::new() } else { format!(" {}", c.test.label()) };
                 let name = format!(
-                    "{}{mt} leaf {} cost {} ({:.1} B/tri)",
+                    "{}{test} leaf {} cost {} ({:.1} B/tri)",
                     c.simd.name(),
                     c.leaf,
                     c.cost,

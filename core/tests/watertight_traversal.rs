@@ -57,7 +57,7 @@ const MOLLER_TRUMBORE_SPREAD: f32 = 1.0 / 1024.0;
 /// Whether `got` is the closest hit the linear scan finds: the same distance, and a different
 /// triangle only where two are hit at exactly that distance.
 ///
-/// With Möller–Trumbore, one exception: its distance has no fixed error bound (it grows with the
+/// With Möller–Trumbore (either form), one exception: its distance has no fixed error bound (it grows with the
 /// origin's distance from the triangle against the triangle's size; 300 units in the last place
 /// were seen with the same triangle listed twice in two vertex orders, hit at its vertex), so two
 /// triangles meeting at the point a ray is aimed at can report distances further apart than the
@@ -72,7 +72,7 @@ fn same_hit(mesh: &Mesh, ray: &Ray, opts: TraceOptions, want: Option<Hit>, got: 
     match (want, got) {
         (None, None) => true,
         (Some(w), Some(g)) if w.t == g.t => w.prim == g.prim || hits_at(&g, w.t),
-        (Some(w), Some(g)) if opts.test == TriangleTest::MollerTrumbore => {
+        (Some(w), Some(g)) if opts.test != TriangleTest::Watertight => {
             g.t > w.t && g.t - w.t <= w.t * MOLLER_TRUMBORE_SPREAD && hits_at(&g, g.t)
         }
         _ => false,

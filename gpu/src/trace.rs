@@ -234,9 +234,10 @@ impl Kernels {
             let mut binds = binds.to_vec();
             binds.extend(std::iter::repeat_n(Bind::Read, tree_buffers));
             let by_distance = (opts.order == TraversalOrder::EntryDistance) as u8 as f64;
-            let moller = (opts.test == TriangleTest::MollerTrumbore) as u8 as f64;
+            // The shader's `TEST`: its index in core's list of tests, as `triangle.wgsl` numbers them.
+            let test = TriangleTest::ALL.iter().position(|&t| t == opts.test).unwrap_or(0) as f64;
             let mut constants =
-                vec![("COUNTED", opts.counted as u8 as f64), ("EXACT", opts.exact as u8 as f64), ("MOLLER", moller)];
+                vec![("COUNTED", opts.counted as u8 as f64), ("EXACT", opts.exact as u8 as f64), ("TEST", test)];
             if crate::shaders::source(self.walk_file).contains("override BY_DISTANCE") {
                 constants.push(("BY_DISTANCE", by_distance));
             }

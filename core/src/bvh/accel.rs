@@ -45,7 +45,7 @@ pub struct TraceOptions {
 macro_rules! dispatch {
     ($opts:expr, |$t:ident, $bd:ident| $body:expr) => {{
         use $crate::bvh::TraversalOrder as O;
-        use $crate::geometry::{MollerTrumbore, TriangleTest as Test, Watertight};
+        use $crate::geometry::{MollerTrumbore, MollerTrumboreStored, TriangleTest as Test, Watertight};
         match ($opts.test, $opts.order) {
             (Test::Watertight, O::EntryDistance) => {
                 type $t = Watertight;
@@ -64,6 +64,16 @@ macro_rules! dispatch {
             }
             (Test::MollerTrumbore, O::SplitAxisSign) => {
                 type $t = MollerTrumbore;
+                const $bd: bool = false;
+                $body
+            }
+            (Test::MollerTrumboreStored, O::EntryDistance) => {
+                type $t = MollerTrumboreStored;
+                const $bd: bool = true;
+                $body
+            }
+            (Test::MollerTrumboreStored, O::SplitAxisSign) => {
+                type $t = MollerTrumboreStored;
                 const $bd: bool = false;
                 $body
             }

@@ -31,6 +31,15 @@ impl AnyBvh {
         }
     }
 
+    /// Make now what a walk with `opts` keeps with the tree (the 8-wide tree's stored leaves for
+    /// `MollerTrumboreStored`, made otherwise by its first walk), so that the tree's memory counts
+    /// it and no walk waits for it.
+    pub fn ready_for(&self, opts: crate::bvh::TraceOptions) {
+        if let (AnyBvh::Wide8(w), crate::geometry::TriangleTest::MollerTrumboreStored) = (self, opts.test) {
+            w.stored_leaves();
+        }
+    }
+
     /// Build the binary BVH with `params.strategy`, then lay it out as `params.layout` says.
     pub fn build(mesh: &Mesh, params: &BuildParams) -> AnyBvh {
         match Self::build_controlled(mesh, params, &WorkControl::new()) {

@@ -313,6 +313,7 @@ fn to_wide<const W: usize>(mut leaves: Leaves) -> Option<(WideBvh<W>, Vec<u32>, 
         params,
         report: Default::default(),
         simd: crate::cpu::Simd::chosen(),
+        stored: Default::default(),
     };
     wide.store_leaves_by_coordinate();
     Some((wide, ids, leaf_ids))

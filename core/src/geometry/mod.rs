@@ -1,4 +1,4 @@
-//! Rays, axis-aligned boxes and the two ray–triangle tests.
+//! Rays, axis-aligned boxes and the three ray–triangle tests.
 
 mod aabb;
 #[cfg(target_arch = "x86_64")]
@@ -12,6 +12,7 @@ mod shear;
 pub mod slab;
 pub mod slab8;
 pub mod slab_packet;
+pub(crate) mod stored_triangle;
 pub(crate) mod triangle;
 mod triangle4;
 #[cfg(target_arch = "x86_64")]
@@ -21,6 +22,7 @@ pub(crate) use triangle4::leaf_triangle;
 
 pub use aabb::Aabb;
 pub use ray::Ray;
+pub use stored_triangle::{intersect_stored, stored_form, MollerTrumboreStored};
 pub use triangle::{
     double_area as triangle_double_area, intersect_triangle, MollerTrumbore, TriangleHit, TriangleIntersector,
     TriangleTest, Watertight,

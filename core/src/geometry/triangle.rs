@@ -11,6 +11,7 @@ use super::avx512::packet::WatertightRay16;
 #[cfg(target_arch = "x86_64")]
 use super::packet8::WatertightRay8;
 pub use super::shear::{Hits4, WatertightRay};
+use super::stored_triangle::MollerTrumboreStored;
 #[cfg(target_arch = "x86_64")]
 use super::{slab8::Avx2, triangle8::Hits8};
 use crate::geometry::avx512::lanes::Avx512;
@@ -37,11 +38,19 @@ pub enum TriangleTest {
     Watertight,
     /// Möller & Trumbore 1997: the test students usually write first; can miss rays through edges.
     MollerTrumbore,
+    /// Möller–Trumbore on stored edges and normal, Embree's form (`stored_triangle`): less work a
+    /// triangle, 48 more bytes of it; can miss rays through edges.
+    MollerTrumboreStored,
 }
 
 /// A ray–triangle test with per-ray precomputation, used as a type parameter of the traversal so
 /// the choice costs nothing per triangle.
 pub trait TriangleIntersector: Copy + Send + Sync + 'static {
+    /// Whether the 8-wide tree's leaves reach `intersect_group_coords` and its wider twins in this
+    /// test's stored form (`stored_triangle`: v0, e1, e2 and the normal, twelve floats a triangle,
+    /// coordinate by coordinate) rather than as their nine vertex coordinates.
+    const STORED: bool = false;
+
     /// Data computed once per ray.
     type Prepared: Copy;
     fn prepare(ray: &Ray) -> Self::Prepared;
@@ -345,38 +354,101 @@ pub struct WatertightRay4 {
     rz: [f32x4; 3],
 }
 
+/// The packet items of a test without a per-ray setup that packets do not vectorise
+/// (`Prepared4`, `Prepared8`, `Prepared16` and their tests): its rays lane by lane.
+macro_rules! lane_by_lane_packets {
+    () => {
+        /// The four rays themselves: the test is not vectorised for packets (the
+        /// fastest preset's packets run the watertight test), so `intersect4` runs it lane by lane.
+        type Prepared4 = [Ray; 4];
+
+        fn prepare4(rays: &[Ray], base: usize) -> [Ray; 4] {
+            std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
+        }
+
+        fn intersect4(rays: &[Ray; 4], t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
+            let (mask, t, u, v) = lane_by_lane::<Self, _>(rays, t_min.to_array(), t_max.to_array(), lanes, tri);
+            Hits4 { mask, t, u, v }
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        type Prepared8 = [Ray; 8];
+
+        #[cfg(target_arch = "x86_64")]
+        fn prepare8(_: Avx2, rays: &[Ray], base: usize) -> [Ray; 8] {
+            std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
+        }
+
+        /// Lane by lane, as `intersect4`.
+        #[cfg(target_arch = "x86_64")]
+        fn intersect8(_: Avx2, rays: &[Ray; 8], t_min: __m256, t_max: __m256, lanes: u32, tri: &[Vec3; 3]) -> Hits8 {
+            // SAFETY: `__m256` and `[f32; 8]` have the same size, and every bit pattern is a float.
+            let (t_min, t_max): ([f32; 8], [f32; 8]) = unsafe {
+                (std::mem::transmute::<__m256, [f32; 8]>(t_min), std::mem::transmute::<__m256, [f32; 8]>(t_max))
+            };
+            let (mask, t, u, v) = lane_by_lane::<Self, _>(rays, t_min, t_max, lanes, tri);
+            Hits8 { mask, t, u, v }
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        type Prepared16 = [Ray; 16];
+
+        #[cfg(target_arch = "x86_64")]
+        fn prepare16(_: Avx512, rays: &[Ray], base: usize) -> [Ray; 16] {
+            std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
+        }
+
+        /// Lane by lane, as `intersect4`.
+        #[cfg(target_arch = "x86_64")]
+        fn intersect16(
+            _: Avx512,
+            rays: &[Ray; 16],
+            t_min: __m512,
+            t_max: __m512,
+            lanes: u32,
+            tri: &[Vec3; 3],
+        ) -> Hits16 {
+            // SAFETY: `__m512` and `[f32; 16]` have the same size, and every bit pattern is a float.
+            let (t_min, t_max): ([f32; 16], [f32; 16]) = unsafe {
+                (std::mem::transmute::<__m512, [f32; 16]>(t_min), std::mem::transmute::<__m512, [f32; 16]>(t_max))
+            };
+            let (mask, t, u, v) = lane_by_lane::<Self, _>(rays, t_min, t_max, lanes, tri);
+            Hits16 { mask, t, u, v }
+        }
+    };
+}
+pub(super) use lane_by_lane_packets;
+
 /// Möller–Trumbore ray–triangle intersection. Möller & Trumbore, "Fast, Minimum Storage
 /// Ray/Triangle Intersection", JGT 2(1), 1997. A ray (nearly) parallel to the plane is rejected
 /// with a tolerance relative to the edge and direction lengths, so the test is scale-independent.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct MollerTrumbore;
 
-impl MollerTrumbore {
-    /// A group of `N` rays one lane at a time (this test is not vectorised): for the lanes in
-    /// `lanes`, ray k within `[t_min[k], t_max[k])` against `tri`; the mask of the hits and their
-    /// `t`, `u`, `v`.
-    #[allow(clippy::type_complexity)]
-    fn lane_by_lane<const N: usize>(
-        rays: &[Ray; N],
-        t_min: [f32; N],
-        t_max: [f32; N],
-        lanes: u32,
-        tri: &[Vec3; 3],
-    ) -> (u32, [f32; N], [f32; N], [f32; N]) {
-        let (mut mask, mut t, mut u, mut v) = (0, [0.0; N], [0.0; N], [0.0; N]);
-        let mut m = lanes;
-        while m != 0 {
-            let k = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let mut ray = rays[k];
-            (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
-            if let Some(h) = <Self as TriangleIntersector>::intersect(&(), &ray, tri) {
-                mask |= 1 << k;
-                (t[k], u[k], v[k]) = (h.t, h.u, h.v);
-            }
+/// A group of `N` rays one lane at a time, for the tests without a per-ray setup that packets do
+/// not vectorise: for the lanes in `lanes`, ray k within `[t_min[k], t_max[k])` against `tri`;
+/// the mask of the hits and their `t`, `u`, `v`.
+#[allow(clippy::type_complexity)]
+pub(super) fn lane_by_lane<T: TriangleIntersector<Prepared = ()>, const N: usize>(
+    rays: &[Ray; N],
+    t_min: [f32; N],
+    t_max: [f32; N],
+    lanes: u32,
+    tri: &[Vec3; 3],
+) -> (u32, [f32; N], [f32; N], [f32; N]) {
+    let (mut mask, mut t, mut u, mut v) = (0, [0.0; N], [0.0; N], [0.0; N]);
+    let mut m = lanes;
+    while m != 0 {
+        let k = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let mut ray = rays[k];
+        (ray.t_min, ray.t_max) = (t_min[k], t_max[k]);
+        if let Some(h) = T::intersect(&(), &ray, tri) {
+            mask |= 1 << k;
+            (t[k], u[k], v[k]) = (h.t, h.u, h.v);
         }
-        (mask, t, u, v)
     }
+    (mask, t, u, v)
 }
 
 impl TriangleIntersector for MollerTrumbore {
@@ -424,55 +496,7 @@ impl TriangleIntersector for MollerTrumbore {
         unsafe { super::triangle8::moller_trumbore_leaf8(k, ray, coords, count, g) }
     }
 
-    /// The four rays themselves: this test is not vectorised (it is the one students write first,
-    /// kept for comparison), so `intersect4` runs it lane by lane.
-    type Prepared4 = [Ray; 4];
-
-    fn prepare4(rays: &[Ray], base: usize) -> [Ray; 4] {
-        std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
-    }
-
-    fn intersect4(rays: &[Ray; 4], t_min: f32x4, t_max: f32x4, lanes: u32, tri: &[Vec3; 3]) -> Hits4 {
-        let (mask, t, u, v) = Self::lane_by_lane(rays, t_min.to_array(), t_max.to_array(), lanes, tri);
-        Hits4 { mask, t, u, v }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    type Prepared8 = [Ray; 8];
-
-    #[cfg(target_arch = "x86_64")]
-    fn prepare8(_: Avx2, rays: &[Ray], base: usize) -> [Ray; 8] {
-        std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
-    }
-
-    /// Lane by lane, as `intersect4`.
-    #[cfg(target_arch = "x86_64")]
-    fn intersect8(_: Avx2, rays: &[Ray; 8], t_min: __m256, t_max: __m256, lanes: u32, tri: &[Vec3; 3]) -> Hits8 {
-        // SAFETY: `__m256` and `[f32; 8]` have the same size, and every bit pattern is a float.
-        let (t_min, t_max): ([f32; 8], [f32; 8]) =
-            unsafe { (std::mem::transmute::<__m256, [f32; 8]>(t_min), std::mem::transmute::<__m256, [f32; 8]>(t_max)) };
-        let (mask, t, u, v) = Self::lane_by_lane(rays, t_min, t_max, lanes, tri);
-        Hits8 { mask, t, u, v }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    type Prepared16 = [Ray; 16];
-
-    #[cfg(target_arch = "x86_64")]
-    fn prepare16(_: Avx512, rays: &[Ray], base: usize) -> [Ray; 16] {
-        std::array::from_fn(|k| rays[(base + k).min(rays.len() - 1)])
-    }
-
-    /// Lane by lane, as `intersect4`.
-    #[cfg(target_arch = "x86_64")]
-    fn intersect16(_: Avx512, rays: &[Ray; 16], t_min: __m512, t_max: __m512, lanes: u32, tri: &[Vec3; 3]) -> Hits16 {
-        // SAFETY: `__m512` and `[f32; 16]` have the same size, and every bit pattern is a float.
-        let (t_min, t_max): ([f32; 16], [f32; 16]) = unsafe {
-            (std::mem::transmute::<__m512, [f32; 16]>(t_min), std::mem::transmute::<__m512, [f32; 16]>(t_max))
-        };
-        let (mask, t, u, v) = Self::lane_by_lane(rays, t_min, t_max, lanes, tri);
-        Hits16 { mask, t, u, v }
-    }
+    lane_by_lane_packets!();
 }
 
 /// Intersect with a run-time choice of test (for callers outside the hot loop).
@@ -480,6 +504,7 @@ pub fn intersect_triangle(test: TriangleTest, ray: &Ray, tri: &[Vec3; 3]) -> Opt
     match test {
         TriangleTest::Watertight => Watertight::intersect(&Watertight::prepare(ray), ray, tri),
         TriangleTest::MollerTrumbore => MollerTrumbore::intersect(&(), ray, tri),
+        TriangleTest::MollerTrumboreStored => MollerTrumboreStored::intersect(&(), ray, tri),
     }
 }
 

@@ -8,7 +8,7 @@ use bvhscope_core::mesh::Mesh;
 use glam::Vec3;
 
 pub const ORDERS: [TraversalOrder; 2] = [TraversalOrder::SplitAxisSign, TraversalOrder::EntryDistance];
-pub const TESTS: [TriangleTest; 2] = [TriangleTest::Watertight, TriangleTest::MollerTrumbore];
+pub const TESTS: [TriangleTest; 3] = TriangleTest::ALL;
 
 /// Midpoint splits, one triangle per leaf: the tree follows from the centroids alone.
 pub fn params() -> BuildParams {

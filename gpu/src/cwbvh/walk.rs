@@ -15,7 +15,9 @@
 use super::Cwbvh;
 use bvhscope_core::bvh::{Hit, RayCounters};
 use bvhscope_core::geometry::slab::{widen, OneRay};
-use bvhscope_core::geometry::{MollerTrumbore, Ray, TriangleIntersector, TriangleTest, Watertight};
+use bvhscope_core::geometry::{
+    MollerTrumbore, MollerTrumboreStored, Ray, TriangleIntersector, TriangleTest, Watertight,
+};
 
 impl Cwbvh {
     /// The octant of `ray`'s direction: bit k set when its reciprocal is negative on axis k (-0
@@ -28,11 +30,12 @@ impl Cwbvh {
     }
 
     /// The closest hit of `ray` (its `t_max` shrunk to it) and the walk's counts, with the
-    /// triangle test `test` (the GPU's `MOLLER` switch).
+    /// triangle test `test` (the GPU's `TEST` switch).
     pub fn trace_cpu(&self, ray: &mut Ray, test: TriangleTest) -> (Option<Hit>, RayCounters) {
         match test {
             TriangleTest::Watertight => self.walk_cpu::<Watertight>(ray),
             TriangleTest::MollerTrumbore => self.walk_cpu::<MollerTrumbore>(ray),
+            TriangleTest::MollerTrumboreStored => self.walk_cpu::<MollerTrumboreStored>(ray),
         }
     }
 

@@ -48,14 +48,18 @@ fn dotx(a: vec3<f32>, r: vec3<f32>) -> f32 {
     return (xm(a.x, r.x) + xm(a.y, r.y)) + xm(a.z, r.z);
 }
 
-// Which test the walk runs: core's TriangleTest, Watertight (false) or MollerTrumbore (true).
-override MOLLER: bool = false;
+// Which test the walk runs: core's TriangleTest in the order of its list (TriangleTest::ALL):
+// 0 Watertight, 1 MollerTrumbore, 2 MollerTrumboreStored.
+override TEST: u32 = 0u;
 
 // The hit of the triangle v0, v1, v2 within [R_t_min, R_t_max): (t, u, v) with u weighting v1
 // and v weighting v2, and w = 1 for a hit, 0 for a miss.
 fn intersect(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec4<f32> {
-    if MOLLER {
+    if TEST == 1u {
         return intersect_mt(v0, v1, v2);
+    }
+    if TEST == 2u {
+        return intersect_mt_stored(v0, v1, v2);
     }
     return intersect_watertight(v0, v1, v2);
 }
@@ -92,6 +96,33 @@ fn intersect_mt(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec4<f32> {
     let t = xm(dotx(e2, q), inv_det);
     if t >= R_t_min && t < R_t_max {
         return vec4<f32>(t, u, v, 1.0);
+    }
+    return vec4<f32>(0.0);
+}
+
+// core's geometry::stored_triangle, operation by operation: Möller–Trumbore on the edges
+// e1 = v0 − v1, e2 = v2 − v0 and the normal e1 × e2 (Embree's form), made here from the vertices
+// as core makes its stored leaves; the signs those of a positive denominator, then one division.
+fn intersect_mt_stored(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec4<f32> {
+    let d = R_d;
+    let e1 = v0 - v1;
+    let e2 = v2 - v0;
+    let ng = crossx(e1, e2);
+    let c = v0 - R_o;
+    let r = crossx(d, c);
+    let den = dotx(ng, d);
+    let sign = bitcast<u32>(den) & 0x80000000u;
+    let abs_den = abs(den);
+    let u = bitcast<f32>(bitcast<u32>(dotx(r, e2)) ^ sign);
+    let v = bitcast<f32>(bitcast<u32>(dotx(r, e1)) ^ sign);
+    // NaN fails core's comparisons; here it is found by its bits (the compiler may assume none).
+    if is_nan(den) || is_nan(u) || is_nan(v) || !(den != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= abs_den) {
+        return vec4<f32>(0.0);
+    }
+    let rcp = 1.0 / abs_den;
+    let t = xm(bitcast<f32>(bitcast<u32>(dotx(ng, c)) ^ sign), rcp);
+    if t >= R_t_min && t < R_t_max {
+        return vec4<f32>(t, xm(u, rcp), xm(v, rcp), 1.0);
     }
     return vec4<f32>(0.0);
 }

@@ -97,12 +97,13 @@ fn adversarial_rays(tree: &AnyBvh, from: &[Vec3]) -> Vec<Ray> {
 }
 
 /// `ray` through each tree with each triangle test: closest hit and counters equal to the first
-/// tree's (the scalar kernel), any-hit too; with the watertight test, the hit at the linear scan's
-/// distance (Möller–Trumbore may return a neighbour a few units in the last place farther, see
-/// `slab.rs`).
+/// tree's (the scalar kernel, which tests a leaf's triangles one by one from their vertices; the
+/// SIMD ones read the stored leaves for `MollerTrumboreStored`), any-hit too; with the watertight
+/// test, the hit at the linear scan's distance (Möller–Trumbore may return a neighbour a few units
+/// in the last place farther, see `slab.rs`).
 fn check(trees: &[(Simd, AnyBvh)], linear: &LinearScan, ray: Ray) -> Result<(), TestCaseError> {
-    let mt = TraceOptions { test: crate::geometry::TriangleTest::MollerTrumbore, ..Preset::Fastest.trace_options() };
-    for opts in [Preset::Fastest.trace_options(), mt] {
+    let fastest = Preset::Fastest.trace_options();
+    for opts in crate::geometry::TriangleTest::ALL.map(|test| TraceOptions { test, ..fastest }) {
         let run = |bvh: &AnyBvh| {
             let (mut r, mut c, mut a) = (ray, RayCounters::default(), RayCounters::default());
             let hit =

@@ -68,6 +68,33 @@ impl<const W: usize> WideBvh<W> {
         });
     }
 
+    /// The leaves in the stored form of `MollerTrumboreStored` (`geometry::stored_triangle`): each
+    /// leaf's triangles as v0, e1, e2 and the normal, coordinate by coordinate (the `count` values
+    /// of v0.x, then of v0.y, …, of ng.z), twelve floats a triangle from its first triangle's
+    /// place. Made on the first walk that asks for it (that test on this tree), then kept: 48 more
+    /// bytes a triangle, paid only by a tree walked with that test.
+    pub(crate) fn stored_leaves(&self) -> &[f32] {
+        self.stored.get_or_init(|| {
+            const F: usize = crate::geometry::stored_triangle::STORED_FLOATS;
+            let mut out = vec![0f32; F * self.tris.len()];
+            for n in &self.nodes {
+                for s in n.slots().filter(|&s| n.count[s] > 0) {
+                    let (first, count) = (n.child[s] as usize, n.count[s] as usize);
+                    let leaf = &mut out[F * first..F * (first + count)];
+                    self.with_leaf(first, count, |tris| {
+                        for (k, t) in tris.iter().enumerate() {
+                            let form = crate::geometry::stored_form(t);
+                            for j in 0..F {
+                                leaf[j * count + k] = form[j / 3][j % 3];
+                            }
+                        }
+                    });
+                }
+            }
+            out
+        })
+    }
+
     /// The `9·count` floats of the leaf at `first` (8-wide trees: coordinate by coordinate).
     #[inline(always)]
     pub(crate) fn leaf_coords(&self, first: usize, count: usize) -> &[f32] {

@@ -44,12 +44,13 @@ fn prefetch<T>(p: &T) {
 }
 
 impl<const W: usize> WideBvh<W> {
-    /// Start loading a child that goes on the stack: the node, or a leaf's first triangle.
+    /// Start loading a child that goes on the stack: the node, or the first cache line of a leaf's
+    /// data as the walk's test reads it (`leaves`, `per` floats a triangle: `walk_ray`).
     #[inline(always)]
-    fn prefetch_child(&self, node: &WideNode<W>, slot: usize) {
+    fn prefetch_child(&self, node: &WideNode<W>, slot: usize, leaves: &[f32], per: usize) {
         let i = node.child[slot] as usize;
         if node.count[slot] > 0 {
-            if let Some(t) = self.tris.get(i) {
+            if let Some(t) = leaves.get(per * i) {
                 prefetch(t);
             }
         } else if let Some(n) = self.nodes.get(i) {
@@ -61,10 +62,13 @@ impl<const W: usize> WideBvh<W> {
     /// leaf reached (its triangles `first..first + count` in leaf order); it may shrink
     /// `ray.t_max` and returns true to stop the walk.
     /// `kernel` tests a node's child boxes; `N` is the stack's size (`STACK` for four children).
+    /// `leaves` are the leaves' floats as `leaf` reads them, `per` a triangle, from which a
+    /// pushed leaf is prefetched.
     #[inline(always)]
     pub(crate) fn walk_ray<S: TraversalStats, K: SlabKernel<W>, const N: usize>(
         &self,
         kernel: K,
+        (leaves, per): (&[f32], usize),
         ray: &mut Ray,
         stats: &mut S,
         mut leaf: impl FnMut(usize, usize, &mut Ray, &mut S) -> bool,
@@ -118,11 +122,11 @@ impl<const W: usize> WideBvh<W> {
                     // Both references first: they do not wait for the comparison.
                     let (r0, r1) = (ChildRef::of(node, index, s0), ChildRef::of(node, index, s1));
                     if enter[s0] <= enter[s1] {
-                        self.prefetch_child(node, s1);
+                        self.prefetch_child(node, s1, leaves, per);
                         stack.push((r1.raw(), enter[s1]));
                         cur = r0;
                     } else {
-                        self.prefetch_child(node, s0);
+                        self.prefetch_child(node, s0, leaves, per);
                         stack.push((r0.raw(), enter[s0]));
                         cur = r1;
                     }
@@ -137,7 +141,7 @@ impl<const W: usize> WideBvh<W> {
                 while m != 0 {
                     let slot = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    self.prefetch_child(node, slot);
+                    self.prefetch_child(node, slot, leaves, per);
                     stack.push((ChildRef::of(node, index, slot).raw(), enter[slot]));
                     k += 1;
                 }
@@ -256,11 +260,18 @@ impl<const W: usize> WideBvh<W> {
         stats: &mut S,
     ) -> Option<Hit> {
         let (mut prepared, mut best) = (None, None);
+        // The leaves as the test reads them: their vertices coordinate by coordinate, or the
+        // stored form of a test that asks for it (`TriangleIntersector::STORED`).
+        let (leaf_floats, per) = match GROUPED && T::STORED {
+            true => (self.stored_leaves(), crate::geometry::stored_triangle::STORED_FLOATS),
+            false => (super::leaves::floats(&self.tris), 9),
+        };
         // Inlined always: this closure is compiled without the AVX2 walk's features (it is defined
         // here, not in `trace_avx2`), and as a call it could not inline the AVX2 leaf test either,
         // which then cost a second call per leaf (seen in a profile).
         self.walk_ray::<S, K, N>(
             kernel,
+            (leaf_floats, per),
             ray,
             stats,
             #[inline(always)]
@@ -268,7 +279,7 @@ impl<const W: usize> WideBvh<W> {
                 let ids = |i: usize| self.prim_ids[i];
                 if GROUPED {
                     // The 8-wide layout's leaves, coordinate by coordinate (`leaves.rs`).
-                    let coords = &super::leaves::floats(&self.tris)[9 * first..];
+                    let coords = &leaf_floats[per * first..];
                     test_triangles_grouped::<T, ANY, S, _>(
                         groups,
                         coords,

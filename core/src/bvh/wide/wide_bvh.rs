@@ -76,6 +76,9 @@ pub struct WideBvh<const W: usize = WIDTH> {
     /// The box kernels this tree's walk uses (`crate::cpu`): the CPU's best unless a test or
     /// `BVHSCOPE_SIMD` asks for a more portable one. Only the eight-wide walk has a choice.
     pub simd: crate::cpu::Simd,
+    /// The leaves in `MollerTrumboreStored`'s form (`leaves.rs`, `stored_leaves`): made by the
+    /// first walk with that test, then kept; empty until then.
+    pub(crate) stored: std::sync::OnceLock<Vec<f32>>,
 }
 
 impl<const W: usize> WideBvh<W> {
@@ -106,7 +109,7 @@ impl<const W: usize> WideBvh<W> {
         let params = BuildParams { layout, ..bvh.params };
         let simd = crate::cpu::Simd::chosen();
         let (prim_ids, tris, report) = (bvh.prim_ids, bvh.tris, bvh.report);
-        let mut wide = WideBvh { nodes, prim_ids, tris, root_bounds, params, report, simd };
+        let mut wide = WideBvh { nodes, prim_ids, tris, root_bounds, params, report, simd, stored: Default::default() };
         wide.store_leaves_by_coordinate();
         wide.report.collapse_time = start.elapsed();
         wide
@@ -178,6 +181,7 @@ impl<const W: usize> TreeView for WideBvh<W> {
         self.nodes.len() * std::mem::size_of::<WideNode<W>>()
             + self.prim_ids.len() * 4
             + self.tris.len() * std::mem::size_of::<[Vec3; 3]>()
+            + self.stored.get().map_or(0, |s| s.len() * 4)
     }
 
     fn params(&self) -> &BuildParams {
