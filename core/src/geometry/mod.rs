@@ -17,13 +17,12 @@ pub(crate) mod triangle;
 mod triangle4;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod triangle8;
+mod triangle_test;
 
 pub(crate) use triangle4::leaf_triangle;
 
 pub use aabb::Aabb;
 pub use ray::Ray;
 pub use stored_triangle::{intersect_stored, stored_form, MollerTrumboreStored};
-pub use triangle::{
-    double_area as triangle_double_area, intersect_triangle, MollerTrumbore, TriangleHit, TriangleIntersector,
-    TriangleTest, Watertight,
-};
+pub use triangle::{double_area as triangle_double_area, MollerTrumbore, TriangleHit, TriangleIntersector, Watertight};
+pub use triangle_test::{intersect_triangle, TriangleTest};

@@ -1,7 +1,7 @@
 //! Ray–triangle intersection: the handout's `rayIntersectShape` step. It returns the distance and
 //! barycentrics only; turning them into a surface point is `Mesh::fill_intersection`.
 //!
-//! Barycentric convention (both tests): the hit point is `(1-u-v)·v0 + u·v1 + v·v2`.
+//! Barycentric convention (every test): the hit point is `(1-u-v)·v0 + u·v1 + v·v2`.
 //! The accepted interval is `t_min <= t < t_max`: the strict upper bound makes a closest-hit query
 //! keep the first of two hits at the same distance and keeps an occlusion ray from hitting the
 //! surface at its far end.
@@ -11,7 +11,6 @@ use super::avx512::packet::WatertightRay16;
 #[cfg(target_arch = "x86_64")]
 use super::packet8::WatertightRay8;
 pub use super::shear::{Hits4, WatertightRay};
-use super::stored_triangle::MollerTrumboreStored;
 #[cfg(target_arch = "x86_64")]
 use super::{slab8::Avx2, triangle8::Hits8};
 use crate::geometry::avx512::lanes::Avx512;
@@ -28,19 +27,6 @@ pub struct TriangleHit {
     pub t: f32,
     pub u: f32,
     pub v: f32,
-}
-
-/// Which triangle test the traversal uses; chosen at run time, compiled as a type parameter.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-pub enum TriangleTest {
-    /// Woop, Benthin & Wald 2013: no gaps along shared edges, no double hits at vertices.
-    #[default]
-    Watertight,
-    /// Möller & Trumbore 1997: the test students usually write first; can miss rays through edges.
-    MollerTrumbore,
-    /// Möller–Trumbore on stored edges and normal, Embree's form (`stored_triangle`): less work a
-    /// triangle, 48 more bytes of it; can miss rays through edges.
-    MollerTrumboreStored,
 }
 
 /// A ray–triangle test with per-ray precomputation, used as a type parameter of the traversal so
@@ -497,15 +483,6 @@ impl TriangleIntersector for MollerTrumbore {
     }
 
     lane_by_lane_packets!();
-}
-
-/// Intersect with a run-time choice of test (for callers outside the hot loop).
-pub fn intersect_triangle(test: TriangleTest, ray: &Ray, tri: &[Vec3; 3]) -> Option<TriangleHit> {
-    match test {
-        TriangleTest::Watertight => Watertight::intersect(&Watertight::prepare(ray), ray, tri),
-        TriangleTest::MollerTrumbore => MollerTrumbore::intersect(&(), ray, tri),
-        TriangleTest::MollerTrumboreStored => MollerTrumboreStored::intersect(&(), ray, tri),
-    }
 }
 
 /// Twice the triangle's area, in double precision (used to detect degenerate triangles).

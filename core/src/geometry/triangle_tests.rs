@@ -1,4 +1,5 @@
 use super::*;
+use crate::geometry::{intersect_triangle, TriangleTest};
 
 const TRI: [Vec3; 3] = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
 
