@@ -43,12 +43,13 @@ fn setups() -> Vec<Setup> {
         .filter(|&k| k >= Simd::Simd4 && k <= Simd::detected())
         .map(|simd| Setup { simd, leaf: fastest.max_leaf_size, cost: fastest.cost.traversal, test: WATERTIGHT })
         .collect();
-    // The other triangle tests on the same tree, their leaves in AVX2 passes of eight:
-    // Möller–Trumbore from the same vertex loads (`triangle8`), and on the stored edges and normal
-    // (`stored_triangle`): what the watertight test costs, and what the stored form buys.
-    if Simd::detected() >= Simd::Avx2 {
+    // The other triangle tests on the same tree, with AVX2 and (where the CPU has it) AVX-512:
+    // Möller–Trumbore from the same vertex loads (`triangle8`; four lanes a pass with AVX-512),
+    // and on the stored edges and normal (`stored_triangle`: eight lanes, or sixteen with
+    // AVX-512): what the watertight test costs, and what the stored form buys.
+    for simd in [Simd::Avx2, Simd::Avx512].into_iter().filter(|&k| k <= Simd::detected()) {
         for test in TriangleTest::ALL.into_iter().filter(|&t| t != WATERTIGHT) {
-            v.push(Setup { simd: Simd::Avx2, leaf: fastest.max_leaf_size, cost: fastest.cost.traversal, test });
+            v.push(Setup { simd, leaf: fastest.max_leaf_size, cost: fastest.cost.traversal, test });
         }
     }
     let extra = std::env::var("BENCH_KERNEL_LEAVES").unwrap_or_default();

@@ -8,8 +8,8 @@
 //! no edge is recomputed from the vertices. Like the classic test it can miss a ray exactly
 //! through a shared edge. The 8-wide tree keeps its leaves in this form, coordinate by coordinate,
 //! when a walk asks for this test (`bvh::wide::leaves`): twelve floats a triangle beside the
-//! vertices, tested eight at a time with AVX2 (`stored_leaf8`) or four at a time elsewhere
-//! (`stored_group4`). Every other structure (the binary tree, the 4-wide one, the linear scan,
+//! vertices, tested sixteen at a time with AVX-512 (`avx512::stored_leaf16`), eight with AVX2
+//! (`stored_leaf8`) or four elsewhere (`stored_group4`). Every other structure (the binary tree, the 4-wide one, the linear scan,
 //! the GPU) computes the same form from the vertices with the same operations, so every path
 //! gives the same bits.
 
@@ -211,6 +211,13 @@ impl TriangleIntersector for MollerTrumboreStored {
     fn intersect_group8_coords(k: Avx2, _: &(), ray: &Ray, stored: &[f32], count: usize, g: usize) -> Hits8 {
         // SAFETY: `k` proves the CPU has AVX2.
         unsafe { stored_leaf8(k, ray, stored, count, g) }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect_group16_coords(k: Avx512, _: &(), ray: &Ray, stored: &[f32], count: usize, g: usize) -> Hits16 {
+        // SAFETY: `k` proves the CPU has AVX-512F/VL.
+        unsafe { super::avx512::stored_leaf16(k, ray, stored, count, g) }
     }
 
     lane_by_lane_packets!();

@@ -45,7 +45,7 @@ fn bits(h: &TriangleHit) -> (u32, u32, u32) {
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(4000))]
-    /// Every pass over a stored leaf, four lanes or eight, is the scalar test of its triangles
+    /// Every pass over a stored leaf, four lanes, eight or sixteen (where the CPU has them), is the scalar test of its triangles
     /// (`MollerTrumboreStored::intersect`, from the vertices), bit for bit.
     #[test]
     fn stored_passes_are_the_scalar_test((tris, ray, more) in leaf_case()) {
@@ -81,6 +81,23 @@ proptest! {
                     if let Some(h) = w {
                         let lane_hit = TriangleHit { t: got.t[lane], u: got.u[lane], v: got.v[lane] };
                         prop_assert_eq!(bits(&lane_hit), bits(&h), "eight lanes: pass {} lane {} bit for bit", g, lane);
+                    }
+                }
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
+        if let Some(k) = crate::geometry::avx512::Avx512::detect() {
+            for g in 0..count.div_ceil(16) {
+                // SAFETY: `detect` found AVX-512F/VL.
+                let got = unsafe { crate::geometry::avx512::stored_leaf16(k, &ray, &stored, count, g) };
+                let n = (count - 16 * g).min(16);
+                prop_assert_eq!(got.mask >> n, 0, "no lane past the leaf");
+                for lane in 0..n {
+                    let w = want[16 * g + lane];
+                    prop_assert_eq!(got.mask & (1 << lane) != 0, w.is_some(), "sixteen lanes: pass {} lane {}", g, lane);
+                    if let Some(h) = w {
+                        let lane_hit = TriangleHit { t: got.t[lane], u: got.u[lane], v: got.v[lane] };
+                        prop_assert_eq!(bits(&lane_hit), bits(&h), "sixteen lanes: pass {} lane {} bit for bit", g, lane);
                     }
                 }
             }

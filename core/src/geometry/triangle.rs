@@ -106,12 +106,14 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
     }
 
     /// `intersect_group_coords` of triangles `16g..16g + 16` (those below `count`) at once: lane k
-    /// of the result is triangle `16g + k`'s `intersect`, bit for bit. The watertight test does
-    /// them in one AVX-512 pass (`avx512::leaf`); this default runs four groups of four.
+    /// of the result is triangle `16g + k`'s `intersect`, bit for bit. The watertight test and the
+    /// stored form do them in one AVX-512 pass (`avx512::leaf`, `avx512::stored_leaf`); this
+    /// default runs two groups of eight (`intersect_group8_coords`: Möller–Trumbore's AVX2 pass;
+    /// four groups of four it measured 0.45× the watertight AVX-512 walk, BENCHMARKS.md).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn intersect_group16_coords(
-        _: Avx512,
+        k: Avx512,
         p: &Self::Prepared,
         ray: &Ray,
         coords: &[f32],
@@ -119,13 +121,13 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
         g: usize,
     ) -> Hits16 {
         let mut hits = Hits16::NONE;
-        for q in (4 * g..4 * g + 4).take_while(|&q| 4 * q < count) {
-            let h = Self::intersect_group_coords(p, ray, coords, count, q);
-            let at = 4 * (q - 4 * g);
+        for q in (2 * g..2 * g + 2).take_while(|&q| 8 * q < count) {
+            let h = Self::intersect_group8_coords(k.avx2(), p, ray, coords, count, q);
+            let at = 8 * (q - 2 * g);
             hits.mask |= h.mask << at;
-            hits.t[at..at + 4].copy_from_slice(&h.t);
-            hits.u[at..at + 4].copy_from_slice(&h.u);
-            hits.v[at..at + 4].copy_from_slice(&h.v);
+            hits.t[at..at + 8].copy_from_slice(&h.t);
+            hits.u[at..at + 8].copy_from_slice(&h.u);
+            hits.v[at..at + 8].copy_from_slice(&h.v);
         }
         hits
     }

@@ -7,25 +7,22 @@ use std::arch::x86_64::*;
 /// instructions. The walks that use it are compiled for them (`#[target_feature]`) and chosen at
 /// run time.
 #[derive(Clone, Copy, Debug)]
-pub struct Avx512(());
+pub struct Avx512(crate::geometry::slab8::Avx2);
 
 impl Avx512 {
     /// The proof, if this CPU has the features (asked once; each call after that is one load).
     #[inline]
     pub fn detect() -> Option<Avx512> {
         static HAS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-        HAS.get_or_init(|| {
-            crate::geometry::slab8::Avx2::detect().is_some()
-                && is_x86_feature_detected!("avx512f")
-                && is_x86_feature_detected!("avx512vl")
-        })
-        .then_some(Avx512(()))
+        let avx2 = crate::geometry::slab8::Avx2::detect()?;
+        HAS.get_or_init(|| is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl"))
+            .then_some(Avx512(avx2))
     }
 
     /// The AVX2 proof this one includes.
     #[inline(always)]
     pub fn avx2(self) -> crate::geometry::slab8::Avx2 {
-        crate::geometry::slab8::Avx2::detect().expect("AVX-512 implies AVX2 (checked by detect)")
+        self.0
     }
 }
 
@@ -50,6 +47,9 @@ pub(crate) trait Lanes: Copy {
     unsafe fn div(self, b: Self) -> Self;
     /// `_CMP_*` predicate `P` lane by lane, as bits.
     unsafe fn cmp<const P: i32>(self, b: Self) -> u32;
+    /// Bitwise and, xor of the lanes' bits (a sign taken, a sign flipped: exact, unlike `0 − x`).
+    unsafe fn and(self, b: Self) -> Self;
+    unsafe fn xor(self, b: Self) -> Self;
     /// Lane k into `out[k]`, for `k < N`.
     unsafe fn store(self, out: &mut [f32; 16]);
 }
@@ -96,6 +96,16 @@ impl Lanes for __m256 {
     unsafe fn store(self, out: &mut [f32; 16]) {
         _mm256_storeu_ps(out.as_mut_ptr(), self)
     }
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    unsafe fn and(self, b: Self) -> Self {
+        _mm256_and_ps(self, b)
+    }
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    unsafe fn xor(self, b: Self) -> Self {
+        _mm256_xor_ps(self, b)
+    }
 }
 
 impl Lanes for __m512 {
@@ -139,5 +149,16 @@ impl Lanes for __m512 {
     #[target_feature(enable = "avx512f,avx512vl")]
     unsafe fn store(self, out: &mut [f32; 16]) {
         _mm512_storeu_ps(out.as_mut_ptr(), self)
+    }
+    // The float forms of these need AVX-512DQ; the integer ones are AVX-512F.
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    unsafe fn and(self, b: Self) -> Self {
+        _mm512_castsi512_ps(_mm512_and_si512(_mm512_castps_si512(self), _mm512_castps_si512(b)))
+    }
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    unsafe fn xor(self, b: Self) -> Self {
+        _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(self), _mm512_castps_si512(b)))
     }
 }

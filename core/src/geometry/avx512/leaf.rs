@@ -194,8 +194,8 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(4000))]
         /// Lane k of each pass is the scalar test of its triangle, bit for bit; no lane past the
-        /// leaf is set. Also the four-lane default of `intersect_group16_coords` (what the
-        /// Möller–Trumbore test runs) agrees, so the two paths of `Groups16` are checked.
+        /// leaf is set. Also the default of `intersect_group16_coords`, two AVX2 passes of eight
+        /// (what the Möller–Trumbore test runs), agrees, so the two paths of `Groups16` are checked.
         #[test]
         fn a_leaf_in_passes_of_sixteen_is_its_scalar_tests((tris, ray) in leaf_case()) {
             let Some(k) = Avx512::detect() else { return Ok(()) };
@@ -207,8 +207,8 @@ mod tests {
                 let got = unsafe { watertight_leaf16(k, &p, &ray, &coords, count, g) };
                 let n = (count - 16 * g).min(16);
                 prop_assert_eq!(got.mask >> n, 0, "no lane past the leaf");
-                let four = four_by_four(k, &p, &ray, &coords, count, g);
-                prop_assert_eq!(four.mask, got.mask, "groups of four");
+                let eights = by_eights(k, &p, &ray, &coords, count, g);
+                prop_assert_eq!(eights.mask, got.mask, "groups of eight");
                 for lane in 0..n {
                     let want = Watertight::intersect(&p, &ray, &tris[16 * g + lane]);
                     prop_assert_eq!(got.mask & (1 << lane) != 0, want.is_some(), "pass {} lane {}", g, lane);
@@ -216,18 +216,18 @@ mod tests {
                         let bits = |x: f32| x.to_bits();
                         let lanes = |h: &Hits16| (bits(h.t[lane]), bits(h.u[lane]), bits(h.v[lane]));
                         prop_assert_eq!(lanes(&got), (bits(h.t), bits(h.u), bits(h.v)), "lane {}", lane);
-                        prop_assert_eq!(lanes(&four), lanes(&got), "groups of four, lane {}", lane);
+                        prop_assert_eq!(lanes(&eights), lanes(&got), "groups of eight, lane {}", lane);
                     }
                 }
             }
         }
     }
 
-    /// The trait's default: four passes of the four-lane kernel.
-    fn four_by_four(k: Avx512, p: &WatertightRay, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits16 {
+    /// The trait's default: two passes of the eight-lane kernel (`triangle8`).
+    fn by_eights(k: Avx512, p: &WatertightRay, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits16 {
         #[derive(Clone, Copy)]
-        struct Four;
-        impl TriangleIntersector for Four {
+        struct Eights;
+        impl TriangleIntersector for Eights {
             type Prepared = WatertightRay;
             fn prepare(ray: &Ray) -> WatertightRay {
                 Watertight::prepare(ray)
@@ -237,6 +237,9 @@ mod tests {
             }
             fn intersect_group_coords(p: &WatertightRay, ray: &Ray, c: &[f32], count: usize, g: usize) -> Hits4 {
                 Watertight::intersect_group_coords(p, ray, c, count, g)
+            }
+            fn intersect_group8_coords(k: Avx2, p: &WatertightRay, ray: &Ray, c: &[f32], n: usize, g: usize) -> Hits8 {
+                Watertight::intersect_group8_coords(k, p, ray, c, n, g)
             }
             type Prepared4 = <Watertight as TriangleIntersector>::Prepared4;
             fn prepare4(rays: &[Ray], base: usize) -> Self::Prepared4 {
@@ -264,6 +267,6 @@ mod tests {
         use crate::geometry::slab8::Avx2;
         use crate::geometry::triangle8::Hits8;
         use wide::f32x4;
-        Four::intersect_group16_coords(k, p, ray, coords, count, g)
+        Eights::intersect_group16_coords(k, p, ray, coords, count, g)
     }
 }
