@@ -109,7 +109,7 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
     /// of the result is triangle `16g + k`'s `intersect`, bit for bit. The watertight test and the
     /// stored form do them in one AVX-512 pass (`avx512::leaf`, `avx512::stored_leaf`); this
     /// default runs two groups of eight (`intersect_group8_coords`: Möller–Trumbore's AVX2 pass;
-    /// four groups of four it measured 0.45× the watertight AVX-512 walk, BENCHMARKS.md).
+    /// four groups of four measured 0.45× the AVX2 watertight walk on AVX-512, BENCHMARKS.md).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn intersect_group16_coords(
