@@ -32,11 +32,22 @@ impl AnyBvh {
     }
 
     /// Make now what a walk with `opts` keeps with the tree (the 8-wide tree's stored leaves for
-    /// `MollerTrumboreStored`, made otherwise by its first walk), so that the tree's memory counts
-    /// it and no walk waits for it.
+    /// `MollerTrumboreStored`, made otherwise by its first walk), so that no walk waits for it.
     pub fn ready_for(&self, opts: crate::bvh::TraceOptions) {
-        if let (AnyBvh::Wide8(w), crate::geometry::TriangleTest::MollerTrumboreStored) = (self, opts.test) {
-            w.stored_leaves();
+        self.stored_for(opts);
+    }
+
+    /// The tree's memory (`TreeView::memory_bytes`, which never depends on what was walked) plus
+    /// what a walk with `opts` keeps beside it: the 8-wide tree's stored leaves for
+    /// `MollerTrumboreStored` (made now if they were not).
+    pub fn bytes_for(&self, opts: crate::bvh::TraceOptions) -> usize {
+        self.tree().memory_bytes() + self.stored_for(opts).map_or(0, std::mem::size_of_val)
+    }
+
+    fn stored_for(&self, opts: crate::bvh::TraceOptions) -> Option<&[f32]> {
+        match (self, opts.test) {
+            (AnyBvh::Wide8(w), crate::geometry::TriangleTest::MollerTrumboreStored) => Some(w.stored_leaves()),
+            _ => None,
         }
     }
 
@@ -148,3 +159,7 @@ impl TreeView for AnyBvh {
         self.tree().report()
     }
 }
+
+#[cfg(test)]
+#[path = "any_tests.rs"]
+mod tests;

@@ -177,11 +177,13 @@ impl<const W: usize> TreeView for WideBvh<W> {
     }
 
     fn memory_bytes(&self) -> usize {
-        // Nodes, primitive ids and the triangles in leaf order (the BVH's own copy).
+        // Nodes, primitive ids and the triangles in leaf order (the BVH's own copy). Not the stored
+        // leaves a walk with `MollerTrumboreStored` makes: whether they exist depends on what was
+        // walked, and a figure must not (the app counts before it renders, `stats` after its
+        // rays); `AnyBvh::bytes_for` counts them for that test.
         self.nodes.len() * std::mem::size_of::<WideNode<W>>()
             + self.prim_ids.len() * 4
             + self.tris.len() * std::mem::size_of::<[Vec3; 3]>()
-            + self.stored.get().map_or(0, |s| s.len() * 4)
     }
 
     fn params(&self) -> &BuildParams {
