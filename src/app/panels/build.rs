@@ -77,8 +77,8 @@ pub fn show(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     }
     ui.label("Traversal order (binary layout)");
     radios(ui, &mut s.trace.order);
-    ui.label("Triangle test");
-    radios(ui, &mut s.trace.test);
+    // A list, not radios: three tests in one row keep the View section in sight (issue 59's room).
+    super::view::combo(ui, "Triangle test", &mut s.trace.test);
     if edited != app.settings {
         out.push(Action::Edit(Box::new(edited)));
     }

@@ -286,7 +286,7 @@ fn node_boxes(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings, top_depth:
 /// with its help on hover. As wide as its widest label whichever is chosen (choosing does not move
 /// what follows), on its label's row where both fit, else below it: its text is never cut (a
 /// narrow tile cut "Primary" to "Pri", issue 59).
-fn combo<T: crate::options::Choice>(ui: &mut egui::Ui, label: &str, value: &mut T) -> egui::Response {
+pub(super) fn combo<T: crate::options::Choice>(ui: &mut egui::Ui, label: &str, value: &mut T) -> egui::Response {
     // Salted by its text, not by the label's id: an auto id moves when widgets before it come
     // and go, and the open list would close.
     let salt = label;
