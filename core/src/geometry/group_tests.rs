@@ -56,26 +56,9 @@ pub(crate) fn rays() -> impl Strategy<Value = Vec<Ray>> {
 /// Triangles on a small grid and up to `n` rays aimed at their vertices, edges and inner points
 /// (the watertight test's exactly-zero edge functions), or anywhere, some with short intervals.
 pub(crate) fn triangle_case(n: usize) -> impl Strategy<Value = ([Vec3; 3], Vec<Ray>)> {
-    let grid = || [(-4i32..=4), (-4i32..=4), (-4i32..=4)].prop_map(|v| Vec3::from_array(v.map(|x| x as f32 * 0.5)));
-    let aim = (0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..4);
-    ([grid(), grid(), grid()], proptest::collection::vec(aim, 1..=n)).prop_map(|(tri, aims)| {
-        let rays = aims
-            .into_iter()
-            .map(|(i, j, k, d, s, interval)| {
-                let w = (i + j + k).max(1) as f32;
-                let at = (tri[0] * i as f32 + tri[1] * j as f32 + tri[2] * k as f32) / w;
-                let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
-                let mut ray = Ray::new(at - dir * s as f32, dir);
-                match interval {
-                    0 => ray.t_max = s as f32,
-                    1 => ray.t_min = s as f32 + 0.25,
-                    _ => {}
-                }
-                ray
-            })
-            .collect();
-        (tri, rays)
-    })
+    use crate::geometry::leaf_cases::{aim, aimed_ray, grid_point};
+    ([grid_point(), grid_point(), grid_point()], proptest::collection::vec(aim(), 1..=n))
+        .prop_map(|(tri, aims)| (tri, aims.into_iter().map(|a| aimed_ray(&tri, a)).collect()))
 }
 
 /// The box test of a group is its four-lane groups', lane for lane (padding lanes included), and

@@ -5,6 +5,8 @@ mod aabb;
 pub mod avx512;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod group_tests;
+#[cfg(test)]
+mod leaf_cases;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod packet8;
 mod ray;

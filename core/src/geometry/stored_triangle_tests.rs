@@ -2,36 +2,9 @@
 //! point its barycentrics name, and every SIMD pass bit for bit the scalar test.
 
 use super::*;
+use crate::geometry::leaf_cases::leaf_case;
 use crate::geometry::triangle::MollerTrumbore;
 use proptest::prelude::*;
-
-/// Grid points: shared vertices and edges, axis-parallel rays and exactly-zero terms come up often.
-fn point() -> impl Strategy<Value = Vec3> {
-    [(-4i32..=4), (-4i32..=4), (-4i32..=4)].prop_map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32) * 0.5)
-}
-
-/// A leaf of up to nineteen triangles (often sharing vertices, some degenerate), a ray aimed at a
-/// vertex, an edge point or an inner point of one of them, an interval that may cut the hits, and
-/// whether more floats follow the leaf (else the array ends with it: the masked loads).
-fn leaf_case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ray, bool)> {
-    let pool = proptest::collection::vec(point(), 6);
-    let picks = proptest::collection::vec([0usize..6, 0usize..6, 0usize..6], 1..=19);
-    let aim = (0usize..19, 0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..4);
-    (pool, picks, aim, proptest::bool::ANY).prop_map(|(pool, picks, (target, i, j, k, d, s, interval), more)| {
-        let tris: Vec<[Vec3; 3]> = picks.iter().map(|p| p.map(|q| pool[q])).collect();
-        let t = &tris[target % tris.len()];
-        let w = (i + j + k).max(1) as f32;
-        let at = (t[0] * i as f32 + t[1] * j as f32 + t[2] * k as f32) / w;
-        let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
-        let mut ray = Ray::new(at - dir * s as f32, dir);
-        match interval {
-            0 => ray.t_max = s as f32, // a hit exactly at t_max is excluded
-            1 => ray.t_min = s as f32 + 0.25,
-            _ => {}
-        }
-        (tris, ray, more)
-    })
-}
 
 /// A leaf's stored form, coordinate by coordinate, as `WideBvh::stored_leaves` keeps it.
 fn stored_leaf(tris: &[[Vec3; 3]]) -> Vec<f32> {
@@ -43,64 +16,62 @@ fn bits(h: &TriangleHit) -> (u32, u32, u32) {
     (h.t.to_bits(), h.u.to_bits(), h.v.to_bits())
 }
 
+/// Pass `g` of `width` lanes over a leaf (its mask and each lane's t, u, v) against the scalar
+/// test's hits `want`, bit for bit, for every pass of the leaf; `name` says which passes failed.
+fn check_passes(
+    want: &[Option<TriangleHit>],
+    width: usize,
+    name: &str,
+    pass: impl Fn(usize) -> (u32, Vec<f32>, Vec<f32>, Vec<f32>),
+) -> Result<(), TestCaseError> {
+    for g in 0..want.len().div_ceil(width) {
+        let (mask, t, u, v) = pass(g);
+        let n = (want.len() - width * g).min(width);
+        prop_assert_eq!(mask >> n, 0, "{} lanes: no lane past the leaf", name);
+        for lane in 0..n {
+            let w = want[width * g + lane];
+            prop_assert_eq!(mask & (1 << lane) != 0, w.is_some(), "{} lanes: pass {} lane {}", name, g, lane);
+            if let Some(h) = w {
+                let lane_hit = TriangleHit { t: t[lane], u: u[lane], v: v[lane] };
+                prop_assert_eq!(bits(&lane_hit), bits(&h), "{} lanes: pass {} lane {} bit for bit", name, g, lane);
+            }
+        }
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(4000))]
     /// Every pass over a stored leaf, four lanes, eight or sixteen (where the CPU has them), is the scalar test of its triangles
     /// (`MollerTrumboreStored::intersect`, from the vertices), bit for bit.
     #[test]
-    fn stored_passes_are_the_scalar_test((tris, ray, more) in leaf_case()) {
+    fn stored_passes_are_the_scalar_test((tris, ray, more) in leaf_case(19)) {
         let count = tris.len();
         let mut stored = stored_leaf(&tris);
         if more {
             stored.extend([7.0, -3.5, 1e9, f32::NAN, 0.0, -0.0, 1e-30, 2.0]);
         }
         let want: Vec<Option<TriangleHit>> = tris.iter().map(|t| MollerTrumboreStored::intersect(&(), &ray, t)).collect();
-        for g in 0..count.div_ceil(4) {
+        let lanes = |got_mask: u32, t: &[f32], u: &[f32], v: &[f32]| (got_mask, t.to_vec(), u.to_vec(), v.to_vec());
+        check_passes(&want, 4, "four", |g| {
             let got = stored_group4(&ray, &stored, count, g);
-            let n = (count - 4 * g).min(4);
-            prop_assert_eq!(got.mask >> n, 0, "no lane past the leaf");
-            for lane in 0..n {
-                let w = want[4 * g + lane];
-                prop_assert_eq!(got.mask & (1 << lane) != 0, w.is_some(), "four lanes: pass {} lane {}", g, lane);
-                if let Some(h) = w {
-                    let lane_hit = TriangleHit { t: got.t[lane], u: got.u[lane], v: got.v[lane] };
-                    prop_assert_eq!(bits(&lane_hit), bits(&h), "four lanes: pass {} lane {} bit for bit", g, lane);
-                }
-            }
-        }
+            lanes(got.mask, &got.t, &got.u, &got.v)
+        })?;
         #[cfg(target_arch = "x86_64")]
         if let Some(k) = Avx2::detect() {
-            for g in 0..count.div_ceil(8) {
+            check_passes(&want, 8, "eight", |g| {
                 // SAFETY: `detect` found AVX2.
                 let got = unsafe { stored_leaf8(k, &ray, &stored, count, g) };
-                let n = (count - 8 * g).min(8);
-                prop_assert_eq!(got.mask >> n, 0, "no lane past the leaf");
-                for lane in 0..n {
-                    let w = want[8 * g + lane];
-                    prop_assert_eq!(got.mask & (1 << lane) != 0, w.is_some(), "eight lanes: pass {} lane {}", g, lane);
-                    if let Some(h) = w {
-                        let lane_hit = TriangleHit { t: got.t[lane], u: got.u[lane], v: got.v[lane] };
-                        prop_assert_eq!(bits(&lane_hit), bits(&h), "eight lanes: pass {} lane {} bit for bit", g, lane);
-                    }
-                }
-            }
+                lanes(got.mask, &got.t, &got.u, &got.v)
+            })?;
         }
         #[cfg(target_arch = "x86_64")]
         if let Some(k) = crate::geometry::avx512::Avx512::detect() {
-            for g in 0..count.div_ceil(16) {
+            check_passes(&want, 16, "sixteen", |g| {
                 // SAFETY: `detect` found AVX-512F/VL.
                 let got = unsafe { crate::geometry::avx512::stored_leaf16(k, &ray, &stored, count, g) };
-                let n = (count - 16 * g).min(16);
-                prop_assert_eq!(got.mask >> n, 0, "no lane past the leaf");
-                for lane in 0..n {
-                    let w = want[16 * g + lane];
-                    prop_assert_eq!(got.mask & (1 << lane) != 0, w.is_some(), "sixteen lanes: pass {} lane {}", g, lane);
-                    if let Some(h) = w {
-                        let lane_hit = TriangleHit { t: got.t[lane], u: got.u[lane], v: got.v[lane] };
-                        prop_assert_eq!(bits(&lane_hit), bits(&h), "sixteen lanes: pass {} lane {} bit for bit", g, lane);
-                    }
-                }
-            }
+                lanes(got.mask, &got.t, &got.u, &got.v)
+            })?;
         }
     }
 

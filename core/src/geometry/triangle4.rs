@@ -115,41 +115,14 @@ pub(super) fn edge_test4(xy: [f32x4; 6], z: [f32x4; 3], t_min: f32x4, t_max: f32
 mod tests {
     use super::super::triangle::{TriangleIntersector, Watertight};
     use super::*;
+    use crate::geometry::leaf_cases::{by_coordinate, leaf_case};
     use proptest::prelude::*;
-
-    /// Grid points: shared vertices and edges, axis-parallel rays and exactly-zero edge
-    /// functions come up often.
-    fn point() -> impl Strategy<Value = Vec3> {
-        [(-4i32..=4), (-4i32..=4), (-4i32..=4)].prop_map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32) * 0.5)
-    }
-
-    /// Up to four triangles (often sharing vertices) and one ray aimed at a vertex, an edge point
-    /// or an inner point of one of them, or anywhere, with an interval that may cut the hits.
-    fn case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ray)> {
-        let pool = proptest::collection::vec(point(), 6);
-        let picks = proptest::collection::vec([0usize..6, 0usize..6, 0usize..6], 1..=4);
-        let aim = (0usize..4, 0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..4);
-        (pool, picks, aim).prop_map(|(pool, picks, (target, i, j, k, d, s, interval))| {
-            let tris: Vec<[Vec3; 3]> = picks.iter().map(|p| p.map(|q| pool[q])).collect();
-            let t = &tris[target % tris.len()];
-            let w = (i + j + k).max(1) as f32;
-            let at = (t[0] * i as f32 + t[1] * j as f32 + t[2] * k as f32) / w;
-            let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
-            let mut ray = Ray::new(at - dir * s as f32, dir);
-            match interval {
-                0 => ray.t_max = s as f32, // a hit exactly at t_max is excluded
-                1 => ray.t_min = s as f32 + 0.25,
-                _ => {}
-            }
-            (tris, ray)
-        })
-    }
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(4000))]
         /// Lane k is the scalar test of triangle k, bit for bit.
         #[test]
-        fn four_triangles_at_once_are_four_scalar_tests((tris, ray) in case()) {
+        fn four_triangles_at_once_are_four_scalar_tests((tris, ray, _) in leaf_case(4)) {
             let p = Watertight::prepare(&ray);
             let got = Watertight::intersect_group(&p, &ray, &tris);
             prop_assert_eq!(got.mask >> tris.len(), 0, "no lane past the triangles");
@@ -168,33 +141,14 @@ mod tests {
         }
     }
 
-    /// A leaf of up to seven triangles stored coordinate by coordinate, as the 8-wide layout keeps
-    /// it, and a ray aimed into it.
-    fn leaf_case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ray, bool)> {
-        let pool = proptest::collection::vec(point(), 6);
-        let picks = proptest::collection::vec([0usize..6, 0usize..6, 0usize..6], 1..=7);
-        let aim = (0usize..7, 0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4);
-        (pool, picks, aim, proptest::bool::ANY).prop_map(|(pool, picks, (target, i, j, k, d, s), more)| {
-            let tris: Vec<[Vec3; 3]> = picks.iter().map(|p| p.map(|q| pool[q])).collect();
-            let t = &tris[target % tris.len()];
-            let w = (i + j + k).max(1) as f32;
-            let at = (t[0] * i as f32 + t[1] * j as f32 + t[2] * k as f32) / w;
-            let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
-            (tris, Ray::new(at - dir * s as f32, dir), more)
-        })
-    }
-
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(3000))]
         /// Each group of a leaf stored coordinate by coordinate is the scalar test of its
         /// triangles, bit for bit, whether more data follows the leaf or the array ends there.
         #[test]
-        fn a_leaf_stored_by_coordinate_tests_as_its_triangles((tris, ray, more) in leaf_case()) {
+        fn a_leaf_stored_by_coordinate_tests_as_its_triangles((tris, ray, more) in leaf_case(7)) {
             let count = tris.len();
-            let mut coords: Vec<f32> = (0..9).flat_map(|j| tris.iter().map(move |t| t[j / 3][j % 3])).collect();
-            if more {
-                coords.extend([7.0, -3.5, 1e9, f32::NAN]);
-            }
+            let coords = by_coordinate(&tris, more);
             let p = Watertight::prepare(&ray);
             for g in 0..count.div_ceil(4) {
                 let got = Watertight::intersect_group_coords(&p, &ray, &coords, count, g);

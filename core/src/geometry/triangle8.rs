@@ -238,51 +238,19 @@ fn in_double(xy: [__m256; 6], uvw: [__m256; 3], which: u32) -> (__m256, __m256, 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::leaf_cases::{by_coordinate, leaf_case};
     use crate::geometry::triangle::{MollerTrumbore, TriangleIntersector, Watertight};
-    use glam::Vec3;
     use proptest::prelude::*;
-
-    /// Grid points: shared vertices and edges, axis-parallel rays and exactly-zero edge
-    /// functions come up often.
-    fn point() -> impl Strategy<Value = Vec3> {
-        [(-4i32..=4), (-4i32..=4), (-4i32..=4)].prop_map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32) * 0.5)
-    }
-
-    /// A leaf of up to nineteen triangles (often sharing vertices), a ray aimed at a vertex, an
-    /// edge point or an inner point of one of them, an interval that may cut the hits, and
-    /// whether more floats follow the leaf (else the array ends with it: the masked loads).
-    fn leaf_case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ray, bool)> {
-        let pool = proptest::collection::vec(point(), 6);
-        let picks = proptest::collection::vec([0usize..6, 0usize..6, 0usize..6], 1..=19);
-        let aim = (0usize..19, 0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..4);
-        (pool, picks, aim, proptest::bool::ANY).prop_map(|(pool, picks, (target, i, j, k, d, s, interval), more)| {
-            let tris: Vec<[Vec3; 3]> = picks.iter().map(|p| p.map(|q| pool[q])).collect();
-            let t = &tris[target % tris.len()];
-            let w = (i + j + k).max(1) as f32;
-            let at = (t[0] * i as f32 + t[1] * j as f32 + t[2] * k as f32) / w;
-            let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
-            let mut ray = Ray::new(at - dir * s as f32, dir);
-            match interval {
-                0 => ray.t_max = s as f32, // a hit exactly at t_max is excluded
-                1 => ray.t_min = s as f32 + 0.25,
-                _ => {}
-            }
-            (tris, ray, more)
-        })
-    }
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(4000))]
         /// Each pass of eight over a leaf stored coordinate by coordinate is the scalar test of
         /// its triangles, bit for bit (the watertight one and Möller–Trumbore), whether more data follows the leaf or the array ends there.
         #[test]
-        fn eight_triangles_at_once_are_eight_scalar_tests((tris, ray, more) in leaf_case()) {
+        fn eight_triangles_at_once_are_eight_scalar_tests((tris, ray, more) in leaf_case(19)) {
             let Some(k) = Avx2::detect() else { return Ok(()) };
             let count = tris.len();
-            let mut coords: Vec<f32> = (0..9).flat_map(|j| tris.iter().map(move |t| t[j / 3][j % 3])).collect();
-            if more {
-                coords.extend([7.0, -3.5, 1e9, f32::NAN, 0.0, -0.0, 1e-30, 2.0]);
-            }
+            let coords = by_coordinate(&tris, more);
             let p = Watertight::prepare(&ray);
             for g in 0..count.div_ceil(8) {
                 // SAFETY: `detect` found AVX2.

@@ -158,38 +158,10 @@ unsafe fn in_double<V: Lanes>(xy: [V; 6], uvw: [V; 3], zero: u32) -> (V, V, V) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::leaf_cases::{by_coordinate, leaf_case};
     use crate::geometry::triangle::{TriangleIntersector, Watertight};
     use glam::Vec3;
     use proptest::prelude::*;
-
-    /// Grid points: shared vertices and edges, axis-parallel rays and exactly-zero edge functions
-    /// (the double-precision fallback) come up often.
-    fn point() -> impl Strategy<Value = Vec3> {
-        [(-4i32..=4), (-4i32..=4), (-4i32..=4)].prop_map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32) * 0.5)
-    }
-
-    /// A leaf of 1 to 20 triangles (more than one pass of sixteen) built from a few shared
-    /// vertices, and a ray aimed at a vertex, an edge or an inner point of one of them from a grid
-    /// point, with an interval that may cut the hits off.
-    fn leaf_case() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ray)> {
-        let pool = proptest::collection::vec(point(), 6);
-        let picks = proptest::collection::vec([0usize..6, 0usize..6, 0usize..6], 1..=20);
-        let aim = (0usize..20, 0u32..3, 0u32..3, 0u32..3, [-3i32..=3, -3i32..=3, -3i32..=3], 1u32..4, 0u32..4);
-        (pool, picks, aim).prop_map(|(pool, picks, (target, i, j, k, d, s, interval))| {
-            let tris: Vec<[Vec3; 3]> = picks.iter().map(|p| p.map(|q| pool[q])).collect();
-            let t = &tris[target % tris.len()];
-            let w = (i + j + k).max(1) as f32;
-            let at = (t[0] * i as f32 + t[1] * j as f32 + t[2] * k as f32) / w;
-            let dir = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
-            let mut ray = Ray::new(at - dir * s as f32, dir);
-            match interval {
-                0 => ray.t_max = s as f32, // a hit exactly at t_max is excluded
-                1 => ray.t_min = s as f32 + 0.25,
-                _ => {}
-            }
-            (tris, ray)
-        })
-    }
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(4000))]
@@ -197,10 +169,10 @@ mod tests {
         /// leaf is set. Also the default of `intersect_group16_coords`, two AVX2 passes of eight
         /// (what the Möller–Trumbore test runs), agrees, so the two paths of `Groups16` are checked.
         #[test]
-        fn a_leaf_in_passes_of_sixteen_is_its_scalar_tests((tris, ray) in leaf_case()) {
+        fn a_leaf_in_passes_of_sixteen_is_its_scalar_tests((tris, ray, more) in leaf_case(20)) {
             let Some(k) = Avx512::detect() else { return Ok(()) };
             let count = tris.len();
-            let coords: Vec<f32> = (0..9).flat_map(|j| tris.iter().map(move |t| t[j / 3][j % 3])).collect();
+            let coords = by_coordinate(&tris, more);
             let p = Watertight::prepare(&ray);
             for g in 0..count.div_ceil(16) {
                 // SAFETY: `k` proves the CPU has AVX-512F/VL.
