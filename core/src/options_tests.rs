@@ -1,6 +1,7 @@
 //! The option tables' own tests (`options.rs`).
 
 use super::*;
+use crate::bvh::Param;
 
 fn check<T: Choice + std::fmt::Debug>() {
     for (i, n) in T::TABLE.iter().enumerate() {
