@@ -178,8 +178,13 @@ pub fn output(a: &StatsArgs) -> Result<String, CliError> {
                 let start = std::time::Instant::now();
                 (epo::measure(&tree, &Hierarchy::of(&tree)), start.elapsed().as_secs_f64() * 1e3)
             });
-            let stats =
-                TreeStats { epo: Some(epo.value), epo_error: epo.error(), epo_ms: Some(ms), ..TreeStats::of(b) };
+            let stats = TreeStats {
+                epo: Some(epo.value),
+                epo_error: epo.error(),
+                epo_ms: Some(ms),
+                walk_bytes: b.walk_bytes(trace),
+                ..TreeStats::of(b)
+            };
             if let StatsOutput::Json = format {
                 let v = serde_json::json!({
                     "mesh": report, "params": params, "stats": stats, "gpu_build": gpu_build_json, "rays": rays_json,
@@ -365,12 +370,24 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
             epo::figure(epo, s.epo_error)
         );
     }
+    let per = |bytes: usize| bytes as f64 / s.triangles.max(1) as f64;
     let _ = writeln!(
         o,
         "memory          {} bytes ({:.1} per triangle: nodes, indices and the triangles in leaf order)",
         s.memory_bytes,
-        s.memory_bytes as f64 / s.triangles.max(1) as f64
+        per(s.memory_bytes)
     );
+    if s.walk_bytes > 0 {
+        let _ = writeln!(
+            o,
+            "                + {} bytes ({:.1} per triangle) of leaves kept for the {} test: {} bytes, {:.1} per triangle",
+            s.walk_bytes,
+            per(s.walk_bytes),
+            crate::geometry::TriangleTest::MollerTrumboreStored.name(),
+            s.memory_bytes + s.walk_bytes,
+            per(s.memory_bytes + s.walk_bytes)
+        );
+    }
     if let Some(k) = s.simd {
         // A 4-wide tree's four boxes fit one four-lane pass: AVX2 and AVX-512 serve eight children.
         let why = if k == "simd4" && crate::cpu::Simd::chosen() > crate::cpu::Simd::Simd4 {

@@ -211,3 +211,40 @@ fn fastest_traversal_is_one_click_and_stats_agrees() {
     let app_counts = h.state().shown.as_ref().unwrap().frame.counts_csv().unwrap();
     assert_eq!(app_counts, std::fs::read_to_string(&csv).unwrap(), "the app's 8-wide counts are render's");
 }
+
+/// With the stored-edges triangle test on the 8-wide layout, "Bytes / triangle" counts the leaves
+/// that test keeps beside the tree (48 bytes a triangle), as `stats --triangle-test
+/// moller-trumbore-stored` does; with the watertight test, the tree's own.
+#[test]
+fn the_stored_tests_leaves_count_in_bytes_per_triangle_as_stats_counts_them() {
+    use bvhscope::geometry::TriangleTest;
+    let (mut h, torus) = open_with("torus.obj", "SAH binned");
+    h.get_by_label("Fastest traversal").click();
+    run_until(&mut h, "the fastest build", |a| {
+        idle(a) && a.current_bvh().is_some_and(|b| b.bvh.build_params().bvh.layout == bvhscope::bvh::Layout::Wide8)
+    });
+    let mut s = h.state().settings.clone();
+    s.trace.test = TriangleTest::MollerTrumboreStored;
+    h.state_mut().act(Action::Edit(Box::new(s)));
+    run_until(&mut h, "the frame with the stored test", |a| {
+        idle(a) && a.shown.as_ref().is_some_and(|s| s.trace.test == TriangleTest::MollerTrumboreStored)
+    });
+    h.run_steps(2);
+    let stats = |test: &str| {
+        let w = ["bvhscope", "stats", torus.to_str().unwrap(), "--preset", "fastest", "--triangle-test", test];
+        let Some(Command::Stats(args)) = Cli::from_words(w.iter().copied().chain(["--no-rays"])).unwrap().command
+        else {
+            panic!("stats")
+        };
+        bvhscope::cli::stats::output(&args).unwrap()
+    };
+    let text = stats("moller-trumbore-stored");
+    let line = text.lines().find(|l| l.contains("of leaves kept for")).unwrap_or_else(|| panic!("{text}"));
+    let total = line.rsplit(", ").next().unwrap().trim_end_matches(" per triangle");
+    let tree = h.state().current_bvh().unwrap().stats.clone();
+    let want = (tree.memory_bytes + 48 * tree.triangles) as f64 / tree.triangles as f64;
+    assert_eq!(total, format!("{want:.1}"), "{line}");
+    assert!(h.query_all_by_label(total).count() >= 1, "the statistics show {total} bytes a triangle");
+    // The watertight test keeps nothing beside the tree: the line is not printed.
+    assert!(!stats("watertight").contains("of leaves kept for"));
+}

@@ -38,10 +38,21 @@ impl AnyBvh {
     }
 
     /// The tree's memory (`TreeView::memory_bytes`, which never depends on what was walked) plus
-    /// what a walk with `opts` keeps beside it: the 8-wide tree's stored leaves for
-    /// `MollerTrumboreStored` (made now if they were not).
+    /// what a walk with `opts` keeps beside it (`walk_bytes`).
     pub fn bytes_for(&self, opts: crate::bvh::TraceOptions) -> usize {
-        self.tree().memory_bytes() + self.stored_for(opts).map_or(0, std::mem::size_of_val)
+        self.tree().memory_bytes() + self.walk_bytes(opts)
+    }
+
+    /// What a walk with `opts` keeps beside the tree, whether it was made yet or not: the 8-wide
+    /// tree's stored leaves for `MollerTrumboreStored` (`STORED_FLOATS` floats a triangle), else
+    /// nothing.
+    pub fn walk_bytes(&self, opts: crate::bvh::TraceOptions) -> usize {
+        match (self, opts.test) {
+            (AnyBvh::Wide8(w), crate::geometry::TriangleTest::MollerTrumboreStored) => {
+                w.tris.len() * crate::geometry::stored_triangle::STORED_FLOATS * std::mem::size_of::<f32>()
+            }
+            _ => 0,
+        }
     }
 
     fn stored_for(&self, opts: crate::bvh::TraceOptions) -> Option<&[f32]> {

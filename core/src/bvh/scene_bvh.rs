@@ -128,6 +128,15 @@ impl SceneBvh {
         }
     }
 
+    /// What a walk with `opts` keeps beside the trees (`AnyBvh::walk_bytes`; for two levels,
+    /// the meshes' BVHs').
+    pub fn walk_bytes(&self, opts: crate::bvh::TraceOptions) -> usize {
+        match self {
+            SceneBvh::Single { bvh: b, .. } => b.walk_bytes(opts),
+            SceneBvh::TwoLevel { bvh: t, .. } => t.bottom.iter().map(|b| b.walk_bytes(opts)).sum(),
+        }
+    }
+
     /// The single BVH, or the top level of two.
     pub fn tree(&self) -> &dyn TreeView {
         match self {

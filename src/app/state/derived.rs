@@ -175,7 +175,12 @@ impl BvhscopeApp {
             // The end-point overlap comes with the prepared tree, a moment after the image.
             stats: {
                 let e = self.nodes.current(Some(&b.bvh));
-                TreeStats { epo: e.map(|e| e.epo), epo_error: e.and_then(|e| e.epo_error), ..b.stats.clone() }
+                TreeStats {
+                    epo: e.map(|e| e.epo),
+                    epo_error: e.and_then(|e| e.epo_error),
+                    walk_bytes: b.bvh.walk_bytes(self.settings.trace),
+                    ..b.stats.clone()
+                }
             },
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
             rays: self.rays,
@@ -222,7 +227,7 @@ impl BvhscopeApp {
         let b = self.compare.b.as_ref().filter(|b| self.compare.on && b.scene_id == self.scene_id)?;
         Some(StrategyFigures {
             label: format!("B: {}", b.bvh.label()),
-            stats: b.stats.clone(),
+            stats: TreeStats { walk_bytes: b.bvh.walk_bytes(b.trace), ..b.stats.clone() },
             build_ms: b.bvh.build_time().as_secs_f64() * 1e3,
             rays: Some(MeasuredRays {
                 summary: b.summary,
