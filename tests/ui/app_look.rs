@@ -260,3 +260,26 @@ fn look_legend() {
         save(&mut h, &format!("projector-heatmap-folded{suffix}"));
     }
 }
+
+/// The build panel at 1280×720, at scale 1 and presenting: the sliders' labels whole (beside the
+/// slider, or above it where the panel is too narrow), and the triangle test's list open.
+#[test]
+#[ignore]
+fn look_triangle_test_list() {
+    use egui::accesskit::Role;
+    use egui_kittest::kittest::Queryable;
+    for present in [false, true] {
+        let mut h = Harness::builder()
+            .with_size(egui::vec2(1280.0, 720.0))
+            .wgpu()
+            .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+        h.state_mut().act(Action::Present(present));
+        run_until(&mut h, "the first frame", idle);
+        let name = if present { "triangle-test-present" } else { "triangle-test" };
+        save(&mut h, name);
+        h.get_by_role_and_label(Role::ComboBox, "Triangle test").scroll_to_me();
+        h.get_by_role_and_label(Role::ComboBox, "Triangle test").click();
+        h.run_steps(3);
+        save(&mut h, &format!("{name}-open"));
+    }
+}

@@ -179,3 +179,31 @@ fn a_save_box_starts_with_the_suggested_file() {
     h.run_steps(3);
     assert_eq!(h.get_by_label("Path").accesskit_node().value().as_deref(), Some(""), "an open starts empty");
 }
+
+/// Presenting at 1280×720 the build panel is narrow (about 175 points): each build setting's name
+/// is whole inside the panel, beside its slider where it fits, on a line of its own above it where
+/// it does not (they ran past the panel's edge, "Max le", "SA", cut off), and the slider still
+/// answers to that name.
+#[test]
+fn presenting_at_720_px_every_build_setting_is_named_whole() {
+    for present in [false, true] {
+        let h = at_720(present, false);
+        // The build panel's right edge: where the image's tab starts.
+        let edge = h.get_by_label("Image").rect().min.x;
+        for o in &bvhscope::options::BUILD_PARAMS {
+            // The name's text (a label's value), and the widgets named by it.
+            let texts: Vec<egui::Rect> = h.query_all_by_value(o.label).map(|n| n.rect()).collect();
+            assert!(!texts.is_empty(), "{} written out", o.label);
+            let names = texts.into_iter().chain(h.query_all_by_label(o.label).map(|n| n.rect()));
+            for r in names {
+                assert!(
+                    r.max.x <= edge,
+                    "presenting {present}: {:?} at {r:?} runs past the panel's edge {edge}",
+                    o.label
+                );
+            }
+            let slider = h.get_by_role_and_label(Role::Slider, o.label).rect();
+            assert!(slider.max.x <= edge, "{}'s slider at {slider:?}", o.label);
+        }
+    }
+}

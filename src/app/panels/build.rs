@@ -15,21 +15,50 @@ fn reinsertion_of(bvh: &crate::bvh::SceneBvh) -> Option<crate::bvh::reinsert::Re
 
 /// A slider over a build parameter's whole range (logarithmic where the table says: leaf sizes of
 /// 1..255 and costs of 0.01..100 are chosen near their small ends), labelled and explained by it.
+/// The rail shrinks so that the value and the label fit the panel's width beside it; where even a
+/// short rail leaves no room (a narrow panel, or presenting at a larger scale), the label takes a
+/// line of its own above the slider instead of being cut off at the panel's edge.
 fn param(ui: &mut egui::Ui, build: &mut BuildParams, o: &ParamOption) {
+    const MIN_RAIL: f32 = 60.0;
+    let width_of = |ui: &egui::Ui, text: &str| {
+        egui::WidgetText::from(text)
+            .into_galley(ui, Some(egui::TextWrapMode::Extend), f32::INFINITY, egui::TextStyle::Body)
+            .size()
+            .x
+    };
     let v = o.param.get(build);
+    // The value's box: its widest text (the largest whole value, or a six-decimal real) in a
+    // button's padding.
+    let widest = match o.limits() {
+        ParamLimits::Whole(l) => l.max.to_string(),
+        ParamLimits::Real(_) => "0.000000".to_string(),
+    };
+    let gap = ui.spacing().item_spacing.x;
+    let value = (width_of(ui, &widest) + 2.0 * ui.spacing().button_padding.x).max(ui.spacing().interact_size.x);
+    let room = ui.available_width() - value - width_of(ui, o.label) - 2.0 * gap;
+    let above = room < MIN_RAIL;
+    let named = above.then(|| ui.label(o.label).on_hover_text(o.help_line()).id);
+    let rail = if above { ui.available_width() - value - gap } else { room };
+    ui.spacing_mut().slider_width = rail.clamp(MIN_RAIL, 100.0);
+    let label = if above { "" } else { o.label };
     let r = match o.limits() {
         ParamLimits::Whole(l) => {
             let mut x = v.whole();
-            let r = ui.add(egui::Slider::new(&mut x, l.min..=l.max).logarithmic(o.log).text(o.label));
+            let r = ui.add(egui::Slider::new(&mut x, l.min..=l.max).logarithmic(o.log).text(label));
             o.param.set(build, ParamValue::Whole(x));
             r
         }
         ParamLimits::Real(l) => {
             let mut x = v.real();
-            let r = ui.add(egui::Slider::new(&mut x, l.min..=l.max).logarithmic(o.log).text(o.label));
+            let r = ui.add(egui::Slider::new(&mut x, l.min..=l.max).logarithmic(o.log).text(label));
             o.param.set(build, ParamValue::Real(x));
             r
         }
+    };
+    // A screen reader (and a test) still finds the slider by its name when it stands above.
+    let r = match named {
+        Some(id) => r.labelled_by(id),
+        None => r,
     };
     r.on_hover_text(o.help_line());
 }
@@ -149,7 +178,9 @@ fn strategy_choice(app: &BvhscopeApp, ui: &mut egui::Ui, s: &mut Settings, out: 
     };
     egui::ComboBox::from_id_salt("strategy")
         .selected_text(selected)
-        .width(200.0)
+        // No wider than the panel: a wider box widens the panel's content past its edge, where
+        // the sliders below would be laid out and cut off.
+        .width(ui.available_width().min(200.0))
         .show_ui(ui, |ui| {
             for k in Strategy::ALL {
                 if ui.selectable_label(!on && s.build.strategy == k, k.label()).on_hover_text(k.help()).clicked() {
