@@ -58,7 +58,7 @@ fn main() {
 }
 
 /// The tree and trace options: the default build in `layout`, or `PRESET=fastest`'s (the layout
-/// argument ignored), with `COST`, `BINS`, `SWEEP` and `LEAF` over them.
+/// argument ignored), with `STRATEGY`, `COST`, `BINS`, `SWEEP` and `LEAF` over them.
 fn params_from_env(layout: Layout) -> (BuildParams, TraceOptions) {
     // `PRESET=fastest`: the `fastest` preset's build and trace options (the layout argument is ignored).
     let fastest = std::env::var("PRESET").is_ok_and(|p| p == "fastest");
@@ -73,6 +73,9 @@ fn params_from_env(layout: Layout) -> (BuildParams, TraceOptions) {
     }
     if let Ok(b) = std::env::var("BINS") {
         params.sah_bins = b.parse().expect("BINS is a number");
+    }
+    if let Ok(k) = std::env::var("STRATEGY") {
+        params.strategy = bvhscope::bvh::Strategy::from_name(&k).expect("STRATEGY is a strategy's name");
     }
     if std::env::var("SWEEP").is_ok() {
         params.strategy = bvhscope::bvh::Strategy::SahSweep;

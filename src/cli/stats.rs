@@ -389,11 +389,17 @@ pub fn format_text(report: &crate::mesh::LoadReport, params: &crate::bvh::BuildP
         );
     }
     if let Some(k) = s.simd {
-        // A 4-wide tree's four boxes fit one four-lane pass: AVX2 and AVX-512 serve eight children.
-        let why = if k == "simd4" && crate::cpu::Simd::chosen() > crate::cpu::Simd::Simd4 {
+        // A 4-wide tree's four boxes fit one four-lane pass, its leaves take AVX2's passes of
+        // eight: AVX-512 serves the 8-wide layout only.
+        let chosen = crate::cpu::Simd::chosen();
+        let why = if params.layout == crate::bvh::Layout::Wide4 && k == crate::cpu::Simd::Avx2.name() {
             format!(
-                "four children per node take one four-lane pass; this CPU's {} serves --layout wide8",
-                crate::cpu::Simd::chosen().name()
+                "four children per node take one four-lane pass, leaves up to eight triangles a pass{}",
+                if chosen > crate::cpu::Simd::Avx2 {
+                    format!("; this CPU's {} serves --layout wide8", chosen.name())
+                } else {
+                    String::new()
+                }
             )
         } else {
             "the best this CPU has for this layout, unless BVHSCOPE_SIMD=avx2|simd4|scalar asks for less".to_string()

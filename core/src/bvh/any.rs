@@ -31,10 +31,18 @@ impl AnyBvh {
         }
     }
 
-    /// Make now what a walk with `opts` keeps with the tree (the 8-wide tree's stored leaves for
+    /// Make now what a walk with `opts` keeps with the tree (a wide tree's stored leaves for
     /// `MollerTrumboreStored`, made otherwise by its first walk), so that no walk waits for it.
     pub fn ready_for(&self, opts: crate::bvh::TraceOptions) {
-        self.stored_for(opts);
+        match self {
+            AnyBvh::Wide8(w) if w.walks_stored(opts) => {
+                let _ = w.stored_leaves();
+            }
+            AnyBvh::Wide(w) if w.walks_stored(opts) => {
+                let _ = w.stored_leaves();
+            }
+            _ => {}
+        }
     }
 
     /// The tree's memory (`TreeView::memory_bytes`, which never depends on what was walked) plus
@@ -43,22 +51,15 @@ impl AnyBvh {
         self.tree().memory_bytes() + self.walk_bytes(opts)
     }
 
-    /// What a walk with `opts` keeps beside the tree, whether it was made yet or not: the 8-wide
-    /// tree's stored leaves for `MollerTrumboreStored` (`STORED_FLOATS` floats a triangle), else
-    /// nothing.
+    /// What a walk with `opts` keeps beside the tree, whether it was made yet or not: a wide
+    /// tree's stored leaves for `MollerTrumboreStored` where a SIMD walk reads them
+    /// (`STORED_FLOATS` floats a triangle), else nothing.
     pub fn walk_bytes(&self, opts: crate::bvh::TraceOptions) -> usize {
-        match (self, opts.test) {
-            (AnyBvh::Wide8(w), crate::geometry::TriangleTest::MollerTrumboreStored) => {
-                w.tris.len() * crate::geometry::stored_triangle::STORED_FLOATS * std::mem::size_of::<f32>()
-            }
+        let per = crate::geometry::stored_triangle::STORED_FLOATS * std::mem::size_of::<f32>();
+        match self {
+            AnyBvh::Wide8(w) if w.walks_stored(opts) => w.tris.len() * per,
+            AnyBvh::Wide(w) if w.walks_stored(opts) => w.tris.len() * per,
             _ => 0,
-        }
-    }
-
-    fn stored_for(&self, opts: crate::bvh::TraceOptions) -> Option<&[f32]> {
-        match (self, opts.test) {
-            (AnyBvh::Wide8(w), crate::geometry::TriangleTest::MollerTrumboreStored) => Some(w.stored_leaves()),
-            _ => None,
         }
     }
 

@@ -47,7 +47,7 @@ pub(crate) fn leaf_case(max: usize) -> impl Strategy<Value = (Vec<[Vec3; 3]>, Ra
     })
 }
 
-/// A leaf's nine coordinates, each over its triangles (the 8-wide layout's leaves), and, when
+/// A leaf's nine coordinates, each over its triangles (the wide layouts' leaves), and, when
 /// `more`, floats of another leaf after it.
 pub(crate) fn by_coordinate(tris: &[[Vec3; 3]], more: bool) -> Vec<f32> {
     let mut coords: Vec<f32> = (0..9).flat_map(|j| tris.iter().map(move |t| t[j / 3][j % 3])).collect();

@@ -95,7 +95,7 @@ pub trait TriangleIntersector: Copy + Send + Sync + 'static {
 
     /// `intersect_group` of triangles `4g..4g + 4` (those below `count`) of a leaf stored
     /// coordinate by coordinate (`coords`: the `count` values of v0.x, then of v0.y, …, v2.z; the
-    /// 8-wide layout's leaves). The watertight test loads its lanes straight from there; this
+    /// wide layouts' leaves). The watertight test loads its lanes straight from there; this
     /// default gathers the triangles and runs `intersect_group`.
     #[inline(always)]
     fn intersect_group_coords(p: &Self::Prepared, ray: &Ray, coords: &[f32], count: usize, g: usize) -> Hits4 {

@@ -35,7 +35,7 @@ pub(super) fn watertight_group(p: &WatertightRay, ray: &Ray, tris: &[[Vec3; 3]])
 }
 
 /// `watertight_group` of triangles `4g..4g + 4` (those below `count`) of a leaf stored coordinate
-/// by coordinate (`coords`, the 8-wide layout's leaves): each of the nine lanes is one load of four
+/// by coordinate (`coords`, the wide layouts' leaves): each of the nine lanes is one load of four
 /// consecutive floats (past the leaf's last triangle they belong to the next coordinate or leaf,
 /// or are zero at the array's end, and are masked off). The same arithmetic as `watertight_group`.
 #[inline(always)]

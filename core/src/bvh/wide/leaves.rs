@@ -1,7 +1,7 @@
-//! The 8-wide layout's leaves, stored for the four-triangle SIMD test: a leaf of `c` triangles
+//! The wide layouts' leaves, stored for the SIMD leaf tests: a leaf of `c` triangles
 //! keeps its 36·c bytes in the triangle array, but coordinate by coordinate — the `c` values of v0.x,
-//! then of v0.y, …, then of v2.z — so the test's nine lanes of a group of four are nine plain loads
-//! instead of thirty-six gathered floats. No padding: memory is the same as the other layouts'.
+//! then of v0.y, …, then of v2.z — so the test's nine lanes of a group of four (or eight) are nine
+//! plain loads instead of thirty-six (seventy-two) gathered floats. No padding: memory is the same as the other layouts'.
 //! Everything else that reads a leaf's triangles (the one-at-a-time test, packets, checks) goes
 //! through `with_leaf`, which hands it the triangles in leaf order, as the other layouts store them.
 
@@ -26,12 +26,9 @@ fn floats_mut(tris: &mut [[Vec3; 3]]) -> &mut [f32] {
 }
 
 impl<const W: usize> WideBvh<W> {
-    /// Rewrite every leaf's triangles coordinate by coordinate (8-wide trees only; done once,
-    /// after the collapse or an import).
+    /// Rewrite every leaf's triangles coordinate by coordinate (done once, after the collapse or an
+    /// import).
     pub(crate) fn store_leaves_by_coordinate(&mut self) {
-        if W != 8 {
-            return;
-        }
         // The leaves tile the array: each slot's count at its leaf's first triangle, then the array
         // cut into the leaves' floats in one pass, and the leaves transposed on all threads.
         let mut count_at = vec![0u8; self.tris.len()];
@@ -68,6 +65,12 @@ impl<const W: usize> WideBvh<W> {
         });
     }
 
+    /// Whether a walk with `opts` reads the stored leaves: the stored-edges test on a SIMD walk
+    /// (the scalar kernel tests the triangles from their vertices).
+    pub(crate) fn walks_stored(&self, opts: crate::bvh::TraceOptions) -> bool {
+        opts.test == crate::geometry::TriangleTest::MollerTrumboreStored && self.simd != crate::cpu::Simd::Scalar
+    }
+
     /// The leaves in the stored form of `MollerTrumboreStored` (`geometry::stored_triangle`): each
     /// leaf's triangles as v0, e1, e2 and the normal, coordinate by coordinate (the `count` values
     /// of v0.x, then of v0.y, …, of ng.z), twelve floats a triangle from its first triangle's
@@ -95,7 +98,7 @@ impl<const W: usize> WideBvh<W> {
         })
     }
 
-    /// The `9·count` floats of the leaf at `first` (8-wide trees: coordinate by coordinate).
+    /// The `9·count` floats of the leaf at `first`, coordinate by coordinate.
     #[inline(always)]
     pub(crate) fn leaf_coords(&self, first: usize, count: usize) -> &[f32] {
         &floats(&self.tris)[9 * first..9 * (first + count)]
@@ -104,9 +107,6 @@ impl<const W: usize> WideBvh<W> {
     /// `f` of the leaf's triangles in leaf order, whatever this layout stores.
     #[inline(always)]
     pub(crate) fn with_leaf<R>(&self, first: usize, count: usize, f: impl FnOnce(&[[Vec3; 3]]) -> R) -> R {
-        if W != 8 {
-            return f(&self.tris[first..first + count]);
-        }
         let coords = self.leaf_coords(first, count);
         if count <= 16 {
             let mut buf = [[Vec3::ZERO; 3]; 16];
@@ -119,11 +119,8 @@ impl<const W: usize> WideBvh<W> {
         }
     }
 
-    /// Every triangle in leaf order, as the binary and 4-wide layouts store them (for checks).
+    /// Every triangle in leaf order, as the binary layout stores them (for checks).
     pub fn leaf_order_triangles(&self) -> Vec<[Vec3; 3]> {
-        if W != 8 {
-            return self.tris.clone();
-        }
         let mut out = self.tris.clone();
         for n in &self.nodes {
             for s in n.slots().filter(|&s| n.count[s] > 0) {

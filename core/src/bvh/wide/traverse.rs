@@ -278,7 +278,7 @@ impl<const W: usize> WideBvh<W> {
             |first, count, ray, stats| {
                 let ids = |i: usize| self.prim_ids[i];
                 if GROUPED {
-                    // The 8-wide layout's leaves, coordinate by coordinate (`leaves.rs`).
+                    // The wide layouts' leaves, coordinate by coordinate (`leaves.rs`).
                     let coords = &leaf_floats[per * first..];
                     test_triangles_grouped::<T, ANY, S, _>(
                         groups,
@@ -311,7 +311,15 @@ impl Accelerator for WideBvh {
     ) -> Option<Hit> {
         match self.simd {
             Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK, false>(Scalar, Groups4, ray, stats),
-            _ => self.trace_with::<T, ANY, S, _, STACK, false>(Simd4, Groups4, ray, stats),
+            // The leaves in SIMD passes, as the 8-wide walk's: the app's default layout gained
+            // 12–18 % on incoherent rays over one triangle at a time (BENCHMARKS.md, 2026-12-03).
+            #[cfg(target_arch = "x86_64")]
+            Simd::Avx2 | Simd::Avx512 => match crate::geometry::slab8::Avx2::detect() {
+                // SAFETY: `detect` found AVX2 and FMA.
+                Some(k) => unsafe { self.trace_avx2::<T, ANY, S>(k, ray, stats) },
+                None => self.trace_with::<T, ANY, S, _, STACK, true>(Simd4, Groups4, ray, stats),
+            },
+            _ => self.trace_with::<T, ANY, S, _, STACK, true>(Simd4, Groups4, ray, stats),
         }
     }
 
@@ -325,6 +333,25 @@ impl Accelerator for WideBvh {
 
     fn any_hits(&self, rays: &[Ray], occluded: &mut [bool], opts: TraceOptions) {
         crate::bvh::packet::walk::any_hits_packet(self, rays, occluded, opts)
+    }
+}
+
+impl WideBvh<4> {
+    /// The 4-wide walk compiled for AVX2: the four boxes in one four-lane pass (VEX-encoded), a
+    /// leaf's triangles eight a pass (`triangle8`; up to four take the four-lane pass).
+    ///
+    /// # Safety
+    /// The CPU must have these features: `kernel` proves it.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,lzcnt")]
+    unsafe fn trace_avx2<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
+        &self,
+        kernel: crate::geometry::slab8::Avx2,
+        ray: &mut Ray,
+        stats: &mut S,
+    ) -> Option<Hit> {
+        let groups = crate::bvh::traverse::Groups8(kernel);
+        self.trace_with::<T, ANY, S, _, STACK, true>(Simd4, groups, ray, stats)
     }
 }
 

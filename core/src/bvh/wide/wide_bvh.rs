@@ -67,8 +67,8 @@ impl ChildRef {
 pub struct WideBvh<const W: usize = WIDTH> {
     pub nodes: Vec<WideNode<W>>,
     pub prim_ids: Vec<u32>,
-    /// The triangles in leaf order, 36 bytes each. In the 8-wide layout each leaf's bytes hold its
-    /// triangles coordinate by coordinate (`leaves.rs`); read them through `leaf_order_triangles`.
+    /// The triangles in leaf order, 36 bytes each. Each leaf's bytes hold its triangles coordinate
+    /// by coordinate (`leaves.rs`); read them through `with_leaf` or `leaf_order_triangles`.
     pub tris: Vec<[Vec3; 3]>,
     pub root_bounds: Aabb,
     pub params: BuildParams,
@@ -190,10 +190,11 @@ impl<const W: usize> TreeView for WideBvh<W> {
         &self.params
     }
 
-    /// The kernels the walk runs: for eight children the tree's choice (AVX2, two SSE/NEON passes or
-    /// scalar); four children are tested in one four-lane pass unless scalar is asked for.
+    /// The kernels the walk runs: for eight children the tree's choice (AVX-512, AVX2, two SSE/NEON
+    /// passes or scalar); four children are tested in one four-lane pass, their leaves with AVX2
+    /// where the CPU has it (the 4-wide walk has no AVX-512 kernel).
     fn simd(&self) -> Option<crate::cpu::Simd> {
-        Some(if W == 4 { self.simd.min(crate::cpu::Simd::Simd4) } else { self.simd })
+        Some(if W == 4 { self.simd.min(crate::cpu::Simd::Avx2) } else { self.simd })
     }
 
     fn report(&self) -> &BuildReport {

@@ -77,7 +77,7 @@ pub const ROWS: &[StatRow] = &[
     },
     StatRow {
         name: "SIMD kernels",
-        tip: "What the wide layout's walk runs on this CPU, chosen when the program starts: avx512 (eight boxes with mask registers, up to sixteen triangles of a leaf per pass), avx2 (eight boxes in one pass, up to eight triangles per pass), simd4 (four lanes: SSE2 or NEON), scalar. BVHSCOPE_SIMD=simd4 or scalar asks for a more portable one. Every choice finds the same hits with the same counts",
+        tip: "What the wide layout's walk runs on this CPU, chosen when the program starts: avx512 (eight boxes with mask registers, up to sixteen triangles of a leaf per pass), avx2 (eight boxes in one pass, or four in one four-lane pass in the 4-wide layout; up to eight triangles per pass), simd4 (four lanes: SSE2 or NEON), scalar. BVHSCOPE_SIMD=simd4 or scalar asks for a more portable one. Every choice finds the same hits with the same counts",
         per_ray: false,
         value: Value::Text(|f| Some(f.stats.simd.unwrap_or("— (binary)").to_string())),
     },
