@@ -312,7 +312,7 @@ impl Accelerator for WideBvh {
         match self.simd {
             Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK, false>(Scalar, Groups4, ray, stats),
             // The leaves in SIMD passes, as the 8-wide walk's: the app's default layout gained
-            // 12–18 % on incoherent rays over one triangle at a time (BENCHMARKS.md, 2026-12-03).
+            // 1.12× on incoherent rays over one triangle at a time (BENCHMARKS.md, 2026-12-03).
             #[cfg(target_arch = "x86_64")]
             Simd::Avx2 | Simd::Avx512 => match crate::geometry::slab8::Avx2::detect() {
                 // SAFETY: `detect` found AVX2 and FMA.
