@@ -15,6 +15,14 @@ fn out_dir() -> PathBuf {
     dir
 }
 
+/// The app at a projector's 1280×720, drawn by wgpu.
+fn projector() -> Harness<'static, BvhscopeApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1280.0, 720.0))
+        .wgpu()
+        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()))
+}
+
 /// The app at the README's window size, drawn by wgpu.
 fn looking() -> Harness<'static, BvhscopeApp> {
     Harness::builder()
@@ -128,12 +136,6 @@ fn look_gpu_frame() {
 fn look_projector() {
     for present in [false, true] {
         let suffix = if present { "-present" } else { "" };
-        let projector = || {
-            Harness::builder()
-                .with_size(egui::vec2(1280.0, 720.0))
-                .wgpu()
-                .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()))
-        };
         let scene = root().join("scenes/knot-on-floor.json");
         // The Node view.
         let mut h = projector();
@@ -225,10 +227,7 @@ fn look_main_views() {
 fn look_view_menu_presenting() {
     use egui::accesskit::Role;
     use egui_kittest::kittest::Queryable;
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1280.0, 720.0))
-        .wgpu()
-        .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+    let mut h = projector();
     h.state_mut().act(Action::Present(true));
     run_until(&mut h, "the first frame", idle);
     h.get_by_role_and_label(Role::Button, "View").click();
@@ -245,10 +244,7 @@ fn look_view_menu_presenting() {
 fn look_legend() {
     for present in [false, true] {
         let suffix = if present { "-present" } else { "" };
-        let mut h = Harness::builder()
-            .with_size(egui::vec2(1280.0, 720.0))
-            .wgpu()
-            .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+        let mut h = projector();
         h.state_mut().act(Action::Present(present));
         open(&mut h, &root().join("scenes/knot-on-floor.json"));
         h.state_mut().act(Action::View(2));
@@ -269,10 +265,7 @@ fn look_triangle_test_list() {
     use egui::accesskit::Role;
     use egui_kittest::kittest::Queryable;
     for present in [false, true] {
-        let mut h = Harness::builder()
-            .with_size(egui::vec2(1280.0, 720.0))
-            .wgpu()
-            .build_eframe(|cc| BvhscopeApp::new(cc, AppOptions::default()));
+        let mut h = projector();
         h.state_mut().act(Action::Present(present));
         run_until(&mut h, "the first frame", idle);
         let name = if present { "triangle-test-present" } else { "triangle-test" };

@@ -316,7 +316,7 @@ impl Accelerator for WideBvh {
             #[cfg(target_arch = "x86_64")]
             Simd::Avx2 | Simd::Avx512 => match crate::geometry::slab8::Avx2::detect() {
                 // SAFETY: `detect` found AVX2 and FMA.
-                Some(k) => unsafe { self.trace_avx2::<T, ANY, S>(k, ray, stats) },
+                Some(k) => unsafe { self.trace_avx2::<T, ANY, S, _, STACK>(k, Simd4, ray, stats) },
                 None => self.trace_with::<T, ANY, S, _, STACK, true>(Simd4, Groups4, ray, stats),
             },
             _ => self.trace_with::<T, ANY, S, _, STACK, true>(Simd4, Groups4, ray, stats),
@@ -336,46 +336,37 @@ impl Accelerator for WideBvh {
     }
 }
 
-impl WideBvh<4> {
-    /// The 4-wide walk compiled for AVX2: the four boxes in one four-lane pass (VEX-encoded), a
-    /// leaf's triangles eight a pass (`triangle8`; up to four take the four-lane pass).
+impl<const W: usize> WideBvh<W> {
+    /// The walk compiled for AVX2 (and the bit instructions that come with it: a loop over a
+    /// mask's bits becomes POPCNT, not a multiply trick), so the box kernel's intrinsics (`boxes`:
+    /// eight boxes in one AVX2 pass, or four in one VEX-encoded four-lane pass) and everything else
+    /// in the walk are inlined as AVX code; leaves are tested eight triangles a pass (`triangle8`;
+    /// up to four take the four-lane pass). FMA is enabled but never contracted into (Rust does not
+    /// fuse `a * b + c`), so results stay those of the other kernels. `N` is the stack's size.
     ///
     /// # Safety
     /// The CPU must have these features: `kernel` proves it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,lzcnt")]
-    unsafe fn trace_avx2<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
+    unsafe fn trace_avx2<
+        T: TriangleIntersector,
+        const ANY: bool,
+        S: TraversalStats,
+        K: SlabKernel<W>,
+        const N: usize,
+    >(
         &self,
         kernel: crate::geometry::slab8::Avx2,
+        boxes: K,
         ray: &mut Ray,
         stats: &mut S,
     ) -> Option<Hit> {
         let groups = crate::bvh::traverse::Groups8(kernel);
-        self.trace_with::<T, ANY, S, _, STACK, true>(Simd4, groups, ray, stats)
+        self.trace_with::<T, ANY, S, _, N, true>(boxes, groups, ray, stats)
     }
 }
 
 impl WideBvh<8> {
-    /// The walk compiled for AVX2 (and the bit instructions that come with it: a loop over a
-    /// mask's bits becomes POPCNT, not a multiply trick), so the eight-lane kernel's intrinsics and
-    /// everything else in the walk are inlined as AVX code; leaves are tested eight triangles a
-    /// pass (`triangle8`; up to four take the four-lane pass). FMA is enabled but never contracted
-    /// into (Rust does not fuse `a * b + c`), so results stay those of the other kernels.
-    ///
-    /// # Safety
-    /// The CPU must have these features: `kernel` proves it.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,lzcnt")]
-    unsafe fn trace_avx2<T: TriangleIntersector, const ANY: bool, S: TraversalStats>(
-        &self,
-        kernel: crate::geometry::slab8::Avx2,
-        ray: &mut Ray,
-        stats: &mut S,
-    ) -> Option<Hit> {
-        let groups = crate::bvh::traverse::Groups8(kernel);
-        self.trace_with::<T, ANY, S, _, STACK8, true>(kernel, groups, ray, stats)
-    }
-
     /// The walk compiled for AVX-512F/VL on top of the AVX2 set: the eight boxes tested with mask
     /// registers and planes picked by offsets (`avx512::slab8`), a leaf's triangles in one pass of up
     /// to sixteen lanes (`avx512::leaf`). Nothing is fused; results are the other kernels'.
@@ -416,13 +407,13 @@ impl Accelerator for WideBvh<8> {
             #[cfg(target_arch = "x86_64")]
             Simd::Avx512 => match crate::geometry::slab8::Avx2::detect() {
                 // SAFETY: `detect` found AVX2 and FMA.
-                Some(k) => unsafe { self.trace_avx2::<T, ANY, S>(k, ray, stats) },
+                Some(k) => unsafe { self.trace_avx2::<T, ANY, S, _, STACK8>(k, k, ray, stats) },
                 None => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, Groups4, ray, stats),
             },
             #[cfg(target_arch = "x86_64")]
             Simd::Avx2 => match crate::geometry::slab8::Avx2::detect() {
                 // SAFETY: `detect` found AVX2 and FMA.
-                Some(k) => unsafe { self.trace_avx2::<T, ANY, S>(k, ray, stats) },
+                Some(k) => unsafe { self.trace_avx2::<T, ANY, S, _, STACK8>(k, k, ray, stats) },
                 None => self.trace_with::<T, ANY, S, _, STACK8, true>(Simd4, Groups4, ray, stats),
             },
             Simd::Scalar => self.trace_with::<T, ANY, S, _, STACK8, false>(Scalar, Groups4, ray, stats),
