@@ -102,6 +102,10 @@ pub(super) fn edge_test4(xy: [f32x4; 6], z: [f32x4; 3], t_min: f32x4, t_max: f32
     }
     let o = zero_f;
     let outside = (u.simd_lt(o) | v.simd_lt(o) | w.simd_lt(o)) & (u.simd_gt(o) | v.simd_gt(o) | w.simd_gt(o));
+    // Every lane outside its triangle: no hit, and no division to wait for.
+    if lanes & !outside.to_bitmask() == 0 {
+        return Hits4 { mask: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+    }
     let det = u + v + w;
     let t_scaled = u * z[0] + v * z[1] + w * z[2];
     let inv_det = f32x4::ONE / det;

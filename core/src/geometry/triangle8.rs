@@ -177,6 +177,10 @@ pub(crate) fn edge_test8(xy: [__m256; 6], z: [__m256; 3], t_min: __m256, t_max: 
         (u, v, w) = in_double(xy, [u, v, w], zero);
     }
     let outside = any::<_CMP_LT_OQ>(u, v, w) & any::<_CMP_GT_OQ>(u, v, w);
+    // Every lane outside its triangle: no hit, and no division to wait for.
+    if lanes & !outside == 0 {
+        return Hits8::NONE;
+    }
     let det = _mm256_add_ps(_mm256_add_ps(u, v), w);
     let t_scaled = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, z[0]), _mm256_mul_ps(v, z[1])), _mm256_mul_ps(w, z[2]));
     let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);

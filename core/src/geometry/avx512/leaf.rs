@@ -109,6 +109,11 @@ pub(super) unsafe fn edge_test<V: Lanes>(xy: [V; 6], z: [V; 3], t_min: V, t_max:
     let neg = u.cmp::<_CMP_LT_OQ>(zero_v) | v.cmp::<_CMP_LT_OQ>(zero_v) | w.cmp::<_CMP_LT_OQ>(zero_v);
     let pos = u.cmp::<_CMP_GT_OQ>(zero_v) | v.cmp::<_CMP_GT_OQ>(zero_v) | w.cmp::<_CMP_GT_OQ>(zero_v);
     let outside = neg & pos;
+    // Every lane outside its triangle (most passes of a packet's rays against one triangle, and
+    // many of a leaf against one ray): no hit, and no division to wait for.
+    if lanes & !outside == 0 {
+        return Hits16::NONE;
+    }
     let det = u.add(v).add(w);
     let t_scaled = u.mul(z[0]).add(v.mul(z[1])).add(w.mul(z[2]));
     let inv_det = V::splat(1.0).div(det);
