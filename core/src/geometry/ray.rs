@@ -17,6 +17,19 @@ pub struct Ray {
     pub t_max: f32,
 }
 
+/// Where a ray's values lie in it, in floats from its start (`Vec3` is three `f32`s in order):
+/// the packets' gathers read sixteen rays' values from there at once.
+pub(crate) mod at {
+    use super::Ray;
+    pub(crate) const ORIGIN: usize = std::mem::offset_of!(Ray, origin) / 4;
+    pub(crate) const INV_DIR: usize = std::mem::offset_of!(Ray, inv_dir) / 4;
+    pub(crate) const T_MIN: usize = std::mem::offset_of!(Ray, t_min) / 4;
+    pub(crate) const T_MAX: usize = std::mem::offset_of!(Ray, t_max) / 4;
+    /// A ray's size in floats.
+    pub(crate) const FLOATS: usize = std::mem::size_of::<Ray>() / 4;
+    const _: () = assert!(std::mem::size_of::<Ray>() % 4 == 0 && std::mem::align_of::<Ray>() == 4);
+}
+
 impl Ray {
     /// A ray over `[0, +inf]`.
     #[inline]
