@@ -27,7 +27,7 @@ pub(crate) mod at {
     pub(crate) const T_MAX: usize = std::mem::offset_of!(Ray, t_max) / 4;
     /// A ray's size in floats.
     pub(crate) const FLOATS: usize = std::mem::size_of::<Ray>() / 4;
-    const _: () = assert!(std::mem::size_of::<Ray>() % 4 == 0 && std::mem::align_of::<Ray>() == 4);
+    const _: () = assert!(std::mem::size_of::<Ray>().is_multiple_of(4) && std::mem::align_of::<Ray>() == 4);
 }
 
 impl Ray {
