@@ -35,13 +35,9 @@ impl AnyBvh {
     /// `MollerTrumboreStored`, made otherwise by its first walk), so that no walk waits for it.
     pub fn ready_for(&self, opts: crate::bvh::TraceOptions) {
         match self {
-            AnyBvh::Wide8(w) if w.walks_stored(opts) => {
-                let _ = w.stored_leaves();
-            }
-            AnyBvh::Wide(w) if w.walks_stored(opts) => {
-                let _ = w.stored_leaves();
-            }
-            _ => {}
+            AnyBvh::Wide8(w) => w.ready_for(opts),
+            AnyBvh::Wide(w) => w.ready_for(opts),
+            AnyBvh::Binary(_) => {}
         }
     }
 
@@ -55,11 +51,10 @@ impl AnyBvh {
     /// tree's stored leaves for `MollerTrumboreStored` where a SIMD walk reads them
     /// (`STORED_FLOATS` floats a triangle), else nothing.
     pub fn walk_bytes(&self, opts: crate::bvh::TraceOptions) -> usize {
-        let per = crate::geometry::stored_triangle::STORED_FLOATS * std::mem::size_of::<f32>();
         match self {
-            AnyBvh::Wide8(w) if w.walks_stored(opts) => w.tris.len() * per,
-            AnyBvh::Wide(w) if w.walks_stored(opts) => w.tris.len() * per,
-            _ => 0,
+            AnyBvh::Wide8(w) => w.walk_bytes(opts),
+            AnyBvh::Wide(w) => w.walk_bytes(opts),
+            AnyBvh::Binary(_) => 0,
         }
     }
 

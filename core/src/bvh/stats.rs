@@ -31,7 +31,7 @@ pub struct TreeStats {
     pub sah_constants: SahCost,
     pub memory_bytes: usize,
     /// What a walk with the chosen triangle test keeps beside the tree (`AnyBvh::walk_bytes`: the
-    /// 8-wide tree's stored leaves for the stored-edges test), set by the caller who knows the
+    /// wide tree's stored leaves for the stored-edges test), set by the caller who knows the
     /// test; `of` leaves it 0.
     pub walk_bytes: usize,
     pub build_setup_ms: f64,

@@ -67,8 +67,26 @@ impl<const W: usize> WideBvh<W> {
 
     /// Whether a walk with `opts` reads the stored leaves: the stored-edges test on a SIMD walk
     /// (the scalar kernel tests the triangles from their vertices).
-    pub(crate) fn walks_stored(&self, opts: crate::bvh::TraceOptions) -> bool {
+    fn walks_stored(&self, opts: crate::bvh::TraceOptions) -> bool {
         opts.test == crate::geometry::TriangleTest::MollerTrumboreStored && self.simd != crate::cpu::Simd::Scalar
+    }
+
+    /// Make the stored leaves now if a walk with `opts` reads them (`AnyBvh::ready_for`).
+    pub(crate) fn ready_for(&self, opts: crate::bvh::TraceOptions) {
+        if self.walks_stored(opts) {
+            let _ = self.stored_leaves();
+        }
+    }
+
+    /// The stored leaves' bytes if a walk with `opts` reads them, made yet or not (`STORED_FLOATS`
+    /// floats a triangle), else 0.
+    pub(crate) fn walk_bytes(&self, opts: crate::bvh::TraceOptions) -> usize {
+        let per = crate::geometry::stored_triangle::STORED_FLOATS * std::mem::size_of::<f32>();
+        if self.walks_stored(opts) {
+            self.tris.len() * per
+        } else {
+            0
+        }
     }
 
     /// The leaves in the stored form of `MollerTrumboreStored` (`geometry::stored_triangle`): each

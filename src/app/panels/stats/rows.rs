@@ -67,7 +67,7 @@ pub const ROWS: &[StatRow] = &[
     },
     StatRow {
         name: "Bytes / triangle",
-        tip: "Memory of the nodes, the triangle index array and the triangles the tree keeps in leaf order (36 bytes each), per triangle; with the stored-edges triangle test on the 8-wide layout, also the leaves it keeps in its own form (v0, two edges and the normal: 48 bytes a triangle more)",
+        tip: "Memory of the nodes, the triangle index array and the triangles the tree keeps in leaf order (36 bytes each), per triangle; with the stored-edges triangle test on a wide layout, also the leaves it keeps in its own form (v0, two edges and the normal: 48 bytes a triangle more)",
         per_ray: false,
         value: Value::Number {
             get: |f| Some((f.stats.memory_bytes + f.stats.walk_bytes) as f64 / f.stats.triangles.max(1) as f64),
