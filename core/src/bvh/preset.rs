@@ -33,7 +33,8 @@ impl Preset {
     /// The handout preset's leaf size: small, as a first BVH's leaves usually are.
     pub const HANDOUT_MAX_LEAF_SIZE: u32 = 4;
     /// The fastest preset's largest leaf and SAH traversal cost (relative to one triangle test)
-    /// for a kernel family: sixteen triangles, one AVX-512 pass (cost 10: BENCH_KERNEL_LEAVES's
+    /// for a kernel family: sixteen triangles, one AVX-512 leaf test (two masked 256-bit passes since
+    /// 2026-12-03; cost 10: BENCH_KERNEL_LEAVES's
     /// best of 8, 10 and 12); eight, one AVX2 pass (cost 5: bunny, one thread, 8:4, 8:5, 8:7 and
     /// 6:4 within 2 % of each other on primary rays, 8:5 kept); or four, one pass of four lanes (cost 3:
     /// bunny, 8-wide, incoherent rays, 1 → 2.54, 2 → 2.82, 3 → 2.91, 4 → 2.82 MRays/s on one

@@ -368,8 +368,8 @@ impl<const W: usize> WideBvh<W> {
 
 impl WideBvh<8> {
     /// The walk compiled for AVX-512F/VL on top of the AVX2 set: the eight boxes tested with mask
-    /// registers and planes picked by offsets (`avx512::slab8`), a leaf's triangles in one pass of up
-    /// to sixteen lanes (`avx512::leaf`). Nothing is fused; results are the other kernels'.
+    /// registers and planes picked by offsets (`avx512::slab8`), a leaf's triangles sixteen at a
+    /// time in masked 256-bit passes (`avx512::leaf`). Nothing is fused; results are the other kernels'.
     ///
     /// # Safety
     /// The CPU must have these features: `kernel` proves it.
@@ -397,8 +397,8 @@ impl Accelerator for WideBvh<8> {
         match self.simd {
             #[cfg(target_arch = "x86_64")]
             // Leaves of up to four triangles take the AVX2 walk (its four-lane pass): there the
-            // AVX-512 one measured 1–8% slower (BENCHMARKS.md, "AVX-512"); it pays from leaves of
-            // eight on, which it tests in one pass.
+            // AVX-512 one measured 1–8% slower (BENCHMARKS.md, "AVX-512"); it is for leaves of
+            // eight and more (sixteen in two masked 256-bit passes: `avx512::leaf`).
             Simd::Avx512 if self.params.max_leaf_size > 4 => match crate::geometry::avx512::Avx512::detect() {
                 // SAFETY: `detect` found AVX-512F/VL and the AVX2 set.
                 Some(k) => unsafe { self.trace_avx512::<T, ANY, S>(k, ray, stats) },

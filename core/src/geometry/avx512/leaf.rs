@@ -6,7 +6,11 @@
 //! function is exactly zero), so lane k is the scalar test of triangle k bit for bit. AVX-512's
 //! masked loads read exactly the leaf's triangles: nothing past its end is touched, so the
 //! four-lane kernel's copy at the array's end is not needed. Up to eight triangles take 256-bit
-//! registers (AVX-512VL), more take 512-bit ones.
+//! registers (AVX-512VL); nine to sixteen take two such passes, not one of 512 bits: on an Intel
+//! Xeon (family 6 model 207) one 512-bit pass made the whole walk 0.83× the AVX2 walk on the same
+//! tree, two 256-bit passes 0.95–0.96× (BENCHMARKS.md, "Leaves of sixteen in two 256-bit passes").
+//! Either the core's slower clock for 512-bit arithmetic or the division a half skips when its
+//! eight lanes all miss (`edge_test`) is why; the two were not separated.
 
 use crate::geometry::avx512::lanes::{Avx512, Lanes};
 use crate::geometry::ray::Ray;
@@ -56,7 +60,16 @@ pub(crate) fn watertight_leaf16(
         if n <= 8 {
             one_ray::<__m256>(p, ray, &at, lanes)
         } else {
-            one_ray::<__m512>(p, ray, &at, lanes)
+            // Both halves against the same `t_max`, as one pass: the same hits, lane for lane.
+            let low = one_ray::<__m256>(p, ray, &at, 0xff);
+            let high = one_ray::<__m256>(p, ray, &|j| at(j).add(8), lanes >> 8);
+            let mut h = Hits16 { mask: low.mask | high.mask << 8, ..low };
+            if high.mask != 0 {
+                h.t[8..].copy_from_slice(&high.t[..8]);
+                h.u[8..].copy_from_slice(&high.u[..8]);
+                h.v[8..].copy_from_slice(&high.v[..8]);
+            }
+            h
         }
     }
 }
