@@ -101,9 +101,12 @@ fn corridor_rays() -> [Ray; 4] {
 /// median is the midpoint). Binary: root over x 0..14 splits at 7 into A = T0..T3 (x 0..6) and
 /// B = T4..T7 (x 8..14); A at 3 into AA = {T0, T1}, AB = {T2, T3}; B at 11 into BA = {T4, T5},
 /// BB = {T6, T7}; each of those into its two leaves. 15 nodes, 8 leaves, all at depth 3.
-/// Wide: the root takes A and B, opens B (equal areas; the later wins the tie) into BA and BB,
-/// then A (area 33 against 13) into AA and AB: slots AA, BA, BB, AB, wide nodes 1 to 4, each with
-/// its two leaves. 5 wide nodes.
+/// Wide (the grouping of least summed wide-node area, `CollapsePlan`; box areas: root 73, A and B
+/// 33 each, AA, AB, BA, BB 13 each): the root's four slots shared one to A, three to B (46; two
+/// and two cost 26 + 26, three and one 13 + 33, a tie the left's smaller share wins). A is a wide
+/// node of its four leaves (33); B's three slots: BA a wide node of its two leaves (13), BB's two
+/// leaves in the root. Slots: root A, BA, T6, T7; node 1 T0..T3; node 2 T4, T5. 3 wide nodes,
+/// 73 + 33 + 13 = 119 of area, against 73 + 4 × 13 = 125 for four nodes of two leaves.
 #[test]
 fn the_corridor_of_one_triangle_leaves_counts_exactly() {
     let mesh = corridor();
@@ -114,11 +117,9 @@ fn the_corridor_of_one_triangle_leaves_counts_exactly() {
         assert!(binary.nodes.iter().filter(|n| !n.is_leaf()).all(|n| n.axis == 0), "{strategy:?}: all splits on x");
         use Slot::{Leaf as L, Node as N};
         let expected = vec![
-            vec![N(1), N(2), N(3), N(4)],
-            vec![L(vec![0]), L(vec![1])],
+            vec![N(1), N(2), L(vec![6]), L(vec![7])],
+            vec![L(vec![0]), L(vec![1]), L(vec![2]), L(vec![3])],
             vec![L(vec![4]), L(vec![5])],
-            vec![L(vec![6]), L(vec![7])],
-            vec![L(vec![2]), L(vec![3])],
         ];
         assert_eq!(wide_slots(&wide), expected, "{strategy:?}");
 
@@ -135,17 +136,19 @@ fn the_corridor_of_one_triangle_leaves_counts_exactly() {
                 let c = counts(4, 7, 1, 1);
                 assert_eq!(run(&binary, &forward, opts), (Some(0), c, true, c), "{strategy:?} {opts:?}");
                 // Wide: root box (1); root visited, its four children tested (+4), all hit:
-                // pushed, sorted, AA (5) taken; AA visited, T0 (5) and T1 (7) tested (+2), T1
-                // pushed; T0 reached, 1 triangle, hit at 5; T1, AB, BA, BB skipped. 2 nodes, 7
+                // pushed, sorted, A (5) taken; A visited, T0..T3 (5, 7, 9, 11) tested (+4), all
+                // hit, T0 taken; T0 reached, 1 triangle, hit at 5; the rest skipped. 2 nodes, 9
                 // box tests, 1 leaf, 1 triangle.
-                let c = counts(2, 7, 1, 1);
+                let c = counts(2, 9, 1, 1);
                 assert_eq!(run(&wide, &forward, opts), (Some(0), c, true, c), "{strategy:?} {opts:?}");
 
                 // Along -x, the mirror image: the right child is both nearer and, by the
                 // direction's negative x, the split-axis rule's pick. B, BB, T7 (hit at 5).
                 let c = counts(4, 7, 1, 1);
                 assert_eq!(run(&binary, &backward, opts), (Some(7), c, true, c), "{strategy:?} {opts:?}");
-                let c = counts(2, 7, 1, 1);
+                // Wide: T7 is a slot of the root and the nearest of its four (entries 5, 7, 9,
+                // 13): root box, root visited, four tests, T7 reached and hit. 1 node, 5 box tests.
+                let c = counts(1, 5, 1, 1);
                 assert_eq!(run(&wide, &backward, opts), (Some(7), c, true, c), "{strategy:?} {opts:?}");
 
                 // Beside every triangle, through every box: no hit prunes anything, every node
@@ -153,15 +156,15 @@ fn the_corridor_of_one_triangle_leaves_counts_exactly() {
                 // 8 leaves, 8 triangles.
                 let c = counts(15, 15, 8, 8);
                 assert_eq!(run(&binary, &beside, opts), (None, c, false, c), "{strategy:?} {opts:?}");
-                // Wide: 5 nodes, box tests 1 + 4 (root) + 4 × 2 = 13, the same 8 leaves and 8
-                // triangles.
-                let c = counts(5, 13, 8, 8);
+                // Wide: 3 nodes, box tests 1 + 4 (root) + 4 (node 1) + 2 (node 2) = 11, the same 8
+                // leaves and 8 triangles.
+                let c = counts(3, 11, 8, 8);
                 assert_eq!(run(&wide, &beside, opts), (None, c, false, c), "{strategy:?} {opts:?}");
 
                 // Down between the halves: inside the root's box (x 0..14), outside A's and B's.
                 // Binary: root box, root visited, A and B missed: 1 node, 3 box tests. Wide: root
-                // box, root visited, AA, BA, BB, AB all missed: 1 node, 5 box tests, more than the
-                // binary walk's 3, where the ray beside the triangles made fewer (13 < 15).
+                // box, root visited, A, BA, T6, T7 all missed: 1 node, 5 box tests, more than the
+                // binary walk's 3, where the ray beside the triangles made fewer (11 < 15).
                 let c = counts(1, 3, 0, 0);
                 assert_eq!(run(&binary, &between, opts), (None, c, false, c), "{strategy:?} {opts:?}");
                 let c = counts(1, 5, 0, 0);
@@ -174,7 +177,8 @@ fn the_corridor_of_one_triangle_leaves_counts_exactly() {
 /// Two triangles per leaf (midpoint): root splits at 7 into A = T0..T3 and B = T4..T7, A at 3
 /// into leaves {T0, T1} and {T3, T2}, B at 11 into {T4, T5} and {T6, T7}. 7 nodes, depth 2. (The
 /// builder's in-place partition is not stable: it leaves T3 before T2, and, after two partitions,
-/// T6 before T7.) Wide: one node whose four slots are those leaves (AA, BA, BB, AB, as above).
+/// T6 before T7.) Wide: one node whose four slots are those leaves, left to right (no wide node
+/// below the root: zero area beyond the root's).
 #[test]
 fn the_corridor_of_two_triangle_leaves_counts_exactly() {
     let mesh = corridor();
@@ -183,7 +187,7 @@ fn the_corridor_of_two_triangle_leaves_counts_exactly() {
     let leaves: Vec<(u32, Vec<u32>)> = vec![(2, vec![0, 1]), (2, vec![3, 2]), (2, vec![4, 5]), (2, vec![6, 7])];
     assert_eq!(binary_leaves(&binary), leaves);
     use Slot::Leaf as L;
-    assert_eq!(wide_slots(&wide), vec![vec![L(vec![0, 1]), L(vec![4, 5]), L(vec![6, 7]), L(vec![3, 2])]]);
+    assert_eq!(wide_slots(&wide), vec![vec![L(vec![0, 1]), L(vec![3, 2]), L(vec![4, 5]), L(vec![6, 7])]]);
 
     let [forward, backward, beside, between] = corridor_rays();
     for order in ORDERS {

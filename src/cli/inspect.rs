@@ -282,7 +282,7 @@ pub fn output(a: &InspectArgs) -> Result<String, CliError> {
             .map_err(|_| CliError::Usage("cancelled".into()))?
             .counts[node as usize];
     // A built wide tree is collapsed from the binary one; an imported one is not.
-    let wide = names.is_none().then(|| wide_group_in(bvh.params().layout, &tree.nodes, &h.parent, node)).flatten();
+    let wide = names.is_none().then(|| wide_group_in(bvh.params().layout, &tree.nodes, &h, node)).flatten();
     let dump_id = names.map(|n| n.dump_of_binary_node(node));
     Ok(match a.format {
         InspectFormat::Csv => csv(&ins),

@@ -3,6 +3,7 @@
 //! EPO and the checker's tests all need them.
 
 use crate::bvh::node::Bvh;
+use crate::bvh::wide::CollapsePlan;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
@@ -23,12 +24,23 @@ pub struct Hierarchy {
     pub slot_of_prim: Vec<u32>,
     /// The other slots of triangles in several leaves (empty unless spatial splits cut some).
     pub other_slots: std::collections::HashMap<u32, Vec<u32>>,
+    /// How the 4- and 8-wide layouts group the nodes (`collapse_plan`), made when first asked.
+    wide4: std::sync::OnceLock<CollapsePlan>,
+    wide8: std::sync::OnceLock<CollapsePlan>,
 }
 
 /// Trees of at least this many nodes are read in parallel (a few tasks' worth).
 const PARALLEL_MIN: usize = 1 << 14;
 
 impl Hierarchy {
+    /// The `W`-wide layout's collapse of this tree (`nodes`, the tree this hierarchy was made
+    /// of), made on first use and kept: the inspector asks for it on every frame.
+    pub fn collapse_plan<const W: usize>(&self, nodes: &[crate::bvh::node::BvhNode]) -> &CollapsePlan {
+        const { assert!(W == 4 || W == 8, "the wide layouts are 4 and 8 wide") };
+        let cell = if W == 8 { &self.wide8 } else { &self.wide4 };
+        cell.get_or_init(|| CollapsePlan::of::<W>(nodes))
+    }
+
     /// The hierarchy of `bvh`. A big tree whose every node but the root is the child of exactly
     /// one node before it (every tree the builders and the importer make) is read in parallel,
     /// its subtrees side by side; anything else, and a small tree, by `serial_of`. The two give
@@ -57,6 +69,7 @@ impl Hierarchy {
             leaf_of_slot: vec![0; bvh.prim_ids.len()],
             slot_of_prim: vec![u32::MAX; bvh.prim_ids.len()],
             other_slots: Default::default(),
+            ..Default::default()
         };
         // Parents come before their children in the node array, so one pass down sets parents and
         // depths, and one pass back up sums the ranges.
@@ -246,7 +259,7 @@ fn parallel_of(bvh: &Bvh) -> Hierarchy {
         *s = slot + 1;
     }
     region(|| slot_of_prim.par_iter_mut().for_each(|s| *s = s.wrapping_sub(1)));
-    Hierarchy { parent, depth, first, count, leaf_of_slot, slot_of_prim, other_slots }
+    Hierarchy { parent, depth, first, count, leaf_of_slot, slot_of_prim, other_slots, ..Default::default() }
 }
 
 /// Levels of the tree split among tasks (up to 2^this subtrees).

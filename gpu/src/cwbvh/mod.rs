@@ -4,9 +4,9 @@
 //! octant of the ray directions that meet them first, and a walk that keeps groups of hit children
 //! as bit masks on its stack (shaders/cwbvh.wgsl; the same walk on the CPU in `walk.rs`).
 //!
-//! Built from any binary `Bvh` bvhscope makes or imports: each wide node takes a binary node's two
-//! children, then, while it has fewer than eight, replaces its interior child of largest surface
-//! area by that child's two children (core's greedy collapse, `bvh::wide`). Leaves are the binary
+//! Built from any binary `Bvh` bvhscope makes or imports, grouped as core's 8-wide layout groups it
+//! (`bvh::wide::CollapsePlan`: the wide nodes of least summed surface area, the paper's own
+//! collapse without its merging of leaves). Leaves are the binary
 //! tree's leaves, unchanged and of any size: where the paper packs up to three triangles per leaf
 //! into a 24-bit triangle mask, a leaf child here names a record (first triangle, count) in a leaf
 //! array, so that trees with larger leaves (bvhscope's default is four, an import may hold any
@@ -18,7 +18,7 @@ mod walk;
 pub use gpu::{CwbvhFormat, GpuCwbvh};
 
 use crate::device::GpuError;
-use bvhscope_core::bvh::wide::wide_children;
+use bvhscope_core::bvh::wide::CollapsePlan;
 use bvhscope_core::bvh::Bvh;
 use bvhscope_core::geometry::Aabb;
 use glam::Vec3;
@@ -186,6 +186,7 @@ impl Cwbvh {
             return Ok(out);
         }
         // (wide node index, its binary node or, for a leaf root, the leaf itself, its level).
+        let plan = CollapsePlan::of::<8>(b);
         let mut queue = std::collections::VecDeque::from([(0usize, 0usize, 0u32)]);
         out.nodes.push(CwbvhNode::zeroed());
         while let Some((w, i, level)) = queue.pop_front() {
@@ -193,7 +194,7 @@ impl Cwbvh {
             let kids = if b[i].is_leaf() {
                 vec![i]
             } else {
-                let (kids, n) = wide_children::<8>(b, i);
+                let (kids, n) = plan.children::<8>(b, i);
                 kids[..n].to_vec()
             };
             let boxes: Vec<Aabb> = kids.iter().map(|&k| b[k].bounds()).collect();

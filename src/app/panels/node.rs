@@ -92,9 +92,9 @@ pub fn ui(app: &BvhscopeApp, ui: &mut egui::Ui, out: &mut Actions) {
     }
     let layout = e.bvh.build_params().bvh.layout;
     if imported.is_none() {
-        if let Some(g) = crate::bvh::wide::wide_group_in(layout, &e.tree.nodes, &e.hierarchy.parent, node) {
+        if let Some(g) = crate::bvh::wide::wide_group_in(layout, &e.tree.nodes, &e.hierarchy, node) {
             ui.label(crate::explain::inspect::text::wide_group_text(node, &g)).on_hover_text(
-                "A wide layout collapses the binary tree: a wide node takes the children of a binary node and, while it has fewer than four (or eight), opens the largest interior one",
+                "A wide layout collapses the binary tree: a wide node takes binary nodes below one of them as its up to four (or eight) children, grouped so that the wide nodes' summed surface area (their SAH cost) is least",
             );
         }
     }

@@ -3,7 +3,7 @@
 use crate::bvh::node::Bvh;
 use crate::bvh::params::{BuildParams, BuildReport};
 use crate::bvh::tree::{NodeKind, TreeNode, TreeView};
-use crate::bvh::wide::collapse::{collapse_parallel, collapse_sequential, PARALLEL_MIN_NODES};
+use crate::bvh::wide::collapse::{collapse_parallel, collapse_sequential, CollapsePlan, PARALLEL_MIN_NODES};
 use crate::bvh::wide::node::{WideNode, WIDTH};
 use crate::geometry::Aabb;
 use glam::Vec3;
@@ -101,9 +101,9 @@ impl<const W: usize> WideBvh<W> {
             }
             vec![root]
         } else if b.len() < PARALLEL_MIN_NODES {
-            collapse_sequential(b, 0, b.len())
+            collapse_sequential(b, &CollapsePlan::of::<W>(b), 0, b.len())
         } else {
-            collapse_parallel(b, 0, 0).into_nodes()
+            collapse_parallel(b, &CollapsePlan::of::<W>(b), 0, 0).into_nodes()
         };
         let layout = if W == 8 { crate::bvh::Layout::Wide8 } else { crate::bvh::Layout::Wide4 };
         let params = BuildParams { layout, ..bvh.params };

@@ -94,7 +94,7 @@ fn wide_to_binary<const W: usize>(
     }
     let mut stack = vec![(0u32, 0u32)];
     while let Some((w, bin)) = stack.pop() {
-        let g = wide_group_in(layout, b, &e.hierarchy.parent, bin)?;
+        let g = wide_group_in(layout, b, &e.hierarchy, bin)?;
         let node = wide.get(w as usize)?;
         if g.top != bin || g.children.len() != node.slots().count() {
             return None;
