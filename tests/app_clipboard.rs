@@ -4,6 +4,9 @@
 //! installs them); without them the test says so and passes, except under `CI=true`.
 #![cfg(feature = "gui")]
 
+#[path = "../core/tests/common/scratch.rs"]
+mod scratch;
+
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -58,7 +61,7 @@ fn copy_trace_command_puts_the_command_on_the_x_clipboard() {
     }
     let (_xvfb, display) = xvfb();
     let torus = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/torus.obj");
-    let home = std::env::temp_dir().join(format!("bvhscope-clipboard-{}", std::process::id()));
+    let home = scratch::shared("clipboard");
     let (data, runtime) = (home.join("data"), home.join("runtime"));
     std::fs::create_dir_all(&data).unwrap();
     std::fs::create_dir_all(&runtime).unwrap();

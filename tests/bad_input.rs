@@ -1,12 +1,14 @@
 //! Every kind of bad mesh file gives its own error naming the file, never a panic.
 
+#[path = "../core/tests/common/scratch.rs"]
+mod scratch;
+
 use bvhscope::files::FileError;
 use bvhscope::mesh::{load_obj, MeshError};
 use std::path::PathBuf;
 
 fn temp_file(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bvhscope-bad-input-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::shared("bad-input");
     let p = dir.join(name);
     std::fs::write(&p, bytes).unwrap();
     p
@@ -133,7 +135,7 @@ fn a_fifo_or_a_device_is_refused_at_once() {
         assert!(matches!(e, MeshError::File(FileError::NotRegular { .. })), "{dev}: {e}");
         assert!(e.to_string().contains("character device"), "{e}");
     }
-    let fifo = std::env::temp_dir().join(format!("bvhscope-fifo-{}.obj", std::process::id()));
+    let fifo = scratch::shared("fifo").join("never-written.obj");
     let _ = std::fs::remove_file(&fifo);
     let made = std::process::Command::new("mkfifo").arg(&fifo).status().expect("mkfifo runs");
     assert!(made.success());

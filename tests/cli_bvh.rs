@@ -121,8 +121,7 @@ fn dumps_number_triangles_as_the_file_does() {
 /// compiler is present, the Python one when Python is; their dumps of a hand-made tree check clean.
 #[test]
 fn the_dumping_snippets_write_dumps_that_check_clean() {
-    let dir = std::env::temp_dir().join(format!("bvhscope-snippets-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = cli_support::scratch::shared("snippets");
     let row = dir.join("row.obj");
     let mut obj = String::new();
     for k in 0..4 {

@@ -5,6 +5,9 @@
 //! face, and the crate imports each name from the file that defines it. Test modules are exempt
 //! (`use super::*` is how a test reads what it tests).
 
+#[path = "../core/tests/common/scratch.rs"]
+mod scratch;
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -403,7 +406,7 @@ fn no_file_imports_through_an_enclosing_module_file() {
 /// imports its folder's `mod.rs` is caught (so the two tests above can fail).
 #[test]
 fn the_checker_finds_a_loop_and_an_import_up() {
-    let dir = std::env::temp_dir().join(format!("bvhscope-import-graph-{}", std::process::id()));
+    let dir = scratch::shared("import-graph");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(dir.join("a")).unwrap();
     std::fs::write(dir.join("lib.rs"), "pub mod a;\n").unwrap();

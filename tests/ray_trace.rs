@@ -4,6 +4,8 @@
 //! goes to first is the one the order rule in use picks. Two levels too.
 
 mod common;
+#[path = "../core/tests/common/scratch.rs"]
+mod scratch;
 
 use bvhscope::bvh::{
     trace_ray, Accelerator, AnyBvh, BuildParams, Layout, NodeId, RayCounters, SceneBuild, StepKind, Strategy,
@@ -142,8 +144,7 @@ fn the_trace_is_the_counted_traversal_on_the_shared_meshes() {
 
 #[test]
 fn two_levels_are_traced_level_by_level() {
-    let dir = std::env::temp_dir().join(format!("bvhscope-trace-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::shared("trace");
     let scene = bvhscope::scene::load_any(common::many_placements(&dir, 9)).unwrap();
     let p = BuildParams::default();
     let bvh = scene.build(&SceneBuild { bvh: p, top: Some(p) }, &Default::default()).unwrap();

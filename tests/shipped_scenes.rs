@@ -5,6 +5,8 @@
 //! a scene whose mesh is missing must say which field and where to get the mesh.
 
 mod common;
+#[path = "../core/tests/common/scratch.rs"]
+mod scratch;
 
 use bvhscope::bvh::{AnyBvh, BuildParams, Layout, LinearScan, SceneBuild, Strategy};
 use bvhscope::mesh::{generate, write_obj};
@@ -193,7 +195,7 @@ fn same_but_last_digits(a: &str, b: &str) -> bool {
 
 #[test]
 fn a_missing_mesh_names_the_field_and_gives_the_hint() {
-    let dir = std::env::temp_dir().join(format!("bvhscope-shipped-{}", std::process::id()));
+    let dir = scratch::shared("shipped");
     // Two levels down, so a scene's `../../shared/models/…` points at a folder that is not there.
     let scenes = dir.join("a/b");
     std::fs::create_dir_all(&scenes).unwrap();

@@ -268,9 +268,7 @@ mod tests {
     use super::*;
 
     fn dir() -> PathBuf {
-        let d = std::env::temp_dir().join(format!("bvhscope-files-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
+        crate::scratch::shared("files")
     }
 
     #[test]

@@ -21,3 +21,8 @@ pub mod random;
 pub mod render;
 pub mod scene;
 pub mod work;
+
+/// Where unit tests write their files (shared with the integration tests by `#[path]`).
+#[cfg(test)]
+#[path = "../tests/common/scratch.rs"]
+pub(crate) mod scratch;

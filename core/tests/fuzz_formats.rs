@@ -9,6 +9,9 @@
 //! `FUZZ_CASES=N` runs N mutations of each valid file instead of the default (CI keeps it short;
 //! the README gives a long run's command and count).
 
+#[path = "common/scratch.rs"]
+mod scratch;
+
 mod formats;
 
 use bvhscope_core::mesh::{generate, is_gltf, load_gltf, load_mesh};
@@ -75,7 +78,7 @@ fn cases(default: usize) -> usize {
 }
 
 fn dir(sub: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bvhscope-fuzz-formats-{}", std::process::id())).join(sub);
+    let d = scratch::shared("fuzz-formats").join(sub);
     std::fs::create_dir_all(&d).unwrap();
     d
 }

@@ -5,6 +5,9 @@
 //! `FUZZ_CASES=N` runs N cases of each instead of the default (CI keeps it short; the closing
 //! note of issue 34 gives a long run's count).
 
+#[path = "common/scratch.rs"]
+mod scratch;
+
 use bvhscope_core::bvh::{Accelerator, LinearScan, NoStats, TraceOptions};
 use bvhscope_core::dump::{BvhDump, DumpNode};
 use bvhscope_core::explain::check::{check, check_tree, Subject};
@@ -22,9 +25,7 @@ fn cases(default: u32) -> u32 {
 }
 
 fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bvhscope-fuzz-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    scratch::shared("fuzz")
 }
 
 /// Run `f` on a thread of its own; a panic is a failure, and so is taking longer than `limit`.

@@ -1,5 +1,8 @@
 //! Scene files: bvhscope's own format and Moer-lite's scene.json.
 
+#[path = "common/scratch.rs"]
+mod scratch;
+
 mod common;
 
 use bvhscope_core::bvh::{AnyBvh, BuildParams, Layout, LinearScan, Strategy};
@@ -10,9 +13,7 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 
 fn temp_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bvhscope-scenes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    scratch::shared("scenes")
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

@@ -10,10 +10,12 @@ pub fn bvhscope(args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_bvhscope")).args(args).output().expect("runs")
 }
 
+#[path = "../../core/tests/common/scratch.rs"]
+pub mod scratch;
+
+/// `name` in this test process's folder (removed when the process exits: `scratch`).
 pub fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bvhscope-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    scratch::shared("cli").join(name)
 }
 
 /// A small mesh of our own: four triangles forming a tent. Each call writes its own file: tests

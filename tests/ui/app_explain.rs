@@ -110,7 +110,7 @@ fn clicking_a_pixel_pins_its_ray_and_the_ray_window_steps_through_it() {
     assert_eq!(h.state().pins.selected, 1);
     h.get_by_label("Pinned ray");
     // Exported counts carry the same numbers for the pinned pixel.
-    let path = std::env::temp_dir().join(format!("bvhscope-ui-counts-{}.csv", std::process::id()));
+    let path = crate::support::scratch::shared("ui").join("counts.csv");
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveCounts, path.clone()));
     let text = std::fs::read_to_string(&path).expect("the counts file is written");
     let row = text.lines().find(|l| l.starts_with(&format!("{x},{y},"))).expect("the pixel's row");

@@ -18,8 +18,7 @@ fn torus() -> PathBuf {
 /// A class of three on the torus, graded by `bvhscope grade`: ada's midpoint tree (correct),
 /// cy's file that is no dump, dee's empty folder. Returns the report folder.
 pub(super) fn graded_class(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bvhscope-ui-grade-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = crate::support::scratch::dir(&format!("ui-grade-{tag}"));
     let class = dir.join("class");
     std::fs::create_dir_all(class.join("dee")).unwrap();
     let ada = class.join("ada.txt");

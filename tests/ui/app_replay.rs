@@ -211,8 +211,7 @@ fn the_replay_window_exports_the_animation() {
     h.state_mut().act(Action::ShowReplay(true));
     run_until(&mut h, "the replay", |a| a.replay.replay.is_some() && idle(a));
     h.get_by_label("Export animation…");
-    let dir = std::env::temp_dir().join(format!("bvhscope-ui-film-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::support::scratch::shared("ui-film");
     let wrong = dir.join("replay.txt");
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveAnimation, wrong.clone()));
     run_until(&mut h, "the refusal", |a| a.messages.iter().any(|m| m.kind == MessageKind::Error));

@@ -110,7 +110,7 @@ fn a_scene_with_placements_builds_two_levels_shown_level_by_level() {
 fn the_builtin_scene_cannot_be_saved_as_a_scene_file() {
     let mut h = harness();
     run_until(&mut h, "the first build", idle);
-    let path = std::env::temp_dir().join(format!("bvhscope-ui-builtin-{}.json", std::process::id()));
+    let path = crate::support::scratch::shared("ui").join("builtin.json");
     h.state_mut().act(Action::Picked(bvhscope::app::Pick::SaveScene, path.clone()));
     assert!(!path.exists());
     assert!(h.state().messages.iter().any(|m| m.kind == MessageKind::Error && m.text.contains("built-in")));
@@ -180,8 +180,7 @@ fn the_moer_lite_lab_scene_opens_in_one_level() {
 /// Unticking Two levels on a scene too large to flatten keeps two levels and says why.
 #[test]
 fn one_level_past_the_budget_switches_back_to_two_levels_and_says_why() {
-    let dir = std::env::temp_dir().join(format!("bvhscope-ui-many-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::support::scratch::shared("ui-many");
     let scene = common::many_placements(&dir, 21_000);
     let mut h = harness();
     run_until(&mut h, "the first build", idle);

@@ -7,6 +7,10 @@ use egui_kittest::Harness;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+/// Where the UI tests write their files (removed when the test process exits).
+#[path = "../../core/tests/common/scratch.rs"]
+pub mod scratch;
+
 pub fn harness() -> Harness<'static, BvhscopeApp> {
     Harness::builder()
         .with_size(egui::vec2(1400.0, 860.0))
@@ -104,9 +108,7 @@ pub fn pair_shown(a: &BvhscopeApp) -> bool {
 }
 
 pub fn temp_file(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bvhscope-ui-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
+    let p = scratch::shared("ui").join(name);
     std::fs::write(&p, text).unwrap();
     p
 }

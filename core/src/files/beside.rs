@@ -71,7 +71,7 @@ mod tests {
 
     #[test]
     fn only_files_at_or_below_the_folder_are_named() {
-        let d = std::env::temp_dir().join(format!("bvhscope-beside-{}", std::process::id()));
+        let d = crate::scratch::shared("beside");
         let inner = d.join("scene");
         std::fs::create_dir_all(inner.join("sub")).unwrap();
         std::fs::write(inner.join("sub/data 1.bin"), b"x").unwrap();

@@ -149,8 +149,7 @@ fn a_broken_lesson_names_the_step_and_the_field() {
 
 #[test]
 fn a_huge_or_binary_lesson_file_is_refused_before_it_is_parsed() {
-    let dir = std::env::temp_dir().join(format!("bvhscope-lesson-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::scratch::shared("lesson");
     let big = dir.join("big.json");
     std::fs::write(&big, vec![b' '; (read::MAX_LESSON_BYTES + 1) as usize]).unwrap();
     let e = read_lesson(&big).unwrap_err().to_string();

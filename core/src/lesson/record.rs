@@ -143,8 +143,7 @@ mod tests {
 
     #[test]
     fn a_lesson_is_told_from_a_scene_file() {
-        let dir = std::env::temp_dir().join(format!("bvhscope-is-lesson-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::shared("is-lesson");
         let file = |name: &str, text: &str| {
             let p = dir.join(name);
             std::fs::write(&p, text).unwrap();

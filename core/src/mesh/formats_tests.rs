@@ -10,9 +10,7 @@ use glam::Vec3;
 use std::path::PathBuf;
 
 fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bvhscope-formats-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    crate::scratch::shared("formats")
 }
 
 fn write(name: &str, bytes: &[u8]) -> PathBuf {

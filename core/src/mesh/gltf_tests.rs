@@ -9,8 +9,7 @@ use crate::mesh::generate;
 use base64::Engine;
 
 fn write(name: &str, bytes: &[u8]) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("bvhscope-gltf-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+    let d = crate::scratch::shared("gltf");
     let p = d.join(name);
     std::fs::write(&p, bytes).unwrap();
     p

@@ -6,9 +6,7 @@ use base64::Engine;
 use std::path::PathBuf;
 
 fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bvhscope-hostile-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    crate::scratch::shared("hostile")
 }
 
 fn write(name: &str, bytes: &[u8]) -> PathBuf {

@@ -120,8 +120,7 @@ mod tests {
     /// few colours; a .png is an animated PNG; any other name is refused.
     #[test]
     fn each_name_gets_its_format_with_every_frame() {
-        let dir = std::env::temp_dir().join(format!("bvhscope-anim-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::shared("anim");
         let f = frames(5, 100);
         let gif = dir.join("a.gif");
         write_animation(&gif, &f, 400).unwrap();

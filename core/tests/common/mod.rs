@@ -2,6 +2,8 @@
 //! every BVH must have, a scene of many placements. Core's own tests use them, and the top-level
 //! package's, the UI tests' and the GPU crate's include this file (`#[path]`), so each helper is
 //! written once. Only `bvhscope_core` paths: every including package depends on it.
+//! Where tests write their files is `scratch.rs` beside this file, included on its own by the
+//! tests that write files (it needs `libc`, which not every including package has).
 #![allow(dead_code)]
 
 use bvhscope_core::bvh::{AnyBvh, BuildParams, Bvh, BvhNode, WideBvh};

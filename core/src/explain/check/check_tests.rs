@@ -150,8 +150,7 @@ fn a_round_trip_gives_back_the_same_tree() {
     let bvh = Bvh::build(&mesh, &BuildParams { layout: crate::bvh::Layout::Binary, ..BuildParams::default() });
     let dump = BvhDump::of_bvh(&bvh, &mesh, None);
     let json: BvhDump = serde_json::from_str(&serde_json::to_string(&dump).unwrap()).unwrap();
-    let dir = std::env::temp_dir().join(format!("bvhscope-dump-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::scratch::shared("dump");
     let text_path = dir.join("tree.txt");
     std::fs::write(&text_path, dump.to_text()).unwrap();
     let text = BvhDump::read(&text_path, 1 << 30).unwrap();
@@ -237,8 +236,7 @@ fn an_exported_four_wide_tree_checks_clean() {
 #[test]
 fn a_gzip_dump_reads_like_its_json() {
     use std::io::Write;
-    let dir = std::env::temp_dir().join(format!("bvhscope-dump-gz-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::scratch::shared("dump-gz");
     let d = good();
     let path = dir.join("tree.json.gz");
     let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
@@ -249,8 +247,7 @@ fn a_gzip_dump_reads_like_its_json() {
 
 #[test]
 fn unreadable_dumps_say_why() {
-    let dir = std::env::temp_dir().join(format!("bvhscope-dump-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::scratch::shared("dump-bad");
     let w = |name: &str, text: &str| {
         let p = dir.join(name);
         std::fs::write(&p, text).unwrap();

@@ -11,10 +11,7 @@ use crate::mesh::generate;
 use std::path::Path;
 
 pub(super) fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bvhscope-grade-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    crate::scratch::dir(&format!("grade-{name}"))
 }
 
 #[test]
