@@ -11,10 +11,7 @@ use crate::work::WorkControl;
 use std::path::Path;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bvhscope-fair-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    crate::scratch::dir(&format!("fair-{name}"))
 }
 
 /// The knot with one zero-area triangle (three points on a line) far above it, read as an OBJ:
@@ -295,6 +292,31 @@ fn an_unreadable_file_is_reported_without_its_content() {
     assert!(rows[2].reason.ends_with("line 2: a word where a number must be"), "{}", rows[2].reason);
 }
 
+/// How far apart two timings are: the larger over the smaller, less one.
+fn apart(x: f64, y: f64) -> f64 {
+    x.max(y) / x.min(y) - 1.0
+}
+
+/// Timing fairness is a systematic property: an unfair method (a tree timed alone against one
+/// timed beside another, a reference timed in a round of three) puts the same tree 1.5 to 2×
+/// apart on every try, while a busy machine's noise moves one try and not the next. So `measure`
+/// is asked up to `TRIES` times and the test holds if any try comes within `tolerance`: noise
+/// cannot fail it three times running (CI once read 1.06 against 1.22 on a single try), and a
+/// bias beyond the tolerance fails every try. Each try's worst gap is returned with a label.
+const TRIES: usize = 3;
+
+fn fair_on_some_try(tolerance: f64, mut measure: impl FnMut() -> (f64, String)) {
+    let mut seen = Vec::new();
+    for _ in 0..TRIES {
+        let (gap, what) = measure();
+        if gap < tolerance {
+            return;
+        }
+        seen.push(format!("{:.0} % ({what})", gap * 100.0));
+    }
+    panic!("{TRIES} tries, each more than {:.0} % apart: {}", tolerance * 100.0, seen.join("; "));
+}
+
 /// Two students who hand in the same tree get the same figures and the same rank, and their
 /// trace times, timed in the same rounds as the SAH tree, are within 15 % of each other while
 /// four threads keep this machine's cores busy.
@@ -308,32 +330,33 @@ fn identical_trees_rank_alike_and_time_alike_on_a_busy_machine() {
     dump.write(&d.join("bea.txt")).unwrap();
     let mut set = setup(&mesh, &mesh_path);
     set.time_rays = 4096;
-    let stop = std::sync::atomic::AtomicBool::new(false);
-    let rows = std::thread::scope(|s| {
-        for _ in 0..4 {
-            s.spawn(|| {
-                let mut x = 1u64;
-                while !stop.load(std::sync::atomic::Ordering::Relaxed) {
-                    x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
-                }
-            });
-        }
-        let rows = grade(&set, &d, &["ann.json", "bea.txt"]);
-        stop.store(true, std::sync::atomic::Ordering::Relaxed);
-        rows
+    // Within 15 % either way: two timings on two cores shared with four busy threads and a
+    // parallel test run came 10.1 % apart (and once 15.1 %); the unfairness this guards against
+    // was 2× (and a reference's 194 ns per ray against its copy's 127).
+    fair_on_some_try(0.15, || {
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let rows = std::thread::scope(|s| {
+            for _ in 0..4 {
+                s.spawn(|| {
+                    let mut x = 1u64;
+                    while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                        x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+                    }
+                });
+            }
+            let rows = grade(&set, &d, &["ann.json", "bea.txt"]);
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            rows
+        });
+        let (a, b) = (&rows[0], &rows[1]);
+        assert_eq!(a.rank, b.rank);
+        let (qa, qb) = (a.quality.clone().unwrap(), b.quality.clone().unwrap());
+        assert_eq!((qa.sah_cost, qa.nodes_per_ray, qa.epo), (qb.sah_cost, qb.nodes_per_ray, qb.epo));
+        let (ta, tb) = (a.versus_sah.unwrap().trace_time, b.versus_sah.unwrap().trace_time);
+        let (sa, sb) = (qa.speedup_over_linear, qb.speedup_over_linear);
+        let gap = apart(ta, tb).max(apart(sa, sb));
+        (gap, format!("{ta:.3} and {tb:.3} of the SAH tree's time, speed-ups {sa:.0}× and {sb:.0}×"))
     });
-    let (a, b) = (&rows[0], &rows[1]);
-    assert_eq!(a.rank, b.rank);
-    let (qa, qb) = (a.quality.clone().unwrap(), b.quality.clone().unwrap());
-    assert_eq!((qa.sah_cost, qa.nodes_per_ray, qa.epo), (qb.sah_cost, qb.nodes_per_ray, qb.epo));
-    // Within 15 % either way (the larger over the smaller): two timings on two cores shared with
-    // four busy threads and a parallel test run came 10.1 % apart; the unfairness this guards
-    // against was 2× (and a reference's 194 ns per ray against its copy's 127).
-    let apart = |x: f64, y: f64| x.max(y) / x.min(y) - 1.0;
-    let (ta, tb) = (a.versus_sah.unwrap().trace_time, b.versus_sah.unwrap().trace_time);
-    assert!(apart(ta, tb) < 0.15, "the same tree timed {ta:.3} and {tb:.3} of the SAH tree's time");
-    let (sa, sb) = (qa.speedup_over_linear, qb.speedup_over_linear);
-    assert!(apart(sa, sb) < 0.15, "speed-ups {sa:.0}× and {sb:.0}×");
 }
 
 /// A student who hands in bvhscope's own midpoint tree, and one who hands in its SAH tree, get
@@ -353,18 +376,27 @@ fn a_reference_and_a_students_identical_tree_time_alike() {
         BvhDump::of_any(&AnyBvh::build(&mesh, &params), &mesh, None).write(&d.join(name)).unwrap();
     }
     let subs = discover(&[d.join("mia.json"), d.join("sam.json")]);
-    let out = ReportDir::prepare(&d.join("report"), Vec::new()).unwrap();
-    let graded = grade_class(&set, References::new(&set), &subs, &out, &WorkControl::new(), |_| {});
-    let reference = |s: &str| graded.references.trees().find(|r| r.strategy == s).unwrap().quality.clone();
-    for (row, strategy) in graded.rows.iter().zip(["midpoint", "sah"]) {
-        let (theirs, ours) = (row.quality.clone().unwrap(), reference(strategy));
-        assert_eq!(theirs.nodes_per_ray, ours.nodes_per_ray, "{strategy}: the same tree");
-        let (a, b) = (theirs.trace_ns_per_ray, ours.trace_ns_per_ray);
-        // Within 30 %: the unfairness this guards against was half again (194 against 127 ns per
-        // ray); two timings of one tree on a machine busy with CI's other tests came 16 % apart.
-        assert!((a / b - 1.0).abs() < 0.3, "{strategy}: {a:.1} ns per ray as a student's, {b:.1} as the reference");
-        let (a, b) = (theirs.speedup_over_linear, ours.speedup_over_linear);
-        // A ratio of two timings in the same rounds, held to the same 30 %.
-        assert!((a / b - 1.0).abs() < 0.3, "{strategy}: speed-ups {a:.0}× as a student's and {b:.0}× as the reference");
-    }
+    // Within 30 %: the unfairness this guards against was half again (194 against 127 ns per
+    // ray); two timings of one tree on a machine busy with CI's other tests came 16 % apart. The
+    // speed-up is a ratio of two timings in the same rounds, held to the same 30 %.
+    let mut tries = 0;
+    fair_on_some_try(0.3, || {
+        tries += 1;
+        let out = ReportDir::prepare(&d.join(format!("report-{tries}")), Vec::new()).unwrap();
+        let graded = grade_class(&set, References::new(&set), &subs, &out, &WorkControl::new(), |_| {});
+        let reference = |s: &str| graded.references.trees().find(|r| r.strategy == s).unwrap().quality.clone();
+        let mut worst = (0.0, String::new());
+        for (row, strategy) in graded.rows.iter().zip(["midpoint", "sah"]) {
+            let (theirs, ours) = (row.quality.clone().unwrap(), reference(strategy));
+            assert_eq!(theirs.nodes_per_ray, ours.nodes_per_ray, "{strategy}: the same tree");
+            let (a, b) = (theirs.trace_ns_per_ray, ours.trace_ns_per_ray);
+            let (sa, sb) = (theirs.speedup_over_linear, ours.speedup_over_linear);
+            let gap = apart(a, b).max(apart(sa, sb));
+            if gap >= worst.0 {
+                let what = format!("{strategy}: {a:.1} ns per ray as a student's, {b:.1} as the reference, speed-ups {sa:.0}× and {sb:.0}×");
+                worst = (gap, what);
+            }
+        }
+        worst
+    });
 }
