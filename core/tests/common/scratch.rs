@@ -35,6 +35,14 @@ extern "C" fn remove_root() {
     let _ = std::fs::remove_dir_all(root_path());
 }
 
+/// Remove this process's folder now, unless `BVHSCOPE_KEEP_TEST_FILES` is set: for a process that
+/// ends without running the `atexit` handlers (the UI tests, `support::end_without_teardown`).
+pub fn remove_unless_kept() {
+    if std::env::var_os("BVHSCOPE_KEEP_TEST_FILES").is_none() {
+        remove_root();
+    }
+}
+
 /// A fresh, empty folder `name` in this process's folder (emptied if this process made it
 /// before: tests that share a name run one after the other in the same process only).
 pub fn dir(name: &str) -> PathBuf {
